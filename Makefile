@@ -1,0 +1,39 @@
+# rockyade: `make test` and `make run` each set up what they need (idempotent).
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+WORKERS ?= 2
+OUT ?= reports/paper
+
+.PHONY: setup system test lint run bench clean
+
+setup: system $(STAMP)
+
+system:
+	@tools/install-system-deps.sh
+
+$(STAMP): pyproject.toml
+	$(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@touch $(STAMP)
+
+lint: setup
+	$(BIN)/ruff check .
+
+test: setup lint
+	ROCKYADE_REQUIRE_YADE=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
+
+run: setup
+	$(BIN)/rockyade tables --out reports/tables
+	@for scene in examples/specimen*_free.toml; do \
+	  $(BIN)/rockyade run $$scene --solver housner --out reports/examples/$$(basename $$scene .toml)_housner.csv || exit 1; \
+	done
+
+bench: setup
+	$(BIN)/python benchmarks/run_all.py
+
+clean:
+	rm -rf $(VENV) reports .pytest_cache .ruff_cache

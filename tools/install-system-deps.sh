@@ -1,0 +1,23 @@
+#!/usr/bin/env bash
+# Install the Debian packages rockyade needs, only those missing (idempotent, no prompts).
+#   python3 + venv : the project's virtual environment
+#   yade           : the YADE DEM engine (Debian package, imported from Debian's python3.11)
+set -euo pipefail
+
+need=()
+command -v python3 >/dev/null 2>&1 || need+=(python3)
+if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then need+=(python3-venv); fi
+if ! [ -f /usr/lib/x86_64-linux-gnu/yade-double/py/yade/__init__.py ]; then need+=(yade); fi
+
+if [ ${#need[@]} -eq 0 ]; then
+  echo "system packages: all present"
+  exit 0
+fi
+if [ "$(id -u)" -ne 0 ]; then
+  echo "missing Debian packages: ${need[*]}; run 'make' as root (or: sudo apt-get install -y ${need[*]})" >&2
+  exit 1
+fi
+echo "installing Debian packages: ${need[*]}"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y --no-install-recommends "${need[@]}"
