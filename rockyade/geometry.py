@@ -1,0 +1,295 @@
+"""Rigid blocks: convex polygon cross-sections with a thickness, and their mass properties.
+
+Conventions (SI): the cross-section lies in the x (horizontal) - y (vertical) plane; a
+block's vertices are given in its own frame with the base on y = 0; they are stored
+counter-clockwise. Rotational inertia is about the z axis.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from rockyade.errors import InputError
+
+#: Relative tolerance used to decide that vertices lie on the base (or top) line.
+LEVEL_TOL = 1e-9
+
+
+@dataclass(frozen=True)
+class PolygonSection:
+    """Area properties of a polygon (per unit thickness and density).
+
+    Attributes
+    ----------
+    area_m2
+        Area, m^2.
+    centroid_m
+        Centroid (x, y), m.
+    polar_second_moment_m4
+        Polar second moment of area about the centroid, integral of r^2 dA, m^4.
+    """
+
+    area_m2: float
+    centroid_m: tuple[float, float]
+    polar_second_moment_m4: float
+
+
+def polygon_section(vertices: NDArray[np.float64]) -> PolygonSection:
+    """Area, centroid and polar second moment of a simple polygon (Green's theorem).
+
+    Parameters
+    ----------
+    vertices
+        (n, 2) array of vertices, m, counter-clockwise.
+
+    Returns
+    -------
+    PolygonSection
+    """
+    x = vertices[:, 0]
+    y = vertices[:, 1]
+    xn = np.roll(x, -1)
+    yn = np.roll(y, -1)
+    cross = x * yn - xn * y
+    area = 0.5 * cross.sum()
+    cx = ((x + xn) * cross).sum() / (6.0 * area)
+    cy = ((y + yn) * cross).sum() / (6.0 * area)
+    ixx_origin = ((y * y + y * yn + yn * yn) * cross).sum() / 12.0
+    iyy_origin = ((x * x + x * xn + xn * xn) * cross).sum() / 12.0
+    polar_centroid = ixx_origin + iyy_origin - area * (cx * cx + cy * cy)
+    return PolygonSection(float(area), (float(cx), float(cy)), float(polar_centroid))
+
+
+def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
+    """Validate a vertex list and return it as a counter-clockwise (n, 2) float array."""
+    try:
+        arr = np.asarray(vertices, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(field_name, f"must be a list of [x, y] pairs in metres ({exc})") from None
+    if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 3:
+        raise InputError(field_name, "must be a list of at least 3 [x, y] pairs in metres")
+    if not np.all(np.isfinite(arr)):
+        raise InputError(field_name, "contains NaN or infinite coordinates")
+    if polygon_section(arr).area_m2 < 0:
+        arr = arr[::-1].copy()
+    edges = np.roll(arr, -1, axis=0) - arr
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    scale = float(np.max(np.ptp(arr, axis=0)))
+    if np.any(lengths <= LEVEL_TOL * scale):
+        raise InputError(field_name, "has repeated (coincident) vertices")
+    nxt = np.roll(edges, -1, axis=0)
+    turn = edges[:, 0] * nxt[:, 1] - edges[:, 1] * nxt[:, 0]
+    if np.any(turn < -LEVEL_TOL * scale * scale):
+        raise InputError(field_name, "polygon must be convex (vertices in order around it)")
+    keep = np.roll(np.abs(turn) > LEVEL_TOL * scale * scale, 1)
+    return arr[keep].copy()
+
+
+def rectangle_vertices(width: float, height: float) -> NDArray[np.float64]:
+    """Vertices of a rectangle centred on x = 0 with its base on y = 0 (counter-clockwise)."""
+    b = 0.5 * width
+    return np.array([[-b, 0.0], [b, 0.0], [b, height], [-b, height]])
+
+
+def chamfered_rectangle_vertices(width: float, height: float, chamfer: float) -> NDArray[np.float64]:
+    """Rectangle with 45-degree chamfers of leg ``chamfer`` at both base corners.
+
+    Specimen 4 of the paper has "a large 45 degree cut (40 mm) at the base" (Section 3.1).
+    """
+    if not 0.0 < chamfer < min(0.5 * width, height):
+        raise InputError("chamfer_m", f"must be in (0, {min(0.5 * width, height):g}) m")
+    b = 0.5 * width
+    return np.array(
+        [
+            [-b + chamfer, 0.0],
+            [b - chamfer, 0.0],
+            [b, chamfer],
+            [b, height],
+            [-b, height],
+            [-b, chamfer],
+        ]
+    )
+
+
+@dataclass(frozen=True)
+class Block:
+    """A rigid block: a convex polygon cross-section extruded over a thickness.
+
+    Create blocks with :meth:`Block.rectangle` or :meth:`Block.polygon`; both validate
+    their inputs and name the offending field in any error.
+
+    Attributes
+    ----------
+    name
+        Identifier used in result column names.
+    vertices_m
+        (n, 2) counter-clockwise vertices in the block frame, base on y = 0, m.
+    thickness_m
+        Out-of-plane thickness, m.
+    mass_kg
+        Mass, kg.
+    inertia_c_kgm2
+        Rotational inertia about the centroid (z axis), kg m^2.
+    inertia_given
+        True when the inertia was given explicitly rather than from uniform density.
+    """
+
+    name: str
+    vertices_m: NDArray[np.float64] = field(repr=False)
+    thickness_m: float
+    mass_kg: float
+    inertia_c_kgm2: float
+    inertia_given: bool = False
+
+    # ----------------------------------------------------------------- constructors
+    @classmethod
+    def rectangle(
+        cls,
+        width_m: float,
+        height_m: float,
+        thickness_m: float,
+        *,
+        mass_kg: float | None = None,
+        density_kg_m3: float | None = None,
+        inertia_kgm2: float | None = None,
+        name: str = "block",
+        field_prefix: str = "",
+    ) -> Block:
+        """A rectangular block of base ``width_m`` (2b) and height ``height_m`` (2h)."""
+        _positive(width_m, f"{field_prefix}width_m")
+        _positive(height_m, f"{field_prefix}height_m")
+        return cls.polygon(
+            rectangle_vertices(width_m, height_m),
+            thickness_m,
+            mass_kg=mass_kg,
+            density_kg_m3=density_kg_m3,
+            inertia_kgm2=inertia_kgm2,
+            name=name,
+            field_prefix=field_prefix,
+        )
+
+    @classmethod
+    def polygon(
+        cls,
+        vertices_m: ArrayLike,
+        thickness_m: float,
+        *,
+        mass_kg: float | None = None,
+        density_kg_m3: float | None = None,
+        inertia_kgm2: float | None = None,
+        name: str = "block",
+        field_prefix: str = "",
+    ) -> Block:
+        """A block of any convex polygon cross-section standing on a flat base.
+
+        Parameters
+        ----------
+        vertices_m
+            Vertices [[x, y], ...] in metres, in order around the polygon. The polygon is
+            shifted vertically so that its lowest vertices are on y = 0.
+        thickness_m
+            Out-of-plane thickness, m.
+        mass_kg, density_kg_m3
+            Exactly one of the two.
+        inertia_kgm2
+            Optional rotational inertia about the centroid, kg m^2; by default that of a
+            uniform density.
+        """
+        verts = _as_vertices(vertices_m, f"{field_prefix}vertices_m")
+        verts = verts - np.array([0.0, verts[:, 1].min()])
+        _positive(thickness_m, f"{field_prefix}thickness_m")
+        section = polygon_section(verts)
+        if (mass_kg is None) == (density_kg_m3 is None):
+            raise InputError(f"{field_prefix}mass_kg", "give exactly one of mass_kg and density_kg_m3")
+        if mass_kg is not None:
+            _positive(mass_kg, f"{field_prefix}mass_kg")
+            mass = float(mass_kg)
+        else:
+            _positive(density_kg_m3, f"{field_prefix}density_kg_m3")
+            mass = float(density_kg_m3) * section.area_m2 * float(thickness_m)
+        if inertia_kgm2 is not None:
+            _positive(inertia_kgm2, f"{field_prefix}inertia_kgm2")
+            inertia = float(inertia_kgm2)
+        else:
+            inertia = mass / section.area_m2 * section.polar_second_moment_m4
+        block = cls(name, verts, float(thickness_m), mass, inertia, inertia_kgm2 is not None)
+        block._check_base(f"{field_prefix}vertices_m")
+        return block
+
+    # ------------------------------------------------------------------- properties
+    @property
+    def section(self) -> PolygonSection:
+        """Area properties of the cross-section."""
+        return polygon_section(self.vertices_m)
+
+    @property
+    def centroid_m(self) -> tuple[float, float]:
+        """Centroid (x, y) in the block frame, m (the centre of mass)."""
+        return self.section.centroid_m
+
+    @property
+    def height_m(self) -> float:
+        """Overall height, m."""
+        return float(np.ptp(self.vertices_m[:, 1]))
+
+    @property
+    def width_m(self) -> float:
+        """Overall width, m."""
+        return float(np.ptp(self.vertices_m[:, 0]))
+
+    @property
+    def density_kg_m3(self) -> float:
+        """Mean density implied by mass, area and thickness, kg/m^3."""
+        return self.mass_kg / (self.section.area_m2 * self.thickness_m)
+
+    def level_vertices(self, level: str) -> tuple[float, float]:
+        """x of the leftmost and rightmost vertex on the base (``"base"``) or top (``"top"``).
+
+        Returns
+        -------
+        (x_left, x_right)
+            In the block frame, m.
+        """
+        y = self.vertices_m[:, 1]
+        target = y.min() if level == "base" else y.max()
+        on_level = np.abs(y - target) <= LEVEL_TOL * max(self.height_m, 1.0)
+        xs = self.vertices_m[on_level, 0]
+        return float(xs.min()), float(xs.max())
+
+    @property
+    def pivots_m(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Left and right base corners (the rocking pivots), block frame, m."""
+        x_left, x_right = self.level_vertices("base")
+        return np.array([x_left, 0.0]), np.array([x_right, 0.0])
+
+    def inertia_about(self, point_m: ArrayLike) -> float:
+        """Rotational inertia about a point of the plane (parallel-axis theorem), kg m^2."""
+        d = np.asarray(point_m, dtype=float) - np.asarray(self.centroid_m)
+        return self.inertia_c_kgm2 + self.mass_kg * float(d @ d)
+
+    def with_inertia(self, inertia_c_kgm2: float) -> Block:
+        """A copy with another centroidal inertia (e.g. to match a measured p)."""
+        return Block(self.name, self.vertices_m, self.thickness_m, self.mass_kg, inertia_c_kgm2, True)
+
+    def _check_base(self, field_name: str) -> None:
+        x_left, x_right = self.level_vertices("base")
+        if x_right - x_left <= LEVEL_TOL * max(self.width_m, 1.0):
+            raise InputError(field_name, "block must stand on a flat base: two vertices at its lowest level")
+        cx = self.centroid_m[0]
+        if not x_left < cx < x_right:
+            raise InputError(
+                field_name,
+                f"centroid x = {cx:g} m lies outside the base [{x_left:g}, {x_right:g}] m: "
+                "the block cannot stand",
+            )
+
+
+def _positive(value: object, field_name: str) -> None:
+    """Raise InputError unless ``value`` is a finite number > 0."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
+        raise InputError(field_name, f"must be a number > 0, got {value!r}")
+    if not np.isfinite(value) or value <= 0:
+        raise InputError(field_name, f"must be a finite number > 0, got {value!r}")
