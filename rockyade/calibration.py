@@ -1,0 +1,310 @@
+"""DEM contact parameters derived from the classical parameters (paper Sections 4-6).
+
+One function per equation of the paper, each citing its number:
+
+* Eq 6  Rayleigh constants a = xi w, b = xi / w from (xi_min, f_min);
+* Eq 7  time step dt = frac 2 sqrt(M_min / K_max);
+* Eq 8  K1 = M p^2;   Eq 9  K2 = M 3g/(4R) (M p_theory^2 for any polygon);
+* Eq 10 K = (K1 + K2) / 2;
+* Eq 11 b_eq = h tan(alpha);
+* Eq 12 Gamma = K R = M/2 (R p^2 + 3/4 g);
+* Eq 13 sqrt(b) = 0.0057 ln(Gamma / mu^2) - 0.0336 (empirical);
+* Eq 14 f_min = p;   Eq 15 xi_min = 2 pi b f_min.
+
+Stiffness scale. Eq 10's K is dimensionally N/m, but read as N/m it lets the block sink
+M g / K ~ 0.7 m into its base (specimen 1). rockyade multiplies the paper's K by an explicit
+``stiffness_scale`` (default 1e6, i.e. the printed numbers read as MN/m), records the choice
+in every output, and refuses a static settlement M g / K above 1e-4 of the block height.
+Eqs 12-13 are evaluated with the paper's own (unscaled) K, as the paper fitted them; Eq 7
+uses the scaled K actually simulated.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+from rockyade.classical import classical_parameters
+from rockyade.constants import (
+    DEFAULT_FRICTION_ANGLE_DEG,
+    DEFAULT_STIFFNESS_SCALE,
+    DEFAULT_TIME_STEP_FRAC,
+    MAX_SETTLEMENT_FRACTION,
+    STIFFNESS_SCALES,
+    G,
+)
+from rockyade.errors import CalibrationError, InputError
+from rockyade.geometry import Block
+
+#: Range of Gamma / mu^2 covered by the paper's four specimens (Fig. 11), for a warning.
+EQ13_FITTED_RANGE = (7.0e2, 5.0e3)
+
+# ------------------------------------------------------------------ the equations
+
+
+def rayleigh_constants_eq6(xi_min: float, f_min_hz: float) -> tuple[float, float]:
+    """Rayleigh constants (a, b) from damping ratio and frequency (paper Eq 6).
+
+    Returns
+    -------
+    a
+        Mass-proportional constant, 1/s.
+    b
+        Stiffness-proportional constant, s.
+    """
+    omega = 2.0 * math.pi * f_min_hz
+    return xi_min * omega, xi_min / omega
+
+
+def time_step_eq7(mass_min_kg: float, k_max_N_per_m: float, frac: float = DEFAULT_TIME_STEP_FRAC) -> float:
+    """Critical time step of the central-difference scheme, s (paper Eq 7)."""
+    return frac * 2.0 * math.sqrt(mass_min_kg / k_max_N_per_m)
+
+
+def stiffness_eq8(mass_kg: float, p_rad_s: float) -> float:
+    """K1 = M p^2, paper units (paper Eq 8)."""
+    return mass_kg * p_rad_s**2
+
+
+def stiffness_eq9(mass_kg: float, R_m: float, g: float = G) -> float:
+    """K2 = M 3 g / (4 R), paper units (paper Eq 9; rectangles)."""
+    return mass_kg * 3.0 * g / (4.0 * R_m)
+
+
+def stiffness_eq10(k1: float, k2: float) -> float:
+    """K = (K1 + K2) / 2, paper units (paper Eq 10)."""
+    return 0.5 * (k1 + k2)
+
+
+def equivalent_half_base_eq11(h_m: float, alpha_rad: float) -> float:
+    """Equivalent half base b_eq = h tan(alpha), m (paper Eq 11).
+
+    ``h_m`` is the height of the centroid above the base (half the height of a rectangle).
+    """
+    return h_m * math.tan(alpha_rad)
+
+
+def generalized_damping_factor_eq12(k_paper: float, R_m: float) -> float:
+    """Gamma = K R (paper Eq 12), with the paper's unscaled K; for rectangles this equals
+    M/2 (R p^2 + 3/4 g)."""
+    return k_paper * R_m
+
+
+def stiffness_damping_eq13(gamma: float, mu: float) -> float:
+    """Stiffness-proportional damping constant b, s (paper Eq 13, empirical).
+
+    sqrt(b) = 0.0057 ln(Gamma / mu^2) - 0.0336.
+
+    Raises
+    ------
+    CalibrationError
+        When the right-hand side is negative (Gamma / mu^2 < exp(0.0336 / 0.0057) ~ 363),
+        far outside the paper's data.
+    """
+    root = 0.0057 * math.log(gamma / mu**2) - 0.0336
+    if root < 0.0:
+        raise CalibrationError(
+            f"Eq 13 gives sqrt(b) = {root:.4g} < 0 for Gamma/mu^2 = {gamma / mu**2:.4g} "
+            f"(needs > {math.exp(0.0336 / 0.0057):.0f}; the paper's data span "
+            f"{EQ13_FITTED_RANGE[0]:.0f}-{EQ13_FITTED_RANGE[1]:.0f}): "
+            "use calibration = 'matched' or give contact.beta_s"
+        )
+    return root * root
+
+
+def f_min_eq14(p_rad_s: float) -> float:
+    """f_min = p (paper Eq 14): the paper sets the number in Hz equal to p in 1/s."""
+    return p_rad_s
+
+
+def xi_min_eq15(b_s: float, f_min_hz: float) -> float:
+    """Damping ratio xi_min = 2 pi b f_min (paper Eq 15)."""
+    return 2.0 * math.pi * b_s * f_min_hz
+
+
+# ------------------------------------------------------------------ stiffness scale
+
+
+def stiffness_scale_factor(scale: float | str | None) -> tuple[float, str]:
+    """Factor converting the paper's K to N/m, and its readable name.
+
+    Parameters
+    ----------
+    scale
+        ``"N/m"``, ``"kN/m"``, ``"MN/m"``, a positive number, or None (the default, MN/m).
+    """
+    if scale is None:
+        return DEFAULT_STIFFNESS_SCALE, "MN/m"
+    if isinstance(scale, str):
+        if scale not in STIFFNESS_SCALES:
+            raise InputError(
+                "contact.stiffness_scale",
+                f"must be one of {sorted(STIFFNESS_SCALES)} or a number > 0, got {scale!r}",
+            )
+        return STIFFNESS_SCALES[scale], scale
+    if (
+        isinstance(scale, bool)
+        or not isinstance(scale, (int, float))
+        or not math.isfinite(scale)
+        or scale <= 0
+    ):
+        raise InputError("contact.stiffness_scale", f"must be a number > 0, got {scale!r}")
+    names = {v: k for k, v in STIFFNESS_SCALES.items()}
+    return float(scale), names.get(float(scale), f"x{float(scale):g} N/m")
+
+
+def check_settlement(
+    supported_mass_kg: float, k_N_per_m: float, height_m: float, field_name: str, g: float = G
+) -> float:
+    """Static settlement M g / K, m; raise InputError when above 1e-4 of the block height."""
+    settlement = supported_mass_kg * g / k_N_per_m
+    limit = MAX_SETTLEMENT_FRACTION * height_m
+    if settlement > limit:
+        raise InputError(
+            field_name,
+            f"K = {k_N_per_m:.4g} N/m gives a static settlement M g / K = {settlement:.3g} m, "
+            f"above {MAX_SETTLEMENT_FRACTION:g} of the block height ({limit:.3g} m): the block "
+            "sinks into its base. Raise the stiffness (the paper's K reads as MN/m: "
+            "stiffness_scale = 'MN/m') or check the units",
+        )
+    return settlement
+
+
+# ------------------------------------------------------------------ calibration
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """Contact (joint) parameters of the interface beneath one block.
+
+    Attributes
+    ----------
+    K_N_per_m, Ks_N_per_m
+        Normal and shear stiffness per contact corner, N/m (scaled).
+    friction_angle_deg, cohesion_Pa
+        Coulomb parameters.
+    beta_s
+        Stiffness-proportional damping b, s: dashpots c_n = b K, c_s = b Ks.
+    rayleigh_a_1_s
+        Mass-proportional Rayleigh constant (0, paper Section 6.2).
+    xi_min, f_min_hz
+        Eq 15 damping ratio and Eq 14 frequency for ``beta_s``.
+    b_eq_m
+        Equivalent half base (Eq 11), m.
+    K_paper
+        Eq 10 value in the paper's units (before the stiffness scale).
+    stiffness_scale, stiffness_reading
+        Factor applied to the paper's K, and its name (e.g. "MN/m").
+    gamma
+        Eq 12 generalised damping factor.
+    beta_eq13_s
+        Eq 13's value of b, s (kept beside a matched or explicit beta).
+    method
+        "paper", "matched" or "explicit".
+    dt_eq7_s
+        Eq 7 time step for this block alone (M of the block, K above), s.
+    settlement_m
+        Static settlement M g / K, m.
+    notes
+        Provenance remarks (overrides, extrapolation of Eq 13, ...).
+    """
+
+    K_N_per_m: float
+    Ks_N_per_m: float
+    friction_angle_deg: float
+    cohesion_Pa: float
+    beta_s: float
+    rayleigh_a_1_s: float
+    xi_min: float
+    f_min_hz: float
+    b_eq_m: float
+    K_paper: float
+    stiffness_scale: float
+    stiffness_reading: str
+    gamma: float
+    beta_eq13_s: float | None
+    method: str
+    dt_eq7_s: float
+    settlement_m: float
+    notes: tuple[str, ...] = field(default=())
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain dictionary, JSON-ready."""
+        d = asdict(self)
+        d["notes"] = list(self.notes)
+        return d
+
+
+def paper_calibration(
+    block: Block,
+    *,
+    alpha_rad: float | None = None,
+    p_rad_s: float | None = None,
+    mu: float | None = None,
+    stiffness_scale: float | str | None = None,
+    friction_angle_deg: float = DEFAULT_FRICTION_ANGLE_DEG,
+    supported_mass_kg: float | None = None,
+    frac: float = DEFAULT_TIME_STEP_FRAC,
+    g: float = G,
+    field_prefix: str = "contact.",
+) -> ContactParameters:
+    """DEM contact parameters of the paper (Eqs 10-15) for the joint beneath ``block``.
+
+    Parameters
+    ----------
+    block
+        The block (mass, geometry).
+    alpha_rad, p_rad_s, mu
+        Classical parameters to calibrate with (e.g. the experimental ones); default: those
+        of the geometry.
+    stiffness_scale
+        Reading of the paper's K (default "MN/m"), see module docstring.
+    friction_angle_deg
+        Joint friction angle (paper: 30 degrees).
+    supported_mass_kg
+        Mass resting on the joint (block plus blocks above) for the settlement check;
+        default the block's mass.
+    frac
+        Eq 7 fraction.
+    """
+    geometric = classical_parameters(block, g=g)
+    used = classical_parameters(block, alpha_rad=alpha_rad, p_rad_s=p_rad_s, mu=mu, g=g)
+    factor, reading = stiffness_scale_factor(stiffness_scale)
+    R = geometric.R_m
+    k1 = stiffness_eq8(block.mass_kg, used.p_rad_s)
+    k2 = stiffness_eq8(block.mass_kg, geometric.p_rad_s)  # Eq 9 for any polygon: M p_theory^2
+    k_paper = stiffness_eq10(k1, k2)
+    gamma = generalized_damping_factor_eq12(k_paper, R)
+    notes: list[str] = []
+    lo, hi = EQ13_FITTED_RANGE
+    ratio = gamma / used.mu**2
+    if not lo <= ratio <= hi:
+        notes.append(
+            f"Gamma/mu^2 = {ratio:.0f} outside the paper's data ({lo:.0f}-{hi:.0f}): Eq 13 is extrapolated"
+        )
+    beta = stiffness_damping_eq13(gamma, used.mu)
+    f_min = f_min_eq14(used.p_rad_s)
+    k = k_paper * factor
+    settlement = check_settlement(
+        supported_mass_kg or block.mass_kg, k, block.height_m, f"{field_prefix}stiffness_scale", g
+    )
+    return ContactParameters(
+        K_N_per_m=k,
+        Ks_N_per_m=k,
+        friction_angle_deg=float(friction_angle_deg),
+        cohesion_Pa=0.0,
+        beta_s=beta,
+        rayleigh_a_1_s=0.0,
+        xi_min=xi_min_eq15(beta, f_min),
+        f_min_hz=f_min,
+        b_eq_m=equivalent_half_base_eq11(used.centroid_height_m, used.alpha_rad),
+        K_paper=k_paper,
+        stiffness_scale=factor,
+        stiffness_reading=reading,
+        gamma=gamma,
+        beta_eq13_s=beta,
+        method="paper",
+        dt_eq7_s=time_step_eq7(block.mass_kg, k, frac),
+        settlement_m=settlement,
+        notes=tuple(notes),
+    )
