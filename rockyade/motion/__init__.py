@@ -1,0 +1,11 @@
+"""Base motions: what the base of a scene does, from the scene's ``[motion]`` table.
+
+Every motion type becomes a :class:`GroundMotion` (piecewise-linear acceleration samples)
+that all solvers read, so that the Housner solver, the reference DEM and YADE see exactly
+the same base acceleration.
+"""
+
+from rockyade.motion.ground import GroundMotion
+from rockyade.motion.spec import MOTION_TYPES, FreeRocking, MotionSpec, parse_motion
+
+__all__ = ["MOTION_TYPES", "FreeRocking", "GroundMotion", "MotionSpec", "parse_motion"]

@@ -1,0 +1,96 @@
+"""A base motion as every solver sees it: piecewise-linear base acceleration samples."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.integrate import cumulative_trapezoid
+
+
+@dataclass(frozen=True)
+class GroundMotion:
+    """Horizontal (and optional vertical) base acceleration, linear between samples.
+
+    Sign convention: ``ah_m_s2 > 0`` accelerates the base towards +x, which makes a block
+    resting on it rock with theta'' > 0 (pivot on the left corner). ``av_m_s2 > 0``
+    accelerates the base upwards (adds to gravity). Outside [t_s[0], t_s[-1]] the
+    acceleration is zero.
+
+    Attributes
+    ----------
+    t_s
+        Strictly increasing sample times, s, starting at 0.
+    ah_m_s2, av_m_s2
+        Horizontal and vertical base acceleration at ``t_s``, m/s^2.
+    label
+        Human-readable description (e.g. "harmonic 3.3 Hz, 6 mm").
+    """
+
+    t_s: NDArray[np.float64]
+    ah_m_s2: NDArray[np.float64]
+    av_m_s2: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
+    label: str = ""
+
+    def __post_init__(self) -> None:
+        t = np.ascontiguousarray(self.t_s, dtype=float)
+        ah = np.ascontiguousarray(self.ah_m_s2, dtype=float)
+        av = np.zeros_like(ah) if self.av_m_s2 is None else np.ascontiguousarray(self.av_m_s2, dtype=float)
+        if t.ndim != 1 or t.size < 2 or ah.shape != t.shape or av.shape != t.shape:
+            raise ValueError("t_s, ah_m_s2 and av_m_s2 must be 1-D arrays of the same length >= 2")
+        if not np.all(np.diff(t) > 0):
+            raise ValueError("t_s must be strictly increasing")
+        if not (np.all(np.isfinite(ah)) and np.all(np.isfinite(av))):
+            raise ValueError("base acceleration contains NaN or infinite values")
+        object.__setattr__(self, "t_s", t)
+        object.__setattr__(self, "ah_m_s2", ah)
+        object.__setattr__(self, "av_m_s2", av)
+
+    @classmethod
+    def uniform(
+        cls, dt_s: float, ah: ArrayLike, av: ArrayLike | None = None, label: str = ""
+    ) -> GroundMotion:
+        """Samples at a constant interval ``dt_s`` from t = 0."""
+        ah = np.asarray(ah, dtype=float)
+        return cls(np.arange(ah.size) * dt_s, ah, None if av is None else np.asarray(av, float), label)
+
+    @property
+    def duration_s(self) -> float:
+        """Time of the last sample, s."""
+        return float(self.t_s[-1])
+
+    @property
+    def has_vertical(self) -> bool:
+        """True when any vertical acceleration is non-zero."""
+        return bool(np.any(self.av_m_s2 != 0.0))
+
+    def horizontal(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Horizontal base acceleration at times ``t``, m/s^2."""
+        return np.interp(t, self.t_s, self.ah_m_s2, left=0.0, right=0.0)
+
+    def vertical(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Vertical base acceleration at times ``t``, m/s^2."""
+        return np.interp(t, self.t_s, self.av_m_s2, left=0.0, right=0.0)
+
+    def scaled(self, factor: float) -> GroundMotion:
+        """The motion with both components multiplied by ``factor``."""
+        return GroundMotion(self.t_s, self.ah_m_s2 * factor, self.av_m_s2 * factor, self.label)
+
+    def velocity_displacement(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Horizontal base velocity (m/s) and displacement (m) at ``t_s``, from rest.
+
+        Exact for the piecewise-linear acceleration: velocity by the trapezoid rule, and
+        displacement by integrating the piecewise-quadratic velocity exactly.
+        """
+        dt = np.diff(self.t_s)
+        a0, a1 = self.ah_m_s2[:-1], self.ah_m_s2[1:]
+        v = cumulative_trapezoid(self.ah_m_s2, self.t_s, initial=0.0)
+        dd = v[:-1] * dt + dt * dt * (a0 / 3.0 + a1 / 6.0)
+        d = np.concatenate([[0.0], np.cumsum(dd)])
+        return v, d
+
+    @property
+    def pga_m_s2(self) -> float:
+        """Peak absolute horizontal acceleration, m/s^2."""
+        return float(np.max(np.abs(self.ah_m_s2)))

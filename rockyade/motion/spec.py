@@ -1,0 +1,183 @@
+"""The ``[motion]`` table of a scene: one dataclass per motion type, parsed and validated.
+
+Types: ``free`` (free rocking from an initial tilt) and ``sampled`` (base acceleration
+samples given inline); :mod:`rockyade.motion.types` registers the shake-table, pulse,
+record and synthetic types.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from abc import ABC, abstractmethod
+from collections.abc import Callable
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from rockyade.fields import TableReader
+from rockyade.motion.ground import GroundMotion
+
+
+class MotionSpec(ABC):
+    """Base class of the motion specifications.
+
+    Subclasses are frozen dataclasses with a ``type`` class attribute; they provide
+    :meth:`ground_motion` (None for free rocking) and the initial tilt of the blocks.
+    """
+
+    type: ClassVar[str] = ""
+
+    @abstractmethod
+    def ground_motion(self, duration_s: float) -> GroundMotion | None:
+        """The base acceleration over ``duration_s`` (None: the base does not move)."""
+
+    @property
+    def initial_theta_rad(self) -> float:
+        """Initial tilt of the released block, rad (0 unless free rocking)."""
+        return 0.0
+
+    @property
+    def initial_omega_rad_s(self) -> float:
+        """Initial angular velocity of the released block, rad/s."""
+        return 0.0
+
+    @property
+    def released_block(self) -> str | None:
+        """Name of the block given the initial tilt (None: the top block)."""
+        return None
+
+    def to_dict(self) -> dict[str, Any]:
+        """Canonical dictionary (all defaults filled in), as in a scene file."""
+        d = {"type": self.type}
+        d.update({k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()})  # type: ignore[call-overload]
+        return d
+
+    def hash_material(self) -> dict[str, Any]:
+        """What identifies the motion in a scene hash (content of files, not their paths)."""
+        return self.to_dict()
+
+
+@dataclass(frozen=True)
+class FreeRocking(MotionSpec):
+    """Free rocking: a block released at ``theta0_rad`` on a base at rest.
+
+    Attributes
+    ----------
+    theta0_rad
+        Initial tilt, rad; > 0 pivots on the left corner. |theta0| < alpha for a block to
+        come back.
+    omega0_rad_s
+        Initial angular velocity, rad/s.
+    block
+        Name of the block released (default: the top block); the others start at rest.
+    """
+
+    type: ClassVar[str] = "free"
+    theta0_rad: float
+    omega0_rad_s: float = 0.0
+    block: str | None = None
+
+    def ground_motion(self, duration_s: float) -> GroundMotion | None:
+        return None
+
+    @property
+    def initial_theta_rad(self) -> float:
+        return self.theta0_rad
+
+    @property
+    def initial_omega_rad_s(self) -> float:
+        return self.omega0_rad_s
+
+    @property
+    def released_block(self) -> str | None:
+        return self.block
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> FreeRocking:
+        theta0 = r.number(
+            "theta0_rad", lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad"
+        )
+        omega0 = r.number("omega0_rad_s", 0.0, unit="rad/s")
+        block = r.string("block", None)
+        if theta0 == 0.0 and omega0 == 0.0:
+            raise r.error("theta0_rad", "free rocking needs a non-zero theta0_rad or omega0_rad_s")
+        return cls(theta0, omega0, block)
+
+
+@dataclass(frozen=True)
+class SampledMotion(MotionSpec):
+    """Base acceleration samples given in the scene itself.
+
+    Attributes
+    ----------
+    accel_m_s2
+        Horizontal base acceleration samples, m/s^2.
+    dt_s
+        Constant sampling interval, s (or give ``t_s``).
+    t_s
+        Sample times, s, strictly increasing from 0 (instead of ``dt_s``).
+    accel_v_m_s2
+        Optional vertical samples, m/s^2 (> 0 upwards).
+    load_factor
+        Multiplies both components.
+    """
+
+    type: ClassVar[str] = "sampled"
+    accel_m_s2: tuple[float, ...]
+    dt_s: float | None = None
+    t_s: tuple[float, ...] | None = None
+    accel_v_m_s2: tuple[float, ...] | None = None
+    load_factor: float = 1.0
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        ah = np.array(self.accel_m_s2) * self.load_factor
+        av = None if self.accel_v_m_s2 is None else np.array(self.accel_v_m_s2) * self.load_factor
+        t = np.arange(ah.size) * self.dt_s if self.t_s is None else np.array(self.t_s)
+        return GroundMotion(t, ah, av, label=f"sampled ({ah.size} samples)")
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> SampledMotion:
+        accel = r.number_list("accel_m_s2", min_len=2, unit="m/s^2")
+        dt = r.positive("dt_s", None, unit="s")
+        t = r.number_list("t_s", None, min_len=2, unit="s")
+        av = r.number_list("accel_v_m_s2", None, min_len=2, unit="m/s^2")
+        lf = r.number("load_factor", 1.0, lo=0.0)
+        if (dt is None) == (t is None):
+            raise r.error("dt_s", "give exactly one of dt_s and t_s")
+        if t is not None:
+            if len(t) != len(accel):
+                raise r.error("t_s", f"must have as many values as accel_m_s2 ({len(accel)})")
+            if t[0] != 0.0 or any(b <= a for a, b in itertools.pairwise(t)):
+                raise r.error("t_s", "must start at 0 and increase strictly")
+        if av is not None and len(av) != len(accel):
+            raise r.error("accel_v_m_s2", f"must have as many values as accel_m_s2 ({len(accel)})")
+        return cls(tuple(accel), dt, None if t is None else tuple(t), None if av is None else tuple(av), lf)
+
+
+#: Parsers of the ``[motion]`` table by ``type``.
+MOTION_TYPES: dict[str, Callable[[TableReader, Path | None], MotionSpec]] = {
+    FreeRocking.type: FreeRocking.parse,
+    SampledMotion.type: SampledMotion.parse,
+}
+
+
+def parse_motion(table: Any, source: str | None = None, base_dir: Path | None = None) -> MotionSpec:
+    """Parse and validate a ``[motion]`` table.
+
+    Parameters
+    ----------
+    table
+        The table as read from TOML or JSON.
+    source
+        File name for error messages.
+    base_dir
+        Directory that relative file paths in the table are relative to.
+    """
+    r = TableReader(table, "motion", source)
+    kind = r.string("type", choices=sorted(MOTION_TYPES))
+    spec = MOTION_TYPES[kind](r, base_dir)
+    r.finish()
+    return spec

@@ -1,0 +1,403 @@
+"""Scenes: the one description of a simulation that every solver reads (TOML or JSON).
+
+A scene is data, never code. Layout::
+
+    duration_s = 4.0          # simulated time, s
+    sample_dt_s = 0.001       # output sampling interval, s
+
+    [[blocks]]                # listed bottom to top
+    name = "specimen1"
+    width_m = 0.25            # or vertices_m = [[x, y], ...] (convex, base on y = 0)
+    height_m = 1.0
+    thickness_m = 0.754
+    mass_kg = 503             # or density_kg_m3
+    # inertia_kgm2 = ...      # optional, about the centroid
+    # x_offset_m = 0.0        # optional horizontal offset of the block frame
+    alpha_rad = 0.235         # optional classical overrides (e.g. experimental values)
+    p_rad_s = 3.84
+    mu = 0.936
+
+    [contact]                 # DEM joints (ignored by the Housner solver)
+    calibration = "paper"     # "paper" (Eqs 10-15) or "matched" (beta matched to mu)
+    # stiffness_scale = "MN/m"; K_N_per_m, Ks_N_per_m, friction_angle_deg, cohesion_Pa,
+    # beta_s, dt_s, time_step_frac, mass_damping_1_s
+
+    [motion]
+    type = "free"
+    theta0_rad = 0.1175
+
+    [output]                  # optional
+    # accel_point = "top_centre" | [x, y] (block frame, m); accel_lowpass_hz = 20.0
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import re
+import tomllib
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from rockyade.classical import ClassicalParameters, classical_parameters
+from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, STIFFNESS_SCALES
+from rockyade.errors import InputError
+from rockyade.fields import TableReader
+from rockyade.geometry import Block
+from rockyade.motion.spec import MotionSpec, parse_motion
+
+NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
+CALIBRATIONS = ("paper", "matched")
+MAX_SAMPLES = 50_000_000
+
+
+@dataclass(frozen=True)
+class BlockSpec:
+    """One ``[[blocks]]`` entry, validated. See the module docstring for the keys."""
+
+    name: str
+    thickness_m: float
+    width_m: float | None = None
+    height_m: float | None = None
+    vertices_m: tuple[tuple[float, float], ...] | None = None
+    mass_kg: float | None = None
+    density_kg_m3: float | None = None
+    inertia_kgm2: float | None = None
+    x_offset_m: float = 0.0
+    alpha_rad: float | None = None
+    p_rad_s: float | None = None
+    mu: float | None = None
+
+    def block(self) -> Block:
+        """The rigid block (geometry, mass, inertia)."""
+        kwargs = dict(
+            mass_kg=self.mass_kg,
+            density_kg_m3=self.density_kg_m3,
+            inertia_kgm2=self.inertia_kgm2,
+            name=self.name,
+        )
+        if self.vertices_m is not None:
+            return Block.polygon(self.vertices_m, self.thickness_m, **kwargs)
+        return Block.rectangle(self.width_m, self.height_m, self.thickness_m, **kwargs)
+
+    def classical(self) -> ClassicalParameters:
+        """Classical parameters: the geometry's, with this block's overrides applied."""
+        return classical_parameters(self.block(), alpha_rad=self.alpha_rad, p_rad_s=self.p_rad_s, mu=self.mu)
+
+
+@dataclass(frozen=True)
+class ContactSpec:
+    """The ``[contact]`` table: calibration method and explicit overrides.
+
+    Explicit values (K_N_per_m, Ks_N_per_m, beta_s) replace the calibrated ones for every
+    joint; the others come from the calibration of the block above each joint.
+    """
+
+    calibration: str = "paper"
+    stiffness_scale: str | float = "MN/m"
+    K_N_per_m: float | None = None
+    Ks_N_per_m: float | None = None
+    friction_angle_deg: float = DEFAULT_FRICTION_ANGLE_DEG
+    cohesion_Pa: float = 0.0
+    beta_s: float | None = None
+    dt_s: float | None = None
+    time_step_frac: float = DEFAULT_TIME_STEP_FRAC
+    mass_damping_1_s: float = 0.0
+
+
+@dataclass(frozen=True)
+class OutputSpec:
+    """The ``[output]`` table.
+
+    Attributes
+    ----------
+    accel_point
+        Where absolute accelerations are reported: "top_centre" (the paper's
+        accelerometers) or [x, y] in the block frame, m.
+    accel_lowpass_hz
+        Optional zero-phase low-pass cut-off for those accelerations, Hz (paper Section 6.1
+        on impact spikes).
+    """
+
+    accel_point: str | tuple[float, float] = "top_centre"
+    accel_lowpass_hz: float | None = None
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A validated scene."""
+
+    duration_s: float
+    sample_dt_s: float
+    blocks: tuple[BlockSpec, ...]
+    contact: ContactSpec
+    motion: MotionSpec
+    output: OutputSpec = field(default_factory=OutputSpec)
+    source: str | None = field(default=None, compare=False)
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def n_samples(self) -> int:
+        """Number of output rows (t = 0, dt, ..., duration)."""
+        return math.floor(self.duration_s / self.sample_dt_s + 1e-9) + 1
+
+    def block_index(self, name: str) -> int:
+        """Index of the block called ``name``."""
+        for i, spec in enumerate(self.blocks):
+            if spec.name == name:
+                return i
+        raise InputError("motion.block", f"no block named {name!r}; blocks: {[b.name for b in self.blocks]}")
+
+    @property
+    def released_index(self) -> int:
+        """Index of the block given the initial tilt (free rocking): named, else the top."""
+        name = self.motion.released_block
+        return len(self.blocks) - 1 if name is None else self.block_index(name)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Canonical dictionary of the scene, defaults filled in (JSON-ready)."""
+        blocks = []
+        for b in self.blocks:
+            d = asdict(b)
+            if d["vertices_m"] is not None:
+                d["vertices_m"] = [list(v) for v in d["vertices_m"]]
+            blocks.append(d)
+        out = asdict(self.output)
+        if isinstance(out["accel_point"], tuple):
+            out["accel_point"] = list(out["accel_point"])
+        return _drop_none(
+            {
+                "duration_s": self.duration_s,
+                "sample_dt_s": self.sample_dt_s,
+                "blocks": blocks,
+                "contact": asdict(self.contact),
+                "motion": self.motion.to_dict(),
+                "output": out,
+            }
+        )
+
+    @property
+    def scene_hash(self) -> str:
+        """SHA-256 of the canonical scene (first 16 hex digits): same physics, same hash."""
+        material = self.to_dict()
+        material["motion"] = self.motion.hash_material()
+        text = json.dumps(material, sort_keys=True, separators=(",", ":"), default=str)
+        return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+    def with_changes(self, **changes: Any) -> Scene:
+        """A copy with top-level fields replaced (e.g. ``motion=...``), re-validated."""
+        d = {**self.__dict__, **changes}
+        scene = Scene(**d)
+        _check_scene(scene)
+        return scene
+
+    def write_json(self, path: str | Path) -> None:
+        """Write the canonical scene as JSON (atomically)."""
+        from rockyade.atomic import write_json
+
+        write_json(path, self.to_dict())
+
+
+def _drop_none(value: Any) -> Any:
+    """Remove None-valued keys recursively (optional fields left out of canonical files)."""
+    if isinstance(value, dict):
+        return {k: _drop_none(v) for k, v in value.items() if v is not None}
+    if isinstance(value, list):
+        return [_drop_none(v) for v in value]
+    return value
+
+
+# ---------------------------------------------------------------------- loading
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file (``.toml`` or ``.json``).
+
+    Raises
+    ------
+    InputError
+        Naming the file, the field and the allowed range, for any bad or missing value.
+    """
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise InputError("scene", f"file not found: {path}")
+    text = path.read_text(encoding="utf-8")
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".toml":
+            data = tomllib.loads(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            raise InputError("scene", f"unknown file type {suffix!r}: use .toml or .json", source)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
+        raise InputError("scene", f"not valid {suffix[1:].upper()}: {exc}", source) from None
+    return scene_from_dict(data, source=source, base_dir=path.parent)
+
+
+def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> Scene:
+    """Validate a scene given as a dictionary (as read from TOML or JSON)."""
+    top = TableReader(data, "", source)
+    duration = top.positive("duration_s", unit="s")
+    sample_dt = top.positive("sample_dt_s", unit="s")
+    if sample_dt > duration:
+        raise top.error("sample_dt_s", f"must be <= duration_s ({duration:g} s), got {sample_dt:g}")
+    if duration / sample_dt > MAX_SAMPLES:
+        raise top.error("sample_dt_s", f"gives more than {MAX_SAMPLES} samples; use a larger interval")
+    raw_blocks = top.raw("blocks")
+    if not isinstance(raw_blocks, list) or not raw_blocks:
+        raise top.error("blocks", "must be a non-empty list of block tables ([[blocks]])")
+    blocks = tuple(_parse_block(b, i, source) for i, b in enumerate(raw_blocks))
+    contact = _parse_contact(top.sub("contact", {}))
+    motion = parse_motion(top.raw("motion"), source, base_dir)
+    output = _parse_output(top.sub("output", {}))
+    top.finish()
+    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source)
+    _check_scene(scene)
+    return scene
+
+
+def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
+    r = TableReader(table, f"blocks[{index}]", source)
+    name = r.string("name", f"block{index}")
+    if not NAME_PATTERN.match(name):
+        raise r.error("name", "must start with a letter and contain only letters, digits and _ (max 64)")
+    thickness = r.positive("thickness_m", unit="m")
+    vertices = None
+    width = height = None
+    if r.has("vertices_m"):
+        raw = r.raw("vertices_m")
+        if (
+            not isinstance(raw, list)
+            or len(raw) < 3
+            or not all(isinstance(v, list) and len(v) == 2 for v in raw)
+        ):
+            raise r.error("vertices_m", "must be a list of at least 3 [x, y] pairs in metres")
+        sub = TableReader({f"v{i}": v for i, v in enumerate(raw)}, r.field("vertices_m"), source)
+        vertices = tuple(tuple(sub.number_list(f"v{i}", min_len=2, unit="m")) for i in range(len(raw)))
+        for key in ("width_m", "height_m"):
+            if r.has(key):
+                raise r.error(key, "give either vertices_m or width_m/height_m, not both")
+            r.raw(key, None)
+    else:
+        width = r.positive("width_m", unit="m")
+        height = r.positive("height_m", unit="m")
+    mass = r.positive("mass_kg", None, unit="kg")
+    density = r.positive("density_kg_m3", None, unit="kg/m^3")
+    if (mass is None) == (density is None):
+        raise r.error("mass_kg", "give exactly one of mass_kg and density_kg_m3")
+    inertia = r.positive("inertia_kgm2", None, unit="kg m^2")
+    x_offset = r.number("x_offset_m", 0.0, unit="m")
+    alpha = r.number("alpha_rad", None, lo=0.0, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
+    p = r.positive("p_rad_s", None, unit="rad/s")
+    mu = r.number("mu", None, lo=0.0, hi=1.0, lo_open=True)
+    if inertia is not None and p is not None:
+        raise r.error("p_rad_s", "give either inertia_kgm2 or p_rad_s (p sets the DEM inertia), not both")
+    r.finish()
+    spec = BlockSpec(
+        name=name,
+        thickness_m=thickness,
+        width_m=width,
+        height_m=height,
+        vertices_m=vertices,
+        mass_kg=mass,
+        density_kg_m3=density,
+        inertia_kgm2=inertia,
+        x_offset_m=x_offset,
+        alpha_rad=None if alpha is None else float(alpha),
+        p_rad_s=None if p is None else float(p),
+        mu=None if mu is None else float(mu),
+    )
+    try:
+        spec.block()
+    except InputError as exc:
+        raise InputError(f"blocks[{index}].{exc.field}", exc.message, source) from None
+    return spec
+
+
+def _parse_contact(r: TableReader) -> ContactSpec:
+    calibration = r.string("calibration", "paper", choices=CALIBRATIONS)
+    scale = r.raw("stiffness_scale", "MN/m")
+    if isinstance(scale, str):
+        if scale not in STIFFNESS_SCALES:
+            raise r.error(
+                "stiffness_scale", f"must be one of {sorted(STIFFNESS_SCALES)} or a number > 0, got {scale!r}"
+            )
+    else:
+        scale = r.positive("stiffness_scale")
+    spec = ContactSpec(
+        calibration=calibration,
+        stiffness_scale=scale,
+        K_N_per_m=r.positive("K_N_per_m", None, unit="N/m"),
+        Ks_N_per_m=r.positive("Ks_N_per_m", None, unit="N/m"),
+        friction_angle_deg=r.number(
+            "friction_angle_deg", DEFAULT_FRICTION_ANGLE_DEG, lo=0.0, hi=90.0, hi_open=True, unit="deg"
+        ),
+        cohesion_Pa=r.number("cohesion_Pa", 0.0, lo=0.0, unit="Pa"),
+        beta_s=r.number("beta_s", None, lo=0.0, unit="s"),
+        dt_s=r.positive("dt_s", None, unit="s"),
+        time_step_frac=r.number(
+            "time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""
+        ),
+        mass_damping_1_s=r.number("mass_damping_1_s", 0.0, lo=0.0, unit="1/s"),
+    )
+    if spec.cohesion_Pa != 0.0:
+        raise r.error(
+            "cohesion_Pa",
+            "must be 0: the paper's dry joints have no cohesion and YADE's ViscElPhys law "
+            "(the same law in both DEMs) has none",
+        )
+    r.finish()
+    return spec
+
+
+def _parse_output(r: TableReader) -> OutputSpec:
+    point = r.raw("accel_point", "top_centre")
+    if isinstance(point, str):
+        if point != "top_centre":
+            raise r.error("accel_point", f"must be 'top_centre' or [x, y] in metres, got {point!r}")
+    else:
+        point = tuple(r.number_list("accel_point", min_len=2, unit="m"))
+        if len(point) != 2:
+            raise r.error("accel_point", "must be 'top_centre' or [x, y] in metres")
+    lowpass = r.positive("accel_lowpass_hz", None, unit="Hz")
+    r.finish()
+    return OutputSpec(point, lowpass)
+
+
+def _check_scene(scene: Scene) -> None:
+    """Cross-field checks: unique names, stacking, the motion's block, sampling."""
+    names = [b.name for b in scene.blocks]
+    for i, name in enumerate(names):
+        if name in names[:i]:
+            raise InputError(f"blocks[{i}].name", f"duplicate block name {name!r}", scene.source)
+    if scene.motion.released_block is not None and scene.motion.released_block not in names:
+        raise InputError(
+            "motion.block", f"no block named {scene.motion.released_block!r}; blocks: {names}", scene.source
+        )
+    lower: Block | None = None
+    lower_offset = 0.0
+    for i, spec in enumerate(scene.blocks):
+        block = spec.block()
+        if lower is not None:
+            lo_l, lo_r = lower.level_vertices("top")
+            up_l, up_r = block.level_vertices("base")
+            overlap = min(lo_r + lower_offset, up_r + spec.x_offset_m) - max(
+                lo_l + lower_offset, up_l + spec.x_offset_m
+            )
+            if lo_r - lo_l <= 0:
+                raise InputError(
+                    f"blocks[{i - 1}].vertices_m",
+                    "a block that carries another needs a flat top",
+                    scene.source,
+                )
+            if overlap <= 0:
+                raise InputError(
+                    f"blocks[{i}].x_offset_m",
+                    "block does not rest on the block below it (no overlap)",
+                    scene.source,
+                )
+        lower, lower_offset = block, spec.x_offset_m
