@@ -1,0 +1,635 @@
+"""Exact solution of Housner's rocking equation (paper Eq 1, nonlinear).
+
+For theta > 0 the block pivots on its left base corner, for theta < 0 on its right one:
+
+    theta'' = (p_L^2 / g) [ -(g + a_v) sin(alpha_L - theta) + a_h cos(alpha_L - theta) ]
+    theta'' = (p_R^2 / g) [ +(g + a_v) sin(alpha_R + theta) + a_h cos(alpha_R + theta) ]
+
+with a_h the horizontal base acceleration (> 0 towards +x makes theta'' > 0: the paper's
+Eq 1 with a(t) the base acceleration) and a_v the vertical one (> 0 upwards; 0 in the
+paper). Phases:
+
+* rest: the block stays at theta = 0 until a_h exceeds the uplift threshold
+  (g + a_v) tan(alpha); the crossing is found exactly on the piecewise-linear base
+  acceleration;
+* rocking: classical 4th-order Runge-Kutta steps no longer than 1 / (``STEPS_PER_RADIAN``
+  p) and aligned with the base-motion samples (the forcing is smooth within a step);
+  impacts theta = 0 are located by root finding (Brent-type bracketing on the Runge-Kutta
+  sub-step theta(tau), to machine precision), and omega is multiplied by mu (the pivot
+  changes);
+* return to rest: after an impact that leaves the block too little energy to lift it by
+  more than ``REST_FRACTION`` * alpha (the impacts would otherwise accumulate
+  geometrically);
+* overturning: |theta| reaching pi/2 (the block lies on its side), located by root
+  finding. The last time |theta| crossed alpha outwards (beyond which, without base motion,
+  there is no way back) is reported beside it.
+
+Output samples are computed by exact Runge-Kutta sub-steps to each sample time, not by
+interpolation. The kernel is compiled by numba.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import pandas as pd
+
+from rockyade import __version__
+from rockyade.classical import ClassicalParameters
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.motion.ground import GroundMotion
+from rockyade.result import Result, column
+from rockyade.scene import Scene
+
+#: A block is declared at rest when an impact leaves it an energy that would lift it by
+#: less than REST_FRACTION * alpha.
+REST_FRACTION = 1e-6
+#: Runge-Kutta steps per radian of p t: the step is at most 1 / (STEPS_PER_RADIAN * p).
+STEPS_PER_RADIAN = 400.0
+#: At most this many impacts, peaks and uplifts are kept (all are counted).
+MAX_RECORDED_EVENTS = 4000
+
+_STATUS_NAMES = ("completed", "overturned")
+
+
+@dataclass(frozen=True)
+class HousnerModel:
+    """The single-degree-of-freedom model: classical parameters of both pivots.
+
+    Attributes
+    ----------
+    alpha_left, alpha_right
+        Critical angles of rocking about the left (theta > 0) and right pivots, rad.
+    p_left, p_right
+        Frequency parameters, rad/s.
+    mu_left_to_right, mu_right_to_left
+        Restitution of an impact moving the pivot from left to right (theta going from
+        > 0 to < 0) and back.
+    g
+        Gravity, m/s^2.
+    """
+
+    alpha_left: float
+    alpha_right: float
+    p_left: float
+    p_right: float
+    mu_left_to_right: float
+    mu_right_to_left: float
+    g: float = G
+
+    @classmethod
+    def from_classical(cls, cp: ClassicalParameters, g: float = G) -> HousnerModel:
+        """Model from classical parameters (geometry or overrides)."""
+        return cls(
+            cp.left.alpha_rad,
+            cp.right.alpha_rad,
+            cp.left.p_rad_s,
+            cp.right.p_rad_s,
+            cp.mu_left_to_right,
+            cp.mu_right_to_left,
+            g,
+        )
+
+    @classmethod
+    def symmetric(cls, alpha: float, p: float, mu: float, g: float = G) -> HousnerModel:
+        """A symmetric block."""
+        return cls(alpha, alpha, p, p, mu, mu, g)
+
+    def acceleration(self, side: int, theta: float, ah: float = 0.0, av: float = 0.0) -> float:
+        """theta'' on ``side`` (+1 left pivot, -1 right pivot), rad/s^2."""
+        return _theta_dd(side, theta, ah, av, self._params())
+
+    def energy(self, side: int, theta: float, omega: float) -> float:
+        """Energy in units of M g R: omega^2 / (2 p^2) + cos(alpha - |theta|) - cos(alpha).
+
+        Conserved between impacts when the base does not move.
+        """
+        p = self.p_left if side > 0 else self.p_right
+        alpha = self.alpha_left if side > 0 else self.alpha_right
+        return 0.5 * omega * omega / (p * p) + math.cos(alpha - abs(theta)) - math.cos(alpha)
+
+    def _params(self) -> np.ndarray:
+        return np.array(
+            [
+                self.alpha_left,
+                self.alpha_right,
+                self.p_left**2 / self.g,
+                self.p_right**2 / self.g,
+                self.mu_left_to_right,
+                self.mu_right_to_left,
+                self.g,
+                self.p_left,
+                self.p_right,
+            ]
+        )
+
+
+# ------------------------------------------------------------------ numba kernel
+
+_AL, _AR, _PL2G, _PR2G, _MULR, _MURL, _G, _PL, _PR = range(9)
+
+
+@numba.njit(cache=True)
+def _theta_dd(side, theta, ah, av, prm):
+    if side > 0:
+        a = prm[_AL] - theta
+        return prm[_PL2G] * (-(prm[_G] + av) * math.sin(a) + ah * math.cos(a))
+    a = prm[_AR] + theta
+    return prm[_PR2G] * ((prm[_G] + av) * math.sin(a) + ah * math.cos(a))
+
+
+@numba.njit(cache=True)
+def _ground(t, mt, mah, mav):
+    """Base acceleration (ah, av) at t: linear between samples, zero outside."""
+    n = mt.size
+    if n < 2 or t < mt[0] or t > mt[n - 1]:
+        return 0.0, 0.0
+    i = np.searchsorted(mt, t, side="right") - 1
+    if i >= n - 1:
+        return mah[n - 1], mav[n - 1]
+    w = (t - mt[i]) / (mt[i + 1] - mt[i])
+    return mah[i] + w * (mah[i + 1] - mah[i]), mav[i] + w * (mav[i + 1] - mav[i])
+
+
+@numba.njit(cache=True)
+def _rk4(t, th, om, h, side, prm, mt, mah, mav):
+    """One classical Runge-Kutta step of size h; returns (theta, omega)."""
+    ah, av = _ground(t, mt, mah, mav)
+    k1t = om
+    k1w = _theta_dd(side, th, ah, av, prm)
+    ah, av = _ground(t + 0.5 * h, mt, mah, mav)
+    k2t = om + 0.5 * h * k1w
+    k2w = _theta_dd(side, th + 0.5 * h * k1t, ah, av, prm)
+    k3t = om + 0.5 * h * k2w
+    k3w = _theta_dd(side, th + 0.5 * h * k2t, ah, av, prm)
+    ah, av = _ground(t + h, mt, mah, mav)
+    k4t = om + h * k3w
+    k4w = _theta_dd(side, th + h * k3t, ah, av, prm)
+    return (
+        th + h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t),
+        om + h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w),
+    )
+
+
+@numba.njit(cache=True)
+def _event_value(kind, th, om, side, level):
+    """Event functions. 0: side*theta (impact when it falls to 0); 1: side*theta - level
+    (overturn when it rises to 0); 2: omega (peak when it changes sign)."""
+    if kind == 0:
+        return side * th
+    if kind == 1:
+        return side * th - level
+    return om
+
+
+@numba.njit(cache=True)
+def _before(kind, f, f0):
+    """True while the event has not happened: f > 0 (impact), f < 0 (overturn), or f
+    keeps the sign of the starting value f0 (peak)."""
+    if kind == 0:
+        return f > 0.0
+    if kind == 1:
+        return f < 0.0
+    return f * f0 > 0.0
+
+
+@numba.njit(cache=True)
+def _bisect(kind, t, th, om, side, level, a, b, f0, prm, mt, mah, mav):
+    """Refine a bracket [a, b] (event not yet at a, happened at b) to machine precision
+    on the Runge-Kutta sub-step."""
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        if m <= a or m >= b:
+            break
+        th1, om1 = _rk4(t, th, om, m, side, prm, mt, mah, mav)
+        if _before(kind, _event_value(kind, th1, om1, side, level), f0):
+            a = m
+        else:
+            b = m
+    return b
+
+
+@numba.njit(cache=True)
+def _first_root(kind, t, th, om, h, side, level, prm, mt, mah, mav):
+    """Smallest tau in (0, h] at which the event happens, or -1.
+
+    The step is scanned at 16 sub-points for the first change, then refined by bisection.
+    A block that starts on theta = 0 (just after an impact) and turns back within the
+    first sub-interval re-impacts after its turning point: the bracket starts there.
+    """
+    f0 = _event_value(kind, th, om, side, level)
+    n_scan = 16
+    a = 0.0
+    for j in range(1, n_scan + 1):
+        tau = h * j / n_scan
+        th1, om1 = _rk4(t, th, om, tau, side, prm, mt, mah, mav)
+        if _before(kind, _event_value(kind, th1, om1, side, level), f0):
+            a = tau
+            continue
+        if a == 0.0 and not _before(kind, f0, f0):
+            if kind != 0 or om == 0.0:
+                return tau if kind == 0 else -1.0
+            # turning point (omega = 0) inside (0, tau), then the fall back to theta = 0
+            tp = _bisect(2, t, th, om, side, level, 0.0, tau, om, prm, mt, mah, mav)
+            thp, omp = _rk4(t, th, om, tp, side, prm, mt, mah, mav)
+            if not _before(kind, _event_value(kind, thp, omp, side, level), f0):
+                return tp
+            a = tp
+        return _bisect(kind, t, th, om, side, level, a, tau, f0, prm, mt, mah, mav)
+    return -1.0
+
+
+@numba.njit(cache=True)
+def _uplift(t0, t_end, mt, mah, mav, prm):
+    """First t in [t0, t_end) where the base lifts the block, and the side (0: none)."""
+    n = mt.size
+    if n < 2 or t0 >= mt[n - 1]:
+        return -1.0, 0
+    tan_l = math.tan(prm[_AL])
+    tan_r = math.tan(prm[_AR])
+    g = prm[_G]
+    ah, av = _ground(t0, mt, mah, mav)
+    fp = ah - (g + av) * tan_l
+    fm = -ah - (g + av) * tan_r
+    if fp > 0.0:
+        return t0, 1
+    if fm > 0.0:
+        return t0, -1
+    i = np.searchsorted(mt, t0, side="right")
+    ta = t0
+    while i < n and ta < t_end:
+        tb = mt[i]
+        ah_b = mah[i]
+        av_b = mav[i]
+        fpb = ah_b - (g + av_b) * tan_l
+        fmb = -ah_b - (g + av_b) * tan_r
+        if fpb > 0.0 or fmb > 0.0:
+            best = math.inf
+            side = 0
+            if fpb > 0.0:
+                tc = ta + (tb - ta) * (-fp) / (fpb - fp)
+                best, side = tc, 1
+            if fmb > 0.0:
+                tc = ta + (tb - ta) * (-fm) / (fmb - fm)
+                if tc < best:
+                    best, side = tc, -1
+            best = min(np.nextafter(best, math.inf), tb)
+            if best >= t_end:
+                return -1.0, 0
+            return best, side
+        ta, fp, fm = tb, fpb, fmb
+        i += 1
+    return -1.0, 0
+
+
+@numba.njit(cache=True)
+def _integrate(
+    prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples, h_max, rest_lift, max_events
+):
+    theta_s = np.zeros(n_samples)
+    omega_s = np.zeros(n_samples)
+    acc_s = np.zeros(n_samples)
+    impacts = np.zeros((max_events, 3))
+    peaks = np.zeros((max_events, 2))
+    uplifts = np.zeros(max_events)
+    counts = np.zeros(3, dtype=np.int64)  # impacts, peaks, uplifts
+    status = 0
+    t_over = -1.0
+    t_alpha = -1.0
+    alpha_min = min(prm[_AL], prm[_AR])
+    n_motion = mt.size
+    t = 0.0
+    th = theta0
+    om = omega0
+    k = 0  # next sample index
+    eps = 1e-9 * dt_sample
+    side = 1
+    resting = th == 0.0 and om == 0.0
+    if not resting:
+        theta_s[0] = th
+        omega_s[0] = om
+        side0 = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
+        ah, av = _ground(0.0, mt, mah, mav)
+        acc_s[0] = _theta_dd(side0, th, ah, av, prm)
+        k = 1
+    while t < duration:
+        if resting:
+            tu, side_up = _uplift(t, duration, mt, mah, mav, prm)
+            t_next = duration if tu < 0.0 else tu
+            while k < n_samples and k * dt_sample <= t_next + eps:
+                k += 1  # samples at rest stay zero
+            if tu < 0.0:
+                break
+            if counts[2] < max_events:
+                uplifts[counts[2]] = tu
+            counts[2] += 1
+            t = tu
+            th = 0.0
+            om = 0.0
+            resting = False
+            side = side_up
+        elif th != 0.0 or om != 0.0:
+            side = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
+        alpha_side = prm[_AL] if side > 0 else prm[_AR]
+        # step end: no longer than h_max, aligned with the next base-motion sample
+        h = h_max
+        if n_motion >= 2 and t < mt[n_motion - 1]:
+            j = np.searchsorted(mt, t, side="right")
+            if j < n_motion:
+                gap = mt[j] - t
+                if gap < h:
+                    h = gap
+                elif gap < h * 1.1:
+                    h = 0.5 * gap
+        if t + h > duration:
+            h = duration - t
+        if h <= 0.0:
+            break
+        th1, om1 = _rk4(t, th, om, h, side, prm, mt, mah, mav)
+        # events inside the step: impact, overturn (terminal), peak (recorded)
+        tau_end = h
+        event = 0  # 0 none, 1 impact, 2 overturn
+        if side * th1 >= 0.5 * math.pi:
+            tau = _first_root(1, t, th, om, h, side, 0.5 * math.pi, prm, mt, mah, mav)
+            if tau >= 0.0:
+                tau_end = tau
+                event = 2
+        if side * th1 <= 0.0:
+            tau = _first_root(0, t, th, om, h, side, 0.0, prm, mt, mah, mav)
+            if tau >= 0.0 and tau <= tau_end:
+                tau_end = tau
+                event = 1
+        if om * om1 < 0.0 or (event != 0 and om != 0.0):
+            tau = _first_root(2, t, th, om, tau_end, side, 0.0, prm, mt, mah, mav)
+            if tau > 0.0 and tau < tau_end:
+                thp, _omp = _rk4(t, th, om, tau, side, prm, mt, mah, mav)
+                if counts[1] < max_events:
+                    peaks[counts[1], 0] = t + tau
+                    peaks[counts[1], 1] = thp
+                counts[1] += 1
+        if side * th < alpha_side <= side * th1:
+            t_alpha = t + h * (alpha_side - side * th) / (side * (th1 - th))
+        # samples inside (t, t + tau_end]
+        t_end = t + tau_end
+        while k < n_samples and k * dt_sample <= t_end + eps:
+            tk = k * dt_sample
+            if tk <= t:
+                thk, omk = th, om
+            else:
+                thk, omk = _rk4(t, th, om, tk - t, side, prm, mt, mah, mav)
+            theta_s[k] = thk
+            omega_s[k] = omk
+            ah, av = _ground(tk, mt, mah, mav)
+            acc_s[k] = _theta_dd(side, thk, ah, av, prm)
+            k += 1
+        if event == 0:
+            t, th, om = t + h, th1, om1
+            continue
+        _th_e, om_e = _rk4(t, th, om, tau_end, side, prm, mt, mah, mav)
+        t = t_end
+        if event == 2:
+            status = 1
+            t_over = t
+            break
+        mu = prm[_MULR] if side > 0 else prm[_MURL]
+        om_after = mu * om_e
+        if counts[0] < max_events:
+            impacts[counts[0], 0] = t
+            impacts[counts[0], 1] = om_e
+            impacts[counts[0], 2] = om_after
+        counts[0] += 1
+        th = 0.0
+        om = om_after
+        new_side = -side
+        p_new = prm[_PL] if new_side > 0 else prm[_PR]
+        a_new = prm[_AL] if new_side > 0 else prm[_AR]
+        lift = 0.5 * om_after * om_after / (p_new * p_new)
+        if lift < math.cos(a_new - rest_lift * alpha_min) - math.cos(a_new):
+            om = 0.0
+            resting = True
+    return theta_s, omega_s, acc_s, impacts, peaks, uplifts, counts, status, t_over, t_alpha, k
+
+
+# ------------------------------------------------------------------ Python API
+
+
+@dataclass
+class Trajectory:
+    """What the solver found.
+
+    Attributes
+    ----------
+    t_s, theta_rad, omega_rad_s, theta_dd_rad_s2
+        Samples (for an overturned run, up to the overturn time).
+    impacts
+        (n, 3): time, omega before, omega after.
+    peaks
+        (n, 2): time, theta where omega = 0 during rocking.
+    uplift_times_s
+        Times the block left rest.
+    n_impacts
+        All impacts (``impacts`` keeps the first MAX_RECORDED_EVENTS).
+    status
+        "completed" or "overturned".
+    overturn_time_s, alpha_exceeded_time_s
+        When |theta| reached pi/2, and last crossed alpha outwards.
+    step_s
+        Largest Runge-Kutta step used, s.
+    """
+
+    t_s: np.ndarray
+    theta_rad: np.ndarray
+    omega_rad_s: np.ndarray
+    theta_dd_rad_s2: np.ndarray
+    impacts: np.ndarray
+    peaks: np.ndarray
+    uplift_times_s: np.ndarray
+    n_impacts: int
+    status: str
+    overturn_time_s: float | None
+    alpha_exceeded_time_s: float | None
+    step_s: float
+
+
+def solve(
+    model: HousnerModel,
+    motion: GroundMotion | None,
+    duration_s: float,
+    theta0: float = 0.0,
+    omega0: float = 0.0,
+    sample_dt_s: float = 0.001,
+    step_s: float | None = None,
+) -> Trajectory:
+    """Integrate the rocking equation from t = 0 to ``duration_s``.
+
+    Parameters
+    ----------
+    model
+        Classical parameters of both pivots.
+    motion
+        Base acceleration (None: the base is at rest).
+    duration_s
+        End time, s.
+    theta0, omega0
+        Initial tilt (rad) and angular velocity (rad/s).
+    sample_dt_s
+        Output sampling interval, s.
+    step_s
+        Largest Runge-Kutta step, s (default 1 / (400 p)).
+    """
+    prm = model._params()
+    if step_s is None:
+        step_s = 1.0 / (STEPS_PER_RADIAN * max(model.p_left, model.p_right))
+    if motion is None:
+        mt = np.zeros(0)
+        mah = np.zeros(0)
+        mav = np.zeros(0)
+    else:
+        mt, mah, mav = motion.t_s, motion.ah_m_s2, motion.av_m_s2
+    n_samples = math.floor(duration_s / sample_dt_s + 1e-9) + 1
+    out = _integrate(
+        prm,
+        mt,
+        mah,
+        mav,
+        float(duration_s),
+        float(theta0),
+        float(omega0),
+        float(sample_dt_s),
+        n_samples,
+        float(step_s),
+        REST_FRACTION,
+        MAX_RECORDED_EVENTS,
+    )
+    theta, omega, acc, impacts, peaks, uplifts, counts, status, t_over, t_alpha, n_filled = out
+    n_imp, n_peak, n_up = (int(c) for c in counts)
+    n_keep = int(n_filled) if status == 1 else n_samples
+    overturned = status == 1
+    return Trajectory(
+        t_s=np.arange(n_keep) * sample_dt_s,
+        theta_rad=theta[:n_keep],
+        omega_rad_s=omega[:n_keep],
+        theta_dd_rad_s2=acc[:n_keep],
+        impacts=impacts[: min(n_imp, MAX_RECORDED_EVENTS)],
+        peaks=peaks[: min(n_peak, MAX_RECORDED_EVENTS)],
+        uplift_times_s=uplifts[: min(n_up, MAX_RECORDED_EVENTS)],
+        n_impacts=n_imp,
+        status=_STATUS_NAMES[status],
+        overturn_time_s=float(t_over) if overturned else None,
+        alpha_exceeded_time_s=float(t_alpha) if overturned and t_alpha >= 0 else None,
+        step_s=float(step_s),
+    )
+
+
+def run_scene(scene: Scene) -> Result:
+    """Solve a single-block scene with Housner's equation and return a Result.
+
+    Raises
+    ------
+    InputError
+        If the scene has more than one block (the classical theory is for one block on a
+        rigid base).
+    """
+    if len(scene.blocks) != 1:
+        raise InputError(
+            "blocks",
+            f"the housner solver takes one block on a rigid base; this scene has {len(scene.blocks)} "
+            "(use the reference or yade solver for stacks)",
+            scene.source,
+        )
+    spec = scene.blocks[0]
+    block = spec.block()
+    cp = spec.classical()
+    model = HousnerModel.from_classical(cp)
+    motion = scene.motion.ground_motion(scene.duration_s)
+    start = time.perf_counter()
+    traj = solve(
+        model,
+        motion,
+        scene.duration_s,
+        scene.motion.initial_theta_rad,
+        scene.motion.initial_omega_rad_s,
+        scene.sample_dt_s,
+    )
+    wall = time.perf_counter() - start
+    frame = _frame(scene, block, model, motion, traj)
+    meta = {
+        "solver": "housner",
+        "version": f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
+        "scene_hash": scene.scene_hash,
+        "wall_time_s": wall,
+        "status": traj.status,
+        "overturn_time_s": traj.overturn_time_s,
+        "overturned_block": spec.name if traj.status == "overturned" else None,
+        "overturn_criterion": "|theta| reached pi/2",
+        "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
+        "blocks": [spec.name],
+        "sample_dt_s": scene.sample_dt_s,
+        "duration_s": scene.duration_s,
+        "classical": {spec.name: cp.as_dict()},
+        "n_impacts": traj.n_impacts,
+        "impacts": traj.impacts[:200].tolist(),
+        "peaks": traj.peaks[:200].tolist(),
+        "uplift_times_s": traj.uplift_times_s[:200].tolist(),
+        "rest_fraction_of_alpha": REST_FRACTION,
+        "motion": motion.label if motion is not None else "free",
+    }
+    return Result(frame, meta)
+
+
+def _frame(
+    scene: Scene, block, model: HousnerModel, motion: GroundMotion | None, traj: Trajectory
+) -> pd.DataFrame:
+    """The Result's time history: rotation, centroid displacement, point accelerations.
+
+    Kinematics about the active pivot, placed at the equivalent base b_eq = h tan(alpha)
+    (the real corners when alpha comes from the geometry).
+    """
+    times, theta, omega, alpha_dd = traj.t_s, traj.theta_rad, traj.omega_rad_s, traj.theta_dd_rad_s2
+    ah = motion.horizontal(times) if motion is not None else np.zeros_like(times)
+    av = motion.vertical(times) if motion is not None else np.zeros_like(times)
+    cx, cy = block.centroid_m
+    pivot_left = np.array([cx - cy * math.tan(model.alpha_left), 0.0])
+    pivot_right = np.array([cx + cy * math.tan(model.alpha_right), 0.0])
+    if scene.output.accel_point == "top_centre":
+        point = np.array([cx, block.height_m])
+    else:
+        point = np.asarray(scene.output.accel_point, dtype=float)
+    pivots = np.where((theta >= 0)[:, None], pivot_left, pivot_right)
+    c, s = np.cos(theta), np.sin(theta)
+    g0 = np.array([cx, cy]) - pivots
+    gx = pivots[:, 0] + c * g0[:, 0] - s * g0[:, 1]
+    gy = pivots[:, 1] + s * g0[:, 0] + c * g0[:, 1]
+    q0 = point - pivots
+    rx = c * q0[:, 0] - s * q0[:, 1]
+    ry = s * q0[:, 0] + c * q0[:, 1]
+    ax = -alpha_dd * ry - omega**2 * rx + ah
+    ay = alpha_dd * rx - omega**2 * ry + av
+    name = scene.blocks[0].name
+    names = [name]
+    frame = pd.DataFrame(
+        {
+            "t_s": times,
+            "ag_m_s2": ah,
+            column(name, "theta_rad", names): theta,
+            column(name, "omega_rad_s", names): omega,
+            column(name, "x_m", names): gx - cx,
+            column(name, "y_m", names): gy - cy,
+            column(name, "ax_m_s2", names): ax,
+            column(name, "ay_m_s2", names): ay,
+        }
+    )
+    if scene.output.accel_lowpass_hz:
+        from rockyade.signals import lowpass_zero_phase
+
+        for q in ("ax_m_s2", "ay_m_s2"):
+            col = column(name, q, names)
+            frame[col] = lowpass_zero_phase(
+                frame[col].to_numpy(), scene.sample_dt_s, scene.output.accel_lowpass_hz
+            )
+    return frame
