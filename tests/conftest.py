@@ -1,0 +1,45 @@
+"""Shared fixtures and helpers for the test suite."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent
+EXAMPLES = ROOT / "examples"
+SHARED = ROOT.parent / "shared"
+
+
+def free_scene_dict(theta0: float = 0.1175, duration: float = 4.0, **block_overrides) -> dict:
+    """Specimen 1 free rocking, as in the issue, with optional block overrides."""
+    block = {
+        "name": "specimen1",
+        "width_m": 0.25,
+        "height_m": 1.0,
+        "thickness_m": 0.754,
+        "mass_kg": 503,
+        "alpha_rad": 0.235,
+        "p_rad_s": 3.84,
+        "mu": 0.936,
+    }
+    block.update(block_overrides)
+    block = {k: v for k, v in block.items() if v is not None}
+    return {
+        "duration_s": duration,
+        "sample_dt_s": 0.001,
+        "blocks": [block],
+        "contact": {"calibration": "paper"},
+        "motion": {"type": "free", "theta0_rad": theta0},
+    }
+
+
+@pytest.fixture
+def examples_dir() -> Path:
+    return EXAMPLES
+
+
+def rel(a: float, b: float) -> float:
+    """Relative difference |a - b| / |b|."""
+    return abs(a - b) / abs(b) if b else math.inf

@@ -1,0 +1,122 @@
+"""The command line: every command, --help, JSON keys, exit codes."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from rockyade.cli import main
+from rockyade.result import Result
+
+
+def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+@pytest.mark.parametrize("command", ["params", "calibrate", "run", "tables"])
+def test_help_for_every_command(command):
+    proc = subprocess.run(
+        [sys.executable, "-m", "rockyade.cli", command, "--help"], capture_output=True, text=True
+    )
+    assert proc.returncode == 0 and "usage: rockyade" in proc.stdout
+
+
+def test_params_json_keys(capsys):
+    code, out, _ = run_cli(
+        capsys,
+        "params",
+        "--width",
+        "0.25",
+        "--height",
+        "1.0",
+        "--thickness",
+        "0.754",
+        "--mass",
+        "503",
+        "--json",
+    )
+    assert code == 0
+    data = json.loads(out)
+    for key in ("alpha_rad", "p_rad_s", "mu", "R_m", "I_O_kgm2", "mass_kg", "uplift_accel_m_s2"):
+        assert key in data
+    assert data["alpha_rad"] == pytest.approx(math.atan(0.25))
+    assert data["uplift_accel_m_s2"] == pytest.approx(9.81 * 0.25)
+
+
+def test_params_from_scene_and_specimen(capsys, examples_dir):
+    code, out, _ = run_cli(capsys, "params", "--scene", str(examples_dir / "specimen1_free.toml"), "--json")
+    assert code == 0 and json.loads(out)["alpha_rad"] == 0.235
+    code, out, _ = run_cli(capsys, "params", "--specimen", "4")
+    assert code == 0 and "alpha" in out
+
+
+def test_calibrate_specimen1_experimental(capsys):
+    code, out, _ = run_cli(
+        capsys, "calibrate", "--specimen", "1", "--parameters", "experimental", "--method", "paper", "--json"
+    )
+    assert code == 0
+    data = json.loads(out)
+    for key in (
+        "K_N_per_m",
+        "Ks_N_per_m",
+        "beta_s",
+        "xi_min",
+        "f_min_hz",
+        "b_eq_m",
+        "dt_s",
+        "friction_angle_deg",
+        "cohesion_Pa",
+        "stiffness_scale",
+    ):
+        assert key in data
+    M, R, p = 503, math.hypot(0.125, 0.5), 3.84
+    K_eq10 = M / 2 * (p * p + 3 * 9.81 / (4 * R))
+    assert data["K_N_per_m"] == pytest.approx(K_eq10 * 1e6)
+    gamma = K_eq10 * R
+    assert data["beta_s"] == pytest.approx((0.0057 * math.log(gamma / 0.936**2) - 0.0336) ** 2)
+    assert data["xi_min"] == pytest.approx(2 * math.pi * data["beta_s"] * 3.84)
+    assert data["b_eq_m"] == pytest.approx(0.5 * math.tan(0.235))
+    assert data["stiffness_scale"] == "MN/m"
+
+
+@pytest.mark.parametrize("specimen", ["2", "3", "4", "upper", "lower"])
+def test_calibrate_other_specimens(capsys, specimen):
+    code, out, _ = run_cli(capsys, "calibrate", "--specimen", specimen, "--json")
+    assert code == 0 and json.loads(out)["K_N_per_m"] > 1e8
+
+
+def test_bad_input_exit_code_and_message(capsys):
+    code, _, err = run_cli(capsys, "calibrate", "--specimen", "7")
+    assert code == 2 and "specimen" in err and "1, 2, 3, 4, upper, lower" in err
+    code, _, err = run_cli(capsys, "calibrate", "--specimen", "1", "--stiffness-scale", "N/m")
+    assert code == 2 and "contact.stiffness_scale" in err and "sinks" in err
+    code, _, err = run_cli(
+        capsys, "params", "--width", "-1", "--height", "1", "--thickness", "1", "--mass", "1"
+    )
+    assert code == 2 and "width" in err
+
+
+def test_run_housner_writes_csv_whose_peaks_give_mu(capsys, examples_dir, tmp_path):
+    out_csv = tmp_path / "r.csv"
+    code, out, _ = run_cli(
+        capsys, "run", str(examples_dir / "specimen1_free.toml"), "--solver", "housner", "--out", str(out_csv)
+    )
+    assert code == 0 and "effective mu = 0.936" in out
+    result = Result.read(out_csv)
+    from rockyade.analysis import effective_restitution, find_peaks
+
+    mu = effective_restitution(find_peaks(result.t, result.series("theta_rad")), 0.235)
+    assert mu == pytest.approx(0.936, abs=2e-5)
+
+
+def test_tables_command_writes_csvs(capsys, tmp_path):
+    code, out, _ = run_cli(capsys, "tables", "--out", str(tmp_path))
+    assert code == 0 and "Table 6" in out
+    assert (tmp_path / "tables_reproduced.csv").is_file()
+    assert (tmp_path / "table5_reproduced.csv").is_file()

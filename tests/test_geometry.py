@@ -1,0 +1,142 @@
+"""Blocks and mass properties: closed forms and a direct numerical integration."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import quad
+
+from rockyade import paper
+from rockyade.errors import InputError
+from rockyade.geometry import Block, chamfered_rectangle_vertices, polygon_section, rectangle_vertices
+
+
+def _integrate_convex(vertices: np.ndarray) -> tuple[float, float, float, float]:
+    """Area, centroid (x, y) and polar moment about the origin by nested quadrature.
+
+    For a convex polygon every horizontal line cuts an interval [xl(y), xr(y)]; the inner
+    integrals over x are done by quad too, so nothing here shares code with Green's theorem.
+    """
+    ys = vertices[:, 1]
+    edges = list(zip(vertices, np.roll(vertices, -1, axis=0), strict=True))
+
+    def span(y: float) -> tuple[float, float]:
+        xs = []
+        for (x0, y0), (x1, y1) in edges:
+            if (y0 - y) * (y1 - y) <= 0 and y0 != y1:
+                xs.append(x0 + (y - y0) * (x1 - x0) / (y1 - y0))
+            elif y0 == y1 == y:
+                xs += [x0, x1]
+        return min(xs), max(xs)
+
+    def inner(y: float, f) -> float:
+        xl, xr = span(y)
+        return quad(lambda x: f(x, y), xl, xr, epsabs=1e-14)[0]
+
+    breaks = sorted(set(ys.tolist()))
+
+    def outer(f):
+        return sum(quad(lambda y: inner(y, f), a, b, epsabs=1e-14)[0] for a, b in itertools.pairwise(breaks))
+
+    area = outer(lambda x, y: 1.0)
+    cx = outer(lambda x, y: x) / area
+    cy = outer(lambda x, y: y) / area
+    polar = outer(lambda x, y: x * x + y * y)
+    return area, cx, cy, polar
+
+
+@pytest.mark.parametrize(
+    "vertices",
+    [
+        rectangle_vertices(0.25, 1.0),
+        chamfered_rectangle_vertices(0.16, 0.457, 0.04),
+        np.array([[0.0, 0.0], [0.5, 0.0], [0.45, 0.3], [0.1, 0.6], [-0.05, 0.2]]),
+    ],
+    ids=["rectangle", "specimen4", "irregular"],
+)
+def test_polygon_section_against_numerical_integration(vertices):
+    area, cx, cy, polar_origin = _integrate_convex(vertices)
+    section = polygon_section(vertices)
+    assert section.area_m2 == pytest.approx(area, rel=1e-10)
+    assert section.centroid_m[0] == pytest.approx(cx, rel=1e-9, abs=1e-12)
+    assert section.centroid_m[1] == pytest.approx(cy, rel=1e-9)
+    polar_centroid = polar_origin - area * (cx * cx + cy * cy)
+    assert section.polar_second_moment_m4 == pytest.approx(polar_centroid, rel=1e-9)
+
+
+def test_rectangle_mass_and_inertia_closed_form():
+    b = Block.rectangle(0.25, 1.0, 0.754, mass_kg=503)
+    assert b.mass_kg == 503
+    assert b.centroid_m == pytest.approx((0.0, 0.5))
+    assert b.inertia_c_kgm2 == pytest.approx(503 * (0.25**2 + 1.0**2) / 12, rel=1e-12)
+    corner = b.pivots_m[0]
+    # I_O = 4/3 M R^2 for a rectangle about a base corner (R^2 = b^2 + h^2)
+    assert b.inertia_about(corner) == pytest.approx(4 / 3 * 503 * (0.125**2 + 0.5**2), rel=1e-12)
+
+
+def test_density_gives_mass():
+    b = Block.rectangle(0.2, 0.6, 0.55, density_kg_m3=2650)
+    assert b.mass_kg == pytest.approx(2650 * 0.2 * 0.6 * 0.55)
+    assert b.density_kg_m3 == pytest.approx(2650)
+
+
+def test_explicit_inertia_is_kept():
+    b = Block.rectangle(0.25, 1.0, 0.754, mass_kg=503, inertia_kgm2=50.0)
+    assert b.inertia_c_kgm2 == 50.0 and b.inertia_given
+
+
+def test_specimen4_is_a_chamfered_polygon():
+    s = paper.specimen(4)
+    b = s.block()
+    assert len(b.vertices_m) == 6
+    xl, xr = b.level_vertices("base")
+    assert (xl, xr) == pytest.approx((-0.04, 0.04))
+    assert b.section.area_m2 == pytest.approx(0.16 * 0.457 - 0.04**2)
+
+
+def test_clockwise_vertices_are_reordered():
+    cw = rectangle_vertices(0.2, 0.5)[::-1]
+    b = Block.polygon(cw, 0.3, mass_kg=10)
+    assert polygon_section(b.vertices_m).area_m2 > 0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        (dict(width_m=0.0, height_m=1.0, thickness_m=0.5, mass_kg=1), "width_m"),
+        (dict(width_m=0.2, height_m=-1.0, thickness_m=0.5, mass_kg=1), "height_m"),
+        (dict(width_m=0.2, height_m=1.0, thickness_m=0.0, mass_kg=1), "thickness_m"),
+        (dict(width_m=0.2, height_m=1.0, thickness_m=0.5), "mass_kg"),
+        (dict(width_m=0.2, height_m=1.0, thickness_m=0.5, mass_kg=1, density_kg_m3=2), "mass_kg"),
+        (dict(width_m=0.2, height_m=1.0, thickness_m=0.5, mass_kg=float("nan")), "mass_kg"),
+        (dict(width_m=0.2, height_m=1.0, thickness_m=0.5, mass_kg=1, inertia_kgm2=-1), "inertia_kgm2"),
+    ],
+)
+def test_bad_rectangle_inputs_name_the_field(kwargs, field):
+    with pytest.raises(InputError) as info:
+        Block.rectangle(**kwargs)
+    assert info.value.field == field
+
+
+def test_non_convex_polygon_rejected():
+    with pytest.raises(InputError, match="convex"):
+        Block.polygon([[0, 0], [1, 0], [1, 1], [0.5, 0.2], [0, 1]], 0.2, mass_kg=1)
+
+
+def test_pointed_base_rejected():
+    with pytest.raises(InputError, match="flat base"):
+        Block.polygon([[0, 0], [0.5, 0.5], [0, 1], [-0.5, 0.5]], 0.2, mass_kg=1)
+
+
+def test_block_that_cannot_stand_rejected():
+    with pytest.raises(InputError, match="cannot stand"):
+        Block.polygon([[0, 0], [0.1, 0], [1.5, 1.0], [1.2, 1.0]], 0.2, mass_kg=1)
+
+
+def test_polygon_vertices_shifted_to_base():
+    b = Block.polygon(rectangle_vertices(0.2, 0.5) + np.array([0.0, 3.0]), 0.3, mass_kg=5)
+    assert b.vertices_m[:, 1].min() == 0.0
+    assert math.isclose(b.height_m, 0.5)
