@@ -32,12 +32,13 @@ A scene is data, never code. Layout::
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
 import re
 import tomllib
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -47,6 +48,12 @@ from rockyade.errors import InputError
 from rockyade.fields import TableReader
 from rockyade.geometry import Block
 from rockyade.motion.spec import MotionSpec, parse_motion
+
+#: Upper bounds that keep inputs physical (and the arithmetic finite).
+MAX_LENGTH_M = 1000.0
+MAX_MASS_KG = 1.0e9
+MAX_DENSITY_KG_M3 = 1.0e5
+MAX_DURATION_S = 1.0e5
 
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
 CALIBRATIONS = ("paper", "matched")
@@ -178,7 +185,7 @@ class Scene:
             }
         )
 
-    @property
+    @functools.cached_property
     def scene_hash(self) -> str:
         """SHA-256 of the canonical scene (first 16 hex digits): same physics, same hash."""
         material = self.to_dict()
@@ -188,8 +195,7 @@ class Scene:
 
     def with_changes(self, **changes: Any) -> Scene:
         """A copy with top-level fields replaced (e.g. ``motion=...``), re-validated."""
-        d = {**self.__dict__, **changes}
-        scene = Scene(**d)
+        scene = replace(self, **changes)
         _check_scene(scene)
         return scene
 
@@ -241,7 +247,7 @@ def load_scene(path: str | Path) -> Scene:
 def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> Scene:
     """Validate a scene given as a dictionary (as read from TOML or JSON)."""
     top = TableReader(data, "", source)
-    duration = top.positive("duration_s", unit="s")
+    duration = top.number("duration_s", lo=0.0, hi=MAX_DURATION_S, lo_open=True, unit="s")
     sample_dt = top.positive("sample_dt_s", unit="s")
     if sample_dt > duration:
         raise top.error("sample_dt_s", f"must be <= duration_s ({duration:g} s), got {sample_dt:g}")
@@ -265,32 +271,30 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
     name = r.string("name", f"block{index}")
     if not NAME_PATTERN.match(name):
         raise r.error("name", "must start with a letter and contain only letters, digits and _ (max 64)")
-    thickness = r.positive("thickness_m", unit="m")
+    thickness = _length(r, "thickness_m")
     vertices = None
     width = height = None
     if r.has("vertices_m"):
         raw = r.raw("vertices_m")
-        if (
-            not isinstance(raw, list)
-            or len(raw) < 3
-            or not all(isinstance(v, list) and len(v) == 2 for v in raw)
-        ):
+        if not isinstance(raw, list) or len(raw) < 3 or not all(isinstance(v, list) and len(v) == 2 for v in raw):
             raise r.error("vertices_m", "must be a list of at least 3 [x, y] pairs in metres")
         sub = TableReader({f"v{i}": v for i, v in enumerate(raw)}, r.field("vertices_m"), source)
         vertices = tuple(tuple(sub.number_list(f"v{i}", min_len=2, unit="m")) for i in range(len(raw)))
+        if max(abs(c) for v in vertices for c in v) > MAX_LENGTH_M:
+            raise r.error("vertices_m", f"coordinates must be within +/-{MAX_LENGTH_M:g} m")
         for key in ("width_m", "height_m"):
             if r.has(key):
                 raise r.error(key, "give either vertices_m or width_m/height_m, not both")
             r.raw(key, None)
     else:
-        width = r.positive("width_m", unit="m")
-        height = r.positive("height_m", unit="m")
-    mass = r.positive("mass_kg", None, unit="kg")
-    density = r.positive("density_kg_m3", None, unit="kg/m^3")
+        width = _length(r, "width_m")
+        height = _length(r, "height_m")
+    mass = r.number("mass_kg", None, lo=0.0, hi=MAX_MASS_KG, lo_open=True, unit="kg")
+    density = r.number("density_kg_m3", None, lo=0.0, hi=MAX_DENSITY_KG_M3, lo_open=True, unit="kg/m^3")
     if (mass is None) == (density is None):
         raise r.error("mass_kg", "give exactly one of mass_kg and density_kg_m3")
     inertia = r.positive("inertia_kgm2", None, unit="kg m^2")
-    x_offset = r.number("x_offset_m", 0.0, unit="m")
+    x_offset = r.number("x_offset_m", 0.0, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m")
     alpha = r.number("alpha_rad", None, lo=0.0, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
     p = r.positive("p_rad_s", None, unit="rad/s")
     mu = r.number("mu", None, lo=0.0, hi=1.0, lo_open=True)
@@ -318,6 +322,11 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
     return spec
 
 
+def _length(r: TableReader, key: str) -> float:
+    """A length in (0, MAX_LENGTH_M] metres."""
+    return r.number(key, lo=0.0, hi=MAX_LENGTH_M, lo_open=True, unit="m")
+
+
 def _parse_contact(r: TableReader) -> ContactSpec:
     calibration = r.string("calibration", "paper", choices=CALIBRATIONS)
     scale = r.raw("stiffness_scale", "MN/m")
@@ -339,9 +348,7 @@ def _parse_contact(r: TableReader) -> ContactSpec:
         cohesion_Pa=r.number("cohesion_Pa", 0.0, lo=0.0, unit="Pa"),
         beta_s=r.number("beta_s", None, lo=0.0, unit="s"),
         dt_s=r.positive("dt_s", None, unit="s"),
-        time_step_frac=r.number(
-            "time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""
-        ),
+        time_step_frac=r.number("time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""),
         mass_damping_1_s=r.number("mass_damping_1_s", 0.0, lo=0.0, unit="1/s"),
     )
     if spec.cohesion_Pa != 0.0:

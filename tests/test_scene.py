@@ -101,12 +101,12 @@ _DELETE = object()
 @pytest.mark.parametrize(
     ("path", "value", "field", "text"),
     [
-        (["duration_s"], 0.0, "duration_s", "> 0"),
+        (["duration_s"], 0.0, "duration_s", "(0, 100000]"),
         (["duration_s"], _DELETE, "duration_s", "required"),
         (["sample_dt_s"], -0.001, "sample_dt_s", "> 0"),
         (["sample_dt_s"], 10.0, "sample_dt_s", "<= duration_s"),
-        (["blocks", 0, "width_m"], 0.0, "blocks[0].width_m", "> 0"),
-        (["blocks", 0, "height_m"], -1.0, "blocks[0].height_m", "> 0"),
+        (["blocks", 0, "width_m"], 0.0, "blocks[0].width_m", "(0, 1000]"),
+        (["blocks", 0, "height_m"], -1.0, "blocks[0].height_m", "(0, 1000]"),
         (["blocks", 0, "thickness_m"], _DELETE, "blocks[0].thickness_m", "required"),
         (["blocks", 0, "mass_kg"], float("nan"), "blocks[0].mass_kg", "finite"),
         (["blocks", 0, "alpha_rad"], math.pi / 2, "blocks[0].alpha_rad", "pi/2"),

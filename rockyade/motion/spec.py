@@ -11,7 +11,7 @@ import itertools
 import math
 from abc import ABC, abstractmethod
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -51,8 +51,10 @@ class MotionSpec(ABC):
 
     def to_dict(self) -> dict[str, Any]:
         """Canonical dictionary (all defaults filled in), as in a scene file."""
-        d = {"type": self.type}
-        d.update({k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()})  # type: ignore[call-overload]
+        d: dict[str, Any] = {"type": self.type}
+        for f in fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            d[f.name] = list(value) if isinstance(value, tuple) else value
         return d
 
     def hash_material(self) -> dict[str, Any]:
@@ -97,9 +99,7 @@ class FreeRocking(MotionSpec):
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> FreeRocking:
-        theta0 = r.number(
-            "theta0_rad", lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad"
-        )
+        theta0 = r.number("theta0_rad", lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
         omega0 = r.number("omega0_rad_s", 0.0, unit="rad/s")
         block = r.string("block", None)
         if theta0 == 0.0 and omega0 == 0.0:
