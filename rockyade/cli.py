@@ -28,7 +28,7 @@ from rockyade.errors import (
 )
 
 #: Calibration methods offered by ``rockyade calibrate``.
-CALIBRATION_METHODS = ["paper"]
+CALIBRATION_METHODS = ["paper", "matched"]
 
 #: Functions that add sub-commands: f(subparsers) -> None (motion, compare, batch, paper ...)
 EXTRA_COMMANDS: list[str] = [
@@ -82,9 +82,7 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
             raise InputError("block", f"no block {args.block!r} in {args.scene}")
         out = []
         for b in specs:
-            overrides = {
-                k: getattr(b, k) for k in ("alpha_rad", "p_rad_s", "mu") if getattr(b, k) is not None
-            }
+            overrides = {k: getattr(b, k) for k in ("alpha_rad", "p_rad_s", "mu") if getattr(b, k) is not None}
             out.append((b.name, b.block(), overrides))
         return out
     if args.thickness is None:
@@ -152,9 +150,7 @@ def cmd_params(args: argparse.Namespace) -> int:
         print(f"  alpha = {d['alpha_rad']:.6g} rad ({alpha_src})")
         print(f"  p     = {d['p_rad_s']:.6g} 1/s (p^2 = M g R / I_O; Eq 3 for rectangles)")
         print(f"  mu    = {d['mu']:.6g} (angular momentum about the new pivot; Eq 4 for rectangles)")
-        print(
-            f"  R     = {d['R_m']:.6g} m, I_O = {d['I_O_kgm2']:.6g} kg m^2, I_c = {d['I_c_kgm2']:.6g} kg m^2"
-        )
+        print(f"  R     = {d['R_m']:.6g} m, I_O = {d['I_O_kgm2']:.6g} kg m^2, I_c = {d['I_c_kgm2']:.6g} kg m^2")
         print(f"  M     = {d['mass_kg']:.6g} kg")
         print(f"  uplift when |a_g| > g tan(alpha) = {d['uplift_accel_m_s2']:.6g} m/s^2")
         if not d["symmetric"]:
@@ -221,9 +217,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     print(f"{spec.label}, {args.parameters} parameters: alpha = {a:.4g} rad, p = {p:.4g} 1/s, mu = {mu:.4g}")
     print(f"  K = Ks   = {cal.K_N_per_m:.6g} N/m (Eq 10: {cal.K_paper:.6g}, read as {cal.stiffness_reading})")
     print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
-    print(
-        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14), Rayleigh a = 0"
-    )
+    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14), Rayleigh a = 0")
     print(f"  b_eq     = {cal.b_eq_m:.6g} m (Eq 11; 2 b_eq = {2 * cal.b_eq_m:.4g} m)")
     print(f"  dt       = {cal.dt_eq7_s:.6g} s (Eq 7, frac 0.1)")
     print(f"  friction = {cal.friction_angle_deg:g} deg, cohesion = 0 Pa")
@@ -344,9 +338,7 @@ def build_parser() -> argparse.ArgumentParser:
         default="MN/m",
         help="reading of the paper's K: N/m, kN/m, MN/m (default) or a factor",
     )
-    p.add_argument(
-        "--friction-angle", type=float, default=30.0, help="joint friction angle, degrees (default 30)"
-    )
+    p.add_argument("--friction-angle", type=float, default=30.0, help="joint friction angle, degrees (default 30)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_calibrate)
 
