@@ -161,7 +161,7 @@ def cmd_params(args: argparse.Namespace) -> int:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
     from rockyade import paper
-    from rockyade.calibration import paper_calibration
+    from rockyade.calibration import paper_calibration, xi_min_eq15
 
     if args.specimen is None:
         raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower")
@@ -206,6 +206,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
             block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
         )
         result.update(matched.as_cli_dict())
+        result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)  # Eq 15 with the matched b
     if args.json:
         _json_out(result)
         return 0
@@ -222,6 +223,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     print(f"  dt       = {cal.dt_eq7_s:.6g} s (Eq 7, frac 0.1)")
     print(f"  friction = {cal.friction_angle_deg:g} deg, cohesion = 0 Pa")
     print(f"  static settlement M g / K = {cal.settlement_m:.3g} m")
+    if args.method == "matched":
+        lo, hi = result["mu_reachable_min"], result["mu_reachable_max"]
+        print(f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable {lo:.4f}-{hi:.4f}")
     for note in result["notes"]:
         print(f"  note: {note}")
     return 0

@@ -21,9 +21,7 @@ def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
 
 @pytest.mark.parametrize("command", ["params", "calibrate", "run", "tables"])
 def test_help_for_every_command(command):
-    proc = subprocess.run(
-        [sys.executable, "-m", "rockyade.cli", command, "--help"], capture_output=True, text=True
-    )
+    proc = subprocess.run([sys.executable, "-m", "rockyade.cli", command, "--help"], capture_output=True, text=True)
     assert proc.returncode == 0 and "usage: rockyade" in proc.stdout
 
 
@@ -96,9 +94,7 @@ def test_bad_input_exit_code_and_message(capsys):
     assert code == 2 and "specimen" in err and "1, 2, 3, 4, upper, lower" in err
     code, _, err = run_cli(capsys, "calibrate", "--specimen", "1", "--stiffness-scale", "N/m")
     assert code == 2 and "contact.stiffness_scale" in err and "sinks" in err
-    code, _, err = run_cli(
-        capsys, "params", "--width", "-1", "--height", "1", "--thickness", "1", "--mass", "1"
-    )
+    code, _, err = run_cli(capsys, "params", "--width", "-1", "--height", "1", "--thickness", "1", "--mass", "1")
     assert code == 2 and "width" in err
 
 
@@ -120,3 +116,27 @@ def test_tables_command_writes_csvs(capsys, tmp_path):
     assert code == 0 and "Table 6" in out
     assert (tmp_path / "tables_reproduced.csv").is_file()
     assert (tmp_path / "table5_reproduced.csv").is_file()
+
+
+def test_run_reference_solver_writes_contacts_and_energy(capsys, examples_dir, tmp_path):
+    out_csv = tmp_path / "ref.csv"
+    code, out, _ = run_cli(
+        capsys, "run", str(examples_dir / "biblock_free.toml"), "--solver", "reference", "--out", str(out_csv)
+    )
+    assert code == 0 and "upper" in out and "lower" in out
+    result = Result.read(out_csv)
+    assert result.meta["solver"] == "reference" and result.blocks == ["lower", "upper"]
+    for col in ("upper_theta_rad", "lower_theta_rad", "upper_c0_state", "energy_balance_error_J"):
+        assert col in result.frame.columns
+    assert result.meta["contact"]["upper"]["stiffness_reading"] == "MN/m"
+
+
+def test_calibrate_matched_json(capsys):
+    code, out, _ = run_cli(capsys, "calibrate", "--specimen", "1", "--method", "matched", "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["mu_eff_matched"] == pytest.approx(0.936, rel=0.002)
+    assert data["beta_eq13_s"] == pytest.approx(1.98e-4, rel=3e-3)
+    assert data["mu_reachable_min"] < 0.936 < data["mu_reachable_max"]
+    code, _, err = run_cli(capsys, "calibrate", "--specimen", "lower", "--method", "matched")
+    assert code == 1 and "cannot" in err.lower()
