@@ -6,6 +6,18 @@ the same base acceleration.
 """
 
 from rockyade.motion.ground import GroundMotion
-from rockyade.motion.spec import MOTION_TYPES, FreeRocking, MotionSpec, parse_motion
+from rockyade.motion.spec import MOTION_TYPES, FreeRocking, MotionSpec, SampledMotion, parse_motion
+from rockyade.motion.types import HarmonicMotion, PulseMotion, RecordMotion, SyntheticMotion
 
-__all__ = ["MOTION_TYPES", "FreeRocking", "GroundMotion", "MotionSpec", "parse_motion"]
+__all__ = [
+    "MOTION_TYPES",
+    "FreeRocking",
+    "GroundMotion",
+    "HarmonicMotion",
+    "MotionSpec",
+    "PulseMotion",
+    "RecordMotion",
+    "SampledMotion",
+    "SyntheticMotion",
+    "parse_motion",
+]

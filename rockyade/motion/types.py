@@ -1,0 +1,249 @@
+"""Scene motion types: harmonic, pulse, record and synthetic (registered in MOTION_TYPES).
+
+Scene tables (all take ``load_factor``, default 1)::
+
+    [motion]                    # shake-table sine (paper Sections 3.3, 7)
+    type = "harmonic"
+    amplitude_mm = 6.0
+    frequency_hz = 3.3
+    cycles = 20                 # stationary cycles (or duration_s: rounded to whole cycles)
+    ramp_cycles = 2             # half-cosine ramps up and down
+    start_s = 0.0
+
+    [motion]                    # overturning pulses
+    type = "pulse"
+    shape = "sine"              # sine | cosine | ricker | symmetric | antisymmetric
+    amplitude_m_s2 = 3.0        # or amplitude_g
+    period_s = 0.5
+    cycles = 1
+    start_s = 0.0
+
+    [motion]                    # recorded accelerogram
+    type = "record"
+    file = "records/RSN6.AT2"   # relative to the scene file
+    format = "at2"              # at2 | csv | single (default by extension)
+    units = "g"                 # default: the AT2 header; m/s2 for text files
+    dt_s = 0.01                 # single-column files only
+    baseline = false            # zero final velocity and displacement
+    bandpass_hz = [0.1, 25.0]   # optional zero-phase band-pass
+    target_pga_m_s2 = 3.0       # optional: scale to this PGA (before load_factor)
+
+    [motion]                    # synthetic, spectrum-compatible (Section 3.3)
+    type = "synthetic"
+    suite = "paper"             # the paper's EC8 Type 2, ground D suite; or give
+    record = 21                 # spectrum_type, ground, ag_s_m_s2 (or ag_m_s2), seed, count
+    load_factor = 0.6
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.fields import TableReader
+from rockyade.motion.analytic import PULSE_SHAPES, Harmonic, Pulse
+from rockyade.motion.ec8 import ElasticSpectrum
+from rockyade.motion.ground import GroundMotion
+from rockyade.motion.processing import bandpass, baseline_correct, scale_to_pga
+from rockyade.motion.records import FORMATS, Record, normalise_units, read_record
+from rockyade.motion.spec import MOTION_TYPES, MotionSpec
+from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
+
+
+def _load_factor(r: TableReader) -> float:
+    return r.number("load_factor", 1.0, lo=0.0, hi=100.0)
+
+
+@dataclass(frozen=True)
+class HarmonicMotion(MotionSpec):
+    """``type = "harmonic"``: see :class:`rockyade.motion.analytic.Harmonic`."""
+
+    type: ClassVar[str] = "harmonic"
+    amplitude_mm: float
+    frequency_hz: float
+    cycles: int
+    ramp_cycles: int = 2
+    start_s: float = 0.0
+    load_factor: float = 1.0
+
+    @property
+    def harmonic(self) -> Harmonic:
+        """The analytic motion."""
+        return Harmonic(self.amplitude_mm, self.frequency_hz, self.cycles, self.ramp_cycles, self.start_s)
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        return self.harmonic.ground_motion(self.load_factor)
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> HarmonicMotion:
+        amplitude = r.number("amplitude_mm", lo=0.0, hi=1000.0, lo_open=True, unit="mm")
+        frequency = r.number("frequency_hz", lo=0.0, hi=100.0, lo_open=True, unit="Hz")
+        cycles = r.integer("cycles", None, lo=1, hi=100_000)
+        duration = r.positive("duration_s", None, unit="s")
+        if (cycles is None) == (duration is None):
+            raise r.error("cycles", "give exactly one of cycles (stationary cycles) and duration_s")
+        if cycles is None:
+            cycles = max(1, round(duration * frequency))
+        ramp = r.integer("ramp_cycles", 2, lo=1, hi=1000)
+        start = r.number("start_s", 0.0, lo=0.0, unit="s")
+        return cls(amplitude, frequency, int(cycles), ramp, start, _load_factor(r))
+
+
+@dataclass(frozen=True)
+class PulseMotion(MotionSpec):
+    """``type = "pulse"``: see :class:`rockyade.motion.analytic.Pulse`."""
+
+    type: ClassVar[str] = "pulse"
+    shape: str
+    amplitude_m_s2: float
+    period_s: float
+    cycles: int = 1
+    start_s: float = 0.0
+    load_factor: float = 1.0
+
+    @property
+    def pulse(self) -> Pulse:
+        """The analytic pulse."""
+        return Pulse(self.shape, self.amplitude_m_s2, self.period_s, self.cycles, self.start_s)
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        return self.pulse.ground_motion(self.load_factor)
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> PulseMotion:
+        shape = r.string("shape", choices=PULSE_SHAPES)
+        amp = r.number("amplitude_m_s2", None, lo=0.0, hi=1000.0, lo_open=True, unit="m/s^2")
+        amp_g = r.number("amplitude_g", None, lo=0.0, hi=100.0, lo_open=True, unit="g")
+        if (amp is None) == (amp_g is None):
+            raise r.error("amplitude_m_s2", "give exactly one of amplitude_m_s2 and amplitude_g")
+        period = r.number("period_s", lo=0.0, hi=100.0, lo_open=True, unit="s")
+        cycles = r.integer("cycles", 1, lo=1, hi=1000)
+        start = r.number("start_s", 0.0, lo=0.0, unit="s")
+        return cls(shape, amp if amp is not None else amp_g * G, period, cycles, start, _load_factor(r))
+
+
+@dataclass(frozen=True)
+class RecordMotion(MotionSpec):
+    """``type = "record"``: a recorded accelerogram file (module docstring)."""
+
+    type: ClassVar[str] = "record"
+    file: str
+    format: str | None = None
+    units: str | None = None
+    dt_s: float | None = None
+    baseline: bool = False
+    bandpass_hz: tuple[float | None, float | None] | None = None
+    target_pga_m_s2: float | None = None
+    load_factor: float = 1.0
+
+    def record(self) -> Record:
+        """The processed record (before the load factor)."""
+        rec = read_record(self.file, self.format, self.units, self.dt_s)
+        accel = rec.accel_m_s2
+        if self.bandpass_hz is not None:
+            if not rec.uniform:
+                raise InputError("motion.bandpass_hz", "needs a uniformly sampled record")
+            accel = bandpass(accel, rec.dt_s, *self.bandpass_hz)
+            rec = rec.with_accel(accel, f"band-pass {self.bandpass_hz} Hz")
+        if self.baseline:
+            rec = rec.with_accel(baseline_correct(rec.t_s, rec.accel_m_s2), "baseline corrected")
+        if self.target_pga_m_s2 is not None:
+            scaled, factor = scale_to_pga(rec.accel_m_s2, self.target_pga_m_s2)
+            rec = rec.with_accel(scaled, f"scaled x{factor:.4g} to PGA {self.target_pga_m_s2:g} m/s^2")
+        return rec
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        rec = self.record()
+        label = f"record {Path(self.file).name}" + (f" x{self.load_factor:g}" if self.load_factor != 1 else "")
+        return GroundMotion(rec.t_s, rec.accel_m_s2 * self.load_factor, None, label)
+
+    def hash_material(self) -> dict[str, Any]:
+        d = self.to_dict()
+        d["file"] = hashlib.sha256(Path(self.file).read_bytes()).hexdigest()
+        return d
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> RecordMotion:
+        name = r.string("file")
+        path = Path(name)
+        if not path.is_absolute() and base_dir is not None:
+            path = base_dir / path
+        if not path.is_file():
+            raise r.error("file", f"record file not found: {path}")
+        fmt = r.string("format", None, choices=FORMATS)
+        units = r.string("units", None)
+        if units is not None:
+            units = normalise_units(units, r.field("units"))
+        dt = r.positive("dt_s", None, unit="s")
+        baseline = r.boolean("baseline", False)
+        bp = r.raw("bandpass_hz", None)
+        band: tuple[float | None, float | None] | None = None
+        if bp is not None:
+            if not (
+                isinstance(bp, list) and len(bp) == 2 and all(x is None or isinstance(x, (int, float)) for x in bp)
+            ):
+                raise r.error("bandpass_hz", "must be [low, high] in Hz")
+            band = (bp[0], bp[1])
+        pga = r.positive("target_pga_m_s2", None, unit="m/s^2")
+        spec = cls(str(path.resolve()), fmt, units, dt, baseline, band, pga, _load_factor(r))
+        spec.record()  # read now so that a bad file is reported with the scene
+        return spec
+
+
+@dataclass(frozen=True)
+class SyntheticMotion(MotionSpec):
+    """``type = "synthetic"``: record i of a spectrum-compatible suite (module docstring)."""
+
+    type: ClassVar[str] = "synthetic"
+    record: int
+    suite: str = "paper"
+    spectrum_type: int | None = None
+    ground: str | None = None
+    ag_s_m_s2: float | None = None
+    seed: int | None = None
+    count: int | None = None
+    load_factor: float = 1.0
+
+    def suite_spec(self) -> SuiteSpec:
+        """The suite's settings."""
+        if self.suite == "paper":
+            return paper_suite()
+        target = ElasticSpectrum.ec8(self.spectrum_type, self.ground, ag_s_m_s2=self.ag_s_m_s2)  # type: ignore[arg-type]
+        return SuiteSpec(target, count=self.count or 30, seed=self.seed or 0, name=self.suite)
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        rec = suite_record(self.suite_spec(), self.record)
+        label = f"synthetic {self.suite} record {self.record}" + (
+            f" x{self.load_factor:g}" if self.load_factor != 1 else ""
+        )
+        return GroundMotion(rec.t_s, rec.accel_m_s2 * self.load_factor, None, label)
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> SyntheticMotion:
+        suite = r.string("suite", "paper")
+        st = r.integer("spectrum_type", None, lo=1, hi=2)
+        ground = r.string("ground", None, choices=["A", "B", "C", "D", "E"])
+        ags = r.positive("ag_s_m_s2", None, unit="m/s^2")
+        seed = r.integer("seed", None, lo=0)
+        count = r.integer("count", None, lo=1, hi=10_000)
+        if suite != "paper" and None in (st, ground, ags, seed, count):
+            raise r.error("suite", "a suite other than 'paper' needs spectrum_type, ground, ag_s_m_s2, seed and count")
+        n = 30 if suite == "paper" else count
+        record = r.integer("record", lo=1, hi=n)
+        return cls(record, suite, st, ground, ags, seed, count, _load_factor(r))
+
+
+MOTION_TYPES.update(
+    {
+        HarmonicMotion.type: HarmonicMotion.parse,
+        PulseMotion.type: PulseMotion.parse,
+        RecordMotion.type: RecordMotion.parse,
+        SyntheticMotion.type: SyntheticMotion.parse,
+    }
+)
+
+__all__ = ["HarmonicMotion", "PulseMotion", "RecordMotion", "SyntheticMotion"]
