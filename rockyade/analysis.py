@@ -104,9 +104,7 @@ def restitution_per_impact(peaks: Peaks | NDArray[np.float64], alpha: float) -> 
     return np.sqrt(v[1:] / v[:-1])
 
 
-def effective_restitution(
-    peaks: Peaks | NDArray[np.float64], alpha: float, n_impacts: int | None = None
-) -> float:
+def effective_restitution(peaks: Peaks | NDArray[np.float64], alpha: float, n_impacts: int | None = None) -> float:
     """Mean effective restitution over the first ``n_impacts`` impacts (geometric mean).
 
     mu_eff = (V_n / V_0)^(1 / (2 n)), which is the geometric mean of the per-impact values.
@@ -139,11 +137,13 @@ def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]
     -------
     dict
         block name -> ``max_abs_theta_rad``, ``max_theta_over_alpha``, ``n_peaks``,
-        ``first_peak_rad``, ``mu_eff`` (NaN without two peaks), ``residual_theta_rad``,
+        ``first_peak_rad``, ``mu_eff`` (free rocking only; NaN otherwise or without two
+        peaks), ``residual_theta_rad``,
         ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool).
     """
     out: dict[str, dict[str, float]] = {}
     t = result.t
+    free = scene.motion.type == "free"
     for spec in scene.blocks:
         alpha = spec.classical().alpha_rad
         theta = result.series("theta_rad", spec.name)
@@ -156,7 +156,7 @@ def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]
             "n_peaks": len(peaks),
             "first_peak_rad": float(peaks.theta_rad[0]) if len(peaks) else math.nan,
             "first_peak_time_s": float(peaks.t_s[0]) if len(peaks) else math.nan,
-            "mu_eff": effective_restitution(peaks, alpha, n_impacts),
+            "mu_eff": effective_restitution(peaks, alpha, n_impacts) if free else math.nan,
             "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
             "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
             "overturned": result.meta.get("overturned_block") == spec.name,

@@ -7,6 +7,7 @@ import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from rockyade.cli import main
@@ -140,3 +141,69 @@ def test_calibrate_matched_json(capsys):
     assert data["mu_reachable_min"] < 0.936 < data["mu_reachable_max"]
     code, _, err = run_cli(capsys, "calibrate", "--specimen", "lower", "--method", "matched")
     assert code == 1 and "cannot" in err.lower()
+
+
+def test_motion_commands(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("ROCKYADE_CACHE", str(tmp_path / "cache"))
+    rec = tmp_path / "quake.AT2"
+    t = np.arange(0, 10, 0.01)
+    values = 0.1 * np.sin(2 * np.pi * 2 * t) * np.exp(-0.3 * t)
+    rec.write_text(
+        "PEER\ntest quake\nACCELERATION IN UNITS OF G\nNPTS= 1000, DT= .0100 SEC\n"
+        + "\n".join(" ".join(f"{v:.7E}" for v in values[i : i + 5]) for i in range(0, 1000, 5))
+        + "\n"
+    )
+    code, out, _ = run_cli(capsys, "motion", "info", str(rec), "--json", "--plot", str(tmp_path / "acc.png"))
+    info = json.loads(out)
+    assert code == 0 and info["npts"] == 1000 and info["dt_s"] == pytest.approx(0.01)
+    assert info["units_in_file"] == "g" and info["pga_m_s2"] == pytest.approx(np.max(np.abs(values)) * 9.81, rel=1e-6)
+    for key in ("duration_s", "pga_time_s"):
+        assert key in info
+    assert (tmp_path / "acc.png").stat().st_size > 1000
+    code, _, _ = run_cli(capsys, "motion", "spectrum", str(rec), "--damping", "0.05", "--out", str(tmp_path / "s.csv"))
+    spectrum = __import__("pandas").read_csv(tmp_path / "s.csv")
+    assert code == 0 and list(spectrum.columns) == ["period_s", "psa_m_s2"] and len(spectrum) == 100
+    out_dir = tmp_path / "suite"
+    code, out, _ = run_cli(
+        capsys,
+        "motion",
+        "synth",
+        "--type",
+        "2",
+        "--ground",
+        "D",
+        "--ag-s",
+        "2.8",
+        "--count",
+        "3",
+        "--seed",
+        "5",
+        "--out",
+        str(out_dir),
+        "--plot",
+        str(tmp_path / "suite.png"),
+    )
+    assert code == 0 and "compatible" in out
+    assert sorted(p.name for p in out_dir.iterdir()) == [
+        "record_01.csv",
+        "record_02.csv",
+        "record_03.csv",
+        "suite.json",
+    ]
+    frame = __import__("pandas").read_csv(out_dir / "record_02.csv")
+    assert list(frame.columns) == ["t_s", "accel_m_s2", "vel_m_s", "disp_m"]
+    assert abs(frame["vel_m_s"].iloc[-1]) < 1e-3 and abs(frame["disp_m"].iloc[-1]) < 1e-3
+    suite = json.loads((out_dir / "suite.json").read_text())
+    assert suite["target"]["TC_s"] == 0.3 and suite["settings"]["seed"] == 5
+    code, out, _ = run_cli(capsys, "motion", "check", str(out_dir), "--json")
+    assert code == 0 and json.loads(out)["ratio_min"] > 0.85
+    code, _, err = run_cli(capsys, "motion", "info", str(tmp_path / "missing.AT2"))
+    assert code == 2 and "missing.AT2" in err and "not found" in err
+
+
+@pytest.mark.parametrize("sub", ["info", "spectrum", "synth", "check"])
+def test_motion_help(sub):
+    proc = subprocess.run(
+        [sys.executable, "-m", "rockyade.cli", "motion", sub, "--help"], capture_output=True, text=True
+    )
+    assert proc.returncode == 0 and "usage:" in proc.stdout

@@ -57,8 +57,7 @@ def test_energy_conserved_between_impacts():
             continue
         side = 1 if traj.theta_rad[inside][0] > 0 else -1
         e = [
-            SPEC1.energy(side, th, om)
-            for th, om in zip(traj.theta_rad[inside], traj.omega_rad_s[inside], strict=True)
+            SPEC1.energy(side, th, om) for th, om in zip(traj.theta_rad[inside], traj.omega_rad_s[inside], strict=True)
         ]
         assert (max(e) - min(e)) / abs(e[0]) < 1e-8
         checked += 1

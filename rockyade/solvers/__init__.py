@@ -43,9 +43,7 @@ def get_solver(name: str) -> Callable[[Scene], Result]:
         module = importlib.import_module(SOLVER_MODULES[name])
     except ModuleNotFoundError as exc:
         if exc.name == SOLVER_MODULES[name]:
-            raise SolverUnavailableError(
-                f"solver {name!r} is not available in this version of rockyade"
-            ) from None
+            raise SolverUnavailableError(f"solver {name!r} is not available in this version of rockyade") from None
         raise
     return module.run_scene
 

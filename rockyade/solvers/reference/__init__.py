@@ -72,11 +72,53 @@ def model_arrays(model: DemModel) -> dict[str, object]:
 
 
 def simulate_model(model: DemModel, record_energy: bool = True) -> tuple[tuple, float]:
-    """Run the kernel on a model; return its raw outputs and the kernel's wall time (s)."""
+    """Run the kernel on a model; return its raw outputs and the kernel's wall time (s).
+
+    The compiled kernel is loaded (or compiled) before the timer starts.
+    """
     args = model_arrays(model)
+    _warm_up(record_energy)
     start = time.perf_counter()
     out = kernel.simulate(**args, record_energy=record_energy)
     return out, time.perf_counter() - start
+
+
+_WARM: set[bool] = set()
+
+
+def _warm_up(record_energy: bool) -> None:
+    """Run the kernel once on a tiny problem so that its loading is not timed."""
+    if record_energy in _WARM:
+        return
+    _WARM.add(record_energy)
+    one = np.ones(1)
+    verts = np.array([[[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]])
+    kernel.simulate(
+        one,
+        one,
+        verts,
+        np.array([4]),
+        one * 0.2,
+        one * 1e6,
+        one * 1e6,
+        one * 0.0,
+        one * 0.0,
+        one,
+        0.0,
+        np.array([[0.0, 0.1]]),
+        np.zeros(1),
+        np.zeros((1, 2)),
+        np.zeros(1),
+        np.zeros(0),
+        np.zeros(0),
+        np.zeros(0),
+        9.81,
+        1e-4,
+        2,
+        1,
+        np.zeros((1, 2)),
+        record_energy,
+    )
 
 
 def run_model(
