@@ -24,11 +24,10 @@ import pandas as pd
 
 from rockyade import __version__
 from rockyade.dem_model import DemModel, build_dem_model
-from rockyade.result import Result, column, failed_result
+from rockyade.dem_result import dem_frame, energy_gain
+from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 from rockyade.solvers.reference import kernel
-
-STATE_NAMES = np.array(["open", "stick", "slip"])
 
 
 def model_arrays(model: DemModel) -> dict[str, object]:
@@ -133,34 +132,15 @@ def run_model(
     pos_s, ang_s, angvel_s, vpoint_s, state_s, energy_s, status, n_filled, t_stop, stop_body = out
     n = int(n_filled)
     names = model.names
-    t = np.arange(n) * model.sample_dt_s
-    motion = model.motion
-    ah = motion.horizontal(t) if motion is not None else np.zeros(n)
-    av = motion.vertical(t) if motion is not None else np.zeros(n)
-    data: dict[str, np.ndarray] = {"t_s": t, "ag_m_s2": ah}
-    for i, body in enumerate(model.bodies):
-        rest = np.asarray(body.rest_centroid_m)
-        data[column(body.name, "theta_rad", names)] = ang_s[:n, i]
-        data[column(body.name, "omega_rad_s", names)] = angvel_s[:n, i]
-        data[column(body.name, "x_m", names)] = pos_s[:n, i, 0] - rest[0]
-        data[column(body.name, "y_m", names)] = pos_s[:n, i, 1] - rest[1]
-        for axis, q, base in ((0, "ax_m_s2", ah), (1, "ay_m_s2", av)):
-            v = vpoint_s[:n, i, axis]
-            a_rel = np.gradient(v, model.sample_dt_s) if n >= 2 else np.zeros(n)
-            acc = a_rel + base
-            if accel_lowpass_hz:
-                from rockyade.signals import lowpass_zero_phase
-
-                acc = lowpass_zero_phase(acc, model.sample_dt_s, accel_lowpass_hz)
-            data[column(body.name, q, names)] = acc
-    frame = pd.DataFrame(data)
-    if record_contacts:
-        extra = {}
-        for i, body in enumerate(model.bodies):
-            prefix = f"{body.name}_" if len(names) > 1 else ""
-            for v in range(len(body.contact_vertices_m)):
-                extra[f"{prefix}c{v}_state"] = pd.Categorical(STATE_NAMES[state_s[:n, i, v]], categories=STATE_NAMES)
-        frame = pd.concat([frame, pd.DataFrame(extra)], axis=1)
+    frame = dem_frame(
+        model,
+        pos_s[:n],
+        ang_s[:n],
+        angvel_s[:n],
+        vpoint_s[:n],
+        state_s[:n] if record_contacts else None,
+        accel_lowpass_hz,
+    )
     meta_energy: dict[str, float] = {}
     if record_energy and n:
         e = energy_s[:n]
@@ -191,11 +171,14 @@ def run_model(
             "energy_balance_max_error_J": float(np.max(np.abs(error))),
             "initial_potential_energy_J": initial_pe,
         }
+    gain, t_blowup = energy_gain(model, pos_s[:n], ang_s[:n], angvel_s[:n])
     status_name = {
         kernel.STATUS_COMPLETED: "completed",
         kernel.STATUS_OVERTURNED: "overturned",
         kernel.STATUS_FAILED: "failed",
     }[int(status)]
+    if t_blowup is not None and status_name != "failed":
+        status_name, t_stop = "failed", t_blowup
     meta = {
         "solver": "reference",
         "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
@@ -206,7 +189,8 @@ def run_model(
         "overturned_block": names[int(stop_body)] if status_name == "overturned" else None,
         "overturn_criterion": "|theta| reached pi/2",
         "failure_reason": (
-            f"non-finite state of {names[int(stop_body)]} at t = {t_stop:.6g} s (numerical instability)"
+            f"numerical instability at t = {t_stop:.6g} s (energy created: {gain:.3g} x weight x height; or a "
+            f"non-finite state, speed > {kernel.MAX_SPEED_M_S:g} m/s or spin > {kernel.MAX_SPIN_RAD_S:g} rad/s)"
             if status_name == "failed"
             else None
         ),

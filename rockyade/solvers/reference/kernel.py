@@ -32,6 +32,11 @@ N_ENERGY = 6
 
 STATUS_COMPLETED, STATUS_OVERTURNED, STATUS_FAILED = 0, 1, 2
 
+#: Beyond these the state is a numerical blow-up, not rocking (a block overturning under
+#: gravity turns at a few rad/s): the run fails instead of being called overturned.
+MAX_SPEED_M_S = 100.0
+MAX_SPIN_RAD_S = 1000.0
+
 
 @numba.njit(cache=True, nogil=True)
 def _ground(t, mt, mah, mav, j):
@@ -371,7 +376,9 @@ def simulate(
             pos[a, 0] += dt * vel[a, 0]
             pos[a, 1] += dt * vel[a, 1]
             ang[a] += dt * angvel[a]
-            if not (math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])):
+            finite = math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])
+            speed2 = vel[a, 0] * vel[a, 0] + vel[a, 1] * vel[a, 1]
+            if not finite or speed2 > MAX_SPEED_M_S * MAX_SPEED_M_S or abs(angvel[a]) > MAX_SPIN_RAD_S:
                 status = STATUS_FAILED
                 stop_body = a
             elif abs(ang[a]) >= half_pi and status == STATUS_COMPLETED:

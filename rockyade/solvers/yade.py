@@ -1,0 +1,338 @@
+"""The YADE backend: a scene's DEM model run by YADE in batch mode, parsed back.
+
+The DEM model (:mod:`rockyade.dem_model`, the same the reference DEM runs) is written as
+JSON data and run by ``yade_scripts/run_scene.py`` in Debian's ``/usr/bin/python3.11``
+with YADE's modules on the path, as a subprocess:
+
+* no listening socket: the ``yade`` launcher (which opens a Python console on
+  0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used;
+* one OpenMP thread per run (``OMP_NUM_THREADS=1``), a timeout, stdout and stderr in a log
+  file next to the result;
+* a non-zero exit, a timeout, a Python exception inside YADE, a non-finite state, or a
+  missing or partial output file give a Result with status ``failed``, the reason and the
+  log path, never a Result that looks complete.
+
+Runs are independent (own files, own process), so several can go in parallel
+(:func:`run_many`).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import shutil
+import subprocess
+import tempfile
+import time
+import zipfile
+from collections.abc import Iterable
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import numpy as np
+
+from rockyade import __version__
+from rockyade.atomic import write_json
+from rockyade.dem_model import DemModel, build_dem_model
+from rockyade.dem_result import dem_frame, energy_gain
+from rockyade.errors import InputError, SolverUnavailableError
+from rockyade.geometry import LEVEL_TOL
+from rockyade.result import Result, failed_result
+from rockyade.scene import Scene
+
+DRIVER = Path(__file__).resolve().parent.parent.parent / "yade_scripts" / "run_scene.py"
+YADE_PYTHON = os.environ.get("ROCKYADE_YADE_PYTHON", "/usr/bin/python3.11")
+YADE_PY_DIR = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
+#: Radius of the vertex spheres as a fraction of the smallest block dimension.
+SPHERE_RADIUS_FRACTION = 1e-3
+#: Thickness of the contact slabs as a fraction of the block height.
+SLAB_FRACTION = 0.05
+MAX_BLOCKS = 30
+
+
+def yade_available() -> bool:
+    """True when Debian's YADE and its Python are installed."""
+    return Path(YADE_PYTHON).is_file() and (Path(YADE_PY_DIR) / "yade" / "__init__.py").is_file()
+
+
+def yade_version() -> str:
+    """The installed YADE's version string (runs YADE's Python briefly)."""
+    out = subprocess.run(
+        [
+            YADE_PYTHON,
+            "-c",
+            f"import sys; sys.path.insert(1, {YADE_PY_DIR!r}); import yade.config as c; print(c.version)",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=_env(),
+    )
+    return out.stdout.strip().splitlines()[-1] if out.returncode == 0 and out.stdout.strip() else "unknown"
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["OMP_NUM_THREADS"] = "1"
+    env.pop("DISPLAY", None)  # no GUI
+    env["ROCKYADE_YADE_PY"] = YADE_PY_DIR
+    env["PYTHONNOUSERSITE"] = "1"
+    return env
+
+
+# ---------------------------------------------------------------------- payload
+
+
+def _roles(vertices: np.ndarray) -> list[str]:
+    y = vertices[:, 1]
+    tol = LEVEL_TOL * max(float(np.ptp(y)), 1.0) * 10
+    return ["base" if v <= y.min() + tol else "top" if v >= y.max() - tol else "side" for v in y]
+
+
+def scene_payload(model: DemModel) -> dict[str, object]:
+    """The DEM model as the JSON data the YADE driver reads."""
+    nb = len(model.bodies)
+    if nb > MAX_BLOCKS:
+        raise InputError(
+            "blocks", f"the YADE backend takes at most {MAX_BLOCKS} blocks (collision mask bits), got {nb}"
+        )
+    sizes = [float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies]
+    radius = SPHERE_RADIUS_FRACTION * min(sizes)
+
+    def joint(b) -> dict[str, float]:
+        j = b.joint
+        return {
+            "kn": j.K_N_per_m,
+            "ks": j.Ks_N_per_m,
+            "cn": j.beta_s * j.K_N_per_m,
+            "cs": j.beta_s * j.Ks_N_per_m,
+            "friction_angle_rad": math.radians(j.friction_angle_deg),
+        }
+
+    bodies = []
+    for i, b in enumerate(model.bodies):
+        verts = b.contact_vertices_m
+        roles = _roles(verts)
+        height = float(np.ptp(verts[:, 1]))
+        s = SLAB_FRACTION * height
+        slabs = []
+        if i + 1 < nb:  # a block rests on this one: its top face
+            top = verts[[r == "top" for r in roles]]
+            slabs.append(
+                {
+                    "center_m": [float(top[:, 0].mean()), float(verts[:, 1].max() - s / 2)],
+                    "half_extents_m": [float(np.ptp(top[:, 0]) / 2), s / 2],
+                    "mask_bits": [i + 1],
+                }
+            )
+        if i > 0:  # this block rests on another: its base face
+            base = verts[[r == "base" for r in roles]]
+            slabs.append(
+                {
+                    "center_m": [float(base[:, 0].mean()), float(verts[:, 1].min() + s / 2)],
+                    "half_extents_m": [float(np.ptp(base[:, 0]) / 2), s / 2],
+                    "mask_bits": [i - 1],
+                }
+            )
+        bodies.append(
+            {
+                "name": b.name,
+                "mass_kg": b.mass_kg,
+                "inertia_kgm2": b.inertia_kgm2,
+                "vertices_m": verts.tolist(),
+                "vertex_roles": roles,
+                "centroid0_m": model.pos0_m[i].tolist(),
+                "rest_centroid_m": list(b.rest_centroid_m),
+                "angle0_rad": float(model.ang0_rad[i]),
+                "vel0_m_s": model.vel0_m_s[i].tolist(),
+                "angvel0_rad_s": float(model.angvel0_rad_s[i]),
+                "accel_point_m": list(b.accel_point_m),
+                "joint_below": joint(b),
+                "joint_above": joint(model.bodies[i + 1]) if i + 1 < nb else None,
+                "thickness_m": max(0.1 * height, 10 * radius),
+                "slabs": slabs,
+            }
+        )
+    motion = model.motion
+    return {
+        "format": "rockyade-yade-scene-1",
+        "scene_hash": model.scene_hash,
+        "dt_s": model.dt_s,
+        "n_steps": model.n_steps,
+        "steps_per_sample": model.steps_per_sample,
+        "n_samples": model.n_samples,
+        "g": model.g,
+        "sphere_radius_m": radius,
+        "bodies": bodies,
+        "motion": None
+        if motion is None
+        else {"t_s": motion.t_s.tolist(), "ah_m_s2": motion.ah_m_s2.tolist(), "av_m_s2": motion.av_m_s2.tolist()},
+    }
+
+
+# ---------------------------------------------------------------------- running
+
+
+def default_timeout(model: DemModel) -> float:
+    """A generous timeout: 30 s of start-up plus 50 us per step."""
+    return 30.0 + 50e-6 * model.n_steps * len(model.bodies)
+
+
+def run_model(
+    model: DemModel,
+    *,
+    workdir: str | Path | None = None,
+    name: str = "yade",
+    timeout_s: float | None = None,
+    accel_lowpass_hz: float | None = None,
+) -> Result:
+    """Run a DEM model in YADE and return a Result (status ``failed`` on any failure).
+
+    Parameters
+    ----------
+    model
+        The DEM model.
+    workdir
+        Where ``<name>.yade.json`` (the scene data), ``<name>.yade.npz`` (YADE's output)
+        and ``<name>.yade.log`` are kept; default a temporary directory, removed after a
+        successful run and kept (its log path in the Result) after a failed one.
+    timeout_s
+        Wall-clock limit of the YADE process, s (default :func:`default_timeout`).
+    """
+    if not yade_available():
+        raise SolverUnavailableError(
+            f"YADE is not installed (looked for {YADE_PYTHON} and {YADE_PY_DIR}/yade): "
+            "apt-get install -y --no-install-recommends yade"
+        )
+    keep = workdir is not None
+    directory = Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))
+    directory.mkdir(parents=True, exist_ok=True)
+    scene_file = directory / f"{name}.yade.json"
+    out_file = directory / f"{name}.yade.npz"
+    log_file = directory / f"{name}.yade.log"
+    for stale in (out_file, log_file):
+        stale.unlink(missing_ok=True)
+    write_json(scene_file, scene_payload(model))
+    timeout = timeout_s if timeout_s is not None else default_timeout(model)
+    start = time.perf_counter()
+    reason = None
+    with open(log_file, "w") as log:
+        try:
+            proc = subprocess.run(
+                [YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)],
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                env=_env(),
+                timeout=timeout,
+                cwd=directory,
+            )
+            if proc.returncode != 0:
+                reason = f"YADE exited with code {proc.returncode}"
+        except subprocess.TimeoutExpired:
+            reason = f"timeout: YADE did not finish within {timeout:.0f} s"
+    total = time.perf_counter() - start
+    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz)
+    if result.ok and not keep:
+        shutil.rmtree(directory, ignore_errors=True)
+    return result
+
+
+def _last_error_line(log_file: Path) -> str:
+    lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+    for line in reversed(lines):
+        if "Error" in line or "Exception" in line:
+            return line
+    return lines[-1] if lines else ""
+
+
+def _parse(model: DemModel, out_file: Path, reason: str | None, log_file: Path, total: float, lowpass) -> Result:
+    extra = {"log_path": str(log_file), "total_time_s": total}
+    if reason is None and not out_file.is_file():
+        reason = "YADE wrote no output file"
+    if reason is not None:
+        detail = _last_error_line(log_file)
+        return failed_result("yade", model.scene_hash, f"{reason}: {detail}" if detail else reason, **extra)
+    try:
+        with np.load(out_file, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn")}
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
+    n = int(meta.get("n_filled", 0))
+    if not meta.get("complete") or arrays["pos"].shape[0] != n:
+        return failed_result("yade", model.scene_hash, "partial YADE output", **extra)
+    status = meta["status"]
+    if status == "completed" and n != model.n_samples:
+        return failed_result("yade", model.scene_hash, f"YADE stopped early: {n} of {model.n_samples} samples", **extra)
+    if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
+        t_stop = meta.get("stop_time_s")
+        return failed_result(
+            "yade",
+            model.scene_hash,
+            f"numerical instability in YADE at t = {t_stop} s (non-finite state or runaway speed)",
+            **extra,
+        )
+    gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
+    if t_blowup is not None:
+        reason = f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+        return failed_result("yade", model.scene_hash, reason, **extra)
+    frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
+    names = model.names
+    for i, body in enumerate(model.bodies):
+        prefix = f"{body.name}_" if len(names) > 1 else ""
+        for v in range(arrays["fn"].shape[2]):
+            if v < len(body.contact_vertices_m):
+                frame[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    overturned = status == "overturned"
+    run_meta = {
+        "solver": "yade",
+        "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",
+        "scene_hash": model.scene_hash,
+        "wall_time_s": meta["wall_time_s"],
+        "startup_time_s": total - meta["wall_time_s"],
+        "status": status,
+        "overturn_time_s": meta["stop_time_s"] if overturned else None,
+        "overturned_block": names[meta["stop_body"]] if overturned else None,
+        "overturn_criterion": "|theta| reached pi/2",
+        "blocks": names,
+        "sample_dt_s": model.sample_dt_s,
+        "duration_s": model.duration_s,
+        "dt_s": meta["dt_s"],
+        "dt_source": model.dt_source,
+        "n_steps": model.n_steps,
+        "iterations": meta["iterations"],
+        "calibration": model.calibration,
+        "contact": model.joint_summary(),
+        "bodies": model.body_summary(),
+        "motion": model.motion.label if model.motion is not None else "free",
+        **extra,
+    }
+    return Result(frame, run_meta)
+
+
+def run_scene(
+    scene: Scene, *, workdir: str | Path | None = None, name: str = "yade", timeout_s: float | None = None
+) -> Result:
+    """Run a scene with YADE (see :func:`run_model`)."""
+    if scene.contact.mass_damping_1_s:
+        raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
+    model = build_dem_model(scene)
+    result = run_model(
+        model, workdir=workdir, name=name, timeout_s=timeout_s, accel_lowpass_hz=scene.output.accel_lowpass_hz
+    )
+    return result
+
+
+def run_many(scenes: Iterable[Scene], workers: int = 2, timeout_s: float | None = None) -> list[Result]:
+    """Several YADE runs in parallel (one process each); a failed one does not stop the others."""
+
+    def one(scene: Scene) -> Result:
+        try:
+            return run_scene(scene, timeout_s=timeout_s)
+        except (InputError, SolverUnavailableError) as exc:
+            return failed_result("yade", scene.scene_hash, str(exc))
+
+    scene_list = list(scenes)
+    with ThreadPoolExecutor(max_workers=max(1, workers)) as pool:
+        return list(pool.map(one, scene_list))
