@@ -238,7 +238,11 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     solver = get_solver(args.solver)
-    result = solver(scene)
+    if args.solver == "yade" and args.out:
+        # YADE's log and scene data are kept beside the result
+        result = solver(scene, workdir=args.out.parent, name=args.out.stem)
+    else:
+        result = solver(scene)
     if args.out:
         json_path = result.write(args.out)
         print(f"wrote {args.out} and {json_path}")
