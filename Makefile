@@ -27,10 +27,7 @@ test: setup lint
 	ROCKYADE_REQUIRE_YADE=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
 
 run: setup
-	$(BIN)/rockyade tables --out reports/tables
-	@for scene in examples/specimen*_free.toml; do \
-	  $(BIN)/rockyade run $$scene --solver housner --out reports/examples/$$(basename $$scene .toml)_housner.csv || exit 1; \
-	done
+	$(BIN)/rockyade paper --out $(OUT) --workers $(WORKERS)
 
 bench: setup
 	$(BIN)/python benchmarks/run_all.py

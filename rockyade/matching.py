@@ -212,9 +212,10 @@ def _match_cached(key: tuple) -> MatchedBeta:
     if not math.isfinite(mu_max):
         raise CalibrationError("the undamped reference DEM does not rock freely for this block (no peaks)")
     if target > mu_max * (1 + MU_RTOL):
+        mu_low = mu_of(beta_max)
         raise CalibrationError(
             f"target mu = {target:.4f} is above what the DEM reaches without damping ({mu_max:.4f}): "
-            f"the corner impacts alone lose more energy; reachable range [?, {mu_max:.4f}]. "
+            f"the corner impacts alone lose more energy; reachable range [{mu_low:.4f}, {mu_max:.4f}]. "
             "Damping cannot add energy: check mu or the stiffness"
         )
     # bracket: increase beta until mu_eff falls below the target

@@ -1,0 +1,1 @@
+"""Studies built on the solvers: the paper reproduced, fragility, patterns, pulses."""
