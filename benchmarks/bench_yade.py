@@ -14,17 +14,9 @@ from rockyade.dem_model import build_dem_model
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import yade as yade_backend
 from rockyade.solvers.reference import run_model
+from rockyade.studies.common import block_table
 
-BLOCK = {
-    "name": "specimen1",
-    "width_m": 0.25,
-    "height_m": 1.0,
-    "thickness_m": 0.754,
-    "mass_kg": 503,
-    "alpha_rad": 0.235,
-    "p_rad_s": 3.84,
-    "mu": 0.936,
-}
+BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 
 
 def scene(duration: float, theta0: float = 0.1175):

@@ -142,12 +142,7 @@ def stiffness_scale_factor(scale: float | str | None) -> tuple[float, str]:
                 f"must be one of {sorted(STIFFNESS_SCALES)} or a number > 0, got {scale!r}",
             )
         return STIFFNESS_SCALES[scale], scale
-    if (
-        isinstance(scale, bool)
-        or not isinstance(scale, (int, float))
-        or not math.isfinite(scale)
-        or scale <= 0
-    ):
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not math.isfinite(scale) or scale <= 0:
         raise InputError("contact.stiffness_scale", f"must be a number > 0, got {scale!r}")
     names = {v: k for k, v in STIFFNESS_SCALES.items()}
     return float(scale), names.get(float(scale), f"x{float(scale):g} N/m")
@@ -279,9 +274,7 @@ def paper_calibration(
     lo, hi = EQ13_FITTED_RANGE
     ratio = gamma / used.mu**2
     if not lo <= ratio <= hi:
-        notes.append(
-            f"Gamma/mu^2 = {ratio:.0f} outside the paper's data ({lo:.0f}-{hi:.0f}): Eq 13 is extrapolated"
-        )
+        notes.append(f"Gamma/mu^2 = {ratio:.0f} outside the paper's data ({lo:.0f}-{hi:.0f}): Eq 13 is extrapolated")
     beta = stiffness_damping_eq13(gamma, used.mu)
     f_min = f_min_eq14(used.p_rad_s)
     k = k_paper * factor

@@ -87,9 +87,7 @@ class TableReader:
         low_bad = value <= lo if lo_open else value < lo
         high_bad = value >= hi if hi_open else value > hi
         if low_bad or high_bad:
-            raise self.error(
-                key, f"must be in {_interval(lo, hi, lo_open, hi_open)}{_unit(unit)}, got {value!r}"
-            )
+            raise self.error(key, f"must be in {_interval(lo, hi, lo_open, hi_open)}{_unit(unit)}, got {value!r}")
         return float(value)
 
     def positive(self, key: str, default: Any = _MISSING, unit: str = "") -> Any:
@@ -137,9 +135,7 @@ class TableReader:
             raise self.error(key, f"must be a list of at least {min_len} numbers{_unit(unit)}")
         for i, v in enumerate(value):
             if not _is_number(v) or not math.isfinite(v):
-                raise InputError(
-                    f"{self.field(key)}[{i}]", f"must be a finite number, got {v!r}", self.source
-                )
+                raise InputError(f"{self.field(key)}[{i}]", f"must be a finite number, got {v!r}", self.source)
         return [float(v) for v in value]
 
     def sub(self, key: str, default: Any = _MISSING) -> TableReader:

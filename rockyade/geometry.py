@@ -282,8 +282,7 @@ class Block:
         if not x_left < cx < x_right:
             raise InputError(
                 field_name,
-                f"centroid x = {cx:g} m lies outside the base [{x_left:g}, {x_right:g}] m: "
-                "the block cannot stand",
+                f"centroid x = {cx:g} m lies outside the base [{x_left:g}, {x_right:g}] m: the block cannot stand",
             )
 
 

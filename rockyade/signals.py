@@ -9,9 +9,7 @@ from scipy import signal
 from rockyade.errors import InputError
 
 
-def lowpass_zero_phase(
-    x: NDArray[np.float64], dt_s: float, cutoff_hz: float, order: int = 4
-) -> NDArray[np.float64]:
+def lowpass_zero_phase(x: NDArray[np.float64], dt_s: float, cutoff_hz: float, order: int = 4) -> NDArray[np.float64]:
     """Zero-phase Butterworth low-pass (forward-backward, ``sosfiltfilt``).
 
     The paper (Section 6.1) notes that the DEM's impact spikes in the top accelerations are
@@ -31,9 +29,7 @@ def lowpass_zero_phase(
     """
     nyquist = 0.5 / dt_s
     if not 0 < cutoff_hz < nyquist:
-        raise InputError(
-            "output.accel_lowpass_hz", f"must be in (0, {nyquist:g}) Hz (Nyquist), got {cutoff_hz!r}"
-        )
+        raise InputError("output.accel_lowpass_hz", f"must be in (0, {nyquist:g}) Hz (Nyquist), got {cutoff_hz!r}")
     sos = signal.butter(order, cutoff_hz, btype="low", fs=1.0 / dt_s, output="sos")
     if x.size <= 3 * (2 * len(sos) + 1):
         return x.copy()

@@ -232,3 +232,19 @@ def test_no_network_listening_in_local_batches(tmp_path):
     after = set(os.listdir("/proc/self/fd"))
     sockets = [f for f in after - before if os.readlink(f"/proc/self/fd/{f}").startswith("socket:")]
     assert not sockets
+
+
+def test_paper_command_writes_index(tmp_path, capsys):
+    from rockyade.cli import main
+
+    code = main(["paper", "--out", str(tmp_path), "--only", "tables,sensitivity", "--no-yade"])
+    assert code == 0
+    index = (tmp_path / "index.md").read_text()
+    assert "Tables 1-6 reproduced" in index and "Sensitivity" in index
+    for name in ("table5_reproduced.csv", "sensitivity.csv", "sensitivity.png"):
+        assert (tmp_path / name).is_file() and name in index
+    table5 = pd.read_csv(tmp_path / "table5_reproduced.csv")
+    assert {"paper", "ours", "diff_pct", "consistent"} <= set(table5.columns)
+    with pytest.raises(SystemExit):
+        main(["paper", "--bogus"])
+    assert main(["paper", "--out", str(tmp_path), "--only", "nope"]) == 2

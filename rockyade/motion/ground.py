@@ -48,9 +48,7 @@ class GroundMotion:
         object.__setattr__(self, "av_m_s2", av)
 
     @classmethod
-    def uniform(
-        cls, dt_s: float, ah: ArrayLike, av: ArrayLike | None = None, label: str = ""
-    ) -> GroundMotion:
+    def uniform(cls, dt_s: float, ah: ArrayLike, av: ArrayLike | None = None, label: str = "") -> GroundMotion:
         """Samples at a constant interval ``dt_s`` from t = 0."""
         ah = np.asarray(ah, dtype=float)
         return cls(np.arange(ah.size) * dt_s, ah, None if av is None else np.asarray(av, float), label)

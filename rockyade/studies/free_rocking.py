@@ -56,11 +56,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                 try:
                     beta = build_dem_model(scene).bodies[0].joint.beta_s
                 except CalibrationError as exc:
-                    note = (
-                        str(exc).split(";")[0] + "; " + str(exc).split(";")[1].split(".")[0]
-                        if ";" in str(exc)
-                        else str(exc)
-                    )
+                    note = f"matched calibration not reachable: {exc}"
                     scene = None
                 cases.append(
                     {
@@ -208,7 +204,9 @@ def _figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> None
     save_figure(fig, report.out / name)
     unreachable = [c for c in cases if c["key"] == key and c["scene"] is None]
     extra = (
-        " Matched calibration not reachable for: " + "; ".join(f"{c['params']} ({c['note']})" for c in unreachable)
+        " Matched calibration not reachable (see free_rocking.csv) for the "
+        + " and ".join(f"{c['params']} parameters" for c in unreachable)
+        + "."
         if unreachable
         else ""
     )
