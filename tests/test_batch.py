@@ -141,7 +141,7 @@ def test_bad_study_files(tmp_path, text, field):
 
 
 def test_the_example_study_loads():
-    study = load_study(EXAMPLES / "study_harmonic_sweep.toml", "/tmp/unused")
+    study = load_study(EXAMPLES / "studies" / "harmonic_sweep.toml", "/tmp/unused")
     assert len(study.tasks) == 2 * 3 * 2 * 2
 
 
