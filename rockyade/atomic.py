@@ -55,6 +55,11 @@ def write_json(path: str | os.PathLike[str], data: Any) -> None:
     write_text(path, json.dumps(data, indent=2, sort_keys=True, default=_json_default) + "\n")
 
 
+def json_text(data: Any) -> str:
+    """Indented, sorted JSON of ``data`` (numpy values converted), as the CLI prints it."""
+    return json.dumps(data, indent=2, sort_keys=True, default=_json_default)
+
+
 def _json_default(obj: Any) -> Any:
     """Convert numpy scalars and arrays for JSON."""
     import numpy as np

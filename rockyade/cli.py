@@ -11,7 +11,6 @@ Exit codes: 0 success, 1 a run failed, 2 bad input (the message names the field)
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from collections.abc import Callable, Sequence
@@ -38,9 +37,9 @@ EXTRA_COMMANDS: list[str] = [
 
 
 def _json_out(data: Any) -> None:
-    from rockyade.atomic import _json_default
+    from rockyade.atomic import json_text
 
-    print(json.dumps(data, indent=2, sort_keys=True, default=_json_default))
+    print(json_text(data))
 
 
 # ------------------------------------------------------------------ block input

@@ -15,9 +15,9 @@ from rockyade.errors import InputError
 
 
 def _json_out(data: Any) -> None:
-    from rockyade.atomic import _json_default
+    from rockyade.atomic import json_text
 
-    print(json.dumps(data, indent=2, sort_keys=True, default=_json_default))
+    print(json_text(data))
 
 
 def _read(args: argparse.Namespace):

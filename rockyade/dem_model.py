@@ -29,7 +29,7 @@ from scipy.linalg import eigh
 from scipy.spatial import ConvexHull
 
 from rockyade.calibration import ContactParameters, check_settlement, paper_calibration, time_step_eq7
-from rockyade.classical import frequency_parameter
+from rockyade.classical import frequency_parameter, inertia_for_frequency
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.geometry import LEVEL_TOL, Block
@@ -194,7 +194,7 @@ def _dem_body(
     alpha = math.atan2(abs(cx - pivot_left[0]), cy)
     inertia = block.inertia_c_kgm2
     if spec.p_rad_s is not None:
-        i_o = block.mass_kg * g * R / spec.p_rad_s**2
+        i_o = inertia_for_frequency(block.mass_kg, R, spec.p_rad_s, g)
         inertia = i_o - block.mass_kg * R * R
         if inertia <= 0:
             raise InputError(

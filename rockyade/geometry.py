@@ -270,10 +270,6 @@ class Block:
         d = np.asarray(point_m, dtype=float) - np.asarray(self.centroid_m)
         return self.inertia_c_kgm2 + self.mass_kg * float(d @ d)
 
-    def with_inertia(self, inertia_c_kgm2: float) -> Block:
-        """A copy with another centroidal inertia (e.g. to match a measured p)."""
-        return Block(self.name, self.vertices_m, self.thickness_m, self.mass_kg, inertia_c_kgm2, True)
-
     def _check_base(self, field_name: str) -> None:
         x_left, x_right = self.level_vertices("base")
         if x_right - x_left <= LEVEL_TOL * max(self.width_m, 1.0):

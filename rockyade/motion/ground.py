@@ -71,10 +71,6 @@ class GroundMotion:
         """Vertical base acceleration at times ``t``, m/s^2."""
         return np.interp(t, self.t_s, self.av_m_s2, left=0.0, right=0.0)
 
-    def scaled(self, factor: float) -> GroundMotion:
-        """The motion with both components multiplied by ``factor``."""
-        return GroundMotion(self.t_s, self.ah_m_s2 * factor, self.av_m_s2 * factor, self.label)
-
     def velocity_displacement(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Horizontal base velocity (m/s) and displacement (m) at ``t_s``, from rest.
 

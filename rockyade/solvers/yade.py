@@ -56,22 +56,6 @@ def yade_available() -> bool:
     return Path(YADE_PYTHON).is_file() and (Path(YADE_PY_DIR) / "yade" / "__init__.py").is_file()
 
 
-def yade_version() -> str:
-    """The installed YADE's version string (runs YADE's Python briefly)."""
-    out = subprocess.run(
-        [
-            YADE_PYTHON,
-            "-c",
-            f"import sys; sys.path.insert(1, {YADE_PY_DIR!r}); import yade.config as c; print(c.version)",
-        ],
-        capture_output=True,
-        text=True,
-        timeout=60,
-        env=_env(),
-    )
-    return out.stdout.strip().splitlines()[-1] if out.returncode == 0 and out.stdout.strip() else "unknown"
-
-
 def _env() -> dict[str, str]:
     env = dict(os.environ)
     env["OMP_NUM_THREADS"] = "1"
