@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 
-from rockyade.dem_model import build_dem_model
+from rockyade.dem.matching import build_matched_model
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import yade as yade_backend
 from rockyade.solvers.reference import run_model
@@ -35,8 +35,8 @@ def main() -> None:
     if not yade_backend.yade_available():
         print("YADE is not installed: no YADE figures")
         return
-    model = build_dem_model(scene(20.0))
-    run_model(build_dem_model(scene(0.1)), record_energy=False)  # JIT warm-up
+    model = build_matched_model(scene(20.0))
+    run_model(build_matched_model(scene(0.1)), record_energy=False)  # JIT warm-up
     ref = min(run_model(model, record_energy=False).meta["wall_time_s"] for _ in range(3))
     y = yade_backend.run_model(model)
     assert y.ok, y.meta.get("failure_reason")

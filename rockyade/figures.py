@@ -9,7 +9,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-from rockyade.atomic import atomic_open
+from rockyade.io.atomic import atomic_open
 
 
 def save_figure(fig: plt.Figure, path: str | Path, dpi: int = 130) -> None:

@@ -27,8 +27,8 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.atomic import atomic_open, write_json
 from rockyade.errors import InputError
+from rockyade.io.atomic import atomic_open, write_json
 
 STATUSES = ("completed", "overturned", "failed")
 PER_BLOCK_QUANTITIES = ("theta_rad", "omega_rad_s", "x_m", "y_m", "ax_m_s2", "ay_m_s2")

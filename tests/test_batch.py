@@ -11,11 +11,11 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from rockyade.batch import comparable, expand, failures, load_study, run_study_tasks
+from rockyade.analysis.fragility import fit_lognormal
+from rockyade.analysis.patterns import classify, classify_samples
 from rockyade.errors import InputError
-from rockyade.fragility import fit_lognormal
-from rockyade.patterns import classify, classify_samples
 from rockyade.scene import load_scene
+from rockyade.studies.batch import comparable, expand, failures, load_study, run_study_tasks
 
 from .conftest import EXAMPLES
 
@@ -182,7 +182,7 @@ def test_pattern_windows_thresholds_and_overturn():
 
 
 def test_pattern_of_a_real_stack_run():
-    from rockyade.patterns import classify_result
+    from rockyade.analysis.patterns import classify_result
     from rockyade.scene import scene_from_dict
     from rockyade.solvers import reference
 

@@ -10,16 +10,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rockyade import paper
-from rockyade.classical import (
+from rockyade.blocks.classical import (
     alpha_rectangle,
     classical_parameters,
     mu_rectangle,
     p_rectangle,
     uplift_acceleration,
 )
+from rockyade.blocks.geometry import Block
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.geometry import Block
 
 
 def test_rectangle_formulas_exactly():

@@ -10,8 +10,8 @@ import pytest
 from scipy.integrate import quad
 
 from rockyade import paper
+from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices, polygon_section, rectangle_vertices
 from rockyade.errors import InputError
-from rockyade.geometry import Block, chamfered_rectangle_vertices, polygon_section, rectangle_vertices
 
 
 def _integrate_convex(vertices: np.ndarray) -> tuple[float, float, float, float]:

@@ -8,11 +8,12 @@ import numpy as np
 import pytest
 
 from rockyade import paper
-from rockyade.analysis import effective_restitution, find_peaks
+from rockyade.analysis.peaks import effective_restitution, find_peaks
 from rockyade.constants import G
-from rockyade.dem_model import build_dem_model, contact_polygon, stability_limit
+from rockyade.dem.build import build_dem_model, contact_polygon
+from rockyade.dem.matching import build_matched_model, match_beta
+from rockyade.dem.model import stability_limit
 from rockyade.errors import CalibrationError, InputError
-from rockyade.matching import match_beta
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.solvers.reference import run_many, run_model
@@ -76,7 +77,7 @@ def test_energy_balance(free_rocking):
         assert error < 0.01
     else:
         assert error < 0.015
-        model = build_dem_model(scene)
+        model = build_matched_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2))
         finer_error = finer.meta["energy_balance_max_error_J"] / pe0
         assert finer_error < 0.01
@@ -167,7 +168,7 @@ def test_results_converge_with_the_time_step():
     """Halving Eq 7's step: the first peak and the peak times change by < 0.5 %; the
     decay per impact changes by ~0.2 % (contact switching is first order in dt)."""
     scene = _matched("specimen1_free.toml")
-    model = build_dem_model(scene)
+    model = build_matched_model(scene)
     a = run_model(model)
     b = run_model(model.with_dt(model.dt_s / 2))
     pa, pb = _peaks(a, alpha=0.235), _peaks(b, alpha=0.235)
@@ -180,13 +181,13 @@ def test_results_converge_with_the_time_step():
 
 def test_user_time_step_above_stability_limit_refused():
     d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
-    model = build_dem_model(scene_from_dict(d))
+    model = build_matched_model(scene_from_dict(d))
     d["contact"]["dt_s"] = 1.5 * model.dt_stable_s
     with pytest.raises(InputError) as info:
-        build_dem_model(scene_from_dict(d))
+        build_matched_model(scene_from_dict(d))
     assert info.value.field == "contact.dt_s" and "stability limit" in str(info.value)
     d["contact"]["dt_s"] = 0.5 * model.dt_stable_s
-    assert build_dem_model(scene_from_dict(d)).dt_source == "user"
+    assert build_matched_model(scene_from_dict(d)).dt_source == "user"
 
 
 def test_stability_limit_is_real():
@@ -204,7 +205,7 @@ def test_stability_limit_is_real():
         "accel_m_s2": [0.0, 0.0, 0.0],
         "accel_v_m_s2": [0.0, 98.1, 98.1],
     }
-    model = build_dem_model(scene_from_dict(d))
+    model = build_matched_model(scene_from_dict(d))
     limit = model.dt_stable_s
 
     def max_theta(steps: int) -> float:

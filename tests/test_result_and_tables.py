@@ -8,8 +8,8 @@ import pytest
 
 from rockyade import paper
 from rockyade.errors import InputError
+from rockyade.paper.tables import format_report, reproduction_report
 from rockyade.result import Result, failed_result
-from rockyade.tables import format_report, reproduction_report
 
 
 def _result() -> Result:

@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from rockyade import paper
-from rockyade.analysis import effective_restitution, find_peaks
-from rockyade.dem_model import build_dem_model
-from rockyade.matching import match_beta
+from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.dem import yade_payload
+from rockyade.dem.matching import build_matched_model, match_beta
 from rockyade.result import Result
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
@@ -83,9 +83,9 @@ def test_pitfall_default_damping():
 
 
 def _describe(scene, tmp_path) -> tuple[dict, object]:
-    model = build_dem_model(scene)
+    model = build_matched_model(scene)
     path = tmp_path / "scene.yade.json"
-    path.write_text(json.dumps(yade_backend.scene_payload(model)))
+    path.write_text(json.dumps(yade_payload.scene_payload(model)))
     out = subprocess.run(
         [yade_backend.YADE_PYTHON, str(yade_backend.DRIVER), "--describe", str(path)],
         capture_output=True,
@@ -181,9 +181,9 @@ def test_yade_run_listens_on_no_port(tmp_path):
     """A rockyade YADE run opens no listening socket; the same check finds the two servers
     that the stock ``yade`` launcher opens (so the check can fail)."""
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 8.0})
-    model = build_dem_model(scene)
+    model = build_matched_model(scene)
     path = tmp_path / "s.yade.json"
-    path.write_text(json.dumps(yade_backend.scene_payload(model)))
+    path.write_text(json.dumps(yade_payload.scene_payload(model)))
     ours, samples = _listening_while_running(
         [yade_backend.YADE_PYTHON, str(yade_backend.DRIVER), str(path), str(tmp_path / "out.npz")], 60
     )
@@ -226,7 +226,7 @@ def test_free_rocking_yade_vs_reference(free_rocking):
     else:
         from rockyade.solvers.reference import run_model
 
-        model = build_dem_model(scene)
+        model = build_matched_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2), record_energy=False)
         pf = find_peaks(finer.t, finer.series("theta_rad"), 1e-3 * alpha)
         own = np.max(np.abs(pf.amplitude_rad[:5] / pr.amplitude_rad[:5] - 1))
@@ -297,7 +297,7 @@ def test_overturning_in_yade():
 
 def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
-    real = yade_backend.scene_payload
+    real = yade_payload.scene_payload
 
     def broken(model):
         payload = real(model)
@@ -318,7 +318,7 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
 def test_instability_inside_yade_gives_failed_result(tmp_path):
     """A time step far above the stability limit (forced past rockyade's own check) makes
     the state non-finite: status failed, with the reason."""
-    model = build_dem_model(
+    model = build_matched_model(
         scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 0.5})
     )
     steps = max(1, math.floor(model.sample_dt_s / (20 * model.dt_stable_s)))
@@ -338,7 +338,7 @@ def test_timeout_gives_failed_result(tmp_path):
 
 
 def test_partial_output_is_not_a_result(tmp_path):
-    model = build_dem_model(load_scene(EXAMPLES / "specimen1_free.toml"))
+    model = build_matched_model(load_scene(EXAMPLES / "specimen1_free.toml"))
     good = yade_backend.run_model(model, workdir=tmp_path, name="ok")
     assert good.ok
     npz = tmp_path / "ok.yade.npz"
@@ -409,7 +409,7 @@ def test_cli_compare_three_solvers(tmp_path, capsys):
 
 def test_matched_beta_comes_from_the_reference_dem():
     scene = _matched("specimen1_free.toml")
-    model = build_dem_model(scene)
+    model = build_matched_model(scene)
     s = paper.specimen(1)
     assert model.bodies[0].joint.beta_s == pytest.approx(match_beta(s.block(), **s.experimental).beta_s)
     assert model.bodies[0].joint.method == "matched"

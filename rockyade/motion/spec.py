@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from rockyade.fields import TableReader
+from rockyade.io.fields import TableReader
 from rockyade.motion.ground import GroundMotion
 
 

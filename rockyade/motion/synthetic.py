@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.atomic import atomic_open
 from rockyade.errors import InputError
+from rockyade.io.atomic import atomic_open
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.processing import baseline_correct, integrate
 from rockyade.motion.records import Record

@@ -44,7 +44,7 @@ from typing import Any, ClassVar
 
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.fields import TableReader
+from rockyade.io.fields import TableReader
 from rockyade.motion.analytic import PULSE_SHAPES, Harmonic, Pulse
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.ground import GroundMotion

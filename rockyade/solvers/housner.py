@@ -40,7 +40,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.classical import ClassicalParameters
+from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
@@ -629,7 +629,7 @@ def _frame(scene: Scene, block, model: HousnerModel, motion: GroundMotion | None
         }
     )
     if scene.output.accel_lowpass_hz:
-        from rockyade.signals import lowpass_zero_phase
+        from rockyade.motion.processing import lowpass_zero_phase
 
         for q in ("ax_m_s2", "ay_m_s2"):
             col = column(name, q, names)

@@ -1,8 +1,8 @@
 """The YADE backend: a scene's DEM model run by YADE in batch mode, parsed back.
 
-The DEM model (:mod:`rockyade.dem_model`, the same the reference DEM runs) is written as
-JSON data and run by ``yade_scripts/run_scene.py`` in Debian's ``/usr/bin/python3.11``
-with YADE's modules on the path, as a subprocess:
+The DEM model (:mod:`rockyade.dem.model`, the same the reference DEM runs) is written as
+JSON data (:mod:`rockyade.dem.yade_payload`) and run by :mod:`rockyade.dem.yade_driver`
+in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess:
 
 * no listening socket: the ``yade`` launcher (which opens a Python console on
   0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used;
@@ -19,7 +19,6 @@ Runs are independent (own files, own process), so several can go in parallel
 from __future__ import annotations
 
 import json
-import math
 import os
 import shutil
 import subprocess
@@ -33,22 +32,19 @@ from pathlib import Path
 import numpy as np
 
 from rockyade import __version__
-from rockyade.atomic import write_json
-from rockyade.dem_model import DemModel, build_dem_model
-from rockyade.dem_result import dem_frame, energy_gain
+from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.matching import build_matched_model
+from rockyade.dem.model import DemModel
+from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
-from rockyade.geometry import LEVEL_TOL
+from rockyade.io.atomic import write_json
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 
-DRIVER = Path(__file__).resolve().parent.parent.parent / "yade_scripts" / "run_scene.py"
+#: The script YADE's Python runs, shipped inside the package.
+DRIVER = Path(__file__).resolve().parent.parent / "dem" / "yade_driver.py"
 YADE_PYTHON = os.environ.get("ROCKYADE_YADE_PYTHON", "/usr/bin/python3.11")
 YADE_PY_DIR = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
-#: Radius of the vertex spheres as a fraction of the smallest block dimension.
-SPHERE_RADIUS_FRACTION = 1e-3
-#: Thickness of the contact slabs as a fraction of the block height.
-SLAB_FRACTION = 0.05
-MAX_BLOCKS = 30
 
 
 def yade_available() -> bool:
@@ -63,96 +59,6 @@ def _env() -> dict[str, str]:
     env["ROCKYADE_YADE_PY"] = YADE_PY_DIR
     env["PYTHONNOUSERSITE"] = "1"
     return env
-
-
-# ---------------------------------------------------------------------- payload
-
-
-def _roles(vertices: np.ndarray) -> list[str]:
-    y = vertices[:, 1]
-    tol = LEVEL_TOL * max(float(np.ptp(y)), 1.0) * 10
-    return ["base" if v <= y.min() + tol else "top" if v >= y.max() - tol else "side" for v in y]
-
-
-def scene_payload(model: DemModel) -> dict[str, object]:
-    """The DEM model as the JSON data the YADE driver reads."""
-    nb = len(model.bodies)
-    if nb > MAX_BLOCKS:
-        raise InputError(
-            "blocks", f"the YADE backend takes at most {MAX_BLOCKS} blocks (collision mask bits), got {nb}"
-        )
-    sizes = [float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies]
-    radius = SPHERE_RADIUS_FRACTION * min(sizes)
-
-    def joint(b) -> dict[str, float]:
-        j = b.joint
-        return {
-            "kn": j.K_N_per_m,
-            "ks": j.Ks_N_per_m,
-            "cn": j.beta_s * j.K_N_per_m,
-            "cs": j.beta_s * j.Ks_N_per_m,
-            "friction_angle_rad": math.radians(j.friction_angle_deg),
-        }
-
-    bodies = []
-    for i, b in enumerate(model.bodies):
-        verts = b.contact_vertices_m
-        roles = _roles(verts)
-        height = float(np.ptp(verts[:, 1]))
-        s = SLAB_FRACTION * height
-        slabs = []
-        if i + 1 < nb:  # a block rests on this one: its top face
-            top = verts[[r == "top" for r in roles]]
-            slabs.append(
-                {
-                    "center_m": [float(top[:, 0].mean()), float(verts[:, 1].max() - s / 2)],
-                    "half_extents_m": [float(np.ptp(top[:, 0]) / 2), s / 2],
-                    "mask_bits": [i + 1],
-                }
-            )
-        if i > 0:  # this block rests on another: its base face
-            base = verts[[r == "base" for r in roles]]
-            slabs.append(
-                {
-                    "center_m": [float(base[:, 0].mean()), float(verts[:, 1].min() + s / 2)],
-                    "half_extents_m": [float(np.ptp(base[:, 0]) / 2), s / 2],
-                    "mask_bits": [i - 1],
-                }
-            )
-        bodies.append(
-            {
-                "name": b.name,
-                "mass_kg": b.mass_kg,
-                "inertia_kgm2": b.inertia_kgm2,
-                "vertices_m": verts.tolist(),
-                "vertex_roles": roles,
-                "centroid0_m": model.pos0_m[i].tolist(),
-                "rest_centroid_m": list(b.rest_centroid_m),
-                "angle0_rad": float(model.ang0_rad[i]),
-                "vel0_m_s": model.vel0_m_s[i].tolist(),
-                "angvel0_rad_s": float(model.angvel0_rad_s[i]),
-                "accel_point_m": list(b.accel_point_m),
-                "joint_below": joint(b),
-                "joint_above": joint(model.bodies[i + 1]) if i + 1 < nb else None,
-                "thickness_m": max(0.1 * height, 10 * radius),
-                "slabs": slabs,
-            }
-        )
-    motion = model.motion
-    return {
-        "format": "rockyade-yade-scene-1",
-        "scene_hash": model.scene_hash,
-        "dt_s": model.dt_s,
-        "n_steps": model.n_steps,
-        "steps_per_sample": model.steps_per_sample,
-        "n_samples": model.n_samples,
-        "g": model.g,
-        "sphere_radius_m": radius,
-        "bodies": bodies,
-        "motion": None
-        if motion is None
-        else {"t_s": motion.t_s.tolist(), "ah_m_s2": motion.ah_m_s2.tolist(), "av_m_s2": motion.av_m_s2.tolist()},
-    }
 
 
 # ---------------------------------------------------------------------- running
@@ -301,7 +207,7 @@ def run_scene(
     """Run a scene with YADE (see :func:`run_model`)."""
     if scene.contact.mass_damping_1_s:
         raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
-    model = build_dem_model(scene)
+    model = build_matched_model(scene)
     result = run_model(
         model, workdir=workdir, name=name, timeout_s=timeout_s, accel_lowpass_hz=scene.output.accel_lowpass_hz
     )

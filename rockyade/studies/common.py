@@ -11,8 +11,8 @@ from typing import Any
 import pandas as pd
 
 from rockyade import paper
-from rockyade.atomic import atomic_open, write_text
-from rockyade.classical import classical_parameters
+from rockyade.blocks.classical import classical_parameters
+from rockyade.io.atomic import atomic_open, write_text
 
 PARAMETER_SETS = ("theoretical", "experimental")
 

@@ -14,12 +14,12 @@ import numpy as np
 import pandas as pd
 
 from rockyade import paper
-from rockyade.batch import expand, run_study_tasks
-from rockyade.dem_model import build_dem_model
+from rockyade.analysis.fragility import fit_lognormal
+from rockyade.dem.matching import build_matched_model
 from rockyade.figures import plt, save_figure
-from rockyade.fragility import fit_lognormal
 from rockyade.motion.synthetic import generate_suite, paper_suite
 from rockyade.scene import scene_from_dict
+from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.common import Report, block_table, fmt, scene_dict
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
@@ -47,7 +47,7 @@ def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
     """Generate the suite and the matched calibrations once, before workers fork."""
     generate_suite(paper_suite())
     for key in specimens:
-        build_dem_model(scene_from_dict(_base(key)))
+        build_matched_model(scene_from_dict(_base(key)))
 
 
 def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -133,7 +133,7 @@ def _figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> None:
             label = f"{solver}: median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$, beta {fmt(fit.beta, 2)}"
             ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4, label=label)
             if fit.status == "fitted":
-                from rockyade.fragility import Fragility
+                from rockyade.analysis.fragility import Fragility
 
                 ax.plot(
                     x, Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x), color=colour, lw=1.2

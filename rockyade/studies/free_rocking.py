@@ -13,8 +13,8 @@ import math
 import pandas as pd
 
 from rockyade import paper
-from rockyade.analysis import effective_restitution, find_peaks
-from rockyade.dem_model import build_dem_model
+from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.dem.matching import build_matched_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import plt, save_figure
 from rockyade.scene import scene_from_dict
@@ -54,7 +54,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                 scene = scene_from_dict(d)
                 note, beta = "", math.nan
                 try:
-                    beta = build_dem_model(scene).bodies[0].joint.beta_s
+                    beta = build_matched_model(scene).bodies[0].joint.beta_s
                 except CalibrationError as exc:
                     note = f"matched calibration not reachable: {exc}"
                     scene = None

@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from rockyade.analysis.patterns import classify_result
 from rockyade.figures import plt, save_figure
 from rockyade.motion.analytic import Harmonic
-from rockyade.patterns import classify_result
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.solvers import yade as yade_backend

@@ -18,7 +18,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade.constants import G
-from rockyade.dem_model import build_dem_model
+from rockyade.dem.matching import build_matched_model
 from rockyade.figures import plt, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
@@ -72,7 +72,7 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     )
     block = block_table("1")
     alpha, p = block["alpha_rad"], block["p_rad_s"]
-    build_dem_model(_scene(2.0, 2.0, alpha, p))  # matched beta once, before the workers fork
+    build_matched_model(_scene(2.0, 2.0, alpha, p))  # matched beta once, before the workers fork
     jobs = [("housner", w, alpha, p, True) for w in FREQUENCY_RATIOS] + [
         ("reference", w, alpha, p, False) for w in FREQUENCY_RATIOS
     ]

@@ -19,12 +19,12 @@ PARTS = ("tables", "free", "harmonic", "random", "patterns", "sensitivity", "fra
 
 def run_tables(report: Report) -> None:
     """Tables 1-6: paper value, ours, difference, consistency flag."""
-    from rockyade.tables import reproduction_report
+    from rockyade.paper.tables import reproduction_report
 
     table = reproduction_report()
     report.section(
         "Tables 1-6 reproduced",
-        "Each printed value beside what the paper's own equations give (rockyade.tables); "
+        "Each printed value beside what the paper's own equations give (rockyade.paper.tables); "
         "`consistent` is false where the printed number does not follow from the equations.",
     )
     for number in range(1, 7):

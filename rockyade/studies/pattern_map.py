@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import pandas as pd
 
-from rockyade.batch import expand, run_study_tasks
 from rockyade.figures import plt, save_figure
 from rockyade.motion.analytic import Harmonic
+from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.common import Report, biblock_blocks, scene_dict
 
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)

@@ -17,15 +17,20 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
 
+import numpy as np
 from scipy.optimize import brentq
 
-from rockyade.analysis import effective_restitution, find_peaks
-from rockyade.classical import classical_parameters
-from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG
+from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.classical import classical_parameters
+from rockyade.blocks.geometry import Block
+from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, G
+from rockyade.dem import kernel
+from rockyade.dem.build import build_dem_model
+from rockyade.dem.engine import simulate_model
+from rockyade.dem.model import DemModel, MatchedBeta
 from rockyade.errors import CalibrationError
-from rockyade.geometry import Block
+from rockyade.scene import Scene, scene_from_dict
 
 #: Impacts after the release over which mu_eff is measured.
 N_IMPACTS = 4
@@ -35,62 +40,28 @@ MU_RTOL = 5e-4
 BETA_MAX_XI = 4.0
 
 
-@dataclass(frozen=True)
-class MatchedBeta:
-    """Result of a matched calibration.
+def free_rocking_duration(alpha_rad: float, p_rad_s: float, mu: float, theta0_rad: float, n_peaks: int) -> float:
+    """Time to the ``n_peaks``-th peak of free rocking, from Housner's linearised equation, s.
 
-    Attributes
-    ----------
-    beta_s
-        Matched stiffness-proportional damping, s.
-    mu_eff, mu_target
-        Achieved and target effective restitution.
-    mu_max, mu_min
-        Reachable range: mu_eff without damping and with the heaviest damping tried.
-    beta_max_s
-        Heaviest damping tried, s.
-    beta_eq13_s
-        The paper's empirical value (Eq 13), for comparison.
-    n_runs
-        DEM runs used.
-    n_impacts
-        Impacts averaged per run.
+    theta'' = p^2 (theta - alpha) about a pivot: from rest at theta_k the block reaches
+    the impact after arccosh(alpha / (alpha - theta_k)) / p with speed
+    p sqrt(alpha^2 - (alpha - theta_k)^2); the impact multiplies it by mu, and the next
+    peak theta_{k+1} solves (alpha - theta_{k+1})^2 = alpha^2 - mu^2 (alpha^2 - (alpha - theta_k)^2).
+    The nonlinear block is a little slower: callers add a margin.
     """
-
-    beta_s: float
-    mu_eff: float
-    mu_target: float
-    mu_max: float
-    mu_min: float
-    beta_max_s: float
-    beta_eq13_s: float
-    n_runs: int
-    n_impacts: int
-
-    def as_cli_dict(self) -> dict[str, float]:
-        """Keys for ``rockyade calibrate --method matched --json``."""
-        return {
-            "beta_s": self.beta_s,
-            "beta_matched_s": self.beta_s,
-            "mu_eff_matched": self.mu_eff,
-            "mu_target": self.mu_target,
-            "mu_reachable_min": self.mu_min,
-            "mu_reachable_max": self.mu_max,
-            "beta_eq13_s": self.beta_eq13_s,
-            "matching_runs": self.n_runs,
-            "matching_impacts": self.n_impacts,
-        }
+    t, theta = 0.0, theta0_rad
+    for k in range(n_peaks):
+        quarter = math.acosh(alpha_rad / (alpha_rad - theta)) / p_rad_s
+        t += quarter if k == 0 else 2.0 * quarter
+        theta = alpha_rad - math.sqrt(alpha_rad**2 - mu**2 * (alpha_rad**2 - (alpha_rad - theta) ** 2))
+    return t
 
 
 def _free_rocking_scene(block: Block, alpha, p, mu, beta, stiffness_scale, friction_angle_deg, K):
-    from rockyade.scene import scene_from_dict
-    from rockyade.solvers.housner import HousnerModel, solve
-
+    """The block alone on a rigid base, released at alpha / 2 with damping ``beta``."""
     cp = classical_parameters(block, alpha_rad=alpha, p_rad_s=p, mu=mu)
     theta0 = 0.5 * cp.alpha_rad
-    traj = solve(HousnerModel.from_classical(cp), None, 60.0, theta0, sample_dt_s=0.01)
-    needed = N_IMPACTS + 2
-    t_peak = traj.peaks[needed - 1, 0] if len(traj.peaks) >= needed else 10.0
+    t_peak = free_rocking_duration(cp.alpha_rad, cp.p_rad_s, cp.mu, theta0, N_IMPACTS + 2)
     block_table: dict[str, object] = {
         "name": "block",
         "vertices_m": block.vertices_m.tolist(),
@@ -112,7 +83,7 @@ def _free_rocking_scene(block: Block, alpha, p, mu, beta, stiffness_scale, frict
         contact["K_N_per_m"] = K
     scene = scene_from_dict(
         {
-            "duration_s": round(1.15 * t_peak + 0.2, 3),
+            "duration_s": round(1.3 * t_peak + 0.3, 3),
             "sample_dt_s": 0.001,
             "blocks": [block_table],
             "contact": contact,
@@ -133,18 +104,50 @@ def dem_effective_mu(
     friction_angle_deg: float = DEFAULT_FRICTION_ANGLE_DEG,
     K_N_per_m: float | None = None,
 ) -> float:
-    """Effective restitution of the reference DEM for one block with damping ``beta_s``."""
-    from rockyade.solvers.reference import run_scene
-
+    """Effective restitution of the DEM (the reference kernel) for one block with damping ``beta_s``."""
     scene, cp = _free_rocking_scene(
         block, alpha_rad, p_rad_s, mu, beta_s, stiffness_scale, friction_angle_deg, K_N_per_m
     )
-    result = run_scene(scene, record_energy=False, record_contacts=False)
-    theta = result.series("theta_rad")
-    peaks = find_peaks(result.t, theta, min_peak_rad=1e-3 * cp.alpha_rad)
-    if len(peaks) < N_IMPACTS + 1 or result.status != "completed":
+    model = build_dem_model(scene)
+    out, _ = simulate_model(model, record_energy=False)
+    ang, status, n_filled = out[1], int(out[6]), int(out[7])
+    theta = ang[:n_filled, 0]
+    t = np.arange(n_filled) * model.sample_dt_s
+    peaks = find_peaks(t, theta, min_peak_rad=1e-3 * cp.alpha_rad)
+    if len(peaks) < N_IMPACTS + 1 or status != kernel.STATUS_COMPLETED:
         return math.nan
     return effective_restitution(peaks, cp.alpha_rad, N_IMPACTS)
+
+
+def matched_betas(scene: Scene) -> dict[str, MatchedBeta]:
+    """Matched damping of every block of a ``calibration = "matched"`` scene, by block name.
+
+    Blocks with an explicit ``contact.beta_s`` need none (an empty dictionary is returned).
+    """
+    c = scene.contact
+    if c.calibration != "matched" or c.beta_s is not None:
+        return {}
+    out = {}
+    for spec in scene.blocks:
+        out[spec.name] = match_beta(
+            spec.block(),
+            alpha_rad=spec.alpha_rad,
+            p_rad_s=spec.p_rad_s,
+            mu=spec.mu,
+            stiffness_scale=c.stiffness_scale,
+            friction_angle_deg=c.friction_angle_deg,
+            K_N_per_m=c.K_N_per_m,
+        )
+    return out
+
+
+def build_matched_model(scene: Scene, g: float = G) -> DemModel:
+    """The scene's DEM model, with the damping matched first when the scene asks for it.
+
+    This is the stage the solvers call: matching runs short DEM models of each block
+    alone, then the scene's model is built with the matched values (never the other way).
+    """
+    return build_dem_model(scene, g=g, matched=matched_betas(scene))
 
 
 def match_beta(
@@ -183,7 +186,7 @@ def match_beta(
 def _match_cached(key: tuple) -> MatchedBeta:
     verts, thickness, mass, inertia, alpha, p, mu, scale, friction, K = key
     block = Block.polygon(verts, thickness, mass_kg=mass, inertia_kgm2=inertia)
-    from rockyade.calibration import paper_calibration
+    from rockyade.blocks.calibration import paper_calibration
 
     paper = paper_calibration(
         block, alpha_rad=alpha, p_rad_s=p, mu=mu, stiffness_scale=scale, friction_angle_deg=friction

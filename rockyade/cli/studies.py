@@ -11,9 +11,9 @@ from rockyade.errors import InputError
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """Run one scene through several solvers and tabulate their agreement."""
-    from rockyade.atomic import atomic_open
-    from rockyade.compare import compare
+    from rockyade.analysis.compare import compare
     from rockyade.figures import plot_results
+    from rockyade.io.atomic import atomic_open
     from rockyade.scene import load_scene
     from rockyade.solvers import get_solver, solver_names
 
@@ -58,7 +58,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run a study file's grid of scenes."""
-    from rockyade.batch import failures, load_study, run_study_tasks
+    from rockyade.studies.batch import failures, load_study, run_study_tasks
 
     study = load_study(args.study, args.out)
     print(f"{study.name}: {len(study.tasks)} runs ({', '.join(study.solvers)}) -> {args.out}")

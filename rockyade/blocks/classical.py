@@ -18,9 +18,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from rockyade.blocks.geometry import Block
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.geometry import Block
 
 # --------------------------------------------------------------------------- Eqs 2-4
 

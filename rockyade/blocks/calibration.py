@@ -24,7 +24,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass, field
 
-from rockyade.classical import classical_parameters
+from rockyade.blocks.classical import classical_parameters
+from rockyade.blocks.geometry import Block
 from rockyade.constants import (
     DEFAULT_FRICTION_ANGLE_DEG,
     DEFAULT_STIFFNESS_SCALE,
@@ -34,7 +35,6 @@ from rockyade.constants import (
     G,
 )
 from rockyade.errors import CalibrationError, InputError
-from rockyade.geometry import Block
 
 #: Range of Gamma / mu^2 covered by the paper's four specimens (Fig. 11), for a warning.
 EQ13_FITTED_RANGE = (7.0e2, 5.0e3)

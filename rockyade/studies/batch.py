@@ -41,9 +41,9 @@ from typing import Any
 
 import pandas as pd
 
-from rockyade.atomic import atomic_open, write_json
 from rockyade.errors import InputError
-from rockyade.fields import TableReader
+from rockyade.io.atomic import atomic_open, write_json
+from rockyade.io.fields import TableReader
 from rockyade.solvers import solver_names
 
 EXECUTORS = ("local", "dask")
@@ -187,7 +187,7 @@ def run_name(scene_hash: str, solver: str) -> str:
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task; return its summary row. Never raises: failures become rows."""
-    from rockyade.analysis import run_metrics
+    from rockyade.analysis.metrics import run_metrics
     from rockyade.result import failed_result
     from rockyade.scene import scene_from_dict
     from rockyade.solvers import get_solver
@@ -224,7 +224,7 @@ def run_task(task: Task) -> dict[str, Any]:
             for key, value in values.items():
                 row[key if single else f"{block}_{key}"] = value
         if len(scene.blocks) == 2:
-            from rockyade.patterns import classify_result
+            from rockyade.analysis.patterns import classify_result
 
             pattern = classify_result(scene, result)
             row["pattern"] = pattern.dominant

@@ -10,14 +10,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rockyade.atomic import atomic_open, write_json
+from rockyade.cli.common import json_out
 from rockyade.errors import InputError
-
-
-def _json_out(data: Any) -> None:
-    from rockyade.atomic import json_text
-
-    print(json_text(data))
+from rockyade.io.atomic import atomic_open, write_json
 
 
 def _read(args: argparse.Namespace):
@@ -54,7 +49,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         v, d = integrate(rec.t_s, rec.accel_m_s2)
         plot_accelerogram(rec.t_s, rec.accel_m_s2, v, d, args.plot, title=rec.title or str(args.record))
     if args.json:
-        _json_out(info)
+        json_out(info)
     else:
         print(f"{args.record}: {rec.title}")
         print(f"  {rec.npts} samples at dt = {rec.dt_s:g} s ({rec.duration_s:g} s), units in file: {rec.units_in_file}")
@@ -186,7 +181,7 @@ def cmd_check(args: argparse.Namespace) -> int:
     records = [read_two_column(f, "m/s2") for f in files]
     report = compatibility_report(records, target, tuple(args.range))
     if args.json:
-        _json_out(report)
+        json_out(report)
     else:
         print(f"{args.dir}: {len(records)} records, target {target.label}")
         _print_report(report)

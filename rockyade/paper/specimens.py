@@ -12,10 +12,10 @@ from pathlib import Path
 
 import pandas as pd
 
+from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices
 from rockyade.errors import InputError
-from rockyade.geometry import Block, chamfered_rectangle_vertices
 
-DATA_DIR = Path(__file__).resolve().parent.parent / "data"
+DATA_DIR = Path(__file__).resolve().parent / "data"
 
 TABLE_FILES = {
     1: "table1_specimens.csv",
@@ -106,7 +106,7 @@ class Specimen:
 
     def vertices(self):
         """Cross-section vertices, m (chamfered for specimen 4)."""
-        from rockyade.geometry import rectangle_vertices
+        from rockyade.blocks.geometry import rectangle_vertices
 
         if self.chamfer_m > 0:
             return chamfered_rectangle_vertices(self.width_m, self.height_m, self.chamfer_m)

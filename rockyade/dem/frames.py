@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from rockyade.dem_model import DemModel
+from rockyade.dem.model import DemModel
 from rockyade.result import column
 
 STATE_NAMES = np.array(["open", "stick", "slip"])
@@ -60,7 +60,7 @@ def dem_frame(
             v = vpoint[:, i, axis]
             acc = (np.gradient(v, model.sample_dt_s) if n >= 2 else np.zeros(n)) + base
             if accel_lowpass_hz:
-                from rockyade.signals import lowpass_zero_phase
+                from rockyade.motion.processing import lowpass_zero_phase
 
                 acc = lowpass_zero_phase(acc, model.sample_dt_s, accel_lowpass_hz)
             data[column(body.name, q, names)] = acc

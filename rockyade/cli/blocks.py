@@ -1,45 +1,16 @@
-"""The ``rockyade`` command line.
-
-Commands: ``params`` (classical parameters of a block), ``calibrate`` (DEM contact
-parameters), ``run`` (a scene through a solver), ``tables`` (the paper's tables
-reproduced); later modules add theirs through :data:`EXTRA_COMMANDS`.
-
-Exit codes: 0 success, 1 a run failed, 2 bad input (the message names the field),
-3 a solver that is not available here.
-"""
+"""``rockyade params`` and ``rockyade calibrate``: a block's classical and DEM parameters."""
 
 from __future__ import annotations
 
 import argparse
-import math
-import sys
-from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from rockyade import __version__
-from rockyade.errors import (
-    CalibrationError,
-    InputError,
-    RockyadeError,
-    SolverFailedError,
-    SolverUnavailableError,
-)
+from rockyade.cli.common import json_out
+from rockyade.errors import InputError
 
 #: Calibration methods offered by ``rockyade calibrate``.
 CALIBRATION_METHODS = ["paper", "matched"]
-
-#: Functions that add sub-commands: f(subparsers) -> None (motion, compare, batch, paper ...)
-EXTRA_COMMANDS: list[str] = [
-    "rockyade.cli_motion",
-    "rockyade.cli_studies",
-]
-
-
-def _json_out(data: Any) -> None:
-    from rockyade.atomic import json_text
-
-    print(json_text(data))
 
 
 # ------------------------------------------------------------------ block input
@@ -63,7 +34,7 @@ def _add_block_arguments(p: argparse.ArgumentParser) -> None:
 def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str, float]]]:
     """(name, Block, classical overrides) for each block the arguments describe."""
     from rockyade import paper
-    from rockyade.geometry import Block, chamfered_rectangle_vertices, rectangle_vertices
+    from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices, rectangle_vertices
     from rockyade.scene import load_scene
 
     chosen = [x for x in (args.specimen, args.scene, args.width or args.vertices) if x]
@@ -119,7 +90,7 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
 
 def cmd_params(args: argparse.Namespace) -> int:
     """Classical parameters of one or more blocks."""
-    from rockyade.classical import classical_parameters
+    from rockyade.blocks.classical import classical_parameters
 
     out = {}
     for name, block, overrides in _blocks_from_args(args):
@@ -141,7 +112,7 @@ def cmd_params(args: argparse.Namespace) -> int:
             "source": cp.source,
         }
     if args.json:
-        _json_out(out[next(iter(out))] if len(out) == 1 else out)
+        json_out(out[next(iter(out))] if len(out) == 1 else out)
         return 0
     for name, d in out.items():
         alpha_src = "Eq 2" if d["source"]["alpha_rad"] == "geometry" else "override"
@@ -160,7 +131,7 @@ def cmd_params(args: argparse.Namespace) -> int:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
     from rockyade import paper
-    from rockyade.calibration import paper_calibration, xi_min_eq15
+    from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 
     if args.specimen is None:
         raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower")
@@ -169,7 +140,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if args.parameters == "experimental":
         params = spec.experimental
     else:
-        from rockyade.classical import classical_parameters
+        from rockyade.blocks.classical import classical_parameters
 
         cp = classical_parameters(block)
         params = {"alpha_rad": cp.alpha_rad, "p_rad_s": cp.p_rad_s, "mu": cp.mu}
@@ -199,7 +170,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "notes": list(cal.notes),
     }
     if args.method == "matched":
-        from rockyade.matching import match_beta
+        from rockyade.dem.matching import match_beta
 
         matched = match_beta(
             block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
@@ -207,7 +178,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         result.update(matched.as_cli_dict())
         result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)  # Eq 15 with the matched b
     if args.json:
-        _json_out(result)
+        json_out(result)
         return 0
     if args.method == "matched":
         beta_src = f"matched to mu; Eq 13 gives {cal.beta_eq13_s:.6g} s"
@@ -230,88 +201,9 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_run(args: argparse.Namespace) -> int:
-    """Run a scene through a solver."""
-    from rockyade.scene import load_scene
-    from rockyade.solvers import get_solver
 
-    scene = load_scene(args.scene)
-    solver = get_solver(args.solver)
-    if args.solver == "yade" and args.out:
-        # YADE's log and scene data are kept beside the result
-        result = solver(scene, workdir=args.out.parent, name=args.out.stem)
-    else:
-        result = solver(scene)
-    if args.out:
-        json_path = result.write(args.out)
-        print(f"wrote {args.out} and {json_path}")
-    if args.plot:
-        from rockyade.figures import plot_results
-
-        plot_results({args.solver: result}, args.plot, title=f"{Path(args.scene).name} ({args.solver})")
-        print(f"wrote {args.plot}")
-    _print_summary(scene, result)
-    return 0 if result.ok else 1
-
-
-def _print_summary(scene: Any, result: Any) -> None:
-    from rockyade.analysis import run_metrics
-
-    meta = result.meta
-    wall = meta.get("wall_time_s", math.nan)
-    print(f"solver {meta['solver']}: status {result.status}, wall time {wall:.3g} s")
-    if not result.ok:
-        print(f"  failure: {meta.get('failure_reason')}")
-        if meta.get("log_path"):
-            print(f"  log: {meta['log_path']}")
-        return
-    for name, m in run_metrics(scene, result).items():
-        theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
-        line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
-        if not math.isnan(m["mu_eff"]):
-            line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, 5)} impacts"
-        print(line)
-    if result.status == "overturned":
-        print(f"  overturned at t = {meta['overturn_time_s']:.4g} s ({meta.get('overturned_block')})")
-
-
-def cmd_tables(args: argparse.Namespace) -> int:
-    """Tables 1-6 of the paper reproduced."""
-    from rockyade.tables import format_report, reproduction_report
-
-    report = reproduction_report()
-    if args.out:
-        from rockyade.atomic import atomic_open
-
-        args.out.mkdir(parents=True, exist_ok=True)
-        for number, group in report.groupby("table"):
-            with atomic_open(args.out / f"table{int(number)}_reproduced.csv") as fh:
-                group.to_csv(fh, index=False, lineterminator="\n")
-        with atomic_open(args.out / "tables_reproduced.csv") as fh:
-            report.to_csv(fh, index=False, lineterminator="\n")
-        print(f"wrote {args.out}/tables_reproduced.csv and one CSV per table")
-    if args.json:
-        _json_out(report.to_dict(orient="records"))
-    else:
-        print(format_report(report))
-    return 0
-
-
-# ------------------------------------------------------------------ parser
-
-
-def build_parser() -> argparse.ArgumentParser:
-    """The argument parser with every sub-command."""
-    from rockyade.solvers import solver_names
-
-    parser = argparse.ArgumentParser(
-        prog="rockyade",
-        description="Seismic rocking of rigid blocks: classical (Housner) parameters, exact "
-        "Housner solver, DEM calibration from the classical parameters, reference DEM and YADE.",
-    )
-    parser.add_argument("--version", action="version", version=f"rockyade {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-
+def register(sub: Any) -> None:
+    """Add ``params`` and ``calibrate``."""
     p = sub.add_parser(
         "params",
         help="classical parameters alpha, p, mu of a block",
@@ -348,75 +240,3 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--friction-angle", type=float, default=30.0, help="joint friction angle, degrees (default 30)")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_calibrate)
-
-    p = sub.add_parser(
-        "run",
-        help="run a scene through a solver",
-        description="Run a scene file through a solver; write the result CSV + JSON.",
-    )
-    p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
-    p.add_argument(
-        "--solver",
-        default="housner",
-        choices=solver_names(),
-        help="housner (exact classical), reference (standalone DEM) or yade",
-    )
-    p.add_argument("--out", type=Path, help="result CSV (the metadata JSON is written beside it)")
-    p.add_argument("--plot", type=Path, help="PNG figure of the time history")
-    p.set_defaults(func=cmd_run)
-
-    p = sub.add_parser(
-        "tables",
-        help="the paper's Tables 1-6 reproduced",
-        description="Tables 1-6: paper value, ours, difference and a flag where the printed number "
-        "does not follow from the paper's own equations.",
-    )
-    p.add_argument("--out", type=Path, help="directory for CSV files")
-    p.add_argument("--json", action="store_true", help="print JSON instead of text")
-    p.set_defaults(func=cmd_tables)
-
-    import importlib
-
-    for module_name in EXTRA_COMMANDS:
-        try:
-            module = importlib.import_module(module_name)
-        except ModuleNotFoundError as exc:
-            if exc.name == module_name:
-                continue
-            raise
-        register: Callable[[Any], None] = module.register
-        register(sub)
-    return parser
-
-
-def _coerce_scale(value: str) -> str | float:
-    try:
-        return float(value)
-    except ValueError:
-        return value
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``rockyade`` console script."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if hasattr(args, "stiffness_scale") and isinstance(args.stiffness_scale, str):
-        args.stiffness_scale = _coerce_scale(args.stiffness_scale)
-    try:
-        return int(args.func(args) or 0)
-    except InputError as exc:
-        print(f"rockyade: error: {exc}", file=sys.stderr)
-        return 2
-    except SolverUnavailableError as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 3
-    except (CalibrationError, SolverFailedError) as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 1
-    except RockyadeError as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,0 +1,7 @@
+"""``python -m rockyade``: the same as the ``rockyade`` command."""
+
+import sys
+
+from rockyade.cli import main
+
+sys.exit(main())

@@ -1,0 +1,52 @@
+"""Per-block summary metrics of a run (the rows of batch summaries and CLI reports)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rockyade.analysis.peaks import effective_restitution, find_peaks
+
+
+def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]]:
+    """Per-block summary of a run: peaks, max |theta|, effective mu, overturn.
+
+    Parameters
+    ----------
+    scene
+        The Scene that produced ``result``.
+    result
+        The Result.
+    n_impacts
+        Impacts used for the effective restitution (free rocking).
+
+    Returns
+    -------
+    dict
+        block name -> ``max_abs_theta_rad``, ``max_theta_over_alpha``, ``n_peaks``,
+        ``first_peak_rad``, ``mu_eff`` (free rocking only; NaN otherwise or without two
+        peaks), ``residual_theta_rad``,
+        ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool).
+    """
+    out: dict[str, dict[str, float]] = {}
+    t = result.t
+    free = scene.motion.type == "free"
+    for spec in scene.blocks:
+        alpha = spec.classical().alpha_rad
+        theta = result.series("theta_rad", spec.name)
+        finite = theta[np.isfinite(theta)]
+        peaks = find_peaks(t, theta, min_peak_rad=max(1e-5, 1e-3 * alpha))
+        lifted = np.nonzero(np.abs(theta) > 1e-4 * alpha)[0]
+        out[spec.name] = {
+            "max_abs_theta_rad": float(np.max(np.abs(finite))) if finite.size else math.nan,
+            "max_theta_over_alpha": float(np.max(np.abs(finite)) / alpha) if finite.size else math.nan,
+            "n_peaks": len(peaks),
+            "first_peak_rad": float(peaks.theta_rad[0]) if len(peaks) else math.nan,
+            "first_peak_time_s": float(peaks.t_s[0]) if len(peaks) else math.nan,
+            "mu_eff": effective_restitution(peaks, alpha, n_impacts) if free else math.nan,
+            "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
+            "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
+            "overturned": result.meta.get("overturned_block") == spec.name,
+        }
+    return out

@@ -1,0 +1,189 @@
+"""Reading scene files (TOML or JSON) and validating them field by field.
+
+Every bad or missing value raises :class:`~rockyade.errors.InputError` naming the file,
+the dotted field and the allowed range.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, STIFFNESS_SCALES
+from rockyade.errors import InputError
+from rockyade.io.fields import TableReader
+from rockyade.motion.spec import parse_motion
+from rockyade.scene.model import (
+    CALIBRATIONS,
+    MAX_DENSITY_KG_M3,
+    MAX_DURATION_S,
+    MAX_LENGTH_M,
+    MAX_MASS_KG,
+    MAX_SAMPLES,
+    NAME_PATTERN,
+    BlockSpec,
+    ContactSpec,
+    OutputSpec,
+    Scene,
+    _check_scene,
+)
+
+
+def load_scene(path: str | Path) -> Scene:
+    """Read and validate a scene file (``.toml`` or ``.json``).
+
+    Raises
+    ------
+    InputError
+        Naming the file, the field and the allowed range, for any bad or missing value.
+    """
+    path = Path(path)
+    source = str(path)
+    if not path.is_file():
+        raise InputError("scene", f"file not found: {path}")
+    text = path.read_text(encoding="utf-8")
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".toml":
+            data = tomllib.loads(text)
+        elif suffix == ".json":
+            data = json.loads(text)
+        else:
+            raise InputError("scene", f"unknown file type {suffix!r}: use .toml or .json", source)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
+        raise InputError("scene", f"not valid {suffix[1:].upper()}: {exc}", source) from None
+    return scene_from_dict(data, source=source, base_dir=path.parent)
+
+
+def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> Scene:
+    """Validate a scene given as a dictionary (as read from TOML or JSON)."""
+    top = TableReader(data, "", source)
+    duration = top.number("duration_s", lo=0.0, hi=MAX_DURATION_S, lo_open=True, unit="s")
+    sample_dt = top.positive("sample_dt_s", unit="s")
+    if sample_dt > duration:
+        raise top.error("sample_dt_s", f"must be <= duration_s ({duration:g} s), got {sample_dt:g}")
+    if duration / sample_dt > MAX_SAMPLES:
+        raise top.error("sample_dt_s", f"gives more than {MAX_SAMPLES} samples; use a larger interval")
+    raw_blocks = top.raw("blocks")
+    if not isinstance(raw_blocks, list) or not raw_blocks:
+        raise top.error("blocks", "must be a non-empty list of block tables ([[blocks]])")
+    blocks = tuple(_parse_block(b, i, source) for i, b in enumerate(raw_blocks))
+    contact = _parse_contact(top.sub("contact", {}))
+    motion = parse_motion(top.raw("motion"), source, base_dir)
+    output = _parse_output(top.sub("output", {}))
+    top.finish()
+    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source)
+    _check_scene(scene)
+    return scene
+
+
+def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
+    r = TableReader(table, f"blocks[{index}]", source)
+    name = r.string("name", f"block{index}")
+    if not NAME_PATTERN.match(name):
+        raise r.error("name", "must start with a letter and contain only letters, digits and _ (max 64)")
+    thickness = _length(r, "thickness_m")
+    vertices = None
+    width = height = None
+    if r.has("vertices_m"):
+        raw = r.raw("vertices_m")
+        if not isinstance(raw, list) or len(raw) < 3 or not all(isinstance(v, list) and len(v) == 2 for v in raw):
+            raise r.error("vertices_m", "must be a list of at least 3 [x, y] pairs in metres")
+        sub = TableReader({f"v{i}": v for i, v in enumerate(raw)}, r.field("vertices_m"), source)
+        vertices = tuple(tuple(sub.number_list(f"v{i}", min_len=2, unit="m")) for i in range(len(raw)))
+        if max(abs(c) for v in vertices for c in v) > MAX_LENGTH_M:
+            raise r.error("vertices_m", f"coordinates must be within +/-{MAX_LENGTH_M:g} m")
+        for key in ("width_m", "height_m"):
+            if r.has(key):
+                raise r.error(key, "give either vertices_m or width_m/height_m, not both")
+            r.raw(key, None)
+    else:
+        width = _length(r, "width_m")
+        height = _length(r, "height_m")
+    mass = r.number("mass_kg", None, lo=0.0, hi=MAX_MASS_KG, lo_open=True, unit="kg")
+    density = r.number("density_kg_m3", None, lo=0.0, hi=MAX_DENSITY_KG_M3, lo_open=True, unit="kg/m^3")
+    if (mass is None) == (density is None):
+        raise r.error("mass_kg", "give exactly one of mass_kg and density_kg_m3")
+    inertia = r.positive("inertia_kgm2", None, unit="kg m^2")
+    x_offset = r.number("x_offset_m", 0.0, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m")
+    alpha = r.number("alpha_rad", None, lo=0.0, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
+    p = r.positive("p_rad_s", None, unit="rad/s")
+    mu = r.number("mu", None, lo=0.0, hi=1.0, lo_open=True)
+    if inertia is not None and p is not None:
+        raise r.error("p_rad_s", "give either inertia_kgm2 or p_rad_s (p sets the DEM inertia), not both")
+    r.finish()
+    spec = BlockSpec(
+        name=name,
+        thickness_m=thickness,
+        width_m=width,
+        height_m=height,
+        vertices_m=vertices,
+        mass_kg=mass,
+        density_kg_m3=density,
+        inertia_kgm2=inertia,
+        x_offset_m=x_offset,
+        alpha_rad=None if alpha is None else float(alpha),
+        p_rad_s=None if p is None else float(p),
+        mu=None if mu is None else float(mu),
+    )
+    try:
+        spec.block()
+    except InputError as exc:
+        raise InputError(f"blocks[{index}].{exc.field}", exc.message, source) from None
+    return spec
+
+
+def _length(r: TableReader, key: str) -> float:
+    """A length in (0, MAX_LENGTH_M] metres."""
+    return r.number(key, lo=0.0, hi=MAX_LENGTH_M, lo_open=True, unit="m")
+
+
+def _parse_contact(r: TableReader) -> ContactSpec:
+    calibration = r.string("calibration", "paper", choices=CALIBRATIONS)
+    scale = r.raw("stiffness_scale", "MN/m")
+    if isinstance(scale, str):
+        if scale not in STIFFNESS_SCALES:
+            raise r.error(
+                "stiffness_scale", f"must be one of {sorted(STIFFNESS_SCALES)} or a number > 0, got {scale!r}"
+            )
+    else:
+        scale = r.positive("stiffness_scale")
+    spec = ContactSpec(
+        calibration=calibration,
+        stiffness_scale=scale,
+        K_N_per_m=r.positive("K_N_per_m", None, unit="N/m"),
+        Ks_N_per_m=r.positive("Ks_N_per_m", None, unit="N/m"),
+        friction_angle_deg=r.number(
+            "friction_angle_deg", DEFAULT_FRICTION_ANGLE_DEG, lo=0.0, hi=90.0, hi_open=True, unit="deg"
+        ),
+        cohesion_Pa=r.number("cohesion_Pa", 0.0, lo=0.0, unit="Pa"),
+        beta_s=r.number("beta_s", None, lo=0.0, unit="s"),
+        dt_s=r.positive("dt_s", None, unit="s"),
+        time_step_frac=r.number("time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""),
+        mass_damping_1_s=r.number("mass_damping_1_s", 0.0, lo=0.0, unit="1/s"),
+    )
+    if spec.cohesion_Pa != 0.0:
+        raise r.error(
+            "cohesion_Pa",
+            "must be 0: the paper's dry joints have no cohesion and YADE's ViscElPhys law "
+            "(the same law in both DEMs) has none",
+        )
+    r.finish()
+    return spec
+
+
+def _parse_output(r: TableReader) -> OutputSpec:
+    point = r.raw("accel_point", "top_centre")
+    if isinstance(point, str):
+        if point != "top_centre":
+            raise r.error("accel_point", f"must be 'top_centre' or [x, y] in metres, got {point!r}")
+    else:
+        point = tuple(r.number_list("accel_point", min_len=2, unit="m"))
+        if len(point) != 2:
+            raise r.error("accel_point", "must be 'top_centre' or [x, y] in metres")
+    lowpass = r.positive("accel_lowpass_hz", None, unit="Hz")
+    r.finish()
+    return OutputSpec(point, lowpass)
