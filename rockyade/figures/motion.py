@@ -1,43 +1,10 @@
-"""Figures (matplotlib, Agg backend): time histories of one or more results."""
+"""Figures of base motions: accelerograms and response spectra."""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
-
-from rockyade.io.atomic import atomic_open
-
-
-def save_figure(fig: plt.Figure, path: str | Path, dpi: int = 130) -> None:
-    """Save ``fig`` as PNG atomically and close it."""
-    with atomic_open(path, "wb") as fh:
-        fig.savefig(fh, format="png", dpi=dpi, bbox_inches="tight")
-    plt.close(fig)
-
-
-def plot_results(results: dict, path: str | Path, title: str = "", quantity: str = "theta_rad") -> None:
-    """theta(t) of each block, one panel per block, one curve per result (label -> Result)."""
-    first = next(iter(results.values()))
-    blocks = first.blocks
-    fig, axes = plt.subplots(len(blocks), 1, figsize=(9, 2.8 * len(blocks) + 0.6), sharex=True, squeeze=False)
-    styles = ["-", "--", ":", "-."]
-    for ax, block in zip(axes[:, 0], blocks, strict=True):
-        for i, (label, res) in enumerate(results.items()):
-            if not res.ok or block not in res.blocks:
-                continue
-            ax.plot(res.t, res.series(quantity, block), styles[i % len(styles)], lw=1.1, label=label)
-        ax.set_ylabel(f"{block}: theta (rad)" if quantity == "theta_rad" else f"{block}: {quantity}")
-        ax.axhline(0.0, color="0.6", lw=0.5)
-        ax.grid(alpha=0.3)
-        ax.legend(loc="upper right", fontsize=8)
-    axes[-1, 0].set_xlabel("time t (s)")
-    if title:
-        fig.suptitle(title)
-    save_figure(fig, path)
+from rockyade.figures.common import plt, save_figure
 
 
 def plot_accelerogram(t, accel, vel, disp, path: str | Path, title: str = "") -> None:
