@@ -12,7 +12,6 @@ from rockyade.analysis.peaks import effective_restitution, find_peaks
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
 from rockyade.dem.matching import build_matched_model, match_beta
-from rockyade.dem.model import stability_limit
 from rockyade.errors import CalibrationError, InputError
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
@@ -223,7 +222,7 @@ def test_stability_limit_of_a_single_spring_matches_closed_form():
     damping the limit is 2 / w_max."""
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
     model = build_dem_model(scene, beta_override=0.0)
-    limit, w_max = stability_limit(model.bodies, 0.0)
+    limit, w_max = model.dt_stable_s, model.w_max_rad_s
     assert limit == pytest.approx(2.0 / w_max)
     k = model.bodies[0].joint.K_N_per_m
     assert w_max > math.sqrt(2 * k / model.bodies[0].mass_kg)  # above the bouncing mode

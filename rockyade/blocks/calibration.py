@@ -242,6 +242,7 @@ def paper_calibration(
     frac: float = DEFAULT_TIME_STEP_FRAC,
     g: float = G,
     field_prefix: str = "contact.",
+    beta_s: float | None = None,
 ) -> ContactParameters:
     """DEM contact parameters of the paper (Eqs 10-15) for the joint beneath ``block``.
 
@@ -261,6 +262,9 @@ def paper_calibration(
         default the block's mass.
     frac
         Eq 7 fraction.
+    beta_s
+        An explicit damping constant, s: used instead of Eq 13, which is then only
+        reported (and may be out of its range without failing).
     """
     geometric = classical_parameters(block, g=g)
     used = classical_parameters(block, alpha_rad=alpha_rad, p_rad_s=p_rad_s, mu=mu, g=g)
@@ -275,7 +279,15 @@ def paper_calibration(
     ratio = gamma / used.mu**2
     if not lo <= ratio <= hi:
         notes.append(f"Gamma/mu^2 = {ratio:.0f} outside the paper's data ({lo:.0f}-{hi:.0f}): Eq 13 is extrapolated")
-    beta = stiffness_damping_eq13(gamma, used.mu)
+    if beta_s is None:
+        beta = beta_eq13 = stiffness_damping_eq13(gamma, used.mu)
+    else:
+        beta = float(beta_s)
+        try:
+            beta_eq13: float | None = stiffness_damping_eq13(gamma, used.mu)
+        except CalibrationError:
+            beta_eq13 = None
+            notes.append("Eq 13 has no value here (sqrt(b) < 0); beta_s explicit")
     f_min = f_min_eq14(used.p_rad_s)
     k = k_paper * factor
     settlement = check_settlement(
@@ -295,8 +307,8 @@ def paper_calibration(
         stiffness_scale=factor,
         stiffness_reading=reading,
         gamma=gamma,
-        beta_eq13_s=beta,
-        method="paper",
+        beta_eq13_s=beta_eq13,
+        method="paper" if beta_s is None else "explicit",
         dt_eq7_s=time_step_eq7(block.mass_kg, k, frac),
         settlement_m=settlement,
         notes=tuple(notes),

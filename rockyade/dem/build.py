@@ -3,9 +3,16 @@
 Bodies: the contact polygon of each block is its own, with its base corners moved to the
 equivalent base x_c +/- b_eq, b_eq = h tan(alpha) (paper Eq 11) when alpha is
 overridden; when p is overridden the inertia is set so that the DEM rocks with that p:
-I_O = M g R / p^2 (Eq 8 does not do it: a stiff contact does not change p). Joints: the
-contact parameters of the interface beneath each block (paper Eqs 10-15, or explicit
-values); a matched calibration must have been resolved before (:mod:`rockyade.dem.matching`).
+I_O = M g R / p^2 (Eq 8 does not do it: a stiff contact does not change p). Each body is
+placed at rest as the scene says (stacked, or at ``position_m`` rotated by
+``rotation_rad``).
+
+Joints (:mod:`rockyade.dem.joints`): each moving block's own joint (paper Eqs 10-15,
+explicit values, or UDEC-style stiffness per area), and the joint of every pair touching
+at rest (bed, head, block-base, block-fixed). A matched calibration must have been
+resolved before (:mod:`rockyade.dem.matching`). The time step (Eq 7, kept below the
+stability limit) and the static settlement come from the springs at rest
+(:mod:`rockyade.dem.statics`).
 """
 
 from __future__ import annotations
@@ -17,13 +24,16 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from rockyade.blocks.calibration import ContactParameters, check_settlement, paper_calibration, time_step_eq7
+from rockyade.blocks.calibration import ContactParameters, time_step_eq7
 from rockyade.blocks.classical import frequency_parameter, inertia_for_frequency
 from rockyade.blocks.geometry import LEVEL_TOL, Block
-from rockyade.constants import G
-from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, MatchedBeta, check_user_dt, stability_limit
+from rockyade.constants import MAX_SETTLEMENT_FRACTION, G
+from rockyade.dem.joints import JointTable, MatchedBeta, own_joint, resolve_joints
+from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt
+from rockyade.dem.statics import mass_vector, rest_springs, stability_limit, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import BlockSpec, Scene
+from rockyade.scene.placement import PlacedBlock, RestContact, placed_blocks, rest_contacts, rotation_matrix
 
 # ---------------------------------------------------------------------- bodies
 
@@ -58,8 +68,8 @@ def _from_bottom_left(verts: np.ndarray) -> np.ndarray:
 def _dem_body(
     spec: BlockSpec,
     index: int,
-    joint: ContactParameters,
-    rest_centroid: tuple[float, float],
+    joint: ContactParameters | None,
+    placed: PlacedBlock,
     accel_point: object,
     g: float,
 ) -> DemBody:
@@ -71,6 +81,23 @@ def _dem_body(
         notes.append(
             f"base corners at the equivalent base b_eq = h tan(alpha) = {cy * math.tan(spec.alpha_rad):.6g} m (Eq 11)"
         )
+    if accel_point == "top_centre":
+        point = (0.0, block.height_m - cy)
+    else:
+        point = (float(accel_point[0]) - cx, float(accel_point[1]) - cy)  # type: ignore[index]
+    common = dict(
+        name=spec.name,
+        mass_kg=block.mass_kg,
+        contact_vertices_m=polygon - np.array([cx, cy]),
+        rest_centroid_m=placed.centroid_m,
+        accel_point_m=point,
+        joint=joint,
+        fixed=spec.fixed,
+        rest_angle_rad=placed.rotation_rad,
+    )
+    if spec.fixed:
+        nan = math.nan
+        return DemBody(inertia_kgm2=block.inertia_c_kgm2, alpha_rad=nan, p_rad_s=nan, R_m=nan, **common)  # type: ignore[arg-type]
     xs = polygon[np.abs(polygon[:, 1]) <= LEVEL_TOL * max(block.height_m, 1.0), 0]
     pivot_left = np.array([xs.min(), 0.0])
     R = float(np.hypot(cx - pivot_left[0], cy))
@@ -89,90 +116,93 @@ def _dem_body(
             f"centroidal inertia set to {inertia:.6g} kg m^2 so that p = sqrt(M g R / I_O) = {spec.p_rad_s:g} 1/s"
         )
     p = frequency_parameter(block.mass_kg, R, inertia + block.mass_kg * R * R, g)
-    if accel_point == "top_centre":
-        point = (0.0, block.height_m - cy)
-    else:
-        point = (float(accel_point[0]) - cx, float(accel_point[1]) - cy)  # type: ignore[index]
-    return DemBody(
-        name=spec.name,
-        mass_kg=block.mass_kg,
-        inertia_kgm2=inertia,
-        contact_vertices_m=polygon - np.array([cx, cy]),
-        rest_centroid_m=rest_centroid,
-        accel_point_m=point,
-        joint=joint,
-        alpha_rad=alpha,
-        p_rad_s=p,
-        R_m=R,
-        notes=tuple(notes),
-    )
+    return DemBody(inertia_kgm2=inertia, alpha_rad=alpha, p_rad_s=p, R_m=R, notes=tuple(notes), **common)  # type: ignore[arg-type]
 
 
-# ---------------------------------------------------------------------- joints
+def world_polygon(body: DemBody) -> np.ndarray:
+    """A body's contact polygon in the base frame at rest, m."""
+    return body.contact_vertices_m @ rotation_matrix(body.rest_angle_rad).T + np.asarray(body.rest_centroid_m)
 
 
-def _joint(
-    scene: Scene, index: int, g: float, beta_override: float | None, matched: Mapping[str, MatchedBeta] | None
-) -> ContactParameters:
-    """Contact parameters of the interface beneath block ``index``."""
-    spec = scene.blocks[index]
-    block = spec.block()
-    c = scene.contact
-    supported = sum(b.block().mass_kg for b in scene.blocks[index:])
-    joint = paper_calibration(
-        block,
-        alpha_rad=spec.alpha_rad,
-        p_rad_s=spec.p_rad_s,
-        mu=spec.mu,
-        stiffness_scale=c.stiffness_scale,
-        friction_angle_deg=c.friction_angle_deg,
-        supported_mass_kg=supported,
-        frac=c.time_step_frac,
-        g=g,
-    )
-    notes = list(joint.notes)
-    changes: dict[str, object] = {}
-    if c.K_N_per_m is not None:
-        changes["K_N_per_m"] = c.K_N_per_m
-        changes["Ks_N_per_m"] = c.K_N_per_m
-        notes.append("K_N_per_m explicit")
-    if c.Ks_N_per_m is not None:
-        changes["Ks_N_per_m"] = c.Ks_N_per_m
-        notes.append("Ks_N_per_m explicit")
-    method = joint.method
-    beta = None
-    if beta_override is not None:
-        beta, method = beta_override, "explicit"
-    elif c.beta_s is not None:
-        beta, method = c.beta_s, "explicit"
-        notes.append("beta_s explicit")
-    elif c.calibration == "matched":
-        found = (matched or {}).get(spec.name)
-        if found is None:
-            raise InputError(
-                "contact.calibration",
-                "matched: the damping must be matched before the model is built "
-                "(rockyade.dem.matching.build_matched_model, or the solvers, do it)",
-            )
-        beta, method = found.beta_s, "matched"
-        notes.append(
-            f"beta matched: reference DEM effective mu {found.mu_eff:.5f} for target {found.mu_target:.5f} "
-            f"(reachable {found.mu_min:.4f}-{found.mu_max:.4f}); Eq 13 gives {joint.beta_eq13_s:.4g} s"
+def _supported_masses(scene: Scene) -> list[float]:
+    """Mass resting on each block's base joint in a column (the block and those above);
+    in an assembly each block's own mass (the statics check covers the load paths)."""
+    masses = [b.block().mass_kg for b in scene.blocks]
+    if scene.positioned:
+        return masses
+    return [sum(masses[i:]) for i in range(len(masses))]
+
+
+def _released_group(index: int, contacts: list[RestContact]) -> list[int]:
+    """The released block and every block resting on it, through bed joints, transitively."""
+    group, todo = {index}, [index]
+    while todo:
+        k = todo.pop()
+        for c in contacts:
+            if c.kind != "bed" or c.b < 0 or k not in (c.a, c.b) or c.upper == k:
+                continue
+            if c.upper not in group:
+                group.add(c.upper)
+                todo.append(c.upper)
+    return sorted(group)
+
+
+def _initial_state(scene: Scene, bodies: tuple[DemBody, ...], contacts: list[RestContact]):
+    nb = len(bodies)
+    pos0 = np.array([b.rest_centroid_m for b in bodies], dtype=float)
+    ang0 = np.array([b.rest_angle_rad for b in bodies], dtype=float)
+    vel0 = np.zeros((nb, 2))
+    angvel0 = np.zeros(nb)
+    theta0, omega0 = scene.motion.initial_theta_rad, scene.motion.initial_omega_rad_s
+    if theta0 == 0.0 and omega0 == 0.0:
+        return pos0, ang0, vel0, angvel0
+    k = scene.released_index
+    verts = world_polygon(bodies[k])
+    low = verts[:, 1] <= verts[:, 1].min() + LEVEL_TOL * max(float(np.ptp(verts[:, 1])), 1.0)
+    base = verts[low]
+    turning_left = theta0 > 0 or (theta0 == 0 and omega0 > 0)
+    pivot = base[np.argmin(base[:, 0])] if turning_left else base[np.argmax(base[:, 0])]
+    c, s = math.cos(theta0), math.sin(theta0)
+    for j in _released_group(k, contacts):
+        r = pos0[j] - pivot
+        r = np.array([c * r[0] - s * r[1], s * r[0] + c * r[1]])
+        pos0[j] = pivot + r
+        ang0[j] += theta0
+        vel0[j] = omega0 * np.array([-r[1], r[0]])
+        angvel0[j] = omega0
+    return pos0, ang0, vel0, angvel0
+
+
+def _check_settlement(
+    springs, bodies: tuple[DemBody, ...], contacts: list[RestContact], joints: JointTable, scene: Scene, g: float
+) -> float:
+    """Largest static penetration, m; refused above MAX_SETTLEMENT_FRACTION of the blocks' height."""
+    pen = static_penetration(springs, [b.mass_kg for b in bodies], [b.fixed for b in bodies], g)
+    if pen is None or pen.size == 0:
+        return math.nan
+    owner = springs.contact[springs.normal]
+    heights = np.array([_joint_height(contacts[int(k)], bodies) for k in owner])
+    worst = int(np.argmax(pen / heights))
+    c = contacts[int(owner[worst])]
+    height = heights[worst]
+    if pen[worst] > MAX_SETTLEMENT_FRACTION * height:
+        names = bodies[c.a].name + ("-base" if c.b < 0 else f"-{bodies[c.b].name}")
+        field_name = "contact.K_N_per_m" if scene.contact.explicit_stiffness else "contact.stiffness_scale"
+        k = joints.params[joints.joint_for(c.a, c.b)].K_N_per_m
+        raise InputError(
+            field_name,
+            f"K = {k:.4g} N/m lets the joint {names} sink {pen[worst]:.3g} m under the static load, above "
+            f"{MAX_SETTLEMENT_FRACTION:g} of the block height ({MAX_SETTLEMENT_FRACTION * height:.3g} m): the blocks "
+            "sink into each other. Raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') "
+            "or check the units",
         )
-    if beta is not None:
-        changes["beta_s"] = beta
-        changes["xi_min"] = 2.0 * math.pi * beta * joint.f_min_hz
-    k = float(changes.get("K_N_per_m", joint.K_N_per_m))  # type: ignore[arg-type]
-    settlement = check_settlement(
-        supported, k, block.height_m, "contact.K_N_per_m" if c.K_N_per_m else "contact.stiffness_scale", g
-    )
-    changes.update(
-        method=method,
-        notes=tuple(notes),
-        settlement_m=settlement,
-        dt_eq7_s=time_step_eq7(block.mass_kg, k, c.time_step_frac),
-    )
-    return replace(joint, **changes)  # type: ignore[arg-type]
+    return float(pen.max())
+
+
+def _joint_height(c: RestContact, bodies: tuple[DemBody, ...]) -> float:
+    """Height of the smaller moving block of a joint, m (the settlement scale)."""
+    heights = [float(np.ptp(bodies[i].contact_vertices_m[:, 1])) for i in (c.a, c.b) if i >= 0 and not bodies[i].fixed]
+    return min(heights)
 
 
 # ---------------------------------------------------------------------- model
@@ -198,42 +228,42 @@ def build_dem_model(
         Matched damping per block name, for ``calibration = "matched"``
         (:func:`rockyade.dem.matching.matched_betas`).
     """
-    joints = [_joint(scene, i, g, beta_override, matched) for i in range(len(scene.blocks))]
-    bodies: list[DemBody] = []
-    base_y = 0.0
-    for index, (spec, joint) in enumerate(zip(scene.blocks, joints, strict=True)):
-        block = spec.block()
-        cx, cy = block.centroid_m
-        rest = (spec.x_offset_m + cx, base_y + cy)
-        bodies.append(_dem_body(spec, index, joint, rest, scene.output.accel_point, g))
-        base_y += block.height_m
-    bodies_t = tuple(bodies)
-    nb = len(bodies_t)
-    pos0 = np.array([b.rest_centroid_m for b in bodies_t], dtype=float)
-    ang0 = np.zeros(nb)
-    vel0 = np.zeros((nb, 2))
-    angvel0 = np.zeros(nb)
-    theta0, omega0 = scene.motion.initial_theta_rad, scene.motion.initial_omega_rad_s
-    if theta0 != 0.0 or omega0 != 0.0:
-        k = scene.released_index
-        verts = bodies_t[k].contact_vertices_m + pos0[k]
-        base = verts[np.abs(verts[:, 1] - verts[:, 1].min()) <= 1e-9]
-        turning_left = theta0 > 0 or (theta0 == 0 and omega0 > 0)
-        pivot = base[np.argmin(base[:, 0])] if turning_left else base[np.argmax(base[:, 0])]
-        c, s = math.cos(theta0), math.sin(theta0)
-        for j in range(k, nb):
-            r = pos0[j] - pivot
-            pos0[j] = pivot + np.array([c * r[0] - s * r[1], s * r[0] + c * r[1]])
-            ang0[j] = theta0
-            r = pos0[j] - pivot
-            vel0[j] = omega0 * np.array([-r[1], r[0]])
-            angvel0[j] = omega0
+    placed = placed_blocks(scene)
+    supported = _supported_masses(scene)
+    own: list[ContactParameters | None] = []
+    for i, spec in enumerate(scene.blocks):
+        if spec.fixed:
+            own.append(None)
+            continue
+        joint = own_joint(scene, i, supported[i], matched, g)
+        if beta_override is not None:
+            xi = 2 * math.pi * beta_override * joint.f_min_hz
+            joint = replace(joint, beta_s=beta_override, method="explicit", xi_min=xi)
+        own.append(joint)
+    bodies = tuple(
+        _dem_body(spec, i, own[i], placed[i], scene.output.accel_point, g) for i, spec in enumerate(scene.blocks)
+    )
+    contacts = rest_contacts(placed, [world_polygon(b) for b in bodies])
+    joints = resolve_joints(
+        scene,
+        own,
+        contacts,
+        [spec.thickness_m for spec in scene.blocks],
+        [float(np.ptp(p.vertices_m[:, 0])) for p in placed],
+    )
+    centroids = np.array([b.rest_centroid_m for b in bodies], dtype=float)
+    fixed = [b.fixed for b in bodies]
+    springs = rest_springs(centroids, fixed, contacts, joints)
+    mass = mass_vector([b.mass_kg for b in bodies], [b.inertia_kgm2 for b in bodies], fixed)
+    dt_stable, w_max = stability_limit(springs, mass, scene.contact.mass_damping_1_s)
+    settlement = _check_settlement(springs, bodies, contacts, joints, scene, g)
+    pos0, ang0, vel0, angvel0 = _initial_state(scene, bodies, contacts)
+    moving = [b for b in bodies if not b.fixed]
     dt_eq7 = time_step_eq7(
-        min(b.mass_kg for b in bodies_t),
-        max(b.joint.K_N_per_m for b in bodies_t),
+        min(b.mass_kg for b in moving),
+        max(p.K_N_per_m for p in joints.params),
         scene.contact.time_step_frac,
     )
-    dt_stable, _ = stability_limit(bodies_t, scene.contact.mass_damping_1_s)
     if scene.contact.dt_s is not None:
         check_user_dt(scene.contact.dt_s, dt_stable)
         dt_target, source = scene.contact.dt_s, "user"
@@ -246,7 +276,8 @@ def build_dem_model(
         )
     steps = max(1, math.ceil(scene.sample_dt_s / dt_target - 1e-9))
     return DemModel(
-        bodies=bodies_t,
+        bodies=bodies,
+        joints=joints,
         motion=scene.motion.ground_motion(scene.duration_s),
         pos0_m=pos0,
         ang0_rad=ang0,
@@ -264,4 +295,7 @@ def build_dem_model(
         g=g,
         scene_hash=scene.scene_hash,
         calibration=scene.contact.calibration,
+        static_settlement_m=settlement,
+        w_max_rad_s=w_max,
+        rest_contacts=tuple(contacts),
     )

@@ -13,6 +13,7 @@ import numpy as np
 
 from rockyade.dem import kernel
 from rockyade.dem.model import DemModel
+from rockyade.errors import InputError
 
 
 def model_arrays(model: DemModel) -> dict[str, object]:
@@ -26,7 +27,9 @@ def model_arrays(model: DemModel) -> dict[str, object]:
         verts[i, :n] = b.contact_vertices_m
         nverts[i] = n
     radius = np.array([np.max(np.hypot(*b.contact_vertices_m.T)) for b in model.bodies]) * (1 + 1e-9)
-    joint = [b.joint for b in model.bodies]
+    if any(b.fixed for b in model.bodies):
+        raise InputError("blocks.fixed", "fixed blocks are not supported by this reference DEM kernel yet")
+    joint = [model.joints.params[int(j)] for j in model.joints.base_joint]
     motion = model.motion
     return {
         "mass": np.array([b.mass_kg for b in model.bodies]),

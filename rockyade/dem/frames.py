@@ -52,7 +52,7 @@ def dem_frame(
     data: dict[str, object] = {"t_s": t, "ag_m_s2": ah}
     for i, body in enumerate(model.bodies):
         rest = np.asarray(body.rest_centroid_m)
-        data[column(body.name, "theta_rad", names)] = ang[:, i]
+        data[column(body.name, "theta_rad", names)] = ang[:, i] - body.rest_angle_rad
         data[column(body.name, "omega_rad_s", names)] = angvel[:, i]
         data[column(body.name, "x_m", names)] = pos[:, i, 0] - rest[0]
         data[column(body.name, "y_m", names)] = pos[:, i, 1] - rest[1]

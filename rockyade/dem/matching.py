@@ -28,7 +28,8 @@ from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, G
 from rockyade.dem import kernel
 from rockyade.dem.build import build_dem_model
 from rockyade.dem.engine import simulate_model
-from rockyade.dem.model import DemModel, MatchedBeta
+from rockyade.dem.joints import MatchedBeta
+from rockyade.dem.model import DemModel
 from rockyade.errors import CalibrationError
 from rockyade.scene import Scene, scene_from_dict
 

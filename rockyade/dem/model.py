@@ -25,11 +25,12 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.linalg import eigh
 
 from rockyade.blocks.calibration import ContactParameters
+from rockyade.dem.joints import JointTable
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
+from rockyade.scene.placement import RestContact
 
 #: Default time step = min(Eq 7, STABILITY_MARGIN * stability limit).
 STABILITY_MARGIN = 0.8
@@ -52,11 +53,17 @@ class DemBody:
     accel_point_m
         Output point relative to the centroid, body frame, m.
     joint
-        Contact parameters of the interface beneath this block.
+        The block's own joint (the interface beneath it, calibrated from it); None for a
+        fixed body. Which joint a contact uses is decided by ``DemModel.joints``.
     alpha_rad, p_rad_s, R_m
-        The DEM's own classical parameters (contact polygon and inertia), left pivot.
+        The DEM's own classical parameters (contact polygon and inertia), left pivot of
+        its base in its own frame; NaN for a fixed body.
     notes
         How the body was derived from the block.
+    fixed
+        Moves with the base (does not move in the base frame).
+    rest_angle_rad
+        Orientation at rest, rad: the body's world angle is rest_angle + theta.
     """
 
     name: str
@@ -65,11 +72,13 @@ class DemBody:
     contact_vertices_m: np.ndarray = field(repr=False)
     rest_centroid_m: tuple[float, float]
     accel_point_m: tuple[float, float]
-    joint: ContactParameters
+    joint: ContactParameters | None
     alpha_rad: float
     p_rad_s: float
     R_m: float
     notes: tuple[str, ...] = ()
+    fixed: bool = False
+    rest_angle_rad: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -77,6 +86,7 @@ class DemModel:
     """Everything both DEMs need, resolved from a scene (see module docstring)."""
 
     bodies: tuple[DemBody, ...]
+    joints: JointTable
     motion: GroundMotion | None
     pos0_m: np.ndarray
     ang0_rad: np.ndarray
@@ -94,6 +104,9 @@ class DemModel:
     g: float
     scene_hash: str
     calibration: str
+    static_settlement_m: float = math.nan
+    w_max_rad_s: float = math.nan
+    rest_contacts: tuple[RestContact, ...] = ()
 
     @property
     def n_steps(self) -> int:
@@ -105,9 +118,22 @@ class DemModel:
         """Body names, bottom to top."""
         return [b.name for b in self.bodies]
 
-    def joint_summary(self) -> dict[str, dict[str, object]]:
-        """Contact parameters actually used, per joint (named by the block above it)."""
-        return {b.name: b.joint.as_dict() for b in self.bodies}
+    @property
+    def moving(self) -> list[int]:
+        """Indices of the bodies that move (not fixed)."""
+        return [i for i, b in enumerate(self.bodies) if not b.fixed]
+
+    def joint_summary(self) -> dict[str, object]:
+        """Contact parameters actually used: each moving block's joint against the base (its
+        own joint unless overridden) by name, and for assemblies the whole joint table."""
+        out: dict[str, object] = {
+            b.name: self.joints.params[int(self.joints.base_joint[i])].as_dict()
+            for i, b in enumerate(self.bodies)
+            if not b.fixed
+        }
+        if self.joints.n_pairs or any(b.fixed for b in self.bodies):
+            out["joint_table"] = self.joints.summary(self.names)
+        return out
 
     def body_summary(self) -> dict[str, dict[str, object]]:
         """The DEM's bodies: mass, inertia, contact polygon, own alpha and p."""
@@ -120,6 +146,9 @@ class DemModel:
                 "p_rad_s": b.p_rad_s,
                 "R_m": b.R_m,
                 "notes": list(b.notes),
+                "fixed": b.fixed,
+                "rest_centroid_m": list(b.rest_centroid_m),
+                "rest_angle_rad": b.rest_angle_rad,
             }
             for b in self.bodies
         }
@@ -137,60 +166,6 @@ class DemModel:
         return replace(self, dt_s=self.sample_dt_s / steps, steps_per_sample=steps, dt_source="user")
 
 
-# ---------------------------------------------------------------------- stability
-
-
-def stability_limit(bodies: tuple[DemBody, ...], mass_damping: float) -> tuple[float, float]:
-    """Largest stable time step of the explicit scheme for the system at rest, and w_max.
-
-    The contact springs active at rest (base corners on their support, and support corners
-    on the base of the block above) give K; M = diag(m, m, I). With the stiffness
-    proportional dashpots the damping ratio of a mode is at most beta_max w / 2 (+ the
-    mass-proportional a / (2 w)); the central-difference limit is
-    (2 / w) (sqrt(1 + xi^2) - xi), smallest for the highest mode.
-    """
-    nb = len(bodies)
-    K = np.zeros((3 * nb, 3 * nb))
-    M = np.zeros(3 * nb)
-    for i, b in enumerate(bodies):
-        M[3 * i : 3 * i + 2] = b.mass_kg
-        M[3 * i + 2] = b.inertia_kgm2
-
-    def add_spring(a: int, b: int, point: np.ndarray, direction: np.ndarray, k: float) -> None:
-        row = np.zeros(3 * nb)
-        for body, sign in ((a, 1.0), (b, -1.0)):
-            if body < 0:
-                continue
-            r = point - np.asarray(bodies[body].rest_centroid_m)
-            row[3 * body : 3 * body + 3] += sign * np.array(
-                [direction[0], direction[1], r[0] * direction[1] - r[1] * direction[0]]
-            )
-        K[:, :] += k * np.outer(row, row)
-
-    n, t = np.array([0.0, 1.0]), np.array([1.0, 0.0])
-    for i, body in enumerate(bodies):
-        c = np.asarray(body.rest_centroid_m)
-        verts = body.contact_vertices_m + c
-        base_y = verts[:, 1].min()
-        base = verts[np.abs(verts[:, 1] - base_y) <= 1e-9 * max(1.0, abs(base_y))]
-        if i == 0:
-            supports = [(p, -1) for p in base]
-        else:
-            below = bodies[i - 1].contact_vertices_m + np.asarray(bodies[i - 1].rest_centroid_m)
-            top_y = below[:, 1].max()
-            top = below[np.abs(below[:, 1] - top_y) <= 1e-9 * max(1.0, abs(top_y))]
-            supports = [(p, i - 1) for p in base if top[:, 0].min() - 1e-12 <= p[0] <= top[:, 0].max() + 1e-12]
-            supports += [(p, i - 1) for p in top if base[:, 0].min() < p[0] < base[:, 0].max()]
-        for point, other in supports:
-            add_spring(i, other, point, n, body.joint.K_N_per_m)
-            add_spring(i, other, point, t, body.joint.Ks_N_per_m)
-    w2 = eigh(K, np.diag(M), eigvals_only=True)
-    w_max = math.sqrt(max(float(w2.max()), 0.0))
-    beta_max = max(b.joint.beta_s for b in bodies)
-    xi = 0.5 * beta_max * w_max + (0.5 * mass_damping / w_max if w_max > 0 else 0.0)
-    return (2.0 / w_max) * (math.sqrt(1.0 + xi * xi) - xi), w_max
-
-
 def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
     """Refuse a time step above the stability limit."""
     if dt_s > dt_stable_s:
@@ -199,50 +174,3 @@ def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
             f"{dt_s:.4g} s is above the stability limit {dt_stable_s:.4g} s of the explicit scheme "
             "for these contacts (stiffness and damping); use a smaller time step or leave it to Eq 7",
         )
-
-
-@dataclass(frozen=True)
-class MatchedBeta:
-    """Result of a matched calibration.
-
-    Attributes
-    ----------
-    beta_s
-        Matched stiffness-proportional damping, s.
-    mu_eff, mu_target
-        Achieved and target effective restitution.
-    mu_max, mu_min
-        Reachable range: mu_eff without damping and with the heaviest damping tried.
-    beta_max_s
-        Heaviest damping tried, s.
-    beta_eq13_s
-        The paper's empirical value (Eq 13), for comparison.
-    n_runs
-        DEM runs used.
-    n_impacts
-        Impacts averaged per run.
-    """
-
-    beta_s: float
-    mu_eff: float
-    mu_target: float
-    mu_max: float
-    mu_min: float
-    beta_max_s: float
-    beta_eq13_s: float
-    n_runs: int
-    n_impacts: int
-
-    def as_cli_dict(self) -> dict[str, float]:
-        """Keys for ``rockyade calibrate --method matched --json``."""
-        return {
-            "beta_s": self.beta_s,
-            "beta_matched_s": self.beta_s,
-            "mu_eff_matched": self.mu_eff,
-            "mu_target": self.mu_target,
-            "mu_reachable_min": self.mu_min,
-            "mu_reachable_max": self.mu_max,
-            "beta_eq13_s": self.beta_eq13_s,
-            "matching_runs": self.n_runs,
-            "matching_impacts": self.n_impacts,
-        }

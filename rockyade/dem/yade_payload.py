@@ -37,8 +37,11 @@ def scene_payload(model: DemModel) -> dict[str, object]:
     sizes = [float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies]
     radius = SPHERE_RADIUS_FRACTION * min(sizes)
 
-    def joint(b) -> dict[str, float]:
-        j = b.joint
+    if any(b.fixed for b in model.bodies) or model.joints.n_pairs > nb - 1:
+        raise InputError("blocks", "the YADE backend runs single columns only (no fixed or side-by-side blocks)")
+
+    def joint(i: int) -> dict[str, float]:
+        j = model.joints.params[int(model.joints.base_joint[i])]
         return {
             "kn": j.K_N_per_m,
             "ks": j.Ks_N_per_m,
@@ -85,8 +88,8 @@ def scene_payload(model: DemModel) -> dict[str, object]:
                 "vel0_m_s": model.vel0_m_s[i].tolist(),
                 "angvel0_rad_s": float(model.angvel0_rad_s[i]),
                 "accel_point_m": list(b.accel_point_m),
-                "joint_below": joint(b),
-                "joint_above": joint(model.bodies[i + 1]) if i + 1 < nb else None,
+                "joint_below": joint(i),
+                "joint_above": joint(i + 1) if i + 1 < nb else None,
                 "thickness_m": max(0.1 * height, 10 * radius),
                 "slabs": slabs,
             }

@@ -6,11 +6,12 @@ the same base acceleration.
 """
 
 from rockyade.motion.ground import GroundMotion
-from rockyade.motion.spec import MOTION_TYPES, FreeRocking, MotionSpec, SampledMotion, parse_motion
+from rockyade.motion.spec import MOTION_TYPES, AtRest, FreeRocking, MotionSpec, SampledMotion, parse_motion
 from rockyade.motion.types import HarmonicMotion, PulseMotion, RecordMotion, SyntheticMotion
 
 __all__ = [
     "MOTION_TYPES",
+    "AtRest",
     "FreeRocking",
     "GroundMotion",
     "HarmonicMotion",

@@ -1,6 +1,7 @@
 """The ``[motion]`` table of a scene: one dataclass per motion type, parsed and validated.
 
-Types: ``free`` (free rocking from an initial tilt) and ``sampled`` (base acceleration
+Types: ``rest`` (the base at rest, every block released from rest: does the assembly
+stand?), ``free`` (free rocking from an initial tilt) and ``sampled`` (base acceleration
 samples given inline); :mod:`rockyade.motion.types` registers the shake-table, pulse,
 record and synthetic types.
 """
@@ -108,6 +109,20 @@ class FreeRocking(MotionSpec):
 
 
 @dataclass(frozen=True)
+class AtRest(MotionSpec):
+    """The base at rest and every block released from rest: gravity alone (does it stand?)."""
+
+    type: ClassVar[str] = "rest"
+
+    def ground_motion(self, duration_s: float) -> GroundMotion | None:
+        return None
+
+    @classmethod
+    def parse(cls, r: TableReader, base_dir: Path | None) -> AtRest:
+        return cls()
+
+
+@dataclass(frozen=True)
 class SampledMotion(MotionSpec):
     """Base acceleration samples given in the scene itself.
 
@@ -159,6 +174,7 @@ class SampledMotion(MotionSpec):
 
 #: Parsers of the ``[motion]`` table by ``type``.
 MOTION_TYPES: dict[str, Callable[[TableReader, Path | None], MotionSpec]] = {
+    AtRest.type: AtRest.parse,
     FreeRocking.type: FreeRocking.parse,
     SampledMotion.type: SampledMotion.parse,
 }

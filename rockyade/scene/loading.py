@@ -18,6 +18,7 @@ from rockyade.io.fields import TableReader
 from rockyade.motion.spec import parse_motion
 from rockyade.scene.model import (
     CALIBRATIONS,
+    JOINT_OVERRIDE_KEYS,
     MAX_DENSITY_KG_M3,
     MAX_DURATION_S,
     MAX_LENGTH_M,
@@ -26,6 +27,7 @@ from rockyade.scene.model import (
     NAME_PATTERN,
     BlockSpec,
     ContactSpec,
+    JointOverride,
     OutputSpec,
     Scene,
     _check_scene,
@@ -74,8 +76,9 @@ def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None 
     contact = _parse_contact(top.sub("contact", {}))
     motion = parse_motion(top.raw("motion"), source, base_dir)
     output = _parse_output(top.sub("output", {}))
+    joints = _parse_joints(top.raw("joints", []), source)
     top.finish()
-    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source)
+    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source, joints)
     _check_scene(scene)
     return scene
 
@@ -109,6 +112,16 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
         raise r.error("mass_kg", "give exactly one of mass_kg and density_kg_m3")
     inertia = r.positive("inertia_kgm2", None, unit="kg m^2")
     x_offset = r.number("x_offset_m", 0.0, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m")
+    position = r.number_list("position_m", None, min_len=2, unit="m")
+    if position is not None:
+        if len(position) != 2:
+            raise r.error("position_m", "must be [x, y] in metres")
+        if max(abs(c) for c in position) > MAX_LENGTH_M:
+            raise r.error("position_m", f"coordinates must be within +/-{MAX_LENGTH_M:g} m")
+    rotation = r.number("rotation_rad", 0.0, lo=-2 * math.pi, hi=2 * math.pi, unit="rad")
+    if rotation != 0.0 and position is None:
+        raise r.error("rotation_rad", "needs position_m (an assembly scene)")
+    fixed = r.boolean("fixed", False)
     alpha = r.number("alpha_rad", None, lo=0.0, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
     p = r.positive("p_rad_s", None, unit="rad/s")
     mu = r.number("mu", None, lo=0.0, hi=1.0, lo_open=True)
@@ -128,6 +141,9 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
         alpha_rad=None if alpha is None else float(alpha),
         p_rad_s=None if p is None else float(p),
         mu=None if mu is None else float(mu),
+        position_m=None if position is None else (position[0], position[1]),
+        rotation_rad=rotation,
+        fixed=fixed,
     )
     try:
         spec.block()
@@ -164,7 +180,19 @@ def _parse_contact(r: TableReader) -> ContactSpec:
         dt_s=r.positive("dt_s", None, unit="s"),
         time_step_frac=r.number("time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""),
         mass_damping_1_s=r.number("mass_damping_1_s", 0.0, lo=0.0, unit="1/s"),
+        jkn_Pa_per_m=r.positive("jkn_Pa_per_m", None, unit="Pa/m"),
+        jks_Pa_per_m=r.positive("jks_Pa_per_m", None, unit="Pa/m"),
     )
+    if spec.K_N_per_m is not None and spec.jkn_Pa_per_m is not None:
+        raise r.error("jkn_Pa_per_m", "give K_N_per_m (per contact point) or jkn_Pa_per_m (per unit area), not both")
+    if spec.jks_Pa_per_m is not None and spec.jkn_Pa_per_m is None:
+        raise r.error("jks_Pa_per_m", "needs jkn_Pa_per_m (UDEC-style stiffness per unit area)")
+    if spec.jkn_Pa_per_m is not None and spec.beta_s is None:
+        raise r.error(
+            "beta_s",
+            "is required with jkn_Pa_per_m: the paper's Eq 13 damping is fitted to its own K (Eq 10), "
+            "not to a stiffness per unit area",
+        )
     if spec.cohesion_Pa != 0.0:
         raise r.error(
             "cohesion_Pa",
@@ -187,3 +215,30 @@ def _parse_output(r: TableReader) -> OutputSpec:
     lowpass = r.positive("accel_lowpass_hz", None, unit="Hz")
     r.finish()
     return OutputSpec(point, lowpass)
+
+
+def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
+    """The ``[[joints]]`` list: per-pair overrides by block names (see scene.model.JointOverride)."""
+    if not isinstance(raw, list):
+        raise InputError("joints", "must be a list of tables ([[joints]])", source)
+    out = []
+    for k, table in enumerate(raw):
+        r = TableReader(table, f"joints[{k}]", source)
+        names = r.raw("blocks")
+        if not isinstance(names, list) or len(names) != 2 or not all(isinstance(n, str) for n in names):
+            raise r.error("blocks", 'must be two block names, e.g. ["b1", "b2"] or ["b1", "base"]')
+        values = []
+        for key in JOINT_OVERRIDE_KEYS:
+            if key == "friction_angle_deg":
+                value = r.number(key, None, lo=0.0, hi=90.0, hi_open=True, unit="deg")
+            elif key == "beta_s":
+                value = r.number(key, None, lo=0.0, unit="s")
+            else:
+                value = r.positive(key, None, unit="Pa/m" if key.startswith("jk") else "N/m")
+            if value is not None:
+                values.append((key, float(value)))
+        if not values:
+            raise r.error("blocks", f"the joint overrides nothing: give one of {', '.join(JOINT_OVERRIDE_KEYS)}")
+        r.finish()
+        out.append(JointOverride((names[0], names[1]), tuple(values)))
+    return tuple(out)

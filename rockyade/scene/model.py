@@ -74,6 +74,9 @@ class BlockSpec:
     alpha_rad: float | None = None
     p_rad_s: float | None = None
     mu: float | None = None
+    position_m: tuple[float, float] | None = None
+    rotation_rad: float = 0.0
+    fixed: bool = False
 
     def block(self) -> Block:
         """The rigid block (geometry, mass, inertia)."""
@@ -110,6 +113,37 @@ class ContactSpec:
     dt_s: float | None = None
     time_step_frac: float = DEFAULT_TIME_STEP_FRAC
     mass_damping_1_s: float = 0.0
+    jkn_Pa_per_m: float | None = None
+    jks_Pa_per_m: float | None = None
+
+    @property
+    def explicit_stiffness(self) -> bool:
+        """True when the stiffness is given (K or jkn) rather than calibrated."""
+        return self.K_N_per_m is not None or self.jkn_Pa_per_m is not None
+
+
+#: The contact values a ``[[joints]]`` entry may override.
+JOINT_OVERRIDE_KEYS = ("K_N_per_m", "Ks_N_per_m", "beta_s", "friction_angle_deg", "jkn_Pa_per_m", "jks_Pa_per_m")
+
+
+@dataclass(frozen=True)
+class JointOverride:
+    """One ``[[joints]]`` entry: contact values for one pair of blocks (or a block and the base).
+
+    Attributes
+    ----------
+    blocks
+        The two block names; the second may be ``"base"``.
+    values
+        Overridden values, keys among :data:`JOINT_OVERRIDE_KEYS` (N/m, s, degrees, Pa/m).
+    """
+
+    blocks: tuple[str, str]
+    values: tuple[tuple[str, float], ...]
+
+    def get(self, key: str) -> float | None:
+        """The overridden value of ``key``, or None."""
+        return dict(self.values).get(key)
 
 
 @dataclass(frozen=True)
@@ -141,6 +175,7 @@ class Scene:
     motion: MotionSpec
     output: OutputSpec = field(default_factory=OutputSpec)
     source: str | None = field(default=None, compare=False)
+    joints: tuple[JointOverride, ...] = ()
 
     # ------------------------------------------------------------------ queries
     @property
@@ -156,6 +191,11 @@ class Scene:
         raise InputError("motion.block", f"no block named {name!r}; blocks: {[b.name for b in self.blocks]}")
 
     @property
+    def positioned(self) -> bool:
+        """True for an assembly (blocks placed by ``position_m``), False for a column."""
+        return self.blocks[0].position_m is not None
+
+    @property
     def released_index(self) -> int:
         """Index of the block given the initial tilt (free rocking): named, else the top."""
         name = self.motion.released_block
@@ -168,20 +208,28 @@ class Scene:
             d = asdict(b)
             if d["vertices_m"] is not None:
                 d["vertices_m"] = [list(v) for v in d["vertices_m"]]
+            if d["position_m"] is not None:
+                d["position_m"] = list(d["position_m"])
+                d.pop("x_offset_m")
+            else:
+                d.pop("rotation_rad")
+            if not d["fixed"]:
+                d.pop("fixed")
             blocks.append(d)
         out = asdict(self.output)
         if isinstance(out["accel_point"], tuple):
             out["accel_point"] = list(out["accel_point"])
-        return _drop_none(
-            {
-                "duration_s": self.duration_s,
-                "sample_dt_s": self.sample_dt_s,
-                "blocks": blocks,
-                "contact": asdict(self.contact),
-                "motion": self.motion.to_dict(),
-                "output": out,
-            }
-        )
+        data = {
+            "duration_s": self.duration_s,
+            "sample_dt_s": self.sample_dt_s,
+            "blocks": blocks,
+            "contact": asdict(self.contact),
+            "motion": self.motion.to_dict(),
+            "output": out,
+        }
+        if self.joints:
+            data["joints"] = [{"blocks": list(j.blocks), **dict(j.values)} for j in self.joints]
+        return _drop_none(data)
 
     @functools.cached_property
     def scene_hash(self) -> str:
@@ -214,18 +262,37 @@ def _drop_none(value: Any) -> Any:
 
 
 def _check_scene(scene: Scene) -> None:
-    """Cross-field checks: unique names, stacking, the motion's block, sampling."""
+    """Cross-field checks: unique names, placement (stacking or positions), joints, motion."""
     names = [b.name for b in scene.blocks]
     for i, name in enumerate(names):
         if name in names[:i]:
             raise InputError(f"blocks[{i}].name", f"duplicate block name {name!r}", scene.source)
+        if name == "base":
+            raise InputError(f"blocks[{i}].name", "'base' is reserved for the base (name the block otherwise)")
     if scene.motion.released_block is not None and scene.motion.released_block not in names:
         raise InputError(
             "motion.block", f"no block named {scene.motion.released_block!r}; blocks: {names}", scene.source
         )
+    if scene.positioned:
+        _check_positioned(scene)
+    else:
+        _check_column(scene)
+    _check_joints(scene, names)
+
+
+def _check_column(scene: Scene) -> None:
+    """A column scene: blocks listed bottom to top, each resting on the one below."""
     lower: Block | None = None
     lower_offset = 0.0
     for i, spec in enumerate(scene.blocks):
+        if spec.position_m is not None:
+            raise InputError(
+                f"blocks[{i}].position_m",
+                "give position_m on every block (assembly) or on none (column); blocks[0] has none",
+                scene.source,
+            )
+        if spec.fixed:
+            raise InputError(f"blocks[{i}].fixed", "fixed blocks need position_m (an assembly scene)", scene.source)
         block = spec.block()
         if lower is not None:
             lo_l, lo_r = lower.level_vertices("top")
@@ -242,7 +309,74 @@ def _check_scene(scene: Scene) -> None:
             if overlap <= 0:
                 raise InputError(
                     f"blocks[{i}].x_offset_m",
-                    "block does not rest on the block below it (no overlap)",
+                    "block does not rest on the block below it (no overlap); to place blocks side by side "
+                    "give every block position_m = [x, y]",
                     scene.source,
                 )
         lower, lower_offset = block, spec.x_offset_m
+
+
+def _check_positioned(scene: Scene) -> None:
+    """An assembly: every block placed, none below the base, none overlapping another."""
+    from rockyade.scene.placement import OVERLAP_TOL, overlapping_pairs, placed_blocks
+
+    for i, spec in enumerate(scene.blocks):
+        if spec.position_m is None:
+            raise InputError(
+                f"blocks[{i}].position_m",
+                f"is required: blocks[0] ({scene.blocks[0].name}) has position_m, so every block needs one",
+                scene.source,
+            )
+        if spec.x_offset_m != 0.0:
+            raise InputError(f"blocks[{i}].x_offset_m", "use position_m alone in an assembly scene", scene.source)
+        if spec.fixed and any(v is not None for v in (spec.alpha_rad, spec.p_rad_s, spec.mu)):
+            raise InputError(
+                f"blocks[{i}].fixed", "a fixed block moves with the base: it takes no alpha_rad, p_rad_s or mu"
+            )
+    placed = placed_blocks(scene)
+    if all(b.fixed for b in placed):
+        raise InputError("blocks", "every block is fixed: nothing can move", scene.source)
+    for b in placed:
+        low = float(b.vertices_m[:, 1].min())
+        if low < -OVERLAP_TOL * b.size_m:
+            raise InputError(
+                f"blocks[{b.index}].position_m",
+                f"block {b.name} reaches y = {low:.6g} m, below the base (y = 0)",
+                scene.source,
+            )
+    clashes = overlapping_pairs(placed)
+    if clashes:
+        i, j, depth = clashes[0]
+        more = f" (and {len(clashes) - 1} more pairs)" if len(clashes) > 1 else ""
+        raise InputError(
+            f"blocks[{j}].position_m",
+            f"blocks {placed[i].name} and {placed[j].name} overlap at rest by {depth:.3g} m{more}",
+            scene.source,
+        )
+    motion = scene.motion
+    if (motion.initial_theta_rad or motion.initial_omega_rad_s) and motion.released_block is None:
+        raise InputError(
+            "motion.block", "is required for free rocking in an assembly: the name of the block to tilt", scene.source
+        )
+    if motion.released_block is not None and scene.blocks[scene.block_index(motion.released_block)].fixed:
+        raise InputError("motion.block", f"{motion.released_block} is fixed: tilt a block that can move", scene.source)
+
+
+def _check_joints(scene: Scene, names: list[str]) -> None:
+    """[[joints]] name existing blocks, each pair once; stiffness given one way."""
+    seen: set[frozenset[str]] = set()
+    for k, joint in enumerate(scene.joints):
+        a, b = joint.blocks
+        for name in (a, b):
+            if name != "base" and name not in names:
+                raise InputError(f"joints[{k}].blocks", f"no block named {name!r}; blocks: {names[:20]}", scene.source)
+        if a == b:
+            raise InputError(f"joints[{k}].blocks", f"needs two different blocks, got {a!r} twice", scene.source)
+        if a == "base":
+            raise InputError(f"joints[{k}].blocks", "name the block first and 'base' second", scene.source)
+        key = frozenset((a, b))
+        if key in seen:
+            raise InputError(f"joints[{k}].blocks", f"the pair {a}-{b} is given twice", scene.source)
+        seen.add(key)
+        if joint.get("K_N_per_m") is not None and joint.get("jkn_Pa_per_m") is not None:
+            raise InputError(f"joints[{k}].jkn_Pa_per_m", "give K_N_per_m or jkn_Pa_per_m, not both", scene.source)
