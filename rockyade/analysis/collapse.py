@@ -1,0 +1,196 @@
+"""Collapse of an assembly: the state of every block over time, which blocks fell and when.
+
+Each moving block is, at each sample, in one of four states (codes in :data:`STATES`):
+
+* ``fallen``: it has left its base for good: from the first time it lies on another face
+  (|theta| within ``LANDING_TOL_RAD`` of its landing angle, :mod:`rockyade.dem.overturn`:
+  the DEMs' overturn criterion) or its centroid has dropped by more than half the block's
+  height (it fell off something); a block that never lands but ends the run beyond its
+  tipping angle alpha (it leans on a neighbour or on the rubble) falls when it last passed
+  alpha. Once fallen, fallen to the end. The report also gives ``tipped_time_s``, when the
+  block last passed alpha before falling (from there gravity alone no longer brings it back);
+* ``sliding``: its base slides: the horizontal speed of the point of the block that was the
+  middle of its base at rest exceeds ``SLIDE_SPEED_M_S`` while it is not rocking fast
+  enough to explain it (rocking about a corner moves that point by b (1 - cos theta));
+* ``rocking``: |theta| above ``ROCK_FRACTION`` x alpha (and at least ``ROCK_MIN_RAD``);
+* ``rest`` otherwise.
+
+The thresholds are stated here and in docs/assemblies.md; none depends on the solver, so
+the same analysis reads Housner, reference DEM and YADE results.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from numpy.typing import NDArray
+
+from rockyade.dem.overturn import LANDING_TOL_RAD, landing_angles
+from rockyade.result import Result
+
+STATES = ("rest", "rocking", "sliding", "fallen")
+REST, ROCKING, SLIDING, FALLEN = range(4)
+
+#: Rocking: |theta| above this fraction of alpha ...
+ROCK_FRACTION = 0.01
+#: ... and above this absolute rotation (the contacts' elastic tilt is ~1e-5 rad).
+ROCK_MIN_RAD = 1e-4
+#: Sliding: horizontal speed of the base's middle point above this, m/s.
+SLIDE_SPEED_M_S = 0.01
+#: Fallen off: the centroid dropped by more than this fraction of the block height.
+DROP_FRACTION = 0.5
+
+
+@dataclass(frozen=True)
+class BlockGeometry:
+    """What the analysis needs of one block.
+
+    Attributes
+    ----------
+    name
+        Block name.
+    alpha_rad
+        Tipping angle (the DEM's own, or the classical one).
+    landing_rad
+        (left, right) landing angles, rad.
+    height_m
+        Height of the block, m.
+    base_mid_m
+        Middle of the base at rest relative to the centroid, rest frame, m.
+    """
+
+    name: str
+    alpha_rad: float
+    landing_rad: tuple[float, float]
+    height_m: float
+    base_mid_m: tuple[float, float]
+
+
+def block_geometry(scene, result: Result) -> list[BlockGeometry]:
+    """Geometry of the moving blocks, from the DEM's bodies in the result when it has them
+    (both DEMs record them), else from the scene (Housner: the block's own polygon)."""
+    bodies = result.meta.get("bodies") or {}
+    out = []
+    for spec in scene.blocks:
+        if spec.fixed:
+            continue
+        body = bodies.get(spec.name)
+        if body is not None:
+            poly = np.asarray(body["contact_vertices_m"], dtype=float)
+            alpha = float(body["alpha_rad"])
+        else:
+            block = spec.block()
+            poly = block.vertices_m - np.asarray(block.centroid_m)
+            alpha = spec.classical().alpha_rad
+        low = poly[:, 1] <= poly[:, 1].min() + 1e-9 * max(float(np.ptp(poly[:, 1])), 1.0)
+        base_mid = (float(poly[low, 0].mean()), float(poly[:, 1].min()))
+        out.append(BlockGeometry(spec.name, alpha, landing_angles(poly), float(np.ptp(poly[:, 1])), base_mid))
+    return out
+
+
+def _series(result: Result, quantity: str, name: str) -> NDArray[np.float64]:
+    return np.asarray(result.series(quantity, name), dtype=float)
+
+
+def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
+    """(n_samples, n_moving) state codes (see module docstring) and the blocks' geometry."""
+    geometry = block_geometry(scene, result)
+    t = result.t
+    n = t.size
+    states = np.zeros((n, len(geometry)), dtype=np.int8)
+    dt = float(t[1] - t[0]) if n > 1 else 1.0
+    for j, g in enumerate(geometry):
+        theta = _series(result, "theta_rad", g.name)
+        x = _series(result, "x_m", g.name)
+        y = _series(result, "y_m", g.name)
+        fallen = _fallen_mask(theta, y, g)
+        # the rest-frame middle of the base, rotated with the block, relative to its rest place
+        c, s = np.cos(theta), np.sin(theta)
+        bx = x + c * g.base_mid_m[0] - s * g.base_mid_m[1] - g.base_mid_m[0]
+        speed = np.abs(np.gradient(bx, dt)) if n > 1 else np.zeros(n)
+        rocking = np.abs(theta) > max(ROCK_MIN_RAD, ROCK_FRACTION * g.alpha_rad)
+        rocking_speed = np.abs(np.gradient(theta, dt)) * abs(g.base_mid_m[1]) * np.abs(np.sin(theta)) if n > 1 else 0.0
+        sliding = speed > SLIDE_SPEED_M_S + rocking_speed
+        code = np.where(rocking, ROCKING, REST)
+        code = np.where(sliding, SLIDING, code)
+        code = np.where(fallen, FALLEN, code)
+        states[:, j] = code
+    return states, geometry
+
+
+def _fall_and_tip(theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry) -> tuple[int, int]:
+    """Sample of the fall and of the tip that led to it (see module docstring), -1 if none."""
+    finite = np.isfinite(theta)
+    landed = (theta >= g.landing_rad[0] - LANDING_TOL_RAD) | (theta <= -(g.landing_rad[1] - LANDING_TOL_RAD))
+    dropped = y < -DROP_FRACTION * g.height_m
+    beyond = (np.abs(theta) > g.alpha_rad) & finite
+    hits = np.flatnonzero((landed | dropped) & finite)
+    last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
+    if hits.size:
+        fall = int(hits[0])
+    elif last >= 0 and beyond[last]:
+        fall = -2  # ends the run beyond alpha: falls when it last passed alpha
+    else:
+        return -1, -1
+    end = fall if fall >= 0 else last
+    below = np.flatnonzero(~beyond[: end + 1])
+    tip = int(below[-1]) + 1 if below.size else 0
+    return (tip if fall == -2 else fall), tip
+
+
+def _fallen_mask(theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry) -> NDArray[np.bool_]:
+    """True from the sample where the block fell for good."""
+    mask = np.zeros(theta.size, dtype=bool)
+    fall, _ = _fall_and_tip(theta, y, g)
+    if fall >= 0:
+        mask[fall:] = True
+    return mask
+
+
+def collapse_report(scene, result: Result) -> pd.DataFrame:
+    """One row per moving block: whether and when it fell, time spent rocking and sliding,
+    peak and residual rotation and displacement.
+
+    Columns: ``block``, ``fell``, ``fall_time_s``, ``tipped_time_s``, ``max_abs_theta_rad``,
+    ``max_theta_over_alpha``, ``residual_theta_rad``, ``residual_x_m``, ``residual_y_m``,
+    ``rocking_time_s``, ``sliding_time_s``, ``final_state``.
+    """
+    states, geometry = block_states(scene, result)
+    t = result.t
+    dt = float(t[1] - t[0]) if t.size > 1 else 0.0
+    rows = []
+    for j, g in enumerate(geometry):
+        theta = _series(result, "theta_rad", g.name)
+        finite = np.isfinite(theta)
+        fell = np.flatnonzero(states[:, j] == FALLEN)
+        last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
+        _, tip = _fall_and_tip(theta, _series(result, "y_m", g.name), g)
+        rows.append(
+            {
+                "block": g.name,
+                "fell": bool(fell.size),
+                "fall_time_s": float(t[fell[0]]) if fell.size else math.nan,
+                "tipped_time_s": float(t[tip]) if fell.size and tip >= 0 else math.nan,
+                "max_abs_theta_rad": float(np.nanmax(np.abs(theta))) if finite.any() else math.nan,
+                "max_theta_over_alpha": float(np.nanmax(np.abs(theta)) / g.alpha_rad) if finite.any() else math.nan,
+                "residual_theta_rad": float(theta[last]) if last >= 0 else math.nan,
+                "residual_x_m": float(_series(result, "x_m", g.name)[last]) if last >= 0 else math.nan,
+                "residual_y_m": float(_series(result, "y_m", g.name)[last]) if last >= 0 else math.nan,
+                "rocking_time_s": float(np.sum(states[:, j] == ROCKING) * dt),
+                "sliding_time_s": float(np.sum(states[:, j] == SLIDING) * dt),
+                "final_state": STATES[int(states[last, j])] if last >= 0 else "rest",
+            }
+        )
+    return pd.DataFrame(rows)
+
+
+def state_frame(scene, result: Result) -> pd.DataFrame:
+    """The states as a DataFrame: ``t_s`` and one categorical column per moving block."""
+    states, geometry = block_states(scene, result)
+    data: dict[str, object] = {"t_s": result.t}
+    for j, g in enumerate(geometry):
+        data[g.name] = pd.Categorical.from_codes(states[:, j], categories=list(STATES))
+    return pd.DataFrame(data)

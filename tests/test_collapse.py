@@ -1,0 +1,100 @@
+"""Overturn criterion of the DEMs and the collapse analysis of assemblies."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rockyade.analysis.collapse import FALLEN, REST, SLIDING, block_states, collapse_report
+from rockyade.blocks.geometry import chamfered_rectangle_vertices, rectangle_vertices
+from rockyade.dem.build import contact_polygon
+from rockyade.dem.overturn import LANDING_TOL_RAD, first_overturn, landing_angles, overturn_thresholds
+from rockyade.scene import load_scene, scene_from_dict
+from rockyade.solvers import run
+
+from .conftest import EXAMPLES
+
+
+def test_landing_angles_rectangle_beq_and_chamfer():
+    assert landing_angles(rectangle_vertices(0.25, 1.0)) == pytest.approx((math.pi / 2, math.pi / 2))
+    spec = load_scene(EXAMPLES / "specimen1_free.toml").blocks[0]
+    poly = contact_polygon(spec.block(), spec.alpha_rad)  # base corners at +/- b_eq (Eq 11)
+    b_eq = 0.5 * math.tan(0.235)
+    lean = math.atan2(0.125 - b_eq, 1.0)  # the side face leans in by this angle
+    assert landing_angles(poly) == pytest.approx((math.pi / 2 - lean, math.pi / 2 - lean), rel=1e-12)
+    chamfered = chamfered_rectangle_vertices(0.16, 0.457, 0.04)
+    assert landing_angles(chamfered) == pytest.approx((math.pi / 4, math.pi / 4))
+
+
+def test_first_overturn_picks_the_body_and_sample():
+    thresholds = overturn_thresholds([rectangle_vertices(0.2, 1.0), rectangle_vertices(0.2, 1.0)])
+    theta = np.zeros((5, 2))
+    theta[3, 1] = -(math.pi / 2 - LANDING_TOL_RAD)  # lands on the right (clockwise)
+    theta[4, 0] = math.pi / 2
+    assert first_overturn(theta, thresholds) == (3, 1)
+    assert first_overturn(np.zeros((5, 2)), thresholds) == (-1, -1)
+
+
+def _pulse_scene(amplitude_g: float, duration: float = 6.0) -> dict:
+    d = load_scene(EXAMPLES / "specimen1_pulse.toml").to_dict()
+    d["motion"]["amplitude_m_s2"] = amplitude_g * 9.81
+    d["contact"]["calibration"] = "paper"
+    d["duration_s"] = duration
+    d["sample_dt_s"] = 0.002
+    return d
+
+
+def test_dem_fall_time_agrees_with_housner_overturn():
+    """One-sine pulses that overturn specimen 1: the DEM lies on its side (it lands at its
+    landing angle, never at pi/2) when Housner's block reaches pi/2 (measured: 0.02-0.03 s
+    apart at 0.4-0.7 g)."""
+    scene = scene_from_dict(_pulse_scene(0.6))
+    exact = run(scene, "housner")
+    dem = run(scene, "reference")
+    assert exact.status == "overturned"
+    report = collapse_report(scene, dem).iloc[0]
+    assert report["fell"] and report["final_state"] == "fallen"
+    assert report["fall_time_s"] == pytest.approx(exact.meta["overturn_time_s"], abs=0.05)
+    assert report["tipped_time_s"] < report["fall_time_s"]
+    assert abs(report["residual_theta_rad"]) > math.pi / 2 - 0.05
+
+
+def test_rocking_without_falling():
+    scene = scene_from_dict(_pulse_scene(0.3))  # rocks to ~0.055 rad; Housner does not overturn either
+    assert run(scene, "housner").status == "completed"
+    dem = run(scene, "reference")
+    report = collapse_report(scene, dem).iloc[0]
+    assert not report["fell"] and math.isnan(report["fall_time_s"])
+    assert report["rocking_time_s"] > 0.5 and report["final_state"] in ("rest", "rocking")
+    assert 0.01 < report["max_abs_theta_rad"] < 0.235
+
+
+def test_sliding_slab_is_sliding_and_a_wall_at_rest_rests():
+    slab = scene_from_dict(
+        {
+            "duration_s": 1.0,
+            "sample_dt_s": 0.001,
+            "blocks": [{"name": "slab", "width_m": 1.0, "height_m": 0.2, "thickness_m": 0.5, "mass_kg": 250}],
+            "contact": {"calibration": "paper", "friction_angle_deg": 10.0},
+            "motion": {"type": "sampled", "t_s": [0.0, 0.05, 2.0], "accel_m_s2": [0.0, 3.0, 3.0]},
+        }
+    )
+    states, _ = block_states(slab, run(slab, "reference"))
+    assert (states[300:, 0] == SLIDING).all() and (states[:20, 0] == REST).all()
+    stack = scene_from_dict(
+        {
+            "duration_s": 0.3,
+            "sample_dt_s": 0.001,
+            "blocks": [
+                {"name": "low", "width_m": 0.3, "height_m": 0.6, "thickness_m": 0.3, "density_kg_m3": 2500},
+                {"name": "up", "width_m": 0.2, "height_m": 0.6, "thickness_m": 0.3, "density_kg_m3": 2500},
+            ],
+            "contact": {"calibration": "paper", "beta_s": 1e-4},
+            "motion": {"type": "rest"},
+        }
+    )
+    states, _ = block_states(stack, run(stack, "reference"))
+    assert (states == REST).all()
+    assert FALLEN not in states
