@@ -3,13 +3,34 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
-SHARED = ROOT.parent / "shared"
+
+#: Environment variable naming a folder of external records (PEER NGA .AT2 files) that
+#: some tests read. rockyade ships no real record; these tests skip when it is unset.
+RECORDS_ENV = "ROCKYADE_RECORDS_DIR"
+
+
+def external_records_dir() -> Path | None:
+    """The folder named by ``$ROCKYADE_RECORDS_DIR``, or None when it is unset or empty."""
+    value = os.environ.get(RECORDS_ENV, "").strip()
+    return Path(value).expanduser() if value else None
+
+
+def needs_records(*names: str) -> pytest.MarkDecorator:
+    """Skip a test unless ``$ROCKYADE_RECORDS_DIR`` holds every one of ``names``."""
+    folder = external_records_dir()
+    if folder is None:
+        reason = f"external records: set {RECORDS_ENV} to a folder holding {', '.join(names)} (PEER NGA)"
+    else:
+        missing = [name for name in names if not (folder / name).is_file()]
+        reason = f"external records: {RECORDS_ENV}={folder} lacks {', '.join(missing)}" if missing else ""
+    return pytest.mark.skipif(bool(reason), reason=reason)
 
 
 def free_scene_dict(theta0: float = 0.1175, duration: float = 4.0, **block_overrides) -> dict:

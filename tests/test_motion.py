@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -28,10 +29,12 @@ from rockyade.motion.synthetic import (
 )
 from rockyade.scene import scene_from_dict
 
-from .conftest import SHARED, free_scene_dict
+from .conftest import external_records_dir, free_scene_dict, needs_records
 
-RECORDS = SHARED / "records"
-needs_shared = pytest.mark.skipif(not RECORDS.is_dir(), reason="../shared/records is not beside the project")
+RECORDS = external_records_dir() or Path()
+needs_peer_records = needs_records(
+    "RSN6_IMPVALL.I_I-ELC180-hor1.AT2", "RSN6_IMPVALL.I_I-ELC270-hor2.AT2", "RSN77_SFERN_PUL164-hor1.AT2"
+)
 
 
 @pytest.fixture(autouse=True)
@@ -216,7 +219,7 @@ def test_two_column_and_single_column(tmp_path):
         read_record(one, "single")
 
 
-@needs_shared
+@needs_peer_records
 @pytest.mark.parametrize(
     ("name", "npts", "pga_g"),
     [
@@ -307,7 +310,7 @@ def test_short_periods_are_substepped():
     assert psa[0] == pytest.approx(w * w * np.max(np.abs(sol.y[0])), rel=2e-3)
 
 
-@needs_shared
+@needs_peer_records
 def test_el_centro_spectrum_against_direct_integration():
     """The spectrum of El Centro 1940 (PEER RSN6, 180) at a few periods against an
     independent integration of the oscillator (scipy RK45, tight tolerances)."""
