@@ -81,6 +81,27 @@ class Result:
             block = names[-1]
         return self.frame[column(block, quantity, names)].to_numpy()
 
+    # -------------------------------------------------------------- figures
+    def plot(
+        self,
+        quantity: str = "theta_rad",
+        ax: Any = None,
+        path: str | os.PathLike[str] | None = None,
+        label: str | None = None,
+        title: str = "",
+    ) -> tuple[Any, Any]:
+        """Plot a per-block quantity against time, one panel per block.
+
+        A thin wrapper of :func:`rockyade.figures.plot_results` (imported here, so that
+        results load without matplotlib). ``ax``: Axes to draw into (one per block), e.g.
+        to overlay several results; ``path``: PNG to write; ``label``: legend entry
+        (default: the solver). Returns ``(fig, ax)`` (``(fig, axes)`` for several blocks).
+        """
+        from rockyade.figures.histories import plot_results
+
+        name = label or str(self.meta.get("solver", "result"))
+        return plot_results({name: self}, path, title=title, quantity=quantity, ax=ax)
+
     # -------------------------------------------------------------- files
     def write(self, csv_path: str | os.PathLike[str]) -> Path:
         """Write ``<name>.csv`` and ``<name>.json`` atomically; return the JSON path.

@@ -34,4 +34,3 @@ def test_spectrum_peaks_within_0p1_percent_of_a_fine_grid(damping):
     np.testing.assert_allclose(psa, reference, rtol=1e-3)
     # a fine grid can only miss a peak: ours may not be lower than it by more than round-off
     assert np.all(psa >= reference * (1 - 1e-9))
-

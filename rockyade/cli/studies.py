@@ -82,16 +82,34 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    """Reproduce the paper: tables, figures and index.md."""
+    """Reproduce the paper: tables, figures and index.md; exit 1 when any run failed."""
+    from rockyade.studies.common import describe_failures
     from rockyade.studies.paper import PARTS, run_paper_study
 
     parts = tuple(p.strip() for p in args.only.split(",")) if args.only else PARTS
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
         raise InputError("only", f"parts must be among {', '.join(PARTS)}, got {unknown}")
-    index = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade)
-    print(f"wrote {index}")
-    return 0
+    report = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade)
+    failed = report.failures()
+    print(f"wrote {report.index_path}")
+    print("runs per part: " + "; ".join(_part_line(report, part) for part in parts))
+    if not failed:
+        print(f"all {len(report.runs)} runs ended without failure")
+        return 0
+    print(f"{len(failed)} of {len(report.runs)} runs FAILED (each listed in {report.out / 'failed_runs.csv'}):")
+    for part, solver, reason, runs in report.failure_groups():
+        print(f"  [{part}] {describe_failures(solver, reason, runs)}")
+    return 1
+
+
+def _part_line(report: Any, part: str) -> str:
+    counts = report.counts(part)
+    total = sum(counts.values())
+    failed = counts.get("failed", 0)
+    if not total:
+        return f"{part}: no solver runs"
+    return f"{part} {total}" + (f" ({failed} FAILED)" if failed else "")
 
 
 def register(sub: Any) -> None:

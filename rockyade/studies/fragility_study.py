@@ -12,15 +12,16 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.analysis.fragility import fit_lognormal
+from rockyade.analysis.fragility import Fragility, fit_lognormal
 from rockyade.dem.matching import build_matched_model
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.motion.synthetic import generate_suite, paper_suite
 from rockyade.scene import scene_from_dict
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import Report, block_table, fmt, scene_dict
+from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, fmt, run_state, scene_dict
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
 RECORDS = tuple(range(1, 31))
@@ -64,33 +65,51 @@ def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     stripes["pga_m_s2"] = stripes.load_factor * ag_s
     stripes["fraction"] = stripes.n_collapse / stripes.n_records
     fits = []
-    for (specimen, solver), group in stripes.groupby(["specimen", "solver"]):
-        fit = fit_lognormal(group.pga_m_s2, group.n_collapse, group.n_records)
-        fits.append(
-            {
-                "specimen": specimen,
-                "solver": solver,
-                "median_pga_m_s2": fit.median,
-                "median_load_factor": fit.median / ag_s,
-                "beta": fit.beta,
-                "status": fit.status,
-                "stripes": fit.n_points,
-                "failed_runs": int(
-                    ((summary.base == specimen) & (summary.solver == solver) & (summary.status == "failed")).sum()
-                ),
-            }
-        )
+    for (specimen, solver), runs in summary.groupby(["base", "solver"]):
+        group = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
+        failed = runs[runs.status == "failed"]
+        reasons = failed.get("failure_reason", pd.Series(dtype=object)).dropna().astype(str)
+        row = {
+            "specimen": specimen,
+            "solver": solver,
+            "median_pga_m_s2": np.nan,
+            "median_load_factor": np.nan,
+            "beta": np.nan,
+            "status": "",
+            "stripes": len(group),
+            "largest_tested_pga_m_s2": float(group.pga_m_s2.max()) if len(group) else np.nan,
+            "extrapolated": False,
+            "runs": len(runs),
+            "failed_runs": len(failed),
+            "failure_reason": reasons.value_counts().index[0] if len(reasons) else "",
+        }
+        if len(group) < 2:
+            row["status"] = f"not fitted: {len(failed)} of {len(runs)} runs failed, {len(group)} stripe(s) left"
+        else:
+            fit = fit_lognormal(group.pga_m_s2, group.n_collapse, group.n_records)
+            row.update(
+                median_pga_m_s2=fit.median, median_load_factor=fit.median / ag_s, beta=fit.beta, status=fit.status
+            )
+            # a median above the largest tested intensity is an extrapolation of the fitted curve
+            row["extrapolated"] = bool(fit.status == "fitted" and fit.median > row["largest_tested_pga_m_s2"])
+        fits.append(row)
     return stripes, pd.DataFrame(fits)
 
 
 def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame:
     """Run the fragility batches; write their CSVs and figure; return the fits."""
+    plan = (
+        f"{len(RECORDS)} records x load factors {LOAD_FACTORS[0]}-{LOAD_FACTORS[-1]} per specimen (experimental "
+        "parameters, matched calibration), reference DEM and Housner"
+    )
+    yade_plan = (
+        f"YADE on specimen {YADE_SUBSET['specimen']}, records 1-{YADE_SUBSET['records'][-1]}, load factors "
+        f"{', '.join(map(str, YADE_SUBSET['load_factors']))}"
+    )
     report.section(
         "Collapse fragility over the synthetic suite",
-        f"{len(RECORDS)} records x load factors {LOAD_FACTORS[0]}-{LOAD_FACTORS[-1]} per specimen (experimental "
-        "parameters, matched calibration), reference DEM and Housner; YADE on specimen "
-        f"{YADE_SUBSET['specimen']}, records 1-{YADE_SUBSET['records'][-1]}, load factors "
-        f"{', '.join(map(str, YADE_SUBSET['load_factors']))}. Lognormal curves by maximum likelihood on the stripes.",
+        f"Planned: {plan}; {yade_plan if use_yade else 'YADE off'}. Lognormal curves by maximum likelihood on the "
+        "stripes. What ran is stated below.",
     )
     prepare()
     runs = report.out / "fragility_runs"
@@ -107,7 +126,26 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
             subset, report.out / "fragility_yade_runs", workers=workers, desc="fragility (YADE)"
         )
         summary = pd.concat([summary, yade_summary], ignore_index=True)
+    report.record_summary(
+        summary, lambda row: f"{row['base']}, record {row['motion.record']} x {row['motion.load_factor']}"
+    )
     stripes, fits = fit_table(summary)
+    ran = "; ".join(
+        f"{SOLVER_LABELS[solver]}: {run_state(report, solver, int((summary.solver == solver).sum()))}"
+        for solver in dict.fromkeys(summary.solver)
+    )
+    report.note(f"Ran: {ran}.")
+    extrapolated = fits[fits.extrapolated]
+    if len(extrapolated):
+        report.note(
+            "**Extrapolated medians** (above the largest tested PGA, "
+            f"{LOAD_FACTORS[-1]} x ag S = {LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2:.3g} m/s^2): "
+            + ", ".join(
+                f"{r.specimen} by {SOLVER_LABELS[r.solver]} ({fmt(r.median_pga_m_s2, 3)} m/s^2)"
+                for r in extrapolated.itertuples()
+            )
+            + ". The fitted curve is not tested there: read these medians as 'above the tested range'."
+        )
     report.table("fragility_stripes.csv", stripes, "collapses / records at each load factor, per specimen and solver.")
     report.table(
         "fragility_fits.csv",
@@ -115,40 +153,108 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "fitted lognormal fragility: median (PGA and load factor) and beta, "
         "per specimen and solver (YADE: subset, see above).",
     )
-    _figure(report, stripes, fits)
+    draw_figure(report, stripes, fits)
     return fits
 
 
-def _figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> None:
-    specimens = sorted(stripes.specimen.unique())
-    fig, axes = plt.subplots(2, 2, figsize=(11, 8), sharex=True, sharey=True)
-    x = np.linspace(0.05, 1.6 * 2.8, 300)
-    styles = {"reference": ("C1", "o"), "housner": ("C0", "s"), "yade": ("C2", "^")}
+def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Figure:
+    """Per specimen: collapse fractions (points), fitted curves (solid over the tested range,
+    dotted beyond it), extrapolated medians flagged and missing curves explained."""
+    specimens = sorted(set(fits.specimen))
+    name = "fragility.png"
+    fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 8.5), sharex=True, sharey=True)
+    tested = LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2
+    x_max = 1.35 * tested  # room to show where an extrapolated curve goes
+    x = np.linspace(0.05, x_max, 300)
+    markers = {"reference": "o", "housner": "s", "yade": "^"}
     for ax, specimen in zip(axes.ravel(), specimens, strict=False):
-        for solver, (colour, marker) in styles.items():
-            pts = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
-            if pts.empty:
+        missing = []
+        for solver, marker in markers.items():
+            sel = fits[(fits.specimen == specimen) & (fits.solver == solver)]
+            if sel.empty:
                 continue
-            fit = fits[(fits.specimen == specimen) & (fits.solver == solver)].iloc[0]
-            label = f"{solver}: median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$, beta {fmt(fit.beta, 2)}"
-            ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4, label=label)
+            fit = sel.iloc[0]
+            colour = SOLVER_STYLES[solver]["color"]
+            pts = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
+            if pts.empty or not fit.status.startswith(("fitted", "no collapse", "all collapse")):
+                missing.append(_missing_curve(solver, fit))
+                continue
             if fit.status == "fitted":
-                from rockyade.analysis.fragility import Fragility
-
-                ax.plot(
-                    x, Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x), color=colour, lw=1.2
-                )
+                median = f"median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$"
+                if fit.extrapolated:
+                    median += " EXTRAPOLATED"
+                label = f"{SOLVER_LABELS[solver]}: {median}, beta {fmt(fit.beta, 2)}"
+            else:
+                label = f"{SOLVER_LABELS[solver]}: {fit.status} in the tested range, no fit"
+            if fit.failed_runs:
+                label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
+            ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
+            if fit.status == "fitted":
+                curve = Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x)
+                inside = x <= fit.largest_tested_pga_m_s2
+                ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
+                ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
+                if fit.extrapolated:
+                    at = min(fit.median_pga_m_s2, x_max)
+                    ax.annotate(
+                        f"median {fmt(fit.median_pga_m_s2, 3)}\n(extrapolated)",
+                        xy=(at, float(Fragility(fit.median_pga_m_s2, fit.beta, 2).probability(at))),
+                        xytext=(-6, 8),
+                        textcoords="offset points",
+                        ha="right",
+                        va="bottom",
+                        fontsize=7,
+                        color=colour,
+                        arrowprops={"arrowstyle": "-", "color": colour, "lw": 0.6},
+                    )
+        ax.axvspan(tested, x_max, color="0.92", lw=0, zorder=0)
+        ax.text(
+            x_max,
+            0.5,
+            "beyond the largest tested PGA ",
+            rotation=90,
+            fontsize=6.5,
+            color="0.4",
+            ha="right",
+            va="center",
+        )
+        for text in missing:  # a legend entry, so that it never covers the points
+            ax.plot([], [], ls="none", marker="x", color="#b2182b", label=text)
         ax.set_title(specimen.replace("specimen", "specimen "))
+        ax.set_xlim(0, x_max)
+        ax.set_ylim(-0.03, 1.03)
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        legend = ax.legend(fontsize=7, loc="best")
+        for text in legend.get_texts():
+            if "no curve" in text.get_text():
+                text.set_color("#b2182b")
     for ax in axes[-1]:
         ax.set_xlabel("PGA of the scaled suite, load factor x ag S (m/s$^2$)")
     for ax in axes[:, 0]:
         ax.set_ylabel("fraction of records that overturn")
-    name = "fragility.png"
     save_figure(fig, report.out / name)
+    notes = []
+    for r in fits.itertuples():
+        if r.extrapolated:
+            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: median extrapolated beyond {fmt(tested, 3)} m/s^2")
+        if not r.status.startswith(("fitted", "no collapse", "all collapse")):
+            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: no curve ({r.status}{_reason(r)})")
     report.figure(
         name,
-        "Collapse fragility of the four specimens: fraction of the 30 records that overturn the block "
-        "at each load factor (points) and the fitted lognormal curves (lines).",
+        f"Collapse fragility of the specimens: fraction of the {len(RECORDS)} records that overturn the block "
+        "at each load factor (points) and the fitted lognormal curves (solid within the tested PGA, dotted beyond "
+        "it, in the grey band)." + (" " + "; ".join(notes) + "." if notes else ""),
     )
+    return fig
+
+
+def _missing_curve(solver: str, fit) -> str:
+    """Why a solver has no curve, in one legend line."""
+    name = SOLVER_LABELS[solver]
+    if fit.runs and fit.failed_runs == fit.runs:
+        return f"{name}: no curve, all {fit.runs} runs failed" + _reason(fit)
+    return f"{name}: no curve, {fit.status}" + _reason(fit)
+
+
+def _reason(fit) -> str:
+    return f" ({fit.failure_reason})" if fit.failure_reason else ""

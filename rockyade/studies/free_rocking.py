@@ -11,16 +11,29 @@ from __future__ import annotations
 import math
 
 import pandas as pd
+from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.analysis.peaks import effective_restitution, find_peaks
 from rockyade.dem.matching import build_matched_model
 from rockyade.errors import CalibrationError
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
-from rockyade.solvers import yade as yade_backend
-from rockyade.studies.common import PARAMETER_SETS, Report, block_alpha, block_table, fmt, scene_dict
+from rockyade.studies.common import (
+    PARAMETER_SETS,
+    SOLVER_LABELS,
+    Report,
+    block_alpha,
+    block_table,
+    fmt,
+    max_difference,
+    plot_solver,
+    run_each,
+    run_state,
+    run_yade,
+    scene_dict,
+)
 
 DURATION_S = 4.0
 N_IMPACTS = 4
@@ -70,18 +83,35 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                     }
                 )
     runnable = [c for c in cases if c["scene"] is not None]
-    for c in runnable:
-        c["reference"] = reference.run_scene(c["scene"], record_energy=False, record_contacts=False)
+    dem_results = run_each(
+        [c["scene"] for c in runnable],
+        lambda scene: reference.run_scene(scene, record_energy=False, record_contacts=False),
+        "free rocking: reference DEM",
+    )
+    for c, r in zip(runnable, dem_results, strict=True):
+        c["reference"] = r
     if use_yade:
-        yade_results = yade_backend.run_many([c["scene"] for c in runnable], workers=workers)
+        yade_results = run_yade([c["scene"] for c in runnable], workers, "free rocking: YADE")
         for c, r in zip(runnable, yade_results, strict=True):
             c["yade"] = r
-    exact = {}
-    for key in paper.ALL_SPECIMENS:
-        for params in PARAMETER_SETS:
-            alpha = block_alpha(key, params)
-            d = scene_dict([block_table(key, params)], {"type": "free", "theta0_rad": alpha / 2}, DURATION_S, 0.002)
-            exact[(key, params)] = housner.run_scene(scene_from_dict(d))
+    keys = [(key, params) for key in paper.ALL_SPECIMENS for params in PARAMETER_SETS]
+
+    def exact_run(key_params: tuple[str, str]):
+        key, params = key_params
+        alpha = block_alpha(key, params)
+        d = scene_dict([block_table(key, params)], {"type": "free", "theta0_rad": alpha / 2}, DURATION_S, 0.002)
+        return housner.run_scene(scene_from_dict(d))
+
+    exact = dict(zip(keys, run_each(keys, exact_run, "free rocking: Housner"), strict=True))
+    for (key, params), result in exact.items():
+        report.record_result(f"{paper.specimen(key).label}, {params}", result)
+    for c in cases:
+        label = f"{paper.specimen(c['key']).label}, {c['params']}, {c['calibration']} calibration"
+        for solver in ("reference", "yade"):
+            if c["scene"] is None and (solver == "reference" or use_yade):
+                report.record(label, solver, "not run", c["note"])
+            elif c.get(solver) is not None:
+                report.record_result(label, c[solver])
     rows = []
     for (key, params), result in exact.items():
         alpha = block_alpha(key, params)
@@ -143,6 +173,16 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                 }
             )
     table = pd.DataFrame(rows)
+    n_dem = len(runnable)
+    states = [f"reference DEM: {run_state(report, 'reference', n_dem)}"]
+    if use_yade:
+        states.append(f"YADE: {run_state(report, 'yade', n_dem)}")
+    report.note(
+        f"Runs: Housner: {run_state(report, 'housner', len(exact))}; "
+        + "; ".join(states)
+        + f" ({len(cases) - n_dem} DEM cases not run: "
+        "matched calibration not reachable)."
+    )
     report.table(
         "free_rocking.csv",
         table,
@@ -150,57 +190,59 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "the damping constant beta (s) and notes (unreachable matched calibrations).",
     )
     for key in paper.ALL_SPECIMENS:
-        _figure(report, key, exact, cases, table)
+        draw_figure(report, key, exact, cases, table)
     return table
 
 
-def _figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> None:
+def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> Figure:
+    """theta(t): rows = parameter sets, columns = calibrations; Housner in every panel."""
     spec = paper.specimen(key)
-    fig, axes = plt.subplots(2, 1, figsize=(10, 7), sharex=True)
-    styles = {
-        ("reference", "paper"): ("C1", "--"),
-        ("yade", "paper"): ("C2", ":"),
-        ("reference", "matched"): ("C3", "--"),
-        ("yade", "matched"): ("C4", ":"),
-    }
-    for ax, params in zip(axes, PARAMETER_SETS, strict=True):
+    name = f"free_rocking_{spec.name}.png"
+    fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 7.5), sharex=True)
+    for row, params in zip(axes, PARAMETER_SETS, strict=True):
         h = exact[(key, params)]
-        ax.plot(h.t, h.series("theta_rad"), color="C0", lw=1.6, label="Housner (exact)")
-        for c in cases:
-            if c["key"] != key or c["params"] != params:
-                continue
+        alpha = block_alpha(key, params)
+        for ax, cal in zip(row, CALIBRATIONS, strict=True):
+            if h.ok:
+                plot_solver(ax, "housner", h.t, h.series("theta_rad"))
+            case = next(c for c in cases if c["key"] == key and c["params"] == params and c["calibration"] == cal)
+            if case["scene"] is None:
+                ax.text(
+                    0.5,
+                    0.08,
+                    "matched calibration not reachable\n(see free_rocking.csv)",
+                    transform=ax.transAxes,
+                    ha="center",
+                    fontsize=8,
+                    color="0.3",
+                )
             for solver in ("reference", "yade"):
-                r = c.get(solver)
-                if r is None or not r.ok:
+                r = case.get(solver)
+                if r is None:
                     continue
-                colour, style = styles[(solver, c["calibration"])]
+                if not r.ok:
+                    ax.plot([], [], label=f"{SOLVER_LABELS[solver]}: FAILED, no curve", **_failed_style())
+                    continue
                 sel = table[
                     (table.block == key)
                     & (table.parameters == params)
                     & (table.solver == solver)
-                    & (table.calibration == c["calibration"])
+                    & (table.calibration == cal)
                 ]
                 mu = sel["mu_eff"].iloc[0] if len(sel) else math.nan
-                ax.plot(
-                    r.t,
-                    r.series("theta_rad"),
-                    color=colour,
-                    ls=style,
-                    lw=1.1,
-                    label=f"{solver}, {c['calibration']} (mu_eff {fmt(mu)})",
-                )
-        target = table[(table.block == key) & (table.parameters == params) & (table.solver == "housner")]
-        ax.set_title(
-            f"{spec.label}, {params} parameters: alpha = {block_alpha(key, params):.3f} rad, "
-            f"mu = {fmt(target['mu_target'].iloc[0])}",
-            fontsize=10,
-        )
-        ax.set_ylabel("theta (rad)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right", ncol=2)
-        ax.axhline(0, color="0.5", lw=0.5)
-    axes[-1].set_xlabel("time t (s)")
-    name = f"free_rocking_{spec.name}.png"
+                label = f"{'reference DEM' if solver == 'reference' else 'YADE'} (mu_eff {fmt(mu)})"
+                dem = case.get("reference")
+                if solver == "yade" and dem is not None and dem.ok:
+                    label += f", max |YADE - DEM| {max_difference(r, dem):.1e} rad"
+                plot_solver(ax, solver, r.t, r.series("theta_rad"), label)
+            ax.set_title(f"{params} parameters (alpha = {alpha:.3f} rad), {cal} calibration", fontsize=9)
+            ax.axhline(0, color="0.5", lw=0.5)
+            ax.grid(alpha=0.3)
+            ax.legend(fontsize=7, loc="upper right")
+        row[0].set_ylabel("theta (rad)")
+    for ax in axes[-1]:
+        ax.set_xlabel("time t (s)")
+    fig.suptitle(f"Free rocking of the {spec.label}, released at alpha / 2", fontsize=11)
     save_figure(fig, report.out / name)
     unreachable = [c for c in cases if c["key"] == key and c["scene"] is None]
     extra = (
@@ -210,8 +252,19 @@ def _figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> None
         if unreachable
         else ""
     )
+    failed = sorted(
+        {s for c in cases if c["key"] == key for s in ("reference", "yade") if c.get(s) is not None and not c[s].ok}
+    )
+    if failed:
+        extra += f" No curve for the failed runs of: {', '.join(failed)} (see free_rocking.csv)."
     report.figure(
         name,
-        f"Free rocking of the {spec.label}: theta(t) by Housner, the reference DEM and YADE, "
-        f"paper (Eq 13) and matched calibration, theoretical (top) and experimental (bottom) parameters.{extra}",
+        f"Free rocking of the {spec.label}: theta(t) by Housner (thin blue), the reference DEM (wide orange band) "
+        f"and YADE (dashed green, with its largest difference from the DEM), paper (Eq 13, left) and matched "
+        f"(right) calibration, theoretical (top) and experimental (bottom) parameters.{extra}",
     )
+    return fig
+
+
+def _failed_style() -> dict:
+    return {"color": "red", "ls": "none", "marker": "x"}

@@ -12,17 +12,18 @@ from __future__ import annotations
 
 import math
 import multiprocessing
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from rockyade.constants import G
 from rockyade.dem.matching import build_matched_model
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
-from rockyade.studies.common import Report, block_table, scene_dict
+from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, progress, run_state, scene_dict
 
 FREQUENCY_RATIOS = tuple(np.round(np.arange(1.0, 10.01, 0.5), 2))
 STEP = 0.05
@@ -55,6 +56,7 @@ def _scan(args: tuple[str, float, float, float, bool]) -> list[dict]:
                 "amplitude_ratio": round(ratio_a, 4),
                 "overturned": result.status == "overturned",
                 "status": result.status,
+                "failure_reason": result.meta.get("failure_reason") or "",
             }
         )
         if result.status == "overturned" and not full:
@@ -77,9 +79,28 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
         ("reference", w, alpha, p, False) for w in FREQUENCY_RATIOS
     ]
     ctx = multiprocessing.get_context("fork")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        scans = [row for rows in pool.map(_scan, jobs) for row in rows]
-    scan = pd.DataFrame(scans)
+    done: dict[int, list[dict]] = {}
+    with (
+        ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool,
+        progress(len(jobs), "overturning: frequency scans") as bar,
+    ):
+        futures = {pool.submit(_scan, job): k for k, job in enumerate(jobs)}
+        for future in as_completed(futures):
+            done[futures[future]] = future.result()
+            bar.update(1)
+    scan = pd.DataFrame([row for k in range(len(jobs)) for row in done[k]])
+    report.record_summary(
+        scan,
+        lambda row: f"pulse omega_p / p = {row['omega_ratio']:g}, a_p / (g tan alpha) = {row['amplitude_ratio']:g}",
+    )
+    report.note(
+        "Ran: "
+        + "; ".join(
+            f"{SOLVER_LABELS[s]}: {run_state(report, s, int((scan.solver == s).sum()))}"
+            for s in ("housner", "reference")
+        )
+        + "."
+    )
     minima = []
     for (solver, w), group in scan.groupby(["solver", "omega_ratio"]):
         over = group[group.overturned]
@@ -104,24 +125,45 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
         "(NaN: no overturn up to the largest amplitude scanned).",
     )
     report.table("overturning_scan.csv", scan, "every pulse run of the scan: overturned or not.")
-    _figure(report, scan, spectrum)
+    draw_figure(report, scan, spectrum)
     return spectrum
 
 
-def _figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> None:
-    fig, ax = plt.subplots(figsize=(8.5, 5.5))
+def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> Figure:
+    name = "overturning_spectrum.png"
+    fig, ax = new_figure(report.out / name, figsize=(8.5, 5.5))
+    housner_colour = SOLVER_STYLES["housner"]["color"]
+    dem_colour = SOLVER_STYLES["reference"]["color"]
     h = scan[scan.solver == "housner"]
     over = h[h.overturned]
-    ax.scatter(over.omega_ratio, over.amplitude_ratio, s=6, color="#f4a261", alpha=0.6, label="Housner: overturns")
-    ax.plot(spectrum.omega_ratio, spectrum.housner_min_ratio, "-o", color="C0", ms=4, label="Housner: minimum")
-    ax.plot(spectrum.omega_ratio, spectrum.reference_min_ratio, "--s", color="C1", ms=4, label="reference DEM: minimum")
+    ax.scatter(
+        over.omega_ratio,
+        over.amplitude_ratio,
+        s=7,
+        color=housner_colour,
+        alpha=0.45,
+        lw=0,
+        label="Housner: overturns (every amplitude scanned)",
+    )
+    ax.plot(
+        spectrum.omega_ratio, spectrum.housner_min_ratio, "-o", color=housner_colour, ms=4, label="Housner: minimum"
+    )
+    ax.plot(
+        spectrum.omega_ratio,
+        spectrum.reference_min_ratio,
+        "--s",
+        color=dem_colour,
+        ms=5,
+        mfc="none",
+        mew=1.3,
+        label="reference DEM: minimum",
+    )
     ax.set_xlabel("pulse frequency / frequency parameter, omega_p / p")
     ax.set_ylabel("pulse amplitude / uplift acceleration, a_p / (g tan alpha)")
     ax.set_ylim(1.0, MAX_RATIO)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left")
     ax.set_title("Overturning under a one-sine pulse (specimen 1)")
-    name = "overturning_spectrum.png"
     save_figure(fig, report.out / name)
     report.figure(
         name,
@@ -129,3 +171,4 @@ def _figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> None:
         "and every amplitude at which Housner's block overturns (dots): above the minimum there are "
         "bands where the block survives (the region is not simply connected).",
     )
+    return fig

@@ -14,11 +14,13 @@ Cells on a region's boundary or outside both are "not reported".
 from __future__ import annotations
 
 import pandas as pd
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
 
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.motion.analytic import Harmonic
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import Report, biblock_blocks, scene_dict
+from rockyade.studies.common import Report, biblock_blocks, run_state, scene_dict
 
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
@@ -32,6 +34,17 @@ COLOURS = {
     "overturn-lower": "#264653",
     "overturn-upper": "#6d597a",
     "failed": "#000000",
+}
+#: The legend in words (paper Fig. 16 for patterns 1-4).
+PATTERN_NAMES = {
+    "rest": "rest: neither block rocks",
+    "1": "1: both rock, same way",
+    "2": "2: both rock, opposite ways",
+    "3": "3: the stack rocks as one body",
+    "4": "4: only the upper block rocks",
+    "overturn-lower": "OT lower: the lower block overturns",
+    "overturn-upper": "OT upper: the upper block overturns",
+    "failed": "failed run (no result)",
 }
 
 
@@ -76,6 +89,8 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
         for i, t in enumerate(tasks)
     ]
     summary = run_study_tasks(tasks, report.out / "pattern_map_runs", workers=workers, desc="pattern map")
+    report.record_summary(summary, lambda row: f"{row['frequency_hz']:g} Hz, {row['motion.amplitude_mm']:g} mm")
+    report.note(f"Ran: reference DEM, {run_state(report, 'reference', len(summary))}.")
     cells = summary[["frequency_hz", "motion.amplitude_mm", "status", "pattern"]].rename(
         columns={"motion.amplitude_mm": "amplitude_mm", "pattern": "pattern_dem"}
     )
@@ -92,17 +107,18 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     for pattern in ("2", "3"):
         sel = reported[reported.pattern_paper == pattern]
         stats[pattern] = (int(sel["agree"].astype(bool).sum()), len(sel))
-    _figure(report, cells, stats)
+    draw_figure(report, cells, stats)
     return cells
 
 
-def _figure(report: Report, cells: pd.DataFrame, stats) -> None:
-    fig, ax = plt.subplots(figsize=(9, 6))
+def draw_figure(report: Report, cells: pd.DataFrame, stats) -> Figure:
+    name = "pattern_map.png"
+    fig, ax = new_figure(report.out / name, figsize=(10.5, 6))
     f_index = {f: i for i, f in enumerate(FREQUENCIES_HZ)}
     a_index = {a: j for j, a in enumerate(AMPLITUDES_MM)}
     for _, row in cells.iterrows():
         i, j = f_index[row.frequency_hz], a_index[row.amplitude_mm]
-        ax.add_patch(plt.Rectangle((i - 0.5, j - 0.5), 1, 1, color=COLOURS.get(row.pattern_dem, "#000000")))
+        ax.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, color=COLOURS.get(row.pattern_dem, "#000000")))
         label = row.pattern_dem.replace("overturn-", "OT ") if isinstance(row.pattern_dem, str) else "?"
         ax.text(
             i,
@@ -111,11 +127,11 @@ def _figure(report: Report, cells: pd.DataFrame, stats) -> None:
             ha="center",
             va="center",
             fontsize=9,
-            color="white" if label.startswith(("OT", "2")) else "black",
+            color="white" if label.startswith(("OT", "2", "failed")) else "black",
         )
         if not pd.isna(row.pattern_paper):
             ax.add_patch(
-                plt.Rectangle(
+                Rectangle(
                     (i - 0.45, j - 0.45),
                     0.9,
                     0.9,
@@ -131,15 +147,20 @@ def _figure(report: Report, cells: pd.DataFrame, stats) -> None:
     ax.set_yticks(range(len(AMPLITUDES_MM)), [f"{a:g}" for a in AMPLITUDES_MM])
     ax.set_xlabel("table frequency (Hz)")
     ax.set_ylabel("table displacement amplitude (mm)")
-    handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in COLOURS.values()]
+    shown = [p for p in COLOURS if p in set(cells.pattern_dem) or p in ("1", "2", "3", "4", "rest")]
+    handles = [Rectangle((0, 0), 1, 1, color=COLOURS[p]) for p in shown]
     handles += [
-        plt.Rectangle((0, 0), 1, 1, fill=False, ec="#1d3557", lw=2),
-        plt.Rectangle((0, 0), 1, 1, fill=False, ec="#e63946", lw=2),
+        Rectangle((0, 0), 1, 1, fill=False, ec="#1d3557", lw=2),
+        Rectangle((0, 0), 1, 1, fill=False, ec="#e63946", lw=2),
+        Rectangle((0, 0), 1, 1, fill=False, ec="0.3", lw=2, ls="--"),
     ]
-    labels = [*COLOURS, "paper: pattern 2", "paper: pattern 3"]
-    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)
+    labels = [PATTERN_NAMES[p] for p in shown] + [
+        "paper's region of pattern 2 (opposite ways)",
+        "paper's region of pattern 3 (one body)",
+        "dashed outline: the DEM disagrees",
+    ]
+    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, title="cell colour: DEM")
     ax.set_title("Bi-block: dominant rocking pattern (reference DEM) and the paper's regions")
-    name = "pattern_map.png"
     save_figure(fig, report.out / name)
     report.figure(
         name,
@@ -153,3 +174,4 @@ def _figure(report: Report, cells: pd.DataFrame, stats) -> None:
         "frequency, small amplitude) lies below the uplift acceleration of a rigid stack (a_g < g tan alpha): "
         "there the DEM stays at rest."
     )
+    return fig

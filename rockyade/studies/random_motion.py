@@ -8,14 +8,28 @@ paper's: the comparison is between solvers, and with the paper's verdict only lo
 
 from __future__ import annotations
 
+import textwrap
+
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
-from rockyade.solvers import yade as yade_backend
-from rockyade.studies.common import Report, block_table, fmt, scene_dict
+from rockyade.studies.common import (
+    SOLVER_LABELS,
+    Report,
+    block_table,
+    fmt,
+    max_difference,
+    no_uplift_note,
+    plot_solver,
+    run_each,
+    run_state,
+    run_yade,
+    scene_dict,
+)
 
 CASES = (("2", 21, 0.6), ("3", 18, 0.5))
 DURATION_S = 25.0
@@ -34,14 +48,20 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     for key, record, factor in CASES:
         motion = {"type": "synthetic", "suite": "paper", "record": record, "load_factor": factor}
         scene = scene_from_dict(scene_dict([block_table(key)], motion, DURATION_S, 0.005, "matched"))
-        results = {"housner": housner.run_scene(scene), "reference": reference.run_scene(scene, record_energy=False)}
-        cases.append((key, record, factor, scene, results))
+        cases.append((key, record, factor, scene, {}))
+    scenes = [c[3] for c in cases]
+    for case, r in zip(cases, run_each(scenes, housner.run_scene, "random: Housner"), strict=True):
+        case[4]["housner"] = r
+    dem = run_each(scenes, lambda s: reference.run_scene(s, record_energy=False), "random: reference DEM")
+    for case, r in zip(cases, dem, strict=True):
+        case[4]["reference"] = r
     if use_yade:
-        for case, r in zip(cases, yade_backend.run_many([c[3] for c in cases], workers=workers), strict=True):
+        for case, r in zip(cases, run_yade(scenes, workers, "random: YADE"), strict=True):
             case[4]["yade"] = r
     for key, record, factor, scene, results in cases:
         alpha = scene.blocks[0].alpha_rad
         for solver, r in results.items():
+            report.record_result(f"specimen {key}, record {record} x {factor}", r)
             theta = r.series("theta_rad") if r.ok else np.array([np.nan])
             rows.append(
                 {
@@ -57,7 +77,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                     "failure_reason": r.meta.get("failure_reason") or "",
                 }
             )
-        _figure(report, key, record, factor, scene, results)
+        draw_figure(report, key, record, factor, scene, results)
     table = pd.DataFrame(rows)
     report.table(
         "random.csv",
@@ -65,37 +85,60 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "collapse predicted or not by each solver (the paper reports collapse for both), "
         "overturn time and max |theta| / alpha.",
     )
+    states = [f"{SOLVER_LABELS[s]}: {run_state(report, s, len(cases))}" for s in cases[0][4]]
+    report.note("Runs: " + "; ".join(states) + ".")
     return table
 
 
-def _figure(report: Report, key, record, factor, scene, results) -> None:
+def draw_figure(report: Report, key, record, factor, scene, results) -> Figure:
     gm = scene.motion.ground_motion(scene.duration_s)
-    fig, axes = plt.subplots(2, 1, figsize=(10, 5.5), sharex=True, gridspec_kw={"height_ratios": [1, 2]})
+    name = f"random_specimen{key}_record{record}.png"
+    note = no_uplift_note(scene, results)
+    fig, axes = new_figure(
+        report.out / name, 2, 1, figsize=(10, 5.8), sharex=True, gridspec_kw={"height_ratios": [1, 2]}
+    )
     axes[0].plot(gm.t_s, gm.ah_m_s2, color="0.3", lw=0.6)
     axes[0].set_ylabel("a_g (m/s$^2$)")
     alpha = scene.blocks[0].alpha_rad
-    styles = {"housner": ("C0", "-"), "reference": ("C1", "--"), "yade": ("C2", ":")}
     for solver, r in results.items():
-        if r.ok:
-            verdict = f"collapse at {r.meta['overturn_time_s']:.2f} s" if r.status == "overturned" else "no collapse"
-            colour, style = styles[solver]
-            axes[1].plot(
-                r.t, r.series("theta_rad") / alpha, color=colour, ls=style, lw=1.0, label=f"{solver}: {verdict}"
-            )
+        if not r.ok:
+            axes[1].plot([], [], color="red", ls="none", marker="x", label=f"{SOLVER_LABELS[solver]}: FAILED, no curve")
+            continue
+        verdict = f"collapse at {r.meta['overturn_time_s']:.2f} s" if r.status == "overturned" else "no collapse"
+        label = f"{SOLVER_LABELS[solver]}: {verdict}"
+        if solver == "yade" and results.get("reference") is not None and results["reference"].ok:
+            label += f" (max |YADE - DEM| = {max_difference(r, results['reference']) / alpha:.2g} alpha)"
+        plot_solver(axes[1], solver, r.t, r.series("theta_rad") / alpha, label)
     axes[1].set_ylim(-1.5, 1.5)
     axes[1].axhline(1, color="0.5", lw=0.5, ls="--")
     axes[1].axhline(-1, color="0.5", lw=0.5, ls="--")
     axes[1].set_ylabel("theta / alpha")
     axes[1].set_xlabel("time t (s)")
-    axes[1].legend(fontsize=8)
+    axes[1].legend(fontsize=8, loc="upper right")
     for ax in axes:
         ax.grid(alpha=0.3)
-    fig.suptitle(f"Specimen {key}, synthetic record {record}, load factor {factor}")
-    name = f"random_specimen{key}_record{record}.png"
+    title = f"Specimen {key}, synthetic record {record}, load factor {factor}"
+    if note:
+        title += ": NO UPLIFT"
+        axes[1].text(
+            0.01,
+            0.04,
+            "\n".join(textwrap.wrap(note, 110)),
+            transform=axes[1].transAxes,
+            fontsize=7.5,
+            bbox={"facecolor": "white", "edgecolor": "0.5", "alpha": 0.9},
+        )
+    fig.suptitle(title)
     save_figure(fig, report.out / name)
-    verdicts = "; ".join(f"{s}: {'collapse' if r.status == 'overturned' else r.status}" for s, r in results.items())
+    verdicts = "; ".join(
+        f"{s}: {'collapse' if r.status == 'overturned' else r.status}"
+        + (f" ({r.meta.get('failure_reason')})" if not r.ok else "")
+        for s, r in results.items()
+    )
     report.figure(
         name,
-        f"Specimen {key} under record {record} x {factor} (PGA {fmt(gm.pga_m_s2, 3)} m/s^2): base "
+        (f"**{note}** " if note else "")
+        + f"Specimen {key} under record {record} x {factor} (PGA {fmt(gm.pga_m_s2, 3)} m/s^2): base "
         f"acceleration and theta/alpha (beyond +/-1 the block passes its critical angle). {verdicts}.",
     )
+    return fig

@@ -13,11 +13,12 @@ import math
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.analysis.peaks import find_peaks
 from rockyade.errors import CalibrationError
-from rockyade.figures import plt, save_figure
+from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.studies.common import Report, block_table, scene_dict
@@ -27,7 +28,8 @@ THETA0 = 0.1175
 PEAK = 5
 
 
-def _responses(block: dict, solver: str) -> dict[str, float]:
+def _responses(block: dict, solver: str, report: Report, label: str) -> dict[str, float]:
+    """The three responses of one variant by one solver (NaN where a run failed); runs logged."""
     free = scene_from_dict(scene_dict([block], {"type": "free", "theta0_rad": THETA0}, 4.0, 0.001, "matched"))
     sine = scene_from_dict(
         scene_dict(
@@ -41,13 +43,15 @@ def _responses(block: dict, solver: str) -> dict[str, float]:
     )
     out = {}
     r = run(free)
-    peaks = find_peaks(r.t, r.series("theta_rad"), 1e-4)
+    report.record_result(f"{label}, free rocking", r)
+    peaks = find_peaks(r.t, r.series("theta_rad"), 1e-4) if r.ok else []
     out[f"free rocking: peak {PEAK} amplitude (rad)"] = (
         float(peaks.amplitude_rad[PEAK - 1]) if len(peaks) >= PEAK else math.nan
     )
     out[f"free rocking: peak {PEAK} time (s)"] = float(peaks.t_s[PEAK - 1]) if len(peaks) >= PEAK else math.nan
     r = run(sine)
-    out["3.3 Hz / 6 mm sine: max |theta| (rad)"] = float(np.max(np.abs(r.series("theta_rad"))))
+    report.record_result(f"{label}, 3.3 Hz / 6 mm sine", r)
+    out["3.3 Hz / 6 mm sine: max |theta| (rad)"] = float(np.max(np.abs(r.series("theta_rad")))) if r.ok else math.nan
     return out
 
 
@@ -59,18 +63,19 @@ def run(report: Report) -> pd.DataFrame:
     )
     base_block = block_table("1")
     rows = []
-    base = {s: _responses(base_block, s) for s in ("housner", "reference")}
+    base = {s: _responses(base_block, s, report, "base parameters") for s in ("housner", "reference")}
     for parameter in ("alpha_rad", "p_rad_s", "mu"):
         for sign in (-1, 1):
             block = dict(base_block)
             block[parameter] = base_block[parameter] * (1 + sign * CHANGE)
             for solver in ("housner", "reference"):
                 try:
-                    values = _responses(block, solver)
+                    values = _responses(block, solver, report, f"{parameter} {100 * sign * CHANGE:+g} %")
                     note = ""
                 except CalibrationError as exc:
                     values = {k: math.nan for k in base[solver]}
                     note = f"DEM cannot be matched: {str(exc).split(':')[0]}"
+                    report.record(f"{parameter} {100 * sign * CHANGE:+g} %", solver, "not run", note)
                 for response, value in values.items():
                     ref = base[solver][response]
                     rows.append(
@@ -92,7 +97,7 @@ def run(report: Report) -> pd.DataFrame:
         table,
         "each response with alpha, p or mu changed by -5 % and +5 %, its base value and the relative change (%).",
     )
-    _figure(report, table)
+    draw_figure(report, table)
     spread = table.groupby("parameter")["relative_change_pct"].apply(lambda s: np.nanmax(np.abs(s)))
     report.note(
         "Largest relative change of any response: "
@@ -102,9 +107,10 @@ def run(report: Report) -> pd.DataFrame:
     return table
 
 
-def _figure(report: Report, table: pd.DataFrame) -> None:
+def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
     responses = list(dict.fromkeys(table.response))
-    fig, axes = plt.subplots(1, len(responses), figsize=(4.2 * len(responses), 4.2), sharey=True)
+    name = "sensitivity.png"
+    fig, axes = new_figure(report.out / name, 1, len(responses), figsize=(4.2 * len(responses), 4.2), sharey=True)
     labels = [f"{p} {c:+.0f}%" for p in ("alpha_rad", "p_rad_s", "mu") for c in (-5, 5)]
     y = np.arange(len(labels))
     for ax, response in zip(axes, responses, strict=True):
@@ -123,7 +129,6 @@ def _figure(report: Report, table: pd.DataFrame) -> None:
         ax.grid(alpha=0.3, axis="x")
     axes[0].set_yticks(y, labels)
     axes[0].legend(fontsize=8)
-    name = "sensitivity.png"
     save_figure(fig, report.out / name)
     report.figure(
         name,
@@ -131,3 +136,4 @@ def _figure(report: Report, table: pd.DataFrame) -> None:
         f"(Housner and the reference DEM; missing bars: the DEM cannot be matched to that mu). "
         f"Base: {paper.specimen(1).label}, experimental parameters.",
     )
+    return fig
