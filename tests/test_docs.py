@@ -1,0 +1,159 @@
+"""The documentation stands alone and is true: no path outside the project, the paper
+cited by its title, a licence that matches pyproject, links that resolve, the paper's
+inconsistency counts in step with ``rockyade tables``, and every command and Python
+block of the README and docs/ runs as printed from a fresh checkout (relative paths)."""
+
+from __future__ import annotations
+
+import re
+import shlex
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from .conftest import ROOT
+
+TITLE = "Modeling the dynamic behavior of masonry walls as rigid blocks"
+DOCS = sorted((ROOT / "docs").rglob("*.md"))
+PAGES = [ROOT / "README.md", *DOCS, ROOT / "examples/records/README.md", ROOT / "examples/gallery/README.md"]
+#: Pages other parts of the project add to docs/ (linked from docs/index.md already).
+PENDING_PAGES = {"assemblies.md", "identification.md", "batches.md", "reliability.md"}
+BIN = Path(sys.executable).parent
+#: Paths of the development machine that users do not have (spelled so that this file
+#: does not contain them).
+OUTSIDE = ("../" + "shared", "/work/" + "shared")
+#: Commands of the docs that need more than a test can give: the whole paper study (make run).
+NOT_RUN_HERE = ("rockyade paper",)
+
+
+def _commands(page: Path) -> list[str]:
+    """Every `.venv/bin/...` line of the page's indented blocks, in order."""
+    out = []
+    for line in page.read_text().splitlines():
+        m = re.match(r"^ {4}(?:\$ )?(\.venv/bin/\S+.*)$", line)
+        if m and not any(skip in m.group(1) for skip in NOT_RUN_HERE):
+            out.append(m.group(1).strip())
+    return out
+
+
+PAGES_WITH_COMMANDS = [page for page in PAGES if _commands(page)]
+#: The YADE backend fails with a relative output folder until issue 10, item 1 is fixed
+#: (FileNotFoundError on 'x.yade.json'); only that exact failure is tolerated, as xfail.
+YADE_RELATIVE_BUG = re.compile(r"No such file or directory: '[^'/][^']*\.yade\.json'")
+
+
+def _python_blocks() -> list[tuple[str, str]]:
+    return [
+        (page.relative_to(ROOT).as_posix(), block)
+        for page in PAGES
+        for block in re.findall(r"```python\n(.*?)```", page.read_text(), re.S)
+    ]
+
+
+def _fresh_checkout(tmp_path: Path) -> Path:
+    """A folder that looks like a clone to relative paths: its examples, no outputs."""
+    (tmp_path / "examples").symlink_to(ROOT / "examples")
+    return tmp_path
+
+
+# ------------------------------------------------------------------ standing alone
+
+
+def test_no_file_points_outside_the_project():
+    tracked = subprocess.run(["git", "ls-files"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+    offenders = []
+    for name in tracked:
+        path = ROOT / name
+        if path.suffix in {".png", ".npz"} or not path.is_file():
+            continue
+        text = path.read_text(errors="replace")
+        if any(outside in text for outside in OUTSIDE):
+            offenders.append(name)
+    assert offenders == []
+
+
+def test_the_paper_is_cited_by_its_title():
+    for page in (ROOT / "README.md", ROOT / "docs/paper.md", ROOT / "docs/index.md"):
+        assert TITLE in " ".join(page.read_text().split()), page
+
+
+def test_licence_matches_pyproject():
+    licence = (ROOT / "LICENSE").read_text()
+    assert "GNU GENERAL PUBLIC LICENSE" in licence and "Version 2, June 1991" in licence
+    assert "any later version" in licence  # the "or later" clause the SPDX id relies on
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+    assert project["license"] == "GPL-2.0-or-later"
+
+
+def test_readme_keeps_the_two_set_up_commands():
+    readme = (ROOT / "README.md").read_text()
+    assert "    apt-get update && apt-get install -y make && make run\n" in readme
+    assert "    apt-get update && apt-get install -y make && make test\n" in readme
+
+
+def test_links_resolve():
+    broken = []
+    for page in PAGES:
+        for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", page.read_text()):
+            if target.startswith(("http://", "https://")) or target.startswith("reports/"):
+                continue
+            if not (page.parent / target).exists() and Path(target).name not in PENDING_PAGES:
+                broken.append(f"{page.relative_to(ROOT)} -> {target}")
+    assert broken == []
+
+
+def test_docs_index_links_every_docs_page():
+    index = (ROOT / "docs/index.md").read_text()
+    for page in DOCS:
+        if page.name != "index.md":
+            assert page.relative_to(ROOT / "docs").as_posix() in index, page
+
+
+def test_inconsistency_counts_in_the_paper_page_match_the_tables_command():
+    from rockyade.paper.tables import reproduction_report
+
+    table = reproduction_report()
+    text = (ROOT / "docs/paper.md").read_text()
+    for number in range(1, 7):
+        part = table[table.table == number]
+        flagged = f"| {int((~part.consistent).sum())} of {len(part)} |"
+        row = next(line for line in text.splitlines() if line.startswith(f"| {number} ("))
+        assert flagged in row, (row, flagged)
+
+
+# ------------------------------------------------------------------ runs as printed
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", PAGES_WITH_COMMANDS, ids=[p.relative_to(ROOT).as_posix() for p in PAGES_WITH_COMMANDS])
+def test_documented_commands_run_as_printed(page, tmp_path):
+    """A page's commands, in order, in one fresh folder (later ones may read earlier outputs)."""
+    folder = _fresh_checkout(tmp_path)
+    known_bug = []
+    for command in _commands(page):
+        args = shlex.split(command)
+        args[0] = str(BIN / Path(args[0]).name)
+        proc = subprocess.run(args, cwd=folder, capture_output=True, text=True, timeout=600)
+        if proc.returncode != 0 and YADE_RELATIVE_BUG.search(proc.stdout + proc.stderr):
+            known_bug.append(command)
+            continue
+        assert proc.returncode == 0, f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
+    if known_bug:
+        pytest.xfail(f"YADE with a relative output folder (issue 10, item 1): {known_bug}")
+
+
+@pytest.mark.parametrize(("page", "code"), _python_blocks(), ids=[p for p, _ in _python_blocks()])
+def test_documented_python_runs_as_printed(page, code, tmp_path):
+    (_fresh_checkout(tmp_path) / "runs").mkdir()
+    proc = subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={"MPLBACKEND": "Agg", "PATH": str(BIN), "HOME": str(Path.home())},
+    )
+    assert proc.returncode == 0, f"{page}\n{code}\n{proc.stderr[-2500:]}"
