@@ -39,7 +39,8 @@ def _commands(page: Path) -> list[str]:
     return out
 
 
-PAGES_WITH_COMMANDS = [page for page in PAGES if _commands(page)]
+#: Each documented command once (pages repeat some), with the first page that shows it.
+COMMANDS = {command: page.relative_to(ROOT).as_posix() for page in reversed(PAGES) for command in _commands(page)}
 #: The YADE backend fails with a relative output folder until issue 10, item 1 is fixed
 #: (FileNotFoundError on 'x.yade.json'); only that exact failure is tolerated, as xfail.
 YADE_RELATIVE_BUG = re.compile(r"No such file or directory: '[^'/][^']*\.yade\.json'")
@@ -128,21 +129,15 @@ def test_inconsistency_counts_in_the_paper_page_match_the_tables_command():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("page", PAGES_WITH_COMMANDS, ids=[p.relative_to(ROOT).as_posix() for p in PAGES_WITH_COMMANDS])
-def test_documented_commands_run_as_printed(page, tmp_path):
-    """A page's commands, in order, in one fresh folder (later ones may read earlier outputs)."""
-    folder = _fresh_checkout(tmp_path)
-    known_bug = []
-    for command in _commands(page):
-        args = shlex.split(command)
-        args[0] = str(BIN / Path(args[0]).name)
-        proc = subprocess.run(args, cwd=folder, capture_output=True, text=True, timeout=600)
-        if proc.returncode != 0 and YADE_RELATIVE_BUG.search(proc.stdout + proc.stderr):
-            known_bug.append(command)
-            continue
-        assert proc.returncode == 0, f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
-    if known_bug:
-        pytest.xfail(f"YADE with a relative output folder (issue 10, item 1): {known_bug}")
+@pytest.mark.parametrize("command", list(COMMANDS), ids=[f"{COMMANDS[c]}: {c[18:80]}" for c in COMMANDS])
+def test_documented_command_runs_as_printed(command, tmp_path):
+    """Each command of the README and docs/, in a fresh folder; no command needs another's output."""
+    args = shlex.split(command)
+    args[0] = str(BIN / Path(args[0]).name)
+    proc = subprocess.run(args, cwd=_fresh_checkout(tmp_path), capture_output=True, text=True, timeout=600)
+    if proc.returncode != 0 and YADE_RELATIVE_BUG.search(proc.stdout + proc.stderr):
+        pytest.xfail("YADE with a relative output folder (issue 10, item 1)")
+    assert proc.returncode == 0, f"{COMMANDS[command]}: {command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
 
 
 @pytest.mark.parametrize(("page", "code"), _python_blocks(), ids=[p for p, _ in _python_blocks()])

@@ -18,10 +18,19 @@ from rockyade import paper
 from rockyade.analysis.fragility import Fragility, fit_lognormal
 from rockyade.dem.matching import build_matched_model
 from rockyade.figures import new_figure, save_figure
-from rockyade.motion.synthetic import generate_suite, paper_suite
+from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.scene import scene_from_dict
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, fmt, run_state, scene_dict
+from rockyade.studies.common import (
+    SOLVER_LABELS,
+    SOLVER_STYLES,
+    Report,
+    block_table,
+    fmt,
+    run_each,
+    run_state,
+    scene_dict,
+)
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
 RECORDS = tuple(range(1, 31))
@@ -45,8 +54,10 @@ def tasks(
 
 
 def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
-    """Generate the suite and the matched calibrations once, before workers fork."""
-    generate_suite(paper_suite())
+    """Generate the suite (cached; minutes the first time, with a progress bar) and the
+    matched calibrations once, before workers fork."""
+    suite = paper_suite()
+    run_each(range(1, suite.count + 1), lambda i: suite_record(suite, i), "fragility: synthetic suite")
     for key in specimens:
         build_matched_model(scene_from_dict(_base(key)))
 
