@@ -59,6 +59,9 @@ def installed(tmp_path_factory) -> Path:
 def test_the_wheel_carries_the_package_data_and_runs_from_another_folder(installed, tmp_path):
     where = _run([str(installed / "python"), "-c", "import rockyade; print(rockyade.__file__)"], tmp_path)
     assert str(ROOT) not in where.stdout and "site-packages" in where.stdout  # not the checkout
+    code = "from importlib.metadata import files; print([str(f) for f in files('rockyade')])"
+    listed = _run([str(installed / "python"), "-c", code], tmp_path).stdout
+    assert "licenses/LICENSE" in listed and "paper/data/table5_dem_single.csv" in listed
     work = tmp_path / "elsewhere"
     work.mkdir()
     shutil.copy(EXAMPLES / "specimen1_free.toml", work / "scene.toml")
