@@ -82,6 +82,20 @@ def test_a_part_that_raises_is_a_failure_and_the_study_goes_on(tmp_path, monkeyp
     assert "Traceback" in (tmp_path / "sensitivity_error.log").read_text()
 
 
+def test_failures_that_differ_only_by_their_run_files_are_grouped(tmp_path):
+    report = Report(tmp_path)
+    report.part = "fragility"
+    report.section("Fragility")
+    for run_hash in ("9e30328ec611424b", "8b3fb1e9218edfbf"):
+        report.record(f"run {run_hash[:3]}", "yade", "failed", f"No such file: 'runs/{run_hash}_yade.yade.json'")
+    report.record("run x", "yade", "failed", "timeout")
+    groups = report.failure_groups()
+    assert [(len(runs), reason) for _, _, reason, runs in groups] == [
+        (2, "No such file: 'runs/<hash>_yade.yade.json'"),
+        (1, "timeout"),
+    ]
+
+
 def test_all_runs_succeeded_is_stated(tmp_path):
     report = Report(tmp_path)
     report.part = "demo"

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from dataclasses import dataclass, field
@@ -21,6 +22,8 @@ from rockyade.constants import G
 from rockyade.io.atomic import atomic_open, write_text
 
 PARAMETER_SETS = ("theoretical", "experimental")
+#: Scene hashes in failure reasons (file names of batch runs), replaced when grouping failures.
+RUN_HASH = re.compile(r"(?<![0-9A-Za-z])[0-9a-f]{12,64}(?![0-9A-Za-z])")
 
 
 def block_table(key: str, parameters: str = "experimental", name: str | None = None) -> dict[str, Any]:
@@ -154,7 +157,9 @@ class Report:
         """Failed runs grouped by (part, solver, reason): ``[(part, solver, reason, runs)]``."""
         groups: dict[tuple[str, str, str], list[str]] = {}
         for r in self.failures(part):
-            groups.setdefault((r.part, r.solver, r.reason or "no reason given"), []).append(r.run)
+            # the same cause names each run's own files (hash-named): group on the rest
+            reason = RUN_HASH.sub("<hash>", r.reason) if r.reason else "no reason given"
+            groups.setdefault((r.part, r.solver, reason), []).append(r.run)
         return [(p, s, reason, runs) for (p, s, reason), runs in groups.items()]
 
     def close_part(self, part: str) -> None:

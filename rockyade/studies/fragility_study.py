@@ -205,18 +205,17 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
                 inside = x <= fit.largest_tested_pga_m_s2
                 ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
                 ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
-                if fit.extrapolated:
-                    at = min(fit.median_pga_m_s2, x_max)
-                    ax.annotate(
-                        f"median {fmt(fit.median_pga_m_s2, 3)}\n(extrapolated)",
-                        xy=(at, float(Fragility(fit.median_pga_m_s2, fit.beta, 2).probability(at))),
-                        xytext=(-6, 8),
-                        textcoords="offset points",
-                        ha="right",
-                        va="bottom",
-                        fontsize=7,
+                if fit.extrapolated:  # the median on the dotted curve (an arrow at the edge when beyond it)
+                    inside_plot = fit.median_pga_m_s2 <= x_max
+                    ax.plot(
+                        min(fit.median_pga_m_s2, x_max),
+                        0.5,
+                        "D" if inside_plot else ">",
                         color=colour,
-                        arrowprops={"arrowstyle": "-", "color": colour, "lw": 0.6},
+                        mfc="white",
+                        ms=6,
+                        mew=1.3,
+                        zorder=5,
                     )
         ax.axvspan(tested, x_max, color="0.92", lw=0, zorder=0)
         ax.text(
@@ -254,7 +253,8 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
         name,
         f"Collapse fragility of the specimens: fraction of the {len(RECORDS)} records that overturn the block "
         "at each load factor (points) and the fitted lognormal curves (solid within the tested PGA, dotted beyond "
-        "it, in the grey band)." + (" " + "; ".join(notes) + "." if notes else ""),
+        "it, in the grey band; a diamond marks a median beyond the largest tested PGA)."
+        + (" " + "; ".join(notes) + "." if notes else ""),
     )
     return fig
 
@@ -267,5 +267,7 @@ def _missing_curve(solver: str, fit) -> str:
     return f"{name}: no curve, {fit.status}" + _reason(fit)
 
 
-def _reason(fit) -> str:
-    return f" ({fit.failure_reason})" if fit.failure_reason else ""
+def _reason(fit, width: int = 40) -> str:
+    """The most frequent failure reason, its first clause, for a legend (the CSVs hold it whole)."""
+    reason = str(fit.failure_reason or "").split(":")[0].strip()
+    return f" ({reason if len(reason) <= width else reason[: width - 3] + '...'})" if reason else ""

@@ -21,7 +21,7 @@ from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference
-from rockyade.studies.common import Report, block_table, scene_dict
+from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, scene_dict
 
 CHANGE = 0.05
 THETA0 = 0.1175
@@ -114,7 +114,7 @@ def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
     labels = [f"{p} {c:+.0f}%" for p in ("alpha_rad", "p_rad_s", "mu") for c in (-5, 5)]
     y = np.arange(len(labels))
     for ax, response in zip(axes, responses, strict=True):
-        for k, (solver, colour) in enumerate((("housner", "C0"), ("reference", "C1"))):
+        for k, solver in enumerate(("housner", "reference")):
             sel = table[(table.response == response) & (table.solver == solver)]
             values = [
                 sel[(sel.parameter == lab.split()[0]) & (np.isclose(sel.change_pct, float(lab.split()[1][:-1])))][
@@ -122,7 +122,11 @@ def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
                 ].iloc[0]
                 for lab in labels
             ]
-            ax.barh(y + (k - 0.5) * 0.38, values, height=0.38, color=colour, label=solver)
+            offset = y + (k - 0.5) * 0.38
+            ax.barh(offset, values, height=0.38, color=SOLVER_STYLES[solver]["color"], label=SOLVER_LABELS[solver])
+            for pos, value in zip(offset, values, strict=True):
+                if np.isnan(value):  # say why there is no bar
+                    ax.text(0, pos, "  DEM: mu not reachable", va="center", fontsize=7, color="0.35")
         ax.axvline(0, color="0.3", lw=0.6)
         ax.set_title(response, fontsize=9)
         ax.set_xlabel("change of the response (%)")
