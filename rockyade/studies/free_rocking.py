@@ -238,7 +238,7 @@ def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> 
             ax.set_title(f"{params} parameters (alpha = {alpha:.3f} rad), {cal} calibration", fontsize=9)
             ax.axhline(0, color="0.5", lw=0.5)
             ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="upper right")
+            ax.legend(fontsize=7, loc="best")
         row[0].set_ylabel("theta (rad)")
     for ax in axes[-1]:
         ax.set_xlabel("time t (s)")
