@@ -67,73 +67,103 @@ def face_separation(wv, wn, ref: int, face: int, other: int, n_other: int) -> fl
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def max_separation(wv, wn, ref: int, n_ref: int, other: int, n_other: int) -> tuple[float, int]:
-    """Largest face separation over ``ref``'s edges and its edge; stops at a separating axis."""
-    best = -math.inf
-    best_face = NO_FACE
+def top_two_separations(wv, wn, ref: int, n_ref: int, other: int, n_other: int) -> tuple[float, int, float]:
+    """The largest face separation over ``ref``'s edges, its edge, and the second largest;
+    stops at a separating axis (then the second is -inf)."""
+    s1 = -math.inf
+    f1 = NO_FACE
+    s2 = -math.inf
     for f in range(n_ref):
         s = face_separation(wv, wn, ref, f, other, n_other)
-        if s > best:
-            best = s
-            best_face = f
+        if s > s1:
+            s2 = s1
+            s1 = s
+            f1 = f
             if s > 0.0:
-                break
-    return best, best_face
+                return s1, f1, -math.inf
+        elif s > s2:
+            s2 = s
+    return s1, f1, s2
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def incident_edge(wn, ref: int, face: int, inc: int, n_inc: int) -> int:
-    """Edge of ``inc`` most anti-parallel to the reference face's normal."""
+def incident_edge(wn, ref: int, face: int, inc: int, n_inc: int) -> tuple[int, float]:
+    """Edge of ``inc`` most anti-parallel to the reference face's normal, and half the gap
+    of its normal's dot product to the next edge's (the relative rotation, rad, under which
+    the choice cannot change)."""
     nx = wn[ref, face, 0]
     ny = wn[ref, face, 1]
     best = math.inf
+    second = math.inf
     edge = 0
     for e in range(n_inc):
         d = nx * wn[inc, e, 0] + ny * wn[inc, e, 1]
         if d < best:
+            second = best
             best = d
             edge = e
-    return edge
+        elif d < second:
+            second = d
+    return edge, 0.5 * (second - best)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def choose_reference(
+def separating_axis_test(
     wv, wn, flen, nverts, a: int, b: int, prev_side: int, prev_face: int, tol: float
 ) -> tuple[int, int, float]:
-    """Reference face of a pair: (side 0 = a's face / 1 = b's face, face, separation).
+    """Reference face of a pair and how far the pair may move before the answer can change.
 
-    ``side = NO_FACE`` when a separating axis exists (no contact).
+    Returns
+    -------
+    side
+        0: a face of ``a``; 1: a face of ``b``; ``NO_FACE``: a separating axis exists.
+    face
+        The reference face (an edge index of that body).
+    slack
+        A bound, m: while no point of either body has moved by more than ``slack``
+        relative to the other since this test, every face separation has changed by less
+        than ``slack``, so the test would give the same answer (with contact: the same
+        reference face under the hysteresis rule and no separating axis; without: the same
+        separating axis). Temporal coherence, as physics engines cache separating axes.
     """
     na = nverts[a]
     nb_ = nverts[b]
-    sa, fa = max_separation(wv, wn, a, na, b, nb_)
+    sa, fa, sa2 = top_two_separations(wv, wn, a, na, b, nb_)
     if sa > 0.0:
         return NO_FACE, NO_FACE, sa
-    sb, fb = max_separation(wv, wn, b, nb_, a, na)
+    sb, fb, sb2 = top_two_separations(wv, wn, b, nb_, a, na)
     if sb > 0.0:
         return NO_FACE, NO_FACE, sb
     best = sa if sa > sb else sb
+    side = NO_FACE
+    face = NO_FACE
     if prev_side >= 0:
         if prev_side == 0:
-            sp = face_separation(wv, wn, a, prev_face, b, nb_)
+            sp = sa if prev_face == fa else face_separation(wv, wn, a, prev_face, b, nb_)
         else:
-            sp = face_separation(wv, wn, b, prev_face, a, na)
+            sp = sb if prev_face == fb else face_separation(wv, wn, b, prev_face, a, na)
         if sp >= best - tol:
-            return prev_side, prev_face, sp
-    if abs(sa - sb) > tol:
-        if sa > sb:
-            return 0, fa, sa
-        return 1, fb, sb
-    # a tie (parallel faces): the longer face, then the face pointing up, then body a
-    la = flen[a, fa]
-    lb = flen[b, fb]
-    if abs(la - lb) > tol:
-        if la > lb:
-            return 0, fa, sa
-        return 1, fb, sb
-    if wn[b, fb, 1] > wn[a, fa, 1] + 1e-9:
-        return 1, fb, sb
-    return 0, fa, sa
+            side = prev_side
+            face = prev_face
+    if side == NO_FACE:
+        if abs(sa - sb) > tol:
+            side = 0 if sa > sb else 1
+        elif abs(flen[a, fa] - flen[b, fb]) > tol:
+            # a tie (parallel faces): the longer face, then the face pointing up, then body a
+            side = 0 if flen[a, fa] > flen[b, fb] else 1
+        else:
+            side = 1 if wn[b, fb, 1] > wn[a, fa, 1] + 1e-9 else 0
+        face = fa if side == 0 else fb
+    # the chosen face's separation and the largest of all the others
+    if side == 0:
+        s_star = sa if face == fa else face_separation(wv, wn, a, face, b, nb_)
+        other = max(sa2 if face == fa else sa, sb)
+    else:
+        s_star = sb if face == fb else face_separation(wv, wn, b, face, a, na)
+        other = max(sb2 if face == fb else sb, sa)
+    # kept while s_star + tol >= every other separation and none of them becomes positive
+    slack = min(0.5 * (s_star + tol - other), -other)
+    return side, face, slack
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

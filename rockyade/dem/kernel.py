@@ -44,7 +44,7 @@ import numba
 import numpy as np
 
 from rockyade.dem.broadphase import candidate_pairs, moved_beyond_margin, sweep_axis
-from rockyade.dem.contacts import HYSTERESIS_REL, NO_FACE, choose_reference, clip_manifold, incident_edge, joint_for
+from rockyade.dem.contacts import HYSTERESIS_REL, NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
 
 # energy columns
 E_KIN, E_POT, E_EL, E_DASH, E_FRIC, W_BASE = range(6)
@@ -266,6 +266,13 @@ def simulate(
     for k in range(npairs):
         pj[k] = joint_for(pa[k], pb[k], nb, base_joint, own_joint, pair_keys, pair_joint, fixed, kn)
     pside = np.full(npairs, NO_FACE, dtype=np.int64)
+    pedge = np.zeros(npairs, dtype=np.int64)
+    # temporal coherence: the pair's last test holds while its relative motion < c_slack
+    c_slack = np.zeros(npairs)
+    c_travel = np.zeros(npairs)
+    c_turn = np.zeros(npairs)
+    travel = np.zeros(nb)  # sum of |dx| + |dy| of each body, m
+    turn = np.zeros(nb)  # sum of |d theta| of each body, rad
     pface = np.full(npairs, NO_FACE, dtype=np.int64)
     pn = np.zeros(npairs, dtype=np.int64)
     ppt = np.zeros((npairs, 2, 2))
@@ -402,12 +409,30 @@ def simulate(
                 inc = b
                 edge = 0
                 if not (lo[a, 0] > hi[b, 0] or lo[b, 0] > hi[a, 0] or lo[a, 1] > hi[b, 1] or lo[b, 1] > hi[a, 1]):
-                    tol = HYSTERESIS_REL * min(scale[a], scale[b])
-                    side, face, _ = choose_reference(wv, wn, edge_len, nverts, a, b, pside[k], pface[k], tol)
+                    # relative motion since the last separating-axis test, bounded above
+                    lever = 3.0 * (radius[a] + radius[b])
+                    moved = travel[a] + travel[b] - c_travel[k] + (turn[a] + turn[b] - c_turn[k]) * lever
+                    if moved < c_slack[k]:
+                        side = pside[k]
+                        face = pface[k]
+                        edge = pedge[k]
+                    else:
+                        tol = HYSTERESIS_REL * min(scale[a], scale[b])
+                        side, face, slack = separating_axis_test(
+                            wv, wn, edge_len, nverts, a, b, pside[k], pface[k], tol
+                        )
+                        if side >= 0:
+                            ref = a if side == 0 else b
+                            inc = b if side == 0 else a
+                            edge, turn_slack = incident_edge(wn, ref, face, inc, nverts[inc])
+                            slack = min(slack, turn_slack * lever)
+                        c_slack[k] = slack
+                        c_travel[k] = travel[a] + travel[b]
+                        c_turn[k] = turn[a] + turn[b]
+                        pedge[k] = edge
                     if side >= 0:
                         ref = a if side == 0 else b
                         inc = b if side == 0 else a
-                        edge = incident_edge(wn, ref, face, inc, nverts[inc])
                         n_new = clip_manifold(wv, wn, edge_len, nverts, ref, face, inc, edge, clip)
                 joint = pj[k]
                 n_old = pn[k]
@@ -417,6 +442,9 @@ def simulate(
                             for i in range(n_old):
                                 d_fric += 0.5 * (psh[k, i, 0] ** 2 + psh[k, i, 1] ** 2) / ks[joint]
                         pn[k] = 0
+                    if side >= 0:
+                        # the manifold emptied without a separating axis: test again next step
+                        c_slack[k] = 0.0
                     pside[k] = NO_FACE
                     pface[k] = NO_FACE
                     continue
@@ -635,6 +663,8 @@ def simulate(
                 pos[a, 0] += dt * vel[a, 0]
                 pos[a, 1] += dt * vel[a, 1]
                 ang[a] += dt * angvel[a]
+                travel[a] += dt * (abs(vel[a, 0]) + abs(vel[a, 1]))
+                turn[a] += dt * abs(angvel[a])
                 finite = math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])
                 speed2 = vel[a, 0] * vel[a, 0] + vel[a, 1] * vel[a, 1]
                 if not finite or speed2 > MAX_SPEED_M_S * MAX_SPEED_M_S or abs(angvel[a]) > MAX_SPIN_RAD_S:
@@ -661,6 +691,10 @@ def simulate(
         new_keys, pa, pb = candidate_pairs(lo, hi, margin, fixed, axis, order)
         # a pair leaves the list only when its grown boxes are apart: it opened before
         pside, pface, pn, ppt, psh = _carry_pairs(keys, pside, pface, pn, ppt, psh, new_keys)
+        pedge = np.zeros(new_keys.size, dtype=np.int64)
+        c_slack = np.zeros(new_keys.size)  # every pair is tested again after a rebuild
+        c_travel = np.zeros(new_keys.size)
+        c_turn = np.zeros(new_keys.size)
         keys = new_keys
         npairs = keys.size
         pj = np.empty(npairs, dtype=np.int64)
