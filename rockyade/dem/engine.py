@@ -44,6 +44,7 @@ class KernelOutput(NamedTuple):
     overturn_time: NDArray[np.float64]
     n_builds: int
     max_pairs: int
+    n_tests: int
 
 
 def polygon_arrays(polygons: list[NDArray[np.float64]]) -> dict[str, NDArray]:
@@ -146,6 +147,7 @@ def simulate_model(
     record_corners: bool = False,
     stop_on_overturn: bool = True,
     stop_angle_rad: NDArray[np.float64] | None = None,
+    coherent: bool = True,
 ) -> tuple[KernelOutput, float]:
     """Run the kernel on a model; return its raw outputs and the kernel's wall time (s).
 
@@ -160,6 +162,9 @@ def simulate_model(
         record when each body first did (assemblies: a falling block does not end a wall's run).
     stop_angle_rad
         (nb,) stop angles, rad; pi/2 by default.
+    coherent
+        Keep each pair's separating-axis answer while the pair has not moved enough to
+        change it (False: test every candidate pair every step; same results, slower).
 
     The compiled kernel is loaded (or compiled) before the timer starts.
     """
@@ -171,6 +176,7 @@ def simulate_model(
         stop_on_overturn=bool(stop_on_overturn),
         record_energy=bool(record_energy),
         record_corners=bool(record_corners),
+        coherent=bool(coherent),
     )
     return KernelOutput(*out), time.perf_counter() - start
 
@@ -218,4 +224,5 @@ def _warm_up() -> None:
         accel_points=np.zeros((1, 2)),
         record_energy=True,
         record_corners=True,
+        coherent=True,
     )

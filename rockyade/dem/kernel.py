@@ -174,6 +174,7 @@ def simulate(
     accel_points,
     record_energy,
     record_corners,
+    coherent,
 ):
     """Run the DEM. See the module docstring; arrays are float64 unless stated.
 
@@ -202,6 +203,8 @@ def simulate(
     g, dt : float; n_steps, steps_per_sample : int
     accel_points : (nb, 2) output point relative to the centroid, body frame
     record_energy, record_corners : bool
+    coherent : bool, keep a pair's separating-axis answer while its relative motion stays
+        below the test's slack (False: test every pair every step; the results are the same)
 
     Returns
     -------
@@ -213,6 +216,7 @@ def simulate(
     slip_s : (n_samples, nb) bool, a point of the body slips
     overturn_t : (nb,) first time |theta| >= stop_angle, NaN if never
     n_builds, max_pairs : broad-phase rebuilds and the largest candidate list
+    n_tests : separating-axis tests run (pair-steps)
     """
     nb = mass.shape[0]
     maxv = verts.shape[1]
@@ -280,6 +284,7 @@ def simulate(
     ref_pos = pos.copy()
     ref_ang = ang.copy()
     n_builds = 1
+    n_tests = 0
     max_pairs = npairs
     multi = nb > 1
 
@@ -403,6 +408,7 @@ def simulate(
                 a = pa[k]
                 b = pb[k]
                 n_new = 0
+                apart = False  # a separating axis holds (tested or cached)
                 side = NO_FACE
                 face = NO_FACE
                 ref = a
@@ -412,7 +418,7 @@ def simulate(
                     # relative motion since the last separating-axis test, bounded above
                     lever = 3.0 * (radius[a] + radius[b])
                     moved = travel[a] + travel[b] - c_travel[k] + (turn[a] + turn[b] - c_turn[k]) * lever
-                    if moved < c_slack[k]:
+                    if coherent and moved < c_slack[k]:
                         side = pside[k]
                         face = pface[k]
                         edge = pedge[k]
@@ -427,9 +433,11 @@ def simulate(
                             edge, turn_slack = incident_edge(wn, ref, face, inc, nverts[inc])
                             slack = min(slack, turn_slack * lever)
                         c_slack[k] = slack
+                        n_tests += 1
                         c_travel[k] = travel[a] + travel[b]
                         c_turn[k] = turn[a] + turn[b]
                         pedge[k] = edge
+                    apart = side == NO_FACE
                     if side >= 0:
                         ref = a if side == 0 else b
                         inc = b if side == 0 else a
@@ -442,8 +450,9 @@ def simulate(
                             for i in range(n_old):
                                 d_fric += 0.5 * (psh[k, i, 0] ** 2 + psh[k, i, 1] ** 2) / ks[joint]
                         pn[k] = 0
-                    if side >= 0:
-                        # the manifold emptied without a separating axis: test again next step
+                    if not apart:
+                        # the boxes parted, or the manifold emptied without a separating
+                        # axis: the cached answer no longer holds, test again next time
                         c_slack[k] = 0.0
                     pside[k] = NO_FACE
                     pface[k] = NO_FACE
@@ -724,4 +733,5 @@ def simulate(
         overturn_t,
         n_builds,
         max_pairs,
+        n_tests,
     )

@@ -139,7 +139,11 @@ def run_model(
         "overturn_times_s": {
             names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)
         },
-        "broad_phase": {"rebuilds": int(out.n_builds), "max_candidate_pairs": int(out.max_pairs)},
+        "broad_phase": {
+            "rebuilds": int(out.n_builds),
+            "max_candidate_pairs": int(out.max_pairs),
+            "separating_axis_tests": int(out.n_tests),
+        },
         "failure_reason": (
             f"numerical instability at t = {t_stop:.6g} s (energy created: {gain:.3g} x weight x height; or a "
             f"non-finite state, speed > {kernel.MAX_SPEED_M_S:g} m/s or spin > {kernel.MAX_SPIN_RAD_S:g} rad/s)"
