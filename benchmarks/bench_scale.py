@@ -5,7 +5,7 @@ same scenes: ``scene_for(n, motion)``):
 
 * n = 1: one 0.4 x 0.2 m brick on the base;
 * n > 1: a dry running-bond wall of about n bricks (0.4 x 0.2 x 0.2 m, half bricks at the
-  ends of every other course), about eight times longer than high.
+  ends of every other course), about sixteen times longer than high.
 
 Motions: ``rest`` (gravity alone: the wall stands, the candidate list is built once) and a
 one-sine ``pulse`` of 0.8 g, 0.3 s (above the friction coefficient tan 30 deg: the courses
@@ -41,7 +41,7 @@ MOTIONS: dict[str, dict[str, Any]] = {
 
 
 def wall_blocks(n: int) -> list[dict[str, Any]]:
-    """A running-bond wall of about n bricks (exactly n for n = 1), four times longer than high."""
+    """A running-bond wall of about n bricks (exactly n for n = 1), about sixteen times longer than high."""
     w, h = BRICK["width_m"], BRICK["height_m"]
     if n == 1:
         return [{"name": "b0", **BRICK, "position_m": [0.0, 0.0]}]

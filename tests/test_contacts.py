@@ -99,7 +99,8 @@ def _world(polys):
 
 def _manifold(polys, prev=(NO_FACE, NO_FACE)):
     wv, wn, flen, nverts = _world(polys)  # polygons given in world coordinates directly
-    side, face, slack = separating_axis_test(wv, wn, flen, nverts, 0, 1, prev[0], prev[1], 1e-9)
+    wd = np.einsum("bvk,bvk->bv", wn, wv)
+    side, face, slack = separating_axis_test(wv, wn, wd, flen, nverts, 0, 1, prev[0], prev[1], 1e-9)
     if side == NO_FACE:
         return side, face, slack, np.zeros((0, 3))
     ref, inc = (0, 1) if side == 0 else (1, 0)

@@ -46,7 +46,7 @@ NO_FACE = -1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def face_separation(wv, wn, ref: int, face: int, other: int, n_other: int) -> float:
+def face_separation(wv, wn, wd, ref: int, face: int, other: int, n_other: int) -> float:
     """Least signed distance of ``other``'s vertices from the line of ``ref``'s edge ``face``.
 
     Parameters
@@ -54,27 +54,26 @@ def face_separation(wv, wn, ref: int, face: int, other: int, n_other: int) -> fl
     wv, wn
         (nb, maxv, 2) world vertices and outward unit edge normals (edge e runs from vertex
         e to vertex e + 1, counter-clockwise).
+    wd
+        (nb, maxv) offsets of the edge lines, n_e . v_e.
     """
     nx = wn[ref, face, 0]
     ny = wn[ref, face, 1]
-    d = nx * wv[ref, face, 0] + ny * wv[ref, face, 1]
     s = math.inf
     for v in range(n_other):
-        p = nx * wv[other, v, 0] + ny * wv[other, v, 1]
-        if p < s:
-            s = p
-    return s - d
+        s = min(s, nx * wv[other, v, 0] + ny * wv[other, v, 1])
+    return s - wd[ref, face]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def top_two_separations(wv, wn, ref: int, n_ref: int, other: int, n_other: int) -> tuple[float, int, float]:
+def top_two_separations(wv, wn, wd, ref: int, n_ref: int, other: int, n_other: int) -> tuple[float, int, float]:
     """The largest face separation over ``ref``'s edges, its edge, and the second largest;
     stops at a separating axis (then the second is -inf)."""
     s1 = -math.inf
     f1 = NO_FACE
     s2 = -math.inf
     for f in range(n_ref):
-        s = face_separation(wv, wn, ref, f, other, n_other)
+        s = face_separation(wv, wn, wd, ref, f, other, n_other)
         if s > s1:
             s2 = s1
             s1 = s
@@ -109,7 +108,7 @@ def incident_edge(wn, ref: int, face: int, inc: int, n_inc: int) -> tuple[int, f
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def separating_axis_test(
-    wv, wn, flen, nverts, a: int, b: int, prev_side: int, prev_face: int, tol: float
+    wv, wn, wd, flen, nverts, a: int, b: int, prev_side: int, prev_face: int, tol: float
 ) -> tuple[int, int, float]:
     """Reference face of a pair and how far the pair may move before the answer can change.
 
@@ -128,10 +127,10 @@ def separating_axis_test(
     """
     na = nverts[a]
     nb_ = nverts[b]
-    sa, fa, sa2 = top_two_separations(wv, wn, a, na, b, nb_)
+    sa, fa, sa2 = top_two_separations(wv, wn, wd, a, na, b, nb_)
     if sa > 0.0:
         return NO_FACE, NO_FACE, sa
-    sb, fb, sb2 = top_two_separations(wv, wn, b, nb_, a, na)
+    sb, fb, sb2 = top_two_separations(wv, wn, wd, b, nb_, a, na)
     if sb > 0.0:
         return NO_FACE, NO_FACE, sb
     best = sa if sa > sb else sb
@@ -139,9 +138,9 @@ def separating_axis_test(
     face = NO_FACE
     if prev_side >= 0:
         if prev_side == 0:
-            sp = sa if prev_face == fa else face_separation(wv, wn, a, prev_face, b, nb_)
+            sp = sa if prev_face == fa else face_separation(wv, wn, wd, a, prev_face, b, nb_)
         else:
-            sp = sb if prev_face == fb else face_separation(wv, wn, b, prev_face, a, na)
+            sp = sb if prev_face == fb else face_separation(wv, wn, wd, b, prev_face, a, na)
         if sp >= best - tol:
             side = prev_side
             face = prev_face
@@ -156,10 +155,10 @@ def separating_axis_test(
         face = fa if side == 0 else fb
     # the chosen face's separation and the largest of all the others
     if side == 0:
-        s_star = sa if face == fa else face_separation(wv, wn, a, face, b, nb_)
+        s_star = sa if face == fa else face_separation(wv, wn, wd, a, face, b, nb_)
         other = max(sa2 if face == fa else sa, sb)
     else:
-        s_star = sb if face == fb else face_separation(wv, wn, b, face, a, na)
+        s_star = sb if face == fb else face_separation(wv, wn, wd, b, face, a, na)
         other = max(sb2 if face == fb else sb, sa)
     # kept while s_star + tol >= every other separation and none of them becomes positive
     slack = min(0.5 * (s_star + tol - other), -other)

@@ -75,8 +75,8 @@ def _ground(t, mt, mah, mav, j):
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _place(a, pos, ang, verts, normals, nverts, wv, wn, lo, hi):
-    """World vertices, edge normals and tight box of body a."""
+def _place(a, pos, ang, verts, normals, nverts, wv, wn, wd, lo, hi):
+    """World vertices, edge normals, edge-line offsets and tight box of body a."""
     c = math.cos(ang[a])
     s = math.sin(ang[a])
     lox = math.inf
@@ -94,6 +94,7 @@ def _place(a, pos, ang, verts, normals, nverts, wv, wn, lo, hi):
         ny = normals[a, v, 1]
         wn[a, v, 0] = c * nx - s * ny
         wn[a, v, 1] = s * nx + c * ny
+        wd[a, v] = wn[a, v, 0] * px + wn[a, v, 1] * py
         lox = min(lox, px)
         hix = max(hix, px)
         loy = min(loy, py)
@@ -243,10 +244,11 @@ def simulate(
     fixed = ~moving
     wv = np.zeros((nb, maxv, 2))
     wn = np.zeros((nb, maxv, 2))
+    wd = np.zeros((nb, maxv))
     lo = np.zeros((nb, 2))
     hi = np.zeros((nb, 2))
     for a in range(nb):
-        _place(a, pos, ang, verts, normals, nverts, wv, wn, lo, hi)
+        _place(a, pos, ang, verts, normals, nverts, wv, wn, wd, lo, hi)
     # base contacts: shear memory per vertex
     shear_base = np.zeros((nb, maxv))
     on_base = np.zeros(nb, dtype=np.bool_)
@@ -322,7 +324,7 @@ def simulate(
             if step > 0:
                 for a in range(nb):
                     if moving[a]:
-                        _place(a, pos, ang, verts, normals, nverts, wv, wn, lo, hi)
+                        _place(a, pos, ang, verts, normals, nverts, wv, wn, wd, lo, hi)
             for a in range(nb):
                 force[a, 0] = -mass[a] * ah
                 force[a, 1] = -mass[a] * (g + av)
@@ -425,7 +427,7 @@ def simulate(
                     else:
                         tol = HYSTERESIS_REL * min(scale[a], scale[b])
                         side, face, slack = separating_axis_test(
-                            wv, wn, edge_len, nverts, a, b, pside[k], pface[k], tol
+                            wv, wn, wd, edge_len, nverts, a, b, pside[k], pface[k], tol
                         )
                         if side >= 0:
                             ref = a if side == 0 else b
@@ -696,7 +698,7 @@ def simulate(
             break
         for a in range(nb):
             if moving[a]:
-                _place(a, pos, ang, verts, normals, nverts, wv, wn, lo, hi)
+                _place(a, pos, ang, verts, normals, nverts, wv, wn, wd, lo, hi)
         new_keys, pa, pb = candidate_pairs(lo, hi, margin, fixed, axis, order)
         # a pair leaves the list only when its grown boxes are apart: it opened before
         pside, pface, pn, ppt, psh = _carry_pairs(keys, pside, pface, pn, ppt, psh, new_keys)
