@@ -228,7 +228,7 @@ def test_thousand_block_wall_stands_under_gravity():
     assert len(blocks) == 1010
     scene = scene_from_dict(
         {
-            "duration_s": 0.03,
+            "duration_s": 0.02,
             "sample_dt_s": 0.001,
             "blocks": blocks,
             "contact": {"calibration": "paper"},

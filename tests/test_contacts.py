@@ -170,6 +170,10 @@ def test_flush_stack_at_rest_splits_as_statics():
     assert abs(forces[0] / forces[1] - 1) < 0.01
     assert statics_forces(model, (0, 1)) == pytest.approx([weight / 2, weight / 2], rel=1e-9)
     assert result.frame["upper_n_contacts"].iloc[-1] == 2  # one joint: two points, not four
+    # corner states: both blocks' corners at the flush joint and on the base, not the top ones
+    last = result.frame.iloc[-1]
+    states = {f"{b}_c{v}": str(last[f"{b}_c{v}_state"]) for b in ("lower", "upper") for v in range(4)}
+    assert states == {**dict.fromkeys(states, "stick"), "upper_c2": "open", "upper_c3": "open"}
 
     offset = scene([block("lower", 0.2, 0.6, 0.0, 0.0), block("upper", 0.2, 0.6, 0.03, 0.6)], duration=1.0)
     model = build_dem_model(offset)

@@ -59,6 +59,9 @@ MAX_SPIN_RAD_S = 1000.0
 
 STATE_OPEN, STATE_STICK, STATE_SLIP = 0, 1, 2
 
+#: A contact point counts for a vertex's state within this fraction of the smaller block's width.
+CORNER_TOL_REL = 0.01
+
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def _ground(t, mt, mah, mav, j):
@@ -542,7 +545,9 @@ def simulate(
                             slipping[a] = True
                             slipping[b] = True
                         if record_corners:
-                            tol2 = match_tol2
+                            # at a corner: within 1 % of the smaller block's width (penetrations
+                            # are far smaller, another block's corner is farther)
+                            tol2 = (CORNER_TOL_REL * min(scale[a], scale[b])) ** 2
                             nr = nverts[ref]
                             ni = nverts[inc]
                             _mark_corner(vstate, ref, face, px, py, wv, tol2, state)
