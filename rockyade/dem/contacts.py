@@ -119,8 +119,8 @@ def separating_axis_test(
     face
         The reference face (an edge index of that body).
     slack
-        A bound, m: while no point of either body has moved by more than ``slack``
-        relative to the other since this test, every face separation has changed by less
+        A bound, m: while no vertex of either body has moved by more than ``slack`` in the
+        other body's frame since this test, every face separation has changed by less
         than ``slack``, so the test would give the same answer (with contact: the same
         reference face under the hysteresis rule and no separating axis; without: the same
         separating axis). Temporal coherence, as physics engines cache separating axes.

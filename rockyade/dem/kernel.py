@@ -278,10 +278,7 @@ def simulate(
     pedge = np.zeros(npairs, dtype=np.int64)
     # temporal coherence: the pair's last test holds while its relative motion < c_slack
     c_slack = np.zeros(npairs)
-    c_travel = np.zeros(npairs)
-    c_turn = np.zeros(npairs)
-    travel = np.zeros(nb)  # sum of |dx| + |dy| of each body, m
-    turn = np.zeros(nb)  # sum of |d theta| of each body, rad
+    c_at = np.zeros((npairs, 4))  # at the test: centroid b - centroid a (x, y), angles of a and b
     pface = np.full(npairs, NO_FACE, dtype=np.int64)
     pn = np.zeros(npairs, dtype=np.int64)
     ppt = np.zeros((npairs, 2, 2))
@@ -420,9 +417,21 @@ def simulate(
                 inc = b
                 edge = 0
                 if not (lo[a, 0] > hi[b, 0] or lo[b, 0] > hi[a, 0] or lo[a, 1] > hi[b, 1] or lo[b, 1] > hi[a, 1]):
-                    # relative motion since the last separating-axis test, bounded above
-                    lever = 3.0 * (radius[a] + radius[b])
-                    moved = travel[a] + travel[b] - c_travel[k] + (turn[a] + turn[b] - c_turn[k]) * lever
+                    # how far a vertex of either body may have moved in the other's frame
+                    # since the last test: |d' - d| + |d theta_a| |d| + |d (theta_b - theta_a)| r_b
+                    # (d = centroid b - centroid a), and the same from b's side
+                    dx = pos[b, 0] - pos[a, 0]
+                    dy = pos[b, 1] - pos[a, 1]
+                    turn_a = abs(ang[a] - c_at[k, 2])
+                    turn_b = abs(ang[b] - c_at[k, 3])
+                    turn_rel = abs(ang[b] - ang[a] - (c_at[k, 3] - c_at[k, 2]))
+                    r_max = max(radius[a], radius[b])
+                    moved = (
+                        abs(dx - c_at[k, 0])
+                        + abs(dy - c_at[k, 1])
+                        + max(turn_a, turn_b) * (abs(c_at[k, 0]) + abs(c_at[k, 1]))
+                        + turn_rel * r_max
+                    )
                     if coherent and moved < c_slack[k]:
                         side = pside[k]
                         face = pface[k]
@@ -436,11 +445,13 @@ def simulate(
                             ref = a if side == 0 else b
                             inc = b if side == 0 else a
                             edge, turn_slack = incident_edge(wn, ref, face, inc, nverts[inc])
-                            slack = min(slack, turn_slack * lever)
+                            slack = min(slack, turn_slack * r_max)
                         c_slack[k] = slack
                         n_tests += 1
-                        c_travel[k] = travel[a] + travel[b]
-                        c_turn[k] = turn[a] + turn[b]
+                        c_at[k, 0] = dx
+                        c_at[k, 1] = dy
+                        c_at[k, 2] = ang[a]
+                        c_at[k, 3] = ang[b]
                         pedge[k] = edge
                     apart = side == NO_FACE
                     if side >= 0:
@@ -679,8 +690,6 @@ def simulate(
                 pos[a, 0] += dt * vel[a, 0]
                 pos[a, 1] += dt * vel[a, 1]
                 ang[a] += dt * angvel[a]
-                travel[a] += dt * (abs(vel[a, 0]) + abs(vel[a, 1]))
-                turn[a] += dt * abs(angvel[a])
                 finite = math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])
                 speed2 = vel[a, 0] * vel[a, 0] + vel[a, 1] * vel[a, 1]
                 if not finite or speed2 > MAX_SPEED_M_S * MAX_SPEED_M_S or abs(angvel[a]) > MAX_SPIN_RAD_S:
@@ -709,8 +718,7 @@ def simulate(
         pside, pface, pn, ppt, psh = _carry_pairs(keys, pside, pface, pn, ppt, psh, new_keys)
         pedge = np.zeros(new_keys.size, dtype=np.int64)
         c_slack = np.zeros(new_keys.size)  # every pair is tested again after a rebuild
-        c_travel = np.zeros(new_keys.size)
-        c_turn = np.zeros(new_keys.size)
+        c_at = np.zeros((new_keys.size, 4))
         keys = new_keys
         npairs = keys.size
         pj = np.empty(npairs, dtype=np.int64)
