@@ -99,33 +99,54 @@ def _describe(scene, tmp_path) -> tuple[dict, object]:
 
 def test_driver_handles_every_pitfall(tmp_path):
     """The scene the driver builds: damping 0, O.dt from Eq 7, the recorder first and every
-    steps_per_sample steps, exact mass and isotropic inertia at the centroid, planar DOFs,
-    the joint's values on the vertex spheres and zeros on the base."""
+    steps_per_sample steps, exact mass and isotropic inertia at the centroid, planar DOFs, a
+    prism per block, zeros on the base and prisms, and on each vertex sphere copy the values
+    of the joint of the body its mask meets (the base: the block's own joint; the other block:
+    the bi-block's bed joint, the upper block's own)."""
     built, model = _describe(load_scene(EXAMPLES / "biblock_free.toml"), tmp_path)
     assert built["newton_damping"] == 0.0
     assert built["gravity"] == [0.0, -9.81, 0.0]
     assert built["dt"] == pytest.approx(model.dt_s, rel=1e-12)
     assert built["recorder_first"] and built["recorder_period"] == model.steps_per_sample
     assert built["base"]["kn"] == 0.0 and not built["base"]["dynamic"]
+    base_mask = built["base"]["mask"]
+    prisms = []
     for clump, body, pos0 in zip(built["clumps"], model.bodies, model.pos0_m, strict=True):
         assert clump["mass"] == pytest.approx(body.mass_kg)
         assert clump["inertia"] == pytest.approx([body.inertia_kgm2] * 3)
         assert clump["blocked"] == "zXY"
         assert clump["pos"][:2] == pytest.approx(pos0.tolist(), abs=1e-7)
-        spheres = [m for m in clump["members"] if m["shape"] == "Sphere" and m["mask"]]
-        assert len(spheres) == len(body.contact_vertices_m)
+        assert len(clump["vertex_ids"]) == len(body.contact_vertices_m)
+        (prism,) = [m for m in clump["members"] if m["shape"] == "Polyhedra"]
+        assert prism["kn"] == 0.0
+        prisms.append(prism["mask"])
         helper = [m for m in clump["members"] if m["mask"] == 0]
         assert len(helper) == 1  # the centroid helper never collides
+    assert prisms[0] & prisms[1] == 0 and not (prisms[0] | prisms[1]) & base_mask
     lower, upper = model.bodies
-    lower_spheres = [m for m in built["clumps"][0]["members"] if m["shape"] == "Sphere" and m["mask"]]
-    kns = sorted({m["kn"] for m in lower_spheres})
-    # the lower block's base corners carry its own joint, its top corners the upper block's
-    assert kns == pytest.approx(sorted({lower.joint.K_N_per_m, upper.joint.K_N_per_m}))
-    cns = {m["cn"] for m in lower_spheres}
-    assert any(c == pytest.approx(lower.joint.beta_s * lower.joint.K_N_per_m) for c in cns)
-    masks_lower = {m["mask"] for m in lower_spheres}
-    masks_upper = {m["mask"] for m in built["clumps"][1]["members"] if m["shape"] == "Sphere" and m["mask"]}
-    assert masks_lower.isdisjoint(masks_upper)  # spheres of different blocks never touch
+    bed = model.joints.params[model.joints.joint_for(0, 1)]
+    assert bed.K_N_per_m == upper.joint.K_N_per_m != lower.joint.K_N_per_m  # the upper block's own
+    for i, clump in enumerate(built["clumps"]):
+        by_id = {mid: m for mid, m in zip(_member_ids(clump), clump["members"], strict=True)}
+        for ids in clump["vertex_ids"]:
+            copies = [by_id[mid] for mid in ids]
+            meets_base = [c for c in copies if c["mask"] & base_mask]
+            meets_other = [c for c in copies if c["mask"] & prisms[1 - i]]
+            assert not any(c["mask"] & prisms[i] for c in copies) or len(built["clumps"]) > 30
+            assert len(meets_other) == 1
+            assert meets_other[0]["kn"] == pytest.approx(bed.K_N_per_m)
+            assert meets_other[0]["cn"] == pytest.approx(bed.beta_s * bed.K_N_per_m)
+            if i == 0:
+                own = lower.joint
+                assert len(meets_base) == 1 and meets_base[0]["kn"] == pytest.approx(own.K_N_per_m)
+            else:
+                assert not meets_base or meets_base[0]["kn"] == pytest.approx(upper.joint.K_N_per_m)
+
+
+def _member_ids(clump: dict) -> list[int]:
+    """Body ids of a clump's members, in the driver's order (vertex copies first)."""
+    first = min(min(ids) for ids in clump["vertex_ids"])
+    return list(range(first, first + len(clump["members"])))
 
 
 # ------------------------------------------------------------------ no listening socket
@@ -301,7 +322,7 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
 
     def broken(model):
         payload = real(model)
-        del payload["bodies"][0]["joint_below"]
+        del payload["bodies"][0]["sphere_copies"]
         return payload
 
     monkeypatch.setattr(yade_backend, "scene_payload", broken)

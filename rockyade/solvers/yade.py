@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -63,10 +64,63 @@ def _env() -> dict[str, str]:
 
 # ---------------------------------------------------------------------- running
 
+#: Default timeout: start-up allowance plus this many seconds per body-step ...
+TIMEOUT_STARTUP_S = 60.0
+TIMEOUT_PER_BODY_STEP_S = 50e-6
+#: ... capped here unless a larger one is asked for (``--yade-timeout``, ``timeout_s``).
+TIMEOUT_CAP_S = 3600.0
+#: Largest timeout accepted, s (30 days).
+MAX_TIMEOUT_S = 30 * 86400.0
+
 
 def default_timeout(model: DemModel) -> float:
-    """A generous timeout: 30 s of start-up plus 50 us per step."""
-    return 30.0 + 50e-6 * model.n_steps * len(model.bodies)
+    """Wall-clock limit of a YADE run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
+    body-step (about 5-20x what YADE needs), capped at TIMEOUT_CAP_S (one hour)."""
+    work = TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * model.n_steps * len(model.bodies)
+    return min(work, TIMEOUT_CAP_S)
+
+
+def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> float | None:
+    """A user timeout checked: None (the default) or a number of seconds in (0, MAX_TIMEOUT_S].
+
+    Raises
+    ------
+    InputError
+        Not a positive finite number of seconds within the limit.
+    """
+    if timeout_s is None:
+        return None
+    try:
+        value = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
+    if not (0.0 < value <= MAX_TIMEOUT_S):
+        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
+    return value
+
+
+def _run_process(cmd: list[str], log_file: Path, cwd: Path, timeout: float) -> str | None:
+    """Run YADE's Python; the reason it failed, or None. On timeout the process group is
+    killed (the driver and anything it started) and waited for: no orphan is left."""
+    with open(log_file, "w") as log:
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=_env(), cwd=cwd, start_new_session=True)
+        try:
+            code = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            _kill_group(proc)
+            return f"timeout: YADE did not finish within {timeout:.6g} s and was stopped (raise it with --yade-timeout)"
+        except BaseException:  # Ctrl-C or any other interruption: never leave YADE running
+            _kill_group(proc)
+            raise
+    return None if code == 0 else f"YADE exited with code {code}"
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        proc.kill()
+    proc.wait()
 
 
 def run_model(
@@ -85,8 +139,9 @@ def run_model(
         The DEM model.
     workdir
         Where ``<name>.yade.json`` (the scene data), ``<name>.yade.npz`` (YADE's output)
-        and ``<name>.yade.log`` are kept; default a temporary directory, removed after a
-        successful run and kept (its log path in the Result) after a failed one.
+        and ``<name>.yade.log`` are kept (relative to the current folder, or absolute);
+        default a temporary directory, removed after a successful run and kept (its log
+        path in the Result) after a failed one.
     timeout_s
         Wall-clock limit of the YADE process, s (default :func:`default_timeout`).
     """
@@ -95,34 +150,25 @@ def run_model(
             f"YADE is not installed (looked for {YADE_PYTHON} and {YADE_PY_DIR}/yade): "
             "apt-get install -y --no-install-recommends yade"
         )
+    timeout = check_timeout(timeout_s)
+    timeout = timeout if timeout is not None else default_timeout(model)
     keep = workdir is not None
-    directory = Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))
+    # absolute paths: the process runs in ``directory``, where a relative path would be
+    # taken relative to it a second time
+    directory = (Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
     directory.mkdir(parents=True, exist_ok=True)
     scene_file = directory / f"{name}.yade.json"
     out_file = directory / f"{name}.yade.npz"
     log_file = directory / f"{name}.yade.log"
     for stale in (out_file, log_file):
         stale.unlink(missing_ok=True)
-    write_json(scene_file, scene_payload(model))
-    timeout = timeout_s if timeout_s is not None else default_timeout(model)
+    payload = scene_payload(model)
+    write_json(scene_file, payload)
     start = time.perf_counter()
-    reason = None
-    with open(log_file, "w") as log:
-        try:
-            proc = subprocess.run(
-                [YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)],
-                stdout=log,
-                stderr=subprocess.STDOUT,
-                env=_env(),
-                timeout=timeout,
-                cwd=directory,
-            )
-            if proc.returncode != 0:
-                reason = f"YADE exited with code {proc.returncode}"
-        except subprocess.TimeoutExpired:
-            reason = f"timeout: YADE did not finish within {timeout:.0f} s"
+    reason = _run_process([YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)], log_file, directory, timeout)
     total = time.perf_counter() - start
-    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz)
+    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, payload.get("contact_plan"))
+    result.meta["timeout_s"] = timeout
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
     return result
@@ -136,8 +182,18 @@ def _last_error_line(log_file: Path) -> str:
     return lines[-1] if lines else ""
 
 
-def _parse(model: DemModel, out_file: Path, reason: str | None, log_file: Path, total: float, lowpass) -> Result:
-    extra = {"log_path": str(log_file), "total_time_s": total}
+def _parse(
+    model: DemModel,
+    out_file: Path,
+    reason: str | None,
+    log_file: Path,
+    total: float,
+    lowpass: float | None,
+    contact_plan: dict | None = None,
+) -> Result:
+    extra: dict[str, object] = {"log_path": str(log_file), "total_time_s": total}
+    if contact_plan is not None:
+        extra["yade_contacts"] = contact_plan
     if reason is None and not out_file.is_file():
         reason = "YADE wrote no output file"
     if reason is not None:
@@ -167,6 +223,16 @@ def _parse(model: DemModel, out_file: Path, reason: str | None, log_file: Path, 
     if t_blowup is not None:
         reason = f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
         return failed_result("yade", model.scene_hash, reason, **extra)
+    depth = float(meta.get("max_penetration_over_radius", 0.0))
+    if depth >= 1.0:
+        return failed_result(
+            "yade",
+            model.scene_hash,
+            "a vertex sphere went deeper into a block than its own radius (YADE's sphere-polyhedron "
+            "contact then loses its normal): the impact is too hard for these contact spheres",
+            **extra,
+        )
+    extra["max_penetration_over_radius"] = depth
     frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
     names = model.names
     for i, body in enumerate(model.bodies):
