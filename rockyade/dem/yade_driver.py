@@ -67,6 +67,7 @@ from yade import (  # noqa: E402
     NewtonIntegrator,
     O,
     PyRunner,
+    Quaternion,
     Vector3,
     ViscElMat,
     utils,
@@ -133,11 +134,24 @@ def build(scene):
                 )
             vertex_members.append((start, len(members)))
         hz = b["prism_half_thickness_m"]
-        corners = []
-        for vx, vy in b["vertices_m"]:
-            wx, wy = _rotate((vx, vy), a0)
-            corners += [Vector3(c0[0] + wx, c0[1] + wy, -hz), Vector3(c0[0] + wx, c0[1] + wy, hz)]
-        members.append(utils.polyhedron(corners, material=O.materials[inert], mask=b["prism_mask"]))
+        box = b.get("prism_box")
+        if box:  # a rectangle: a Box (cheaper contact, robust however deep a sphere goes)
+            wx, wy = _rotate(box["center_m"], a0)
+            members.append(
+                utils.box(
+                    center=(c0[0] + wx, c0[1] + wy, 0.0),
+                    extents=(box["half_extents_m"][0], box["half_extents_m"][1], hz),
+                    orientation=Quaternion(Vector3(0, 0, 1), a0 + box["angle_rad"]),
+                    material=O.materials[inert],
+                    mask=b["prism_mask"],
+                )
+            )
+        else:
+            corners = []
+            for vx, vy in b["vertices_m"]:
+                wx, wy = _rotate((vx, vy), a0)
+                corners += [Vector3(c0[0] + wx, c0[1] + wy, -hz), Vector3(c0[0] + wx, c0[1] + wy, hz)]
+            members.append(utils.polyhedron(corners, material=O.materials[inert], mask=b["prism_mask"]))
         members.append(utils.sphere((c0[0], c0[1], 0.0), r, material=O.materials[helper_mat], mask=0))
         clump_id, member_ids = O.bodies.appendClumped(members)
         state = O.bodies[clump_id].state
@@ -166,6 +180,8 @@ def build(scene):
                 "point": b["accel_point_m"],
                 "mass": b["mass_kg"],
                 "radius": r,
+                "prism": member_ids[len(members) - 2],
+                "prism_is_polyhedra": not box,
             }
         )
     return clumps
@@ -266,6 +282,13 @@ class Recorder:
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
         self.max_depth_ratio = 0.0
+        self.polyhedra = {c["prism"] for c in clumps if c["prism_is_polyhedra"]}
+        self.vertex_of = {
+            sid: (i, v, c["radius"])
+            for i, c in enumerate(clumps)
+            for v, ids in enumerate(c["vertex_ids"])
+            for sid in ids
+        }
         self.start = time.perf_counter()
         self.written = False
         self.wait = True
@@ -291,27 +314,43 @@ class Recorder:
             rec["angvel"][k, i] = w
             px, py = _rotate(c["point"], theta)
             rec["vpoint"][k, i] = (st.vel[0] - w * py, st.vel[1] + w * px)
-            for v, ids in enumerate(c["vertex_ids"]):
-                total_fn, state = 0.0, 0
-                for sid in ids:
-                    for inter in O.interactions.withBody(sid):
-                        if not inter.isReal:
-                            continue
-                        depth = inter.geom.penetrationDepth / c["radius"]
-                        if depth > self.max_depth_ratio:
-                            self.max_depth_ratio = depth
-                        fn = inter.phys.normalForce.norm()
-                        fs = inter.phys.shearForce.norm()
-                        total_fn += fn
-                        s = 2 if fn > 0 and fs >= 0.9999 * fn * inter.phys.tangensOfFrictionAngle else 1
-                        state = max(state, s)
-                rec["fn"][k, i, v] = total_fn
-                rec["state"][k, i, v] = state
             if not c["fixed"] and abs(theta - c["rest"]) >= 0.5 * math.pi and self.status == "completed":
                 self.status, self.stop_time, self.stop_body = "overturned", O.time, i
+        self.contact_forces(k)
         self.k = k + 1
         if self.status != "completed" or self.k >= self.ns:
             self.stop()
+
+    def contact_forces(self, k):
+        """Normal force and state (1 stick, 2 slip) at each vertex: its copies' real contacts.
+
+        Also the deepest penetration seen against a Polyhedra prism, in sphere radii: at one
+        radius the sphere's centre is inside the prism and YADE's contact loses its normal."""
+        fn_k, state_k = self.rec["fn"][k], self.rec["state"][k]
+        vertex_of, polyhedra = self.vertex_of, self.polyhedra
+        for inter in O.interactions:
+            if not inter.isReal:
+                continue
+            id1, id2 = inter.id1, inter.id2
+            where = vertex_of.get(id1)
+            other = id2
+            if where is None:
+                where, other = vertex_of.get(id2), id1
+                if where is None:
+                    continue
+            i, v, radius = where
+            phys = inter.phys
+            fn = phys.normalForce.norm()
+            if fn <= 0.0:
+                continue
+            fn_k[i, v] += fn
+            s = 2 if phys.shearForce.norm() >= 0.9999 * fn * phys.tangensOfFrictionAngle else 1
+            if s > state_k[i, v]:
+                state_k[i, v] = s
+            if other in polyhedra:
+                depth = inter.geom.penetrationDepth / radius
+                if depth > self.max_depth_ratio:
+                    self.max_depth_ratio = depth
 
     def stop(self):
         """End of the run seen from inside it: pause, and write now unless the caller waits."""
@@ -335,7 +374,7 @@ class Recorder:
             "build_time_s": self.scene.get("_build_time_s"),
             "yade_version": __import__("yade.config", fromlist=["version"]).version,
             "dt_s": O.dt,
-            "max_penetration_over_radius": self.max_depth_ratio,
+            "max_polyhedra_penetration_over_radius": self.max_depth_ratio,
             "complete": True,
         }
         tmp = self.out_path + ".part"

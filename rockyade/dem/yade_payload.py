@@ -14,10 +14,15 @@ import numpy as np
 from rockyade.dem.model import DemModel
 from rockyade.dem.yade_contacts import BASE_BIT, plan_contacts
 
-#: Radius of the vertex spheres: this fraction of the largest of the blocks' smallest
-#: dimensions (a contact breaks when it penetrates deeper than the sphere's radius, so a
-#: heavy block landing on a small one must not meet spheres scaled to the small one).
+#: Radius of the vertex spheres: at least this fraction of the largest of the moving
+#: blocks' smallest dimensions ...
 SPHERE_RADIUS_FRACTION = 1e-3
+#: ... and at least the penetration of the heaviest block hitting the softest joint at this
+#: speed, v sqrt(M / K) (a contact breaks when it penetrates deeper than the sphere's
+#: radius: YADE's sphere-polyhedron contact then loses its normal) ...
+IMPACT_SPEED_M_S = 1.0
+#: ... but at most this fraction of that dimension (the spheres round the corners).
+SPHERE_RADIUS_MAX_FRACTION = 1e-2
 #: Half thickness (z) of the prisms as a fraction of the block size (contacts are at z = 0).
 PRISM_HALF_THICKNESS_FRACTION = 0.05
 FORMAT = "rockyade-yade-scene-2"
@@ -25,9 +30,33 @@ FORMAT = "rockyade-yade-scene-2"
 
 def sphere_radii(model: DemModel) -> np.ndarray:
     """Radius of each body's vertex spheres, m (see SPHERE_RADIUS_FRACTION): the same for all,
-    from the moving blocks' sizes (a large fixed abutment does not round the small blocks)."""
-    small = [float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies if not b.fixed]
-    return np.full(len(model.bodies), SPHERE_RADIUS_FRACTION * max(small))
+    from the moving blocks (a large fixed abutment does not round the small blocks)."""
+    moving = [b for b in model.bodies if not b.fixed]
+    size = max(float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in moving)
+    k_min = min(p.K_N_per_m for p in model.joints.params)
+    impact = IMPACT_SPEED_M_S * math.sqrt(max(b.mass_kg for b in moving) / k_min)
+    radius = min(max(SPHERE_RADIUS_FRACTION * size, impact), SPHERE_RADIUS_MAX_FRACTION * size)
+    return np.full(len(model.bodies), radius)
+
+
+def rectangle(vertices: np.ndarray, tol: float = 1e-9) -> dict[str, object] | None:
+    """A rectangular contact polygon as a box (centre, half sides, angle of its first edge
+    in the body frame), or None. YADE's Box-Sphere contact is several times cheaper than its
+    Polyhedra-Sphere contact and keeps its normal however deep a sphere goes."""
+    if len(vertices) != 4:
+        return None
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    scale = float(lengths.max())
+    if np.any(np.abs(edges[0] + edges[2]) > tol * scale) or np.any(np.abs(edges[1] + edges[3]) > tol * scale):
+        return None
+    if abs(float(edges[0] @ edges[1])) > tol * scale * scale:
+        return None
+    return {
+        "center_m": vertices.mean(axis=0).tolist(),
+        "half_extents_m": [float(lengths[0]) / 2, float(lengths[1]) / 2],
+        "angle_rad": math.atan2(float(edges[0, 1]), float(edges[0, 0])),
+    }
 
 
 def scene_payload(model: DemModel) -> dict[str, object]:
@@ -62,6 +91,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
                 "sphere_centers_m": plan.centers_m[i].tolist(),
                 "sphere_copies": [[list(c) for c in vertex] for vertex in plan.copies[i]],
                 "prism_mask": plan.prism_mask(i),
+                "prism_box": rectangle(b.contact_vertices_m),
                 "sphere_radius_m": float(radii[i]),
                 "prism_half_thickness_m": max(PRISM_HALF_THICKNESS_FRACTION * size, 5 * float(radii[i])),
                 "centroid0_m": model.pos0_m[i].tolist(),

@@ -223,16 +223,16 @@ def _parse(
     if t_blowup is not None:
         reason = f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
         return failed_result("yade", model.scene_hash, reason, **extra)
-    depth = float(meta.get("max_penetration_over_radius", 0.0))
+    depth = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
     if depth >= 1.0:
         return failed_result(
             "yade",
             model.scene_hash,
-            "a vertex sphere went deeper into a block than its own radius (YADE's sphere-polyhedron "
+            "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
             "contact then loses its normal): the impact is too hard for these contact spheres",
             **extra,
         )
-    extra["max_penetration_over_radius"] = depth
+    extra["max_polyhedra_penetration_over_radius"] = depth
     frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
     names = model.names
     for i, body in enumerate(model.bodies):
