@@ -438,6 +438,8 @@ def main(scene_path, out_path, csv_path=None, describe=False, wait=True):
     O.run(scene["n_steps"] + 1, wait)
     if wait:
         recorder.write()
+        if csv_path:
+            print(f"{recorder.status}: wrote {out_path} and {csv_path}")
 
 
 def _interactive_launcher():

@@ -38,7 +38,7 @@ from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
-from rockyade.io.atomic import write_json
+from rockyade.io.atomic import write_json, write_text
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 
@@ -278,6 +278,32 @@ def run_scene(
         model, workdir=workdir, name=name, timeout_s=timeout_s, accel_lowpass_hz=scene.output.accel_lowpass_hz
     )
     return result
+
+
+def write_script(scene: Scene, directory: str | Path) -> dict[str, Path]:
+    """A standalone YADE script for a scene: ``run.py`` (the driver rockyade itself runs) and
+    ``scene.json`` (its data) in ``directory``, for YADE users who go on by hand.
+
+    ``yade -x run.py`` (batch) or ``yade run.py`` (with YADE's GUI and console) builds the
+    same scene and writes ``result.npz`` (what rockyade parses) and ``result.csv`` (t,
+    centroid and rotation of each block) beside the script; so does
+    ``/usr/bin/python3.11 run.py`` (Debian's Python) with YADE's modules on the path. The launcher opens a Python
+    console and an XMLRPC server on all interfaces (rockyade never uses it).
+
+    Returns
+    -------
+    dict
+        Paths of ``script`` and ``data``.
+    """
+    if scene.contact.mass_damping_1_s:
+        raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    model = build_matched_model(scene)
+    data, script = out / "scene.json", out / "run.py"
+    write_json(data, scene_payload(model))
+    write_text(script, DRIVER.read_text())
+    return {"script": script, "data": data}
 
 
 def run_many(scenes: Iterable[Scene], workers: int = 2, timeout_s: float | None = None) -> list[Result]:
