@@ -45,7 +45,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.dem.model import DemModel
-from rockyade.scene.placement import candidate_pairs, rotation_matrix
+from rockyade.scene.placement import candidate_pairs, penetration_depth, rotation_matrix
 
 #: Mask bit of the base.
 BASE_BIT = 1
@@ -289,8 +289,9 @@ def assign_labels(model: DemModel, n_labels: int = N_LABELS) -> NDArray[np.int64
         for idx, key in enumerate(keys):
             pools[key] = [idx * n_labels // len(keys)]
     neighbours = _rest_neighbours(model)
+    centroids = np.array([b.rest_centroid_m for b in model.bodies], dtype=float)
     labels = np.full(nb, -1, dtype=np.int64)
-    usage = np.zeros(n_labels, dtype=np.int64)
+    members: dict[int, list[int]] = defaultdict(list)
     for i in range(nb):
         pool = pools[(bool(jt.fixed[i]), int(jt.own_joint[i]))]
         close = set(neighbours[i])
@@ -298,10 +299,15 @@ def assign_labels(model: DemModel, n_labels: int = N_LABELS) -> NDArray[np.int64
             close |= neighbours[j]
         close.discard(i)
         taken = [int(labels[j]) for j in close if labels[j] >= 0]
-        conflicts = {lab: taken.count(lab) for lab in pool}
-        best = min(pool, key=lambda lab: (conflicts[lab], usage[lab], lab))
+        # fewest conflicts, then the label whose blocks are farthest away (the blocks a vertex
+        # cannot tell apart are then far from each other), then the lowest
+        costs = []
+        for lab in pool:
+            gap = min((float(np.hypot(*(centroids[j] - centroids[i]))) for j in members[lab]), default=math.inf)
+            costs.append((taken.count(lab), -gap, lab))
+        best = min(costs)[2]
         labels[i] = best
-        usage[best] += 1
+        members[best].append(i)
     return labels
 
 
@@ -354,6 +360,7 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
     copies: list[list[list[tuple[int, int]]]] = []
     counts = {"differ_at_rest": 0, "differ_in_motion": 0, "vertex_body_pairs": 0}
     examples: list[dict[str, object]] = []
+    closest = math.inf
     names = model.names
     for a in range(nb):
         row = body_row(model, a)
@@ -383,6 +390,8 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
             for b in np.flatnonzero(differ):
                 at_rest = int(b) in neighbours[a]
                 counts["differ_at_rest" if at_rest else "differ_in_motion"] += 1
+                gap = -penetration_depth(polys[a], polys[int(b)])
+                closest = min(closest, gap)
                 if len(examples) < MAX_LISTED:
                     examples.append(
                         {
@@ -399,6 +408,7 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
         **counts,
         "labels": int(labels.max()) + 1 if nb else 0,
         "flush_vertex_spheres": len(flush),
+        "closest_differing_pair_gap_m": None if math.isinf(closest) else closest,
         "examples": examples,
     }
     return ContactPlan(variants, labels, centers, copies, report)

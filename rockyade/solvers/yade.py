@@ -31,6 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from rockyade import __version__
 from rockyade.dem.frames import dem_frame, energy_gain
@@ -235,11 +236,12 @@ def _parse(
     extra["max_polyhedra_penetration_over_radius"] = depth
     frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
     names = model.names
+    forces = {}
     for i, body in enumerate(model.bodies):
         prefix = f"{body.name}_" if len(names) > 1 else ""
-        for v in range(arrays["fn"].shape[2]):
-            if v < len(body.contact_vertices_m):
-                frame[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+        for v in range(len(body.contact_vertices_m)):
+            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    frame = pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
     overturned = status == "overturned"
     run_meta = {
         "solver": "yade",
