@@ -434,3 +434,131 @@ def test_matched_beta_comes_from_the_reference_dem():
     s = paper.specimen(1)
     assert model.bodies[0].joint.beta_s == pytest.approx(match_beta(s.block(), **s.experimental).beta_s)
     assert model.bodies[0].joint.method == "matched"
+
+
+# ------------------------------------------------------------------ relative paths, timeout, script
+
+
+def _short_scene_file(folder: Path, duration: float = 0.6) -> Path:
+    d = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
+    d["duration_s"] = duration
+    path = folder / "s3.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+def test_cli_run_yade_with_relative_paths(tmp_path, monkeypatch, capsys):
+    """`rockyade run SCENE --solver yade --out sub/x.csv` from the scene's folder (the YADE
+    process runs in sub/: it must be given absolute paths)."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "s3.json", "--solver", "yade", "--out", "sub/x.csv"]) == 0
+    assert Result.read(Path("sub/x.csv")).meta["solver"] == "yade"
+    assert Path("sub/x.yade.log").is_file() and Path("sub/x.yade.json").is_file()
+
+
+def test_cli_compare_with_relative_out(tmp_path, monkeypatch, capsys):
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["compare", "s3.json", "--solvers", "reference,yade", "--out", "compare/"]) == 0
+    table = __import__("pandas").read_csv("compare/s3_compare.csv")
+    assert set(table["solver"]) == {"reference", "yade"}
+    assert Result.read(Path("compare/s3_yade.csv")).ok
+
+
+def test_cli_batch_with_relative_out(tmp_path, monkeypatch, capsys):
+    """A study with YADE runs, its output folder relative (as `make run` gives it)."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    (tmp_path / "study.toml").write_text(
+        'name = "rel"\nsolvers = ["yade"]\nyade_timeout_s = 600\n[base]\nfile = "s3.json"\n'
+        '[grid]\n"motion.theta0_rad" = [0.03, 0.05]\n'
+    )
+    monkeypatch.chdir(tmp_path)
+    assert main(["batch", "study.toml", "--out", "reports/rel", "--workers", "1", "--quiet"]) == 0
+    summary = __import__("pandas").read_csv("reports/rel/summary.csv")
+    assert list(summary["status"]) == ["completed", "completed"]
+
+
+def test_default_timeout_grows_with_the_work_and_is_capped():
+    model = build_matched_model(load_scene(EXAMPLES / "specimen1_free.toml"))
+    short = yade_backend.default_timeout(model)
+    assert short == pytest.approx(yade_backend.TIMEOUT_STARTUP_S + yade_backend.TIMEOUT_PER_BODY_STEP_S * model.n_steps)
+    longer = replace(model, n_samples=10 * model.n_samples)
+    assert yade_backend.default_timeout(longer) > short
+    huge = replace(model, n_samples=10_000 * model.n_samples)
+    assert yade_backend.default_timeout(huge) == yade_backend.TIMEOUT_CAP_S == 3600.0
+
+
+def _processes_with(text: str) -> list[int]:
+    found = []
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
+        except OSError:
+            continue
+        if text in cmdline:
+            found.append(int(pid))
+    return found
+
+
+def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
+    """--yade-timeout: a failed result saying so, exit 1, and no YADE process left behind."""
+    from rockyade.cli import main
+
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    d["duration_s"] = 60.0
+    (tmp_path / "long.json").write_text(json.dumps(d))
+    monkeypatch.chdir(tmp_path)
+    start = time.time()
+    code = main(["run", "long.json", "--solver", "yade", "--out", "t/long.csv", "--yade-timeout", "2"])
+    assert code == 1 and time.time() - start < 30
+    out = capsys.readouterr().out
+    assert "timeout: YADE did not finish within 2 s" in out
+    assert Result.read(Path("t/long.csv")).status == "failed"
+    assert _processes_with(str(tmp_path / "t" / "long.yade.json")) == []
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])
+def test_cli_bad_yade_timeout_is_refused(value, tmp_path, capsys):
+    from rockyade.cli import main
+
+    code = main(["run", str(EXAMPLES / "specimen3_free.toml"), "--solver", "yade", "--yade-timeout", value])
+    assert code == 2
+    assert "--yade-timeout" in capsys.readouterr().err
+
+
+def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
+    """`rockyade yade-script` writes run.py + scene.json; Debian's python3.11 with YADE's
+    modules runs it (no launcher, no server) and writes the same output as the backend."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["yade-script", "s3.json", "--out", "by_hand"]) == 0
+    assert "yade -x by_hand/run.py" in capsys.readouterr().out
+    script = Path("by_hand/run.py")
+    assert "json" in script.read_text() and Path("by_hand/scene.json").is_file()
+    proc = subprocess.run(
+        [yade_backend.YADE_PYTHON, str(script)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    scene = load_scene(Path("s3.json"))
+    model = build_matched_model(scene)
+    by_hand = yade_backend._parse(model, Path("by_hand/result.npz"), None, Path("none.log"), 0.0, None)
+    backend = yade_backend.run_scene(scene)
+    assert by_hand.ok and backend.ok
+    np.testing.assert_array_equal(by_hand.series("theta_rad"), backend.series("theta_rad"))
+    table = __import__("pandas").read_csv("by_hand/result.csv")
+    np.testing.assert_allclose(table["specimen3_rotation_rad"], backend.series("theta_rad"), atol=1e-9)
