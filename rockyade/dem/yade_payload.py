@@ -20,7 +20,7 @@ SPHERE_RADIUS_FRACTION = 1e-3
 #: ... and at least the penetration of the heaviest block hitting the softest joint at this
 #: speed, v sqrt(M / K) (a contact breaks when it penetrates deeper than the sphere's
 #: radius: YADE's sphere-polyhedron contact then loses its normal) ...
-IMPACT_SPEED_M_S = 1.0
+IMPACT_SPEED_M_S = 0.5
 #: ... but at most this fraction of that dimension (the spheres round the corners).
 SPHERE_RADIUS_MAX_FRACTION = 1e-2
 #: Half thickness (z) of the prisms as a fraction of the block size (contacts are at z = 0).
