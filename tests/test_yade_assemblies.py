@@ -296,6 +296,28 @@ def _max_overlap(model, result) -> float:
     return worst
 
 
+def _column_pulse(blocks):
+    motion = {"type": "pulse", "shape": "sine", "amplitude_g": 0.4, "period_s": 0.5}
+    return yade_backend.run_scene(_scene(blocks, motion=motion, duration=1.5))
+
+
+def test_fixed_pedestal_and_rest_rotation_are_the_base_and_no_rotation():
+    """A 0.25 x 1 m column rocking to 0.9 rad under a pulse rocks the same (to 1e-7 rad) on
+    the base, on a fixed pedestal (which moves with the base: not at all in the base frame),
+    and built as a 1 x 0.25 m block turned by pi/2 at rest (theta counts from rest)."""
+    on_base = _column_pulse([_block("col", 0.0, 0.0, 0.25, 1.0)])
+    on_pedestal = _column_pulse([_block("ped", 0.0, 0.0, 0.6, 0.2, fixed=True), _block("col", 0.0, 0.2, 0.25, 1.0)])
+    turned = _column_pulse([_block("col", 0.125, 0.5, 1.0, 0.25, rotation_rad=math.pi / 2)])
+    for r in (on_base, on_pedestal, turned):
+        assert r.ok, r.meta.get("failure_reason")
+    theta = on_base.series("theta_rad")
+    assert np.max(np.abs(theta)) > 0.5
+    np.testing.assert_allclose(on_pedestal.series("theta_rad", "col"), theta, atol=1e-7)
+    np.testing.assert_allclose(turned.series("theta_rad"), theta, atol=1e-7)
+    np.testing.assert_allclose(on_pedestal.series("y_m", "col"), on_base.series("y_m"), atol=1e-7)
+    assert not np.any(on_pedestal.series("x_m", "ped")) and not np.any(on_pedestal.series("theta_rad", "ped"))
+
+
 def test_wall_beyond_30_blocks_stands():
     """A 44-block running-bond wall (shared mask labels) at rest: no block moves more than
     0.2 mm or turns more than 1e-3 rad."""
