@@ -562,3 +562,17 @@ def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
     np.testing.assert_array_equal(by_hand.series("theta_rad"), backend.series("theta_rad"))
     table = __import__("pandas").read_csv("by_hand/result.csv")
     np.testing.assert_allclose(table["specimen3_rotation_rad"], backend.series("theta_rad"), atol=1e-9)
+
+
+def test_study_file_yade_timeout(tmp_path):
+    """``yade_timeout_s`` in a study file reaches every task; a bad value names the key."""
+    from rockyade.errors import InputError
+    from rockyade.studies.batch import load_study
+
+    _short_scene_file(tmp_path)
+    body = '\nsolvers = ["yade"]\n[base]\nfile = "s3.json"\n'
+    (tmp_path / "ok.toml").write_text("yade_timeout_s = 90" + body)
+    assert {t.yade_timeout_s for t in load_study(tmp_path / "ok.toml", tmp_path / "out").tasks} == {90.0}
+    (tmp_path / "bad.toml").write_text("yade_timeout_s = -1" + body)
+    with pytest.raises(InputError, match="yade_timeout_s"):
+        load_study(tmp_path / "bad.toml", tmp_path / "out")
