@@ -271,12 +271,12 @@ def assign_labels(model: DemModel, n_labels: int = N_LABELS) -> NDArray[np.int64
         {(bool(jt.fixed[i]), int(jt.own_joint[i])) for i in range(nb)},
         key=lambda key: (key[0], k[key[1]] if key[1] >= 0 else 0.0, key[1]),
     )
-    members = {key: [i for i in range(nb) if (bool(jt.fixed[i]), int(jt.own_joint[i])) == key] for key in keys}
+    by_class = {key: [i for i in range(nb) if (bool(jt.fixed[i]), int(jt.own_joint[i])) == key] for key in keys}
     pools: dict[tuple[bool, int], list[int]] = {}
     if len(keys) <= n_labels:
         # every class at least one label, the rest in proportion to the class sizes
         extra = n_labels - len(keys)
-        shares = np.array([len(members[key]) for key in keys], dtype=float)
+        shares = np.array([len(by_class[key]) for key in keys], dtype=float)
         quota = shares / shares.sum() * extra
         counts = np.floor(quota).astype(int)
         for idx in np.argsort(-(quota - counts))[: extra - int(counts.sum())]:
@@ -369,6 +369,7 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
         priority = {b: int(body_codes[b]) for b in neighbours[a]}
         shared = _choose(body_codes, labels, priority, n_labels)
         body_copies = []
+        gaps: dict[int, float] = {}
         for v in range(len(model.bodies[a].contact_vertices_m)):
             codes = body_codes.copy()
             chosen = shared.copy()
@@ -390,8 +391,9 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
             for b in np.flatnonzero(differ):
                 at_rest = int(b) in neighbours[a]
                 counts["differ_at_rest" if at_rest else "differ_in_motion"] += 1
-                gap = -penetration_depth(polys[a], polys[int(b)])
-                closest = min(closest, gap)
+                if int(b) not in gaps:
+                    gaps[int(b)] = -penetration_depth(polys[a], polys[int(b)])
+                closest = min(closest, gaps[int(b)])
                 if len(examples) < MAX_LISTED:
                     examples.append(
                         {
