@@ -17,9 +17,13 @@ def cmd_run(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     solver = get_solver(args.solver)
-    if args.solver == "yade" and args.out:
+    if args.solver == "yade":
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
         # YADE's log and scene data are kept beside the result
-        result = solver(scene, workdir=args.out.parent, name=args.out.stem)
+        where = {"workdir": args.out.parent, "name": args.out.stem} if args.out else {}
+        result = solver(scene, timeout_s=timeout, **where)
     else:
         result = solver(scene)
     if args.out:
@@ -78,6 +82,17 @@ def cmd_tables(args: argparse.Namespace) -> int:
 
 
 
+def add_yade_timeout(p: Any) -> None:
+    """The ``--yade-timeout`` option (run, compare, batch)."""
+    p.add_argument(
+        "--yade-timeout",
+        type=float,
+        metavar="SECONDS",
+        help="wall-clock limit of each YADE run (default: 60 s plus 50 us per block-step, at most one hour); "
+        "the run is stopped and reported failed when it is reached",
+    )
+
+
 def register(sub: Any) -> None:
     """Add ``run`` and ``tables``."""
     from rockyade.solvers import solver_names
@@ -96,6 +111,7 @@ def register(sub: Any) -> None:
     )
     p.add_argument("--out", type=Path, help="result CSV (the metadata JSON is written beside it)")
     p.add_argument("--plot", type=Path, help="PNG figure of the time history")
+    add_yade_timeout(p)
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser(

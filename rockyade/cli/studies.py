@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.run import add_yade_timeout
 from rockyade.errors import InputError
 
 
@@ -24,13 +25,18 @@ def cmd_compare(args: argparse.Namespace) -> int:
         raise InputError(
             "solvers", f"must be a comma-separated list of {', '.join(solver_names())}, got {args.solvers!r}"
         )
+    timeout = None
+    if "yade" in solvers:
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
     out: Path = args.out
     out.mkdir(parents=True, exist_ok=True)
     stem = args.scene.stem
     results = {}
     for name in solvers:
         run = get_solver(name)
-        result = run(scene, workdir=out, name=stem) if name == "yade" else run(scene)
+        result = run(scene, workdir=out, name=stem, timeout_s=timeout) if name == "yade" else run(scene)
         result.write(out / f"{stem}_{name}.csv")
         results[name] = result
         status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
@@ -61,9 +67,17 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from rockyade.studies.batch import failures, load_study, run_study_tasks
 
     study = load_study(args.study, args.out)
-    print(f"{study.name}: {len(study.tasks)} runs ({', '.join(study.solvers)}) -> {args.out}")
+    tasks = list(study.tasks)
+    if args.yade_timeout is not None:
+        from dataclasses import replace
+
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
+        tasks = [replace(t, yade_timeout_s=timeout) for t in tasks]
+    print(f"{study.name}: {len(tasks)} runs ({', '.join(study.solvers)}) -> {args.out}")
     summary = run_study_tasks(
-        list(study.tasks),
+        tasks,
         args.out,
         executor=args.executor,
         workers=args.workers,
@@ -109,6 +123,7 @@ def register(sub: Any) -> None:
     p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (default: an in-process cluster)")
     p.add_argument("--resume", action="store_true", help="skip runs already completed; re-run failed ones")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_yade_timeout(p)
     p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser(
@@ -136,4 +151,5 @@ def register(sub: Any) -> None:
     p.add_argument("--solvers", default="housner,reference,yade", help="comma-separated solvers")
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
     p.add_argument("--out", type=Path, default=Path("compare"), help="output directory")
+    add_yade_timeout(p)
     p.set_defaults(func=cmd_compare)

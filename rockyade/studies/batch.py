@@ -5,6 +5,7 @@ Study file (TOML)::
     name = "harmonic-sweep"
     solvers = ["reference", "housner"]     # each scene runs with each solver
     save_histories = true                  # the time history of every run (else summary only)
+    yade_timeout_s = 600                   # optional: wall-clock limit of each YADE run, s
 
     [base]                                 # base scenes: one file, or several
     files = ["examples/specimen1_harmonic.toml", "examples/specimen3_free.toml"]
@@ -35,7 +36,7 @@ import time
 import tomllib
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -77,6 +78,7 @@ class Task:
     out_dir: str
     save_history: bool = True
     extra: dict[str, Any] = field(default_factory=dict)
+    yade_timeout_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -123,6 +125,9 @@ def load_study(path: str | Path, out_dir: str | Path) -> Study:
     if not isinstance(solvers, list) or not solvers or any(s not in solver_names() for s in solvers):
         raise r.error("solvers", f"must be a list of {', '.join(solver_names())}, got {solvers!r}")
     save = r.boolean("save_histories", True)
+    from rockyade.solvers.yade import MAX_TIMEOUT_S
+
+    timeout = r.number("yade_timeout_s", None, lo=0.0, lo_open=True, hi=MAX_TIMEOUT_S, unit="s")
     base = r.sub("base")
     files = base.raw("files", None)
     single = base.raw("file", None)
@@ -140,7 +145,8 @@ def load_study(path: str | Path, out_dir: str | Path) -> Study:
             raise InputError(f"grid.{key}", "must be a non-empty list of values", source)
     r.finish()
     bases = [(Path(f).stem, _scene_dict(path.parent / f)) for f in file_list]
-    return Study(name, tuple(expand(bases, grid_table, solvers, out_dir, save, source)), tuple(solvers))
+    tasks = [replace(t, yade_timeout_s=timeout) for t in expand(bases, grid_table, solvers, out_dir, save, source)]
+    return Study(name, tuple(tasks), tuple(solvers))
 
 
 def expand(
@@ -200,7 +206,10 @@ def run_task(task: Task) -> dict[str, Any]:
         scene = scene_from_dict(task.scene)
         name = run_name(scene.scene_hash, task.solver)
         solver = get_solver(task.solver)
-        result = solver(scene, workdir=runs / "yade", name=name) if task.solver == "yade" else solver(scene)
+        if task.solver == "yade":
+            result = solver(scene, workdir=runs / "yade", name=name, timeout_s=task.yade_timeout_s)
+        else:
+            result = solver(scene)
     except Exception as exc:  # one failed run never stops the batch
         scene_hash = scene.scene_hash if scene is not None else "invalid"
         name = run_name(scene_hash, task.solver)
