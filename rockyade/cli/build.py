@@ -342,7 +342,7 @@ def _flags(kind: str) -> dict[str, str]:
 def _cli_words(message: str, kind: str) -> str:
     """A generator's message with its parameter names replaced by the CLI flags."""
     flags = _flags(kind)
-    return re.sub(r"\b[a-z][a-z0-9_]*\b", lambda m: flags.get(m.group(0), m.group(0)), message)
+    return re.sub(r"\b[a-z][a-z0-9]*_[a-z0-9_]*\b", lambda m: flags.get(m.group(0), m.group(0)), message)
 
 
 def _command_line(args: argparse.Namespace, kind: str) -> str:
@@ -395,9 +395,10 @@ def cmd_build(args: argparse.Namespace) -> int:
     kwargs["contact"] = _contact_table(args, kind, _unit_height(args, kind))
     try:
         data = GENERATORS[kind](**kwargs)
-        scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
+    out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
+    scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
     summary = _summary(scene)
     header = "\n".join(
         [
