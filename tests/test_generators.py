@@ -7,6 +7,7 @@ import inspect
 import itertools
 import math
 import random
+import shlex
 import tomllib
 
 import numpy as np
@@ -38,6 +39,8 @@ from rockyade.scene.generators.common import (
 )
 from rockyade.scene.placement import candidate_pairs, penetration_depth, placed_blocks, rest_contacts
 from rockyade.scene.toml_writer import toml_text
+
+from .conftest import EXAMPLES
 
 FLUSH = 1e-12  # m: joints flush to this
 
@@ -459,3 +462,18 @@ def test_build_bad_values_exit_2_with_one_line_naming_the_option(tmp_path, capsy
 def test_write_scene_refuses_other_suffixes(tmp_path):
     with pytest.raises(InputError):
         write_scene(tmp_path / "x.yaml", wall(courses=1, units_per_course=1))
+
+
+def test_example_assemblies_load_and_are_what_their_command_makes(tmp_path, monkeypatch, capsys):
+
+    files = sorted((EXAMPLES / "assemblies").glob("*.toml"))
+    assert len(files) >= 5
+    monkeypatch.chdir(tmp_path)
+    for path in files:
+        load_scene(path)
+        made_by = next(line for line in path.read_text().splitlines() if line.startswith("# Made by rockyade"))
+        words = shlex.split(made_by.split(": ", 1)[1])
+        assert words[:2] == ["rockyade", "build"] and words[-2:] == ["--out", path.name]
+        assert main(words[1:]) == 0
+        assert tomllib.loads((tmp_path / path.name).read_text()) == tomllib.loads(path.read_text()), path.name
+    capsys.readouterr()

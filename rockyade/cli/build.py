@@ -235,12 +235,38 @@ COMMON_PARAMS = ("density_kg_m3", "duration_s", "sample_dt_s")
 UDEC_KINDS = ("wall", "arch")
 
 
-def _add(parser: argparse.ArgumentParser, opt: Opt) -> None:
-    kwargs: dict[str, Any] = {"default": opt.default, "help": opt.help, "dest": opt.dest}
+#: Short metavars from the unit at the end of an option's name.
+UNIT_METAVARS = {"-m": "M", "-s": "S", "-kg-m3": "KG/M3", "-pa-per-m": "PA/M", "-deg": "DEG", "-rad": "RAD"}
+
+
+def _metavar(opt: Opt) -> str | None:
+    if opt.metavar or opt.choices:
+        return opt.metavar
+    for suffix, metavar in sorted(UNIT_METAVARS.items(), key=lambda item: -len(item[0])):
+        if opt.flag.endswith(suffix):
+            return metavar
+    return "N" if opt.type is int else "X"
+
+
+class _DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows "(default: ...)" for options that have a default value (not for None)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        if action.default is None or action.default is argparse.SUPPRESS or isinstance(action.default, bool):
+            return action.help or ""
+        if isinstance(action.default, list):
+            return f"{action.help} (default: {','.join(f'{v:g}' for v in action.default)})"
+        if isinstance(action.default, float):
+            return f"{action.help} (default: {action.default:g})"
+        return super()._get_help_string(action) or ""
+
+
+def _add(parser: argparse.ArgumentParser | Any, opt: Opt) -> None:
+    kwargs: dict[str, Any] = {"default": opt.default, "help": opt.help, "dest": opt.dest, "metavar": _metavar(opt)}
     if opt.append:
-        kwargs.update(action="append", type=opt.type, metavar=opt.metavar)
+        kwargs.update(action="append", type=opt.type)
     else:
-        kwargs.update(type=opt.type, choices=opt.choices, metavar=opt.metavar)
+        kwargs.update(type=opt.type, choices=opt.choices)
     parser.add_argument(opt.flag, **kwargs)
 
 
@@ -556,7 +582,7 @@ def register(sub: Any) -> None:
             kind,
             help=text,
             description=f"Generate {text}.",
-            formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+            formatter_class=_DefaultsFormatter,
         )
         for opt in options:
             _add(k, opt)

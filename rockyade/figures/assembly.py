@@ -39,7 +39,7 @@ FIXED = "#b9b9b9"
 FIGURE_WIDTH_IN = 10.0
 #: Colours of moving blocks by |rotation|: stone at rest, dark red at the largest rotation shown.
 ROTATION_CMAP = LinearSegmentedColormap.from_list("stone_to_red", [STONE, "#e8a15c", "#c0392b", "#5e0d0d"])
-MAX_HEIGHT_IN = 9.0
+MAX_HEIGHT_IN = 8.0
 
 
 # ---------------------------------------------------------------------- geometry
@@ -181,8 +181,8 @@ def _label_blocks(fig, ax, placed: Sequence[PlacedBlock]) -> int:
         local = (b.vertices_m - np.asarray(b.centroid_m)) @ rotation_matrix(-b.rotation_rad).T
         w, h = np.ptp(local, axis=0) * scale
         chars = max(len(b.name), 1)
-        along = min(0.7 * h, 0.9 * w / (0.62 * chars))
-        across = min(0.7 * w, 0.9 * h / (0.62 * chars))
+        along = min(0.7 * h, 0.9 * w / (0.62 * chars), MAX_LABEL_PT)
+        across = min(0.7 * w, 0.9 * h / (0.62 * chars), MAX_LABEL_PT)
         fits.append((along, 0.0) if along >= 0.8 * across else (across, 90.0))  # prefer along the base
     common = min(MAX_LABEL_PT, float(np.median([size for size, _ in fits])))
     if common < READABLE_LABEL_PT:  # most names would be specks: print none
@@ -399,10 +399,11 @@ def draw_snapshots(
 
 def _clip_bounds(bounds, rest_bounds) -> tuple[float, float, float, float]:
     """The drawn area: everything, but no more than one assembly size beyond the rest bounds
-    (a block thrown far away leaves the picture rather than shrinking the assembly)."""
+    sideways and upwards, and not below the base (a block thrown far away leaves the picture
+    rather than shrinking the assembly)."""
     x0, x1, y0, y1 = rest_bounds
     size = max(x1 - x0, y1 - y0)
-    return (max(bounds[0], x0 - size), min(bounds[1], x1 + size), max(bounds[2], y0 - size), min(bounds[3], y1 + size))
+    return (max(bounds[0], x0 - size), min(bounds[1], x1 + size), max(bounds[2], y0), min(bounds[3], y1 + size))
 
 
 def animation_writer_for(path: str | Path, fps: float):
