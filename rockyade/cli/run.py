@@ -7,6 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.build import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.cli.common import json_out
 
 
@@ -16,6 +17,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from rockyade.solvers import get_solver
 
     scene = load_scene(args.scene)
+    check_run_drawings(args)
     solver = get_solver(args.solver)
     if args.solver == "yade":
         from rockyade.solvers.yade import check_timeout
@@ -34,6 +36,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         plot_results({args.solver: result}, args.plot, title=f"{Path(args.scene).name} ({args.solver})")
         print(f"wrote {args.plot}")
+    write_run_drawings(args, scene, result, args.out or Path(Path(args.scene).stem + ".csv"))
     _print_summary(scene, result)
     return 0 if result.ok else 1
 
@@ -112,6 +115,7 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, help="result CSV (the metadata JSON is written beside it)")
     p.add_argument("--plot", type=Path, help="PNG figure of the time history")
     add_yade_timeout(p)
+    add_snapshot_options(p)
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser(
