@@ -83,3 +83,33 @@ def fit_lognormal(im: ArrayLike, n_collapse: ArrayLike, n_total: ArrayLike) -> F
     )
     mu, log_beta = best.x
     return Fragility(float(math.exp(mu)), float(math.exp(log_beta)), int(x.size))
+
+
+def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Wilson score interval of a binomial proportion k / n (Wilson 1927).
+
+    Parameters
+    ----------
+    k, n
+        Successes and trials (n > 0).
+    confidence
+        Two-sided level.
+    """
+    if n <= 0 or k < 0 or k > n:
+        raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
+    z = float(stats.norm.ppf(0.5 + confidence / 2.0))
+    phat = k / n
+    den = 1.0 + z * z / n
+    centre = (phat + z * z / (2 * n)) / den
+    half = z * math.sqrt(phat * (1 - phat) / n + z * z / (4 * n * n)) / den
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
+    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n."""
+    if n <= 0 or k < 0 or k > n:
+        raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
+    a = 1.0 - confidence
+    lo = 0.0 if k == 0 else float(stats.beta.ppf(a / 2, k, n - k + 1))
+    hi = 1.0 if k == n else float(stats.beta.ppf(1 - a / 2, k + 1, n - k))
+    return lo, hi
