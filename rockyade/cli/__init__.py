@@ -30,6 +30,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.run",
     "rockyade.cli.motion",
     "rockyade.cli.studies",
+    "rockyade.cli.identify",
 ]
 
 
