@@ -1,8 +1,17 @@
-"""Collapse fragility: lognormal curves fitted by maximum likelihood.
+"""Collapse fragility: lognormal curves fitted by maximum likelihood, against any intensity measure.
 
 P(collapse | IM = x) = Phi(ln(x / theta) / beta), fitted to grouped outcomes (n_i collapses
 out of N_i records at intensity x_i, a multiple-stripe analysis) by maximising the binomial
-likelihood sum_i [n_i ln p_i + (N_i - n_i) ln(1 - p_i)] (Baker 2015) with scipy.
+likelihood sum_i [n_i ln p_i + (N_i - n_i) ln(1 - p_i)] (Baker 2015, "Efficient analytical
+fragility function fitting using dynamic structural analysis", Earthquake Spectra 31) with
+scipy. When every run has its own intensity (PGV, Arias intensity, a/(g tan alpha) ...
+differ from record to record at one load factor) each run is its own stripe of one: the
+same likelihood over individual outcomes (Shinozuka et al. 2000, "Statistical analysis of
+fragility curves", J. Eng. Mech. 126), :func:`fit_lognormal_points`. The measures are those
+of :mod:`rockyade.motion.intensity`.
+
+Probabilities estimated from n runs carry binomial confidence bands: Wilson's score interval
+and the exact Clopper-Pearson one.
 """
 
 from __future__ import annotations
@@ -77,12 +86,43 @@ def fit_lognormal(im: ArrayLike, n_collapse: ArrayLike, n_total: ArrayLike) -> F
         return -float(np.sum(k * np.log(p) + (n - k) * np.log(1 - p)))
 
     frac = k / n
-    start_mu = float(np.interp(0.5, np.maximum.accumulate(frac), logx)) if frac.max() >= 0.5 else float(logx.max())
+    order = np.argsort(logx)
+    cum = np.maximum.accumulate(frac[order])
+    start_mu = float(np.interp(0.5, cum, logx[order])) if frac.max() >= 0.5 else float(logx.max())
     best = optimize.minimize(
         nll, [start_mu, math.log(0.4)], method="Nelder-Mead", options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000}
     )
     mu, log_beta = best.x
     return Fragility(float(math.exp(mu)), float(math.exp(log_beta)), int(x.size))
+
+
+def fit_lognormal_points(im: ArrayLike, collapsed: ArrayLike) -> Fragility:
+    """Maximum-likelihood lognormal fragility from individual runs (intensity, collapsed or not).
+
+    Runs at equal intensity are grouped into stripes first, so that stripes and points give
+    the same fit (:func:`fit_lognormal`).
+
+    Parameters
+    ----------
+    im
+        Intensity of each run (> 0; NaN runs are dropped).
+    collapsed
+        True where the run collapsed (overturned).
+    """
+    x = np.asarray(im, dtype=float)
+    c = np.asarray(collapsed, dtype=bool)
+    if x.shape != c.shape:
+        raise InputError("im", "needs one collapse flag per intensity")
+    keep = np.isfinite(x)
+    x, c = x[keep], c[keep]
+    if np.any(x <= 0):
+        raise InputError("im", "intensities must be > 0")
+    levels, inverse = np.unique(x, return_inverse=True)
+    if levels.size < 2:
+        raise InputError("im", f"needs runs at two intensities or more, got {levels.size}")
+    n_total = np.bincount(inverse).astype(float)
+    n_collapse = np.bincount(inverse, weights=c.astype(float))
+    return fit_lognormal(levels, n_collapse, n_total)
 
 
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:

@@ -31,6 +31,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.motion",
     "rockyade.cli.studies",
     "rockyade.cli.identify",
+    "rockyade.cli.uncertainty",
 ]
 
 

@@ -84,6 +84,51 @@ def _print_text(result: Any) -> None:
     )
 
 
+def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
+    """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
+    from rockyade.analysis.identified import calibrate_from_identified
+
+    if len(blocks) != 1:
+        raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")
+    name, block, _overrides = blocks[0]
+    result = calibrate_from_identified(
+        block,
+        args.from_identified,
+        method=args.method,
+        stiffness_scale=args.stiffness_scale,
+        friction_angle_deg=args.friction_angle,
+    )
+    result["block"] = name
+    result["from"] = str(args.from_identified)
+    if args.json:
+        json_out(result)
+        return 0
+    c, ci = result["classical"], result["classical_ci"]
+
+    def interval(key: str) -> str:
+        return f" [{ci[key][0]:.4g}, {ci[key][1]:.4g}]" if key in ci else ""
+
+    print(f"{name} ({block.mass_kg:.4g} kg), identified parameters from {args.from_identified}:")
+    print(
+        f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
+        f"mu = {c['mu']:.5g}{interval('mu')}"
+    )
+    print(f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10, read as {result['stiffness_scale']})")
+    if args.method == "matched":
+        print(f"  beta     = {result['beta_s']:.6g} s (matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s)")
+        print(
+            f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable "
+            f"{result['mu_reachable_min']:.4f}-{result['mu_reachable_max']:.4f}"
+        )
+    else:
+        print(f"  beta     = {result['beta_s']:.6g} s (Eq 13, Gamma = {result['gamma']:.6g})")
+    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14)")
+    print(f"  b_eq     = {result['b_eq_m']:.6g} m (Eq 11); dt = {result['dt_s']:.6g} s (Eq 7)")
+    for note in result["notes"]:
+        print(f"  note: {note}")
+    return 0
+
+
 def register(sub: Any) -> None:
     """Add ``rockyade identify``."""
     p = sub.add_parser(
