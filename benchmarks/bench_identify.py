@@ -19,9 +19,9 @@ import time
 import numpy as np
 
 from rockyade import paper
+from rockyade.analysis.fragility import wilson_interval
 from rockyade.analysis.identify import CLASSICAL, identify, synthetic_measurement
 from rockyade.analysis.measurement import measured_history
-from rockyade.analysis.fragility import wilson_interval
 
 RATES_HZ = (100.0, 200.0, 500.0, 1000.0)
 
@@ -82,7 +82,8 @@ def report(label: str, seeds, ar1: float = 0.0) -> None:
         e = 100 * np.array(errors[k])
         clo, chi = wilson_interval(covered[k], n)
         print(
-            f"  {k:9s} |error| max {e.max():.3f} %, 95th pct {np.percentile(e, 95):.3f} %, median {np.median(e):.4f} %; "
+            f"  {k:9s} |error| max {e.max():.3f} %, 95th pct {np.percentile(e, 95):.3f} %, "
+            f"median {np.median(e):.4f} %; "
             f"95 % interval covers the truth in {covered[k]}/{n} ({100 * clo:.0f}-{100 * chi:.0f} % Wilson)"
         )
     print(f"  flagged unidentifiable: {unidentified}/{n}; interval methods: {methods}")

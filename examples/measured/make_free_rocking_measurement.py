@@ -32,7 +32,7 @@ HALF_WIDTH, LED_X, LED_HEIGHT = 0.125, 0.10, 0.80
 
 def main() -> Path:
     rng = np.random.default_rng(SEED)
-    n = int(round(DURATION_S * RATE_HZ)) + 1
+    n = round(DURATION_S * RATE_HZ) + 1
     t = np.arange(n) / RATE_HZ
     truth = FreeRockingFit(ALPHA, P, MU, HOLD_S, 0.0, THETA0 / ALPHA, 1)
     theta = model_history(truth, 0.0, 1.0 / RATE_HZ, n)[0]

@@ -66,7 +66,7 @@ def fragility_table(runs: pd.DataFrame, measures: Iterable[str]) -> pd.DataFrame
                     "median": fit.median,
                     "beta": fit.beta,
                     "status": fit.status,
-                    "n_runs": int(len(done)),
+                    "n_runs": len(done),
                     "n_overturned": int(collapsed.sum()),
                 }
             )

@@ -130,9 +130,7 @@ def calibrate_from_identified(
     if method == "matched":
         from rockyade.dem.matching import match_beta
 
-        matched = match_beta(
-            block, **params, stiffness_scale=stiffness_scale, friction_angle_deg=friction_angle_deg
-        )
+        matched = match_beta(block, **params, stiffness_scale=stiffness_scale, friction_angle_deg=friction_angle_deg)
         result.update(matched.as_cli_dict())
         result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)
     if not math.isfinite(result["beta_s"]):

@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 from scipy import optimize, stats
 
 from rockyade.analysis.measurement import MeasuredHistory
-from rockyade.analysis.peaks import effective_restitution, rocking_potential
+from rockyade.analysis.peaks import effective_restitution
 from rockyade.errors import InputError, RockyadeError
 from rockyade.solvers.housner import HousnerModel, solve
 
@@ -257,7 +257,7 @@ def _peak_value(t: NDArray[np.float64], y: NDArray[np.float64], i: int, half_win
     """Extreme of y near sample i from a least-squares parabola over +/- ``half_window_s``
     (noise on single samples biases the raw extreme)."""
     dt = float(t[1] - t[0])
-    w = max(2, int(round(half_window_s / dt)))
+    w = max(2, round(half_window_s / dt))
     lo, hi = max(0, i - w), min(y.size, i + w + 1)
     if hi - lo < 5:
         return float(y[i])
@@ -296,8 +296,9 @@ def _alpha_p_from_half_periods(amplitudes: NDArray[np.float64], half_periods: ND
     costs = [p_and_cost(a)[1] for a in grid]
     k = int(np.argmin(costs))
     lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    best = optimize.minimize_scalar(lambda a: p_and_cost(a)[1], bounds=(lo, hi), method="bounded",
-                                    options={"xatol": 1e-6 * a_max})
+    best = optimize.minimize_scalar(
+        lambda a: p_and_cost(a)[1], bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * a_max}
+    )
     alpha = float(best.x)
     return min(alpha, 1.5), p_and_cost(alpha)[0]
 
@@ -339,8 +340,10 @@ def initial_guess(history: MeasuredHistory) -> Guess:
     side = 1 if smooth[k0] > 0 else -1
     theta0 = float(abs(smooth[k0]))
     started_moving = k0 == 0 and abs(smooth[-1]) < abs(smooth[0]) and first_seg.size > 3
-    peak_values = [_peak_value(t, y - offset, int(i), 0.05 * float(np.median(np.diff(crossings))) if crossings.size > 1 else 0.02)
-                   for i in ext_index[1:]]
+    peak_values = [
+        _peak_value(t, y - offset, int(i), 0.05 * float(np.median(np.diff(crossings))) if crossings.size > 1 else 0.02)
+        for i in ext_index[1:]
+    ]
     amplitudes = np.concatenate([[theta0], np.abs(peak_values)])
     half_periods = np.diff(crossings)
     usable = amplitudes[1 : 1 + half_periods.size] > 10.0 * max(noise, 1e-12)
@@ -477,7 +480,7 @@ def _covariance(jac: NDArray[np.float64], resid: NDArray[np.float64], n_par: int
     n = resid.size
     dof = max(n - n_par, 1)
     s2 = float(resid @ resid) / dof
-    u, sv, vt = np.linalg.svd(jac, full_matrices=False)
+    _u, sv, vt = np.linalg.svd(jac, full_matrices=False)
     keep = sv > sv[0] * 1e-12
     inv = (vt[keep].T / sv[keep] ** 2) @ vt[keep]
     rho1 = float(resid[:-1] @ resid[1:] / (resid @ resid)) if n > 2 and resid @ resid > 0 else 0.0
@@ -564,8 +567,17 @@ def identify(
     result = None
     for m in windows:
         result = optimize.least_squares(
-            residuals, x, args=(m,), bounds=(lo, hi), method="trf", x_scale="jac", diff_step=DIFF_STEP,
-            xtol=1e-12, ftol=1e-12, gtol=1e-12, max_nfev=400,
+            residuals,
+            x,
+            args=(m,),
+            bounds=(lo, hi),
+            method="trf",
+            x_scale="jac",
+            diff_step=DIFF_STEP,
+            xtol=1e-12,
+            ftol=1e-12,
+            gtol=1e-12,
+            max_nfev=400,
         )
         x = result.x
     assert result is not None
@@ -577,7 +589,7 @@ def identify(
     se = np.sqrt(np.maximum(np.diag(cov), 0.0))
     ci = {name: (float(v - tq * s), float(v + tq * s)) for name, v, s in zip(FIT_PARAMETERS, x, se, strict=True)}
     rms = float(math.sqrt(np.mean(resid**2)))
-    modelled, traj, delta = model_history(fit, t0, dt, n, step)
+    _modelled, traj, delta = model_history(fit, t0, dt, n, step)
     t_end_rel = float(t[-1]) - fit.release_time_s
     n_impacts = _observable_impacts(fit, traj, delta, t_end_rel, OBSERVABLE_PEAK_RMS * rms)
     unidentifiable = _unidentifiable(fit, ci, se, n_impacts, rms, history, max_relative_ci, lo, hi, x)
@@ -624,9 +636,7 @@ def _unidentifiable(fit, ci, se, n_impacts, rms, history, max_rel, lo, hi, x) ->
                 cause = f"too short: {n_impacts} observable impacts in {after:.3g} s after the release"
             else:
                 cause = "the data do not constrain it"
-            out[name] = (
-                f"95 % interval +/-{100 * rel:.3g} % of the value (limit {100 * max_rel:g} %): {cause}"
-            )
+            out[name] = f"95 % interval +/-{100 * rel:.3g} % of the value (limit {100 * max_rel:g} %): {cause}"
         elif x[k] <= lo[k] * (1 + 1e-9) or (math.isfinite(hi[k]) and x[k] >= hi[k] * (1 - 1e-9)):
             bound = lo[k] if x[k] <= lo[k] * (1 + 1e-9) else hi[k]
             out[name] = f"the optimum lies on the bound {bound:g} of the search: no interval"
@@ -684,9 +694,14 @@ def synthetic_measurement(
     from rockyade.analysis.measurement import measured_history
 
     dt = 1.0 / rate_hz
-    n = int(round(duration_s * rate_hz)) + 1
+    n = round(duration_s * rate_hz) + 1
     truth = FreeRockingFit(
-        alpha_rad, p_rad_s, mu, hold_s + release_offset_s, offset_rad, abs(theta0_rad) / alpha_rad,
+        alpha_rad,
+        p_rad_s,
+        mu,
+        hold_s + release_offset_s,
+        offset_rad,
+        abs(theta0_rad) / alpha_rad,
         1 if theta0_rad >= 0 else -1,
     )
     theta = model_history(truth, 0.0, dt, n)[0]

@@ -218,7 +218,9 @@ def read_measurement(
         notes.append(f"rotation from LED columns {led_columns[0]!r}, {led_columns[1]!r}: {note}")
     else:
         if theta_column is None:
-            theta_column = "theta_rad" if "theta_rad" in frame.columns or "theta_deg" not in frame.columns else "theta_deg"
+            theta_column = (
+                "theta_rad" if "theta_rad" in frame.columns or "theta_deg" not in frame.columns else "theta_deg"
+            )
         in_degrees = theta_column.endswith("_deg") if degrees is None else degrees
         theta = column(theta_column, "theta_column")
         if in_degrees:

@@ -224,7 +224,7 @@ def register(sub: Any) -> None:
         "matched to mu with the reference DEM), xi_min (Eq 15), f_min (Eq 14), dt (Eq 7).",
     )
     _add_block_arguments(p)
-    p.add_argument("--from", dest="from_identified", type=Path, help="identified alpha, p, mu (rockyade identify --out)")
+    p.add_argument("--from", dest="from_identified", type=Path, help="identified values (rockyade identify --out)")
     p.add_argument(
         "--parameters",
         choices=["theoretical", "experimental"],

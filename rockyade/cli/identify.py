@@ -52,7 +52,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         json_out(data)
     else:
         _print_text(result)
-        for path in [args.out] + figures if args.out else figures:
+        for path in [args.out, *figures] if args.out else figures:
             print(f"wrote {path}")
     if result.unidentifiable:
         for name, why in result.unidentifiable.items():
@@ -155,7 +155,8 @@ def register(sub: Any) -> None:
         "--max-relative-ci",
         type=float,
         default=0.10,
-        help="a parameter whose 95 %% half interval exceeds this fraction of its value is unidentifiable (default 0.10)",
+        help="a parameter whose 95 %% half interval exceeds this fraction of its value is not identified "
+        "(default 0.10)",
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", type=Path, help="write the identified values as JSON (input of calibrate --from)")

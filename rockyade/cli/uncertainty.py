@@ -21,7 +21,10 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
     n_runs_per_sample = len(study.load_factors) * len(study.solvers)
     records = 1 if study.pairing == "sampled" else len(study.motions)
     total = (study.samples * records + (len(study.motions) if study.include_nominal else 0)) * n_runs_per_sample
-    print(f"{study.name}: {study.samples} samples (seed {study.seed}), {total} runs ({', '.join(study.solvers)}) -> {args.out}")
+    print(
+        f"{study.name}: {study.samples} samples (seed {study.seed}), {total} runs "
+        f"({', '.join(study.solvers)}) -> {args.out}"
+    )
     for name, text in study.describe_parameters().items():
         print(f"  {name}: {text}")
     result = run_uncertainty(
@@ -48,8 +51,10 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
         print("spread caused by the parameters alone (per-sample P(overturn) 5-95 %, nominal):")
         for row in result.spread.itertuples(index=False):
             print(
-                f"  {row.solver:9s} x{row.load_factor:<5g} {row.p_overturn_sample_q05:.3f}-{row.p_overturn_sample_q95:.3f}"
-                f" (nominal {row.p_overturn_nominal:.3f}); records with mixed outcomes {100 * row.records_mixed_fraction:.0f} %"
+                f"  {row.solver:9s} x{row.load_factor:<5g} "
+                f"{row.p_overturn_sample_q05:.3f}-{row.p_overturn_sample_q95:.3f} "
+                f"(nominal {row.p_overturn_nominal:.3f}); "
+                f"records with mixed outcomes {100 * row.records_mixed_fraction:.0f} %"
             )
     written = ["samples.csv", "summary.csv", "runs.csv", "probabilities.csv", "fragility.csv"]
     written += ["spread.csv"] if result.spread is not None else []

@@ -25,17 +25,17 @@ def plot_fit(result: Identification, path: str | Path) -> None:
     h = result.history
     modelled = result.modelled()
     resid = h.theta_rad - modelled
-    fig, (ax, axr) = plt.subplots(
-        2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
-    )
+    fig, (ax, axr) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
     ax.plot(h.t_s, h.theta_rad, ".", ms=2.0, color="0.45", label=f"measured ({h.rate_hz:.4g} Hz)")
     ax.plot(h.t_s, modelled, "-", lw=1.1, color="C3", label="Housner, identified parameters")
     ax.axhline(result.fit.offset_rad, color="0.6", lw=0.6, ls="--", label=f"offset {result.fit.offset_rad:.3g} rad")
-    ax.axvline(result.fit.release_time_s, color="C0", lw=0.8, ls=":", label=f"release t = {result.fit.release_time_s:.4g} s")
+    ax.axvline(
+        result.fit.release_time_s, color="C0", lw=0.8, ls=":", label=f"release t = {result.fit.release_time_s:.4g} s"
+    )
     ax.set_ylabel("theta (rad)")
     ax.grid(alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
-    pct = int(round(100 * CONFIDENCE))
+    pct = round(100 * CONFIDENCE)
     lines = [
         _value_text(result, "alpha_rad", " rad", 4),
         _value_text(result, "p_rad_s", " 1/s", 3),
@@ -53,8 +53,14 @@ def plot_fit(result: Identification, path: str | Path) -> None:
         fontsize=8,
     )
     if result.unidentifiable:
-        fig.text(0.01, 0.005, "unidentifiable: " + "; ".join(f"{k}: {v}" for k, v in result.unidentifiable.items()),
-                 fontsize=7, color="C3", wrap=True)
+        fig.text(
+            0.01,
+            0.005,
+            "unidentifiable: " + "; ".join(f"{k}: {v}" for k, v in result.unidentifiable.items()),
+            fontsize=7,
+            color="C3",
+            wrap=True,
+        )
     save_figure(fig, path)
 
 
@@ -67,7 +73,9 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
     half_a = max(4.0 * sa, 0.01 * fit.alpha_rad)
     half_p = max(4.0 * sp, 0.01 * fit.p_rad_s)
     a_lo = max(fit.alpha_rad - half_a, 1.001 * abs(fit.theta0_rad))
-    alphas, ps, rms = error_surface(result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n)
+    alphas, ps, rms = error_surface(
+        result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n
+    )
     fig, ax = plt.subplots(figsize=(7.4, 5.8))
     levels = np.geomspace(rms.min(), rms.max(), 16)
     cs = ax.contourf(alphas, ps, rms, levels=levels, cmap="viridis_r", norm=_log_norm(levels))
@@ -76,7 +84,7 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
     cbar.set_label("rms of measured - modelled rotation (rad)")
     ax.plot(fit.alpha_rad, fit.p_rad_s, "r*", ms=12, label="optimum")
     ex, ey = _ellipse(np.array([fit.alpha_rad, fit.p_rad_s]), cov, CONFIDENCE)
-    ax.plot(ex, ey, "r-", lw=1.2, label=f"joint {int(round(100 * CONFIDENCE))} % confidence region (all unknowns free)")
+    ax.plot(ex, ey, "r-", lw=1.2, label=f"joint {round(100 * CONFIDENCE)} % confidence region (all unknowns free)")
     ax.set_xlabel("alpha (rad)")
     ax.set_ylabel("p (1/s)")
     ax.set_title(

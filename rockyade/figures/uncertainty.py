@@ -72,8 +72,9 @@ def plot_uncertainty(
         if len(row) and row.iloc[0]["status"] == "fitted":
             fit = Fragility(float(row.iloc[0]["median"]), float(row.iloc[0]["beta"]), int(row.iloc[0]["n_runs"]))
             xs = np.geomspace(max(x.min(), 1e-6) * 0.8, x.max() * 1.2, 200)
-            ax.plot(xs, fit.probability(xs), "-", color=c,
-                    label=f"{solver}: median {fit.median:.3g}, beta {fit.beta:.2f}")
+            ax.plot(
+                xs, fit.probability(xs), "-", color=c, label=f"{solver}: median {fit.median:.3g}, beta {fit.beta:.2f}"
+            )
         else:
             ax.plot([], [], "-", color=c, label=f"{solver}: {row.iloc[0]['status'] if len(row) else 'no fit'}")
     ax.set_xlabel(LABELS.get(measure, measure))
@@ -88,8 +89,15 @@ def plot_uncertainty(
         for k, (solver, group) in enumerate(spread.groupby("solver")):
             c = _colour(solver, k)
             x = group["load_factor"].to_numpy()
-            ax.fill_between(x, group["p_overturn_sample_q05"], group["p_overturn_sample_q95"], color=c, alpha=0.25,
-                            lw=0, label=f"{solver}: 5-95 % over parameter samples")
+            ax.fill_between(
+                x,
+                group["p_overturn_sample_q05"],
+                group["p_overturn_sample_q95"],
+                color=c,
+                alpha=0.25,
+                lw=0,
+                label=f"{solver}: 5-95 % over parameter samples",
+            )
             ax.plot(x, group["p_overturn_sample_median"], "-", color=c, lw=1.0)
             if group["p_overturn_nominal"].notna().any():
                 ax.plot(x, group["p_overturn_nominal"], "k*", ms=7, label="nominal block" if k == 0 else None)
@@ -100,8 +108,15 @@ def plot_uncertainty(
     else:
         done = runs[runs["status"] != "failed"]
         for k, (solver, group) in enumerate(done.groupby("solver")):
-            ax.semilogy(group["load_factor"] + 0.01 * k, group["max_theta_over_alpha"].clip(lower=1e-4), ".",
-                        color=_colour(solver, k), ms=3, alpha=0.5, label=solver)
+            ax.semilogy(
+                group["load_factor"] + 0.01 * k,
+                group["max_theta_over_alpha"].clip(lower=1e-4),
+                ".",
+                color=_colour(solver, k),
+                ms=3,
+                alpha=0.5,
+                label=solver,
+            )
         ax.set_ylabel("peak theta / alpha (every run)")
         ax.set_title("peak rotation of every run", fontsize=9)
         ax.set_xlabel("load factor")

@@ -188,8 +188,10 @@ def _motions(r: TableReader, base_dir: Path) -> tuple[list[tuple[str, dict[str, 
         records = r.raw("records", "all")
         if records == "all":
             records = list(range(1, 31))
-        if not isinstance(records, list) or not records or not all(
-            isinstance(i, int) and not isinstance(i, bool) and 1 <= i <= 30 for i in records
+        if (
+            not isinstance(records, list)
+            or not records
+            or not all(isinstance(i, int) and not isinstance(i, bool) and 1 <= i <= 30 for i in records)
         ):
             raise r.error("records", f'must be "all" or a list of record numbers 1-30, got {records!r}')
         motions = [(f"{suite}-{i}", {"type": "synthetic", "suite": suite, "record": i}) for i in records]
@@ -309,10 +311,7 @@ def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | P
     index = 0
     for row in samples.itertuples(index=False):
         block = dict(study.block, alpha_rad=float(row.alpha_rad), p_rad_s=float(row.p_rad_s), mu=float(row.mu))
-        if study.pairing == "sampled" and not row.nominal:
-            records = [row.record]
-        else:
-            records = list(motions)
+        records = [row.record] if study.pairing == "sampled" and not row.nominal else list(motions)
         for record in records:
             for lf in study.load_factors:
                 motion = dict(motions[record], load_factor=lf)
@@ -416,7 +415,13 @@ def run_uncertainty(
     prepare(study)
     tasks = build_tasks(study, samples, out)
     summary = run_study_tasks(
-        tasks, out, executor=executor, workers=workers, scheduler=scheduler, resume=resume, progress=progress,
+        tasks,
+        out,
+        executor=executor,
+        workers=workers,
+        scheduler=scheduler,
+        resume=resume,
+        progress=progress,
         desc=study.name,
     )
     runs = with_measures(summary, record_measures(study))
@@ -449,7 +454,7 @@ def run_uncertainty(
             "load_factors": list(study.load_factors),
             "parameters": study.describe_parameters(),
             "nominal": study.nominal,
-            "runs": int(len(runs)),
+            "runs": len(runs),
             "failed_runs": int((runs["status"] == "failed").sum()),
             "probabilities": probabilities.to_dict(orient="records"),
             "fragility": fragility.to_dict(orient="records"),
