@@ -329,9 +329,14 @@ def initial_guess(history: MeasuredHistory) -> Guess:
         offset = refined
     notes.append("offset from the rest at the end" if quiet_tail else "offset from the decay of the peaks")
     if crossings.size < 1:
+        cause = (
+            f"too noisy: a noise of {noise:.3g} rad hides a swing of {amplitude:.3g} rad"
+            if 6.0 * noise > 0.25 * amplitude
+            else "the block does not rock (too short, or no release in the record)"
+        )
         raise IdentificationError(
             f"{history.source or 'the record'}: the rotation never crosses its rest value clearly (threshold "
-            f"{threshold:.3g} rad above a noise of {noise:.3g} rad): no impact, nothing to identify"
+            f"{threshold:.3g} rad): no impact, nothing to identify: {cause}"
         )
     # release tilt: the extreme of the first excursion (a hold, or a record starting at rest)
     first_seg = y[: np.searchsorted(t, crossings[0])]
@@ -592,7 +597,7 @@ def identify(
     _modelled, traj, delta = model_history(fit, t0, dt, n, step)
     t_end_rel = float(t[-1]) - fit.release_time_s
     n_impacts = _observable_impacts(fit, traj, delta, t_end_rel, OBSERVABLE_PEAK_RMS * rms)
-    unidentifiable = _unidentifiable(fit, ci, se, n_impacts, rms, history, max_relative_ci, lo, hi, x)
+    unidentifiable = _unidentifiable(fit, ci, cov, n_impacts, rms, history, max_relative_ci, lo, hi, x)
     return Identification(
         fit=fit,
         ci=ci,
@@ -610,11 +615,13 @@ def identify(
     )
 
 
-def _unidentifiable(fit, ci, se, n_impacts, rms, history, max_rel, lo, hi, x) -> dict[str, str]:
+def _unidentifiable(fit, ci, cov, n_impacts, rms, history, max_rel, lo, hi, x) -> dict[str, str]:
     """Which classical parameters the data leave undetermined, and why."""
     out: dict[str, str] = {}
     theta0 = abs(fit.theta0_rad)
-    after = float(history.t_s[-1]) - fit.release_time_s
+    span = history.duration_s
+    sd = np.sqrt(np.maximum(np.diag(cov)[:2], 1e-300))
+    corr = float(cov[0, 1] / (sd[0] * sd[1]))
     for k, name in enumerate(CLASSICAL):
         value = float(getattr(fit, name))
         half = 0.5 * (ci[name][1] - ci[name][0])
@@ -627,15 +634,19 @@ def _unidentifiable(fit, ci, se, n_impacts, rms, history, max_rel, lo, hi, x) ->
             )
             out[name] = (
                 f"too few impacts: {n_impacts} observable above the noise (peak > {OBSERVABLE_PEAK_RMS:g} x rms "
-                f"residual {rms:.3g} rad), {MIN_IMPACTS[name]} needed for {why}; record {after:.3g} s after the release"
+                f"residual {rms:.3g} rad) in a {span:.3g} s record, {MIN_IMPACTS[name]} needed for {why}"
             )
         elif not math.isfinite(rel) or rel > max_rel:
             if rms > 0.05 * theta0:
                 cause = f"too noisy: rms residual {rms:.3g} rad is {100 * rms / theta0:.0f} % of the release tilt"
             elif n_impacts < 4:
-                cause = f"too short: {n_impacts} observable impacts in {after:.3g} s after the release"
+                cause = f"too short: {n_impacts} observable impacts in a {span:.3g} s record"
             else:
-                cause = "the data do not constrain it"
+                cause = (
+                    f"weakly constrained: a release at {fit.release_ratio:.2f} alpha and {n_impacts} impacts above "
+                    f"a noise of {rms:.3g} rad leave alpha and p correlated ({corr:.3f}); release from a larger "
+                    "tilt, record longer or with less noise"
+                )
             out[name] = f"95 % interval +/-{100 * rel:.3g} % of the value (limit {100 * max_rel:g} %): {cause}"
         elif x[k] <= lo[k] * (1 + 1e-9) or (math.isfinite(hi[k]) and x[k] >= hi[k] * (1 - 1e-9)):
             bound = lo[k] if x[k] <= lo[k] * (1 + 1e-9) else hi[k]
