@@ -67,7 +67,8 @@ def plot_uncertainty(
             n, kk = int(sel.sum()), int(y[sel].sum())
             lo, hi = wilson_interval(kk, n)
             xm = float(np.median(x[sel]))
-            ax.errorbar(xm, kk / n, yerr=[[kk / n - lo], [hi - kk / n]], fmt="s", color=c, ms=4, capsize=2)
+            yerr = [[max(kk / n - lo, 0.0)], [max(hi - kk / n, 0.0)]]
+            ax.errorbar(xm, kk / n, yerr=yerr, fmt="s", color=c, ms=4, capsize=2)
         row = fragility[(fragility["solver"] == solver) & (fragility["measure"] == measure)]
         if len(row) and row.iloc[0]["status"] == "fitted":
             fit = Fragility(float(row.iloc[0]["median"]), float(row.iloc[0]["beta"]), int(row.iloc[0]["n_runs"]))
