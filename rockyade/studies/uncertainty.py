@@ -30,7 +30,8 @@ Study file (TOML)::
     calibration = "matched"
 
     [parameters]                          # identified = "identified.json" (joint normal,
-    [parameters.alpha_rad]                # std_factor = 1), or one table per parameter
+    [parameters.alpha_rad]                # std_factor = 1; nominal = the identified values),
+                                          # or one table per parameter
     distribution = "uniform"              # (a parameter without one keeps its nominal value)
     mean = 0.235
     plus_minus_pct = 5
@@ -247,6 +248,7 @@ def uncertainty_study_from_dict(data: Any, source: str | None = None, base_dir: 
         factor = params.positive("std_factor", 1.0)
         params.finish()
         joint = joint_from_identified(load_identified(ident_path), factor, str(ident_path))
+        nominal = dict(zip(PARAMETERS, joint.mean, strict=True))  # the identified block is the nominal one
     else:
         marginals = {}
         for k in PARAMETERS:
