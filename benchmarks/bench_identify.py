@@ -34,11 +34,12 @@ def trial(seed: int, ar1: float = 0.0):
     a = truth["alpha_rad"]
     rate = float(rng.choice(RATES_HZ))
     noise = rng.uniform(0.002, 0.01) * a
+    ratio = rng.uniform(0.3, 0.7)
     history = synthetic_measurement(
         truth["alpha_rad"],
         truth["p_rad_s"],
         truth["mu"],
-        theta0_rad=rng.uniform(0.3, 0.7) * a * rng.choice([-1.0, 1.0]),
+        theta0_rad=ratio * a * rng.choice([-1.0, 1.0]),
         rate_hz=rate,
         duration_s=8.0,
         hold_s=rng.uniform(0.2, 1.0),
@@ -57,15 +58,16 @@ def trial(seed: int, ar1: float = 0.0):
         history = measured_history(history.t_s, theta + e, "ar1")
     start = time.perf_counter()
     result = identify(history)
-    return truth, result, time.perf_counter() - start, rate
+    return truth, result, time.perf_counter() - start, rate, ratio
 
 
 def report(label: str, seeds, ar1: float = 0.0) -> None:
     errors = {k: [] for k in CLASSICAL}
     covered = {k: 0 for k in CLASSICAL}
-    times, by_rate, unidentified, methods = [], {}, 0, {}
+    times, by_rate, unidentified, methods, tilts = [], {}, 0, {}, []
     for seed in seeds:
-        truth, result, seconds, rate = trial(seed, ar1)
+        truth, result, seconds, rate, tilt = trial(seed, ar1)
+        tilts.append(tilt)
         times.append(seconds)
         by_rate.setdefault(rate, []).append(seconds)
         methods[result.ci_method.split(" ")[0]] = methods.get(result.ci_method.split(" ")[0], 0) + 1
@@ -87,6 +89,17 @@ def report(label: str, seeds, ar1: float = 0.0) -> None:
             f"95 % interval covers the truth in {covered[k]}/{n} ({100 * clo:.0f}-{100 * chi:.0f} % Wilson)"
         )
     print(f"  flagged unidentifiable: {unidentified}/{n}; interval methods: {methods}")
+    tilts = np.array(tilts)
+    for lo, hi in ((0.3, 0.4), (0.4, 0.55), (0.55, 0.7)):
+        sel = (tilts >= lo) & (tilts < hi)
+        if sel.any():
+            ea = 100 * np.array(errors["alpha_rad"])[sel]
+            ep = 100 * np.array(errors["p_rad_s"])[sel]
+            em = 100 * np.array(errors["mu"])[sel]
+            print(
+                f"  release at {lo:.2f}-{hi:.2f} alpha ({sel.sum()} trials): max |error| alpha {ea.max():.2f} %, "
+                f"p {ep.max():.2f} %, mu {em.max():.3f} %"
+            )
     rates = ", ".join(f"{r:.0f} Hz {np.mean(v):.2f} s" for r, v in sorted(by_rate.items()))
     print(f"  time per identification: mean {np.mean(times):.2f} s, max {np.max(times):.2f} s ({rates})")
 

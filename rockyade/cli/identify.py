@@ -135,7 +135,7 @@ def register(sub: Any) -> None:
         "identify",
         help="alpha, p, mu with 95 %% intervals from a measured free-rocking test",
         description="Fit Housner's free rocking (exact solver) to a measured rotation history: alpha, p, mu, "
-        "the release time, the release tilt and the sensor offset by least squares, with 95 %% intervals. "
+        "the release time, the release tilt and the sensor offset by least squares, with 95 % intervals. "
         "Input: CSV with t_s and theta_rad (or theta_deg), or two LED displacement columns. "
         "Exit code 1 when a parameter cannot be identified (the message says why). See docs/identification.md.",
     )

@@ -71,7 +71,7 @@ def register(sub: Any) -> None:
         help="probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)",
         description="Draw alpha, p, mu (normal, lognormal, uniform, or an identification's joint normal) by "
         "Latin hypercube, run every sample under the records and load factors with each solver (batch engine, "
-        "local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 %% Wilson bands, fragility "
+        "local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 % Wilson bands, fragility "
         "fits against intensity measures and the spread due to the parameters. See docs/identification.md.",
     )
     p.add_argument("study", type=Path, help="uncertainty study file (.toml)")
