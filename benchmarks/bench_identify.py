@@ -5,7 +5,8 @@
 a hold of 0.2-1 s before a release that falls between samples, a release tilt of 0.3-0.7
 alpha on either side, 8 s records. Reports the recovery errors, the coverage of the 95 %
 intervals (with its own Wilson interval) and the time per identification; then the same
-with coloured (AR(1), lag-1 correlation 0.8) noise, where the Newey-West intervals apply.
+with coloured (AR(1), lag-1 correlation 0.8) noise, where the prewhitened Newey-West
+intervals apply.
 
     .venv/bin/python benchmarks/bench_identify.py [--trials 100] [--ar1-trials 40]
 """
@@ -70,7 +71,8 @@ def report(label: str, seeds, ar1: float = 0.0) -> None:
         tilts.append(tilt)
         times.append(seconds)
         by_rate.setdefault(rate, []).append(seconds)
-        methods[result.ci_method.split(" ")[0]] = methods.get(result.ci_method.split(" ")[0], 0) + 1
+        method = result.ci_method.split(" (")[0]
+        methods[method] = methods.get(method, 0) + 1
         if result.unidentifiable:
             unidentified += 1
         for k in CLASSICAL:
@@ -107,7 +109,7 @@ def report(label: str, seeds, ar1: float = 0.0) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=int, default=100)
-    parser.add_argument("--ar1-trials", type=int, default=40)
+    parser.add_argument("--ar1-trials", type=int, default=100)
     args = parser.parse_args()
     identify(synthetic_measurement(0.2, 4.0, 0.95, theta0_rad=0.1, noise_rad=1e-4))  # compile the kernel
     report("white noise 0.2-1 % of alpha", range(args.trials))

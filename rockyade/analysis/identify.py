@@ -29,8 +29,9 @@ Starting point (:func:`initial_guess`), from the peaks and zero crossings of the
 95 % intervals: Gauss-Newton covariance s^2 (J^T J)^-1 (J the Jacobian at the optimum,
 s^2 = SSR / (n - 6)) with Student's t quantile (Bates & Watts 1988, Ch. 2). When the
 residuals are serially correlated (lag-1 autocorrelation above 3/sqrt(n)) the covariance is
-the Newey-West (1987) sandwich with a Bartlett kernel instead, so that model error or
-coloured noise widens the intervals; ``ci_method`` says which was used.
+the Newey-West (1987) sandwich with a Bartlett kernel instead, on scores prewhitened by the
+residuals' AR(1) coefficient (Andrews & Monahan 1992), so that model error or coloured
+noise widens the intervals; ``ci_method`` says which was used.
 
 A parameter the data cannot identify is not returned as a number: it is listed in
 ``unidentifiable`` with the reason (too few impacts above the noise, too short, too
@@ -491,23 +492,29 @@ def _covariance(jac: NDArray[np.float64], resid: NDArray[np.float64], n_par: int
     rho1 = float(resid[:-1] @ resid[1:] / (resid @ resid)) if n > 2 and resid @ resid > 0 else 0.0
     if rho1 <= 3.0 / math.sqrt(n):
         return s2 * inv, "gauss-newton (residuals uncorrelated)", rho1
-    # Newey-West: bandwidth from where the residual autocorrelation dies out (Bartlett kernel)
-    r = resid - resid.mean()
+    # Newey-West (Bartlett kernel) on the scores J_t r_t prewhitened by the residuals' AR(1)
+    # coefficient and recoloured (Andrews & Monahan 1992): the kernel alone under-estimates
+    # the long-run variance of strongly correlated residuals
+    rho = min(rho1, 0.97)
+    g = jac * resid[:, None]
+    e = g[1:] - rho * g[:-1]
+    r = resid[1:] - rho * resid[:-1]
     denom = float(r @ r)
+    m = r.size
     lag = 1
-    limit = max(2, n // 10)
-    while lag < limit and float(r[:-lag] @ r[lag:]) / denom > 2.0 / math.sqrt(n):
+    limit = max(2, m // 10)
+    while lag < limit and abs(float(r[:-lag] @ r[lag:])) / denom > 2.0 / math.sqrt(m):
         lag *= 2
     bandwidth = min(2 * lag, limit)
-    g = jac * resid[:, None]
-    meat = g.T @ g
+    meat = e.T @ e
     for ell in range(1, bandwidth + 1):
         w = 1.0 - ell / (bandwidth + 1.0)
-        gamma = g[:-ell].T @ g[ell:]
+        gamma = e[:-ell].T @ e[ell:]
         meat += w * (gamma + gamma.T)
-    meat *= n / dof
+    meat *= (n / m) * (n / dof) / (1.0 - rho) ** 2
     cov = inv @ meat @ inv
-    return cov, f"newey-west (residual lag-1 correlation {rho1:.2f}, bandwidth {bandwidth} samples)", rho1
+    text = f"newey-west, AR(1)-prewhitened (residual lag-1 correlation {rho1:.2f}, bandwidth {bandwidth} samples)"
+    return cov, text, rho1
 
 
 def _observable_impacts(fit: FreeRockingFit, traj, delta: float, t_end_rel: float, level: float) -> int:
