@@ -90,6 +90,10 @@ def test_fragility_from_individual_runs_recovers_median_and_beta():
     assert points.median == pytest.approx(grouped.median, rel=1e-9)
     assert points.beta == pytest.approx(grouped.beta, rel=1e-9)
     assert fit_lognormal_points(im, np.zeros_like(c)).status == "no collapse"
+    # collapses only at the top level, none below: a threshold, not a curve
+    step = fit_lognormal([0.5, 1.0, 2.0], [0, 0, 3], [10, 10, 10])
+    assert step.status == "separated" and step.median == 2.0 and math.isnan(step.beta)
+    assert list(step.probability([1.5, 2.5])) == [0.0, 1.0]
 
 
 def test_binomial_intervals():

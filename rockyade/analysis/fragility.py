@@ -39,7 +39,10 @@ class Fragility:
     n_points
         Stripes used.
     status
-        "fitted", or why not ("no collapse", "all collapse").
+        "fitted", or why not: "no collapse", "all collapse", or "separated" when no run
+        collapses below the intensity of a run that does not (the likelihood then grows
+        without bound as beta -> 0: the data fix a threshold, ``median``, not a slope;
+        ``beta`` is NaN).
     """
 
     median: float
@@ -50,6 +53,8 @@ class Fragility:
     def probability(self, im: ArrayLike) -> np.ndarray:
         """P(collapse) at intensities ``im``."""
         x = np.asarray(im, dtype=float)
+        if self.status == "separated":
+            return (x > self.median).astype(float)
         if self.status != "fitted":
             return np.full(x.shape, 0.0 if self.status == "no collapse" else 1.0)
         with np.errstate(divide="ignore"):
@@ -77,6 +82,10 @@ def fit_lognormal(im: ArrayLike, n_collapse: ArrayLike, n_total: ArrayLike) -> F
         return Fragility(math.inf, math.nan, int(x.size), "no collapse")
     if np.all(k == n):
         return Fragility(0.0, math.nan, int(x.size), "all collapse")
+    top_survivor = float(np.max(x[k < n]))
+    lowest_collapse = float(np.min(x[k > 0]))
+    if top_survivor <= lowest_collapse:  # (quasi-)complete separation: no finite maximum
+        return Fragility(math.sqrt(top_survivor * lowest_collapse), math.nan, int(x.size), "separated")
     logx = np.log(x)
 
     def nll(params: np.ndarray) -> float:

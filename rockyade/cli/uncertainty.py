@@ -46,6 +46,8 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
     print("fragility (lognormal, maximum likelihood):")
     for row in result.fragility.itertuples(index=False):
         fit = f"median {row.median:.4g}, beta {row.beta:.3g}" if row.status == "fitted" else row.status
+        if row.status == "separated":
+            fit += f" (every overturning run is above every other: a threshold near {row.median:.4g}, no slope)"
         print(f"  {row.solver:9s} {row.measure:24s} {fit}")
     if result.spread is not None:
         print("spread caused by the parameters alone (per-sample P(overturn) 5-95 %, nominal):")
