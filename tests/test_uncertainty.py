@@ -186,3 +186,32 @@ def test_cli_uncertainty_on_the_example(tmp_path, monkeypatch, capsys):
     assert list(probabilities["load_factor"]) == [0.8, 1.0, 1.2, 1.4]
     assert (probabilities["n_runs"] == 2 * 6).all()
     assert main(["uncertainty", "missing.toml", "--out", "x"]) == 2
+
+
+def test_recorded_files_and_block_dimensions(tmp_path):
+    """Records given as files (two-column CSV), a block given by its dimensions, lognormal p."""
+    t = np.arange(0.0, 4.0, 0.005)
+    for k, amp in enumerate((2.0, 3.5)):
+        a = amp * np.sin(2 * np.pi * 1.5 * t) * (t < 2.0)
+        pd.DataFrame({"t": t, "a": a}).to_csv(tmp_path / f"pulse{k}.csv", index=False)
+    data = _study(
+        samples=3,
+        duration_s=6.0,
+        intensity_measures=["arias_m_s"],
+        block={"name": "wall", "width_m": 0.3, "height_m": 1.2, "thickness_m": 0.5, "density_kg_m3": 2000.0},
+        parameters={"p_rad_s": {"distribution": "lognormal", "mean": 3.5, "cov": 0.05}},
+        motion={"files": ["pulse0.csv", "pulse1.csv"], "load_factors": [1.0]},
+    )
+    study = uncertainty_study_from_dict(data, str(tmp_path / "s.toml"), tmp_path)
+    result = run_uncertainty(study, tmp_path / "out", workers=1, progress=False, figure=False)
+    runs = result.runs
+    assert set(runs["record"]) == {"pulse0", "pulse1"} and len(runs) == 8
+    assert runs["alpha_rad"].nunique() == 1  # alpha stays at the geometry's value
+    assert runs.loc[runs.record == "pulse1", "arias_m_s"].iloc[0] == pytest.approx(
+        (3.5 / 2.0) ** 2 * runs.loc[runs.record == "pulse0", "arias_m_s"].iloc[0], rel=1e-9
+    )
+    # the stronger pulse rocks the block further
+    peak = runs.groupby("record")["max_theta_over_alpha"].median()
+    assert peak["pulse1"] > peak["pulse0"]
+    with pytest.raises(InputError, match=r"motion\.files"):
+        uncertainty_study_from_dict(dict(data, motion={"files": ["none.csv"], "load_factors": [1.0]}), None, tmp_path)
