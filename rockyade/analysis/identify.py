@@ -15,16 +15,8 @@ side it was tilted to, t_r the release time and o the sensor offset. The six unk
 exactly: the solver is advanced from the release to the first sample after it, then sampled
 on the measurement grid.
 
-Starting point (:func:`initial_guess`), from the peaks and zero crossings of the record:
-
-* the quarter period of free rocking from rest at theta_0 scales as 1/p:
-  T_q = tau(theta_0 / alpha) / p (Housner's linearised value is
-  (1/p) arccosh(1 / (1 - theta_0/alpha)); tau is taken from the exact solver at p = 1);
-  each half period between two zero crossings, 2 tau(A_k/alpha) / p with A_k the peak
-  between them, gives (alpha, p) from the amplitude dependence of the period;
-* mu from the potential energy at successive peaks,
-  mu^2 = V(A_{k+1}) / V(A_k), V(A) = cos(alpha - A) - cos(alpha) (DESIGN.md);
-* t_r = (first crossing) - T_q(theta_0); o from the rest at the end or from the peaks.
+Starting point: :func:`rockyade.analysis.identify_start.initial_guess` (peaks, zero crossings
+and exact Housner periods). The model: :mod:`rockyade.analysis.free_rocking_model`.
 
 95 % intervals: Gauss-Newton covariance s^2 (J^T J)^-1 (J the Jacobian at the optimum,
 s^2 = SSR / (n - 6)) with Student's t quantile (Bates & Watts 1988, Ch. 2). When the
@@ -40,21 +32,38 @@ noisy, or an interval wider than ``max_relative_ci`` of the value).
 
 from __future__ import annotations
 
-import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy import optimize, stats
 
+from rockyade.analysis.free_rocking_model import (
+    FIT_PARAMETERS,
+    FreeRockingFit,
+    IdentificationError,
+    model_history,
+    synthetic_measurement,
+)
+from rockyade.analysis.identify_start import Guess, initial_guess
 from rockyade.analysis.measurement import MeasuredHistory
-from rockyade.analysis.peaks import effective_restitution
-from rockyade.errors import InputError, RockyadeError
-from rockyade.solvers.housner import HousnerModel, solve
+from rockyade.errors import InputError
 
-#: The fitted unknowns, in the order of the parameter vector.
-FIT_PARAMETERS = ("alpha_rad", "p_rad_s", "mu", "release_time_s", "offset_rad", "release_ratio")
+__all__ = [
+    "CLASSICAL",
+    "FIT_PARAMETERS",
+    "FreeRockingFit",
+    "Guess",
+    "Identification",
+    "IdentificationError",
+    "error_surface",
+    "identify",
+    "initial_guess",
+    "model_history",
+    "synthetic_measurement",
+]
+
 #: The classical parameters reported with intervals.
 CLASSICAL = ("alpha_rad", "p_rad_s", "mu")
 #: Impacts above the noise needed to identify alpha and p separately (the amplitude
@@ -68,317 +77,6 @@ OBSERVABLE_PEAK_RMS = 5.0
 CONFIDENCE = 0.95
 #: Relative finite-difference step of the Jacobian (the solver is accurate to ~1e-11).
 DIFF_STEP = 1e-6
-
-
-class IdentificationError(RockyadeError):
-    """The record shows no free rocking that Housner's model can be fitted to."""
-
-
-@dataclass(frozen=True)
-class FreeRockingFit:
-    """Values of the six unknowns.
-
-    Attributes
-    ----------
-    alpha_rad, p_rad_s, mu
-        Classical parameters (rad, rad/s, -).
-    release_time_s
-        Time of the release, s (in the record's time base).
-    offset_rad
-        Sensor offset: the reading when the block stands upright, rad.
-    release_ratio
-        theta_0 / alpha, the release tilt as a fraction of alpha (0 < r < 1).
-    side
-        +1 when released tilted to theta > 0, -1 otherwise.
-    """
-
-    alpha_rad: float
-    p_rad_s: float
-    mu: float
-    release_time_s: float
-    offset_rad: float
-    release_ratio: float
-    side: int = 1
-
-    @property
-    def vector(self) -> NDArray[np.float64]:
-        """The unknowns in :data:`FIT_PARAMETERS` order."""
-        return np.array([getattr(self, k) for k in FIT_PARAMETERS])
-
-    @classmethod
-    def from_vector(cls, x: NDArray[np.float64], side: int) -> FreeRockingFit:
-        """Unknowns from a parameter vector."""
-        return cls(*(float(v) for v in x), side=side)
-
-    @property
-    def theta0_rad(self) -> float:
-        """Signed release tilt, rad."""
-        return self.side * self.release_ratio * self.alpha_rad
-
-
-def model_history(fit: FreeRockingFit, t0_s: float, dt_s: float, n: int, step_s: float | None = None):
-    """The modelled measurement at t0 + k dt (k = 0..n-1), and Housner's trajectory.
-
-    Returns
-    -------
-    theta
-        Modelled reading, rad (hold, then free rocking, plus the offset).
-    trajectory
-        The solver's trajectory from the first sample after the release (or None when the
-        release is after the record).
-    delta_s
-        Time from the release to that first sample, s.
-    """
-    theta = np.full(n, fit.theta0_rad + fit.offset_rad)
-    i0 = max(0, math.ceil((fit.release_time_s - t0_s) / dt_s - 1e-9))
-    if i0 >= n:
-        return theta, None, 0.0
-    model = HousnerModel.symmetric(fit.alpha_rad, fit.p_rad_s, fit.mu)
-    start = abs(fit.theta0_rad)
-    omega = 0.0
-    delta = t0_s + i0 * dt_s - fit.release_time_s
-    if delta > 1e-12:
-        head = solve(model, None, delta, start, 0.0, sample_dt_s=delta, step_s=step_s)
-        if head.status == "overturned":
-            theta[i0:] = fit.side * 0.5 * math.pi + fit.offset_rad
-            return theta, head, delta
-        start, omega = float(head.theta_rad[-1]), float(head.omega_rad_s[-1])
-    duration = (n - 1 - i0) * dt_s
-    if duration <= 0.0:
-        theta[i0:] = fit.side * start + fit.offset_rad
-        return theta, None, delta
-    traj = solve(model, None, duration, start, omega, sample_dt_s=dt_s, step_s=step_s)
-    m = traj.theta_rad.size
-    theta[i0 : i0 + m] = fit.side * traj.theta_rad + fit.offset_rad
-    if m < n - i0:  # overturned: lying on its side
-        theta[i0 + m :] = fit.side * math.copysign(0.5 * math.pi, traj.theta_rad[-1]) + fit.offset_rad
-    return theta, traj, delta
-
-
-# ------------------------------------------------------------------ starting point
-
-
-@functools.lru_cache(maxsize=4096)
-def quarter_period_p1(ratio: float, alpha_rad: float) -> float:
-    """Time from rest at theta_0 = ratio alpha to the first impact, for p = 1 rad/s.
-
-    Exact (Housner's nonlinear equation through the solver); it scales as 1/p. The
-    linearised value is arccosh(1 / (1 - ratio)).
-    """
-    linear = math.acosh(1.0 / (1.0 - ratio))
-    model = HousnerModel.symmetric(alpha_rad, 1.0, 1.0)
-    duration = 1.5 * linear + 1.0
-    traj = solve(model, None, duration, ratio * alpha_rad, 0.0, sample_dt_s=duration, step_s=2.5e-3)
-    if traj.n_impacts == 0:
-        return math.inf
-    return float(traj.impacts[0, 0])
-
-
-@dataclass(frozen=True)
-class Guess:
-    """The starting point and what the record shows.
-
-    Attributes
-    ----------
-    fit
-        Starting values of the unknowns.
-    noise_rad
-        Noise level estimated from second differences, rad.
-    crossings_s
-        Times the reading crosses the offset (impacts), s.
-    amplitudes_rad
-        Release tilt, then the peak of each closed excursion after it, rad.
-    half_periods_s
-        Time between successive crossings, s.
-    notes
-        How each value was obtained.
-    """
-
-    fit: FreeRockingFit
-    noise_rad: float
-    crossings_s: NDArray[np.float64]
-    amplitudes_rad: NDArray[np.float64]
-    half_periods_s: NDArray[np.float64]
-    notes: tuple[str, ...] = field(default=())
-
-
-def noise_level(theta: NDArray[np.float64]) -> float:
-    """Standard deviation of white measurement noise, rad, from second differences.
-
-    The second difference of white noise has variance 6 sigma^2; the median absolute value
-    (/0.6745) ignores the few samples at impacts and keeps the estimate robust.
-    """
-    d2 = np.diff(theta, 2)
-    return float(np.median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
-
-
-def _crossings(t: NDArray[np.float64], y: NDArray[np.float64], threshold: float):
-    """Zero crossings of y with hysteresis ``threshold`` and the extreme between them.
-
-    Returns the crossing times (linear interpolation at the last sign change before the
-    signal leaves the band), the signed extremes of the excursions between crossings
-    (index-aligned: extreme k lies before crossing k) and the extreme indices.
-    """
-    state = 0
-    last_sign_change = -1
-    crossings: list[float] = []
-    extremes: list[float] = []
-    extreme_index: list[int] = []
-    ext_i = 0
-    for i, v in enumerate(y):
-        if i > 0 and (y[i - 1] > 0) != (v > 0):
-            last_sign_change = i
-        s = 1 if v > threshold else (-1 if v < -threshold else 0)
-        if state == 0:
-            if s != 0:
-                state = s
-                ext_i = i
-            continue
-        if s == -state:
-            j = last_sign_change
-            frac = y[j - 1] / (y[j - 1] - y[j])
-            crossings.append(float(t[j - 1] + frac * (t[j] - t[j - 1])))
-            extremes.append(float(y[ext_i]))
-            extreme_index.append(ext_i)
-            state = s
-            ext_i = i
-        elif s == state and abs(v) > abs(y[ext_i]):
-            ext_i = i
-    return np.array(crossings), np.array(extremes), np.array(extreme_index, dtype=int)
-
-
-def _smooth(y: NDArray[np.float64], width: int) -> NDArray[np.float64]:
-    if width <= 1:
-        return y
-    kernel = np.ones(width) / width
-    return np.convolve(np.pad(y, width // 2, mode="edge"), kernel, mode="valid")[: y.size]
-
-
-def _peak_value(t: NDArray[np.float64], y: NDArray[np.float64], i: int, half_window_s: float) -> float:
-    """Extreme of y near sample i from a least-squares parabola over +/- ``half_window_s``
-    (noise on single samples biases the raw extreme)."""
-    dt = float(t[1] - t[0])
-    w = max(2, round(half_window_s / dt))
-    lo, hi = max(0, i - w), min(y.size, i + w + 1)
-    if hi - lo < 5:
-        return float(y[i])
-    tt = t[lo:hi] - t[i]
-    c2, c1, c0 = np.polyfit(tt, y[lo:hi], 2)
-    if c2 == 0.0 or abs(-c1 / (2 * c2)) > tt.max() - tt.min():
-        return float(y[i])
-    return float(c0 - c1 * c1 / (4.0 * c2))
-
-
-def _offset_from_peaks(peaks: NDArray[np.float64]) -> float | None:
-    """Offset o that makes successive peaks decay geometrically: (P_{k+1} - o)^2 = (P_k - o)(P_{k+2} - o)."""
-    values = []
-    for k in range(min(len(peaks) - 2, 6)):
-        a, b, c = peaks[k], peaks[k + 1], peaks[k + 2]
-        den = a + c - 2.0 * b
-        if abs(den) > 1e-12:
-            values.append((a * c - b * b) / den)
-    return float(np.median(values)) if values else None
-
-
-def _alpha_p_from_half_periods(amplitudes: NDArray[np.float64], half_periods: NDArray[np.float64]):
-    """(alpha, p) that fit half periods 2 tau(A/alpha, alpha) / p best (relative error)."""
-    a_max = float(np.max(amplitudes))
-
-    def p_and_cost(alpha: float) -> tuple[float, float]:
-        tau = np.array([2.0 * quarter_period_p1(round(a / alpha, 12), round(alpha, 12)) for a in amplitudes])
-        if not np.all(np.isfinite(tau)):
-            return math.nan, math.inf
-        # T = tau / p: least squares on relative errors gives 1/p = mean(T / tau)
-        inv_p = float(np.mean(half_periods / tau))
-        cost = float(np.sum((half_periods - tau * inv_p) ** 2 / half_periods**2))
-        return 1.0 / inv_p, cost
-
-    grid = a_max * np.geomspace(1.05, 40.0, 60)
-    costs = [p_and_cost(a)[1] for a in grid]
-    k = int(np.argmin(costs))
-    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
-    best = optimize.minimize_scalar(
-        lambda a: p_and_cost(a)[1], bounds=(lo, hi), method="bounded", options={"xatol": 1e-6 * a_max}
-    )
-    alpha = float(best.x)
-    return min(alpha, 1.5), p_and_cost(alpha)[0]
-
-
-def initial_guess(history: MeasuredHistory) -> Guess:
-    """Starting values from the record's peaks and zero crossings (module docstring).
-
-    Raises
-    ------
-    IdentificationError
-        When the reading never crosses its rest value clearly (no impact to fit).
-    """
-    t, y = history.t_s, history.theta_rad
-    noise = noise_level(y)
-    amplitude = float(np.max(y) - np.min(y))
-    notes = [f"noise {noise:.3g} rad (second differences)"]
-    tail = y[-max(10, y.size // 10) :]
-    quiet_tail = float(np.std(tail)) < max(4.0 * noise, 1e-3 * amplitude)
-    offset = float(np.median(tail))
-    threshold = max(6.0 * noise, 0.02 * amplitude)
-    for _ in range(3):
-        crossings, extremes, ext_index = _crossings(t, y - offset, threshold)
-        if quiet_tail or len(extremes) < 4:
-            break
-        refined = _offset_from_peaks(extremes[1:] + offset)
-        if refined is None:
-            break
-        offset = refined
-    notes.append("offset from the rest at the end" if quiet_tail else "offset from the decay of the peaks")
-    if crossings.size < 1:
-        cause = (
-            f"too noisy: a noise of {noise:.3g} rad hides a swing of {amplitude:.3g} rad"
-            if 6.0 * noise > 0.25 * amplitude
-            else "the block does not rock (too short, or no release in the record)"
-        )
-        raise IdentificationError(
-            f"{history.source or 'the record'}: the rotation never crosses its rest value clearly (threshold "
-            f"{threshold:.3g} rad): no impact, nothing to identify: {cause}"
-        )
-    # release tilt: the extreme of the first excursion (a hold, or a record starting at rest)
-    first_seg = y[: np.searchsorted(t, crossings[0])]
-    smooth = _smooth(first_seg - offset, 5)
-    k0 = int(np.argmax(np.abs(smooth)))
-    side = 1 if smooth[k0] > 0 else -1
-    theta0 = float(abs(smooth[k0]))
-    started_moving = k0 == 0 and abs(smooth[-1]) < abs(smooth[0]) and first_seg.size > 3
-    peak_values = [
-        _peak_value(t, y - offset, int(i), 0.05 * float(np.median(np.diff(crossings))) if crossings.size > 1 else 0.02)
-        for i in ext_index[1:]
-    ]
-    amplitudes = np.concatenate([[theta0], np.abs(peak_values)])
-    half_periods = np.diff(crossings)
-    usable = amplitudes[1 : 1 + half_periods.size] > 10.0 * max(noise, 1e-12)
-    amps_hp = amplitudes[1 : 1 + half_periods.size][usable]
-    hps = half_periods[usable]
-    if hps.size >= 2:
-        alpha, p = _alpha_p_from_half_periods(amps_hp, hps)
-        notes.append(f"alpha, p from {hps.size} half periods and their amplitudes (exact Housner periods)")
-    elif hps.size == 1:
-        alpha = 2.0 * max(theta0, amps_hp[0])
-        p = 2.0 * quarter_period_p1(amps_hp[0] / alpha, alpha) / hps[0]
-        notes.append("one half period only: alpha guessed as twice the release tilt")
-    else:
-        alpha = 2.0 * theta0
-        p = quarter_period_p1(0.5, alpha) / max(crossings[0] - t[0], history.dt_s)
-        notes.append("no complete half period: alpha guessed as twice the release tilt, p from the first fall")
-    alpha = max(alpha, 1.02 * theta0)
-    peaks_for_mu = amplitudes[amplitudes > 10.0 * max(noise, 1e-12)]
-    mu = effective_restitution(peaks_for_mu[:8], alpha) if peaks_for_mu.size >= 2 else 0.9
-    mu = float(min(max(mu, 0.05), 0.999)) if math.isfinite(mu) else 0.9
-    ratio = min(theta0 / alpha, 0.98)
-    t_release = float(crossings[0] - quarter_period_p1(round(ratio, 12), round(alpha, 12)) / p)
-    if started_moving:
-        notes.append("the record starts after the release: release time extrapolated before it")
-    fit = FreeRockingFit(alpha, p, mu, t_release, offset, ratio, side)
-    return Guess(fit, noise, crossings, amplitudes, half_periods, tuple(notes))
-
-
-# ------------------------------------------------------------------ the fit
 
 
 @dataclass
@@ -686,43 +384,3 @@ def error_surface(
             m = model_history(fit, float(h.t_s[0]), h.dt_s, h.t_s.size)[0]
             rms[i, j] = math.sqrt(float(np.mean((m - h.theta_rad) ** 2)))
     return alphas, ps, rms
-
-
-def synthetic_measurement(
-    alpha_rad: float,
-    p_rad_s: float,
-    mu: float,
-    *,
-    theta0_rad: float,
-    rate_hz: float = 200.0,
-    duration_s: float = 8.0,
-    hold_s: float = 0.5,
-    release_offset_s: float = 0.0,
-    offset_rad: float = 0.0,
-    noise_rad: float = 0.0,
-    seed: int = 0,
-    source: str = "synthetic",
-) -> MeasuredHistory:
-    """A free-rocking record made by Housner's solver, with a hold, an offset and white noise.
-
-    The release happens at ``hold_s + release_offset_s`` (``release_offset_s`` lets the
-    release fall between samples); the noise is Gaussian with standard deviation
-    ``noise_rad`` from ``numpy.random.default_rng(seed)``.
-    """
-    from rockyade.analysis.measurement import measured_history
-
-    dt = 1.0 / rate_hz
-    n = round(duration_s * rate_hz) + 1
-    truth = FreeRockingFit(
-        alpha_rad,
-        p_rad_s,
-        mu,
-        hold_s + release_offset_s,
-        offset_rad,
-        abs(theta0_rad) / alpha_rad,
-        1 if theta0_rad >= 0 else -1,
-    )
-    theta = model_history(truth, 0.0, dt, n)[0]
-    rng = np.random.default_rng(seed)
-    theta = theta + noise_rad * rng.standard_normal(n)
-    return measured_history(np.arange(n) * dt, theta, source)
