@@ -32,6 +32,8 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.studies",
     "rockyade.cli.yade_script",
     "rockyade.cli.build",
+    "rockyade.cli.identify",
+    "rockyade.cli.uncertainty",
 ]
 
 

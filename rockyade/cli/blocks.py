@@ -133,8 +133,12 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rockyade import paper
     from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 
-    if args.specimen is None:
-        raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower")
+    if args.from_identified is not None:
+        from rockyade.cli.identify import calibrate_identified
+
+        return calibrate_identified(args, _blocks_from_args(args))
+    if args.specimen is None or args.scene or args.width or args.vertices:
+        raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower (--scene, dimensions: with --from)")
     spec = paper.specimen(args.specimen)
     block = spec.block()
     if args.parameters == "experimental":
@@ -219,7 +223,8 @@ def register(sub: Any) -> None:
         description="DEM contact parameters of a specimen: K (Eq 10), b_eq (Eq 11), beta (Eq 13 or "
         "matched to mu with the reference DEM), xi_min (Eq 15), f_min (Eq 14), dt (Eq 7).",
     )
-    p.add_argument("--specimen", required=True, help="1, 2, 3, 4, upper or lower")
+    _add_block_arguments(p)
+    p.add_argument("--from", dest="from_identified", type=Path, help="identified values (rockyade identify --out)")
     p.add_argument(
         "--parameters",
         choices=["theoretical", "experimental"],
