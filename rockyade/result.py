@@ -107,14 +107,17 @@ class Result:
             _settle(csv_path, json_path)
             with staged_file(csv_path) as (fh, csv_tmp):
                 fh.write(text)
+            leftovers = [csv_tmp, pending]
             try:
                 with staged_file(json_path) as (fh, json_tmp):
                     fh.write(json_text(meta) + "\n")
+                leftovers.append(json_tmp)
                 os.replace(json_tmp, pending)
                 os.replace(csv_tmp, csv_path)  # from here the new pair (CSV + pending JSON) is complete
+                leftovers = []
                 os.replace(pending, json_path)
             except BaseException:
-                for leftover in (csv_tmp, pending):
+                for leftover in leftovers:
                     with contextlib.suppress(FileNotFoundError):
                         leftover.unlink()
                 raise
