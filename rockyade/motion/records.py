@@ -181,7 +181,7 @@ def _check_not_cut(path: Path, tokens: list[tuple[str, int]], last_in_file: bool
     if len({(exp, frac) for exp, frac, _ in others}) != 1:
         return  # free format: the values vary anyway
     has_exp, frac, _ = others[0]
-    min_exp_digits = min(d for _, _, d in others)
+    min_exp_digits = min(2, *(d for _, _, d in others))  # exponents are written with 2 digits or more
     mine = _signature(last)
     if mine[0] != has_exp or mine[1] != frac or mine[2] < min_exp_digits:
         raise RecordError(
@@ -338,6 +338,12 @@ def _split(line: str) -> list[str]:
     return [t for t in re.split(r"[,;\s]+", line.strip()) if t]
 
 
+def _header_names(line: str) -> list[str]:
+    """Column names of a header: split at commas, semicolons or tabs if it has any, else at spaces."""
+    parts = re.split(r"[,;\t]", line) if re.search(r"[,;\t]", line) else line.split()
+    return [p.strip() for p in parts if p.strip()]
+
+
 def _is_header(tokens: list[str]) -> bool:
     """A header line: words only. A token that starts like a number (``1_0``, ``1.2x``, a
     non-ASCII digit) makes it a data line with a typo, reported as such."""
@@ -384,8 +390,9 @@ def read_two_column(path: str | Path, units: str | None = None) -> Record:
         tokens = _split(body)
         if not seen_data and header_line is None and _is_header(tokens):
             header_line = lineno  # a header: names only, no number at all
-            if len(tokens) >= 2:
-                header_unit = header_units(tokens[1])
+            names = _header_names(body)
+            if len(names) >= 2:
+                header_unit = header_units(names[1])
             continue
         seen_data = True
         if len(tokens) < 2:
