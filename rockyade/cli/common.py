@@ -36,10 +36,13 @@ def check_output_dir(path: Path, option: str) -> None:
     _check_dir(path, option, f"cannot write into {path}")
 
 
-def check_output_file(path: Path, option: str) -> None:
-    """Refuse an output file whose folder cannot be created or written."""
+def check_output_file(path: Path, option: str, suffix: str | None = None) -> None:
+    """Refuse an output file whose folder cannot be created or written, or (``suffix``, e.g.
+    ``".png"``) whose name does not end as the file it will be (no scene overwritten by a plot)."""
     if path.is_dir():
         raise InputError(option, f"{path} is a directory; give a file name")
+    if suffix is not None and path.suffix.lower() != suffix:
+        raise InputError(option, f"must be a {suffix} file, got {path}")
     _check_dir(path.parent if str(path.parent) else Path("."), option, f"cannot write {path}")
 
 

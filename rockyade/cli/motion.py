@@ -37,7 +37,7 @@ def cmd_info(args: argparse.Namespace) -> int:
 
     rec = _read(args)
     if args.plot:
-        check_output_file(args.plot, "plot")
+        check_output_file(args.plot, "plot", ".png")
     info = {
         "npts": rec.npts,
         "dt_s": rec.dt_s,
@@ -80,9 +80,9 @@ def cmd_spectrum(args: argparse.Namespace) -> int:
         raise InputError("n", f"must be in [2, 10000] periods, got {args.n}")
     if not 0.0 <= args.damping < 1.0:
         raise InputError("damping", f"must be in [0, 1), got {args.damping:g}")
-    for option in ("out", "plot"):
+    for option, suffix in (("out", ".csv"), ("plot", ".png")):
         if getattr(args, option):
-            check_output_file(getattr(args, option), option)
+            check_output_file(getattr(args, option), option, suffix)
     rec = _read(args)
     if not rec.uniform:
         raise InputError("record", "the response spectrum needs a uniformly sampled record")
@@ -134,7 +134,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     out: Path = args.out
     check_output_dir(out, "out")
     if args.plot:
-        check_output_file(args.plot, "plot")
+        check_output_file(args.plot, "plot", ".png")
     records = []
     with output_lock(out), tqdm(
         total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet
@@ -201,6 +201,8 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rockyade.motion.records import read_two_column
     from rockyade.motion.synthetic import compatibility_report
 
+    if args.plot:
+        check_output_file(args.plot, "plot", ".png")
     suite_file = args.dir / "suite.json"
     if not suite_file.is_file():
         raise InputError("dir", f"{suite_file} not found (write a suite with 'rockyade motion synth')")

@@ -19,9 +19,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     from rockyade.scene import load_scene
     from rockyade.solvers import get_solver
 
-    for option in ("out", "plot"):
+    for option, suffix in (("out", ".csv"), ("plot", ".png")):
         if getattr(args, option):
-            check_output_file(getattr(args, option), option)
+            check_output_file(getattr(args, option), option, suffix)
     scene = load_scene(args.scene)
     check_cost(scene, args.solver, allow_large=args.allow_large)
     solver = get_solver(args.solver)

@@ -172,15 +172,20 @@ def _check_not_cut(path: Path, tokens: list[tuple[str, int]], last_in_file: bool
     """Refuse a last value that is cut short: every other value is written one way, it another.
 
     ``tokens`` are the (text, line) of the values of one column, in order;
-    ``last_in_file``: no value follows the last of them.
+    ``last_in_file``: no value follows the last of them. Only a column written in a fixed
+    format (every other value with an exponent, or with 3 decimals or more, alike) says how
+    the last value should look; a free-format column is left alone.
     """
-    if not last_in_file or len(tokens) < 3:
+    if not last_in_file or len(tokens) < 2:
         return
     last, line = tokens[-1]
     others = [_signature(t) for t, _ in tokens[:-1]]
     if len({(exp, frac) for exp, frac, _ in others}) != 1:
         return  # free format: the values vary anyway
     has_exp, frac, _ = others[0]
+    fixed = has_exp if len(others) == 1 else (has_exp or frac >= 3)
+    if not fixed:
+        return
     min_exp_digits = min(2, *(d for _, _, d in others))  # exponents are written with 2 digits or more
     mine = _signature(last)
     if mine[0] != has_exp or mine[1] != frac or mine[2] < min_exp_digits:
