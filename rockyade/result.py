@@ -16,6 +16,7 @@ actually used (``contact`` for the DEMs, ``classical`` for Housner).
 from __future__ import annotations
 
 import contextlib
+import glob
 import hashlib
 import json
 import os
@@ -28,7 +29,7 @@ import pandas as pd
 
 from rockyade import __version__
 from rockyade.errors import InputError
-from rockyade.io.atomic import fsync_dir, json_text, remove_stale_temporaries, staged_file
+from rockyade.io.atomic import TEMP_SUFFIX, fsync_dir, json_text, remove_stale_temporaries, staged_file
 from rockyade.io.locking import output_lock
 
 STATUSES = ("completed", "overturned", "failed")
@@ -171,6 +172,10 @@ def _matching_meta(csv_path: Path, text: str) -> dict[str, Any] | None:
 
 def _settle(csv_path: Path, json_path: Path) -> None:
     """Finish or discard what a killed writer left (call with the result's lock held)."""
+    for name in (csv_path.name, json_path.name):  # temporary files of a killed writer of this result
+        for stale in csv_path.parent.glob(f".{glob.escape(name)}.*{TEMP_SUFFIX}"):
+            with contextlib.suppress(FileNotFoundError):
+                stale.unlink()
     pending = pending_json_path(json_path)
     if not pending.is_file():
         return

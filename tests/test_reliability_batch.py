@@ -147,11 +147,18 @@ def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
         assert (out / "runs" / name).stat().st_mtime_ns == stamp  # not run twice
 
 
-def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path):
+@pytest.mark.parametrize("executor", ["local", "dask"])
+def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path, executor):
+    if executor == "dask":
+        pytest.importorskip("dask")
     _study(tmp_path, duration_s=4000.0, runs=4, sample_dt=0.05)  # runs of ~20 s
-    proc = _batch(tmp_path, "--workers", "2")
-    workers = _workers_of(proc, 2)
-    time.sleep(1.0)  # the runs are under way
+    proc = _batch(tmp_path, "--workers", "2", "--executor", executor)
+    if executor == "local":
+        workers = _workers_of(proc, 2)
+    else:  # the runs are threads of the batch process
+        workers = set()
+        _wait_for(lambda: (tmp_path / "out" / "runs").is_dir(), 120, "the runs to start")
+    time.sleep(1.5)  # the runs are under way
     os.killpg(proc.pid, signal.SIGINT)
     time.sleep(0.3)
     start = time.monotonic()
@@ -162,7 +169,8 @@ def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path):
     assert "Ctrl-C again: stopping the running runs now" in stderr
     summary = pd.read_csv(tmp_path / "out" / "summary.csv")
     assert len(summary) == 4 and (summary.status == "unfinished").all()
-    assert set(summary.failure_reason) <= {"stopped by Ctrl-C"}
+    assert set(summary.failure_reason) == {"stopped by Ctrl-C", "not started: Ctrl-C"}
+    assert (summary.failure_reason == "stopped by Ctrl-C").sum() == 2  # the two running runs
     _wait_for(lambda: not any(_alive(p) for p in workers), 10, "the workers to end")
     assert not _leftovers(tmp_path / "out")
 

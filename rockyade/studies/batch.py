@@ -430,7 +430,7 @@ def _crashed_row(task: Task, reason: str) -> dict[str, Any]:
 
 
 def _run_local(
-    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest
+    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest, started: set[int]
 ) -> list[Task]:
     """Run tasks on a pool of worker processes; return the tasks that did not finish.
 
@@ -450,6 +450,7 @@ def _run_local(
                 task = pending.popleft()
                 try:
                     running[pool.submit(run_task, task)] = task
+                    started.add(task.index)
                 except BrokenProcessPool:
                     pending.appendleft(task)
                     pool = _fresh_pool(pool, ctx, workers)
@@ -489,7 +490,7 @@ def _fresh_pool(pool: ProcessPoolExecutor, ctx: Any, workers: int) -> ProcessPoo
 
 
 def _run_dask_in_process(
-    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest
+    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest, started: set[int]
 ) -> list[Task]:
     """Dask's threaded scheduler in this process: no cluster, no socket. Returns the tasks
     that did not finish (a stop request makes the unstarted ones return at once)."""
@@ -504,7 +505,10 @@ def _run_dask_in_process(
     finished: set[int] = set()
 
     def guarded(task: Task) -> dict[str, Any] | None:
-        return None if stop.event.is_set() else run_task(task)
+        if stop.event.is_set():
+            return None
+        started.add(task.index)
+        return run_task(task)
 
     def posttask(key: Any, row: Any, dsk: Any, state: Any, worker_id: Any) -> None:
         if row is not None:
@@ -534,6 +538,7 @@ def _run_dask_remote(
     on_done: Callable[[dict[str, Any]], None],
     stop: StopRequest,
     timeout_s: float,
+    started: set[int],
 ) -> list[Task]:
     """A ``distributed`` cluster at ``scheduler``; Ctrl-C cancels what has not finished."""
     try:
@@ -554,6 +559,7 @@ def _run_dask_remote(
     finished: set[int] = set()
     try:
         futures = client.map(run_task, tasks, pure=False)
+        started.update(t.index for t in tasks)  # the cluster decides when: cancelled ones count as stopped
         pending = dask_completed(futures)
         while not pending.is_empty():
             batch = pending.next_batch(block=False)
@@ -703,16 +709,17 @@ def _run_locked(
             bar.write(f"failed: {row['run']}: {row['failure_reason']}")
 
     unfinished: list[Task] = []
+    started: set[int] = set()
     stopped_now = False
     in_process_dask = executor == "dask" and not scheduler
     with StopRequest(raise_on_second=in_process_dask) as stop:
         try:
             if executor == "local":
-                unfinished = _run_local(todo, workers, on_done, stop)
+                unfinished = _run_local(todo, workers, on_done, stop, started)
             elif in_process_dask:
-                unfinished = _run_dask_in_process(todo, workers, on_done, stop)
+                unfinished = _run_dask_in_process(todo, workers, on_done, stop, started)
             else:
-                unfinished = _run_dask_remote(todo, scheduler or "", on_done, stop, scheduler_timeout_s)
+                unfinished = _run_dask_remote(todo, scheduler or "", on_done, stop, scheduler_timeout_s, started)
         except KeyboardInterrupt:
             if not stop.requested:
                 raise
@@ -723,8 +730,8 @@ def _run_locked(
             bar.close()
     interrupted = stop.requested
     if interrupted:
-        for task in unfinished:
-            reason = "stopped by Ctrl-C" if stop.now or stopped_now else "not started: Ctrl-C"
+        for task in sorted(unfinished, key=lambda t: t.index):
+            reason = "stopped by Ctrl-C" if task.index in started else "not started: Ctrl-C"
             rows.append(_placeholder_row(task, UNFINISHED, reason))
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
     write_summary(summary, out)
