@@ -32,7 +32,8 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
 
 
 def check_output_dir(path: Path, option: str) -> None:
-    """Refuse an output directory that cannot be created or written (InputError naming ``option``)."""
+    """Refuse an output directory that cannot be created or written (InputError naming
+    ``option``), before any work; nothing is created here."""
     _check_dir(path, option, f"cannot write into {path}")
 
 
@@ -56,10 +57,6 @@ def _check_dir(path: Path, option: str, what: str) -> None:
         raise InputError(option, f"{what}: {existing} is not a directory")
     if not os.access(existing, os.W_OK | os.X_OK):
         raise InputError(option, f"{what}: {existing} is not writable")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(option, f"{what}: {exc.strerror or exc}") from None
 
 
 def total_time(args: argparse.Namespace) -> float:

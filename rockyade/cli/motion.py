@@ -136,6 +136,7 @@ def cmd_synth(args: argparse.Namespace) -> int:
     if args.plot:
         check_output_file(args.plot, "plot", ".png")
     records = []
+    out.mkdir(parents=True, exist_ok=True)
     with output_lock(out), tqdm(
         total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet
     ) as bar:

@@ -38,6 +38,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
         check_cost(scene, name, allow_large=args.allow_large)
     stem = args.scene.stem
     results = {}
+    out.mkdir(parents=True, exist_ok=True)
     with output_lock(out):
         for name in solvers:
             run = get_solver(name)

@@ -728,7 +728,7 @@ def _run_locked(
             unfinished = [t for t in todo if t.index not in finished]
         finally:
             bar.close()
-    interrupted = stop.requested
+    interrupted = stop.requested and bool(unfinished)  # a Ctrl-C after the last run changes nothing
     if interrupted:
         for task in sorted(unfinished, key=lambda t: t.index):
             reason = "stopped by Ctrl-C" if task.index in started else "not started: Ctrl-C"
