@@ -327,7 +327,7 @@ def test_tiny_tmpfs_full_disk_is_a_clear_failure(tmp_path):
     scene = EXAMPLES / "specimen1_free.toml"
     script = (
         f"mount -t tmpfs -o size=64k tmpfs {disk} && cd {disk} && "
-        f"{sys.executable} -m rockyade run {scene} --solver reference --out r.csv; "
+        f"{sys.executable} -m rockyade run {scene} --out r.csv; "
         f"echo EXIT=$?; ls -A {disk}"
     )
     proc = subprocess.run(["unshare", "-Urm", "sh", "-c", script], capture_output=True, text=True, timeout=300)
