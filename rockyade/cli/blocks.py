@@ -35,7 +35,6 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
     """(name, Block, classical overrides) for each block the arguments describe."""
     from rockyade import paper
     from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices, rectangle_vertices
-    from rockyade.scene import load_scene
 
     chosen = [x for x in (args.specimen, args.scene, args.width or args.vertices) if x]
     if len(chosen) != 1:
@@ -46,6 +45,8 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
         spec = paper.specimen(args.specimen)
         return [(spec.name, spec.block(), {})]
     if args.scene:
+        from rockyade.scene import load_scene
+
         scene = load_scene(args.scene)
         specs = [b for b in scene.blocks if args.block in (None, b.name)]
         if not specs:
@@ -133,6 +134,8 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rockyade import paper
     from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 
+    if not 0.0 < args.friction_angle < 90.0:
+        raise InputError("friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
     if args.from_identified is not None:
         from rockyade.cli.identify import calibrate_identified
 
