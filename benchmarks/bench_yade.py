@@ -4,13 +4,20 @@
   simulated second, its start-up cost (process, imports, scene building), and the
   reference DEM's kernel time on the same model: the ratio per simulated second.
 * Runs per minute with two parallel YADE workers (8 runs of 5 s simulated).
+* Assemblies: dry running-bond walls of about 10 and 100 blocks under a one-sine pulse,
+  us per block-step and start-up time of YADE beside the reference DEM's
+  (:func:`assembly_costs`, which ``bench_scale.py`` can call).
 """
 
 from __future__ import annotations
 
+import math
+import sys
 import time
+from pathlib import Path
 
 from rockyade.dem.matching import build_matched_model
+from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import yade as yade_backend
 from rockyade.solvers.reference import run_model
@@ -31,10 +38,99 @@ def scene(duration: float, theta0: float = 0.1175):
     )
 
 
+def running_bond_wall(n_blocks: int, duration: float = 0.3, unit_m: float = 0.25):
+    """A dry running-bond wall of about ``n_blocks`` square units (half units at the ends of
+    odd courses, as wide as tall at most), under a one-sine pulse of 0.3 g."""
+    units = max(2, round(math.sqrt(n_blocks / 1.1)))
+    courses = max(2, round(n_blocks / (units + 0.5)))
+    blocks = []
+    for c in range(courses):
+        if c % 2 == 0:
+            row = [(i * unit_m, unit_m) for i in range(units)]
+        else:
+            half = unit_m / 2
+            row = (
+                [(0.0, half)]
+                + [(half + i * unit_m, unit_m) for i in range(units - 1)]
+                + [(units * unit_m - half, half)]
+            )
+        for k, (x0, w) in enumerate(row):
+            blocks.append(
+                {
+                    "name": f"c{c}u{k}",
+                    "width_m": w,
+                    "height_m": unit_m,
+                    "thickness_m": 0.2,
+                    "density_kg_m3": 2200.0,
+                    "position_m": [x0 + w / 2, c * unit_m],
+                }
+            )
+    return scene_from_dict(
+        {
+            "duration_s": duration,
+            "sample_dt_s": 0.002,
+            "blocks": blocks,
+            "contact": {"K_N_per_m": 1e9, "beta_s": 5e-5, "friction_angle_deg": 35.0},
+            "motion": {"type": "pulse", "shape": "sine", "amplitude_g": 0.3, "period_s": 0.3},
+        }
+    )
+
+
+def _wall_builder():
+    """The scale benchmark's scenes when it is there (``bench_scale.scene_for``: the reference
+    DEM is timed on the same walls), else :func:`running_bond_wall`."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    try:
+        from bench_scale import scene_for  # type: ignore[import-not-found]
+    except ImportError:
+        return running_bond_wall
+    finally:
+        sys.path.pop(0)
+    return lambda n, duration: scene_for(n, "pulse", duration)
+
+
+def assembly_costs(sizes=(10, 100), duration: float = 0.3) -> list[dict[str, object]]:
+    """YADE beside the reference DEM on walls of about ``sizes`` blocks under a pulse: us per
+    block-step (each solver's own run time; YADE's includes its recorder), YADE's start-up
+    (process, imports, scene building), or why a solver could not run."""
+    build = _wall_builder()
+    rows = []
+    for n in sizes:
+        model = build_matched_model(build(n, duration))
+        nb = len(model.bodies)
+        row: dict[str, object] = {"blocks": nb, "steps": model.n_steps, "dt_s": model.dt_s}
+        y = yade_backend.run_model(model)
+        if y.ok:
+            row["yade_us_per_block_step"] = 1e6 * y.meta["wall_time_s"] / (model.n_steps * nb)
+            row["yade_startup_s"] = y.meta["startup_time_s"]
+        else:
+            row["yade_error"] = y.meta.get("failure_reason")
+        try:
+            run_model(model, record_energy=False)  # compile and warm up
+            r = min((run_model(model, record_energy=False) for _ in range(3)), key=lambda x: x.meta["wall_time_s"])
+            row["reference_us_per_block_step"] = 1e6 * r.meta["wall_time_s"] / (model.n_steps * nb)
+        except InputError as exc:
+            row["reference_error"] = str(exc)
+        rows.append(row)
+    return rows
+
+
 def main() -> None:
     if not yade_backend.yade_available():
         print("YADE is not installed: no YADE figures")
         return
+    for row in assembly_costs():
+        yade = (
+            f"YADE {row['yade_us_per_block_step']:.2f} us/block-step + {row['yade_startup_s']:.2f} s start-up"
+            if "yade_us_per_block_step" in row
+            else f"YADE failed: {row['yade_error']}"
+        )
+        ref = (
+            f"reference {row['reference_us_per_block_step']:.3f} us/block-step"
+            if "reference_us_per_block_step" in row
+            else f"reference: {row['reference_error']}"
+        )
+        print(f"wall of {row['blocks']} blocks, {row['steps']} steps of {row['dt_s']:.3g} s: {yade}; {ref}")
     model = build_matched_model(scene(20.0))
     run_model(build_matched_model(scene(0.1)), record_energy=False)  # JIT warm-up
     ref = min(run_model(model, record_energy=False).meta["wall_time_s"] for _ in range(3))

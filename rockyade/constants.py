@@ -4,6 +4,12 @@
 #: (e.g. p = 3.78 1/s for specimen 1 via Eq 3) follow from g = 9.81.
 G = 9.81
 
+#: Standard gravity (CGPM 1901), m/s^2: what a record "in g" means (PEER NGA AT2 files and
+#: most accelerograph software). Records are converted with it; the paper's classical
+#: parameters (p, the uplift acceleration g tan(alpha), amplitudes given in g in scenes)
+#: keep :data:`G` = 9.81 as the paper computed them.
+STANDARD_GRAVITY = 9.80665
+
 #: Stiffness scale applied to the paper's printed K (Tables 5-6 and Eq 10) by default.
 #: Read as N/m, Eq 10's K lets specimen 1 sink Mg/K ~ 0.7 m into its base; read as MN/m the
 #: static settlement is ~1 micrometre and the DEM rocks as Housner predicts (DESIGN.md).

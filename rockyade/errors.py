@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import errno
+
 
 class RockyadeError(Exception):
     """Base class of every error rockyade raises on purpose."""
@@ -44,3 +46,39 @@ class SolverFailedError(RockyadeError):
         self.log_path = log_path
         extra = f" (log: {log_path})" if log_path else ""
         super().__init__(f"{reason}{extra}")
+
+
+class BatchInterruptedError(RockyadeError):
+    """A batch stopped by Ctrl-C (SIGINT) after writing the summary of what finished.
+
+    Attributes
+    ----------
+    finished
+        Runs that finished (completed, overturned or failed).
+    unfinished
+        Runs that did not start or were stopped.
+    summary_path
+        The summary written, or None when it could not be.
+    hard
+        A second Ctrl-C stopped the running runs (the process should end at once).
+    """
+
+    def __init__(self, finished: int, unfinished: int, summary_path: str | None, hard: bool = False) -> None:
+        self.finished = finished
+        self.unfinished = unfinished
+        self.summary_path = summary_path
+        self.hard = hard
+        where = f"; {summary_path} lists them" if summary_path else ""
+        super().__init__(
+            f"interrupted: {finished} run(s) finished, {unfinished} unfinished{where} "
+            "(run the same command with --resume to finish them)"
+        )
+
+
+def os_error_message(exc: OSError) -> str:
+    """One line for a file-system error: the file and what went wrong (a full disk said so)."""
+    what = exc.strerror or str(exc)
+    if exc.errno == errno.ENOSPC:
+        what = "no space left on the device (disk full)"
+    where = f"{exc.filename}: " if exc.filename else ""
+    return f"{where}{what}"

@@ -16,6 +16,7 @@ actually used (``contact`` for the DEMs, ``classical`` for Housner).
 from __future__ import annotations
 
 import contextlib
+import glob
 import hashlib
 import json
 import os
@@ -28,7 +29,8 @@ import pandas as pd
 
 from rockyade import __version__
 from rockyade.errors import InputError
-from rockyade.io.atomic import atomic_open, write_json
+from rockyade.io.atomic import TEMP_SUFFIX, fsync_dir, json_text, remove_stale_temporaries, staged_file
+from rockyade.io.locking import output_lock
 
 STATUSES = ("completed", "overturned", "failed")
 PER_BLOCK_QUANTITIES = ("theta_rad", "omega_rad_s", "x_m", "y_m", "ax_m_s2", "ay_m_s2")
@@ -103,24 +105,45 @@ class Result:
         return plot_results({name: self}, path, title=title, quantity=quantity, ax=ax)
 
     # -------------------------------------------------------------- files
-    def write(self, csv_path: str | os.PathLike[str]) -> Path:
-        """Write ``<name>.csv`` and ``<name>.json`` atomically; return the JSON path.
+    def write(self, csv_path: str | os.PathLike[str], extra_meta: dict[str, Any] | None = None) -> Path:
+        """Write ``<name>.csv`` and ``<name>.json``; return the JSON path.
 
-        The JSON (written last, with the CSV's SHA-256) marks the pair complete: a reader
-        never mistakes a half-written or stale CSV for a result.
+        The JSON (with the CSV's SHA-256) marks the pair complete. Both files are written
+        to temporary files first; the old pair is replaced only when the new one is
+        complete (CSV renamed, then the JSON), so a kill at any moment leaves the old pair
+        or the new one (:meth:`read` finds the new JSON in ``.<name>.json.pending`` if the
+        kill fell between the two renames). Another process writing the same result is
+        refused (:func:`rockyade.io.locking.output_lock`); temporary files are removed on
+        failure. ``extra_meta`` is merged into the metadata.
         """
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
-        with contextlib.suppress(FileNotFoundError):
-            json_path.unlink()  # an old pair stops looking complete before we rewrite it
         text = self.frame.to_csv(index=False, float_format=CSV_FLOAT_FORMAT, lineterminator="\n")
-        with atomic_open(csv_path, "w") as fh:
-            fh.write(text)
         meta = dict(self.meta)
+        meta.update(extra_meta or {})
         meta["csv_file"] = csv_path.name
         meta["csv_sha256"] = hashlib.sha256(text.encode()).hexdigest()
         meta["columns"] = list(self.frame.columns)
-        write_json(json_path, meta)
+        pending = pending_json_path(json_path)
+        with output_lock(csv_path):
+            _settle(csv_path, json_path)
+            with staged_file(csv_path) as (fh, csv_tmp):
+                fh.write(text)
+            leftovers = [csv_tmp, pending]
+            try:
+                with staged_file(json_path) as (fh, json_tmp):
+                    fh.write(json_text(meta) + "\n")
+                leftovers.append(json_tmp)
+                os.replace(json_tmp, pending)
+                os.replace(csv_tmp, csv_path)  # from here the new pair (CSV + pending JSON) is complete
+                leftovers = []
+                os.replace(pending, json_path)
+            except BaseException:
+                for leftover in leftovers:
+                    with contextlib.suppress(FileNotFoundError):
+                        leftover.unlink()
+                raise
+            fsync_dir(csv_path.parent)
         return json_path
 
     @classmethod
@@ -128,11 +151,13 @@ class Result:
         """Read a result pair written by :meth:`write`, verifying it is complete."""
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
-        if not json_path.is_file():
-            raise InputError("result", f"{json_path} is missing: the result is incomplete")
-        meta = json.loads(json_path.read_text())
+        if not csv_path.is_file():
+            raise InputError("result", f"{csv_path} is missing")
         text = csv_path.read_text()
-        if hashlib.sha256(text.encode()).hexdigest() != meta.get("csv_sha256"):
+        meta = _matching_meta(csv_path, text)
+        if meta is None:
+            if not json_path.is_file():
+                raise InputError("result", f"{json_path} is missing: the result is incomplete")
             raise InputError("result", f"{csv_path} does not match {json_path.name} (partial or stale)")
         from io import StringIO
 
@@ -140,6 +165,63 @@ class Result:
         for key in ("csv_file", "csv_sha256", "columns"):
             meta.pop(key, None)
         return cls(frame, meta)
+
+
+def pending_json_path(json_path: Path) -> Path:
+    """Where :meth:`Result.write` keeps the new JSON between its two renames."""
+    return json_path.parent / f".{json_path.name}.pending"
+
+
+def _load_meta(path: Path) -> dict[str, Any] | None:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) else None
+
+
+def _matching_meta(csv_path: Path, text: str) -> dict[str, Any] | None:
+    """The metadata whose SHA-256 matches the CSV: the JSON, or a pending JSON."""
+    digest = hashlib.sha256(text.encode()).hexdigest()
+    json_path = csv_path.with_suffix(".json")
+    for candidate in (json_path, pending_json_path(json_path)):
+        meta = _load_meta(candidate) if candidate.is_file() else None
+        if meta is not None and meta.get("csv_sha256") == digest:
+            return meta
+    return None
+
+
+def _settle(csv_path: Path, json_path: Path) -> None:
+    """Finish or discard what a killed writer left (call with the result's lock held)."""
+    for name in (csv_path.name, json_path.name):  # temporary files of a killed writer of this result
+        for stale in csv_path.parent.glob(f".{glob.escape(name)}.*{TEMP_SUFFIX}"):
+            with contextlib.suppress(FileNotFoundError):
+                stale.unlink()
+    pending = pending_json_path(json_path)
+    if not pending.is_file():
+        return
+    meta = _load_meta(pending)
+    try:
+        text = csv_path.read_text()
+    except OSError:
+        text = None
+    if meta is not None and text is not None and meta.get("csv_sha256") == hashlib.sha256(text.encode()).hexdigest():
+        os.replace(pending, json_path)  # the killed writer's new pair was complete: commit it
+    else:
+        with contextlib.suppress(FileNotFoundError):
+            pending.unlink()
+
+
+def settle_results(directory: str | os.PathLike[str]) -> None:
+    """Commit or discard the pending JSONs and remove the temporary files killed writers left.
+
+    Call it only while holding the directory's lock (no writer is active there).
+    """
+    directory = Path(directory)
+    for pending in directory.glob(".*.json.pending"):
+        json_path = directory / pending.name[1 : -len(".pending")]
+        _settle(json_path.with_suffix(".csv"), json_path)
+    remove_stale_temporaries(directory)
 
 
 def failed_result(solver: str, scene_hash: str, reason: str, **extra: Any) -> Result:

@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
+from rockyade.constants import STANDARD_GRAVITY as SG
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.analytic import Harmonic, Pulse
@@ -130,7 +131,7 @@ def test_at2_header_variants(tmp_path, variant, crlf):
     path = _write_at2(tmp_path / "r.AT2", AT2_VARIANTS[variant], crlf=crlf, extra=[9.9, 9.9])
     rec = read_at2(path)
     assert rec.npts == 6 and rec.dt_s == pytest.approx(0.01)
-    np.testing.assert_allclose(rec.accel_m_s2, np.array(AT2_DATA) * G)  # values beyond NPTS ignored
+    np.testing.assert_allclose(rec.accel_m_s2, np.array(AT2_DATA) * SG)  # values beyond NPTS ignored
     assert rec.units_in_file == "g"
 
 
@@ -191,7 +192,7 @@ def test_property_at2_round_trip(tmp_path_factory, values, dt, per_line):
     path.write_text("\n".join(lines) + "\n")
     rec = read_at2(path)
     assert rec.npts == len(values) and rec.dt_s == pytest.approx(dt)
-    np.testing.assert_allclose(rec.accel_m_s2, np.array(values) * G, rtol=1e-7, atol=1e-12)
+    np.testing.assert_allclose(rec.accel_m_s2, np.array(values) * SG, rtol=1e-7, atol=1e-12)
 
 
 def test_two_column_and_single_column(tmp_path):
@@ -202,7 +203,7 @@ def test_two_column_and_single_column(tmp_path):
     assert rec.dt_s == pytest.approx(0.01)
     ws = tmp_path / "two.txt"
     ws.write_text("0 1\n0.5 2\n1.0 3\n")
-    assert read_record(ws, units="g").accel_m_s2[1] == pytest.approx(2 * G)
+    assert read_record(ws, units="g").accel_m_s2[1] == pytest.approx(2 * SG)
     one = tmp_path / "one.txt"
     one.write_text("0.1\n0.2\n-0.3\n")
     rec = read_single_column(one, 0.02, "g")
@@ -233,9 +234,9 @@ def test_real_peer_records(name, npts, pga_g):
     assert rec.npts == npts and rec.dt_s == pytest.approx(0.01) and rec.units_in_file == "g"
     text = (RECORDS / name).read_text().split()
     values = [float(x) for x in text[text.index("SEC,") + 1 :]]
-    assert rec.pga_m_s2 == pytest.approx(max(abs(v) for v in values) * G)
+    assert rec.pga_m_s2 == pytest.approx(max(abs(v) for v in values) * SG)
     if pga_g is not None:
-        assert rec.pga_m_s2 / G == pytest.approx(pga_g, rel=1e-7)
+        assert rec.pga_m_s2 / SG == pytest.approx(pga_g, rel=1e-7)
 
 
 # --------------------------------------------------------------------- processing

@@ -39,21 +39,29 @@ def test_partial_or_stale_csv_is_detected(tmp_path):
         Result.read(path)
 
 
-def test_failing_write_leaves_no_complete_looking_result(tmp_path, monkeypatch):
+def test_failing_write_keeps_the_old_pair_and_no_temporary_file(tmp_path, monkeypatch):
     path = tmp_path / "r.csv"
     _result().write(path)  # an earlier complete pair
+    before = Result.read(path)
+    new = _result()
+    new.frame["theta_rad"] = new.frame["theta_rad"] + 1.0
 
     import rockyade.result as result_module
 
-    def boom(*args, **kwargs):
-        raise OSError("disk full")
+    real_replace = result_module.os.replace
 
-    monkeypatch.setattr(result_module, "write_json", boom)
+    def full_disk_on_json(src, dst, *args, **kwargs):
+        if str(dst).endswith(".json.pending"):
+            raise OSError(28, "No space left on device")
+        return real_replace(src, dst, *args, **kwargs)
+
+    monkeypatch.setattr(result_module.os, "replace", full_disk_on_json)
     with pytest.raises(OSError):
-        _result().write(path)
-    assert not path.with_suffix(".json").exists()  # the stale JSON was removed first
-    with pytest.raises(InputError):
-        Result.read(path)
+        new.write(path)
+    monkeypatch.undo()
+    back = Result.read(path)  # the old pair is still complete
+    pd.testing.assert_frame_equal(back.frame, before.frame)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r.csv", "r.json"]  # no temporary file left
 
 
 def test_status_is_validated_and_failed_result():

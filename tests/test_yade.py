@@ -99,33 +99,54 @@ def _describe(scene, tmp_path) -> tuple[dict, object]:
 
 def test_driver_handles_every_pitfall(tmp_path):
     """The scene the driver builds: damping 0, O.dt from Eq 7, the recorder first and every
-    steps_per_sample steps, exact mass and isotropic inertia at the centroid, planar DOFs,
-    the joint's values on the vertex spheres and zeros on the base."""
+    steps_per_sample steps, exact mass and isotropic inertia at the centroid, planar DOFs, a
+    prism per block, zeros on the base and prisms, and on each vertex sphere copy the values
+    of the joint of the body its mask meets (the base: the block's own joint; the other block:
+    the bi-block's bed joint, the upper block's own)."""
     built, model = _describe(load_scene(EXAMPLES / "biblock_free.toml"), tmp_path)
     assert built["newton_damping"] == 0.0
     assert built["gravity"] == [0.0, -9.81, 0.0]
     assert built["dt"] == pytest.approx(model.dt_s, rel=1e-12)
     assert built["recorder_first"] and built["recorder_period"] == model.steps_per_sample
     assert built["base"]["kn"] == 0.0 and not built["base"]["dynamic"]
+    base_mask = built["base"]["mask"]
+    prisms = []
     for clump, body, pos0 in zip(built["clumps"], model.bodies, model.pos0_m, strict=True):
         assert clump["mass"] == pytest.approx(body.mass_kg)
         assert clump["inertia"] == pytest.approx([body.inertia_kgm2] * 3)
         assert clump["blocked"] == "zXY"
         assert clump["pos"][:2] == pytest.approx(pos0.tolist(), abs=1e-7)
-        spheres = [m for m in clump["members"] if m["shape"] == "Sphere" and m["mask"]]
-        assert len(spheres) == len(body.contact_vertices_m)
+        assert len(clump["vertex_ids"]) == len(body.contact_vertices_m)
+        (prism,) = [m for m in clump["members"] if m["shape"] == "Polyhedra"]
+        assert prism["kn"] == 0.0
+        prisms.append(prism["mask"])
         helper = [m for m in clump["members"] if m["mask"] == 0]
         assert len(helper) == 1  # the centroid helper never collides
+    assert prisms[0] & prisms[1] == 0 and not (prisms[0] | prisms[1]) & base_mask
     lower, upper = model.bodies
-    lower_spheres = [m for m in built["clumps"][0]["members"] if m["shape"] == "Sphere" and m["mask"]]
-    kns = sorted({m["kn"] for m in lower_spheres})
-    # the lower block's base corners carry its own joint, its top corners the upper block's
-    assert kns == pytest.approx(sorted({lower.joint.K_N_per_m, upper.joint.K_N_per_m}))
-    cns = {m["cn"] for m in lower_spheres}
-    assert any(c == pytest.approx(lower.joint.beta_s * lower.joint.K_N_per_m) for c in cns)
-    masks_lower = {m["mask"] for m in lower_spheres}
-    masks_upper = {m["mask"] for m in built["clumps"][1]["members"] if m["shape"] == "Sphere" and m["mask"]}
-    assert masks_lower.isdisjoint(masks_upper)  # spheres of different blocks never touch
+    bed = model.joints.params[model.joints.joint_for(0, 1)]
+    assert bed.K_N_per_m == upper.joint.K_N_per_m != lower.joint.K_N_per_m  # the upper block's own
+    for i, clump in enumerate(built["clumps"]):
+        by_id = {mid: m for mid, m in zip(_member_ids(clump), clump["members"], strict=True)}
+        for ids in clump["vertex_ids"]:
+            copies = [by_id[mid] for mid in ids]
+            meets_base = [c for c in copies if c["mask"] & base_mask]
+            meets_other = [c for c in copies if c["mask"] & prisms[1 - i]]
+            assert not any(c["mask"] & prisms[i] for c in copies) or len(built["clumps"]) > 30
+            assert len(meets_other) == 1
+            assert meets_other[0]["kn"] == pytest.approx(bed.K_N_per_m)
+            assert meets_other[0]["cn"] == pytest.approx(bed.beta_s * bed.K_N_per_m)
+            if i == 0:
+                own = lower.joint
+                assert len(meets_base) == 1 and meets_base[0]["kn"] == pytest.approx(own.K_N_per_m)
+            else:
+                assert not meets_base or meets_base[0]["kn"] == pytest.approx(upper.joint.K_N_per_m)
+
+
+def _member_ids(clump: dict) -> list[int]:
+    """Body ids of a clump's members, in the driver's order (vertex copies first)."""
+    first = min(min(ids) for ids in clump["vertex_ids"])
+    return list(range(first, first + len(clump["members"])))
 
 
 # ------------------------------------------------------------------ no listening socket
@@ -301,7 +322,7 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
 
     def broken(model):
         payload = real(model)
-        del payload["bodies"][0]["joint_below"]
+        del payload["bodies"][0]["sphere_copies"]
         return payload
 
     monkeypatch.setattr(yade_backend, "scene_payload", broken)
@@ -413,3 +434,145 @@ def test_matched_beta_comes_from_the_reference_dem():
     s = paper.specimen(1)
     assert model.bodies[0].joint.beta_s == pytest.approx(match_beta(s.block(), **s.experimental).beta_s)
     assert model.bodies[0].joint.method == "matched"
+
+
+# ------------------------------------------------------------------ relative paths, timeout, script
+
+
+def _short_scene_file(folder: Path, duration: float = 0.6) -> Path:
+    d = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
+    d["duration_s"] = duration
+    path = folder / "s3.json"
+    path.write_text(json.dumps(d))
+    return path
+
+
+def test_cli_run_yade_with_relative_paths(tmp_path, monkeypatch, capsys):
+    """`rockyade run SCENE --solver yade --out sub/x.csv` from the scene's folder (the YADE
+    process runs in sub/: it must be given absolute paths)."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "s3.json", "--solver", "yade", "--out", "sub/x.csv"]) == 0
+    assert Result.read(Path("sub/x.csv")).meta["solver"] == "yade"
+    assert Path("sub/x.yade.log").is_file() and Path("sub/x.yade.json").is_file()
+
+
+def test_cli_compare_with_relative_out(tmp_path, monkeypatch, capsys):
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["compare", "s3.json", "--solvers", "reference,yade", "--out", "compare/"]) == 0
+    table = __import__("pandas").read_csv("compare/s3_compare.csv")
+    assert set(table["solver"]) == {"reference", "yade"}
+    assert Result.read(Path("compare/s3_yade.csv")).ok
+
+
+def test_cli_batch_with_relative_out(tmp_path, monkeypatch, capsys):
+    """A study with YADE runs, its output folder relative (as `make run` gives it)."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    (tmp_path / "study.toml").write_text(
+        'name = "rel"\nsolvers = ["yade"]\nyade_timeout_s = 600\n[base]\nfile = "s3.json"\n'
+        '[grid]\n"motion.theta0_rad" = [0.03, 0.05]\n'
+    )
+    monkeypatch.chdir(tmp_path)
+    assert main(["batch", "study.toml", "--out", "reports/rel", "--workers", "1", "--quiet"]) == 0
+    summary = __import__("pandas").read_csv("reports/rel/summary.csv")
+    assert list(summary["status"]) == ["completed", "completed"]
+
+
+def test_default_timeout_grows_with_the_work_and_is_capped():
+    model = build_matched_model(load_scene(EXAMPLES / "specimen1_free.toml"))
+    short = yade_backend.default_timeout(model)
+    assert short == pytest.approx(yade_backend.TIMEOUT_STARTUP_S + yade_backend.TIMEOUT_PER_BODY_STEP_S * model.n_steps)
+    longer = replace(model, n_samples=10 * model.n_samples)
+    assert yade_backend.default_timeout(longer) > short
+    huge = replace(model, n_samples=10_000 * model.n_samples)
+    assert yade_backend.default_timeout(huge) == yade_backend.TIMEOUT_CAP_S == 3600.0
+
+
+def _processes_with(text: str) -> list[int]:
+    found = []
+    for pid in os.listdir("/proc"):
+        if not pid.isdigit():
+            continue
+        try:
+            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().decode(errors="replace")
+        except OSError:
+            continue
+        if text in cmdline:
+            found.append(int(pid))
+    return found
+
+
+def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
+    """--yade-timeout: a failed result saying so, exit 1, and no YADE process left behind."""
+    from rockyade.cli import main
+
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    d["duration_s"] = 60.0
+    (tmp_path / "long.json").write_text(json.dumps(d))
+    monkeypatch.chdir(tmp_path)
+    start = time.time()
+    code = main(["run", "long.json", "--solver", "yade", "--out", "t/long.csv", "--yade-timeout", "2"])
+    assert code == 1 and time.time() - start < 30
+    out = capsys.readouterr().out
+    assert "timeout: YADE did not finish within 2 s" in out
+    assert Result.read(Path("t/long.csv")).status == "failed"
+    assert _processes_with(str(tmp_path / "t" / "long.yade.json")) == []
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])
+def test_cli_bad_yade_timeout_is_refused(value, tmp_path, capsys):
+    from rockyade.cli import main
+
+    code = main(["run", str(EXAMPLES / "specimen3_free.toml"), "--solver", "yade", "--yade-timeout", value])
+    assert code == 2
+    assert "--yade-timeout" in capsys.readouterr().err
+
+
+def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
+    """`rockyade yade-script` writes run.py + scene.json; Debian's python3.11 with YADE's
+    modules runs it (no launcher, no server) and writes the same output as the backend."""
+    from rockyade.cli import main
+
+    _short_scene_file(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert main(["yade-script", "s3.json", "--out", "by_hand"]) == 0
+    assert "yade -x by_hand/run.py" in capsys.readouterr().out
+    script = Path("by_hand/run.py")
+    assert "json" in script.read_text() and Path("by_hand/scene.json").is_file()
+    proc = subprocess.run(
+        [yade_backend.YADE_PYTHON, str(script)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    scene = load_scene(Path("s3.json"))
+    model = build_matched_model(scene)
+    by_hand = yade_backend._parse(model, Path("by_hand/result.npz"), None, Path("none.log"), 0.0, None)
+    backend = yade_backend.run_scene(scene)
+    assert by_hand.ok and backend.ok
+    np.testing.assert_array_equal(by_hand.series("theta_rad"), backend.series("theta_rad"))
+    table = __import__("pandas").read_csv("by_hand/result.csv")
+    np.testing.assert_allclose(table["specimen3_rotation_rad"], backend.series("theta_rad"), atol=1e-9)
+
+
+def test_study_file_yade_timeout(tmp_path):
+    """``yade_timeout_s`` in a study file reaches every task; a bad value names the key."""
+    from rockyade.errors import InputError
+    from rockyade.studies.batch import load_study
+
+    _short_scene_file(tmp_path)
+    body = '\nsolvers = ["yade"]\n[base]\nfile = "s3.json"\n'
+    (tmp_path / "ok.toml").write_text("yade_timeout_s = 90" + body)
+    assert {t.yade_timeout_s for t in load_study(tmp_path / "ok.toml", tmp_path / "out").tasks} == {90.0}
+    (tmp_path / "bad.toml").write_text("yade_timeout_s = -1" + body)
+    with pytest.raises(InputError, match="yade_timeout_s"):
+        load_study(tmp_path / "bad.toml", tmp_path / "out")

@@ -73,19 +73,40 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
         raise InputError(field_name, "must be a list of at least 3 [x, y] pairs in metres")
     if not np.all(np.isfinite(arr)):
         raise InputError(field_name, "contains NaN or infinite coordinates")
-    if polygon_section(arr).area_m2 < 0:
-        arr = arr[::-1].copy()
-    edges = np.roll(arr, -1, axis=0) - arr
-    lengths = np.hypot(edges[:, 0], edges[:, 1])
     scale = float(np.max(np.ptp(arr, axis=0)))
-    if np.any(lengths <= LEVEL_TOL * scale):
+    if not scale > 0:
+        raise InputError(field_name, "all vertices are the same point")
+    area = polygon_section_area(arr / scale)  # the checks on a polygon of unit size: no underflow
+    if abs(area) <= LEVEL_TOL:
+        raise InputError(field_name, "the vertices enclose no area (they lie on one line)")
+    if area < 0:
+        arr = arr[::-1].copy()
+    unit = arr / scale
+    edges = np.roll(unit, -1, axis=0) - unit
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    if np.any(lengths <= LEVEL_TOL):
         raise InputError(field_name, "has repeated (coincident) vertices")
     nxt = np.roll(edges, -1, axis=0)
     turn = edges[:, 0] * nxt[:, 1] - edges[:, 1] * nxt[:, 0]
-    if np.any(turn < -LEVEL_TOL * scale * scale):
+    if np.any(turn < -LEVEL_TOL):
         raise InputError(field_name, "polygon must be convex (vertices in order around it)")
-    keep = np.roll(np.abs(turn) > LEVEL_TOL * scale * scale, 1)
+    keep = np.roll(np.abs(turn) > LEVEL_TOL, 1)
+    dot = edges[:, 0] * nxt[:, 0] + edges[:, 1] * nxt[:, 1]
+    winding = float(np.arctan2(turn, dot).sum()) / (2.0 * np.pi)
+    if winding > 1.5:
+        raise InputError(
+            field_name,
+            f"the outline crosses itself (it winds {winding:.0f} times, e.g. a star): "
+            "give the vertices in order around a convex polygon",
+        )
     return arr[keep].copy()
+
+
+def polygon_section_area(vertices: NDArray[np.float64]) -> float:
+    """Signed area of a polygon (> 0 counter-clockwise), m^2 (shoelace formula)."""
+    x = vertices[:, 0]
+    y = vertices[:, 1]
+    return 0.5 * float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum())
 
 
 def rectangle_vertices(width: float, height: float) -> NDArray[np.float64]:

@@ -4,24 +4,33 @@ Commands: ``params`` (classical parameters of a block), ``calibrate`` (DEM conta
 parameters), ``run`` (a scene through a solver), ``tables`` (the paper's tables
 reproduced); every command module registers its own (:data:`COMMAND_MODULES`).
 
-Exit codes: 0 success, 1 a run failed, 2 bad input (the message names the field),
-3 a solver that is not available here.
+Exit codes: 0 success, 1 a run failed (or a file could not be written), 2 bad input (the
+message names the field or option), 3 a solver that is not available here, 130 stopped by
+Ctrl-C, 141 the output pipe was closed (e.g. ``rockyade tables | head -1``).
+
+Building the parser imports no solver, numpy, scipy, numba, pandas or matplotlib: command
+modules import them inside their command functions, so ``rockyade --help`` answers at once.
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import sys
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from rockyade import __version__
 from rockyade.errors import (
+    BatchInterruptedError,
     CalibrationError,
     InputError,
     RockyadeError,
     SolverFailedError,
     SolverUnavailableError,
+    os_error_message,
 )
 
 #: Modules that add sub-commands, each through ``register(subparsers)``.
@@ -30,8 +39,17 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.run",
     "rockyade.cli.motion",
     "rockyade.cli.studies",
+    "rockyade.cli.yade_script",
+    "rockyade.cli.build",
+    "rockyade.cli.identify",
+    "rockyade.cli.uncertainty",
 ]
 
+_T0 = time.perf_counter()  # the total wall time printed by ``rockyade run`` counts from here
+
+EXIT_OK, EXIT_FAILED, EXIT_INPUT, EXIT_UNAVAILABLE = 0, 1, 2, 3
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a process stopped by Ctrl-C
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports ``yes | head -1``
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -59,25 +77,78 @@ def _coerce_scale(value: str) -> str | float:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``rockyade`` console script."""
+    """Entry point of the ``rockyade`` console script: never ends in a traceback for bad
+    input, a full disk, a closed pipe or Ctrl-C (see the module docstring for exit codes)."""
+    try:
+        return _main(argv)
+    except BrokenPipeError:
+        _silence_stdout()
+        return EXIT_BROKEN_PIPE
+    except KeyboardInterrupt:
+        _error("interrupted (Ctrl-C)")
+        return EXIT_INTERRUPTED
+
+
+def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.started_at = _T0
     if hasattr(args, "stiffness_scale") and isinstance(args.stiffness_scale, str):
         args.stiffness_scale = _coerce_scale(args.stiffness_scale)
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()  # a closed pipe is reported here rather than at exit
+        return code
     except InputError as exc:
-        print(f"rockyade: error: {exc}", file=sys.stderr)
-        return 2
+        _error(f"error: {exc}")
+        return EXIT_INPUT
     except SolverUnavailableError as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 3
-    except (CalibrationError, SolverFailedError) as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 1
-    except RockyadeError as exc:
-        print(f"rockyade: {exc}", file=sys.stderr)
-        return 1
+        _error(str(exc))
+        return EXIT_UNAVAILABLE
+    except BatchInterruptedError as exc:
+        _error(str(exc))
+        if exc.hard:
+            _end_now(EXIT_INTERRUPTED)
+        return EXIT_INTERRUPTED
+    except (CalibrationError, SolverFailedError, RockyadeError) as exc:
+        _error(str(exc))
+        return EXIT_FAILED
+    except MemoryError:
+        _error("error: out of memory; a smaller run (shorter duration, larger sample_dt_s) fits")
+        return EXIT_FAILED
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        _error(f"error: {os_error_message(exc)}")
+        return EXIT_FAILED
+
+
+def _end_now(code: int) -> None:
+    """End the process at once if threads of stopped runs are still busy (they cannot be
+    killed, and the interpreter would wait for them at exit)."""
+    import threading
+
+    busy = [t for t in threading.enumerate() if t is not threading.main_thread() and not t.daemon and t.is_alive()]
+    if busy:
+        with contextlib.suppress(OSError, ValueError):
+            sys.stdout.flush()
+            sys.stderr.flush()
+        os._exit(code)
+
+
+def _error(message: str) -> None:
+    with contextlib.suppress(OSError):
+        print(f"rockyade: {message}", file=sys.stderr, flush=True)
+
+
+def _silence_stdout() -> None:
+    """After a closed pipe: point stdout at /dev/null so that the exit flush stays quiet."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
+    except (OSError, ValueError):
+        pass
 
 
 if __name__ == "__main__":

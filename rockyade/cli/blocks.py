@@ -35,7 +35,6 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
     """(name, Block, classical overrides) for each block the arguments describe."""
     from rockyade import paper
     from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices, rectangle_vertices
-    from rockyade.scene import load_scene
 
     chosen = [x for x in (args.specimen, args.scene, args.width or args.vertices) if x]
     if len(chosen) != 1:
@@ -46,6 +45,8 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
         spec = paper.specimen(args.specimen)
         return [(spec.name, spec.block(), {})]
     if args.scene:
+        from rockyade.scene import load_scene
+
         scene = load_scene(args.scene)
         specs = [b for b in scene.blocks if args.block in (None, b.name)]
         if not specs:
@@ -133,8 +134,14 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rockyade import paper
     from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 
-    if args.specimen is None:
-        raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower")
+    if not 0.0 < args.friction_angle < 90.0:
+        raise InputError("friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
+    if args.from_identified is not None:
+        from rockyade.cli.identify import calibrate_identified
+
+        return calibrate_identified(args, _blocks_from_args(args))
+    if args.specimen is None or args.scene or args.width or args.vertices:
+        raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower (--scene, dimensions: with --from)")
     spec = paper.specimen(args.specimen)
     block = spec.block()
     if args.parameters == "experimental":
@@ -219,7 +226,8 @@ def register(sub: Any) -> None:
         description="DEM contact parameters of a specimen: K (Eq 10), b_eq (Eq 11), beta (Eq 13 or "
         "matched to mu with the reference DEM), xi_min (Eq 15), f_min (Eq 14), dt (Eq 7).",
     )
-    p.add_argument("--specimen", required=True, help="1, 2, 3, 4, upper or lower")
+    _add_block_arguments(p)
+    p.add_argument("--from", dest="from_identified", type=Path, help="identified values (rockyade identify --out)")
     p.add_argument(
         "--parameters",
         choices=["theoretical", "experimental"],

@@ -1,8 +1,17 @@
-"""Helpers shared by the command modules."""
+"""Helpers shared by the command modules (standard library only: the parser stays fast)."""
 
 from __future__ import annotations
 
+import argparse
+import os
+from pathlib import Path
 from typing import Any
+
+from rockyade.errors import InputError
+
+#: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
+#: building the parser does not import the solvers; a test checks the two agree).
+SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade")
 
 
 def json_out(data: Any) -> None:
@@ -10,3 +19,49 @@ def json_out(data: Any) -> None:
     from rockyade.io.atomic import json_text
 
     print(json_text(data))
+
+
+def add_allow_large(p: argparse.ArgumentParser) -> None:
+    """``--allow-large``: run above the documented cost limits (docs/reliability.md)."""
+    p.add_argument(
+        "--allow-large",
+        action="store_true",
+        help="run even when the cost estimate (integration steps, samples, memory) is above the "
+        "documented limits",
+    )
+
+
+def check_output_dir(path: Path, option: str) -> None:
+    """Refuse an output directory that cannot be created or written (InputError naming
+    ``option``), before any work; nothing is created here."""
+    _check_dir(path, option, f"cannot write into {path}")
+
+
+def check_output_file(path: Path, option: str, suffix: str | None = None) -> None:
+    """Refuse an output file whose folder cannot be created or written, or (``suffix``, e.g.
+    ``".png"``) whose name does not end as the file it will be (no scene overwritten by a plot)."""
+    if path.is_dir():
+        raise InputError(option, f"{path} is a directory; give a file name")
+    if suffix is not None and path.suffix.lower() != suffix:
+        raise InputError(option, f"must be a {suffix} file, got {path}")
+    _check_dir(path.parent if str(path.parent) else Path("."), option, f"cannot write {path}")
+
+
+def _check_dir(path: Path, option: str, what: str) -> None:
+    existing = path
+    while not existing.exists():
+        if existing.parent == existing:
+            break
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        raise InputError(option, f"{what}: {existing} is not a directory")
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise InputError(option, f"{what}: {existing} is not writable")
+
+
+def total_time(args: argparse.Namespace) -> float:
+    """Seconds since the command line started (imports of the command included)."""
+    import time
+
+    start = getattr(args, "started_at", None)
+    return time.perf_counter() - start if start is not None else float("nan")

@@ -7,12 +7,11 @@ import json
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-import pandas as pd
-
-from rockyade.cli.common import json_out
+from rockyade.cli.common import check_output_dir, check_output_file, json_out
 from rockyade.errors import InputError
-from rockyade.io.atomic import atomic_open, write_json
+
+#: Period range of ``motion spectrum``, s.
+SPECTRUM_PERIODS_S = (1.0e-3, 1000.0)
 
 
 def _read(args: argparse.Namespace):
@@ -24,19 +23,27 @@ def _read(args: argparse.Namespace):
 def _add_record_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("record", type=Path, help="record file: PEER .AT2, two-column time/acceleration, or one column")
     p.add_argument("--format", choices=["at2", "csv", "single"], help="file format (default: by extension)")
-    p.add_argument("--units", help="units of the values: g, m/s2, cm/s2 (default: AT2 header, else m/s2)")
+    p.add_argument(
+        "--units",
+        help="units of the values when the file does not name them: g, m/s2, cm/s2 (default m/s2); "
+        "units named in the file win, and a different --units is refused",
+    )
     p.add_argument("--dt", type=float, help="sampling interval of a single-column file, s")
 
 
 def cmd_info(args: argparse.Namespace) -> int:
     """Summary of a record."""
+    from rockyade.constants import STANDARD_GRAVITY
+
     rec = _read(args)
+    if args.plot:
+        check_output_file(args.plot, "plot", ".png")
     info = {
         "npts": rec.npts,
         "dt_s": rec.dt_s,
         "duration_s": rec.duration_s,
         "pga_m_s2": rec.pga_m_s2,
-        "pga_g": rec.pga_m_s2 / 9.81,
+        "pga_g": rec.pga_m_s2 / STANDARD_GRAVITY,
         "pga_time_s": rec.pga_time_s,
         "units_in_file": rec.units_in_file,
         "title": rec.title,
@@ -53,14 +60,29 @@ def cmd_info(args: argparse.Namespace) -> int:
     else:
         print(f"{args.record}: {rec.title}")
         print(f"  {rec.npts} samples at dt = {rec.dt_s:g} s ({rec.duration_s:g} s), units in file: {rec.units_in_file}")
-        print(f"  PGA = {rec.pga_m_s2:.4g} m/s^2 ({rec.pga_m_s2 / 9.81:.4g} g) at t = {rec.pga_time_s:g} s")
+        pga_g = rec.pga_m_s2 / STANDARD_GRAVITY
+        print(f"  PGA = {rec.pga_m_s2:.4g} m/s^2 ({pga_g:.4g} g, standard gravity) at t = {rec.pga_time_s:g} s")
     return 0
 
 
 def cmd_spectrum(args: argparse.Namespace) -> int:
     """Pseudo-acceleration response spectrum of a record."""
+    import pandas as pd
+
     from rockyade.motion.spectra import default_periods, response_spectrum
 
+    lo, hi = SPECTRUM_PERIODS_S
+    if not lo <= args.t_min <= hi:
+        raise InputError("t-min", f"must be in [{lo:g}, {hi:g}] s, got {args.t_min:g}")
+    if not args.t_min < args.t_max <= hi:
+        raise InputError("t-max", f"must be in ({args.t_min:g}, {hi:g}] s (above --t-min), got {args.t_max:g}")
+    if not 2 <= args.n <= 10_000:
+        raise InputError("n", f"must be in [2, 10000] periods, got {args.n}")
+    if not 0.0 <= args.damping < 1.0:
+        raise InputError("damping", f"must be in [0, 1), got {args.damping:g}")
+    for option, suffix in (("out", ".csv"), ("plot", ".png")):
+        if getattr(args, option):
+            check_output_file(getattr(args, option), option, suffix)
     rec = _read(args)
     if not rec.uniform:
         raise InputError("record", "the response spectrum needs a uniformly sampled record")
@@ -68,6 +90,8 @@ def cmd_spectrum(args: argparse.Namespace) -> int:
     periods, psa = response_spectrum(rec.accel_m_s2, rec.dt_s, periods, args.damping)
     table = pd.DataFrame({"period_s": periods, "psa_m_s2": psa})
     if args.out:
+        from rockyade.io.atomic import atomic_open
+
         with atomic_open(args.out) as fh:
             table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
         print(f"wrote {args.out}")
@@ -96,20 +120,34 @@ def _suite_spec(args: argparse.Namespace):
 
 def cmd_synth(args: argparse.Namespace) -> int:
     """Generate a spectrum-compatible suite into a directory."""
+    import pandas as pd
+    from tqdm import tqdm
+
+    from rockyade.io.atomic import atomic_open, write_json
+    from rockyade.io.locking import output_lock
     from rockyade.motion.processing import integrate
     from rockyade.motion.synthetic import compatibility_report, suite_record
 
+    if not 1 <= args.count <= 1000:
+        raise InputError("count", f"must be in [1, 1000] records, got {args.count}")
     spec = _suite_spec(args)
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
+    check_output_dir(out, "out")
+    if args.plot:
+        check_output_file(args.plot, "plot", ".png")
     records = []
-    for i in range(1, spec.count + 1):
-        rec = suite_record(spec, i)
-        records.append(rec)
-        v, d = integrate(rec.t_s, rec.accel_m_s2)
-        frame = pd.DataFrame({"t_s": rec.t_s, "accel_m_s2": rec.accel_m_s2, "vel_m_s": v, "disp_m": d})
-        with atomic_open(out / f"record_{i:02d}.csv") as fh:
-            frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
+    out.mkdir(parents=True, exist_ok=True)
+    with output_lock(out), tqdm(
+        total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet
+    ) as bar:
+        for i in range(1, spec.count + 1):
+            rec = suite_record(spec, i)
+            records.append(rec)
+            v, d = integrate(rec.t_s, rec.accel_m_s2)
+            frame = pd.DataFrame({"t_s": rec.t_s, "accel_m_s2": rec.accel_m_s2, "vel_m_s": v, "disp_m": d})
+            with atomic_open(out / f"record_{i:02d}.csv") as fh:
+                frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
+            bar.update(1)
     report = compatibility_report(records, spec.target)
     write_json(
         out / "suite.json", {"settings": spec.as_dict(), "target": spec.target.as_dict(), "check": _short(report)}
@@ -146,6 +184,8 @@ def _print_report(report: dict[str, Any]) -> None:
 
 
 def _plot_report(records, target, report, path) -> None:
+    import numpy as np
+
     from rockyade.figures import plot_spectra
     from rockyade.motion.spectra import response_spectrum
 
@@ -162,23 +202,28 @@ def cmd_check(args: argparse.Namespace) -> int:
     from rockyade.motion.records import read_two_column
     from rockyade.motion.synthetic import compatibility_report
 
+    if args.plot:
+        check_output_file(args.plot, "plot", ".png")
     suite_file = args.dir / "suite.json"
     if not suite_file.is_file():
         raise InputError("dir", f"{suite_file} not found (write a suite with 'rockyade motion synth')")
-    target_d = json.loads(suite_file.read_text())["target"]
-    target = ElasticSpectrum(
-        target_d["ag_m_s2"],
-        target_d["S"],
-        target_d["TB_s"],
-        target_d["TC_s"],
-        target_d["TD_s"],
-        target_d["damping"],
-        target_d["label"],
-    )
+    try:
+        target_d = json.loads(suite_file.read_text(encoding="utf-8"))["target"]
+        target = ElasticSpectrum(
+            float(target_d["ag_m_s2"]),
+            float(target_d["S"]),
+            float(target_d["TB_s"]),
+            float(target_d["TC_s"]),
+            float(target_d["TD_s"]),
+            float(target_d["damping"]),
+            str(target_d["label"]),
+        )
+    except (ValueError, KeyError, TypeError) as exc:
+        raise InputError("dir", f"{suite_file} is not a suite file written by 'motion synth' ({exc})") from None
     files = sorted(args.dir.glob("record_*.csv"))
     if not files:
         raise InputError("dir", f"no record_*.csv in {args.dir}")
-    records = [read_two_column(f, "m/s2") for f in files]
+    records = [read_two_column(f) for f in files]
     report = compatibility_report(records, target, tuple(args.range))
     if args.json:
         json_out(report)
@@ -238,6 +283,7 @@ def register(sub: Any) -> None:
     p.add_argument("--name", default="suite", help="suite name")
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--plot", type=Path, help="PNG: target vs mean spectrum with the +/-10%% band")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_synth)
 
     p = msub.add_parser(

@@ -7,39 +7,57 @@ import math
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import json_out
+from rockyade.cli.build import add_snapshot_options, check_run_drawings, write_run_drawings
+from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_file, json_out, total_time
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     """Run a scene through a solver."""
+    import contextlib
+
+    from rockyade.cost import check_cost
+    from rockyade.io.locking import output_lock
     from rockyade.scene import load_scene
     from rockyade.solvers import get_solver
 
+    for option, suffix in (("out", ".csv"), ("plot", ".png")):
+        if getattr(args, option):
+            check_output_file(getattr(args, option), option, suffix)
     scene = load_scene(args.scene)
+    check_run_drawings(args)
+    check_cost(scene, args.solver, allow_large=args.allow_large)
     solver = get_solver(args.solver)
-    if args.solver == "yade" and args.out:
-        # YADE's log and scene data are kept beside the result
-        result = solver(scene, workdir=args.out.parent, name=args.out.stem)
-    else:
-        result = solver(scene)
-    if args.out:
-        json_path = result.write(args.out)
-        print(f"wrote {args.out} and {json_path}")
+    timeout = None
+    if args.solver == "yade":
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
+    with output_lock(args.out) if args.out else contextlib.nullcontext():
+        if args.solver == "yade":
+            # YADE's log and scene data are kept beside the result
+            where = {"workdir": args.out.parent, "name": args.out.stem} if args.out else {}
+            result = solver(scene, timeout_s=timeout, **where)
+        else:
+            result = solver(scene)
+        if args.out:
+            json_path = result.write(args.out)
+            print(f"wrote {args.out} and {json_path}")
     if args.plot:
         from rockyade.figures import plot_results
 
         plot_results({args.solver: result}, args.plot, title=f"{Path(args.scene).name} ({args.solver})")
         print(f"wrote {args.plot}")
-    _print_summary(scene, result)
+    write_run_drawings(args, scene, result, args.out or Path(Path(args.scene).stem + ".csv"))
+    _print_summary(scene, result, total_time(args))
     return 0 if result.ok else 1
 
 
-def _print_summary(scene: Any, result: Any) -> None:
+def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
     from rockyade.analysis.metrics import run_metrics
 
     meta = result.meta
     wall = meta.get("wall_time_s", math.nan)
-    print(f"solver {meta['solver']}: status {result.status}, wall time {wall:.3g} s")
+    print(f"solver {meta['solver']}: status {result.status}, wall time {wall:.3g} s (solver), {total_s:.3g} s (total)")
     if not result.ok:
         print(f"  failure: {meta.get('failure_reason')}")
         if meta.get("log_path"):
@@ -59,11 +77,14 @@ def cmd_tables(args: argparse.Namespace) -> int:
     """Tables 1-6 of the paper reproduced."""
     from rockyade.paper.tables import format_report, reproduction_report
 
+    if args.out:
+        from rockyade.cli.common import check_output_dir
+
+        check_output_dir(args.out, "out")
     report = reproduction_report()
     if args.out:
         from rockyade.io.atomic import atomic_open
 
-        args.out.mkdir(parents=True, exist_ok=True)
         for number, group in report.groupby("table"):
             with atomic_open(args.out / f"table{int(number)}_reproduced.csv") as fh:
                 group.to_csv(fh, index=False, lineterminator="\n")
@@ -78,10 +99,19 @@ def cmd_tables(args: argparse.Namespace) -> int:
 
 
 
+def add_yade_timeout(p: Any) -> None:
+    """The ``--yade-timeout`` option (run, compare, batch)."""
+    p.add_argument(
+        "--yade-timeout",
+        type=float,
+        metavar="SECONDS",
+        help="wall-clock limit of each YADE run (default: 60 s plus 50 us per block-step, at most one hour); "
+        "the run is stopped and reported failed when it is reached",
+    )
+
+
 def register(sub: Any) -> None:
     """Add ``run`` and ``tables``."""
-    from rockyade.solvers import solver_names
-
     p = sub.add_parser(
         "run",
         help="run a scene through a solver",
@@ -91,11 +121,14 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--solver",
         default="housner",
-        choices=solver_names(),
+        choices=SOLVER_NAMES,
         help="housner (exact classical), reference (standalone DEM) or yade",
     )
     p.add_argument("--out", type=Path, help="result CSV (the metadata JSON is written beside it)")
     p.add_argument("--plot", type=Path, help="PNG figure of the time history")
+    add_yade_timeout(p)
+    add_snapshot_options(p)
+    add_allow_large(p)
     p.set_defaults(func=cmd_run)
 
     p = sub.add_parser(

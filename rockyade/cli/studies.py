@@ -1,4 +1,4 @@
-"""``rockyade compare`` (and, later, batch and study commands)."""
+"""``rockyade compare``, ``rockyade batch`` and ``rockyade paper``."""
 
 from __future__ import annotations
 
@@ -6,39 +6,57 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_dir, total_time
+from rockyade.cli.run import add_yade_timeout
 from rockyade.errors import InputError
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """Run one scene through several solvers and tabulate their agreement."""
+    solvers = [s.strip() for s in args.solvers.split(",") if s.strip()]
+    unknown = [s for s in solvers if s not in SOLVER_NAMES]
+    if unknown or not solvers or len(set(solvers)) != len(solvers):
+        raise InputError(
+            "solvers", f"must be a comma-separated list of distinct {', '.join(SOLVER_NAMES)}, got {args.solvers!r}"
+        )
+    if args.reference is not None and args.reference not in solvers:
+        raise InputError(
+            "reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}"
+        )
+    timeout = None
+    if "yade" in solvers:
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
+    out: Path = args.out
+    check_output_dir(out, "out")
+
     from rockyade.analysis.compare import compare
+    from rockyade.cost import check_cost
     from rockyade.figures import plot_results
     from rockyade.io.atomic import atomic_open
+    from rockyade.io.locking import output_lock
     from rockyade.scene import load_scene
-    from rockyade.solvers import get_solver, solver_names
+    from rockyade.solvers import get_solver
 
     scene = load_scene(args.scene)
-    solvers = [s.strip() for s in args.solvers.split(",") if s.strip()]
-    unknown = [s for s in solvers if s not in solver_names()]
-    if unknown or not solvers:
-        raise InputError(
-            "solvers", f"must be a comma-separated list of {', '.join(solver_names())}, got {args.solvers!r}"
-        )
-    out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
+    for name in solvers:
+        check_cost(scene, name, allow_large=args.allow_large)
     stem = args.scene.stem
     results = {}
-    for name in solvers:
-        run = get_solver(name)
-        result = run(scene, workdir=out, name=stem) if name == "yade" else run(scene)
-        result.write(out / f"{stem}_{name}.csv")
-        results[name] = result
-        status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
-        print(f"{name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
-    table = compare(scene, results, args.reference)
-    with atomic_open(out / f"{stem}_compare.csv") as fh:
-        table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
-    plot_results(results, out / f"{stem}_compare.png", title=f"{stem}: {', '.join(solvers)}")
+    out.mkdir(parents=True, exist_ok=True)
+    with output_lock(out):
+        for name in solvers:
+            run = get_solver(name)
+            result = run(scene, workdir=out, name=stem, timeout_s=timeout) if name == "yade" else run(scene)
+            result.write(out / f"{stem}_{name}.csv")
+            results[name] = result
+            status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
+            print(f"{name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
+        table = compare(scene, results, args.reference)
+        with atomic_open(out / f"{stem}_compare.csv") as fh:
+            table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
+        plot_results(results, out / f"{stem}_compare.png", title=f"{stem}: {', '.join(solvers)}")
     view = table[
         table["metric"].isin(
             [
@@ -53,17 +71,34 @@ def cmd_compare(args: argparse.Namespace) -> int:
     ]
     print(view.to_string(index=False, float_format=lambda v: f"{v:.5g}"))
     print(f"wrote {out / f'{stem}_compare.csv'} and {out / f'{stem}_compare.png'}")
+    print(f"total wall time {total_time(args):.3g} s")
     return 0 if all(r.ok for r in results.values()) else 1
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run a study file's grid of scenes."""
+    check_output_dir(args.out, "out")
+    if not 1 <= args.workers <= 1024:
+        raise InputError("workers", f"must be in [1, 1024], got {args.workers}")
+    if not 0.1 <= args.scheduler_timeout <= 3600:
+        raise InputError("scheduler-timeout", f"must be in [0.1, 3600] s, got {args.scheduler_timeout:g}")
+    if args.scheduler and args.executor != "dask":
+        raise InputError("scheduler", "needs --executor dask")
+
     from rockyade.studies.batch import failures, load_study, run_study_tasks
 
     study = load_study(args.study, args.out)
-    print(f"{study.name}: {len(study.tasks)} runs ({', '.join(study.solvers)}) -> {args.out}")
+    tasks = list(study.tasks)
+    if args.yade_timeout is not None:
+        from dataclasses import replace
+
+        from rockyade.solvers.yade import check_timeout
+
+        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
+        tasks = [replace(t, yade_timeout_s=timeout) for t in tasks]
+    print(f"{study.name}: {len(tasks)} runs ({', '.join(study.solvers)}) -> {args.out}", flush=True)
     summary = run_study_tasks(
-        list(study.tasks),
+        tasks,
         args.out,
         executor=args.executor,
         workers=args.workers,
@@ -71,6 +106,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
         resume=args.resume,
         progress=not args.quiet,
         desc=study.name,
+        allow_large=args.allow_large,
+        scheduler_timeout_s=args.scheduler_timeout,
     )
     failed = failures(summary)
     counts = summary["status"].value_counts().to_dict()
@@ -124,9 +161,21 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or a Dask cluster")
-    p.add_argument("--scheduler", help="Dask scheduler address, e.g. tcp://host:8786 (default: an in-process cluster)")
+    p.add_argument(
+        "--scheduler",
+        help="Dask scheduler address, e.g. tls://host:8786 (default: Dask's threaded scheduler in this "
+        "process; no port opens). See docs/batches.md for TLS",
+    )
+    p.add_argument(
+        "--scheduler-timeout",
+        type=float,
+        default=10.0,
+        help="seconds to wait for the scheduler to answer (default 10)",
+    )
     p.add_argument("--resume", action="store_true", help="skip runs already completed; re-run failed ones")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_yade_timeout(p)
+    add_allow_large(p)
     p.set_defaults(func=cmd_batch)
 
     p = sub.add_parser(
@@ -154,4 +203,6 @@ def register(sub: Any) -> None:
     p.add_argument("--solvers", default="housner,reference,yade", help="comma-separated solvers")
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
     p.add_argument("--out", type=Path, default=Path("compare"), help="output directory")
+    add_yade_timeout(p)
+    add_allow_large(p)
     p.set_defaults(func=cmd_compare)

@@ -8,101 +8,221 @@ from __future__ import annotations
 
 import math
 import time
+from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rockyade.dem import kernel
+from rockyade.dem.broadphase import MARGIN_REL
 from rockyade.dem.model import DemModel
-from rockyade.errors import InputError
+
+#: A contact point keeps its shear spring when last step's point of the same pair lies within
+#: this fraction of the shortest edge of the two polygons.
+FEATURE_TOL_REL = 0.25
 
 
-def model_arrays(model: DemModel) -> dict[str, object]:
-    """The kernel's inputs for a model."""
-    nb = len(model.bodies)
-    maxv = max(len(b.contact_vertices_m) for b in model.bodies)
+class KernelOutput(NamedTuple):
+    """Raw outputs of :func:`rockyade.dem.kernel.simulate` (see its docstring).
+
+    The first ten fields keep the order of earlier versions, so positional unpacking of
+    ``pos, ang, ...`` keeps working.
+    """
+
+    pos: NDArray[np.float64]
+    ang: NDArray[np.float64]
+    angvel: NDArray[np.float64]
+    vpoint: NDArray[np.float64]
+    corner_states: NDArray[np.int8]
+    energy: NDArray[np.float64]
+    status: int
+    n_filled: int
+    t_stop: float
+    stop_body: int
+    n_contacts: NDArray[np.int32]
+    slipping: NDArray[np.bool_]
+    overturn_time: NDArray[np.float64]
+    n_builds: int
+    max_pairs: int
+    n_tests: int
+
+
+def polygon_arrays(polygons: list[NDArray[np.float64]]) -> dict[str, NDArray]:
+    """Padded vertex, normal and edge-length arrays and the per-body tolerances.
+
+    Parameters
+    ----------
+    polygons
+        Convex polygons relative to their centroids, counter-clockwise, m.
+    """
+    nb = len(polygons)
+    maxv = max(len(p) for p in polygons)
     verts = np.zeros((nb, maxv, 2))
+    normals = np.zeros((nb, maxv, 2))
+    edge_len = np.ones((nb, maxv))
     nverts = np.zeros(nb, dtype=np.int64)
-    for i, b in enumerate(model.bodies):
-        n = len(b.contact_vertices_m)
-        verts[i, :n] = b.contact_vertices_m
+    radius = np.zeros(nb)
+    scale = np.zeros(nb)
+    feature_tol = np.zeros(nb)
+    for i, poly in enumerate(polygons):
+        p = np.asarray(poly, dtype=float)
+        n = len(p)
+        edges = np.roll(p, -1, axis=0) - p
+        length = np.hypot(edges[:, 0], edges[:, 1])
+        out = np.column_stack([edges[:, 1], -edges[:, 0]]) / length[:, None]  # outward for CCW
+        verts[i, :n] = p
+        normals[i, :n] = out
+        edge_len[i, :n] = length
         nverts[i] = n
-    radius = np.array([np.max(np.hypot(*b.contact_vertices_m.T)) for b in model.bodies]) * (1 + 1e-9)
-    if any(b.fixed for b in model.bodies):
-        raise InputError("blocks.fixed", "fixed blocks are not supported by this reference DEM kernel yet")
-    joint = [model.joints.params[int(j)] for j in model.joints.base_joint]
-    motion = model.motion
+        radius[i] = float(np.max(np.hypot(p[:, 0], p[:, 1]))) * (1 + 1e-9)
+        # smallest width of a convex polygon: over its edges, the depth of the farthest vertex
+        depth = np.einsum("evk,ek->ev", p[None, :, :] - p[:, None, :], out)  # (v - p_e) . n_e <= 0
+        scale[i] = float(np.min(-depth.min(axis=1)))
+        feature_tol[i] = FEATURE_TOL_REL * float(length.min())
     return {
-        "mass": np.array([b.mass_kg for b in model.bodies]),
-        "inertia": np.array([b.inertia_kgm2 for b in model.bodies]),
         "verts": verts,
+        "normals": normals,
+        "edge_len": edge_len,
         "nverts": nverts,
         "radius": radius,
-        "kn": np.array([j.K_N_per_m for j in joint]),
-        "ks": np.array([j.Ks_N_per_m for j in joint]),
-        "cn": np.array([j.beta_s * j.K_N_per_m for j in joint]),
-        "cs": np.array([j.beta_s * j.Ks_N_per_m for j in joint]),
-        "tanphi": np.array([math.tan(math.radians(j.friction_angle_deg)) for j in joint]),
+        "scale": scale,
+        "feature_tol": feature_tol,
+        "margin": MARGIN_REL * scale,
+    }
+
+
+def model_arrays(model: DemModel, stop_angle_rad: NDArray[np.float64] | None = None) -> dict[str, object]:
+    """The kernel's inputs for a model.
+
+    Parameters
+    ----------
+    stop_angle_rad
+        (nb,) |theta| at which each body counts as overturned; pi/2 by default (Housner's
+        criterion, as for column scenes).
+    """
+    bodies = model.bodies
+    nb = len(bodies)
+    table = model.joints
+    params = table.params
+    stop = np.full(nb, 0.5 * math.pi) if stop_angle_rad is None else np.asarray(stop_angle_rad, dtype=float)
+    moving = np.array([not b.fixed for b in bodies], dtype=bool)
+    stop = np.where(moving, stop, math.inf)
+    motion = model.motion
+    return {
+        "mass": np.array([b.mass_kg for b in bodies], dtype=float),
+        "inertia": np.array([b.inertia_kgm2 for b in bodies], dtype=float),
+        "moving": moving,
+        **polygon_arrays([b.contact_vertices_m for b in bodies]),
+        "kn": np.array([j.K_N_per_m for j in params], dtype=float),
+        "ks": np.array([j.Ks_N_per_m for j in params], dtype=float),
+        "cn": np.array([j.beta_s * j.K_N_per_m for j in params], dtype=float),
+        "cs": np.array([j.beta_s * j.Ks_N_per_m for j in params], dtype=float),
+        "tanphi": np.array([math.tan(math.radians(j.friction_angle_deg)) for j in params], dtype=float),
+        "base_joint": np.asarray(table.base_joint, dtype=np.int64),
+        "own_joint": np.asarray(table.own_joint, dtype=np.int64),
+        "pair_keys": np.asarray(table.pair_a, dtype=np.int64) * (nb + 1) + np.asarray(table.pair_b, dtype=np.int64),
+        "pair_joint": np.asarray(table.pair_joint, dtype=np.int64),
         "mass_damping": float(model.mass_damping_1_s),
         "pos0": model.pos0_m.astype(float),
         "ang0": model.ang0_rad.astype(float),
         "vel0": model.vel0_m_s.astype(float),
         "angvel0": model.angvel0_rad_s.astype(float),
-        "mt": np.zeros(0) if motion is None else motion.t_s,
-        "mah": np.zeros(0) if motion is None else motion.ah_m_s2,
-        "mav": np.zeros(0) if motion is None else motion.av_m_s2,
+        "rest_ang": np.array([b.rest_angle_rad for b in bodies], dtype=float),
+        "stop_angle": stop,
+        "mt": np.zeros(0) if motion is None else np.asarray(motion.t_s, dtype=float),
+        "mah": np.zeros(0) if motion is None else np.asarray(motion.ah_m_s2, dtype=float),
+        "mav": np.zeros(0) if motion is None else np.asarray(motion.av_m_s2, dtype=float),
         "g": float(model.g),
         "dt": float(model.dt_s),
         "n_steps": int(model.n_steps),
         "steps_per_sample": int(model.steps_per_sample),
-        "accel_points": np.array([b.accel_point_m for b in model.bodies], dtype=float),
+        "accel_points": np.array([b.accel_point_m for b in bodies], dtype=float),
     }
 
 
-def simulate_model(model: DemModel, record_energy: bool = True) -> tuple[tuple, float]:
+def simulate_model(
+    model: DemModel,
+    record_energy: bool = True,
+    *,
+    record_corners: bool = False,
+    stop_on_overturn: bool = True,
+    stop_angle_rad: NDArray[np.float64] | None = None,
+    coherent: bool = True,
+) -> tuple[KernelOutput, float]:
     """Run the kernel on a model; return its raw outputs and the kernel's wall time (s).
+
+    Parameters
+    ----------
+    record_energy
+        Record the energy terms.
+    record_corners
+        Record the contact state of every vertex (open, stick, slip).
+    stop_on_overturn
+        End the run when a moving body reaches its stop angle (column scenes); else only
+        record when each body first did (assemblies: a falling block does not end a wall's run).
+    stop_angle_rad
+        (nb,) stop angles, rad; pi/2 by default.
+    coherent
+        Keep each pair's separating-axis answer while the pair has not moved enough to
+        change it (False: test every candidate pair every step; same results, slower).
 
     The compiled kernel is loaded (or compiled) before the timer starts.
     """
-    args = model_arrays(model)
-    _warm_up(record_energy)
+    args = model_arrays(model, stop_angle_rad)
+    _warm_up()
     start = time.perf_counter()
-    out = kernel.simulate(**args, record_energy=record_energy)
-    return out, time.perf_counter() - start
+    out = kernel.simulate(
+        **args,
+        stop_on_overturn=bool(stop_on_overturn),
+        record_energy=bool(record_energy),
+        record_corners=bool(record_corners),
+        coherent=bool(coherent),
+    )
+    return KernelOutput(*out), time.perf_counter() - start
 
 
-_WARM: set[bool] = set()
+_WARM: list[bool] = []
 
 
-def _warm_up(record_energy: bool) -> None:
+def _warm_up() -> None:
     """Run the kernel once on a tiny problem so that its loading is not timed."""
-    if record_energy in _WARM:
+    if _WARM:
         return
-    _WARM.add(record_energy)
+    _WARM.append(True)
+    square = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
     one = np.ones(1)
-    verts = np.array([[[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]]])
+    zero = np.zeros(1)
     kernel.simulate(
-        one,
-        one,
-        verts,
-        np.array([4]),
-        one * 0.2,
-        one * 1e6,
-        one * 1e6,
-        one * 0.0,
-        one * 0.0,
-        one,
-        0.0,
-        np.array([[0.0, 0.1]]),
-        np.zeros(1),
-        np.zeros((1, 2)),
-        np.zeros(1),
-        np.zeros(0),
-        np.zeros(0),
-        np.zeros(0),
-        9.81,
-        1e-4,
-        2,
-        1,
-        np.zeros((1, 2)),
-        record_energy,
+        mass=one,
+        inertia=one,
+        moving=np.ones(1, dtype=bool),
+        **polygon_arrays([square]),
+        kn=one * 1e6,
+        ks=one * 1e6,
+        cn=zero,
+        cs=zero,
+        tanphi=one,
+        base_joint=np.zeros(1, dtype=np.int64),
+        own_joint=np.zeros(1, dtype=np.int64),
+        pair_keys=np.zeros(0, dtype=np.int64),
+        pair_joint=np.zeros(0, dtype=np.int64),
+        mass_damping=0.0,
+        pos0=np.array([[0.0, 0.1]]),
+        ang0=zero,
+        vel0=np.zeros((1, 2)),
+        angvel0=zero,
+        rest_ang=zero,
+        stop_angle=one,
+        stop_on_overturn=True,
+        mt=np.zeros(0),
+        mah=np.zeros(0),
+        mav=np.zeros(0),
+        g=9.81,
+        dt=1e-4,
+        n_steps=2,
+        steps_per_sample=1,
+        accel_points=np.zeros((1, 2)),
+        record_energy=True,
+        record_corners=True,
+        coherent=True,
     )

@@ -5,7 +5,9 @@ point and corner states, both DEM solvers build the same columns: ``t_s``, ``ag_
 per block ``theta_rad``, ``omega_rad_s``, ``x_m``, ``y_m`` (centroid displacement from
 rest), ``ax_m_s2``, ``ay_m_s2`` (absolute acceleration of the output point: mean over
 +/- one sample interval, the central difference of its velocity, plus the base
-acceleration; optionally low-passed) and ``c<i>_state`` (open / stick / slip).
+acceleration; optionally low-passed); optionally per block ``n_contacts`` (contact points on
+the block) and ``slipping`` (one of them slips), and per corner ``c<i>_state`` (open /
+stick / slip).
 """
 
 from __future__ import annotations
@@ -27,6 +29,9 @@ def dem_frame(
     vpoint: np.ndarray,
     states: np.ndarray | None,
     accel_lowpass_hz: float | None = None,
+    *,
+    n_contacts: np.ndarray | None = None,
+    slipping: np.ndarray | None = None,
 ) -> pd.DataFrame:
     """Result frame from sampled arrays.
 
@@ -42,6 +47,9 @@ def dem_frame(
         (n, nb, maxv) corner states 0 open, 1 stick, 2 slip; None to leave them out.
     accel_lowpass_hz
         Optional zero-phase low-pass of the accelerations.
+    n_contacts, slipping
+        (n, nb) contact points on each block and whether one of them slips; None to leave
+        them out.
     """
     n = pos.shape[0]
     names = model.names
@@ -64,6 +72,10 @@ def dem_frame(
 
                 acc = lowpass_zero_phase(acc, model.sample_dt_s, accel_lowpass_hz)
             data[column(body.name, q, names)] = acc
+    if n_contacts is not None and slipping is not None:
+        for i, body in enumerate(model.bodies):
+            data[column(body.name, "n_contacts", names)] = n_contacts[:, i].astype(np.int32)
+            data[column(body.name, "slipping", names)] = slipping[:, i].astype(bool)
     if states is not None:
         for i, body in enumerate(model.bodies):
             prefix = f"{body.name}_" if len(names) > 1 else ""
@@ -97,6 +109,8 @@ def energy_gain(model: DemModel, pos: np.ndarray, ang: np.ndarray, angvel: np.nd
     work = np.zeros(n)
     scale = 0.0
     for i, body in enumerate(model.bodies):
+        if body.fixed:
+            continue
         v = np.gradient(pos[:, i, :], dt, axis=0)
         rest_y = body.rest_centroid_m[1]
         energy += 0.5 * body.mass_kg * (v**2).sum(axis=1) + 0.5 * body.inertia_kgm2 * angvel[:, i] ** 2
@@ -104,6 +118,8 @@ def energy_gain(model: DemModel, pos: np.ndarray, ang: np.ndarray, angvel: np.nd
         power = -body.mass_kg * (ah * v[:, 0] + av * v[:, 1])
         work += np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * dt)])
         scale += body.mass_kg * model.g * rest_y  # weight times centroid height above the base
+    if scale <= 0.0:
+        return 0.0, None
     gain = (energy - energy[0] - work) / scale
     bad = np.nonzero(gain > ENERGY_GROWTH_LIMIT)[0]
     return float(np.nanmax(gain)), (float(t[bad[0]]) if bad.size else None)

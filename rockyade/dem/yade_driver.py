@@ -1,28 +1,37 @@
 """Run a rockyade DEM scene in YADE and write its time history (executed by YADE's Python).
 
-Usage: python3.11 run_scene.py SCENE.json RESULT.npz
+Usage::
 
-Runs inside Debian's /usr/bin/python3.11 with YADE's modules on the path; imports only the
-standard library, numpy and YADE (never the ``yade`` launcher, which opens a Python console
-and an XMLRPC server on all interfaces). The scene is data prepared by rockyade
-(``rockyade.solvers.yade.scene_payload``).
+    python3.11 yade_driver.py SCENE.json RESULT.npz    # how rockyade runs it
+    yade -x run.py                                     # a `rockyade yade-script` folder:
+    yade run.py                                        # scene.json beside run.py, writes
+                                                       # result.npz and result.csv there
+
+Runs inside Debian's /usr/bin/python3.11 with YADE's modules on the path and imports only
+the standard library, numpy and YADE. rockyade never uses the ``yade`` launcher, which
+opens a Python console and an XMLRPC server on all interfaces; a user may (it also gives
+the 3-D view). The scene is data prepared by rockyade (``rockyade.dem.yade_payload``):
+every contact decision (sphere places, copies, materials, masks) is in it.
 
 The model, as the reference DEM's:
 
-* each block is one clump: a small sphere at every contact vertex (tangent to the base
-  line at a base corner, to the top line at a top corner), thin Box slabs where another
-  block rests on it or it rests on another block, and a heavy non-colliding helper
-  sphere at the centroid so that the clump's centre of mass is the block's centroid; the
-  clump's mass and inertia are then set to the block's, with the inertia isotropic
-  (Izz, Izz, Izz) because with blocked rotations NewtonIntegrator divides the global torque
-  by the principal inertia of the clump's own frame;
-* planar motion: blockedDOFs = "zXY";
-* contacts: Law2_ScGeom_ViscElPhys_Basic with ViscElMat giving kn, ks, cn = beta kn,
-  cs = beta ks and the friction angle on the spheres, and all zeros on the base and the
-  slabs (Ip2 combines materials in series and skips zeros, so the sphere's values are
-  used exactly); collision masks keep spheres of different blocks apart;
+* each block is one clump: a small sphere at every contact vertex (one copy per joint it
+  needs, each with its own material and collision mask), a Polyhedra prism (the contact
+  polygon extruded in z) that the other blocks' vertex spheres meet, and a heavy
+  non-colliding helper sphere at the centroid so that the clump's centre of mass is the
+  block's centroid; the clump's mass and inertia are then set to the block's, the inertia
+  isotropic (Izz, Izz, Izz) because with blocked rotations NewtonIntegrator divides the
+  global torque by the principal inertia of the clump's own frame;
+* planar motion: blockedDOFs = "zXY"; a fixed block is a non-dynamic clump (it moves with
+  the base, i.e. not at all in the base frame);
+* contacts: sphere-prism (Ig2_Sphere_Polyhedra_ScGeom) and sphere-base
+  (Ig2_Box_Sphere_ScGeom) only, Law2_ScGeom_ViscElPhys_Basic with the sphere copy's
+  ViscElMat (kn, ks, cn = beta kn, cs = beta ks, friction angle) and zeros on prisms and
+  base (Ip2 combines materials in series and skips zeros, so the sphere's values are used
+  exactly);
 * the base is a fixed Box; the ground motion acts in the base frame as a force -M a_g(t)
-  on each clump (InterpolatingDirectedForceEngine, linear between samples, zero after);
+  on each moving clump (InterpolatingDirectedForceEngine, linear between samples, zero
+  after; one engine per distinct mass and direction);
 * NewtonIntegrator with damping 0 (its default is 0.2), gravity -g, O.dt as given;
 * a PyRunner *before* the other engines records every ``steps_per_sample`` steps, so the
   sample at step n sees x_n and t_n = n dt; rotation is measured as the z component of
@@ -39,15 +48,17 @@ import time
 import traceback
 
 YADE_PY = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
-sys.path.insert(1, YADE_PY)
+if YADE_PY not in sys.path:
+    sys.path.insert(1, YADE_PY)
 
 import numpy as np  # noqa: E402
 from yade import (  # noqa: E402
     Bo1_Box_Aabb,
+    Bo1_Polyhedra_Aabb,
     Bo1_Sphere_Aabb,
     ForceResetter,
     Ig2_Box_Sphere_ScGeom,
-    Ig2_Sphere_Sphere_ScGeom,
+    Ig2_Sphere_Polyhedra_ScGeom,
     InsertionSortCollider,
     InteractionLoop,
     InterpolatingDirectedForceEngine,
@@ -62,23 +73,24 @@ from yade import (  # noqa: E402
     utils,
 )
 
+SCENE_FORMAT = "rockyade-yade-scene-2"
 BASE_HALF_SIZE = 50.0
 HELPER_DENSITY = 1.0e15
+LIGHT_DENSITY = 1.0e-3
 # beyond these the state is a numerical blow-up, not rocking (as in the reference DEM)
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
-LIGHT_DENSITY = 1.0e-3
 
 
-def _material(joint, density):
-    if joint is None:
+def _material(values, density):
+    if values is None:  # prisms, base, helpers: zeros, skipped by Ip2's series combination
         return ViscElMat(kn=0.0, ks=0.0, cn=0.0, cs=0.0, frictionAngle=math.pi / 2 - 1e-9, density=density)
     return ViscElMat(
-        kn=joint["kn"],
-        ks=joint["ks"],
-        cn=joint["cn"],
-        cs=joint["cs"],
-        frictionAngle=joint["friction_angle_rad"],
+        kn=values["kn"],
+        ks=values["ks"],
+        cn=values["cn"],
+        cs=values["cs"],
+        frictionAngle=values["friction_angle_rad"],
         density=density,
     )
 
@@ -89,64 +101,59 @@ def _rotate(v, angle):
 
 
 def build(scene):
+    """Build the scene in O; return the clumps' bookkeeping."""
+    if scene.get("format") != SCENE_FORMAT:
+        raise ValueError(f"scene data format {scene.get('format')!r}, expected {SCENE_FORMAT!r}")
     O.reset()
     O.dt = scene["dt_s"]
-    bodies = scene["bodies"]
-    nb = len(bodies)
-    r = scene["sphere_radius_m"]
-    sphere_bit = [1 << (i + 1) for i in range(nb)]
-    all_spheres = sum(sphere_bit)
-    zero_mat = O.materials.append(_material(None, LIGHT_DENSITY))
+    inert = O.materials.append(_material(None, LIGHT_DENSITY))
     helper_mat = O.materials.append(_material(None, HELPER_DENSITY))
-    base_id = O.bodies.append(
+    sphere_mats = [O.materials.append(_material(m, LIGHT_DENSITY)) for m in scene["materials"]]
+    O.bodies.append(
         utils.box(
             center=(0, -0.5, 0),
             extents=(BASE_HALF_SIZE, 0.5, BASE_HALF_SIZE),
             fixed=True,
-            material=O.materials[zero_mat],
-            mask=all_spheres,
+            material=O.materials[inert],
+            mask=scene["base_mask"],
         )
     )
     clumps = []
-    for i, b in enumerate(bodies):
-        c0 = b["centroid0_m"]
-        a0 = b["angle0_rad"]
-        mat_below = O.materials.append(_material(b["joint_below"], LIGHT_DENSITY))
-        mat_above = O.materials.append(_material(b["joint_above"], LIGHT_DENSITY)) if b["joint_above"] else mat_below
-        members = []
-        vertex_ids = []
-        for (vx, vy), role in zip(b["vertices_m"], b["vertex_roles"], strict=False):
-            if role == "base":
-                cx, cy = vx, vy + r
-            elif role == "top":
-                cx, cy = vx, vy - r
-            else:
-                norm = math.hypot(vx, vy)
-                cx, cy = vx - r * vx / norm, vy - r * vy / norm
+    for b in scene["bodies"]:
+        c0, a0 = b["centroid0_m"], b["angle0_rad"]
+        r = b["sphere_radius_m"]
+        members, vertex_members = [], []
+        for (cx, cy), copies in zip(b["sphere_centers_m"], b["sphere_copies"], strict=True):
             wx, wy = _rotate((cx, cy), a0)
-            sph = utils.sphere(
-                (c0[0] + wx, c0[1] + wy, 0.0),
-                r,
-                material=O.materials[mat_above if role == "top" else mat_below],
-                mask=sphere_bit[i],
+            start = len(members)
+            for material, mask in copies:
+                members.append(
+                    utils.sphere(
+                        (c0[0] + wx, c0[1] + wy, 0.0), r, material=O.materials[sphere_mats[material]], mask=mask
+                    )
+                )
+            vertex_members.append((start, len(members)))
+        hz = b["prism_half_thickness_m"]
+        box = b.get("prism_box")
+        if box:  # a rectangle: a Box (cheaper contact, robust however deep a sphere goes)
+            wx, wy = _rotate(box["center_m"], a0)
+            members.append(
+                utils.box(
+                    center=(c0[0] + wx, c0[1] + wy, 0.0),
+                    extents=(box["half_extents_m"][0], box["half_extents_m"][1], hz),
+                    orientation=Quaternion(Vector3(0, 0, 1), a0 + box["angle_rad"]),
+                    material=O.materials[inert],
+                    mask=b["prism_mask"],
+                )
             )
-            members.append(sph)
-        helper = utils.sphere((c0[0], c0[1], 0.0), r, material=O.materials[helper_mat], mask=0)
-        members.append(helper)
-        thickness = b["thickness_m"]
-        for slab in b["slabs"]:
-            (sx, sy), (hx, hy) = slab["center_m"], slab["half_extents_m"]
-            wx, wy = _rotate((sx, sy), a0)
-            box = utils.box(
-                center=(c0[0] + wx, c0[1] + wy, 0.0),
-                extents=(hx, hy, 0.5 * thickness),
-                orientation=Quaternion(Vector3(0, 0, 1), a0),
-                material=O.materials[zero_mat],
-                mask=slab["mask_bits"] and sum(sphere_bit[j] for j in slab["mask_bits"]),
-            )
-            members.append(box)
+        else:
+            corners = []
+            for vx, vy in b["vertices_m"]:
+                wx, wy = _rotate((vx, vy), a0)
+                corners += [Vector3(c0[0] + wx, c0[1] + wy, -hz), Vector3(c0[0] + wx, c0[1] + wy, hz)]
+            members.append(utils.polyhedron(corners, material=O.materials[inert], mask=b["prism_mask"]))
+        members.append(utils.sphere((c0[0], c0[1], 0.0), r, material=O.materials[helper_mat], mask=0))
         clump_id, member_ids = O.bodies.appendClumped(members)
-        vertex_ids = member_ids[: len(b["vertices_m"])]
         state = O.bodies[clump_id].state
         offset = (state.pos[0] - c0[0], state.pos[1] - c0[1])
         if math.hypot(*offset) > 1e-6 * max(1.0, math.hypot(*c0)):
@@ -154,25 +161,34 @@ def build(scene):
         state.mass = b["mass_kg"]
         inertia = b["inertia_kgm2"]
         state.inertia = Vector3(inertia, inertia, inertia)
-        state.blockedDOFs = "zXY"
-        state.vel = Vector3(b["vel0_m_s"][0], b["vel0_m_s"][1], 0.0)
-        state.angVel = Vector3(0.0, 0.0, b["angvel0_rad_s"])
+        if b["fixed"]:
+            O.bodies[clump_id].dynamic = False
+            state.vel = Vector3(0, 0, 0)
+            state.angVel = Vector3(0, 0, 0)
+        else:
+            state.blockedDOFs = "zXY"
+            state.vel = Vector3(b["vel0_m_s"][0], b["vel0_m_s"][1], 0.0)
+            state.angVel = Vector3(0.0, 0.0, b["angvel0_rad_s"])
         clumps.append(
             {
                 "id": clump_id,
-                "vertex_ids": vertex_ids,
-                "ori0": Quaternion(state.ori),
+                "fixed": b["fixed"],
+                "vertex_ids": [member_ids[s:e] for s, e in vertex_members],
+                "ori0": state.ori.conjugate(),
                 "angle0": a0,
-                "rest": b["rest_centroid_m"],
+                "rest": b["rest_angle_rad"],
                 "point": b["accel_point_m"],
                 "mass": b["mass_kg"],
-                "tanphi": math.tan(b["joint_below"]["friction_angle_rad"]),
+                "radius": r,
+                "prism": member_ids[len(members) - 2],
+                "prism_is_polyhedra": not box,
             }
         )
-    return base_id, clumps
+    return clumps
 
 
 def ground_engines(scene, clumps):
+    """Base motion as forces -M a_g(t) on the moving clumps, one engine per mass and direction."""
     motion = scene["motion"]
     if motion is None:
         return []
@@ -180,19 +196,21 @@ def ground_engines(scene, clumps):
     engines = []
     # zero after the last sample (the reference DEM's convention), and before the first
     times = [t[0] - 1.0, *t, t[-1] + 1e-09, t[-1] + 1000000000.0]
+    by_mass = {}
+    for c in clumps:
+        if not c["fixed"]:
+            by_mass.setdefault(c["mass"], []).append(c["id"])
     for key, direction in (("ah_m_s2", Vector3(1, 0, 0)), ("av_m_s2", Vector3(0, 1, 0))):
         values = list(motion[key])
         if not any(values):
             continue
-        for c in clumps:
-            mags = [0.0] + [-c["mass"] * a for a in values] + [0.0, 0.0]
-            engines.append(
-                InterpolatingDirectedForceEngine(ids=[c["id"]], times=times, magnitudes=mags, direction=direction)
-            )
+        for mass, ids in by_mass.items():
+            mags = [0.0] + [-mass * a for a in values] + [0.0, 0.0]
+            engines.append(InterpolatingDirectedForceEngine(ids=ids, times=times, magnitudes=mags, direction=direction))
     return engines
 
 
-def _describe(scene, clumps):
+def _describe(clumps):
     """What was built: for tests of the YADE pitfalls (no simulation is run)."""
     newton = next(e for e in O.engines if type(e).__name__ == "NewtonIntegrator")
     runner = O.engines[0]
@@ -228,9 +246,10 @@ def _describe(scene, clumps):
                 "mass": body.state.mass,
                 "inertia": list(body.state.inertia),
                 "blocked": body.state.blockedDOFs,
+                "dynamic": body.dynamic,
                 "pos": list(body.state.pos),
                 "members": members,
-                "vertex_ids": list(c["vertex_ids"]),
+                "vertex_ids": [list(ids) for ids in c["vertex_ids"]],
             }
         )
     base = O.bodies[0]
@@ -243,112 +262,221 @@ def _describe(scene, clumps):
     return out
 
 
-def main(scene_path, out_path, describe=False):
-    with open(scene_path) as fh:
-        scene = json.load(fh)
-    start_build = time.perf_counter()
-    _base_id, clumps = build(scene)
-    nb = len(clumps)
-    ns = scene["n_samples"]
-    maxv = max(len(b["vertices_m"]) for b in scene["bodies"])
-    rec = {
-        "pos": np.full((ns, nb, 2), np.nan),
-        "ang": np.full((ns, nb), np.nan),
-        "angvel": np.full((ns, nb), np.nan),
-        "vpoint": np.full((ns, nb, 2), np.nan),
-        "fn": np.zeros((ns, nb, maxv)),
-        "state": np.zeros((ns, nb, maxv), dtype=np.int8),
-    }
-    info = {"k": 0, "status": "completed", "stop_time": None, "stop_body": None}
-    half_pi = 0.5 * math.pi
+class Recorder:
+    """Samples the state every ``steps_per_sample`` steps; writes the output when done."""
 
-    def record():
-        k = info["k"]
-        if k >= ns:
+    def __init__(self, scene, clumps, out_path, csv_path=None):
+        nb = len(clumps)
+        ns = scene["n_samples"]
+        maxv = max(len(b["vertices_m"]) for b in scene["bodies"])
+        self.scene, self.clumps, self.ns = scene, clumps, ns
+        self.out_path, self.csv_path = out_path, csv_path
+        self.rec = {
+            "pos": np.full((ns, nb, 2), np.nan),
+            "ang": np.full((ns, nb), np.nan),
+            "angvel": np.full((ns, nb), np.nan),
+            "vpoint": np.full((ns, nb, 2), np.nan),
+            "fn": np.zeros((ns, nb, maxv)),
+            "state": np.zeros((ns, nb, maxv), dtype=np.int8),
+        }
+        self.k = 0
+        self.status, self.stop_time, self.stop_body = "completed", None, None
+        self.max_depth_ratio = 0.0
+        self.polyhedra = {c["prism"] for c in clumps if c["prism_is_polyhedra"]}
+        self.vertex_of = {
+            sid: (i, v, c["radius"])
+            for i, c in enumerate(clumps)
+            for v, ids in enumerate(c["vertex_ids"])
+            for sid in ids
+        }
+        self.start = time.perf_counter()
+        self.written = False
+        self.wait = True
+
+    def __call__(self):
+        k = self.k
+        if k >= self.ns or self.written:
             return
-        for i, c in enumerate(clumps):
+        rec = self.rec
+        for i, c in enumerate(self.clumps):
             st = O.bodies[c["id"]].state
-            q = st.ori * c["ori0"].conjugate()
-            axis, angle = q.toAxisAngle()
+            axis, angle = (st.ori * c["ori0"]).toAxisAngle()
             theta = c["angle0"] + angle * axis[2]
             x, y = st.pos[0], st.pos[1]
             w = st.angVel[2]
             finite = math.isfinite(x) and math.isfinite(y) and math.isfinite(theta)
             if not finite or st.vel.norm() > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
-                info["status"], info["stop_time"], info["stop_body"] = "failed", O.time, i
-                O.pause()
+                self.status, self.stop_time, self.stop_body = "failed", O.time, i
+                self.stop()
                 return
             rec["pos"][k, i] = (x, y)
             rec["ang"][k, i] = theta
             rec["angvel"][k, i] = w
             px, py = _rotate(c["point"], theta)
             rec["vpoint"][k, i] = (st.vel[0] - w * py, st.vel[1] + w * px)
-            for v, sid in enumerate(c["vertex_ids"]):
-                total_fn, state = 0.0, 0
-                for inter in O.interactions.withBody(sid):
-                    if not inter.isReal:
-                        continue
-                    fn = inter.phys.normalForce.norm()
-                    fs = inter.phys.shearForce.norm()
-                    total_fn += fn
-                    s = 2 if fn > 0 and fs >= 0.9999 * fn * c["tanphi"] else 1
-                    state = max(state, s)
-                rec["fn"][k, i, v] = total_fn
-                rec["state"][k, i, v] = state
-            if abs(theta) >= half_pi and info["status"] == "completed":
-                info["status"], info["stop_time"], info["stop_body"] = "overturned", O.time, i
-        info["k"] = k + 1
-        if info["status"] != "completed" or info["k"] >= ns:
-            O.pause()
+            if not c["fixed"] and abs(theta - c["rest"]) >= 0.5 * math.pi and self.status == "completed":
+                self.status, self.stop_time, self.stop_body = "overturned", O.time, i
+        self.contact_forces(k)
+        self.k = k + 1
+        if self.status != "completed" or self.k >= self.ns:
+            self.stop()
 
-    recorder = PyRunner(command="record_hook()", iterPeriod=scene["steps_per_sample"], initRun=True)
-    globals()["record_hook"] = record
+    def contact_forces(self, k):
+        """Normal force and state (1 stick, 2 slip) at each vertex: its copies' real contacts.
+
+        Also the deepest penetration seen against a Polyhedra prism, in sphere radii: at one
+        radius the sphere's centre is inside the prism and YADE's contact loses its normal."""
+        fn_k, state_k = self.rec["fn"][k], self.rec["state"][k]
+        vertex_of, polyhedra = self.vertex_of, self.polyhedra
+        for inter in O.interactions:
+            if not inter.isReal:
+                continue
+            id1, id2 = inter.id1, inter.id2
+            where = vertex_of.get(id1)
+            other = id2
+            if where is None:
+                where, other = vertex_of.get(id2), id1
+                if where is None:
+                    continue
+            i, v, radius = where
+            phys = inter.phys
+            fn = phys.normalForce.norm()
+            if fn <= 0.0:
+                continue
+            fn_k[i, v] += fn
+            s = 2 if phys.shearForce.norm() >= 0.9999 * fn * phys.tangensOfFrictionAngle else 1
+            if s > state_k[i, v]:
+                state_k[i, v] = s
+            if other in polyhedra:
+                depth = inter.geom.penetrationDepth / radius
+                if depth > self.max_depth_ratio:
+                    self.max_depth_ratio = depth
+
+    def stop(self):
+        """End of the run seen from inside it: pause, and write now unless the caller waits."""
+        O.pause()
+        if not self.wait:
+            self.write()
+
+    def write(self):
+        """Write the output (once)."""
+        if self.written:
+            return
+        self.written = True
+        n = self.k
+        meta = {
+            "status": self.status,
+            "stop_time_s": self.stop_time,
+            "stop_body": self.stop_body,
+            "n_filled": n,
+            "iterations": O.iter,
+            "wall_time_s": time.perf_counter() - self.start,
+            "build_time_s": self.scene.get("_build_time_s"),
+            "yade_version": __import__("yade.config", fromlist=["version"]).version,
+            "dt_s": O.dt,
+            "max_polyhedra_penetration_over_radius": self.max_depth_ratio,
+            "complete": True,
+        }
+        tmp = self.out_path + ".part"
+        with open(tmp, "wb") as fh:
+            np.savez(fh, **{k: v[:n] for k, v in self.rec.items()}, meta=np.array(json.dumps(meta)))
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, self.out_path)
+        if self.csv_path:
+            self.write_csv(n)
+
+    def write_csv(self, n):
+        """A plain table for hand work: t, and per block x, y (centroid) and theta (from rest)."""
+        names = [b["name"] for b in self.scene["bodies"]]
+        rest = [b["rest_angle_rad"] for b in self.scene["bodies"]]
+        header = ["t_s"]
+        for name in names:
+            header += [f"{name}_x_m", f"{name}_y_m", f"{name}_rotation_rad"]
+        t = np.arange(n) * self.scene["dt_s"] * self.scene["steps_per_sample"]
+        cols = [t]
+        for i in range(len(names)):
+            cols += [self.rec["pos"][:n, i, 0], self.rec["pos"][:n, i, 1], self.rec["ang"][:n, i] - rest[i]]
+        tmp = self.csv_path + ".part"
+        np.savetxt(tmp, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
+        os.replace(tmp, self.csv_path)
+
+
+def prepare(scene, out_path, csv_path=None):
+    """Build the scene and its engines; return the recorder."""
+    start = time.perf_counter()
+    clumps = build(scene)
+    recorder = Recorder(scene, clumps, out_path, csv_path)
+    globals()["rockyade_record"] = recorder
     O.engines = [
-        recorder,
+        PyRunner(command="rockyade_record()", iterPeriod=scene["steps_per_sample"], initRun=True),
         ForceResetter(),
-        InsertionSortCollider([Bo1_Sphere_Aabb(), Bo1_Box_Aabb()], verletDist=0.2 * scene["sphere_radius_m"]),
+        InsertionSortCollider(
+            [Bo1_Sphere_Aabb(), Bo1_Box_Aabb(), Bo1_Polyhedra_Aabb()], verletDist=0.2 * scene["min_sphere_radius_m"]
+        ),
         InteractionLoop(
-            [Ig2_Sphere_Sphere_ScGeom(), Ig2_Box_Sphere_ScGeom()],
+            [Ig2_Sphere_Polyhedra_ScGeom(), Ig2_Box_Sphere_ScGeom()],
             [Ip2_ViscElMat_ViscElMat_ViscElPhys()],
             [Law2_ScGeom_ViscElPhys_Basic()],
         ),
         *ground_engines(scene, clumps),
         NewtonIntegrator(damping=0.0, gravity=Vector3(0.0, -scene["g"], 0.0)),
     ]
-    build_time = time.perf_counter() - start_build
+    scene["_build_time_s"] = time.perf_counter() - start
+    return recorder, clumps
+
+
+def main(scene_path, out_path, csv_path=None, describe=False, wait=True):
+    with open(scene_path) as fh:
+        scene = json.load(fh)
+    recorder, clumps = prepare(scene, out_path, csv_path)
     if describe:
-        print(json.dumps(_describe(scene, clumps)))
+        print(json.dumps(_describe(clumps)))
         return
-    start = time.perf_counter()
-    O.run(scene["n_steps"] + 1, True)
-    wall = time.perf_counter() - start
-    n = info["k"]
-    meta = {
-        "status": info["status"],
-        "stop_time_s": info["stop_time"],
-        "stop_body": info["stop_body"],
-        "n_filled": n,
-        "iterations": O.iter,
-        "wall_time_s": wall,
-        "build_time_s": build_time,
-        "yade_version": __import__("yade.config", fromlist=["version"]).version,
-        "dt_s": O.dt,
-        "complete": True,
-    }
-    tmp = out_path + ".part"
-    with open(tmp, "wb") as fh:
-        np.savez(fh, **{k: v[:n] for k, v in rec.items()}, meta=np.array(json.dumps(meta)))
-        fh.flush()
-        os.fsync(fh.fileno())
-    os.replace(tmp, out_path)
+    recorder.wait = wait
+    recorder.start = time.perf_counter()
+    O.run(scene["n_steps"] + 1, wait)
+    if wait:
+        recorder.write()
+        if csv_path:
+            print(f"{recorder.status}: wrote {out_path} and {csv_path}")
+
+
+def _interactive_launcher():
+    """True under ``yade run.py`` (the launcher's console stays open: do not block it)."""
+    runtime = sys.modules.get("yade.runtime")
+    opts = getattr(runtime, "opts", None)
+    return opts is not None and not getattr(opts, "exitAfter", True)
+
+
+def _exit(code):
+    """Leave at once: YADE's simulation thread, cancelled by the interpreter's normal exit,
+    sometimes aborts the process ("exception not rethrown") after the output is written."""
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
 
 
 if __name__ == "__main__":
+    launcher = "yade.runtime" in sys.modules and hasattr(sys.modules["yade.runtime"], "opts")
     try:
-        if sys.argv[1] == "--describe":
-            main(sys.argv[2], None, describe=True)
-        else:
-            main(sys.argv[1], sys.argv[2])
+        args = sys.argv[1:]
+        if args and args[0] == "--describe":
+            main(args[1], None, describe=True)
+        elif len(args) >= 2:
+            main(args[0], args[1])
+        else:  # a yade-script folder: the data beside this script, the output there too
+            here = os.path.dirname(os.path.abspath(sys.argv[0]))
+            main(
+                os.path.join(here, "scene.json"),
+                os.path.join(here, "result.npz"),
+                os.path.join(here, "result.csv"),
+                wait=not _interactive_launcher(),
+            )
     except Exception:
         traceback.print_exc()
-        sys.exit(1)
+        if not launcher:
+            _exit(1)
+        raise
+    if not launcher:
+        _exit(0)

@@ -1,6 +1,8 @@
 """A DEM model as the JSON data the YADE driver (:mod:`rockyade.dem.yade_driver`) reads.
 
-Scenes are data, never code: no value is pasted into Python source for YADE.
+Scenes are data, never code: no value is pasted into Python source for YADE. Everything
+about the contacts (sphere centres, their copies, materials and collision masks) is decided
+here (:mod:`rockyade.dem.yade_contacts`); the driver only builds what the data says.
 """
 
 from __future__ import annotations
@@ -9,102 +11,111 @@ import math
 
 import numpy as np
 
-from rockyade.blocks.geometry import LEVEL_TOL
 from rockyade.dem.model import DemModel
-from rockyade.errors import InputError
+from rockyade.dem.yade_contacts import BASE_BIT, plan_contacts
 
-#: Radius of the vertex spheres as a fraction of the smallest block dimension.
+#: Radius of the vertex spheres: at least this fraction of the largest of the moving
+#: blocks' smallest dimensions ...
 SPHERE_RADIUS_FRACTION = 1e-3
-#: Thickness of the contact slabs as a fraction of the block height.
-SLAB_FRACTION = 0.05
-MAX_BLOCKS = 30
+#: ... and at least the penetration of the heaviest block hitting the softest joint at this
+#: speed, v sqrt(M / K) (a contact breaks when it penetrates deeper than the sphere's
+#: radius: YADE's sphere-polyhedron contact then loses its normal) ...
+IMPACT_SPEED_M_S = 0.5
+#: ... but at most this fraction of that dimension (the spheres round the corners).
+SPHERE_RADIUS_MAX_FRACTION = 1e-2
+#: Half thickness (z) of the prisms as a fraction of the block size (contacts are at z = 0).
+PRISM_HALF_THICKNESS_FRACTION = 0.05
+FORMAT = "rockyade-yade-scene-2"
 
 
+def sphere_radii(model: DemModel) -> np.ndarray:
+    """Radius of each body's vertex spheres, m (see SPHERE_RADIUS_FRACTION): the same for all,
+    from the moving blocks (a large fixed abutment does not round the small blocks)."""
+    moving = [b for b in model.bodies if not b.fixed]
+    size = max(float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in moving)
+    k_min = min(p.K_N_per_m for p in model.joints.params)
+    impact = IMPACT_SPEED_M_S * math.sqrt(max(b.mass_kg for b in moving) / k_min)
+    radius = min(max(SPHERE_RADIUS_FRACTION * size, impact), SPHERE_RADIUS_MAX_FRACTION * size)
+    return np.full(len(model.bodies), radius)
 
-def _roles(vertices: np.ndarray) -> list[str]:
-    y = vertices[:, 1]
-    tol = LEVEL_TOL * max(float(np.ptp(y)), 1.0) * 10
-    return ["base" if v <= y.min() + tol else "top" if v >= y.max() - tol else "side" for v in y]
+
+def rectangle(vertices: np.ndarray, tol: float = 1e-9) -> dict[str, object] | None:
+    """A rectangular contact polygon as a box (centre, half sides, angle of its first edge
+    in the body frame), or None. YADE's Box-Sphere contact is several times cheaper than its
+    Polyhedra-Sphere contact and keeps its normal however deep a sphere goes."""
+    if len(vertices) != 4:
+        return None
+    edges = np.roll(vertices, -1, axis=0) - vertices
+    lengths = np.hypot(edges[:, 0], edges[:, 1])
+    scale = float(lengths.max())
+    if np.any(np.abs(edges[0] + edges[2]) > tol * scale) or np.any(np.abs(edges[1] + edges[3]) > tol * scale):
+        return None
+    if abs(float(edges[0] @ edges[1])) > tol * scale * scale:
+        return None
+    return {
+        "center_m": vertices.mean(axis=0).tolist(),
+        "half_extents_m": [float(lengths[0]) / 2, float(lengths[1]) / 2],
+        "angle_rad": math.atan2(float(edges[0, 1]), float(edges[0, 0])),
+    }
 
 
 def scene_payload(model: DemModel) -> dict[str, object]:
     """The DEM model as the JSON data the YADE driver reads."""
-    nb = len(model.bodies)
-    if nb > MAX_BLOCKS:
-        raise InputError(
-            "blocks", f"the YADE backend takes at most {MAX_BLOCKS} blocks (collision mask bits), got {nb}"
+    radii = sphere_radii(model)
+    plan = plan_contacts(model, radii)
+    params = model.joints.params
+    materials = []
+    for v in plan.variants:
+        j = params[v.joint]
+        materials.append(
+            {
+                "kn": v.factor * j.K_N_per_m,
+                "ks": v.factor * j.Ks_N_per_m,
+                "cn": v.factor * j.beta_s * j.K_N_per_m,
+                "cs": v.factor * j.beta_s * j.Ks_N_per_m,
+                "friction_angle_rad": math.radians(j.friction_angle_deg),
+                "joint": v.joint,
+                "factor": v.factor,
+            }
         )
-    sizes = [float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies]
-    radius = SPHERE_RADIUS_FRACTION * min(sizes)
-
-    if any(b.fixed for b in model.bodies) or model.joints.n_pairs > nb - 1:
-        raise InputError("blocks", "the YADE backend runs single columns only (no fixed or side-by-side blocks)")
-
-    def joint(i: int) -> dict[str, float]:
-        j = model.joints.params[int(model.joints.base_joint[i])]
-        return {
-            "kn": j.K_N_per_m,
-            "ks": j.Ks_N_per_m,
-            "cn": j.beta_s * j.K_N_per_m,
-            "cs": j.beta_s * j.Ks_N_per_m,
-            "friction_angle_rad": math.radians(j.friction_angle_deg),
-        }
-
     bodies = []
     for i, b in enumerate(model.bodies):
-        verts = b.contact_vertices_m
-        roles = _roles(verts)
-        height = float(np.ptp(verts[:, 1]))
-        s = SLAB_FRACTION * height
-        slabs = []
-        if i + 1 < nb:  # a block rests on this one: its top face
-            top = verts[[r == "top" for r in roles]]
-            slabs.append(
-                {
-                    "center_m": [float(top[:, 0].mean()), float(verts[:, 1].max() - s / 2)],
-                    "half_extents_m": [float(np.ptp(top[:, 0]) / 2), s / 2],
-                    "mask_bits": [i + 1],
-                }
-            )
-        if i > 0:  # this block rests on another: its base face
-            base = verts[[r == "base" for r in roles]]
-            slabs.append(
-                {
-                    "center_m": [float(base[:, 0].mean()), float(verts[:, 1].min() + s / 2)],
-                    "half_extents_m": [float(np.ptp(base[:, 0]) / 2), s / 2],
-                    "mask_bits": [i - 1],
-                }
-            )
+        size = float(np.max(np.ptp(b.contact_vertices_m, axis=0)))
         bodies.append(
             {
                 "name": b.name,
+                "fixed": bool(b.fixed),
                 "mass_kg": b.mass_kg,
                 "inertia_kgm2": b.inertia_kgm2,
-                "vertices_m": verts.tolist(),
-                "vertex_roles": roles,
+                "vertices_m": b.contact_vertices_m.tolist(),
+                "sphere_centers_m": plan.centers_m[i].tolist(),
+                "sphere_copies": [[list(c) for c in vertex] for vertex in plan.copies[i]],
+                "prism_mask": plan.prism_mask(i),
+                "prism_box": rectangle(b.contact_vertices_m),
+                "sphere_radius_m": float(radii[i]),
+                "prism_half_thickness_m": max(PRISM_HALF_THICKNESS_FRACTION * size, 5 * float(radii[i])),
                 "centroid0_m": model.pos0_m[i].tolist(),
-                "rest_centroid_m": list(b.rest_centroid_m),
                 "angle0_rad": float(model.ang0_rad[i]),
+                "rest_angle_rad": b.rest_angle_rad,
                 "vel0_m_s": model.vel0_m_s[i].tolist(),
                 "angvel0_rad_s": float(model.angvel0_rad_s[i]),
                 "accel_point_m": list(b.accel_point_m),
-                "joint_below": joint(i),
-                "joint_above": joint(i + 1) if i + 1 < nb else None,
-                "thickness_m": max(0.1 * height, 10 * radius),
-                "slabs": slabs,
             }
         )
     motion = model.motion
     return {
-        "format": "rockyade-yade-scene-1",
+        "format": FORMAT,
         "scene_hash": model.scene_hash,
         "dt_s": model.dt_s,
         "n_steps": model.n_steps,
         "steps_per_sample": model.steps_per_sample,
         "n_samples": model.n_samples,
         "g": model.g,
-        "sphere_radius_m": radius,
+        "min_sphere_radius_m": float(radii.min()),
+        "base_mask": BASE_BIT,
+        "materials": materials,
         "bodies": bodies,
+        "contact_plan": plan.report,
         "motion": None
         if motion is None
         else {"t_s": motion.t_s.tolist(), "ah_m_s2": motion.ah_m_s2.tolist(), "av_m_s2": motion.av_m_s2.tolist()},

@@ -1,7 +1,13 @@
-"""Atomic file writing: a failed run never leaves a half-written file that looks complete.
+"""Atomic file writing: a failed or killed run never leaves a half-written file that looks
+complete, and never leaves its temporary files behind when it fails.
 
-Every writer goes to a temporary file in the destination directory, flushes and fsyncs it,
-then renames it over the destination (``os.replace`` is atomic on POSIX filesystems).
+Every writer goes to a temporary file ``.<name>.<random>.tmp`` in the destination
+directory, flushes and fsyncs it, gives it the permissions the umask allows (as ``open``
+would: ``0o666 & ~umask``; ``mkstemp`` alone makes 0600), then renames it over the
+destination (``os.replace`` is atomic on POSIX filesystems) and fsyncs the directory. On
+any failure (a full disk, Ctrl-C) the temporary file is removed. A process killed with
+SIGKILL may leave one behind: :func:`remove_stale_temporaries` clears a directory that
+the caller holds the lock of (:mod:`rockyade.io.locking`).
 """
 
 from __future__ import annotations
@@ -13,6 +19,54 @@ import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
+
+#: Suffix of every temporary file written here.
+TEMP_SUFFIX = ".tmp"
+
+
+def current_umask() -> int:
+    """The process umask, read without changing it (Linux ``/proc``), else by set-and-restore."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError):
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def file_mode() -> int:
+    """Permissions of a new file under the current umask (``0o666 & ~umask``)."""
+    return 0o666 & ~current_umask()
+
+
+@contextlib.contextmanager
+def staged_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[tuple[IO[Any], Path]]:
+    """A complete, fsynced temporary file beside ``path`` that the caller renames itself.
+
+    Yields ``(file, temporary_path)``; on success the file is closed with the umask's
+    permissions and left in place for the caller to ``os.replace``; on failure it is removed.
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError(f"mode must be 'w' or 'wb', not {mode!r}")
+    dest = Path(path)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=TEMP_SUFFIX, dir=dest.parent)
+    tmp = Path(tmp_name)
+    try:
+        binary = "b" in mode
+        with os.fdopen(fd, mode, encoding=None if binary else "utf-8", newline=None if binary else "") as fh:
+            yield fh, tmp
+            fh.flush()
+            os.fchmod(fh.fileno(), file_mode())
+            os.fsync(fh.fileno())
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
 
 
 @contextlib.contextmanager
@@ -26,22 +80,39 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
     mode
         ``"w"`` (text, UTF-8) or ``"wb"`` (binary).
     """
-    if mode not in ("w", "wb"):
-        raise ValueError(f"mode must be 'w' or 'wb', not {mode!r}")
     dest = Path(path)
-    dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
+    with staged_file(dest, mode) as (fh, tmp):
+        yield fh
     try:
-        encoding = None if "b" in mode else "utf-8"
-        with os.fdopen(fd, mode, encoding=encoding, newline=None if "b" in mode else "") as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
         os.replace(tmp, dest)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
-            os.unlink(tmp)
+            tmp.unlink()
         raise
+    fsync_dir(dest.parent)
+
+
+def fsync_dir(directory: str | os.PathLike[str]) -> None:
+    """Make renames in ``directory`` durable (best effort: some filesystems refuse)."""
+    with contextlib.suppress(OSError):
+        fd = os.open(directory, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
+    """Remove the temporary files a killed writer left in ``directory``; return them.
+
+    Only call this while holding the directory's lock (no other writer is active there).
+    """
+    removed = []
+    for path in Path(directory).glob(f".*{TEMP_SUFFIX}"):
+        with contextlib.suppress(FileNotFoundError):
+            path.unlink()
+            removed.append(path)
+    return removed
 
 
 def write_text(path: str | os.PathLike[str], text: str) -> None:
@@ -52,7 +123,7 @@ def write_text(path: str | os.PathLike[str], text: str) -> None:
 
 def write_json(path: str | os.PathLike[str], data: Any) -> None:
     """Write ``data`` as indented JSON to ``path`` atomically."""
-    write_text(path, json.dumps(data, indent=2, sort_keys=True, default=_json_default) + "\n")
+    write_text(path, json_text(data) + "\n")
 
 
 def json_text(data: Any) -> str:

@@ -22,6 +22,10 @@ from scipy.integrate import cumulative_trapezoid
 
 from rockyade.errors import InputError
 
+#: Lowest corner of a Butterworth filter, as a fraction of the Nyquist frequency: below
+#: it the digital filter's poles sit within rounding of 1 and the filter is meaningless.
+MIN_CORNER_FRACTION = 1.0e-5
+
 
 def integrate(t: NDArray[np.float64], accel: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Velocity and displacement from rest, exact for piecewise-linear acceleration."""
@@ -57,10 +61,11 @@ def bandpass(
     """Zero-phase Butterworth band-pass (or low/high-pass when one corner is None)."""
     fs = 1.0 / dt_s
     nyq = 0.5 * fs
-    if low_hz is not None and not 0 < low_hz < nyq:
-        raise InputError("bandpass_hz", f"low corner must be in (0, {nyq:g}) Hz, got {low_hz!r}")
-    if high_hz is not None and not 0 < high_hz < nyq:
-        raise InputError("bandpass_hz", f"high corner must be in (0, {nyq:g}) Hz (Nyquist), got {high_hz!r}")
+    lowest = MIN_CORNER_FRACTION * nyq
+    if low_hz is not None and not lowest <= low_hz < nyq:
+        raise InputError("bandpass_hz", f"low corner must be in [{lowest:g}, {nyq:g}) Hz, got {low_hz!r}")
+    if high_hz is not None and not lowest <= high_hz < nyq:
+        raise InputError("bandpass_hz", f"high corner must be in [{lowest:g}, {nyq:g}) Hz (Nyquist), got {high_hz!r}")
     if low_hz is not None and high_hz is not None and low_hz >= high_hz:
         raise InputError("bandpass_hz", f"low corner {low_hz} Hz must be below the high corner {high_hz} Hz")
     if low_hz is None and high_hz is None:
@@ -102,8 +107,11 @@ def lowpass_zero_phase(x: NDArray[np.float64], dt_s: float, cutoff_hz: float, or
         Filter order (applied twice).
     """
     nyquist = 0.5 / dt_s
-    if not 0 < cutoff_hz < nyquist:
-        raise InputError("output.accel_lowpass_hz", f"must be in (0, {nyquist:g}) Hz (Nyquist), got {cutoff_hz!r}")
+    lowest = MIN_CORNER_FRACTION * nyquist
+    if not lowest <= cutoff_hz < nyquist:
+        raise InputError(
+            "output.accel_lowpass_hz", f"must be in [{lowest:g}, {nyquist:g}) Hz (Nyquist), got {cutoff_hz!r}"
+        )
     sos = signal.butter(order, cutoff_hz, btype="low", fs=1.0 / dt_s, output="sos")
     if x.size <= 3 * (2 * len(sos) + 1):
         return x.copy()

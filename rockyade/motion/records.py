@@ -1,30 +1,48 @@
-"""Readers of recorded accelerograms.
+"""Readers of recorded accelerograms: a record is read exactly, or refused.
 
 * PEER NGA ``.AT2``: four header lines (database, event/station, units, sampling), then
   the values in free format. The sampling line comes as ``NPTS=  5372, DT=   .0100 SEC,``
   with or without the commas and trailing text, or in the old layout
   ``  4000   .0100   NPTS, DT`` (two numbers first). Values beyond NPTS are ignored; CRLF
   line ends are accepted. The units line names G, CM/S/S (or CM/SEC/SEC, GAL) or M/S/S.
+  A file with fewer than NPTS values, or whose last value is cut short (it lacks the
+  digits or the exponent every other value has), is refused as truncated.
 * Two-column text or CSV: time (s) and acceleration, comma / semicolon / whitespace
-  separated, an optional header line, ``#`` comments.
+  separated, ``#`` comments, an optional header line whose acceleration column may name
+  its units (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``, ...).
 * Single-column text: one acceleration per line at a given dt.
 
-Every bad file raises :class:`RecordError` naming the file and the line.
+Numbers are ASCII decimals, with an optional exponent written E or Fortran's D
+(``1.0D-02``); ``1_0``, non-ASCII digits, ``inf`` and ``nan`` are refused. A UTF-8 byte
+order mark is skipped. Units named by the file win: a different ``units`` argument is
+refused as a conflict. Values in g are converted with standard gravity, 9.80665 m/s^2
+(:data:`rockyade.constants.STANDARD_GRAVITY`). Every bad file raises
+:class:`RecordError` naming the file and the line.
 """
 
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from rockyade.constants import G
+from rockyade.constants import STANDARD_GRAVITY
 from rockyade.errors import InputError
 
-#: factor to m/s^2 per unit name
-UNITS = {"g": G, "m/s2": 1.0, "cm/s2": 0.01}
+#: factor to m/s^2 per unit name (a record "in g" means standard gravity)
+UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
+
+#: Most samples a record may hold (a day at 100 Hz is 8.6 million).
+MAX_RECORD_SAMPLES = 10_000_000
+#: Largest record file read, bytes.
+MAX_RECORD_BYTES = 512 * 1024 * 1024
+#: Sampling interval range of a record, s.
+DT_RANGE_S = (1.0e-5, 1.0)
+#: Largest |acceleration| accepted, m/s^2 (about 100 g; the strongest records reach 4 g).
+MAX_ABS_ACCEL_M_S2 = 1000.0
 UNIT_ALIASES = {
     "g": "g",
     "m/s2": "m/s2",
@@ -129,14 +147,70 @@ class Record:
         )
 
 
-_NUMBER = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eEdD][-+]?\d+)?"
+_NUMBER = r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eEdD][-+]?[0-9]+)?"
+_NUMBER_RE = re.compile(rf"^{_NUMBER}$", re.ASCII)
+
+
+def parse_number(token: str) -> float | None:
+    """A decimal number as written in records (exponent E or D), or None if not one.
+
+    Only ASCII digits; no ``_``, no ``inf``/``nan``. A value beyond the float range gives
+    ``inf`` (the callers refuse it).
+    """
+    if not _NUMBER_RE.match(token):
+        return None
+    return float(token.replace("D", "E").replace("d", "e"))
+
+
+def _signature(token: str) -> tuple[bool, int, int]:
+    """How a number is written: (has an exponent, digits after the point, exponent digits)."""
+    mantissa, mark, exponent = token.upper().replace("D", "E").partition("E")
+    return (bool(mark), len(mantissa.partition(".")[2]), len(exponent.lstrip("+-")))
+
+
+def _check_not_cut(path: Path, tokens: list[tuple[str, int]], last_in_file: bool) -> None:
+    """Refuse a last value that is cut short: every other value is written one way, it another.
+
+    ``tokens`` are the (text, line) of the values of one column, in order;
+    ``last_in_file``: no value follows the last of them. Only a column written in a fixed
+    format (every other value with an exponent, or with 3 decimals or more, alike) says how
+    the last value should look; a free-format column is left alone.
+    """
+    if not last_in_file or len(tokens) < 2:
+        return
+    last, line = tokens[-1]
+    others = [_signature(t) for t, _ in tokens[:-1]]
+    if len({(exp, frac) for exp, frac, _ in others}) != 1:
+        return  # free format: the values vary anyway
+    has_exp, frac, _ = others[0]
+    fixed = has_exp if len(others) == 1 else (has_exp or frac >= 3)
+    if not fixed:
+        return
+    min_exp_digits = min(2, *(d for _, _, d in others))  # exponents are written with 2 digits or more
+    mine = _signature(last)
+    if mine[0] != has_exp or mine[1] != frac or mine[2] < min_exp_digits:
+        raise RecordError(
+            path,
+            line,
+            f"the last value {last!r} is written differently from every other value (e.g. "
+            f"{tokens[0][0]!r}): the file looks truncated inside it",
+        )
+
+
+def _number(path: Path, lineno: int, token: str, what: str = "value") -> float:
+    value = parse_number(token)
+    if value is None:
+        raise RecordError(path, lineno, f"not a number: {token!r}")
+    if not math.isfinite(value):
+        raise RecordError(path, lineno, f"{what} {token!r} is beyond the floating-point range")
+    return value
 
 
 def _parse_at2_sampling(line: str, path: Path, lineno: int) -> tuple[int, float]:
     """NPTS and DT from the fourth AT2 header line (new or old layout)."""
     upper = line.upper()
-    m_n = re.search(r"NPTS\s*=\s*(" + _NUMBER + ")", upper)
-    m_dt = re.search(r"DT\s*=\s*(" + _NUMBER + ")", upper)
+    m_n = re.search(r"NPTS\s*=\s*(\S+?)(?:[,\s]|$)", upper)
+    m_dt = re.search(r"DT\s*=\s*(\S+?)(?:[,\s]|$)", upper)
     if m_n or m_dt:
         if not m_n:
             raise RecordError(path, lineno, "header has DT= but no NPTS=")
@@ -144,19 +218,21 @@ def _parse_at2_sampling(line: str, path: Path, lineno: int) -> tuple[int, float]
             raise RecordError(path, lineno, "header has NPTS= but no DT=")
         npts_text, dt_text = m_n.group(1), m_dt.group(1)
     else:
-        numbers = re.findall(_NUMBER, upper)
+        numbers = re.findall(_NUMBER, upper, re.ASCII)
         if len(numbers) < 2:
             raise RecordError(path, lineno, f"expected 'NPTS=..., DT=... SEC' or 'NPTS DT', got {line.strip()!r}")
         npts_text, dt_text = numbers[0], numbers[1]
-    try:
-        npts_f = float(npts_text.replace("D", "E").replace("d", "e"))
-        dt = float(dt_text.replace("D", "E").replace("d", "e"))
-    except ValueError:
-        raise RecordError(path, lineno, f"cannot read NPTS and DT from {line.strip()!r}") from None
-    if npts_f != int(npts_f) or npts_f < 2:
+    npts_f, dt = parse_number(npts_text), parse_number(dt_text)
+    if npts_f is None or dt is None:
+        raise RecordError(path, lineno, f"expected 'NPTS=..., DT=... SEC' or 'NPTS DT', got {line.strip()!r}")
+    if not math.isfinite(npts_f) or npts_f != int(npts_f) or npts_f < 2:
         raise RecordError(path, lineno, f"NPTS must be an integer >= 2, got {npts_text}")
+    if npts_f > MAX_RECORD_SAMPLES:
+        raise RecordError(path, lineno, f"NPTS must be at most {MAX_RECORD_SAMPLES}, got {npts_text}")
     if not dt > 0:
         raise RecordError(path, lineno, f"DT must be > 0 s, got {dt_text}")
+    if not DT_RANGE_S[0] <= dt <= DT_RANGE_S[1]:
+        raise RecordError(path, lineno, f"DT must be in [{DT_RANGE_S[0]:g}, {DT_RANGE_S[1]:g}] s, got {dt_text}")
     return int(npts_f), dt
 
 
@@ -171,14 +247,50 @@ def _at2_units(line: str) -> str | None:
     return None
 
 
-def _read_lines(path: Path) -> list[str]:
+def _read_text(path: Path) -> str:
     if not path.is_file():
         raise RecordError(path, None, "file not found")
+    size = path.stat().st_size
+    if size > MAX_RECORD_BYTES:
+        raise RecordError(path, None, f"the file has {size} bytes, more than the {MAX_RECORD_BYTES} a record may have")
+    data = path.read_bytes()
     try:
-        text = path.read_bytes().decode("utf-8", errors="strict")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError:
-        text = path.read_bytes().decode("latin-1")
-    return text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
+        text = data.decode("latin-1")
+    return text.replace("\r\n", "\n").replace("\r", "\n")
+
+
+def _read_lines(path: Path) -> list[str]:
+    return _read_text(path).split("\n")
+
+
+def _resolve_units(path: Path, line: int | None, in_file: str | None, given: str | None) -> str:
+    """The units to use: the file's; ``given`` must agree with them (or stand in for none)."""
+    wanted = normalise_units(given) if given else None
+    if in_file is not None and wanted is not None and wanted != in_file:
+        raise RecordError(
+            path,
+            line,
+            f"the file says its values are in {in_file} but units = {wanted} was given: "
+            "drop the units option (the file's units are used) or fix the file",
+        )
+    return in_file or wanted or ""
+
+
+def _accel(path: Path, values: list[float], unit: str) -> np.ndarray:
+    a = np.asarray(values, dtype=float) * UNITS[unit]
+    if not np.all(np.isfinite(a)):
+        raise RecordError(path, None, "contains NaN or infinite values")
+    worst = int(np.argmax(np.abs(a)))
+    if abs(a[worst]) > MAX_ABS_ACCEL_M_S2:
+        raise RecordError(
+            path,
+            None,
+            f"sample {worst + 1} is {a[worst]:.4g} m/s^2, beyond +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2: "
+            f"wrong units ({unit})?",
+        )
+    return a
 
 
 def read_at2(path: str | Path, units: str | None = None) -> Record:
@@ -189,32 +301,40 @@ def read_at2(path: str | Path, units: str | None = None) -> Record:
     path
         The file.
     units
-        Override the units named in the header (g, m/s2, cm/s2).
+        Units of the values when the header does not name them (g, m/s2, cm/s2); if the
+        header names other units the file is refused as a conflict.
     """
     path = Path(path)
-    lines = _read_lines(path)
+    text = _read_text(path)
+    lines = text.split("\n")
     if len(lines) < 5:
         raise RecordError(path, len(lines), "an AT2 file needs 4 header lines and data")
     npts, dt = _parse_at2_sampling(lines[3], path, 4)
-    file_units = normalise_units(units) if units else _at2_units(lines[2])
-    if file_units is None:
+    file_units = _resolve_units(path, 3, _at2_units(lines[2]), units)
+    if not file_units:
         raise RecordError(path, 3, f"cannot tell the units from {lines[2].strip()!r}; give units explicitly")
+    tokens: list[tuple[str, int]] = []
     values: list[float] = []
+    more = False  # anything after the NPTS-th value
     for lineno, line in enumerate(lines[4:], start=5):
-        for token in line.replace(",", " ").split():
-            try:
-                values.append(float(token.replace("D", "E").replace("d", "e")))
-            except ValueError:
-                raise RecordError(path, lineno, f"not a number: {token!r}") from None
-            if len(values) == npts:
-                break
+        parts = line.replace(",", " ").split()
         if len(values) == npts:
-            break
+            more = more or bool(parts)
+            if more:
+                break
+            continue
+        for k, token in enumerate(parts):
+            values.append(_number(path, lineno, token))
+            tokens.append((token, lineno))
+            if len(values) == npts:
+                more = k + 1 < len(parts)
+                break
     if len(values) < npts:
-        raise RecordError(path, len(lines), f"NPTS = {npts} in the header but the file holds {len(values)} values")
-    accel = np.asarray(values) * UNITS[file_units]
-    if not np.all(np.isfinite(accel)):
-        raise RecordError(path, None, "contains NaN or infinite values")
+        raise RecordError(
+            path, len(lines), f"NPTS = {npts} in the header but the file holds {len(values)} values: truncated?"
+        )
+    _check_not_cut(path, tokens, not more)
+    accel = _accel(path, values, file_units)
     title = lines[1].strip()
     return Record(np.arange(npts) * dt, accel, file_units, str(path), title, {"format": "at2", "dt_file_s": dt})
 
@@ -223,62 +343,131 @@ def _split(line: str) -> list[str]:
     return [t for t in re.split(r"[,;\s]+", line.strip()) if t]
 
 
-def read_two_column(path: str | Path, units: str = "m/s2") -> Record:
-    """Read time (s) and acceleration columns (comma, semicolon or whitespace separated)."""
+def _header_names(line: str) -> list[str]:
+    """Column names of a header: split at commas, semicolons or tabs if it has any, else at spaces."""
+    parts = re.split(r"[,;\t]", line) if re.search(r"[,;\t]", line) else line.split()
+    return [p.strip() for p in parts if p.strip()]
+
+
+def _is_header(tokens: list[str]) -> bool:
+    """A header line: words only. A token that starts like a number (``1_0``, ``1.2x``, a
+    non-ASCII digit) makes it a data line with a typo, reported as such."""
+    return all(parse_number(t) is None and not (t[0].isdigit() or t[0] in "+-.") for t in tokens)
+
+
+_HEADER_UNITS = (
+    (re.compile(r"cm\s*/\s*s(?:ec)?\s*(?:\^?2|/\s*s(?:ec)?)|cm_s2|\bgals?\b", re.I), "cm/s2"),
+    (re.compile(r"(?<![a-z])m\s*/\s*s(?:ec)?\s*(?:\^?2|/\s*s(?:ec)?)|(?<![a-z])m_s2|mps2", re.I), "m/s2"),
+    (re.compile(r"(?:^|[_\s(\[])g(?:$|[)\]\s])|\bin\s+g\b", re.I), "g"),
+)
+
+
+def header_units(name: str) -> str | None:
+    """Units named by a column header (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``), or None."""
+    for pattern, unit in _HEADER_UNITS:
+        if pattern.search(name):
+            return unit
+    return None
+
+
+def read_two_column(path: str | Path, units: str | None = None) -> Record:
+    """Read time (s) and acceleration columns (comma, semicolon or whitespace separated).
+
+    Parameters
+    ----------
+    units
+        Units of the accelerations when the header does not name them (default m/s2); a
+        header naming other units is refused as a conflict.
+    """
     path = Path(path)
-    unit = normalise_units(units)
+    text = _read_text(path)
     times: list[float] = []
     accel: list[float] = []
-    for lineno, line in enumerate(_read_lines(path), start=1):
+    column: list[tuple[str, int]] = []
+    header_unit: str | None = None
+    header_line: int | None = None
+    seen_data = False
+    last_row_width = 0
+    for lineno, line in enumerate(text.split("\n"), start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
             continue
         tokens = _split(body)
-        try:
-            numbers = [float(t) for t in tokens]
-        except ValueError:
-            if not times:  # a header line
-                continue
-            raise RecordError(path, lineno, f"not numeric: {body!r}") from None
-        if len(numbers) < 2:
+        if not seen_data and header_line is None and _is_header(tokens):
+            header_line = lineno  # a header: names only, no number at all
+            names = _header_names(body)
+            if len(names) >= 2:
+                header_unit = header_units(names[1])
+            continue
+        seen_data = True
+        if len(tokens) < 2:
             raise RecordError(path, lineno, f"expected two columns (time, acceleration), got {body!r}")
-        times.append(numbers[0])
-        accel.append(numbers[1])
+        times.append(_number(path, lineno, tokens[0], "time"))
+        accel.append(_number(path, lineno, tokens[1]))
+        column.append((tokens[1], lineno))
+        last_row_width = len(tokens)
     if len(times) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
+    if len(times) > MAX_RECORD_SAMPLES:
+        raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
+    _check_not_cut(path, column, last_row_width == 2)
+    unit = _resolve_units(path, header_line, header_unit, units) or "m/s2"
     t = np.asarray(times)
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if bad.size:
-        raise RecordError(path, None, f"time must increase strictly (sample {int(bad[0]) + 2})")
-    a = np.asarray(accel) * UNITS[unit]
-    if not np.all(np.isfinite(a)) or not np.all(np.isfinite(t)):
-        raise RecordError(path, None, "contains NaN or infinite values")
+        raise RecordError(path, column[int(bad[0]) + 1][1], f"time must increase strictly (sample {int(bad[0]) + 2})")
+    a = _accel(path, accel, unit)
     return Record(t - t[0], a, unit, str(path), "", {"format": "csv"})
 
 
-def read_single_column(path: str | Path, dt_s: float, units: str = "m/s2") -> Record:
-    """Read one acceleration value per line, sampled at ``dt_s``."""
+def read_single_column(path: str | Path, dt_s: float, units: str | None = None) -> Record:
+    """Read one acceleration value per line, sampled at ``dt_s``.
+
+    An optional first line without any number is a header (it may name the units).
+    """
     path = Path(path)
-    if not (isinstance(dt_s, (int, float)) and dt_s > 0):
+    if not (isinstance(dt_s, (int, float)) and not isinstance(dt_s, bool) and math.isfinite(dt_s) and dt_s > 0):
         raise RecordError(path, None, f"dt must be > 0 s, got {dt_s!r}")
-    unit = normalise_units(units)
+    if not DT_RANGE_S[0] <= dt_s <= DT_RANGE_S[1]:
+        raise RecordError(path, None, f"dt must be in [{DT_RANGE_S[0]:g}, {DT_RANGE_S[1]:g}] s, got {dt_s!r}")
+    text = _read_text(path)
     values: list[float] = []
-    for lineno, line in enumerate(_read_lines(path), start=1):
+    column: list[tuple[str, int]] = []
+    header_unit: str | None = None
+    header_line: int | None = None
+    for lineno, line in enumerate(text.split("\n"), start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
             continue
-        try:
-            values.append(float(body))
-        except ValueError:
-            if not values:
-                continue
-            raise RecordError(path, lineno, f"not a number: {body!r}") from None
+        if not values and header_line is None and _is_header(_split(body)):
+            header_line, header_unit = lineno, header_units(body)
+            continue
+        values.append(_number(path, lineno, body))
+        column.append((body, lineno))
     if len(values) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
-    a = np.asarray(values) * UNITS[unit]
-    if not np.all(np.isfinite(a)):
-        raise RecordError(path, None, "contains NaN or infinite values")
+    if len(values) > MAX_RECORD_SAMPLES:
+        raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
+    _check_not_cut(path, column, True)
+    unit = _resolve_units(path, header_line, header_unit, units) or "m/s2"
+    a = _accel(path, values, unit)
     return Record(np.arange(a.size) * dt_s, a, unit, str(path), "", {"format": "single"})
+
+
+def count_samples(path: str | Path, fmt: str | None = None) -> int:
+    """Samples a record file holds, without reading its values: NPTS of an AT2 header, the
+    line count of a text file (an upper bound). For cost estimates."""
+    path = Path(path)
+    fmt = fmt or detect_format(path)
+    try:
+        if fmt == "at2":
+            with path.open("rb") as fh:
+                head = [fh.readline(4096).decode("latin-1") for _ in range(4)]
+            return _parse_at2_sampling(head[3], path, 4)[0]
+        with path.open("rb") as fh:
+            return sum(chunk.count(b"\n") for chunk in iter(lambda: fh.read(1 << 20), b"")) + 1
+    except (OSError, IndexError):
+        return 0
 
 
 def detect_format(path: str | Path) -> str:
@@ -299,7 +488,8 @@ def read_record(
         "at2", "csv" (two columns) or "single" (one column, needs ``dt_s``); default by
         extension.
     units
-        Units of the values (default: from the AT2 header; m/s2 for text files).
+        Units of the values when the file does not name them (default m/s2 for text
+        files); units the file names win, and a different value here is refused.
     dt_s
         Sampling interval for single-column files, s.
     """
@@ -309,7 +499,7 @@ def read_record(
     if fmt == "at2":
         return read_at2(path, units)
     if fmt == "csv":
-        return read_two_column(path, units or "m/s2")
+        return read_two_column(path, units)
     if dt_s is None:
         raise InputError("dt_s", "a single-column record needs its sampling interval dt_s")
-    return read_single_column(path, dt_s, units or "m/s2")
+    return read_single_column(path, dt_s, units)

@@ -21,6 +21,15 @@ import numpy as np
 from rockyade.io.fields import TableReader
 from rockyade.motion.ground import GroundMotion
 
+#: Largest |initial angular velocity| of free rocking, rad/s.
+MAX_OMEGA0_RAD_S = 100.0
+#: Largest |base acceleration| given in a scene (samples, pulses), m/s^2 (about 100 g).
+MAX_ABS_ACCEL_M_S2 = 1000.0
+#: Latest time a motion may reach (start times, sample times), s.
+MAX_MOTION_TIME_S = 1.0e5
+#: Latest start of a harmonic motion or a pulse, s.
+MAX_START_S = 1000.0
+
 
 class MotionSpec(ABC):
     """Base class of the motion specifications.
@@ -62,6 +71,11 @@ class MotionSpec(ABC):
         """What identifies the motion in a scene hash (content of files, not their paths)."""
         return self.to_dict()
 
+    def sample_count(self, duration_s: float) -> int:
+        """Samples of the base acceleration the motion builds (0 when the base does not move),
+        computed without building them: the run's cost estimate (:mod:`rockyade.cost`)."""
+        return 0
+
 
 @dataclass(frozen=True)
 class FreeRocking(MotionSpec):
@@ -101,7 +115,7 @@ class FreeRocking(MotionSpec):
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> FreeRocking:
         theta0 = r.number("theta0_rad", lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
-        omega0 = r.number("omega0_rad_s", 0.0, unit="rad/s")
+        omega0 = r.number("omega0_rad_s", 0.0, lo=-MAX_OMEGA0_RAD_S, hi=MAX_OMEGA0_RAD_S, unit="rad/s")
         block = r.string("block", None)
         if theta0 == 0.0 and omega0 == 0.0:
             raise r.error("theta0_rad", "free rocking needs a non-zero theta0_rad or omega0_rad_s")
@@ -147,6 +161,9 @@ class SampledMotion(MotionSpec):
     accel_v_m_s2: tuple[float, ...] | None = None
     load_factor: float = 1.0
 
+    def sample_count(self, duration_s: float) -> int:
+        return len(self.accel_m_s2)
+
     def ground_motion(self, duration_s: float) -> GroundMotion:
         ah = np.array(self.accel_m_s2) * self.load_factor
         av = None if self.accel_v_m_s2 is None else np.array(self.accel_v_m_s2) * self.load_factor
@@ -156,10 +173,16 @@ class SampledMotion(MotionSpec):
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> SampledMotion:
         accel = r.number_list("accel_m_s2", min_len=2, unit="m/s^2")
-        dt = r.positive("dt_s", None, unit="s")
+        dt = r.number("dt_s", None, lo=1.0e-6, hi=1.0, unit="s")
         t = r.number_list("t_s", None, min_len=2, unit="s")
         av = r.number_list("accel_v_m_s2", None, min_len=2, unit="m/s^2")
-        lf = r.number("load_factor", 1.0, lo=0.0)
+        lf = r.number("load_factor", 1.0, lo=0.0, hi=100.0)
+        for key, values in (("accel_m_s2", accel), ("accel_v_m_s2", av or [])):
+            worst = max((abs(v) for v in values), default=0.0)
+            if worst > MAX_ABS_ACCEL_M_S2:
+                raise r.error(key, f"values must be within +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2, got {worst:g}")
+        if t is not None and not all(0.0 <= v <= MAX_MOTION_TIME_S for v in t):
+            raise r.error("t_s", f"times must be in [0, {MAX_MOTION_TIME_S:g}] s")
         if (dt is None) == (t is None):
             raise r.error("dt_s", "give exactly one of dt_s and t_s")
         if t is not None:

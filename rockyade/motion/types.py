@@ -38,6 +38,7 @@ Scene tables (all take ``load_factor``, default 1)::
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -49,8 +50,16 @@ from rockyade.motion.analytic import PULSE_SHAPES, Harmonic, Pulse
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.ground import GroundMotion
 from rockyade.motion.processing import bandpass, baseline_correct, scale_to_pga
-from rockyade.motion.records import FORMATS, Record, normalise_units, read_record
-from rockyade.motion.spec import MOTION_TYPES, MotionSpec
+from rockyade.motion.records import (
+    DT_RANGE_S,
+    FORMATS,
+    MAX_ABS_ACCEL_M_S2,
+    Record,
+    count_samples,
+    normalise_units,
+    read_record,
+)
+from rockyade.motion.spec import MAX_START_S, MOTION_TYPES, MotionSpec
 from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
 
 
@@ -78,6 +87,10 @@ class HarmonicMotion(MotionSpec):
     def ground_motion(self, duration_s: float) -> GroundMotion:
         return self.harmonic.ground_motion(self.load_factor)
 
+    def sample_count(self, duration_s: float) -> int:
+        # as Harmonic.ground_motion samples it: 400 points per cycle to the end
+        return math.ceil(self.harmonic.phases_s["end_s"] * self.frequency_hz * 400) + 1
+
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> HarmonicMotion:
         amplitude = r.number("amplitude_mm", lo=0.0, hi=1000.0, lo_open=True, unit="mm")
@@ -89,7 +102,7 @@ class HarmonicMotion(MotionSpec):
         if cycles is None:
             cycles = max(1, round(duration * frequency))
         ramp = r.integer("ramp_cycles", 2, lo=1, hi=1000)
-        start = r.number("start_s", 0.0, lo=0.0, unit="s")
+        start = r.number("start_s", 0.0, lo=0.0, hi=MAX_START_S, unit="s")
         return cls(amplitude, frequency, int(cycles), ramp, start, _load_factor(r))
 
 
@@ -113,6 +126,11 @@ class PulseMotion(MotionSpec):
     def ground_motion(self, duration_s: float) -> GroundMotion:
         return self.pulse.ground_motion(self.load_factor)
 
+    def sample_count(self, duration_s: float) -> int:
+        # as Pulse.ground_motion samples it: T / 400, at most 1 ms, to the end
+        pulse = self.pulse
+        return math.ceil((pulse.start_s + pulse.duration_s) / min(pulse.period_s / 400.0, 1e-3)) + 2
+
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> PulseMotion:
         shape = r.string("shape", choices=PULSE_SHAPES)
@@ -122,7 +140,7 @@ class PulseMotion(MotionSpec):
             raise r.error("amplitude_m_s2", "give exactly one of amplitude_m_s2 and amplitude_g")
         period = r.number("period_s", lo=0.0, hi=100.0, lo_open=True, unit="s")
         cycles = r.integer("cycles", 1, lo=1, hi=1000)
-        start = r.number("start_s", 0.0, lo=0.0, unit="s")
+        start = r.number("start_s", 0.0, lo=0.0, hi=MAX_START_S, unit="s")
         return cls(shape, amp if amp is not None else amp_g * G, period, cycles, start, _load_factor(r))
 
 
@@ -166,6 +184,9 @@ class RecordMotion(MotionSpec):
         d["file"] = hashlib.sha256(Path(self.file).read_bytes()).hexdigest()
         return d
 
+    def sample_count(self, duration_s: float) -> int:
+        return count_samples(self.file, self.format)
+
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> RecordMotion:
         name = r.string("file")
@@ -178,17 +199,20 @@ class RecordMotion(MotionSpec):
         units = r.string("units", None)
         if units is not None:
             units = normalise_units(units, r.field("units"))
-        dt = r.positive("dt_s", None, unit="s")
+        dt = r.number("dt_s", None, lo=DT_RANGE_S[0], hi=DT_RANGE_S[1], unit="s")
         baseline = r.boolean("baseline", False)
         bp = r.raw("bandpass_hz", None)
         band: tuple[float | None, float | None] | None = None
         if bp is not None:
-            if not (
-                isinstance(bp, list) and len(bp) == 2 and all(x is None or isinstance(x, (int, float)) for x in bp)
-            ):
-                raise r.error("bandpass_hz", "must be [low, high] in Hz")
-            band = (bp[0], bp[1])
-        pga = r.positive("target_pga_m_s2", None, unit="m/s^2")
+            if not (isinstance(bp, list) and len(bp) == 2):
+                raise r.error("bandpass_hz", "must be [low, high] in Hz (either may be omitted as a bare low/high)")
+            corners = TableReader({"low": bp[0], "high": bp[1]}, r.field("bandpass_hz"), r.source)
+            low = corners.number("low", None, lo=1e-3, hi=1e4, unit="Hz")
+            high = corners.number("high", None, lo=1e-3, hi=1e4, unit="Hz")
+            if low is None and high is None:
+                raise r.error("bandpass_hz", "give at least one corner, in Hz")
+            band = (low, high)
+        pga = r.number("target_pga_m_s2", None, lo=1e-3, hi=MAX_ABS_ACCEL_M_S2, unit="m/s^2")
         spec = cls(str(path.resolve()), fmt, units, dt, baseline, band, pga, _load_factor(r))
         spec.record()  # read now so that a bad file is reported with the scene
         return spec
@@ -215,6 +239,10 @@ class SyntheticMotion(MotionSpec):
         target = ElasticSpectrum.ec8(self.spectrum_type, self.ground, ag_s_m_s2=self.ag_s_m_s2)  # type: ignore[arg-type]
         return SuiteSpec(target, count=self.count or 30, seed=self.seed or 0, name=self.suite)
 
+    def sample_count(self, duration_s: float) -> int:
+        spec = self.suite_spec()
+        return round(spec.envelope.duration_s / spec.dt_s) + 1
+
     def ground_motion(self, duration_s: float) -> GroundMotion:
         rec = suite_record(self.suite_spec(), self.record)
         label = f"synthetic {self.suite} record {self.record}" + (
@@ -227,7 +255,7 @@ class SyntheticMotion(MotionSpec):
         suite = r.string("suite", "paper")
         st = r.integer("spectrum_type", None, lo=1, hi=2)
         ground = r.string("ground", None, choices=["A", "B", "C", "D", "E"])
-        ags = r.positive("ag_s_m_s2", None, unit="m/s^2")
+        ags = r.number("ag_s_m_s2", None, lo=1e-3, hi=100.0, unit="m/s^2")
         seed = r.integer("seed", None, lo=0)
         count = r.integer("count", None, lo=1, hi=10_000)
         if suite != "paper" and None in (st, ground, ags, seed, count):

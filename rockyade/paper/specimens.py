@@ -6,14 +6,17 @@ re-typing values.
 
 from __future__ import annotations
 
+import csv
 from dataclasses import dataclass
 from functools import cache
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:  # pandas is imported when a table is asked for: ``rockyade params`` stays quick
+    import pandas as pd
 
 DATA_DIR = Path(__file__).resolve().parent / "data"
 
@@ -33,13 +36,26 @@ ALL_SPECIMENS = SINGLE_SPECIMENS + BIBLOCK_BLOCKS
 
 @cache
 def _raw_table(number: int) -> pd.DataFrame:
+    import pandas as pd
+
     if number not in TABLE_FILES:
         raise InputError("table", f"must be one of {sorted(TABLE_FILES)}, got {number!r}")
     return pd.read_csv(DATA_DIR / TABLE_FILES[number], dtype=str, keep_default_na=False)
 
 
+@cache
+def _rows(name: str) -> dict[str, dict[str, str]]:
+    """A data CSV as {first column: {column: text}} (the standard library's reader)."""
+    with (DATA_DIR / name).open(newline="", encoding="utf-8") as fh:
+        reader = csv.DictReader(fh)
+        key = reader.fieldnames[0] if reader.fieldnames else ""
+        return {row[key]: row for row in reader}
+
+
 def table(number: int) -> pd.DataFrame:
     """Paper table ``number`` (1-6) as floats, indexed by specimen or block name."""
+    import pandas as pd
+
     raw = _raw_table(number).copy()
     key = raw.columns[0]
     out = raw.set_index(key)
@@ -55,6 +71,8 @@ def printed_decimals(number: int, row: str, column: str) -> int:
 
 def shapes() -> pd.DataFrame:
     """Base chamfers of the specimens (Section 3.1), indexed by specimen."""
+    import pandas as pd
+
     return pd.read_csv(DATA_DIR / "specimen_shapes.csv", dtype={"specimen": str}).set_index("specimen")
 
 
@@ -127,9 +145,9 @@ def specimen(key: str | int) -> Specimen:
     """A specimen of the paper by id: 1-4 (Table 1) or "upper"/"lower" (Table 2)."""
     key = check_specimen(key)
     single = key in SINGLE_SPECIMENS
-    dims = table(1 if single else 2).loc[key]
-    classical = table(3 if single else 4).loc[key]
-    chamfer = float(shapes().loc[key, "base_chamfer_m"]) if single else 0.0
+    dims = _rows(TABLE_FILES[1 if single else 2])[key]
+    classical = _rows(TABLE_FILES[3 if single else 4])[key]
+    chamfer = float(_rows("specimen_shapes.csv")[key]["base_chamfer_m"]) if single else 0.0
 
     def triple(tag: str) -> dict[str, float]:
         return {

@@ -14,15 +14,14 @@ from typing import Any
 
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, STIFFNESS_SCALES
 from rockyade.errors import InputError
-from rockyade.io.fields import TableReader
+from rockyade.io.fields import TableReader, plain_data
 from rockyade.motion.spec import parse_motion
+from rockyade.scene.bounds import BOUNDS, check_block_ranges
 from rockyade.scene.model import (
     CALIBRATIONS,
     JOINT_OVERRIDE_KEYS,
-    MAX_DENSITY_KG_M3,
     MAX_DURATION_S,
     MAX_LENGTH_M,
-    MAX_MASS_KG,
     MAX_SAMPLES,
     NAME_PATTERN,
     BlockSpec,
@@ -46,25 +45,43 @@ def load_scene(path: str | Path) -> Scene:
     source = str(path)
     if not path.is_file():
         raise InputError("scene", f"file not found: {path}")
-    text = path.read_text(encoding="utf-8")
     suffix = path.suffix.lower()
-    try:
-        if suffix == ".toml":
-            data = tomllib.loads(text)
-        elif suffix == ".json":
-            data = json.loads(text)
-        else:
-            raise InputError("scene", f"unknown file type {suffix!r}: use .toml or .json", source)
-    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
-        raise InputError("scene", f"not valid {suffix[1:].upper()}: {exc}", source) from None
+    if suffix not in (".toml", ".json"):
+        raise InputError("scene", f"unknown file type {suffix!r}: use .toml or .json", source)
+    data = parse_text_file(path, "scene")
     return scene_from_dict(data, source=source, base_dir=path.parent)
 
 
+def parse_text_file(path: Path, field: str) -> Any:
+    """The table in a UTF-8 TOML or JSON file (by suffix); InputError naming the file otherwise."""
+    source = str(path)
+    try:
+        text = path.read_bytes().decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        byte = exc.object[exc.start]
+        raise InputError(field, f"not UTF-8 text (byte {byte:#04x} at offset {exc.start})", source) from None
+    except OSError as exc:
+        raise InputError(field, f"cannot read the file: {exc.strerror or exc}", source) from None
+    kind = "JSON" if path.suffix.lower() == ".json" else "TOML"
+    try:
+        return json.loads(text) if kind == "JSON" else tomllib.loads(text)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(field, f"not valid {kind}: {exc}", source) from None
+    except RecursionError:
+        raise InputError(field, f"not valid {kind}: nested too deeply", source) from None
+    except ValueError as exc:  # e.g. an integer literal too long to convert
+        raise InputError(field, f"not valid {kind}: {exc}", source) from None
+
+
 def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> Scene:
-    """Validate a scene given as a dictionary (as read from TOML or JSON)."""
+    """Validate a scene given as a dictionary (as read from TOML or JSON).
+
+    numpy arrays and scalars are accepted wherever lists and numbers are.
+    """
+    data = plain_data(data, "scene", source)
     top = TableReader(data, "", source)
     duration = top.number("duration_s", lo=0.0, hi=MAX_DURATION_S, lo_open=True, unit="s")
-    sample_dt = top.positive("sample_dt_s", unit="s")
+    sample_dt = top.number("sample_dt_s", **BOUNDS["sample_dt_s"].kwargs())
     if sample_dt > duration:
         raise top.error("sample_dt_s", f"must be <= duration_s ({duration:g} s), got {sample_dt:g}")
     if duration / sample_dt > MAX_SAMPLES:
@@ -76,6 +93,13 @@ def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None 
     contact = _parse_contact(top.sub("contact", {}))
     motion = parse_motion(top.raw("motion"), source, base_dir)
     output = _parse_output(top.sub("output", {}))
+    if output.accel_lowpass_hz is not None and output.accel_lowpass_hz >= 0.5 / sample_dt:
+        raise InputError(
+            "output.accel_lowpass_hz",
+            f"must be below the Nyquist frequency 1 / (2 sample_dt_s) = {0.5 / sample_dt:g} Hz, "
+            f"got {output.accel_lowpass_hz:g}",
+            source,
+        )
     joints = _parse_joints(top.raw("joints", []), source)
     top.finish()
     scene = Scene(duration, sample_dt, blocks, contact, motion, output, source, joints)
@@ -106,8 +130,8 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
     else:
         width = _length(r, "width_m")
         height = _length(r, "height_m")
-    mass = r.number("mass_kg", None, lo=0.0, hi=MAX_MASS_KG, lo_open=True, unit="kg")
-    density = r.number("density_kg_m3", None, lo=0.0, hi=MAX_DENSITY_KG_M3, lo_open=True, unit="kg/m^3")
+    mass = r.number("mass_kg", None, **BOUNDS["mass_kg"].kwargs())
+    density = r.number("density_kg_m3", None, **BOUNDS["density_kg_m3"].kwargs())
     if (mass is None) == (density is None):
         raise r.error("mass_kg", "give exactly one of mass_kg and density_kg_m3")
     inertia = r.positive("inertia_kgm2", None, unit="kg m^2")
@@ -122,9 +146,9 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
     if rotation != 0.0 and position is None:
         raise r.error("rotation_rad", "needs position_m (an assembly scene)")
     fixed = r.boolean("fixed", False)
-    alpha = r.number("alpha_rad", None, lo=0.0, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
+    alpha = r.number("alpha_rad", None, **BOUNDS["alpha_rad"].kwargs())
     p = r.positive("p_rad_s", None, unit="rad/s")
-    mu = r.number("mu", None, lo=0.0, hi=1.0, lo_open=True)
+    mu = r.number("mu", None, **BOUNDS["mu"].kwargs())
     if inertia is not None and p is not None:
         raise r.error("p_rad_s", "give either inertia_kgm2 or p_rad_s (p sets the DEM inertia), not both")
     r.finish()
@@ -146,15 +170,21 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
         fixed=fixed,
     )
     try:
-        spec.block()
+        block = spec.block()
     except InputError as exc:
         raise InputError(f"blocks[{index}].{exc.field}", exc.message, source) from None
+    check_block_ranges(block, spec, f"blocks[{index}].", source)
     return spec
 
 
 def _length(r: TableReader, key: str) -> float:
-    """A length in (0, MAX_LENGTH_M] metres."""
-    return r.number(key, lo=0.0, hi=MAX_LENGTH_M, lo_open=True, unit="m")
+    """A length in the documented range (:data:`rockyade.scene.bounds.BOUNDS`), metres."""
+    return r.number(key, **BOUNDS["length_m"].kwargs())
+
+
+def _bounded(r: TableReader, key: str, default: Any = None) -> Any:
+    """A ``[contact]`` (or ``[[joints]]``) number in its documented range."""
+    return r.number(key, default, **BOUNDS[f"contact.{key}"].kwargs())
 
 
 def _parse_contact(r: TableReader) -> ContactSpec:
@@ -166,22 +196,22 @@ def _parse_contact(r: TableReader) -> ContactSpec:
                 "stiffness_scale", f"must be one of {sorted(STIFFNESS_SCALES)} or a number > 0, got {scale!r}"
             )
     else:
-        scale = r.positive("stiffness_scale")
+        scale = r.number("stiffness_scale", **BOUNDS["contact.stiffness_scale"].kwargs())
     spec = ContactSpec(
         calibration=calibration,
         stiffness_scale=scale,
-        K_N_per_m=r.positive("K_N_per_m", None, unit="N/m"),
-        Ks_N_per_m=r.positive("Ks_N_per_m", None, unit="N/m"),
+        K_N_per_m=_bounded(r, "K_N_per_m"),
+        Ks_N_per_m=_bounded(r, "Ks_N_per_m"),
         friction_angle_deg=r.number(
             "friction_angle_deg", DEFAULT_FRICTION_ANGLE_DEG, lo=0.0, hi=90.0, hi_open=True, unit="deg"
         ),
         cohesion_Pa=r.number("cohesion_Pa", 0.0, lo=0.0, unit="Pa"),
-        beta_s=r.number("beta_s", None, lo=0.0, unit="s"),
-        dt_s=r.positive("dt_s", None, unit="s"),
-        time_step_frac=r.number("time_step_frac", DEFAULT_TIME_STEP_FRAC, lo=0.0, hi=1.0, lo_open=True, unit=""),
-        mass_damping_1_s=r.number("mass_damping_1_s", 0.0, lo=0.0, unit="1/s"),
-        jkn_Pa_per_m=r.positive("jkn_Pa_per_m", None, unit="Pa/m"),
-        jks_Pa_per_m=r.positive("jks_Pa_per_m", None, unit="Pa/m"),
+        beta_s=_bounded(r, "beta_s"),
+        dt_s=_bounded(r, "dt_s"),
+        time_step_frac=_bounded(r, "time_step_frac", DEFAULT_TIME_STEP_FRAC),
+        mass_damping_1_s=_bounded(r, "mass_damping_1_s", 0.0),
+        jkn_Pa_per_m=_bounded(r, "jkn_Pa_per_m"),
+        jks_Pa_per_m=_bounded(r, "jks_Pa_per_m"),
     )
     if spec.K_N_per_m is not None and spec.jkn_Pa_per_m is not None:
         raise r.error("jkn_Pa_per_m", "give K_N_per_m (per contact point) or jkn_Pa_per_m (per unit area), not both")
@@ -212,7 +242,11 @@ def _parse_output(r: TableReader) -> OutputSpec:
         point = tuple(r.number_list("accel_point", min_len=2, unit="m"))
         if len(point) != 2:
             raise r.error("accel_point", "must be 'top_centre' or [x, y] in metres")
-    lowpass = r.positive("accel_lowpass_hz", None, unit="Hz")
+        limit = BOUNDS["output.accel_point"]
+        if not all(limit.lo <= c <= limit.hi for c in point):
+            rng = f"[{limit.lo:g}, {limit.hi:g}] m"
+            raise r.error("accel_point", f"coordinates must be within {rng}, got {list(point)}")
+    lowpass = r.number("accel_lowpass_hz", None, **BOUNDS["output.accel_lowpass_hz"].kwargs())
     r.finish()
     return OutputSpec(point, lowpass)
 
@@ -231,10 +265,8 @@ def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
         for key in JOINT_OVERRIDE_KEYS:
             if key == "friction_angle_deg":
                 value = r.number(key, None, lo=0.0, hi=90.0, hi_open=True, unit="deg")
-            elif key == "beta_s":
-                value = r.number(key, None, lo=0.0, unit="s")
             else:
-                value = r.positive(key, None, unit="Pa/m" if key.startswith("jk") else "N/m")
+                value = _bounded(r, key)
             if value is not None:
                 values.append((key, float(value)))
         if not values:

@@ -1,14 +1,21 @@
 """The reference DEM: a standalone rigid-polygon DEM (numpy + numba) with the paper's joint.
 
-It reads the same :class:`~rockyade.dem_model.DemModel` as the YADE backend and returns the
-common Result schema, plus contact states per corner (``<block>_c<i>_state``: open, stick
-or slip; corners numbered counter-clockwise from the bottom left) and energy terms
+It reads the same :class:`~rockyade.dem.model.DemModel` as the YADE backend and returns the
+common Result schema, plus per block ``n_contacts`` (contact points on the block) and
+``slipping`` (one of them slips), for column scenes the contact state per corner
+(``<block>_c<i>_state``: open, stick or slip, the worst of the contact points at that
+corner; corners numbered counter-clockwise from the bottom left), and energy terms
 (``energy_*_J``, ``work_base_J`` and ``energy_balance_error_J``).
 
 Accelerations (``ax_m_s2``, ``ay_m_s2``) are absolute, at the output point, and are the
 mean over +/- one sample interval (central difference of the point velocity), which
 keeps the impact spikes from aliasing; ``[output] accel_lowpass_hz`` adds a zero-phase
 low-pass (paper Section 6.1).
+
+Overturning: a moving block whose |theta| reaches its stop angle (pi/2 by default) ends a
+column scene's run (status ``overturned``); in a positioned scene (an assembly) the run
+goes on, since a falling block must not end a wall's run. Either way ``meta
+["overturn_times_s"]`` gives, per block that reached its stop angle, the first time it did.
 """
 
 from __future__ import annotations
@@ -37,11 +44,38 @@ def run_model(
     record_energy: bool = True,
     record_contacts: bool = True,
     accel_lowpass_hz: float | None = None,
+    per_corner: bool = True,
+    stop_on_overturn: bool = True,
+    stop_angle_rad: np.ndarray | None = None,
 ) -> Result:
-    """Run a DEM model and return a Result (see module docstring)."""
-    out, wall = simulate_model(model, record_energy)
-    pos_s, ang_s, angvel_s, vpoint_s, state_s, energy_s, status, n_filled, t_stop, stop_body = out
-    n = int(n_filled)
+    """Run a DEM model and return a Result (see module docstring).
+
+    Parameters
+    ----------
+    record_energy
+        Energy terms in the frame.
+    record_contacts
+        ``n_contacts`` and ``slipping`` per block, and with ``per_corner`` the state of
+        every corner.
+    accel_lowpass_hz
+        Optional zero-phase low-pass of the output accelerations, Hz.
+    per_corner
+        Corner states (``c<i>_state``), one column per vertex: meant for single blocks and
+        columns, not for walls of thousands of blocks.
+    stop_on_overturn
+        End the run when a block reaches its stop angle (column scenes).
+    stop_angle_rad
+        (nb,) |theta| at which each block counts as overturned; pi/2 by default.
+    """
+    out, wall = simulate_model(
+        model,
+        record_energy,
+        record_corners=record_contacts and per_corner,
+        stop_on_overturn=stop_on_overturn,
+        stop_angle_rad=stop_angle_rad,
+    )
+    pos_s, ang_s, angvel_s, vpoint_s = out.pos, out.ang, out.angvel, out.vpoint
+    n = int(out.n_filled)
     names = model.names
     frame = dem_frame(
         model,
@@ -49,13 +83,16 @@ def run_model(
         ang_s[:n],
         angvel_s[:n],
         vpoint_s[:n],
-        state_s[:n] if record_contacts else None,
+        out.corner_states[:n] if record_contacts and per_corner else None,
         accel_lowpass_hz,
+        n_contacts=out.n_contacts[:n] if record_contacts else None,
+        slipping=out.slipping[:n] if record_contacts else None,
     )
+    energy_s, status, t_stop, stop_body = out.energy, out.status, out.t_stop, out.stop_body
     meta_energy: dict[str, float] = {}
     if record_energy and n:
         e = energy_s[:n]
-        e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies)
+        e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies if not b.fixed)
         total = (
             e[:, kernel.E_KIN]
             + e[:, kernel.E_POT]
@@ -98,7 +135,15 @@ def run_model(
         "status": status_name,
         "overturn_time_s": float(t_stop) if status_name == "overturned" else None,
         "overturned_block": names[int(stop_body)] if status_name == "overturned" else None,
-        "overturn_criterion": "|theta| reached pi/2",
+        "overturn_criterion": "|theta| reached pi/2" if stop_angle_rad is None else "|theta| reached its stop angle",
+        "overturn_times_s": {
+            names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)
+        },
+        "broad_phase": {
+            "rebuilds": int(out.n_builds),
+            "max_candidate_pairs": int(out.max_pairs),
+            "separating_axis_tests": int(out.n_tests),
+        },
         "failure_reason": (
             f"numerical instability at t = {t_stop:.6g} s (energy created: {gain:.3g} x weight x height; or a "
             f"non-finite state, speed > {kernel.MAX_SPEED_M_S:g} m/s or spin > {kernel.MAX_SPIN_RAD_S:g} rad/s)"
@@ -139,6 +184,8 @@ def run_scene(scene: Scene, *, record_energy: bool = True, record_contacts: bool
         record_energy=record_energy,
         record_contacts=record_contacts,
         accel_lowpass_hz=scene.output.accel_lowpass_hz,
+        per_corner=not scene.positioned,
+        stop_on_overturn=not scene.positioned,
     )
     result.meta["setup_time_s"] = setup
     return result

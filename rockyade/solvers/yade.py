@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -30,6 +31,7 @@ from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from rockyade import __version__
 from rockyade.dem.frames import dem_frame, energy_gain
@@ -37,7 +39,7 @@ from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
-from rockyade.io.atomic import write_json
+from rockyade.io.atomic import write_json, write_text
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 
@@ -63,10 +65,63 @@ def _env() -> dict[str, str]:
 
 # ---------------------------------------------------------------------- running
 
+#: Default timeout: start-up allowance plus this many seconds per body-step ...
+TIMEOUT_STARTUP_S = 60.0
+TIMEOUT_PER_BODY_STEP_S = 50e-6
+#: ... capped here unless a larger one is asked for (``--yade-timeout``, ``timeout_s``).
+TIMEOUT_CAP_S = 3600.0
+#: Largest timeout accepted, s (30 days).
+MAX_TIMEOUT_S = 30 * 86400.0
+
 
 def default_timeout(model: DemModel) -> float:
-    """A generous timeout: 30 s of start-up plus 50 us per step."""
-    return 30.0 + 50e-6 * model.n_steps * len(model.bodies)
+    """Wall-clock limit of a YADE run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
+    body-step (about 5-20x what YADE needs), capped at TIMEOUT_CAP_S (one hour)."""
+    work = TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * model.n_steps * len(model.bodies)
+    return min(work, TIMEOUT_CAP_S)
+
+
+def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> float | None:
+    """A user timeout checked: None (the default) or a number of seconds in (0, MAX_TIMEOUT_S].
+
+    Raises
+    ------
+    InputError
+        Not a positive finite number of seconds within the limit.
+    """
+    if timeout_s is None:
+        return None
+    try:
+        value = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
+    if not (0.0 < value <= MAX_TIMEOUT_S):
+        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
+    return value
+
+
+def _run_process(cmd: list[str], log_file: Path, cwd: Path, timeout: float) -> str | None:
+    """Run YADE's Python; the reason it failed, or None. On timeout the process group is
+    killed (the driver and anything it started) and waited for: no orphan is left."""
+    with open(log_file, "w") as log:
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=_env(), cwd=cwd, start_new_session=True)
+        try:
+            code = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            _kill_group(proc)
+            return f"timeout: YADE did not finish within {timeout:.6g} s and was stopped (raise it with --yade-timeout)"
+        except BaseException:  # Ctrl-C or any other interruption: never leave YADE running
+            _kill_group(proc)
+            raise
+    return None if code == 0 else f"YADE exited with code {code}"
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        proc.kill()
+    proc.wait()
 
 
 def run_model(
@@ -85,8 +140,9 @@ def run_model(
         The DEM model.
     workdir
         Where ``<name>.yade.json`` (the scene data), ``<name>.yade.npz`` (YADE's output)
-        and ``<name>.yade.log`` are kept; default a temporary directory, removed after a
-        successful run and kept (its log path in the Result) after a failed one.
+        and ``<name>.yade.log`` are kept (relative to the current folder, or absolute);
+        default a temporary directory, removed after a successful run and kept (its log
+        path in the Result) after a failed one.
     timeout_s
         Wall-clock limit of the YADE process, s (default :func:`default_timeout`).
     """
@@ -95,34 +151,25 @@ def run_model(
             f"YADE is not installed (looked for {YADE_PYTHON} and {YADE_PY_DIR}/yade): "
             "apt-get install -y --no-install-recommends yade"
         )
+    timeout = check_timeout(timeout_s)
+    timeout = timeout if timeout is not None else default_timeout(model)
     keep = workdir is not None
-    directory = Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))
+    # absolute paths: the process runs in ``directory``, where a relative path would be
+    # taken relative to it a second time
+    directory = (Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
     directory.mkdir(parents=True, exist_ok=True)
     scene_file = directory / f"{name}.yade.json"
     out_file = directory / f"{name}.yade.npz"
     log_file = directory / f"{name}.yade.log"
     for stale in (out_file, log_file):
         stale.unlink(missing_ok=True)
-    write_json(scene_file, scene_payload(model))
-    timeout = timeout_s if timeout_s is not None else default_timeout(model)
+    payload = scene_payload(model)
+    write_json(scene_file, payload)
     start = time.perf_counter()
-    reason = None
-    with open(log_file, "w") as log:
-        try:
-            proc = subprocess.run(
-                [YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)],
-                stdout=log,
-                stderr=subprocess.STDOUT,
-                env=_env(),
-                timeout=timeout,
-                cwd=directory,
-            )
-            if proc.returncode != 0:
-                reason = f"YADE exited with code {proc.returncode}"
-        except subprocess.TimeoutExpired:
-            reason = f"timeout: YADE did not finish within {timeout:.0f} s"
+    reason = _run_process([YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)], log_file, directory, timeout)
     total = time.perf_counter() - start
-    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz)
+    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, payload.get("contact_plan"))
+    result.meta["timeout_s"] = timeout
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
     return result
@@ -136,8 +183,18 @@ def _last_error_line(log_file: Path) -> str:
     return lines[-1] if lines else ""
 
 
-def _parse(model: DemModel, out_file: Path, reason: str | None, log_file: Path, total: float, lowpass) -> Result:
-    extra = {"log_path": str(log_file), "total_time_s": total}
+def _parse(
+    model: DemModel,
+    out_file: Path,
+    reason: str | None,
+    log_file: Path,
+    total: float,
+    lowpass: float | None,
+    contact_plan: dict | None = None,
+) -> Result:
+    extra: dict[str, object] = {"log_path": str(log_file), "total_time_s": total}
+    if contact_plan is not None:
+        extra["yade_contacts"] = contact_plan
     if reason is None and not out_file.is_file():
         reason = "YADE wrote no output file"
     if reason is not None:
@@ -167,13 +224,24 @@ def _parse(model: DemModel, out_file: Path, reason: str | None, log_file: Path, 
     if t_blowup is not None:
         reason = f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
         return failed_result("yade", model.scene_hash, reason, **extra)
+    depth = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
+    if depth >= 1.0:
+        return failed_result(
+            "yade",
+            model.scene_hash,
+            "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
+            "contact then loses its normal): the impact is too hard for these contact spheres",
+            **extra,
+        )
+    extra["max_polyhedra_penetration_over_radius"] = depth
     frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
     names = model.names
+    forces = {}
     for i, body in enumerate(model.bodies):
         prefix = f"{body.name}_" if len(names) > 1 else ""
-        for v in range(arrays["fn"].shape[2]):
-            if v < len(body.contact_vertices_m):
-                frame[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+        for v in range(len(body.contact_vertices_m)):
+            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    frame = pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
     overturned = status == "overturned"
     run_meta = {
         "solver": "yade",
@@ -212,6 +280,32 @@ def run_scene(
         model, workdir=workdir, name=name, timeout_s=timeout_s, accel_lowpass_hz=scene.output.accel_lowpass_hz
     )
     return result
+
+
+def write_script(scene: Scene, directory: str | Path) -> dict[str, Path]:
+    """A standalone YADE script for a scene: ``run.py`` (the driver rockyade itself runs) and
+    ``scene.json`` (its data) in ``directory``, for YADE users who go on by hand.
+
+    ``yade -x run.py`` (batch) or ``yade run.py`` (with YADE's GUI and console) builds the
+    same scene and writes ``result.npz`` (what rockyade parses) and ``result.csv`` (t,
+    centroid and rotation of each block) beside the script; so does
+    ``/usr/bin/python3.11 run.py`` (Debian's Python) with YADE's modules on the path. The launcher opens a Python
+    console and an XMLRPC server on all interfaces (rockyade never uses it).
+
+    Returns
+    -------
+    dict
+        Paths of ``script`` and ``data``.
+    """
+    if scene.contact.mass_damping_1_s:
+        raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    model = build_matched_model(scene)
+    data, script = out / "scene.json", out / "run.py"
+    write_json(data, scene_payload(model))
+    write_text(script, DRIVER.read_text())
+    return {"script": script, "data": data}
 
 
 def run_many(scenes: Iterable[Scene], workers: int = 2, timeout_s: float | None = None) -> list[Result]:

@@ -5,6 +5,7 @@ Study file (TOML)::
     name = "harmonic-sweep"
     solvers = ["reference", "housner"]     # each scene runs with each solver
     save_histories = true                  # the time history of every run (else summary only)
+    yade_timeout_s = 600                   # optional: wall-clock limit of each YADE run, s
 
     [base]                                 # base scenes: one file, or several
     files = ["examples/specimen1_harmonic.toml", "examples/specimen3_free.toml"]
@@ -19,35 +20,66 @@ written for every run, ``runs/<name>.csv`` with the time history when asked. The
 the grid values, status, failure reason, wall time and per-block metrics (see
 :func:`rockyade.analysis.run_metrics`, and the rocking pattern for stacks).
 
-A failed run never stops the batch: its row says why. ``resume`` skips runs whose JSON
-says they completed (or overturned) for the same scene hash and re-runs failed ones. The
-summary is sorted by run order, so the same inputs give the same summary on either
-executor (wall times aside).
+A failed run never stops the batch: its row says why (a full disk too: the run fails with
+that reason and the batch goes on). ``resume`` skips runs whose JSON says they completed
+(or overturned) for the same scene hash and re-runs failed ones. The summary is sorted by
+run order, so the same inputs give the same summary on either executor (wall times aside).
+
+Before any run, the cost of every run is estimated and the batch is refused if one is above
+the limits of :mod:`rockyade.cost` (``allow_large`` lifts them). One batch at a time may
+write an output directory (a lock); what a killed batch left (temporary files, a result
+between its two renames) is settled when the next one starts.
+
+Executors: ``local`` runs each task in a pool of worker processes; ``dask`` without a
+scheduler runs them on Dask's threaded scheduler inside this process (no socket is opened:
+the ``distributed`` LocalCluster would start HTTP servers), and with ``scheduler`` on a
+``distributed`` cluster at that address.
+
+Ctrl-C (SIGINT): the first stops dispatching (queued runs never start) and lets the
+running runs finish; the second stops them at once (their worker processes are killed).
+Either way ``summary.csv`` is written with what finished, the unfinished runs listed with
+status ``unfinished``, and :class:`~rockyade.errors.BatchInterruptedError` is raised.
+Worker processes ignore SIGINT, lead their own process group (killing a worker kills the
+YADE process it started) and are killed by the kernel if this process dies, however it dies
+(``prctl(PR_SET_PDEATHSIG, SIGKILL)``).
 """
 
 from __future__ import annotations
 
+import collections
+import contextlib
 import copy
+import ctypes
+import ctypes.util
 import itertools
 import json
 import os
+import re
+import signal
+import sys
+import threading
 import time
-import tomllib
 from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor, as_completed
-from dataclasses import dataclass, field
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from concurrent.futures.process import BrokenProcessPool
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from rockyade.errors import InputError
-from rockyade.io.atomic import atomic_open, write_json
+from rockyade.errors import BatchInterruptedError, InputError, RockyadeError, os_error_message
+from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
+from rockyade.io.locking import output_lock
 from rockyade.solvers import solver_names
 
 EXECUTORS = ("local", "dask")
 TIMING_COLUMNS = ("wall_time_s", "elapsed_s")
+#: Seconds to wait for a Dask scheduler to answer.
+SCHEDULER_TIMEOUT_S = 10.0
+#: Status of a run that a Ctrl-C stopped or kept from starting (summary only).
+UNFINISHED = "unfinished"
 
 
 @dataclass(frozen=True)
@@ -77,6 +109,7 @@ class Task:
     out_dir: str
     save_history: bool = True
     extra: dict[str, Any] = field(default_factory=dict)
+    yade_timeout_s: float | None = None
 
 
 @dataclass(frozen=True)
@@ -113,16 +146,19 @@ def load_study(path: str | Path, out_dir: str | Path) -> Study:
     source = str(path)
     if not path.is_file():
         raise InputError("study", f"file not found: {path}")
-    try:
-        data = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError("study", f"not valid TOML: {exc}", source) from None
+    from rockyade.io.fields import plain_data
+    from rockyade.scene.loading import parse_text_file
+
+    data = plain_data(parse_text_file(path, "study"), "study", source)
     r = TableReader(data, "", source)
     name = r.string("name", path.stem)
     solvers = r.raw("solvers", ["reference"])
     if not isinstance(solvers, list) or not solvers or any(s not in solver_names() for s in solvers):
         raise r.error("solvers", f"must be a list of {', '.join(solver_names())}, got {solvers!r}")
     save = r.boolean("save_histories", True)
+    from rockyade.solvers.yade import MAX_TIMEOUT_S
+
+    timeout = r.number("yade_timeout_s", None, lo=0.0, lo_open=True, hi=MAX_TIMEOUT_S, unit="s")
     base = r.sub("base")
     files = base.raw("files", None)
     single = base.raw("file", None)
@@ -140,7 +176,8 @@ def load_study(path: str | Path, out_dir: str | Path) -> Study:
             raise InputError(f"grid.{key}", "must be a non-empty list of values", source)
     r.finish()
     bases = [(Path(f).stem, _scene_dict(path.parent / f)) for f in file_list]
-    return Study(name, tuple(expand(bases, grid_table, solvers, out_dir, save, source)), tuple(solvers))
+    tasks = [replace(t, yade_timeout_s=timeout) for t in expand(bases, grid_table, solvers, out_dir, save, source)]
+    return Study(name, tuple(tasks), tuple(solvers))
 
 
 def expand(
@@ -152,6 +189,7 @@ def expand(
     source: str | None = None,
 ) -> list[Task]:
     """Tasks for every base scene x grid point x solver (validated scenes)."""
+    from rockyade.cost import estimate_cost, estimate_dict
     from rockyade.scene import scene_from_dict
 
     keys = list(grid)
@@ -168,7 +206,11 @@ def expand(
                 canonical["motion"]["file"] = str(Path(canonical["motion"]["file"]).resolve())
             labels = {"base": base_name, **{k: _label(v) for k, v in zip(keys, values, strict=True)}}
             for solver in solvers:
-                tasks.append(Task(index, canonical, solver, labels, str(out_dir), save_history))
+                try:
+                    extra = {"cost": estimate_dict(estimate_cost(scene, solver))}
+                except RockyadeError:
+                    extra = {}  # the run itself will fail and say why
+                tasks.append(Task(index, canonical, solver, labels, str(out_dir), save_history, extra))
                 index += 1
     return tasks
 
@@ -200,7 +242,10 @@ def run_task(task: Task) -> dict[str, Any]:
         scene = scene_from_dict(task.scene)
         name = run_name(scene.scene_hash, task.solver)
         solver = get_solver(task.solver)
-        result = solver(scene, workdir=runs / "yade", name=name) if task.solver == "yade" else solver(scene)
+        if task.solver == "yade":
+            result = solver(scene, workdir=runs / "yade", name=name, timeout_s=task.yade_timeout_s)
+        else:
+            result = solver(scene)
     except Exception as exc:  # one failed run never stops the batch
         scene_hash = scene.scene_hash if scene is not None else "invalid"
         name = run_name(scene_hash, task.solver)
@@ -230,20 +275,26 @@ def run_task(task: Task) -> dict[str, Any]:
             row["pattern"] = pattern.dominant
             row["pattern_fractions"] = json.dumps(pattern.fractions, sort_keys=True)
     row["elapsed_s"] = time.perf_counter() - start
-    meta = dict(result.meta)
-    meta["summary"] = row
-    if task.save_history and result.ok:
-        result.write(runs / f"{name}.csv")  # writes <name>.json last
-        _merge_json(runs / f"{name}.json", {"summary": row})
-    else:
-        write_json(runs / f"{name}.json", meta)
+    try:
+        if task.save_history and result.ok:
+            result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
+        else:
+            write_json(runs / f"{name}.json", {**result.meta, "summary": row})
+    except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
+        row = _write_failure(task, row, exc)
     return row
 
 
-def _merge_json(path: Path, extra: dict[str, Any]) -> None:
-    data = json.loads(path.read_text())
-    data.update(extra)
-    write_json(path, data)
+def _write_failure(task: Task, row: dict[str, Any], exc: OSError) -> dict[str, Any]:
+    """The row of a run whose result could not be written (no file of it is left half-written)."""
+    keep = (*LEADING_COLUMNS, *task.labels, "wall_time_s", "elapsed_s")
+    return {
+        **{k: v for k, v in row.items() if k in keep},
+        "status": "failed",
+        "failure_reason": f"cannot write the result: {os_error_message(exc)}",
+        "overturn_time_s": None,
+        "overturned_block": "",
+    }
 
 
 def _completed_row(task: Task) -> dict[str, Any] | None:
@@ -269,6 +320,65 @@ def _completed_row(task: Task) -> dict[str, Any] | None:
     return None
 
 
+# ---------------------------------------------------------------------- Ctrl-C
+
+
+class StopRequest:
+    """Counts Ctrl-C (SIGINT) during a batch: the first asks to stop dispatching, the second
+    to stop at once. Installed only in the main thread (elsewhere Python delivers no signal).
+
+    Parameters
+    ----------
+    raise_on_second
+        Raise KeyboardInterrupt on the second Ctrl-C (executors whose runs are threads of
+        this process cannot be killed: the caller then ends the process).
+    """
+
+    def __init__(self, raise_on_second: bool = False) -> None:
+        self.count = 0
+        self.event = threading.Event()
+        self.raise_on_second = raise_on_second
+        self._previous: Any = None
+        self._installed = False
+
+    @property
+    def requested(self) -> bool:
+        """A first Ctrl-C came: start no new run."""
+        return self.count >= 1
+
+    @property
+    def now(self) -> bool:
+        """A second Ctrl-C came: stop the running runs."""
+        return self.count >= 2
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        self.count += 1
+        self.event.set()
+        if self.count == 1:
+            _say("Ctrl-C: no new run starts; waiting for the running runs to finish (Ctrl-C again stops them now)")
+        elif self.count == 2:
+            _say("Ctrl-C again: stopping the running runs now")
+            if self.raise_on_second:
+                raise KeyboardInterrupt
+
+    def __enter__(self) -> StopRequest:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handler)
+            self._installed = True
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._installed:
+            signal.signal(signal.SIGINT, self._previous)
+            self._installed = False
+
+
+def _say(message: str) -> None:
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(f"\n{message}\n")
+        sys.stderr.flush()
+
+
 # ---------------------------------------------------------------------- executors
 
 
@@ -278,45 +388,252 @@ def _progress(total: int, enabled: bool, desc: str):
     return tqdm(total=total, disable=not enabled, desc=desc, unit="run", smoothing=0.05)
 
 
-def _run_local(tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None]) -> None:
-    if workers <= 1:
-        for task in tasks:
-            on_done(run_task(task))
-        return
+PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent(parent_pid: int) -> None:
+    """Ask the kernel to SIGKILL this process when its parent dies (Linux prctl), and leave
+    at once if the parent is already gone."""
+    libc_name = ctypes.util.find_library("c")
+    if libc_name:
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(libc_name, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if os.getppid() != parent_pid:
+        os._exit(1)
+
+
+def _worker_init(parent_pid: int) -> None:
+    """Pool worker set-up: ignore Ctrl-C (the parent decides), own process group (killing it
+    kills a YADE process the worker started), killed with the parent."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    with contextlib.suppress(OSError):
+        os.setpgid(0, 0)
+    _die_with_parent(parent_pid)
+    if threading.current_thread() is threading.main_thread():
+        threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="watch-parent").start()
+
+
+def _watch_parent(parent_pid: int) -> None:
+    """Where prctl is missing: poll the parent and end this worker's group when it is gone."""
+    while True:
+        time.sleep(0.5)
+        if os.getppid() != parent_pid:
+            with contextlib.suppress(OSError):
+                os.killpg(os.getpgrp(), signal.SIGKILL)
+            os._exit(1)
+
+
+def _kill_workers(pool: ProcessPoolExecutor) -> None:
+    """SIGKILL every worker of the pool and the processes they started."""
+    processes = dict(getattr(pool, "_processes", None) or {})
+    for pid in processes:
+        try:
+            os.killpg(pid, signal.SIGKILL)
+        except OSError:
+            with contextlib.suppress(OSError):
+                os.kill(pid, signal.SIGKILL)
+
+
+def _crashed_row(task: Task, reason: str) -> dict[str, Any]:
+    return _placeholder_row(task, "failed", reason)
+
+
+def _run_local(
+    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest, started: set[int]
+) -> list[Task]:
+    """Run tasks on a pool of worker processes; return the tasks that did not finish.
+
+    At most ``workers`` tasks are handed to the pool at a time, so a stop request leaves
+    the others unstarted.
+    """
     import multiprocessing
 
     ctx = multiprocessing.get_context("fork" if os.name == "posix" else "spawn")
-    with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
-        futures = [pool.submit(run_task, t) for t in tasks]
-        for future in as_completed(futures):
-            on_done(future.result())
-
-
-def _run_dask(
-    tasks: list[Task], scheduler: str | None, workers: int, on_done: Callable[[dict[str, Any]], None]
-) -> None:
+    pending = collections.deque(tasks)
+    running: dict[Future[dict[str, Any]], Task] = {}
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(os.getpid(),))
+    killed = False
     try:
-        from dask.distributed import Client, LocalCluster
+        while pending or running:
+            while pending and len(running) < workers and not stop.requested:
+                task = pending.popleft()
+                try:
+                    running[pool.submit(run_task, task)] = task
+                    started.add(task.index)
+                except BrokenProcessPool:
+                    pending.appendleft(task)
+                    pool = _fresh_pool(pool, ctx, workers)
+            if not running:
+                break
+            done, _ = wait(running, timeout=0.2, return_when=FIRST_COMPLETED)
+            broken = False
+            for future in done:
+                task = running.pop(future)
+                try:
+                    on_done(future.result())
+                except BrokenProcessPool:
+                    broken = True
+                    on_done(_crashed_row(task, "the worker process died (killed, or out of memory)"))
+            if stop.now:
+                _kill_workers(pool)
+                killed = True
+                break
+            if broken:
+                for future, task in list(running.items()):
+                    running.pop(future)
+                    on_done(_crashed_row(task, "the worker process died (killed, or out of memory)"))
+                pool = _fresh_pool(pool, ctx, workers)
+    except BaseException:
+        _kill_workers(pool)
+        killed = True
+        raise
+    finally:
+        pool.shutdown(wait=not killed, cancel_futures=True)
+    return [*running.values(), *pending]
+
+
+def _fresh_pool(pool: ProcessPoolExecutor, ctx: Any, workers: int) -> ProcessPoolExecutor:
+    _kill_workers(pool)
+    pool.shutdown(wait=False, cancel_futures=True)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(os.getpid(),))
+
+
+def _run_dask_in_process(
+    tasks: list[Task], workers: int, on_done: Callable[[dict[str, Any]], None], stop: StopRequest, started: set[int]
+) -> list[Task]:
+    """Dask's threaded scheduler in this process: no cluster, no socket. Returns the tasks
+    that did not finish (a stop request makes the unstarted ones return at once)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    try:
+        import dask.threaded
+        from dask.callbacks import Callback
+    except ImportError:
+        raise InputError("executor", "the dask executor needs dask: pip install 'rockyade[dask]'") from None
+
+    finished: set[int] = set()
+
+    def guarded(task: Task) -> dict[str, Any] | None:
+        if stop.event.is_set():
+            return None
+        started.add(task.index)
+        return run_task(task)
+
+    def posttask(key: Any, row: Any, dsk: Any, state: Any, worker_id: Any) -> None:
+        if row is not None:
+            finished.add(row["index"])
+            on_done(row)
+
+    graph = {f"run-{task.index}": (guarded, task) for task in tasks}
+    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-dask")
+    clean = False
+    try:
+        with Callback(posttask=posttask):
+            dask.threaded.get(graph, list(graph), pool=pool)
+        clean = True
+    finally:
+        # after a second Ctrl-C the running runs are threads that cannot be killed: the
+        # command line ends the process (BatchInterruptedError.hard)
+        pool.shutdown(wait=clean, cancel_futures=True)
+    return [t for t in tasks if t.index not in finished]
+
+
+SCHEDULER_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc)://\S+$")
+
+
+def _run_dask_remote(
+    tasks: list[Task],
+    scheduler: str,
+    on_done: Callable[[dict[str, Any]], None],
+    stop: StopRequest,
+    timeout_s: float,
+    started: set[int],
+) -> list[Task]:
+    """A ``distributed`` cluster at ``scheduler``; Ctrl-C cancels what has not finished."""
+    try:
+        from dask.distributed import Client
         from dask.distributed import as_completed as dask_completed
     except ImportError:
         raise InputError(
             "executor", "the dask executor needs dask[distributed]: pip install 'rockyade[dask]'"
         ) from None
-    cluster = None
-    if scheduler:
-        client = Client(scheduler)
-    else:
-        # no scheduler given: an in-process cluster (threads, in-process transport): no port opens
-        cluster = LocalCluster(n_workers=1, threads_per_worker=max(1, workers), processes=False, dashboard_address=None)
-        client = Client(cluster)
+    if not SCHEDULER_ADDRESS.match(scheduler):
+        raise InputError("scheduler", f"must be an address like tcp://host:8786 or tls://host:8786, got {scheduler!r}")
+    try:
+        client = Client(scheduler, timeout=timeout_s)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(
+            "scheduler", f"no Dask scheduler answered at {scheduler} within {timeout_s:g} s ({exc})"
+        ) from None
+    finished: set[int] = set()
     try:
         futures = client.map(run_task, tasks, pure=False)
-        for future in dask_completed(futures):
-            on_done(future.result())
+        started.update(t.index for t in tasks)  # the cluster decides when: cancelled ones count as stopped
+        pending = dask_completed(futures)
+        while not pending.is_empty():
+            batch = pending.next_batch(block=False)
+            for future in batch:
+                row = future.result()
+                finished.add(row["index"])
+                on_done(row)
+            if stop.requested:
+                client.cancel([f for f in futures if not f.done()])
+                break
+            if not batch:
+                stop.event.wait(0.1)
     finally:
         client.close()
-        if cluster is not None:
-            cluster.close()
+    return [t for t in tasks if t.index not in finished]
+
+
+def _placeholder_row(task: Task, status: str, reason: str) -> dict[str, Any]:
+    """A summary row for a run that produced no result (unfinished, or its worker died)."""
+    from rockyade.scene import scene_from_dict
+
+    try:
+        scene_hash = scene_from_dict(task.scene).scene_hash
+    except Exception:  # a scene that does not even load: its run would have failed the same way
+        scene_hash = "invalid"
+    return {
+        "index": task.index,
+        "run": run_name(scene_hash, task.solver),
+        "scene_hash": scene_hash,
+        "solver": task.solver,
+        **task.labels,
+        "status": status,
+        "failure_reason": reason,
+        "overturn_time_s": None,
+        "overturned_block": "",
+        "wall_time_s": None,
+    }
+
+
+def check_task_costs(tasks: list[Task], allow_large: bool = False) -> None:
+    """Refuse the batch, before any run, if a run's cost is above :data:`rockyade.cost.LIMITS`."""
+    if allow_large:
+        return
+    from rockyade.cost import CostEstimate, check_cost
+    from rockyade.scene import scene_from_dict
+
+    for task in tasks:
+        label = f"run {task.index} ({', '.join(f'{k} = {v}' for k, v in task.labels.items())})"
+        cost = task.extra.get("cost")
+        if cost is not None:
+            if CostEstimate(**cost).over_limits():
+                check_cost(scene_from_dict(task.scene), task.solver, label=label)
+            continue
+        try:
+            scene = scene_from_dict(task.scene)
+        except RockyadeError:
+            continue  # the run fails and says why
+        try:
+            check_cost(scene, task.solver, label=label)
+        except InputError as exc:
+            if exc.field == "allow_large":
+                raise
+            continue  # not a cost refusal: the run itself fails and says why
+        except RockyadeError:
+            continue
 
 
 def run_study_tasks(
@@ -329,22 +646,60 @@ def run_study_tasks(
     resume: bool = False,
     progress: bool = True,
     desc: str = "runs",
+    allow_large: bool = False,
+    scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
 ) -> pd.DataFrame:
     """Run tasks and write the summary; return it (sorted by task order).
 
     Parameters
     ----------
     executor
-        "local" (processes) or "dask" (``scheduler`` address, or an in-process cluster).
+        "local" (worker processes) or "dask" (``scheduler`` address, or Dask's threaded
+        scheduler in this process).
     resume
         Skip runs already completed for the same scene hash; re-run failed ones.
+    allow_large
+        Run even if a run's cost estimate is above the limits of :mod:`rockyade.cost`.
+
+    Raises
+    ------
+    InputError
+        Bad settings, a run above the cost limits, an output another batch is writing.
+    BatchInterruptedError
+        After Ctrl-C, once the summary of what finished is written.
     """
     if executor not in EXECUTORS:
         raise InputError("executor", f"must be one of {', '.join(EXECUTORS)}, got {executor!r}")
-    if workers < 1:
-        raise InputError("workers", f"must be >= 1, got {workers}")
+    if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
+        raise InputError("workers", f"must be an integer >= 1, got {workers!r}")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
+    with output_lock(out, "out"):
+        _settle(out)
+        check_task_costs(tasks, allow_large)
+        return _run_locked(tasks, out, executor, workers, scheduler, resume, progress, desc, scheduler_timeout_s)
+
+
+def _settle(out: Path) -> None:
+    """What a killed batch left: finish or drop half-replaced results, remove temporary files."""
+    from rockyade.result import settle_results
+
+    remove_stale_temporaries(out)
+    if (out / "runs").is_dir():
+        settle_results(out / "runs")
+
+
+def _run_locked(
+    tasks: list[Task],
+    out: Path,
+    executor: str,
+    workers: int,
+    scheduler: str | None,
+    resume: bool,
+    progress: bool,
+    desc: str,
+    scheduler_timeout_s: float,
+) -> pd.DataFrame:
     rows: list[dict[str, Any]] = []
     todo = []
     for task in tasks:
@@ -362,15 +717,39 @@ def run_study_tasks(
         if row["status"] == "failed":
             bar.write(f"failed: {row['run']}: {row['failure_reason']}")
 
-    try:
-        if executor == "local":
-            _run_local(todo, workers, on_done)
-        else:
-            _run_dask(todo, scheduler, workers, on_done)
-    finally:
-        bar.close()
+    unfinished: list[Task] = []
+    started: set[int] = set()
+    stopped_now = False
+    in_process_dask = executor == "dask" and not scheduler
+    with StopRequest(raise_on_second=in_process_dask) as stop:
+        try:
+            if executor == "local":
+                unfinished = _run_local(todo, workers, on_done, stop, started)
+            elif in_process_dask:
+                unfinished = _run_dask_in_process(todo, workers, on_done, stop, started)
+            else:
+                unfinished = _run_dask_remote(todo, scheduler or "", on_done, stop, scheduler_timeout_s, started)
+        except KeyboardInterrupt:
+            if not stop.requested:
+                raise
+            stopped_now = True
+            finished = {row["index"] for row in rows}
+            unfinished = [t for t in todo if t.index not in finished]
+        finally:
+            bar.close()
+    interrupted = stop.requested and bool(unfinished)  # a Ctrl-C after the last run changes nothing
+    if interrupted:
+        for task in sorted(unfinished, key=lambda t: t.index):
+            reason = "stopped by Ctrl-C" if task.index in started else "not started: Ctrl-C"
+            rows.append(_placeholder_row(task, UNFINISHED, reason))
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
     write_summary(summary, out)
+    if interrupted:
+        if stop.now or stopped_now:
+            _settle(out)
+        raise BatchInterruptedError(
+            len(tasks) - len(unfinished), len(unfinished), str(out / "summary.csv"), hard=stop.now or stopped_now
+        )
     return summary
 
 

@@ -1,0 +1,164 @@
+"""``rockyade identify``: alpha, p, mu (with 95 % intervals) from a measured free-rocking test."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from rockyade.cli.common import json_out
+from rockyade.errors import InputError
+
+
+def _led_columns(text: str | None) -> tuple[str, str] | None:
+    if text is None:
+        return None
+    names = [c.strip() for c in text.split(",")]
+    if len(names) != 2 or not all(names):
+        raise InputError("led_columns", f'must be two column names "led1_y_m,led2_y_m", got {text!r}')
+    return names[0], names[1]
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    """Identify the classical parameters of a measured free-rocking record."""
+    from rockyade.analysis.identify import identify
+    from rockyade.analysis.measurement import read_measurement
+
+    history = read_measurement(
+        args.measured,
+        time_column=args.time_column,
+        theta_column=args.theta_column,
+        degrees=True if args.degrees else None,
+        led_columns=_led_columns(args.led_columns),
+        led_distance_m=args.led_distance_m,
+        led_zero=args.led_zero,
+    )
+    result = identify(history, max_relative_ci=args.max_relative_ci)
+    data = result.as_dict()
+    if args.out:
+        from rockyade.io.atomic import write_json
+
+        write_json(args.out, data)
+    figures = []
+    if args.plot:
+        from rockyade.figures.identify import plot_error_surface, plot_fit
+
+        stem = Path(args.measured).stem
+        figures = [args.plot / f"{stem}_fit.png", args.plot / f"{stem}_error_surface.png"]
+        plot_fit(result, figures[0])
+        plot_error_surface(result, figures[1])
+    if args.json:
+        json_out(data)
+    else:
+        _print_text(result)
+        for path in [args.out, *figures] if args.out else figures:
+            print(f"wrote {path}")
+    if result.unidentifiable:
+        for name, why in result.unidentifiable.items():
+            print(f"rockyade: {name} cannot be identified from this record: {why}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _print_text(result: Any) -> None:
+    h = result.history
+    fit = result.fit
+    print(f"{h.source}: {h.t_s.size} samples at {h.rate_hz:.4g} Hz over {h.duration_s:.4g} s")
+    units = {"alpha_rad": "rad", "p_rad_s": "1/s", "mu": ""}
+    for name, digits in (("alpha_rad", 5), ("p_rad_s", 4), ("mu", 5)):
+        label = name.split("_")[0]
+        if name in result.unidentifiable:
+            print(f"  {label:5s} = unidentifiable")
+            continue
+        lo, hi = result.ci[name]
+        value = getattr(fit, name)
+        print(f"  {label:5s} = {value:.{digits}f} {units[name]:3s}  95 % interval [{lo:.{digits}f}, {hi:.{digits}f}]")
+    print(
+        f"  release at t = {fit.release_time_s:.4f} s from theta = {fit.theta0_rad:.5g} rad; "
+        f"sensor offset {fit.offset_rad:.4g} rad"
+    )
+    print(
+        f"  rms residual {result.rms_residual_rad:.3g} rad; {result.n_impacts} impacts above the noise; "
+        f"intervals: {result.ci_method}"
+    )
+
+
+def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
+    """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
+    from rockyade.analysis.identified import calibrate_from_identified
+
+    if len(blocks) != 1:
+        raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")
+    name, block, _overrides = blocks[0]
+    result = calibrate_from_identified(
+        block,
+        args.from_identified,
+        method=args.method,
+        stiffness_scale=args.stiffness_scale,
+        friction_angle_deg=args.friction_angle,
+    )
+    result["block"] = name
+    result["from"] = str(args.from_identified)
+    if args.json:
+        json_out(result)
+        return 0
+    c, ci = result["classical"], result["classical_ci"]
+
+    def interval(key: str) -> str:
+        return f" [{ci[key][0]:.4g}, {ci[key][1]:.4g}]" if key in ci else ""
+
+    print(f"{name} ({block.mass_kg:.4g} kg), identified parameters from {args.from_identified}:")
+    print(
+        f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
+        f"mu = {c['mu']:.5g}{interval('mu')}"
+    )
+    print(f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10, read as {result['stiffness_scale']})")
+    if args.method == "matched":
+        print(f"  beta     = {result['beta_s']:.6g} s (matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s)")
+        print(
+            f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable "
+            f"{result['mu_reachable_min']:.4f}-{result['mu_reachable_max']:.4f}"
+        )
+    else:
+        print(f"  beta     = {result['beta_s']:.6g} s (Eq 13, Gamma = {result['gamma']:.6g})")
+    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14)")
+    print(f"  b_eq     = {result['b_eq_m']:.6g} m (Eq 11); dt = {result['dt_s']:.6g} s (Eq 7)")
+    for note in result["notes"]:
+        print(f"  note: {note}")
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add ``rockyade identify``."""
+    p = sub.add_parser(
+        "identify",
+        help="alpha, p, mu with 95 %% intervals from a measured free-rocking test",
+        description="Fit Housner's free rocking (exact solver) to a measured rotation history: alpha, p, mu, "
+        "the release time, the release tilt and the sensor offset by least squares, with 95 % intervals. "
+        "Input: CSV with t_s and theta_rad (or theta_deg), or two LED displacement columns. "
+        "Exit code 1 when a parameter cannot be identified (the message says why). See docs/identification.md.",
+    )
+    p.add_argument("measured", type=Path, help="measured history (CSV with a header row)")
+    p.add_argument("--time-column", default="t_s", help="time column, s (default t_s)")
+    p.add_argument("--theta-column", help="rotation column (default theta_rad, or theta_deg in degrees)")
+    p.add_argument("--degrees", action="store_true", help="the rotation column is in degrees")
+    p.add_argument("--led-columns", help='two vertical LED displacement columns, m: "led1_y_m,led2_y_m"')
+    p.add_argument("--led-distance-m", type=float, help="horizontal distance between the LEDs, m (LED 2 to the right)")
+    p.add_argument(
+        "--led-zero",
+        choices=["end", "none"],
+        default="end",
+        help="upright reference of the LEDs: the rest at the end of the record (default) or zero displacement",
+    )
+    p.add_argument(
+        "--max-relative-ci",
+        type=float,
+        default=0.10,
+        help="a parameter whose 95 %% half interval exceeds this fraction of its value is not identified "
+        "(default 0.10)",
+    )
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--out", type=Path, help="write the identified values as JSON (input of calibrate --from)")
+    p.add_argument("--plot", type=Path, help="directory for the fit and error-surface figures (PNG)")
+    p.set_defaults(func=cmd_identify)

@@ -1,0 +1,88 @@
+"""``rockyade uncertainty``: propagate the uncertainty of alpha, p, mu through a record suite."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+
+def cmd_uncertainty(args: argparse.Namespace) -> int:
+    """Run an uncertainty study and print its probabilities and fragility fits."""
+    from rockyade.studies.uncertainty import load_uncertainty_study, run_uncertainty
+
+    study = load_uncertainty_study(args.study)
+    if args.samples is not None or args.seed is not None:
+        if args.samples is not None and args.samples < 1:
+            from rockyade.errors import InputError
+
+            raise InputError("samples", f"must be >= 1, got {args.samples}")
+        study = study.with_samples(args.samples or study.samples, args.seed)
+    n_runs_per_sample = len(study.load_factors) * len(study.solvers)
+    records = 1 if study.pairing == "sampled" else len(study.motions)
+    total = (study.samples * records + (len(study.motions) if study.include_nominal else 0)) * n_runs_per_sample
+    print(
+        f"{study.name}: {study.samples} samples (seed {study.seed}), {total} runs "
+        f"({', '.join(study.solvers)}) -> {args.out}"
+    )
+    for name, text in study.describe_parameters().items():
+        print(f"  {name}: {text}")
+    result = run_uncertainty(
+        study,
+        args.out,
+        executor=args.executor,
+        workers=args.workers,
+        scheduler=args.scheduler,
+        resume=args.resume,
+        progress=not args.quiet,
+    )
+    p = result.probabilities
+    print("P(overturn) per load factor [95 % Wilson band]:")
+    for row in p.itertuples(index=False):
+        print(
+            f"  {row.solver:9s} x{row.load_factor:<5g} {row.p_overturn:.3f} [{row.p_overturn_lo:.3f}, "
+            f"{row.p_overturn_hi:.3f}] of {row.n_runs} runs" + (f" ({row.n_failed} failed)" if row.n_failed else "")
+        )
+    print("fragility (lognormal, maximum likelihood):")
+    for row in result.fragility.itertuples(index=False):
+        fit = f"median {row.median:.4g}, beta {row.beta:.3g}" if row.status == "fitted" else row.status
+        if row.status == "separated":
+            fit += f" (every overturning run is above every other: a threshold near {row.median:.4g}, no slope)"
+        print(f"  {row.solver:9s} {row.measure:24s} {fit}")
+    if result.spread is not None:
+        print("spread caused by the parameters alone (per-sample P(overturn) 5-95 %, nominal):")
+        for row in result.spread.itertuples(index=False):
+            print(
+                f"  {row.solver:9s} x{row.load_factor:<5g} "
+                f"{row.p_overturn_sample_q05:.3f}-{row.p_overturn_sample_q95:.3f} "
+                f"(nominal {row.p_overturn_nominal:.3f}); "
+                f"records with mixed outcomes {100 * row.records_mixed_fraction:.0f} %"
+            )
+    written = ["samples.csv", "summary.csv", "runs.csv", "probabilities.csv", "fragility.csv"]
+    written += ["spread.csv"] if result.spread is not None else []
+    written += ["uncertainty.png"] if result.figure else []
+    print(f"wrote {', '.join(written)}, uncertainty.json in {args.out}")
+    failed = int((result.runs["status"] == "failed").sum())
+    return 1 if failed else 0
+
+
+def register(sub: Any) -> None:
+    """Add ``rockyade uncertainty``."""
+    p = sub.add_parser(
+        "uncertainty",
+        help="probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)",
+        description="Draw alpha, p, mu (normal, lognormal, uniform, or an identification's joint normal) by "
+        "Latin hypercube, run every sample under the records and load factors with each solver (batch engine, "
+        "local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 % Wilson bands, fragility "
+        "fits against intensity measures and the spread due to the parameters. See docs/identification.md.",
+    )
+    p.add_argument("study", type=Path, help="uncertainty study file (.toml)")
+    p.add_argument("--out", type=Path, required=True, help="output directory")
+    p.add_argument("--samples", type=int, help="override the number of parameter samples")
+    p.add_argument("--seed", type=int, help="override the seed of the Latin hypercube")
+    p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
+    p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or a Dask cluster")
+    p.add_argument("--scheduler", help="Dask scheduler address (default: an in-process cluster)")
+    p.add_argument("--resume", action="store_true", help="skip runs already completed")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_uncertainty)

@@ -1,0 +1,43 @@
+"""``rockyade yade-script``: a scene as a standalone YADE script and its data."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+LAUNCHER_WARNING = (
+    "note: YADE's own launcher opens a Python console and an XMLRPC server on all network interfaces "
+    "while it runs (rockyade never uses it); run it only where that is acceptable, or run the script "
+    "with python3.11 and YADE's modules on the path (see docs/yade.md)"
+)
+
+
+def cmd_yade_script(args: argparse.Namespace) -> int:
+    """Write run.py and scene.json for YADE's own launcher."""
+    from rockyade.scene import load_scene
+    from rockyade.solvers.yade import write_script
+
+    paths = write_script(load_scene(args.scene), args.out)
+    out = args.out
+    print(f"wrote {paths['script']} and {paths['data']}")
+    print(f"  batch:        yade -x {out / 'run.py'}")
+    print(f"  with the GUI: yade {out / 'run.py'}")
+    print(f"  without the launcher (no server): /usr/bin/python3.11 {out / 'run.py'}")
+    print(f"  output: {out / 'result.npz'} (rockyade's format) and {out / 'result.csv'}")
+    print(LAUNCHER_WARNING)
+    return 0
+
+
+def register(sub: Any) -> None:
+    """Add ``rockyade yade-script``."""
+    p = sub.add_parser(
+        "yade-script",
+        help="a scene as a standalone YADE script (run.py + scene.json) to go on by hand",
+        description="Write run.py (the script rockyade runs in YADE) and scene.json (the scene's data) "
+        "into a folder. `yade -x DIR/run.py` runs it in batch, `yade DIR/run.py` with YADE's GUI; it "
+        "writes result.npz and result.csv beside itself. " + LAUNCHER_WARNING + ".",
+    )
+    p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
+    p.add_argument("--out", type=Path, required=True, help="folder for run.py and scene.json")
+    p.set_defaults(func=cmd_yade_script)

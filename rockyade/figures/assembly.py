@@ -1,0 +1,501 @@
+"""Drawings of assemblies: the scene at rest with block names, snapshots of a run, animations.
+
+Blocks are drawn in the base frame (positions relative to the base, which is the hatched
+line y = 0): moving blocks in stone colour, fixed blocks (they move with the base) grey and
+hatched. A block's polygon at time t is R(k theta)(v - c) + c + k (x, y): v its vertices at
+rest, c its centroid at rest, and theta, x, y the Result's rotation and centroid
+displacement from rest; k is a display magnification (1: true scale).
+
+Names are written inside blocks at the largest size that fits (along the block's own base
+direction, or across it for tall blocks), and left out where that size would be below
+:data:`MIN_LABEL_PT` (e.g. the units of a 1,000-block wall in one figure).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from matplotlib.collections import PolyCollection
+from matplotlib.colors import LinearSegmentedColormap
+from matplotlib.patches import Rectangle
+
+from rockyade.errors import InputError
+from rockyade.figures.common import plt, save_figure
+from rockyade.result import Result, column
+from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
+
+#: Labels smaller than MIN_LABEL_PT (points) are left out, larger than MAX_LABEL_PT capped;
+#: below READABLE_LABEL_PT for most blocks, no label is printed.
+MIN_LABEL_PT = 4.5
+READABLE_LABEL_PT = 6.0
+MAX_LABEL_PT = 10.0
+STONE = "#dccbaa"
+STONE_EDGE = "#4a3f31"
+FIXED = "#b9b9b9"
+FIGURE_WIDTH_IN = 10.0
+#: Colours of moving blocks by |rotation|: stone at rest, dark red at the largest rotation shown.
+ROTATION_CMAP = LinearSegmentedColormap.from_list("stone_to_red", [STONE, "#e8a15c", "#c0392b", "#5e0d0d"])
+MAX_HEIGHT_IN = 8.0
+
+
+# ---------------------------------------------------------------------- geometry
+
+
+def moving_polygons(placed: Sequence[PlacedBlock], result: Result, index: int, scale: float = 1.0) -> list[np.ndarray]:
+    """Polygons of the blocks at sample ``index`` of ``result``, base frame, m.
+
+    Fixed blocks, and blocks the result has no columns for, are drawn at rest.
+    """
+    names = result.blocks
+    frame = result.frame
+    out = []
+    for b in placed:
+        key = column(b.name, "theta_rad", names)
+        if b.fixed or b.name not in names or key not in frame:
+            out.append(b.vertices_m)
+            continue
+        theta = float(frame[key].iat[index])
+        dx = float(frame[column(b.name, "x_m", names)].iat[index])
+        dy = float(frame[column(b.name, "y_m", names)].iat[index])
+        c = np.asarray(b.centroid_m)
+        out.append((b.vertices_m - c) @ rotation_matrix(scale * theta).T + c + scale * np.array([dx, dy]))
+    return out
+
+
+def rotations(placed: Sequence[PlacedBlock], result: Result, index: int) -> np.ndarray:
+    """|theta| of each block at sample ``index`` (0 for fixed or missing blocks), rad."""
+    names = result.blocks
+    out = np.zeros(len(placed))
+    for i, b in enumerate(placed):
+        key = column(b.name, "theta_rad", names)
+        if not b.fixed and b.name in names and key in result.frame:
+            out[i] = abs(float(result.frame[key].iat[index]))
+    return out
+
+
+def sample_index(result: Result, t_s: float, field: str = "times") -> int:
+    """Index of the sample nearest ``t_s``; InputError outside the result's time span."""
+    t = result.t
+    if t.size == 0:
+        raise InputError(field, "the result has no samples (the run failed)")
+    half = 0.5 * (t[1] - t[0]) if t.size > 1 else 0.0
+    if not (t[0] - half <= t_s <= t[-1] + half):
+        end = f"; the run stopped at {t[-1]:.4g} s ({result.status})" if result.status != "completed" else ""
+        raise InputError(field, f"t = {t_s:g} s is outside the result's {t[0]:g}-{t[-1]:g} s{end}")
+    return int(np.argmin(np.abs(t - t_s)))
+
+
+# ---------------------------------------------------------------------- drawing pieces
+
+
+def _bounds(polygons: Sequence[np.ndarray]) -> tuple[float, float, float, float]:
+    pts = np.vstack(polygons)
+    x0, y0 = pts.min(axis=0)
+    x1, y1 = pts.max(axis=0)
+    return float(x0), float(x1), min(float(y0), 0.0), float(y1)
+
+
+def _limits(bounds: tuple[float, float, float, float]) -> tuple[tuple[float, float], tuple[float, float], float]:
+    """Axis limits with a margin, and the depth of the hatched ground band, m."""
+    x0, x1, y0, y1 = bounds
+    size = max(x1 - x0, y1 - y0)
+    pad = 0.06 * size
+    ground = 0.04 * size
+    return (x0 - pad, x1 + pad), (min(y0, 0.0) - ground - 0.5 * pad, y1 + pad), ground
+
+
+def _line_width(n_blocks: int) -> float:
+    return float(np.clip(1.2 / math.sqrt(max(n_blocks, 1) / 10.0), 0.25, 1.0))
+
+
+def _draw_ground(ax, xlim: tuple[float, float], depth: float) -> None:
+    ax.add_patch(
+        Rectangle(
+            (xlim[0], -depth),
+            xlim[1] - xlim[0],
+            depth,
+            facecolor="white",
+            edgecolor="0.35",
+            hatch="////",
+            linewidth=0.0,
+            zorder=0,
+        )
+    )
+    ax.plot(xlim, (0.0, 0.0), color="black", linewidth=1.6, zorder=3, solid_capstyle="butt")
+
+
+def _draw_blocks(
+    ax,
+    polygons: Sequence[np.ndarray],
+    fixed: Sequence[bool],
+    facecolors=None,
+    zorder: float = 2.0,
+) -> PolyCollection:
+    """Moving blocks as one collection (returned, for animations) and fixed blocks as another."""
+    lw = _line_width(len(polygons))
+    moving = [p for p, f in zip(polygons, fixed, strict=True) if not f]
+    still = [p for p, f in zip(polygons, fixed, strict=True) if f]
+    coll = PolyCollection(
+        moving,
+        facecolors=STONE if facecolors is None else facecolors,
+        edgecolors=STONE_EDGE,
+        linewidths=lw,
+        zorder=zorder,
+    )
+    ax.add_collection(coll)
+    if still:
+        ax.add_collection(
+            PolyCollection(still, facecolors=FIXED, edgecolors="0.25", linewidths=lw, hatch="///", zorder=zorder)
+        )
+    return coll
+
+
+def _draw_rest_outline(ax, rest: Sequence[np.ndarray]) -> None:
+    """The blocks at rest as thin dashed outlines (behind the moving blocks)."""
+    ax.add_collection(
+        PolyCollection(rest, facecolors="none", edgecolors="0.5", linewidths=0.5, linestyles="--", zorder=1)
+    )
+
+
+def _points_per_metre(fig, ax) -> float:
+    """Drawing scale after layout (equal aspect), points per metre."""
+    fig.canvas.draw()
+    (x0, _), (x1, _) = ax.transData.transform([(0.0, 0.0), (1.0, 0.0)])
+    return abs(x1 - x0) * 72.0 / fig.dpi
+
+
+def _label_blocks(fig, ax, placed: Sequence[PlacedBlock]) -> int:
+    """Write each block's name inside it where it fits; return how many were left out.
+
+    Names share one size (the median of what fits, at most MAX_LABEL_PT); a block too small
+    for it gets a smaller one, down to MIN_LABEL_PT, below which its name is left out. When
+    the shared size would be below READABLE_LABEL_PT no name is printed.
+    """
+    scale = _points_per_metre(fig, ax)
+    fits = []
+    for b in placed:
+        local = (b.vertices_m - np.asarray(b.centroid_m)) @ rotation_matrix(-b.rotation_rad).T
+        w, h = np.ptp(local, axis=0) * scale
+        chars = max(len(b.name), 1)
+        along = min(0.7 * h, 0.9 * w / (0.62 * chars), MAX_LABEL_PT)
+        across = min(0.7 * w, 0.9 * h / (0.62 * chars), MAX_LABEL_PT)
+        fits.append((along, 0.0) if along >= 0.8 * across else (across, 90.0))  # prefer along the base
+    common = min(MAX_LABEL_PT, float(np.median([size for size, _ in fits])))
+    if common < READABLE_LABEL_PT:  # most names would be specks: print none
+        return len(placed)
+    skipped = 0
+    for b, (size, turn) in zip(placed, fits, strict=True):
+        if size < MIN_LABEL_PT:
+            skipped += 1
+            continue
+        angle = (math.degrees(b.rotation_rad) + turn + 90.0) % 180.0 - 90.0
+        ax.text(
+            *b.centroid_m,
+            b.name,
+            ha="center",
+            va="center",
+            rotation=angle,
+            rotation_mode="anchor",
+            fontsize=max(min(size, common), MIN_LABEL_PT),
+            color="#2b241b",
+            zorder=5,
+            bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1.0) if b.fixed else None,
+        )
+    return skipped
+
+
+def _figure_for(
+    bounds: tuple[float, float, float, float], panels: tuple[int, int] = (1, 1), width_in: float = FIGURE_WIDTH_IN
+):
+    """A figure whose panels fit the drawing's aspect within ``width_in`` x MAX_HEIGHT_IN."""
+    xlim, ylim, _ = _limits(bounds)
+    aspect = (ylim[1] - ylim[0]) / (xlim[1] - xlim[0])
+    rows, cols = panels
+    panel_w = width_in / cols
+    panel_h = panel_w * aspect
+    if panel_h * rows > MAX_HEIGHT_IN:  # tall assemblies: narrower panels rather than a long strip
+        panel_h = MAX_HEIGHT_IN / rows
+        panel_w = max(panel_h / aspect, 1.2)
+    width = max(panel_w * cols + 1.2, 4.5)
+    height = panel_h * rows + 0.35 * rows + 0.8
+    shared = rows * cols > 1
+    return plt.subplots(
+        rows, cols, figsize=(width, height), squeeze=False, sharex=shared, sharey=shared, layout="constrained"
+    )
+
+
+def _setup_axes(ax, bounds) -> float:
+    xlim, ylim, ground = _limits(bounds)
+    ax.set_xlim(*xlim)
+    ax.set_ylim(*ylim)
+    ax.set_aspect("equal", adjustable="box")
+    spec = ax.get_subplotspec()
+    if spec is None or spec.is_last_row():
+        ax.set_xlabel("x (m)")
+    if spec is None or spec.is_first_col():
+        ax.set_ylabel("y (m)")
+    ax.grid(alpha=0.25, linewidth=0.5)
+    ax.set_axisbelow(True)
+    _draw_ground(ax, xlim, ground)
+    return ground
+
+
+def _title(scene, label: str | None) -> str:
+    n = len(scene.blocks)
+    n_fixed = sum(1 for b in scene.blocks if b.fixed)
+    name = label or (Path(scene.source).name if scene.source else "scene")
+    fixed = f", {n_fixed} fixed (grey, hatched)" if n_fixed else ""
+    return f"{name}: {n} block{'s' if n != 1 else ''}{fixed}"
+
+
+# ---------------------------------------------------------------------- figures
+
+
+def draw_assembly(scene, path: str | Path, title: str | None = None, labels: bool = True) -> int:
+    """Draw a scene's blocks at rest with their names; write a PNG.
+
+    Parameters
+    ----------
+    scene
+        A validated :class:`~rockyade.scene.Scene`.
+    path
+        PNG file to write.
+    title
+        Figure title (default: the scene file name and block counts).
+    labels
+        Write block names (where they fit).
+
+    Returns
+    -------
+    int
+        Number of block names left out because they would be too small to read.
+    """
+    placed = placed_blocks(scene)
+    polygons = [b.vertices_m for b in placed]
+    bounds = _bounds(polygons)
+    fig, axes = _figure_for(bounds)
+    ax = axes[0, 0]
+    _setup_axes(ax, bounds)
+    _draw_blocks(ax, polygons, [b.fixed for b in placed])
+    skipped = _label_blocks(fig, ax, placed) if labels else 0
+    heading = title or _title(scene, None)
+    if skipped:
+        first = min(placed, key=lambda b: (round(b.centroid_m[1], 9), b.centroid_m[0]))
+        last = max(placed, key=lambda b: (round(b.centroid_m[1], 9), b.centroid_m[0]))
+        heading += (
+            f"\n{skipped} names too small to print: bottom left {first.name}, top right {last.name} "
+            "(all in the scene file)"
+        )
+    ax.set_title(heading, fontsize=10)
+    save_figure(fig, path)
+    return skipped
+
+
+def _rotation_norm(placed, result, indices) -> float:
+    peak = max(float(rotations(placed, result, i).max()) for i in indices)
+    return max(peak, 1e-6)
+
+
+def draw_snapshots(
+    scene,
+    result: Result,
+    times_s: Sequence[float],
+    path: str | Path,
+    layout: str = "grid",
+    scale: float = 1.0,
+    title: str | None = None,
+) -> list[Path]:
+    """Draw the moving assembly at chosen times.
+
+    Parameters
+    ----------
+    scene
+        The scene that was run.
+    result
+        Its Result (per block ``theta_rad``, ``x_m``, ``y_m`` from rest).
+    times_s
+        Times to draw, s (the nearest samples are used).
+    path
+        ``layout = "grid"``: the PNG of all panels; ``"files"``: a name from which one PNG per
+        time is made, ``<stem>_t<time>s.png``.
+    layout
+        "grid" or "files".
+    scale
+        Display magnification k of displacements and rotations (1: true scale).
+    title
+        Figure title (default: scene file name and solver).
+
+    Returns
+    -------
+    list of Path
+        Files written.
+    """
+    if layout not in ("grid", "files"):
+        raise InputError("layout", f"must be grid or files, got {layout!r}")
+    if not times_s:
+        raise InputError("times", "give at least one time")
+    if not (math.isfinite(scale) and scale > 0):
+        raise InputError("scale", f"must be a number > 0, got {scale!r}")
+    placed = placed_blocks(scene)
+    indices = [sample_index(result, float(t)) for t in times_s]
+    frames = [moving_polygons(placed, result, i, scale) for i in indices]
+    rest = [b.vertices_m for b in placed]
+    bounds = _bounds(rest + [p for f in frames for p in f])
+    bounds = _clip_bounds(bounds, _bounds(rest))
+    norm = plt.Normalize(0.0, _rotation_norm(placed, result, indices))
+    cmap = ROTATION_CMAP
+    fixed = [b.fixed for b in placed]
+    moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
+    solver = result.meta.get("solver", "")
+    heading = title or (_title(scene, None) + (f" ({solver})" if solver else ""))
+    if scale != 1.0:
+        heading += f"; displacements and rotations x{scale:g}"
+    path = Path(path)
+
+    def panel(ax, k: int) -> None:
+        _setup_axes(ax, bounds)
+        _draw_rest_outline(ax, rest)
+        colours = cmap(norm(rotations(placed, result, indices[k])[moving_idx]))
+        _draw_blocks(ax, frames[k], fixed, facecolors=colours)
+        ax.set_title(f"t = {result.t[indices[k]]:.3f} s", fontsize=10)
+
+    def colourbar(fig, axes) -> None:
+        mappable = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+        bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02)
+        bar.set_label("|rotation from rest| (rad)")
+
+    written: list[Path] = []
+    if layout == "grid":
+        n = len(indices)
+        aspect = (bounds[1] - bounds[0]) / max(bounds[3] - bounds[2], 1e-9)
+        cols = min(n, 3 if aspect < 1.3 else 2 if aspect < 2.6 else 1)
+        rows = math.ceil(n / cols)
+        fig, axes = _figure_for(bounds, (rows, cols), width_in=FIGURE_WIDTH_IN + 1.0)
+        for k in range(rows * cols):
+            ax = axes.flat[k]
+            if k < n:
+                panel(ax, k)
+            else:
+                ax.set_visible(False)
+        colourbar(fig, axes)
+        fig.suptitle(heading + "\nrest positions dashed; positions relative to the base", fontsize=10)
+        save_figure(fig, path)
+        written.append(path)
+    else:
+        for k, i in enumerate(indices):
+            fig, axes = _figure_for(bounds, width_in=FIGURE_WIDTH_IN + 1.0)
+            panel(axes[0, 0], k)
+            colourbar(fig, axes)
+            fig.suptitle(heading, fontsize=10)
+            out = path.with_name(f"{path.stem}_t{result.t[i]:.3f}s.png")
+            save_figure(fig, out)
+            written.append(out)
+    return written
+
+
+def _clip_bounds(bounds, rest_bounds) -> tuple[float, float, float, float]:
+    """The drawn area: everything, but no more than one assembly size beyond the rest bounds
+    sideways and upwards, and not below the base (a block thrown far away leaves the picture
+    rather than shrinking the assembly)."""
+    x0, x1, y0, y1 = rest_bounds
+    size = max(x1 - x0, y1 - y0)
+    return (max(bounds[0], x0 - size), min(bounds[1], x1 + size), max(bounds[2], y0), min(bounds[3], y1 + size))
+
+
+def animation_writer_for(path: str | Path, fps: float):
+    """The matplotlib writer for ``path``: Pillow for .gif, ffmpeg for .mp4.
+
+    Raises
+    ------
+    InputError
+        Another suffix, or a writer that is not available here (saying which is).
+    """
+    from matplotlib import animation
+
+    suffix = Path(path).suffix.lower()
+    if suffix == ".gif":
+        if not animation.writers.is_available("pillow"):
+            raise InputError("animation", "writing a GIF needs Pillow, which is not installed (pip install pillow)")
+        return animation.PillowWriter(fps=fps)
+    if suffix == ".mp4":
+        if not animation.writers.is_available("ffmpeg"):
+            raise InputError(
+                "animation", "writing an MP4 needs ffmpeg, which is not installed here: write a .gif instead"
+            )
+        return animation.FFMpegWriter(fps=fps)
+    raise InputError("animation", f"must end in .gif (Pillow) or .mp4 (ffmpeg), got {suffix or 'no suffix'!r}")
+
+
+def animate(
+    scene,
+    result: Result,
+    path: str | Path,
+    fps: float = 20.0,
+    speed: float = 1.0,
+    scale: float = 1.0,
+    max_frames: int = 600,
+) -> int:
+    """An animation of the run (GIF through Pillow, MP4 through ffmpeg); return the frame count.
+
+    Parameters
+    ----------
+    fps
+        Frames per second of the animation.
+    speed
+        Simulated seconds per second of animation (1: real time, 0.25: slow motion).
+    scale
+        Display magnification of displacements and rotations.
+    max_frames
+        Upper bound on the number of frames (the time step between frames grows to fit).
+    """
+    from matplotlib import animation
+
+    if not (math.isfinite(fps) and fps > 0):
+        raise InputError("fps", f"must be a number > 0, got {fps!r}")
+    if not (math.isfinite(speed) and speed > 0):
+        raise InputError("speed", f"must be a number > 0, got {speed!r}")
+    writer = animation_writer_for(path, fps)
+    t = result.t
+    if t.size == 0:
+        raise InputError("animation", "the result has no samples (the run failed)")
+    step = max(speed / fps, (t[-1] - t[0]) / max(max_frames - 1, 1))
+    times = np.arange(t[0], t[-1] + 0.5 * step, step)
+    indices = [int(np.argmin(np.abs(t - x))) for x in times]
+    placed = placed_blocks(scene)
+    rest = [b.vertices_m for b in placed]
+    frames = [moving_polygons(placed, result, i, scale) for i in indices]
+    bounds = _clip_bounds(_bounds(rest + [p for f in frames for p in f]), _bounds(rest))
+    fig, axes = _figure_for(bounds, width_in=8.0)
+    ax = axes[0, 0]
+    _setup_axes(ax, bounds)
+    _draw_rest_outline(ax, rest)
+    fixed = [b.fixed for b in placed]
+    moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
+    norm = plt.Normalize(0.0, _rotation_norm(placed, result, indices))
+    cmap = ROTATION_CMAP
+    coll = _draw_blocks(ax, frames[0], fixed)
+    clock = ax.set_title("", fontsize=10)
+    note = f" (motion x{scale:g})" if scale != 1.0 else ""
+
+    def update(k: int):
+        coll.set_verts([p for p, f in zip(frames[k], fixed, strict=True) if not f])
+        coll.set_facecolor(cmap(norm(rotations(placed, result, indices[k])[moving_idx])))
+        clock.set_text(f"{_title(scene, None)}\nt = {t[indices[k]]:.2f} s{note}")
+        return coll, clock
+
+    anim = animation.FuncAnimation(fig, update, frames=len(indices), blit=False)
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    # writers need a file name: write beside the target, then rename it in place (atomic)
+    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
+    try:
+        anim.save(str(tmp), writer=writer, dpi=90)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+        plt.close(fig)
+    return len(indices)

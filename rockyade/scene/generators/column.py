@@ -1,0 +1,207 @@
+"""Columns: multi-drum columns (with an optional capital) and stacks of blocks of given sizes.
+
+Both are centred on x = 0 and can be written as an assembly (every block placed by
+``position_m``) or as a column scene (blocks listed bottom to top, no positions: the form
+the Housner solver reads for one or two blocks). The blocks are the same either way.
+
+Block names: drums ``d01`` ... from the bottom and ``capital``; stack blocks ``b01`` ....
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+from rockyade.errors import InputError
+from rockyade.scene.generators.common import (
+    DEFAULT_DENSITY_KG_M3,
+    DEFAULT_DURATION_S,
+    DEFAULT_SAMPLE_DT_S,
+    check_choice,
+    check_count,
+    check_density,
+    check_length,
+    digits,
+    exact,
+    num,
+    paper_contact,
+    rect_block,
+    scene_table,
+)
+
+LAYOUTS = ("positioned", "column")
+TAPERS = ("steps", "continuous")
+MAX_STACK_BLOCKS = 10_000
+
+
+def _block(
+    name: str,
+    bottom_width: Fraction,
+    top_width: Fraction,
+    height: Fraction,
+    y: Fraction,
+    thickness: float,
+    density: float,
+    layout: str,
+) -> dict[str, Any]:
+    """A rectangle (equal widths) or a symmetric trapezoid, base centre at (0, y)."""
+    if bottom_width == top_width:
+        table = rect_block(name, bottom_width, height, Fraction(0), y, thickness, density)
+    else:
+        b, t = bottom_width / 2, top_width / 2
+        table = {
+            "name": name,
+            "vertices_m": [[num(-b), 0.0], [num(b), 0.0], [num(t), num(height)], [num(-t), num(height)]],
+            "thickness_m": float(thickness),
+            "density_kg_m3": float(density),
+            "position_m": [0.0, num(y)],
+        }
+    if layout == "column":
+        del table["position_m"]
+    return table
+
+
+def tapered_widths(
+    blocks: int, bottom_width_m: float, top_width_m: float, taper: str = "steps"
+) -> tuple[list[float], float | None]:
+    """Widths for a linearly tapered :func:`stack` of ``blocks`` blocks, m.
+
+    Returns
+    -------
+    (widths_m, top_width_m)
+        "steps": the blocks' widths from ``bottom_width_m`` (bottom block) to ``top_width_m``
+        (top block), and None. "continuous": the blocks' bottom widths and the top block's
+        top width ``top_width_m``: straight sides from the bottom to the top of the stack.
+    """
+    n = check_count("blocks", blocks, 1, MAX_STACK_BLOCKS)
+    lo = exact(check_length("bottom_width_m", bottom_width_m))
+    hi = exact(check_length("top_width_m", top_width_m))
+    taper = check_choice("taper", taper, TAPERS)
+    if taper == "continuous":
+        return [num(lo + (hi - lo) * k / n) for k in range(n)], num(hi)
+    if n == 1:
+        return [num(lo)], None
+    return [num(lo + (hi - lo) * k / (n - 1)) for k in range(n)], None
+
+
+def stack(
+    widths_m: Sequence[float] = (0.4, 0.35, 0.3, 0.25),
+    heights_m: Sequence[float] | float = 0.6,
+    thickness_m: float = 0.4,
+    taper: str = "steps",
+    top_width_m: float | None = None,
+    layout: str = "positioned",
+    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    motion: Mapping[str, Any] | None = None,
+    contact: Mapping[str, Any] | None = None,
+    duration_s: float = DEFAULT_DURATION_S,
+    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+) -> dict[str, Any]:
+    """A stack of blocks of given sizes, bottom to top, centred on x = 0.
+
+    Parameters
+    ----------
+    widths_m
+        Width of each block, bottom first, m (:func:`tapered_widths` makes a linear taper);
+        with ``taper = "continuous"`` the width of each block's bottom.
+    heights_m
+        Height of each block, m, or one height for all.
+    thickness_m
+        Out-of-plane thickness, m.
+    taper
+        "steps": rectangles (each block as wide as given); "continuous": trapezoids whose
+        bottom is the block's width and top the next block's width (``top_width_m`` for the
+        top block, default its own width), so the sides are straight lines.
+    layout
+        "positioned" (an assembly) or "column" (a column scene).
+    density_kg_m3, motion, contact, duration_s, sample_dt_s
+        As for :func:`~rockyade.scene.generators.wall.wall`; the default contact is the
+        paper's calibration (slender blocks).
+    """
+    if isinstance(widths_m, str) or not isinstance(widths_m, Sequence) or not widths_m:
+        raise InputError("widths_m", "must be a non-empty list of widths in metres")
+    n = check_count("widths_m (number of blocks)", len(widths_m), 1, MAX_STACK_BLOCKS)
+    widths = [exact(check_length(f"widths_m[{i}]", w)) for i, w in enumerate(widths_m)]
+    if isinstance(heights_m, (int, float)):
+        heights = [exact(check_length("heights_m", heights_m))] * n
+    else:
+        if len(heights_m) != n:
+            raise InputError("heights_m", f"needs one height per block ({n}) or a single height, got {len(heights_m)}")
+        heights = [exact(check_length(f"heights_m[{i}]", h)) for i, h in enumerate(heights_m)]
+    thickness = check_length("thickness_m", thickness_m)
+    taper = check_choice("taper", taper, TAPERS)
+    layout = check_choice("layout", layout, LAYOUTS)
+    density = check_density("density_kg_m3", density_kg_m3)
+    if taper == "steps" and top_width_m is not None:
+        raise InputError("top_width_m", 'applies to taper = "continuous" only')
+    last = widths[-1] if top_width_m is None else exact(check_length("top_width_m", top_width_m))
+    tops = widths if taper == "steps" else [*widths[1:], last]
+    blocks = []
+    y = Fraction(0)
+    width_n = digits(n)
+    for i in range(n):
+        blocks.append(_block(f"b{i + 1:0{width_n}d}", widths[i], tops[i], heights[i], y, thickness, density, layout))
+        y += heights[i]
+    return scene_table(
+        blocks,
+        contact=contact if contact is not None else paper_contact(),
+        motion=motion,
+        duration_s=duration_s,
+        sample_dt_s=sample_dt_s,
+    )
+
+
+def drum_column(
+    drums: int = 8,
+    diameter_m: float = 0.3,
+    drum_height_m: float = 0.5,
+    thickness_m: float | None = None,
+    capital_width_m: float | None = None,
+    capital_height_m: float | None = None,
+    layout: str = "positioned",
+    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    motion: Mapping[str, Any] | None = None,
+    contact: Mapping[str, Any] | None = None,
+    duration_s: float = DEFAULT_DURATION_S,
+    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+) -> dict[str, Any]:
+    """A column of ``drums`` equal drums, optionally under a capital (abacus) block.
+
+    Parameters
+    ----------
+    drums
+        Number of drums.
+    diameter_m
+        Drum width in the plane of rocking (the diameter of a round drum), m.
+    drum_height_m
+        Height of each drum, m.
+    thickness_m
+        Out-of-plane thickness, m (default: the diameter).
+    capital_width_m, capital_height_m
+        Give both for a capital block on top (an abacus: a slab wider than the drums).
+    layout, density_kg_m3, motion, contact, duration_s, sample_dt_s
+        As for :func:`stack`.
+    """
+    n = check_count("drums", drums, 1, MAX_STACK_BLOCKS)
+    d = exact(check_length("diameter_m", diameter_m))
+    h = exact(check_length("drum_height_m", drum_height_m))
+    t = num(d) if thickness_m is None else check_length("thickness_m", thickness_m)
+    layout = check_choice("layout", layout, LAYOUTS)
+    density = check_density("density_kg_m3", density_kg_m3)
+    if (capital_width_m is None) != (capital_height_m is None):
+        missing = "capital_height_m" if capital_height_m is None else "capital_width_m"
+        raise InputError(missing, "give both capital_width_m and capital_height_m for a capital, or neither")
+    width_n = digits(n)
+    blocks = [_block(f"d{i + 1:0{width_n}d}", d, d, h, i * h, t, density, layout) for i in range(n)]
+    if capital_width_m is not None:
+        cw = exact(check_length("capital_width_m", capital_width_m))
+        ch = exact(check_length("capital_height_m", capital_height_m))
+        blocks.append(_block("capital", cw, cw, ch, n * h, t, density, layout))
+    return scene_table(
+        blocks,
+        contact=contact if contact is not None else paper_contact(),
+        motion=motion,
+        duration_s=duration_s,
+        sample_dt_s=sample_dt_s,
+    )

@@ -1,0 +1,245 @@
+"""What every generator shares: exact numbers, parameter checks, block tables, the scene table.
+
+Geometry is computed with :class:`fractions.Fraction` from the decimal value of each input
+(``0.1`` is read as 1/10), and converted to the nearest double only when a block table is
+written: a joint's two faces are then the same number, or one rounding apart (< 1e-15 m),
+and the file shows ``0.3`` rather than ``0.30000000000000004``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from fractions import Fraction
+from typing import Any
+
+from rockyade.errors import InputError
+from rockyade.scene.model import MAX_DENSITY_KG_M3, MAX_LENGTH_M
+
+#: Defaults shared by the generators.
+DEFAULT_DENSITY_KG_M3 = 2400.0
+DEFAULT_DURATION_S = 3.0
+DEFAULT_SAMPLE_DT_S = 0.002
+#: The placeholder base motion: a one-sine acceleration pulse (edit it in the scene file).
+DEFAULT_PULSE = {"type": "pulse", "shape": "sine", "amplitude_g": 0.3, "period_s": 0.5, "cycles": 1}
+#: Header comment of written scenes: how to change the placeholder motion.
+MOTION_NOTE = (
+    "[motion] is a placeholder one-sine pulse: edit it (type = pulse | record | synthetic | harmonic | free | rest)"
+)
+#: Joint stiffness per unit area of the UDEC-style default contact, Pa/m (stone or brick
+#: masonry joints are usually modelled with 1e9 to 1e11 Pa/m).
+DEFAULT_JKN_PA_PER_M = 1.0e10
+#: Fraction of critical damping of the default beta_s (see :func:`udec_contact`).
+DEFAULT_JOINT_DAMPING_RATIO = 0.05
+DEFAULT_FRICTION_ANGLE_DEG = 30.0
+
+
+def exact(value: float | int | Fraction) -> Fraction:
+    """The decimal value of ``value`` as an exact fraction (0.1 -> 1/10)."""
+    if isinstance(value, Fraction):
+        return value
+    if isinstance(value, int):
+        return Fraction(value)
+    return Fraction(repr(float(value)))
+
+
+def num(value: Fraction | float) -> float:
+    """The nearest double of an exact value (for the scene table)."""
+    return float(value)
+
+
+# ---------------------------------------------------------------------- checks
+
+
+def check_number(
+    name: str,
+    value: Any,
+    lo: float,
+    hi: float,
+    *,
+    lo_open: bool = False,
+    hi_open: bool = False,
+    unit: str = "",
+) -> float:
+    """``value`` as a float within [lo, hi] (bounds open as asked), else InputError naming ``name``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, Fraction)) or not math.isfinite(float(value)):
+        raise InputError(name, f"must be a number, got {value!r}")
+    x = float(value)
+    low_ok = x > lo if lo_open else x >= lo
+    high_ok = x < hi if hi_open else x <= hi
+    if not (low_ok and high_ok):
+        left = "(" if lo_open else "["
+        right = ")" if hi_open else "]"
+        units = f" {unit}" if unit else ""
+        raise InputError(name, f"must be in {left}{lo:g}, {hi:g}{right}{units}, got {x:g}")
+    return x
+
+
+def check_length(name: str, value: Any, *, zero_ok: bool = False) -> float:
+    """A length in (0, MAX_LENGTH_M] m ([0, ...] with ``zero_ok``)."""
+    return check_number(name, value, 0.0, MAX_LENGTH_M, lo_open=not zero_ok, unit="m")
+
+
+def check_count(name: str, value: Any, lo: int, hi: int) -> int:
+    """An integer in [lo, hi]."""
+    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
+        raise InputError(name, f"must be an integer in [{lo}, {hi}], got {value!r}")
+    return value
+
+
+def check_density(name: str, value: Any) -> float:
+    """A density in (0, MAX_DENSITY_KG_M3] kg/m^3."""
+    return check_number(name, value, 0.0, MAX_DENSITY_KG_M3, lo_open=True, unit="kg/m^3")
+
+
+def check_choice(name: str, value: Any, choices: Sequence[str]) -> str:
+    """One of ``choices``."""
+    if value not in choices:
+        raise InputError(name, f"must be one of {', '.join(choices)}, got {value!r}")
+    return str(value)
+
+
+def digits(count: int) -> int:
+    """Zero-padding width for block numbers 1..count (at least 2: c01, c02, ...)."""
+    return max(2, len(str(count)))
+
+
+# ---------------------------------------------------------------------- tables
+
+
+def rect_block(
+    name: str,
+    width: Fraction,
+    height: Fraction,
+    x: Fraction,
+    y: Fraction,
+    thickness_m: float,
+    density_kg_m3: float,
+    *,
+    fixed: bool = False,
+) -> dict[str, Any]:
+    """A ``[[blocks]]`` table of a rectangle whose base edge centre sits at (x, y), m."""
+    table: dict[str, Any] = {
+        "name": name,
+        "width_m": num(width),
+        "height_m": num(height),
+        "thickness_m": float(thickness_m),
+        "density_kg_m3": float(density_kg_m3),
+        "position_m": [num(x), num(y)],
+    }
+    if fixed:
+        table["fixed"] = True
+    return table
+
+
+def polygon_block(
+    name: str,
+    vertices_m: Sequence[Sequence[float]],
+    position_m: Sequence[float],
+    rotation_rad: float,
+    thickness_m: float,
+    density_kg_m3: float,
+    *,
+    fixed: bool = False,
+) -> dict[str, Any]:
+    """A ``[[blocks]]`` table of a polygon given in its own frame, placed and rotated."""
+    table: dict[str, Any] = {
+        "name": name,
+        "vertices_m": [[float(x), float(y)] for x, y in vertices_m],
+        "thickness_m": float(thickness_m),
+        "density_kg_m3": float(density_kg_m3),
+        "position_m": [float(position_m[0]), float(position_m[1])],
+    }
+    if rotation_rad != 0.0:
+        table["rotation_rad"] = float(rotation_rad)
+    if fixed:
+        table["fixed"] = True
+    return table
+
+
+def paper_contact() -> dict[str, Any]:
+    """``[contact]`` of the paper's calibration (Eqs 10-15 from the block above each bed joint).
+
+    For slender blocks (columns, frames, stacks): the paper's equations need
+    1 - 1.5 sin^2(alpha) > 0, i.e. blocks taller than about 1.6 x their width.
+    """
+    return {"calibration": "paper"}
+
+
+def udec_contact(
+    unit_height_m: float,
+    density_kg_m3: float,
+    jkn_Pa_per_m: float = DEFAULT_JKN_PA_PER_M,
+    damping_ratio: float = DEFAULT_JOINT_DAMPING_RATIO,
+    friction_angle_deg: float = DEFAULT_FRICTION_ANGLE_DEG,
+) -> dict[str, Any]:
+    """``[contact]`` with UDEC-style joint stiffness per unit area and an explicit damping.
+
+    The paper's calibration (Eqs 10-15) holds for slender blocks only, so masonry units
+    (often wider than tall) get explicit joints: normal and shear stiffness ``jkn`` per unit
+    area (K = jkn x L/2 x t per contact point) and the stiffness-proportional damping
+    ``beta_s = 2 zeta / omega`` that gives a unit on its bed joint the fraction ``zeta`` of
+    critical damping in vertical vibration, omega = sqrt(jkn / (rho h)) (two points of
+    stiffness jkn L t / 2 carrying a mass rho L h t).
+    """
+    omega = math.sqrt(jkn_Pa_per_m / (density_kg_m3 * unit_height_m))
+    beta = 2.0 * damping_ratio / omega
+    return {
+        "jkn_Pa_per_m": float(jkn_Pa_per_m),
+        "jks_Pa_per_m": float(jkn_Pa_per_m),
+        "beta_s": float(f"{beta:.3g}"),
+        "friction_angle_deg": float(friction_angle_deg),
+    }
+
+
+def pulse_motion(amplitude_g: float = 0.3, period_s: float = 0.5, shape: str = "sine", cycles: int = 1) -> dict:
+    """A ``[motion]`` table: an acceleration pulse (see rockyade.motion.types)."""
+    return {
+        "type": "pulse",
+        "shape": shape,
+        "amplitude_g": float(amplitude_g),
+        "period_s": float(period_s),
+        "cycles": int(cycles),
+    }
+
+
+def free_motion(block: str, theta0_rad: float) -> dict:
+    """A ``[motion]`` table: free rocking of ``block`` (and what rests on it) from ``theta0_rad``."""
+    return {"type": "free", "theta0_rad": float(theta0_rad), "block": block}
+
+
+def rest_motion() -> dict:
+    """A ``[motion]`` table: the base at rest (does the assembly stand?)."""
+    return {"type": "rest"}
+
+
+def record_motion(file: str, load_factor: float = 1.0, **options: Any) -> dict:
+    """A ``[motion]`` table: a recorded accelerogram (``file`` relative to the scene file)."""
+    table = {"type": "record", "file": str(file), **options}
+    if load_factor != 1.0:
+        table["load_factor"] = float(load_factor)
+    return table
+
+
+def scene_table(
+    blocks: list[dict[str, Any]],
+    *,
+    contact: Mapping[str, Any],
+    motion: Mapping[str, Any] | None,
+    duration_s: float,
+    sample_dt_s: float,
+    joints: list[dict[str, Any]] | None = None,
+) -> dict[str, Any]:
+    """The scene dictionary (keys in the order a reader expects them in the file)."""
+    check_number("duration_s", duration_s, 0.0, 1.0e5, lo_open=True, unit="s")
+    check_number("sample_dt_s", sample_dt_s, 0.0, duration_s, lo_open=True, unit="s")
+    data: dict[str, Any] = {
+        "duration_s": float(duration_s),
+        "sample_dt_s": float(sample_dt_s),
+        "contact": dict(contact),
+        "motion": dict(motion if motion is not None else DEFAULT_PULSE),
+        "blocks": blocks,
+    }
+    if joints:
+        data["joints"] = joints
+    return data

@@ -1,0 +1,73 @@
+"""Shared pieces of the fuzz suite (tests/test_fuzz_*.py): outcome counting and settings.
+
+Every fuzz case ends in one of: ``accepted`` (the input was valid), ``clean error`` (a
+:class:`~rockyade.errors.RockyadeError` naming the field, or argparse's usage error), a
+``traceback`` (any other exception: the test fails), a ``hang`` (over :data:`HANG_S`: the
+test fails) or ``data lost`` (a damaged record read as if whole: the test fails).
+
+``ROCKYADE_FUZZ_EXAMPLES`` sets the number of cases per test (default: quick enough for
+``make test``); ``pytest -s`` prints the counts.
+"""
+
+from __future__ import annotations
+
+import collections
+import os
+import time
+from collections.abc import Callable
+from typing import Any
+
+from hypothesis import HealthCheck, settings
+
+from rockyade.errors import RockyadeError
+
+#: Seconds after which one case counts as a hang.
+HANG_S = 20.0
+
+COUNTS: dict[str, collections.Counter[str]] = collections.defaultdict(collections.Counter)
+
+
+def fuzz_settings(default: int) -> settings:
+    """Hypothesis settings of a fuzz test: ``default`` cases unless the environment says."""
+    examples = int(os.environ.get("ROCKYADE_FUZZ_EXAMPLES", default))
+    return settings(
+        max_examples=examples,
+        deadline=None,
+        suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
+        database=None,
+        derandomize=os.environ.get("ROCKYADE_FUZZ_RANDOM") is None,
+    )
+
+
+def outcome(suite: str, call: Callable[[], Any], clean: tuple[type[BaseException], ...] = (RockyadeError,)) -> Any:
+    """Run one case, count its outcome, re-raise anything that is not a clean error."""
+    start = time.perf_counter()
+    try:
+        value = call()
+    except clean:
+        COUNTS[suite]["clean error"] += 1
+        _check_time(suite, start)
+        return None
+    except BaseException:
+        COUNTS[suite]["traceback"] += 1
+        raise
+    COUNTS[suite]["accepted"] += 1
+    _check_time(suite, start)
+    return value
+
+
+def _check_time(suite: str, start: float) -> None:
+    elapsed = time.perf_counter() - start
+    if elapsed > HANG_S:
+        COUNTS[suite]["hang"] += 1
+        raise AssertionError(f"{suite}: a case took {elapsed:.1f} s (a hang)")
+
+
+def report(suite: str) -> str:
+    """One line of counts for a suite."""
+    c = COUNTS[suite]
+    tried = sum(c[k] for k in ("accepted", "clean error", "traceback"))
+    return (
+        f"fuzz {suite}: {tried} cases, {c['accepted']} accepted, {c['clean error']} clean errors, "
+        f"{c['traceback']} tracebacks, {c['hang']} hangs, {c['data lost']} data lost"
+    )
