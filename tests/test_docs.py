@@ -25,8 +25,9 @@ BIN = Path(sys.executable).parent
 #: Paths of the development machine that users do not have (spelled so that this file
 #: does not contain them).
 OUTSIDE = ("../" + "shared", "/work/" + "shared")
-#: Commands of the docs that need more than a test can give: the whole paper study (make run).
-NOT_RUN_HERE = ("rockyade paper",)
+#: Commands of the docs that need more than a test can give: the whole paper study (make run
+#: runs it) and a Dask cluster (placeholder address).
+NOT_RUN_HERE = ("rockyade paper", "SCHEDULER")
 
 
 def _commands(page: Path) -> list[str]:
@@ -41,11 +42,6 @@ def _commands(page: Path) -> list[str]:
 
 #: Each documented command once (pages repeat some), with the first page that shows it.
 COMMANDS = {command: page.relative_to(ROOT).as_posix() for page in reversed(PAGES) for command in _commands(page)}
-#: The YADE backend fails with a relative output folder until issue 10, item 1 is fixed
-#: (FileNotFoundError on 'x.yade.json'); only that exact failure is tolerated, as xfail.
-YADE_RELATIVE_BUG = re.compile(r"No such file or directory: '[^'/][^']*\.yade\.json'")
-
-
 def _python_blocks() -> list[tuple[str, str]]:
     return [
         (page.relative_to(ROOT).as_posix(), block)
@@ -135,8 +131,6 @@ def test_documented_command_runs_as_printed(command, tmp_path):
     args = shlex.split(command)
     args[0] = str(BIN / Path(args[0]).name)
     proc = subprocess.run(args, cwd=_fresh_checkout(tmp_path), capture_output=True, text=True, timeout=600)
-    if proc.returncode != 0 and YADE_RELATIVE_BUG.search(proc.stdout + proc.stderr):
-        pytest.xfail("YADE with a relative output folder (issue 10, item 1)")
     assert proc.returncode == 0, f"{COMMANDS[command]}: {command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
 
 

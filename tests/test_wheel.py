@@ -76,12 +76,11 @@ def test_the_wheel_carries_the_package_data_and_runs_from_another_folder(install
 
     _run([rockyade, "run", "scene.toml", "--solver", "housner", "--out", "sub/h.csv"], work)
     assert json.loads((work / "sub/h.json").read_text())["status"] == "completed"
-    # YADE: the driver script and the payload come from the wheel. The output folder is
-    # absolute until the relative-path fix of the YADE backend lands (issue 10, item 1).
+    # YADE: the driver script and the payload come from the wheel; a relative output folder
     if not yade_backend.yade_available():
         message = f"YADE is not installed ({yade_backend.YADE_PYTHON}): apt-get install yade"
         if os.environ.get("ROCKYADE_REQUIRE_YADE") == "1":
             pytest.fail(message)
         pytest.skip(message)
-    _run([rockyade, "run", "scene.toml", "--solver", "yade", "--out", str(work / "sub/y.csv")], work)
+    _run([rockyade, "run", "scene.toml", "--solver", "yade", "--out", "sub/y.csv"], work)
     assert json.loads((work / "sub/y.json").read_text())["status"] == "completed"

@@ -19,12 +19,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib.cm import ScalarMappable
 from matplotlib.collections import PolyCollection
-from matplotlib.colors import LinearSegmentedColormap
+from matplotlib.colors import LinearSegmentedColormap, Normalize
 from matplotlib.patches import Rectangle
 
 from rockyade.errors import InputError
-from rockyade.figures.common import plt, save_figure
+from rockyade.figures.common import file_figure, save_figure
 from rockyade.result import Result, column
 from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
 
@@ -223,7 +224,7 @@ def _figure_for(
     width = max(panel_w * cols + 1.2, 4.5)
     height = panel_h * rows + 0.35 * rows + 0.8
     shared = rows * cols > 1
-    return plt.subplots(
+    return file_figure(
         rows, cols, figsize=(width, height), squeeze=False, sharex=shared, sharey=shared, layout="constrained"
     )
 
@@ -346,7 +347,7 @@ def draw_snapshots(
     rest = [b.vertices_m for b in placed]
     bounds = _bounds(rest + [p for f in frames for p in f])
     bounds = _clip_bounds(bounds, _bounds(rest))
-    norm = plt.Normalize(0.0, _rotation_norm(placed, result, indices))
+    norm = Normalize(0.0, _rotation_norm(placed, result, indices))
     cmap = ROTATION_CMAP
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
@@ -364,7 +365,7 @@ def draw_snapshots(
         ax.set_title(f"t = {result.t[indices[k]]:.3f} s", fontsize=10)
 
     def colourbar(fig, axes) -> None:
-        mappable = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
+        mappable = ScalarMappable(norm=norm, cmap=cmap)
         bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02)
         bar.set_label("|rotation from rest| (rad)")
 
@@ -475,7 +476,7 @@ def animate(
     _draw_rest_outline(ax, rest)
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
-    norm = plt.Normalize(0.0, _rotation_norm(placed, result, indices))
+    norm = Normalize(0.0, _rotation_norm(placed, result, indices))
     cmap = ROTATION_CMAP
     coll = _draw_blocks(ax, frames[0], fixed)
     clock = ax.set_title("", fontsize=10)
@@ -497,5 +498,4 @@ def animate(
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
-        plt.close(fig)
     return len(indices)

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open
 
-__all__ = ["axes_list", "new_figure", "save_figure"]
+__all__ = ["axes_list", "file_figure", "new_figure", "save_figure"]
 
 
 def new_figure(path: str | Path | None = None, nrows: int = 1, ncols: int = 1, **subplots: Any) -> tuple[Figure, Any]:
@@ -36,12 +36,19 @@ def new_figure(path: str | Path | None = None, nrows: int = 1, ncols: int = 1, *
     nrows, ncols, **subplots
         Passed to ``Figure.subplots`` (``figsize`` goes to the figure).
     """
-    figsize = subplots.pop("figsize", None)
     if path is None:
         import matplotlib.pyplot as plt  # only for figures meant for the screen
 
-        return plt.subplots(nrows, ncols, figsize=figsize, **subplots)
-    fig = Figure(figsize=figsize)
+        return plt.subplots(nrows, ncols, **subplots)
+    return file_figure(nrows, ncols, **subplots)
+
+
+def file_figure(nrows: int = 1, ncols: int = 1, **subplots: Any) -> tuple[Figure, Any]:
+    """A figure outside pyplot, drawn by Agg (for files and animations), and its axes.
+
+    ``figsize`` and ``layout`` go to the Figure, the rest to ``Figure.subplots``.
+    """
+    fig = Figure(figsize=subplots.pop("figsize", None), layout=subplots.pop("layout", None))
     FigureCanvasAgg(fig)
     return fig, fig.subplots(nrows, ncols, **subplots)
 

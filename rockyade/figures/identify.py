@@ -6,10 +6,12 @@ import math
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from scipy import stats
 
 from rockyade.analysis.identify import CONFIDENCE, Identification, error_surface
-from rockyade.figures.common import plt, save_figure
+from rockyade.figures.common import new_figure, save_figure
 
 
 def _value_text(result: Identification, name: str, unit: str, digits: int) -> str:
@@ -20,12 +22,12 @@ def _value_text(result: Identification, name: str, unit: str, digits: int) -> st
     return f"{name.split('_')[0]} = {v:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]{unit}"
 
 
-def plot_fit(result: Identification, path: str | Path) -> None:
+def plot_fit(result: Identification, path: str | Path) -> tuple[Figure, tuple[Axes, Axes]]:
     """Measured rotation, the fitted Housner history and the residuals (two panels)."""
     h = result.history
     modelled = result.modelled()
     resid = h.theta_rad - modelled
-    fig, (ax, axr) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    fig, (ax, axr) = new_figure(path, 2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
     ax.plot(h.t_s, h.theta_rad, ".", ms=2.0, color="0.45", label=f"measured ({h.rate_hz:.4g} Hz)")
     ax.plot(h.t_s, modelled, "-", lw=1.1, color="C3", label="Housner, identified parameters")
     ax.axhline(result.fit.offset_rad, color="0.6", lw=0.6, ls="--", label=f"offset {result.fit.offset_rad:.3g} rad")
@@ -62,9 +64,10 @@ def plot_fit(result: Identification, path: str | Path) -> None:
             wrap=True,
         )
     save_figure(fig, path)
+    return fig, (ax, axr)
 
 
-def plot_error_surface(result: Identification, path: str | Path, n: int = 41) -> None:
+def plot_error_surface(result: Identification, path: str | Path, n: int = 41) -> tuple[Figure, Axes]:
     """RMS misfit over the alpha-p plane (other unknowns at the optimum), with the optimum and
     the joint 95 % confidence ellipse of (alpha, p)."""
     fit = result.fit
@@ -76,7 +79,7 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
     alphas, ps, rms = error_surface(
         result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n
     )
-    fig, ax = plt.subplots(figsize=(7.4, 5.8))
+    fig, ax = new_figure(path, figsize=(7.4, 5.8))
     levels = np.geomspace(rms.min(), rms.max(), 16)
     cs = ax.contourf(alphas, ps, rms, levels=levels, cmap="viridis_r", norm=_log_norm(levels))
     ax.contour(alphas, ps, rms, levels=levels, colors="k", linewidths=0.3)
@@ -94,6 +97,7 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
     )
     ax.legend(loc="upper right", fontsize=8)
     save_figure(fig, path)
+    return fig, ax
 
 
 def _log_norm(levels: np.ndarray):

@@ -11,7 +11,7 @@ import pandas as pd
 
 from rockyade.analysis.exceedance import level_column
 from rockyade.analysis.fragility import Fragility, wilson_interval
-from rockyade.figures.common import plt, save_figure
+from rockyade.figures.common import new_figure, save_figure
 from rockyade.motion.intensity import LABELS
 
 SOLVER_COLOURS = {"housner": "C0", "reference": "C1", "yade": "C2"}
@@ -29,13 +29,13 @@ def plot_uncertainty(
     spread: pd.DataFrame | None,
     path: str | Path,
     n_bins: int = 8,
-) -> None:
+) -> tuple[Any, Any]:
     """Three panels: P(overturn) and P(theta/alpha >= level) against the load factor with 95 %
     Wilson bands; the fragility against the study's first intensity measure (binned fractions
     with their bands, and the fitted lognormal curve); per-sample P(overturn) against the
     nominal block (pairing "all"), or the peak theta/alpha of every run."""
     measure = study.measures[0]
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.8))
+    fig, axes = new_figure(path, 1, 3, figsize=(16, 4.8))
     ax = axes[0]
     styles = ["--", ":", "-."]
     for k, (solver, group) in enumerate(probabilities.groupby("solver")):
@@ -124,3 +124,4 @@ def plot_uncertainty(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     save_figure(fig, path)
+    return fig, axes
