@@ -42,12 +42,24 @@ def _commands(page: Path) -> list[str]:
 
 #: Each documented command once (pages repeat some), with the first page that shows it.
 COMMANDS = {command: page.relative_to(ROOT).as_posix() for page in reversed(PAGES) for command in _commands(page)}
-def _python_blocks() -> list[tuple[str, str]]:
-    return [
-        (page.relative_to(ROOT).as_posix(), block)
-        for page in PAGES
-        for block in re.findall(r"```python\n(.*?)```", page.read_text(), re.S)
-    ]
+
+
+def _python_blocks() -> list[tuple[str, str, list[str]]]:
+    """(page, code, setup): each Python block, with the page's earlier commands whose ``--out``
+    is a file the block names (it reads what they wrote)."""
+    out = []
+    for page in PAGES:
+        text = page.read_text()
+        for m in re.finditer(r"```python\n(.*?)```", text, re.S):
+            code = m.group(1)
+            quoted = set(re.findall(r"[\"']([^\"'\s]+\.\w+)[\"']", code))
+            setup = [
+                c.group(1).strip()
+                for c in re.finditer(r"^\s*(?:\$ )?(?:\.venv/bin/)?(rockyade .*)$", text[: m.start()], re.M)
+                if quoted & set(re.findall(r"--out (\S+)", c.group(1)))
+            ]
+            out.append((page.relative_to(ROOT).as_posix(), code, setup))
+    return out
 
 
 def _fresh_checkout(tmp_path: Path) -> Path:
@@ -134,9 +146,13 @@ def test_documented_command_runs_as_printed(command, tmp_path):
     assert proc.returncode == 0, f"{COMMANDS[command]}: {command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
 
 
-@pytest.mark.parametrize(("page", "code"), _python_blocks(), ids=[p for p, _ in _python_blocks()])
-def test_documented_python_runs_as_printed(page, code, tmp_path):
+@pytest.mark.parametrize(("page", "code", "setup"), _python_blocks(), ids=[p for p, _, _ in _python_blocks()])
+def test_documented_python_runs_as_printed(page, code, setup, tmp_path):
     (_fresh_checkout(tmp_path) / "runs").mkdir()
+    for command in setup:  # the page's commands that write what the block reads
+        args = shlex.split(command)
+        proc = subprocess.run([str(BIN / args[0]), *args[1:]], cwd=tmp_path, capture_output=True, text=True)
+        assert proc.returncode == 0, f"{page}: {command}\n{proc.stderr[-2500:]}"
     proc = subprocess.run(
         [sys.executable, "-c", code],
         cwd=tmp_path,
