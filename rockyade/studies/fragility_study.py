@@ -199,6 +199,8 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
                 label = f"{SOLVER_LABELS[solver]}: {fit.status} in the tested range, no fit"
             if fit.failed_runs:
                 label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
+            elif fit.runs < fits[fits.specimen == specimen].runs.max():  # a subset (YADE): say how small
+                label += f" ({int(pts.n_records.max())} records x {len(pts)} load factors)"
             ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
             if fit.status == "fitted":
                 curve = Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x)
@@ -232,9 +234,10 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
             ax.plot([], [], ls="none", marker="x", color="#b2182b", label=text)
         ax.set_title(specimen.replace("specimen", "specimen "))
         ax.set_xlim(0, x_max)
-        ax.set_ylim(-0.03, 1.03)
+        ax.set_ylim(-0.03, 1.32)  # headroom for the legend above the curves
+        ax.set_yticks(np.linspace(0, 1, 6))
         ax.grid(alpha=0.3)
-        legend = ax.legend(fontsize=7, loc="best")
+        legend = ax.legend(fontsize=7, loc="upper left")  # curves rise to the right: that corner is free
         for text in legend.get_texts():
             if "no curve" in text.get_text():
                 text.set_color("#b2182b")
