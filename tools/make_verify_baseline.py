@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.scene import load_scene
 from rockyade.solvers import run
 

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 
 
 def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]]:

@@ -13,7 +13,7 @@ import math
 import pandas as pd
 
 from rockyade import paper
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.dem.matching import build_matched_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import plt, save_figure

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade import paper
-from rockyade.analysis.peaks import find_peaks
+from rockyade.blocks.restitution import find_peaks
 from rockyade.errors import CalibrationError
 from rockyade.figures import plt, save_figure
 from rockyade.scene import scene_from_dict
