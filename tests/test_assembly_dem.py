@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.analysis.peaks import find_peaks
+from rockyade.blocks.restitution import find_peaks
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model
 from rockyade.scene import scene_from_dict

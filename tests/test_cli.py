@@ -106,7 +106,7 @@ def test_run_housner_writes_csv_whose_peaks_give_mu(capsys, examples_dir, tmp_pa
     )
     assert code == 0 and "effective mu = 0.936" in out
     result = Result.read(out_csv)
-    from rockyade.analysis.peaks import effective_restitution, find_peaks
+    from rockyade.blocks.restitution import effective_restitution, find_peaks
 
     mu = effective_restitution(find_peaks(result.t, result.series("theta_rad")), 0.235)
     assert mu == pytest.approx(0.936, abs=2e-5)

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.analysis.peaks import effective_restitution, find_peaks, restitution_per_impact
+from rockyade.blocks.restitution import effective_restitution, find_peaks, restitution_per_impact
 from rockyade.constants import G
 from rockyade.motion.ground import GroundMotion
 from rockyade.scene import scene_from_dict

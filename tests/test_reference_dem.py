@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rockyade import paper
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
 from rockyade.dem.matching import build_matched_model, match_beta

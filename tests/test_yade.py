@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from rockyade import paper
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.dem import yade_payload
 from rockyade.dem.matching import build_matched_model, match_beta
 from rockyade.result import Result

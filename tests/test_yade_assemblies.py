@@ -17,7 +17,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.analysis.peaks import find_peaks
+from rockyade.blocks.restitution import find_peaks
 from rockyade.dem.matching import build_matched_model
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.dem.yade_contacts import BASE_BIT, N_LABELS, body_row, plan_contacts

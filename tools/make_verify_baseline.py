@@ -4,12 +4,15 @@ Run once per release from the repository root (it takes about a minute with YADE
 
     .venv/bin/python tools/make_verify_baseline.py rockyade/studies/data/baseline_0_1.csv
 
-The verification report compares the current DEMs with this file (issue: the paper study's
-single-block and bi-block results must not change when the contact code changes).
+It also writes the scenes themselves (``baseline_scenes.json`` beside it), so that the
+check runs from an installed wheel. The verification report compares the current DEMs with
+this file: the paper study's single-block and bi-block results must not change when the
+contact code changes.
 """
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -17,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.scene import load_scene
 from rockyade.solvers import run
 
@@ -63,6 +66,8 @@ def main(out: str) -> None:
                     row[f"peak{k + 1}_time_s"] = float(peaks.t_s[k]) if len(peaks) > k else np.nan
                 rows.append(row)
                 print(example, calibration, solver, spec.name, result.status, row["peak1_rad"], row["mu_eff"])
+    scenes = {example: load_scene(ROOT / "examples" / f"{example}.toml").to_dict() for example, _ in CASES}
+    (Path(out).parent / "baseline_scenes.json").write_text(json.dumps(scenes, indent=1, sort_keys=True) + "\n")
     frame = pd.DataFrame(rows)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w") as fh:

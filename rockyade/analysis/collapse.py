@@ -106,7 +106,7 @@ def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeo
         theta = _series(result, "theta_rad", g.name)
         x = _series(result, "x_m", g.name)
         y = _series(result, "y_m", g.name)
-        fallen = _fallen_mask(theta, y, g)
+        fallen = _fallen_mask(theta, y, g, t, _solver_fall_time(result, g.name))
         # the rest-frame middle of the base, rotated with the block, relative to its rest place
         c, s = np.cos(theta), np.sin(theta)
         bx = x + c * g.base_mid_m[0] - s * g.base_mid_m[1] - g.base_mid_m[0]
@@ -121,10 +121,18 @@ def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeo
     return states, geometry
 
 
-def _fall_and_tip(theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry) -> tuple[int, int]:
-    """Sample of the fall and of the tip that led to it (see module docstring), -1 if none."""
+def _fall_and_tip(
+    theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry, t: NDArray[np.float64], t_solver: float | None
+) -> tuple[int, int]:
+    """Sample of the fall and of the tip that led to it (see module docstring), -1 if none.
+
+    ``t_solver`` is the time at which the solver itself found the block overturned (between
+    samples, ``meta["overturn_times_s"]``): a run that stops there ends before a sample shows it.
+    """
     finite = np.isfinite(theta)
     landed = (theta >= g.landing_rad[0] - LANDING_TOL_RAD) | (theta <= -(g.landing_rad[1] - LANDING_TOL_RAD))
+    if t_solver is not None and finite.any():
+        landed |= t >= min(t_solver, float(t[np.flatnonzero(finite)[-1]]))
     dropped = y < -DROP_FRACTION * g.height_m
     beyond = (np.abs(theta) > g.alpha_rad) & finite
     hits = np.flatnonzero((landed | dropped) & finite)
@@ -141,10 +149,21 @@ def _fall_and_tip(theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGe
     return (tip if fall == -2 else fall), tip
 
 
-def _fallen_mask(theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry) -> NDArray[np.bool_]:
+def _solver_fall_time(result: Result, name: str) -> float | None:
+    times = result.meta.get("overturn_times_s") or {}
+    if name in times:
+        return float(times[name])
+    if result.meta.get("overturned_block") == name and result.meta.get("overturn_time_s") is not None:
+        return float(result.meta["overturn_time_s"])
+    return None
+
+
+def _fallen_mask(
+    theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry, t: NDArray[np.float64], t_solver: float | None
+) -> NDArray[np.bool_]:
     """True from the sample where the block fell for good."""
     mask = np.zeros(theta.size, dtype=bool)
-    fall, _ = _fall_and_tip(theta, y, g)
+    fall, _ = _fall_and_tip(theta, y, g, t, t_solver)
     if fall >= 0:
         mask[fall:] = True
     return mask
@@ -167,7 +186,7 @@ def collapse_report(scene, result: Result) -> pd.DataFrame:
         finite = np.isfinite(theta)
         fell = np.flatnonzero(states[:, j] == FALLEN)
         last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
-        _, tip = _fall_and_tip(theta, _series(result, "y_m", g.name), g)
+        _, tip = _fall_and_tip(theta, _series(result, "y_m", g.name), g, t, _solver_fall_time(result, g.name))
         rows.append(
             {
                 "block": g.name,

@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.result import Result
 from rockyade.scene import Scene
 

@@ -23,7 +23,7 @@ from scipy import optimize
 
 from rockyade.analysis.free_rocking_model import FreeRockingFit, IdentificationError
 from rockyade.analysis.measurement import MeasuredHistory
-from rockyade.analysis.peaks import effective_restitution
+from rockyade.blocks.restitution import effective_restitution
 from rockyade.solvers.housner import HousnerModel, solve
 
 

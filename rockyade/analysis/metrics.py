@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 
 
 def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]]:
@@ -33,6 +33,8 @@ def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]
     t = result.t
     free = scene.motion.type == "free"
     for spec in scene.blocks:
+        if spec.fixed:
+            continue
         alpha = spec.classical().alpha_rad
         theta = result.series("theta_rad", spec.name)
         finite = theta[np.isfinite(theta)]
@@ -47,6 +49,36 @@ def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]
             "mu_eff": effective_restitution(peaks, alpha, n_impacts) if free else math.nan,
             "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
             "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
-            "overturned": result.meta.get("overturned_block") == spec.name,
+            "overturned": result.meta.get("overturned_block") == spec.name
+            or spec.name in (result.meta.get("overturn_times_s") or {}),
         }
     return out
+
+
+#: Assemblies with more blocks than this get aggregate metrics only (batch rows, CLI summary).
+PER_BLOCK_LIMIT = 10
+
+
+def assembly_metrics(scene, result) -> dict[str, float]:
+    """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
+    ``n_blocks``, ``n_fallen``, ``fallen_fraction``, ``first_fall_time_s``, ``first_fallen_block``,
+    ``max_abs_theta_rad`` and its block, ``max_residual_displacement_m`` and its block."""
+    from rockyade.analysis.collapse import collapse_report
+
+    report = collapse_report(scene, result)
+    fallen = report[report["fell"]]
+    residual = np.hypot(report["residual_x_m"], report["residual_y_m"])
+    first = fallen.sort_values("fall_time_s").iloc[0] if len(fallen) else None
+    k_theta = int(np.nanargmax(report["max_abs_theta_rad"])) if len(report) else -1
+    k_disp = int(np.nanargmax(residual)) if len(report) else -1
+    return {
+        "n_blocks": len(report),
+        "n_fallen": len(fallen),
+        "fallen_fraction": float(len(fallen) / max(len(report), 1)),
+        "first_fall_time_s": float(first["fall_time_s"]) if first is not None else math.nan,
+        "first_fallen_block": str(first["block"]) if first is not None else "",
+        "max_abs_theta_rad": float(report["max_abs_theta_rad"].iloc[k_theta]) if k_theta >= 0 else math.nan,
+        "max_theta_block": str(report["block"].iloc[k_theta]) if k_theta >= 0 else "",
+        "max_residual_displacement_m": float(residual.iloc[k_disp]) if k_disp >= 0 else math.nan,
+        "max_residual_block": str(report["block"].iloc[k_disp]) if k_disp >= 0 else "",
+    }

@@ -229,6 +229,27 @@ class ContactParameters:
         d["notes"] = list(self.notes)
         return d
 
+    def report(self) -> dict[str, object]:
+        """The keys ``rockyade calibrate --json`` prints (names as the command documents them)."""
+        return {
+            "K_N_per_m": self.K_N_per_m,
+            "Ks_N_per_m": self.Ks_N_per_m,
+            "beta_s": self.beta_s,
+            "beta_eq13_s": self.beta_eq13_s,
+            "xi_min": self.xi_min,
+            "f_min_hz": self.f_min_hz,
+            "b_eq_m": self.b_eq_m,
+            "dt_s": self.dt_eq7_s,
+            "friction_angle_deg": self.friction_angle_deg,
+            "cohesion_Pa": self.cohesion_Pa,
+            "stiffness_scale": self.stiffness_reading,
+            "stiffness_scale_factor": self.stiffness_scale,
+            "K_paper_units": self.K_paper,
+            "gamma": self.gamma,
+            "settlement_m": self.settlement_m,
+            "notes": list(self.notes),
+        }
+
 
 def paper_calibration(
     block: Block,

@@ -43,6 +43,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.build",
     "rockyade.cli.identify",
     "rockyade.cli.uncertainty",
+    "rockyade.cli.verify",
 ]
 
 _T0 = time.perf_counter()  # the total wall time printed by ``rockyade run`` counts from here

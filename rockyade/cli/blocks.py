@@ -159,22 +159,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "parameters": args.parameters,
         "classical": params,
         "method": args.method,
-        "K_N_per_m": cal.K_N_per_m,
-        "Ks_N_per_m": cal.Ks_N_per_m,
-        "beta_s": cal.beta_s,
-        "beta_eq13_s": cal.beta_eq13_s,
-        "xi_min": cal.xi_min,
-        "f_min_hz": cal.f_min_hz,
-        "b_eq_m": cal.b_eq_m,
-        "dt_s": cal.dt_eq7_s,
-        "friction_angle_deg": cal.friction_angle_deg,
-        "cohesion_Pa": cal.cohesion_Pa,
-        "stiffness_scale": cal.stiffness_reading,
-        "stiffness_scale_factor": cal.stiffness_scale,
-        "K_paper_units": cal.K_paper,
-        "gamma": cal.gamma,
-        "settlement_m": cal.settlement_m,
-        "notes": list(cal.notes),
+        **cal.report(),
     }
     if args.method == "matched":
         from rockyade.dem.matching import match_beta

@@ -42,6 +42,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.out:
             json_path = result.write(args.out)
             print(f"wrote {args.out} and {json_path}")
+            if scene.positioned and result.ok:
+                _write_collapse(scene, result, args.out.with_name(f"{args.out.stem}_collapse.csv"))
     if args.plot:
         from rockyade.figures import plot_results
 
@@ -52,8 +54,18 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0 if result.ok else 1
 
 
+def _write_collapse(scene: Any, result: Any, path: Path) -> None:
+    """Per block: whether and when it fell, rocking and sliding time, residual displacement."""
+    from rockyade.analysis.collapse import collapse_report
+    from rockyade.io.atomic import atomic_open
+
+    with atomic_open(path) as fh:
+        collapse_report(scene, result).to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
+    print(f"wrote {path} (collapse: the state of every block)")
+
+
 def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
-    from rockyade.analysis.metrics import run_metrics
+    from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
 
     meta = result.meta
     wall = meta.get("wall_time_s", math.nan)
@@ -63,13 +75,22 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         if meta.get("log_path"):
             print(f"  log: {meta['log_path']}")
         return
+    if scene.positioned:
+        a = assembly_metrics(scene, result)
+        line = f"  {a['n_blocks']} moving blocks: {a['n_fallen']} fell"
+        if a["n_fallen"]:
+            line += f" (first {a['first_fallen_block']} at t = {a['first_fall_time_s']:.4g} s)"
+        print(line + f"; max |theta| = {a['max_abs_theta_rad']:.4g} rad ({a['max_theta_block']})")
+        print(f"  largest residual displacement {a['max_residual_displacement_m']:.4g} m ({a['max_residual_block']})")
+        if len(scene.blocks) > PER_BLOCK_LIMIT:
+            return
     for name, m in run_metrics(scene, result).items():
         theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
         line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
         if not math.isnan(m["mu_eff"]):
             line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, 5)} impacts"
         print(line)
-    if result.status == "overturned":
+    if result.status == "overturned" and not scene.positioned:
         print(f"  overturned at t = {meta['overturn_time_s']:.4g} s ({meta.get('overturned_block')})")
 
 

@@ -30,6 +30,7 @@ from rockyade.blocks.geometry import LEVEL_TOL, Block
 from rockyade.constants import MAX_SETTLEMENT_FRACTION, G
 from rockyade.dem.joints import JointTable, MatchedBeta, own_joint, resolve_joints
 from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt
+from rockyade.dem.overturn import stop_angles
 from rockyade.dem.statics import mass_vector, rest_springs, stability_limit, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import BlockSpec, Scene
@@ -297,5 +298,7 @@ def build_dem_model(
         calibration=scene.contact.calibration,
         static_settlement_m=settlement,
         w_max_rad_s=w_max,
+        stop_angle_rad=stop_angles([b.contact_vertices_m for b in bodies], fixed),
+        stop_on_overturn=not scene.positioned,
         rest_contacts=tuple(contacts),
     )

@@ -97,14 +97,16 @@ def model_arrays(model: DemModel, stop_angle_rad: NDArray[np.float64] | None = N
     Parameters
     ----------
     stop_angle_rad
-        (nb,) |theta| at which each body counts as overturned; pi/2 by default (Housner's
-        criterion, as for column scenes).
+        (nb,) |theta| at which each body counts as overturned; default the model's landing
+        angles (:mod:`rockyade.dem.overturn`), or pi/2 for a model without them.
     """
     bodies = model.bodies
     nb = len(bodies)
     table = model.joints
     params = table.params
-    stop = np.full(nb, 0.5 * math.pi) if stop_angle_rad is None else np.asarray(stop_angle_rad, dtype=float)
+    if stop_angle_rad is None:
+        stop_angle_rad = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(nb, 0.5 * math.pi)
+    stop = np.asarray(stop_angle_rad, dtype=float)
     moving = np.array([not b.fixed for b in bodies], dtype=bool)
     stop = np.where(moving, stop, math.inf)
     motion = model.motion
@@ -161,7 +163,7 @@ def simulate_model(
         End the run when a moving body reaches its stop angle (column scenes); else only
         record when each body first did (assemblies: a falling block does not end a wall's run).
     stop_angle_rad
-        (nb,) stop angles, rad; pi/2 by default.
+        (nb,) stop angles, rad; default the model's (landing angles, :mod:`rockyade.dem.overturn`).
     coherent
         Keep each pair's separating-axis answer while the pair has not moved enough to
         change it (False: test every candidate pair every step; same results, slower).

@@ -21,9 +21,9 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from rockyade.analysis.peaks import effective_restitution, find_peaks
 from rockyade.blocks.classical import classical_parameters
 from rockyade.blocks.geometry import Block
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, G
 from rockyade.dem import kernel
 from rockyade.dem.build import build_dem_model

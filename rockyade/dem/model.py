@@ -106,6 +106,8 @@ class DemModel:
     calibration: str
     static_settlement_m: float = math.nan
     w_max_rad_s: float = math.nan
+    stop_angle_rad: np.ndarray | None = field(default=None, repr=False)
+    stop_on_overturn: bool = True
     rest_contacts: tuple[RestContact, ...] = ()
 
     @property

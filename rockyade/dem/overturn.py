@@ -59,6 +59,22 @@ def overturn_thresholds(contact_polygons: list[NDArray[np.float64]]) -> NDArray[
     return out
 
 
+def stop_angles(contact_polygons: list[NDArray[np.float64]], fixed: list[bool]) -> NDArray[np.float64]:
+    """(nb,) |theta| at which each body counts as overturned (the smaller side's threshold;
+    infinite for fixed bodies): what the DEM kernels test every sample."""
+    thresholds = overturn_thresholds(contact_polygons)
+    return np.where(np.asarray(fixed, dtype=bool), np.inf, thresholds.min(axis=1))
+
+
+def run_outcome(overturn_times_s: dict[str, float], names: list[str]) -> tuple[str, float | None, str | None]:
+    """Status, overturn time and block of an assembly's run from its blocks' overturn times:
+    ``overturned`` at the first block's fall (the run itself goes on to the end)."""
+    if not overturn_times_s:
+        return "completed", None, None
+    block = min(overturn_times_s, key=lambda n: (overturn_times_s[n], names.index(n)))
+    return "overturned", overturn_times_s[block], block
+
+
 def first_overturn(theta: NDArray[np.float64], thresholds: NDArray[np.float64]) -> tuple[int, int]:
     """First sample and body that meet the criterion, or (-1, -1).
 

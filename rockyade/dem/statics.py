@@ -166,13 +166,11 @@ def stability_limit(springs: RestSprings, mass: NDArray[np.float64], mass_dampin
     return (2.0 / w_max) * (math.sqrt(1.0 + xi * xi) - xi), w_max
 
 
-def static_penetration(
+def static_displacement(
     springs: RestSprings, masses: Sequence[float], fixed: Sequence[bool], g: float
 ) -> NDArray[np.float64] | None:
-    """Static compression of every normal spring under gravity, m (None for a mechanism).
-
-    Solves K u = f with f the weights of the moving bodies. When K is singular (a body
-    with no support at rest, or a mechanism) the settlement is not defined: None.
+    """(nb, 3) static displacement (x, y, rotation) of every body under gravity, m and rad
+    (zeros for fixed bodies); None when K is singular (a body with no support, a mechanism).
     """
     K = springs.stiffness.tocsc()
     if K.shape[0] == 0 or springs.k.size == 0:
@@ -191,5 +189,20 @@ def static_penetration(
     residual = np.linalg.norm(K @ u - f) / max(np.linalg.norm(f), 1e-300)
     if residual > 1e-6:
         return None
+    out = np.zeros((len(fixed), 3))
+    for i, d in enumerate(springs.dof_of):
+        if d >= 0:
+            out[i] = u[d : d + 3]
+    return out
+
+
+def static_penetration(
+    springs: RestSprings, masses: Sequence[float], fixed: Sequence[bool], g: float
+) -> NDArray[np.float64] | None:
+    """Static compression of every normal spring under gravity, m (None for a mechanism)."""
+    disp = static_displacement(springs, masses, fixed, g)
+    if disp is None:
+        return None
+    u = np.concatenate([disp[i] for i, d in enumerate(springs.dof_of) if d >= 0])
     elongation = springs.B @ u
     return -elongation[springs.normal]

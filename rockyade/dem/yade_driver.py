@@ -36,7 +36,9 @@ The model, as the reference DEM's:
 * a PyRunner *before* the other engines records every ``steps_per_sample`` steps, so the
   sample at step n sees x_n and t_n = n dt; rotation is measured as the z component of
   the axis-angle of ori * ori0.conjugate() (State.rot() can flip sign);
-* the run stops when any block reaches |theta| >= pi/2 (overturned) or a state is not
+* a block has overturned when |theta| from rest reaches its stop angle (the landing angle
+  of rockyade's overturn criterion, given in the data); the run stops there in a column
+  scene (``stop_on_overturn``) and goes on in an assembly; it stops when a state is not
   finite (failed).
 """
 
@@ -177,6 +179,7 @@ def build(scene):
                 "ori0": state.ori.conjugate(),
                 "angle0": a0,
                 "rest": b["rest_angle_rad"],
+                "stop_angle": b["stop_angle_rad"] if b.get("stop_angle_rad") is not None else math.inf,
                 "point": b["accel_point_m"],
                 "mass": b["mass_kg"],
                 "radius": r,
@@ -281,6 +284,8 @@ class Recorder:
         }
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
+        self.overturn_times = {}
+        self.stop_on_overturn = scene.get("stop_on_overturn", True)
         self.max_depth_ratio = 0.0
         self.polyhedra = {c["prism"] for c in clumps if c["prism_is_polyhedra"]}
         self.vertex_of = {
@@ -314,8 +319,10 @@ class Recorder:
             rec["angvel"][k, i] = w
             px, py = _rotate(c["point"], theta)
             rec["vpoint"][k, i] = (st.vel[0] - w * py, st.vel[1] + w * px)
-            if not c["fixed"] and abs(theta - c["rest"]) >= 0.5 * math.pi and self.status == "completed":
-                self.status, self.stop_time, self.stop_body = "overturned", O.time, i
+            if not c["fixed"] and abs(theta - c["rest"]) >= c["stop_angle"] and i not in self.overturn_times:
+                self.overturn_times[i] = O.time
+                if self.stop_on_overturn and self.status == "completed":
+                    self.status, self.stop_time, self.stop_body = "overturned", O.time, i
         self.contact_forces(k)
         self.k = k + 1
         if self.status != "completed" or self.k >= self.ns:
@@ -367,6 +374,7 @@ class Recorder:
         meta = {
             "status": self.status,
             "stop_time_s": self.stop_time,
+            "overturn_times_s": {str(i): t for i, t in self.overturn_times.items()},
             "stop_body": self.stop_body,
             "n_filled": n,
             "iterations": O.iter,

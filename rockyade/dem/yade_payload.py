@@ -79,6 +79,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
             }
         )
     bodies = []
+    stop = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(len(model.bodies), 0.5 * math.pi)
     for i, b in enumerate(model.bodies):
         size = float(np.max(np.ptp(b.contact_vertices_m, axis=0)))
         bodies.append(
@@ -97,6 +98,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
                 "centroid0_m": model.pos0_m[i].tolist(),
                 "angle0_rad": float(model.ang0_rad[i]),
                 "rest_angle_rad": b.rest_angle_rad,
+                "stop_angle_rad": float(stop[i]) if np.isfinite(stop[i]) else None,
                 "vel0_m_s": model.vel0_m_s[i].tolist(),
                 "angvel0_rad_s": float(model.angvel0_rad_s[i]),
                 "accel_point_m": list(b.accel_point_m),
@@ -111,6 +113,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
         "steps_per_sample": model.steps_per_sample,
         "n_samples": model.n_samples,
         "g": model.g,
+        "stop_on_overturn": bool(model.stop_on_overturn),
         "min_sphere_radius_m": float(radii.min()),
         "base_mask": BASE_BIT,
         "materials": materials,

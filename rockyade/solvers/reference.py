@@ -12,10 +12,13 @@ mean over +/- one sample interval (central difference of the point velocity), wh
 keeps the impact spikes from aliasing; ``[output] accel_lowpass_hz`` adds a zero-phase
 low-pass (paper Section 6.1).
 
-Overturning: a moving block whose |theta| reaches its stop angle (pi/2 by default) ends a
-column scene's run (status ``overturned``); in a positioned scene (an assembly) the run
-goes on, since a falling block must not end a wall's run. Either way ``meta
-["overturn_times_s"]`` gives, per block that reached its stop angle, the first time it did.
+Overturning (:mod:`rockyade.dem.overturn`): a moving block has overturned when it lies on
+another face, |theta| within 0.01 rad of the angle at which the face next to its pivot
+reaches the ground (pi/2 for a rectangle, a little less with the base corners at b_eq). It
+ends a column scene's run (status ``overturned``); in a positioned scene (an assembly) the
+run goes on, since a falling block must not end a wall's run, and the run is ``overturned``
+at the first block's fall. Either way ``meta["overturn_times_s"]`` gives, per block that
+fell, the first time it did.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ from rockyade.dem.engine import simulate_model
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
+from rockyade.dem.overturn import CRITERION, run_outcome
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 
@@ -45,7 +49,7 @@ def run_model(
     record_contacts: bool = True,
     accel_lowpass_hz: float | None = None,
     per_corner: bool = True,
-    stop_on_overturn: bool = True,
+    stop_on_overturn: bool | None = None,
     stop_angle_rad: np.ndarray | None = None,
 ) -> Result:
     """Run a DEM model and return a Result (see module docstring).
@@ -63,10 +67,16 @@ def run_model(
         Corner states (``c<i>_state``), one column per vertex: meant for single blocks and
         columns, not for walls of thousands of blocks.
     stop_on_overturn
-        End the run when a block reaches its stop angle (column scenes).
+        End the run when a block reaches its stop angle (default: the model's, True for
+        column scenes).
     stop_angle_rad
-        (nb,) |theta| at which each block counts as overturned; pi/2 by default.
+        (nb,) |theta| at which each block counts as overturned (default: the model's
+        landing angles, :func:`rockyade.dem.overturn.stop_angles`).
     """
+    if stop_on_overturn is None:
+        stop_on_overturn = model.stop_on_overturn
+    if stop_angle_rad is None:
+        stop_angle_rad = model.stop_angle_rad
     out, wall = simulate_model(
         model,
         record_energy,
@@ -127,6 +137,11 @@ def run_model(
     }[int(status)]
     if t_blowup is not None and status_name != "failed":
         status_name, t_stop = "failed", t_blowup
+    overturn_times = {names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)}
+    overturned_block = names[int(stop_body)] if status_name == "overturned" else None
+    if not stop_on_overturn and status_name == "completed":
+        status_name, t_first, overturned_block = run_outcome(overturn_times, names)
+        t_stop = t_first if t_first is not None else t_stop
     meta = {
         "solver": "reference",
         "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
@@ -134,11 +149,9 @@ def run_model(
         "wall_time_s": wall,
         "status": status_name,
         "overturn_time_s": float(t_stop) if status_name == "overturned" else None,
-        "overturned_block": names[int(stop_body)] if status_name == "overturned" else None,
-        "overturn_criterion": "|theta| reached pi/2" if stop_angle_rad is None else "|theta| reached its stop angle",
-        "overturn_times_s": {
-            names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)
-        },
+        "overturned_block": overturned_block,
+        "overturn_criterion": CRITERION if model.stop_angle_rad is stop_angle_rad else "|theta| reached its stop angle",
+        "overturn_times_s": overturn_times,
         "broad_phase": {
             "rebuilds": int(out.n_builds),
             "max_candidate_pairs": int(out.max_pairs),
@@ -185,7 +198,6 @@ def run_scene(scene: Scene, *, record_energy: bool = True, record_contacts: bool
         record_contacts=record_contacts,
         accel_lowpass_hz=scene.output.accel_lowpass_hz,
         per_corner=not scene.positioned,
-        stop_on_overturn=not scene.positioned,
     )
     result.meta["setup_time_s"] = setup
     return result

@@ -37,6 +37,7 @@ from rockyade import __version__
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
+from rockyade.dem.overturn import CRITERION, run_outcome
 from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
 from rockyade.io.atomic import write_json, write_text
@@ -242,7 +243,11 @@ def _parse(
         for v in range(len(body.contact_vertices_m)):
             forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
     frame = pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
-    overturned = status == "overturned"
+    overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
+    overturn_time = meta["stop_time_s"] if status == "overturned" else None
+    overturned_block = names[meta["stop_body"]] if status == "overturned" else None
+    if not model.stop_on_overturn and status == "completed":
+        status, overturn_time, overturned_block = run_outcome(overturn_times, names)
     run_meta = {
         "solver": "yade",
         "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",
@@ -250,9 +255,10 @@ def _parse(
         "wall_time_s": meta["wall_time_s"],
         "startup_time_s": total - meta["wall_time_s"],
         "status": status,
-        "overturn_time_s": meta["stop_time_s"] if overturned else None,
-        "overturned_block": names[meta["stop_body"]] if overturned else None,
-        "overturn_criterion": "|theta| reached pi/2",
+        "overturn_time_s": overturn_time,
+        "overturned_block": overturned_block,
+        "overturn_criterion": CRITERION,
+        "overturn_times_s": overturn_times,
         "blocks": names,
         "sample_dt_s": model.sample_dt_s,
         "duration_s": model.duration_s,

@@ -229,7 +229,7 @@ def run_name(scene_hash: str, solver: str) -> str:
 
 def run_task(task: Task) -> dict[str, Any]:
     """Run one task; return its summary row. Never raises: failures become rows."""
-    from rockyade.analysis.metrics import run_metrics
+    from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
     from rockyade.result import failed_result
     from rockyade.scene import scene_from_dict
     from rockyade.solvers import get_solver
@@ -263,11 +263,14 @@ def run_task(task: Task) -> dict[str, Any]:
         "wall_time_s": result.meta.get("wall_time_s"),
     }
     if result.ok and scene is not None:
-        metrics = run_metrics(scene, result)
-        single = len(scene.blocks) == 1
-        for block, values in metrics.items():
-            for key, value in values.items():
-                row[key if single else f"{block}_{key}"] = value
+        if scene.positioned:
+            row.update(assembly_metrics(scene, result))
+        if not scene.positioned or len(scene.blocks) <= PER_BLOCK_LIMIT:
+            metrics = run_metrics(scene, result)
+            single = len(scene.blocks) == 1
+            for block, values in metrics.items():
+                for key, value in values.items():
+                    row[key if single else f"{block}_{key}"] = value
         if len(scene.blocks) == 2:
             from rockyade.analysis.patterns import classify_result
 

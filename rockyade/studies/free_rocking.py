@@ -14,7 +14,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.analysis.peaks import effective_restitution, find_peaks
+from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.dem.matching import build_matched_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure

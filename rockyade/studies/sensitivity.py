@@ -16,7 +16,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.analysis.peaks import find_peaks
+from rockyade.blocks.restitution import find_peaks
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict

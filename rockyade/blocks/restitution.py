@@ -1,6 +1,7 @@
-"""Analysis of rocking time histories: peaks, effective restitution, response metrics.
+"""Rocking peaks and the effective restitution measured on a history theta(t).
 
-Effective restitution (DESIGN.md): with V(theta) = M g R (cos(alpha - |theta|) - cos alpha)
+Classical theory applied to any solver's output (and to measurements). Effective
+restitution: with V(theta) = M g R (cos(alpha - |theta|) - cos alpha)
 the potential energy at a peak, mu_eff = sqrt(V(theta_peak,n+1) / V(theta_peak,n)) for
 successive peaks of a free-rocking history (one impact between them). M g R cancels.
 """
