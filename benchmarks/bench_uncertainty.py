@@ -27,11 +27,12 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from matplotlib import colormaps
 
 from rockyade import paper
 from rockyade.analysis.fragility import Fragility
 from rockyade.analysis.identify import identify, synthetic_measurement
-from rockyade.figures.common import plt, save_figure
+from rockyade.figures.common import file_figure, save_figure
 from rockyade.io.atomic import atomic_open, write_json
 from rockyade.studies.uncertainty import run_uncertainty, uncertainty_study_from_dict
 
@@ -180,7 +181,7 @@ def convergence(out: Path, sizes, seeds) -> pd.DataFrame:
 
 
 def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    fig, axes = file_figure(1, 3, figsize=(15, 4.4))
     measure = "pga_over_g_tan_alpha"
     sel = table[table.measure == measure]
     for seed, g in sel.groupby("seed"):
@@ -201,7 +202,7 @@ def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
             axes[2].plot(
                 x,
                 Fragility(row["median"], row["beta"], 0).probability(x),
-                color=plt.cm.viridis(k / 5),
+                color=colormaps["viridis"](k / 5),
                 label=f"N = {n}",
             )
     axes[2].set_xlabel("PGA / (g tan alpha)")

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rockyade.figures.common import plt, save_figure
+from rockyade.figures.common import new_figure, save_figure
 from rockyade.result import Result
 
 #: check -> (title, [(block in the DEM results or None for a single-block result, legend)])
@@ -41,7 +41,7 @@ def _series(result: Result, name: str | None, quantity: str = "theta_rad") -> np
 def plot_check(check: str, results: dict[str, Result], path: str | Path):
     """theta(t) of the blocks a check compares, one curve per solver (closed forms in black)."""
     title, panels = PANELS.get(check, (check, []))
-    fig, ax = plt.subplots(figsize=(9, 4.2))
+    fig, ax = new_figure(path, figsize=(9, 4.2))
     if check == "wall":
         for solver, result in results.items():
             theta = np.column_stack([np.abs(result.series("theta_rad", b)) for b in result.blocks])
