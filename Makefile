@@ -28,6 +28,7 @@ test: setup lint
 
 run: setup
 	$(BIN)/rockyade paper --out $(OUT) --workers $(WORKERS)
+	$(BIN)/rockyade verify --out reports/verify
 
 bench: setup
 	$(BIN)/python benchmarks/run_all.py
