@@ -11,7 +11,9 @@ Each moving block is, at each sample, in one of four states (codes in :data:`STA
   block last passed alpha before falling (from there gravity alone no longer brings it back);
 * ``sliding``: its base slides: the horizontal speed of the point of the block that was the
   middle of its base at rest exceeds ``SLIDE_SPEED_M_S`` while it is not rocking fast
-  enough to explain it (rocking about a corner moves that point by b (1 - cos theta));
+  enough to explain it (rocking about a corner moves that point by b (1 - cos theta)), and,
+  where the result records it (the reference DEM's ``slipping``), one of the block's
+  contacts slips: a drum carried by the rocking drums under it moves fast but does not slide;
 * ``rocking``: |theta| above ``ROCK_FRACTION`` x alpha (and at least ``ROCK_MIN_RAD``);
 * ``rest`` otherwise.
 
@@ -114,11 +116,22 @@ def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeo
         rocking = np.abs(theta) > max(ROCK_MIN_RAD, ROCK_FRACTION * g.alpha_rad)
         rocking_speed = np.abs(np.gradient(theta, dt)) * abs(g.base_mid_m[1]) * np.abs(np.sin(theta)) if n > 1 else 0.0
         sliding = speed > SLIDE_SPEED_M_S + rocking_speed
+        slipping = _slipping(result, g.name)
+        if slipping is not None:  # the DEM says whether a contact slips: a block carried
+            sliding &= slipping  # by the rocking blocks under it does not slide
         code = np.where(rocking, ROCKING, REST)
         code = np.where(sliding, SLIDING, code)
         code = np.where(fallen, FALLEN, code)
         states[:, j] = code
     return states, geometry
+
+
+def _slipping(result: Result, name: str) -> NDArray[np.bool_] | None:
+    """The reference DEM's per-block slip flag (one of the block's contact points slips), if recorded."""
+    try:
+        return np.asarray(result.series("slipping", name), dtype=bool)
+    except KeyError:
+        return None
 
 
 def _fall_and_tip(
