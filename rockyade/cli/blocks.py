@@ -86,6 +86,15 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
     return [("block", block, {})]
 
 
+def _is_rectangle(vertices_m: Any) -> bool:
+    """Four vertices on two x and two y values: the paper's Eqs 2-4 apply as printed."""
+    import numpy as np
+
+    v = np.asarray(vertices_m, dtype=float)
+    scale = float(np.ptp(v)) or 1.0
+    return len(v) == 4 and all(len(np.unique(np.round(v[:, k] / scale, 9))) == 2 for k in (0, 1))
+
+
 # ------------------------------------------------------------------ commands
 
 
@@ -93,9 +102,10 @@ def cmd_params(args: argparse.Namespace) -> int:
     """Classical parameters of one or more blocks."""
     from rockyade.blocks.classical import classical_parameters
 
-    out = {}
+    out, rectangles = {}, {}
     for name, block, overrides in _blocks_from_args(args):
         cp = classical_parameters(block, **overrides)
+        rectangles[name] = _is_rectangle(block.vertices_m)
         out[name] = {
             "alpha_rad": cp.alpha_rad,
             "p_rad_s": cp.p_rad_s,
@@ -116,11 +126,15 @@ def cmd_params(args: argparse.Namespace) -> int:
         json_out(out[next(iter(out))] if len(out) == 1 else out)
         return 0
     for name, d in out.items():
-        alpha_src = "Eq 2" if d["source"]["alpha_rad"] == "geometry" else "override"
+        rect = rectangles[name]
+        general = "" if rect else " generalised to polygons"
+        alpha_src = f"Eq 2{general}" if d["source"]["alpha_rad"] == "geometry" else "override"
+        p_src = "Eq 3 for rectangles" if rect else f"Eq 3{general}"
+        mu_src = "Eq 4 for rectangles" if rect else f"Eq 4{general}"
         print(f"{name}:")
         print(f"  alpha = {d['alpha_rad']:.6g} rad ({alpha_src})")
-        print(f"  p     = {d['p_rad_s']:.6g} 1/s (p^2 = M g R / I_O; Eq 3 for rectangles)")
-        print(f"  mu    = {d['mu']:.6g} (angular momentum about the new pivot; Eq 4 for rectangles)")
+        print(f"  p     = {d['p_rad_s']:.6g} 1/s (p^2 = M g R / I_O; {p_src})")
+        print(f"  mu    = {d['mu']:.6g} (angular momentum about the new pivot; {mu_src})")
         print(f"  R     = {d['R_m']:.6g} m, I_O = {d['I_O_kgm2']:.6g} kg m^2, I_c = {d['I_c_kgm2']:.6g} kg m^2")
         print(f"  M     = {d['mass_kg']:.6g} kg")
         print(f"  uplift when |a_g| > g tan(alpha) = {d['uplift_accel_m_s2']:.6g} m/s^2")

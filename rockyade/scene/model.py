@@ -49,8 +49,6 @@ from rockyade.motion.spec import MotionSpec
 
 #: Upper bounds that keep inputs physical (and the arithmetic finite).
 MAX_LENGTH_M = 1000.0
-MAX_MASS_KG = 1.0e9
-MAX_DENSITY_KG_M3 = 1.0e5
 MAX_DURATION_S = 1.0e5
 
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")

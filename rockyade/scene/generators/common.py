@@ -14,7 +14,7 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.model import MAX_DENSITY_KG_M3, MAX_LENGTH_M
+from rockyade.scene.bounds import BOUNDS
 
 #: Defaults shared by the generators.
 DEFAULT_DENSITY_KG_M3 = 2400.0
@@ -76,8 +76,8 @@ def check_number(
 
 
 def check_length(name: str, value: Any, *, zero_ok: bool = False) -> float:
-    """A length in (0, MAX_LENGTH_M] m ([0, ...] with ``zero_ok``)."""
-    return check_number(name, value, 0.0, MAX_LENGTH_M, lo_open=not zero_ok, unit="m")
+    """A length in (0, the scene's largest length] m ([0, ...] with ``zero_ok``)."""
+    return check_number(name, value, 0.0, BOUNDS["length_m"].hi, lo_open=not zero_ok, unit="m")
 
 
 def check_count(name: str, value: Any, lo: int, hi: int) -> int:
@@ -88,8 +88,9 @@ def check_count(name: str, value: Any, lo: int, hi: int) -> int:
 
 
 def check_density(name: str, value: Any) -> float:
-    """A density in (0, MAX_DENSITY_KG_M3] kg/m^3."""
-    return check_number(name, value, 0.0, MAX_DENSITY_KG_M3, lo_open=True, unit="kg/m^3")
+    """A density within the scene's bounds, kg/m^3 (``BOUNDS["density_kg_m3"]``)."""
+    bound = BOUNDS["density_kg_m3"]
+    return check_number(name, value, bound.lo, bound.hi, unit="kg/m^3")
 
 
 def check_choice(name: str, value: Any, choices: Sequence[str]) -> str:
