@@ -6,11 +6,14 @@ Skipped only where YADE is absent and ROCKYADE_REQUIRE_YADE is not set; ``make t
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
 import re
+import signal
 import subprocess
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -576,3 +579,59 @@ def test_study_file_yade_timeout(tmp_path):
     (tmp_path / "bad.toml").write_text("yade_timeout_s = -1" + body)
     with pytest.raises(InputError, match="yade_timeout_s"):
         load_study(tmp_path / "bad.toml", tmp_path / "out")
+
+
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+def test_yade_dies_with_a_sigkilled_parent(tmp_path):
+    """No clean-up code runs on SIGKILL: the kernel must end YADE with the rockyade process
+    that started it (otherwise YADE runs on, an orphan, to the end of its simulation)."""
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    d.update(duration_s=600.0, sample_dt_s=0.01)  # minutes of YADE: it is running when the parent dies
+    scene = tmp_path / "long.json"
+    scene.write_text(json.dumps(d))
+    parent = subprocess.Popen(
+        [sys.executable, "-m", "rockyade", "run", str(scene), "--solver", "yade", "--out", "r.csv", "--allow-large"],
+        cwd=tmp_path,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+    )
+    yade: list[int] = []
+    try:
+        deadline = time.monotonic() + 60
+        while not yade and time.monotonic() < deadline and parent.poll() is None:
+            time.sleep(0.2)
+            yade = _children(parent.pid)
+        assert yade, "rockyade never started YADE"
+        time.sleep(0.5)
+        parent.kill()
+        parent.wait()
+        deadline = time.monotonic() + 10
+        while any(_alive(p) for p in yade) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(_alive(p) for p in yade), "YADE outlived the process that started it"
+    finally:
+        parent.kill()
+        parent.wait()
+        for p in yade:  # never leave an orphan behind, even when the test fails
+            with contextlib.suppress(OSError):
+                os.kill(p, signal.SIGKILL)

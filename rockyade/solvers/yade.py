@@ -41,6 +41,7 @@ from rockyade.dem.overturn import CRITERION, run_outcome
 from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
 from rockyade.io.atomic import write_json, write_text
+from rockyade.io.lifetime import child_dies_with_parent
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 
@@ -105,7 +106,15 @@ def _run_process(cmd: list[str], log_file: Path, cwd: Path, timeout: float) -> s
     """Run YADE's Python; the reason it failed, or None. On timeout the process group is
     killed (the driver and anything it started) and waited for: no orphan is left."""
     with open(log_file, "w") as log:
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=_env(), cwd=cwd, start_new_session=True)
+        proc = subprocess.Popen(
+            cmd,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            env=_env(),
+            cwd=cwd,
+            start_new_session=True,  # a group of its own: a timeout kills YADE and its children
+            preexec_fn=child_dies_with_parent(),  # ... and YADE dies with this process, even by SIGKILL
+        )
         try:
             code = proc.wait(timeout=timeout)
         except subprocess.TimeoutExpired:

@@ -39,9 +39,9 @@ Ctrl-C (SIGINT): the first stops dispatching (queued runs never start) and lets 
 running runs finish; the second stops them at once (their worker processes are killed).
 Either way ``summary.csv`` is written with what finished, the unfinished runs listed with
 status ``unfinished``, and :class:`~rockyade.errors.BatchInterruptedError` is raised.
-Worker processes ignore SIGINT, lead their own process group (killing a worker kills the
-YADE process it started) and are killed by the kernel if this process dies, however it dies
-(``prctl(PR_SET_PDEATHSIG, SIGKILL)``).
+Worker processes ignore SIGINT, lead their own process group and are killed by the kernel
+if this process dies, however it dies (``prctl(PR_SET_PDEATHSIG, SIGKILL)``,
+:mod:`rockyade.io.lifetime`); a YADE process dies the same way with the worker that started it.
 """
 
 from __future__ import annotations
@@ -49,8 +49,6 @@ from __future__ import annotations
 import collections
 import contextlib
 import copy
-import ctypes
-import ctypes.util
 import itertools
 import json
 import os
@@ -71,6 +69,7 @@ import pandas as pd
 from rockyade.errors import BatchInterruptedError, InputError, RockyadeError, os_error_message
 from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
+from rockyade.io.lifetime import die_with_parent
 from rockyade.io.locking import output_lock
 from rockyade.solvers import solver_names
 
@@ -391,27 +390,13 @@ def _progress(total: int, enabled: bool, desc: str):
     return tqdm(total=total, disable=not enabled, desc=desc, unit="run", smoothing=0.05)
 
 
-PR_SET_PDEATHSIG = 1
-
-
-def _die_with_parent(parent_pid: int) -> None:
-    """Ask the kernel to SIGKILL this process when its parent dies (Linux prctl), and leave
-    at once if the parent is already gone."""
-    libc_name = ctypes.util.find_library("c")
-    if libc_name:
-        with contextlib.suppress(OSError, AttributeError):
-            ctypes.CDLL(libc_name, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
-    if os.getppid() != parent_pid:
-        os._exit(1)
-
-
 def _worker_init(parent_pid: int) -> None:
-    """Pool worker set-up: ignore Ctrl-C (the parent decides), own process group (killing it
-    kills a YADE process the worker started), killed with the parent."""
+    """Pool worker set-up: ignore Ctrl-C (the parent decides), own process group, killed with
+    the parent (and a YADE process it started with it)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     with contextlib.suppress(OSError):
         os.setpgid(0, 0)
-    _die_with_parent(parent_pid)
+    die_with_parent(parent_pid)
     if threading.current_thread() is threading.main_thread():
         threading.Thread(target=_watch_parent, args=(parent_pid,), daemon=True, name="watch-parent").start()
 
