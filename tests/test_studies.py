@@ -272,6 +272,23 @@ def test_overturning_draws_housner_dots_in_housner_colour(tmp_path):
     assert to_rgb(lines["Housner: minimum"].get_color()) == to_rgb(SOLVER_STYLES["housner"]["color"])
 
 
+def test_overturning_marks_frequencies_where_a_solver_never_overturned(tmp_path):
+    """A missing point is not a gap in the line: it says the block survived every amplitude scanned."""
+    scan = pd.DataFrame(
+        {"solver": ["reference"], "omega_ratio": [10.0], "amplitude_ratio": [14.4], "overturned": [True]}
+    )
+    spectrum = pd.DataFrame(
+        {"omega_ratio": [9.5, 10.0], "housner_min_ratio": [13.5, np.nan], "reference_min_ratio": [13.0, 14.4]}
+    )
+    report = Report(tmp_path)
+    report.section("Overturning")
+    fig = overturning.draw_figure(report, scan, spectrum)
+    lines = {line.get_label(): line for line in fig.axes[0].lines}
+    marker = lines[f"Housner: no overturn up to {overturning.MAX_RATIO:g} (the scan's limit)"]
+    assert list(marker.get_xdata()) == [10.0] and list(marker.get_ydata()) == [overturning.MAX_RATIO]
+    assert not any(label.startswith("reference DEM: no overturn") for label in lines)
+
+
 def test_overturning_scan_shows_progress(tmp_path, monkeypatch, capfd):
     monkeypatch.setattr(overturning, "FREQUENCY_RATIOS", (6.0,))
     monkeypatch.setattr(overturning, "MAX_RATIO", 2.0)

@@ -158,6 +158,23 @@ def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> F
         mew=1.3,
         label="reference DEM: minimum",
     )
+    for column, colour, who in (
+        ("housner_min_ratio", housner_colour, "Housner"),
+        ("reference_min_ratio", dem_colour, "reference DEM"),
+    ):
+        survived = spectrum[spectrum[column].isna()]  # no overturn up to the largest amplitude scanned
+        if len(survived):
+            ax.plot(
+                survived.omega_ratio,
+                np.full(len(survived), MAX_RATIO),
+                "^",
+                color=colour,
+                ms=9,
+                mfc="none",
+                mew=1.5,
+                clip_on=False,
+                label=f"{who}: no overturn up to {MAX_RATIO:g} (the scan's limit)",
+            )
     ax.set_xlabel("pulse frequency / frequency parameter, omega_p / p")
     ax.set_ylabel("pulse amplitude / uplift acceleration, a_p / (g tan alpha)")
     ax.set_ylim(1.0, MAX_RATIO)
@@ -169,6 +186,7 @@ def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> F
         name,
         "Minimum overturning amplitude of a one-sine acceleration pulse against its frequency (lines), "
         "and every amplitude at which Housner's block overturns (dots): above the minimum there are "
-        "bands where the block survives (the region is not simply connected).",
+        "bands where the block survives (the region is not simply connected). Open triangles at the "
+        f"top: no overturn up to {MAX_RATIO:g} g tan alpha, the largest amplitude scanned.",
     )
     return fig
