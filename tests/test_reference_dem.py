@@ -331,7 +331,7 @@ def test_friction_energy_of_a_sliding_block_is_coulomb_force_times_slip():
         }
     )
     dem = reference.run_scene(scene)
-    t, x = dem.t, dem.series("x_m")
+    x = dem.series("x_m")
     slip = -x[-1]  # the block lags the table
     assert slip == pytest.approx(0.5 * (0.65 - math.tan(math.radians(30.0))) * G * 1.0**2, rel=0.01)
     friction = dem.frame["energy_friction_J"].to_numpy()
