@@ -276,3 +276,37 @@ def test_cli_calibrate_from_identified(tmp_path, monkeypatch, capsys):
     assert "K = Ks" in capsys.readouterr().out
     assert main(["calibrate", "--from", "missing.json", "--specimen", "1"]) == 2
     assert main(["calibrate", "--width", "0.25", "--height", "1", "--thickness", "0.7"]) == 2
+
+
+def test_shipped_study_comment_points_at_the_readme_identified_file(tmp_path, monkeypatch, capsys):
+    """The example study's comment names identified.json as the README writes it (in the
+    repository folder); a missing file is reported under the study's field, not ``from``."""
+    import re
+
+    from rockyade.studies.uncertainty import load_uncertainty_study
+
+    shipped = EXAMPLES / "studies" / "uncertainty_specimen1.toml"
+    line = re.search(r"^#\s+(identified = \"[^\"]+\")", shipped.read_text(), re.M).group(1)
+    body = re.sub(r"\n\[parameters\.\w+\]\n(?:\w+ = .*\n)+", "\n", shipped.read_text())
+    study_dir = tmp_path / "examples" / "studies"
+    study_dir.mkdir(parents=True)
+    study = study_dir / "identified_study.toml"
+    study.write_text(body + f"\n[parameters]\n{line}\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["uncertainty", "examples/studies/identified_study.toml", "--out", "u"]) == 2
+    err = capsys.readouterr().err
+    assert "parameters.identified: file not found" in err and "from:" not in err and "Traceback" not in err
+    (tmp_path / "identified.json").write_text(
+        json.dumps(
+            {
+                "alpha_rad": 0.23,
+                "p_rad_s": 3.8,
+                "mu": 0.93,
+                "alpha_rad_ci": [0.22, 0.24],
+                "p_rad_s_ci": [3.7, 3.9],
+                "mu_ci": [0.92, 0.94],
+            }
+        )
+    )
+    loaded = load_uncertainty_study("examples/studies/identified_study.toml")
+    assert loaded.nominal["alpha_rad"] == pytest.approx(0.23)

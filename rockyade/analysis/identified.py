@@ -21,8 +21,18 @@ CLASSICAL_KEYS = ("alpha_rad", "p_rad_s", "mu")
 METHODS = ("paper", "matched")
 
 
-def load_identified(source: str | Path | Mapping[str, Any]) -> dict[str, Any]:
+def load_identified(
+    source: str | Path | Mapping[str, Any], *, field: str = "from", named_in: str | None = None
+) -> dict[str, Any]:
     """Identified values from a JSON file (or a mapping): alpha_rad, p_rad_s, mu and their intervals.
+
+    Parameters
+    ----------
+    source
+        The JSON file ``rockyade identify --out`` wrote, or its content.
+    field, named_in
+        Where the file was named, for the message when it cannot be read: the option or field
+        (default ``from``, ``calibrate --from``) and the file that names it (e.g. a study).
 
     Raises
     ------
@@ -37,13 +47,14 @@ def load_identified(source: str | Path | Mapping[str, Any]) -> dict[str, Any]:
         path = Path(source)
         where = str(path)
         if not path.is_file():
-            raise InputError("from", f"file not found: {path}")
+            hint = " (rockyade identify --out writes it; a relative path is read from this file's folder)"
+            raise InputError(field, f"file not found: {path}" + (hint if named_in else ""), named_in)
         try:
             data = json.loads(path.read_text())
         except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise InputError("from", f"not a readable JSON file: {exc}", where) from None
+            raise InputError(field, f"not a readable JSON file: {exc}", where) from None
     if not isinstance(data, dict):
-        raise InputError("from", "must be a JSON object with alpha_rad, p_rad_s and mu", where)
+        raise InputError(field, "must be a JSON object with alpha_rad, p_rad_s and mu", where)
     unidentifiable = data.get("unidentifiable") or {}
     out: dict[str, Any] = {}
     for key in CLASSICAL_KEYS:

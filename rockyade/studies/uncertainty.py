@@ -247,7 +247,8 @@ def uncertainty_study_from_dict(data: Any, source: str | None = None, base_dir: 
         ident_path = base_dir / params.string("identified")
         factor = params.positive("std_factor", 1.0)
         params.finish()
-        joint = joint_from_identified(load_identified(ident_path), factor, str(ident_path))
+        identified = load_identified(ident_path, field=params.field("identified"), named_in=r.source)
+        joint = joint_from_identified(identified, factor, str(ident_path))
         nominal = dict(zip(PARAMETERS, joint.mean, strict=True))  # the identified block is the nominal one
     else:
         marginals = {}
