@@ -131,6 +131,50 @@ def test_inconsistency_counts_in_the_paper_page_match_the_tables_command():
         assert flagged in row, (row, flagged)
 
 
+def test_motion_type_table_lists_every_motion_type():
+    import rockyade.motion  # noqa: F401  (registers every type)
+    from rockyade.motion.spec import MOTION_TYPES
+
+    text = (ROOT / "docs/howto/run-a-scene.md").read_text()
+    listed = set(re.findall(r"^\| `(\w+)` \|", text.split("Motion types", 1)[1].split("\n\n", 2)[1], re.M))
+    assert listed == set(MOTION_TYPES)
+
+
+@pytest.mark.parametrize("page", ["README.md", "docs/howto/run-a-scene.md"])
+def test_the_example_error_message_is_the_real_one(page, tmp_path):
+    """The pages quote the message for mu = 1.2: it is what load_scene says."""
+    from rockyade.errors import InputError
+    from rockyade.scene import load_scene
+
+    quoted = re.search(r"`(scene\.toml: blocks\[0\]\.mu: [^`]+)`", (ROOT / page).read_text()).group(1)
+    text = re.sub(r"(?m)^mu = .*$", "mu = 1.2", (ROOT / "examples/specimen1_free.toml").read_text())
+    (tmp_path / "scene.toml").write_text(text)
+    with pytest.raises(InputError) as info:
+        load_scene(tmp_path / "scene.toml")
+    assert str(info.value).replace(str(tmp_path / "scene.toml"), "scene.toml") == quoted
+
+
+def test_python_page_shows_keyword_only_arguments_as_such():
+    """A function the Python page lists with its arguments: a keyword-only one is shown after
+    ``*`` or as ``name=...``, never as a bare positional name."""
+    import importlib
+    import inspect
+
+    text = (ROOT / "docs/python.md").read_text()
+    for dotted, shown in re.findall(r"`(rockyade(?:\.\w+)+)\(([^)`]*)\)`", text):
+        module, name = dotted.rsplit(".", 1)
+        try:
+            func = getattr(importlib.import_module(module), name)
+        except (ImportError, AttributeError):
+            continue  # a method or attribute path, e.g. Block.rectangle
+        params = inspect.signature(func).parameters
+        shown_args = [a.strip() for a in shown.split(",")]
+        star = shown_args.index("*") if "*" in shown_args else len(shown_args)
+        for i, arg in enumerate(shown_args[:star]):
+            if arg in params and params[arg].kind is inspect.Parameter.KEYWORD_ONLY:
+                raise AssertionError(f"python.md: {dotted}({shown}): {arg} (argument {i + 1}) is keyword-only")
+
+
 # ------------------------------------------------------------------ runs as printed
 
 
