@@ -86,6 +86,13 @@ def test_calibrate_specimen1_experimental(capsys):
     assert data["stiffness_scale"] == "MN/m"
 
 
+def test_calibrate_text_says_f_min_is_p_in_hz(capsys):
+    """Eq 14 sets f_min to the number of p (1/s) in Hz: the line says so, not a bare 3.84 Hz."""
+    code, out, _ = run_cli(capsys, "calibrate", "--specimen", "1")
+    line = next(x for x in out.splitlines() if "f_min" in x)
+    assert code == 0 and "f_min = 3.84 Hz" in line and "p in 1/s" in line
+
+
 @pytest.mark.parametrize("specimen", ["2", "3", "4", "upper", "lower"])
 def test_calibrate_other_specimens(capsys, specimen):
     code, out, _ = run_cli(capsys, "calibrate", "--specimen", specimen, "--json")

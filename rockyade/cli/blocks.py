@@ -194,7 +194,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     print(f"{spec.label}, {args.parameters} parameters: alpha = {a:.4g} rad, p = {p:.4g} 1/s, mu = {mu:.4g}")
     print(f"  K = Ks   = {cal.K_N_per_m:.6g} N/m (Eq 10: {cal.K_paper:.6g}, read as {cal.stiffness_reading})")
     print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
-    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14), Rayleigh a = 0")
+    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14: the number of p in 1/s), Rayleigh a = 0")
     print(f"  b_eq     = {cal.b_eq_m:.6g} m (Eq 11; 2 b_eq = {2 * cal.b_eq_m:.4g} m)")
     print(f"  dt       = {cal.dt_eq7_s:.6g} s (Eq 7, frac 0.1)")
     print(f"  friction = {cal.friction_angle_deg:g} deg, cohesion = 0 Pa")
