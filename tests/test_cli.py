@@ -108,6 +108,22 @@ def test_bad_input_exit_code_and_message(capsys):
     assert code == 2 and "width" in err
 
 
+@pytest.mark.parametrize(
+    ("extra", "expected"),
+    [
+        ([], "--mass: give exactly one of --mass and --density"),
+        (["--mass", "3", "--density", "2000"], "--mass: give exactly one of --mass and --density"),
+        (["--density", "-1"], "--density: must be a finite number > 0"),
+        (["--mass", "3", "--chamfer", "0.2"], "--chamfer: must be in (0, 0.125) m"),
+    ],
+)
+def test_params_block_errors_name_the_options(capsys, extra, expected):
+    """Block.polygon's fields (mass_kg, density_kg_m3, ...) are spoken as the command's options."""
+    code, _, err = run_cli(capsys, "params", "--width", "0.25", "--height", "1", "--thickness", "0.754", *extra)
+    assert code == 2 and expected in err
+    assert "_kg" not in err and "Traceback" not in err
+
+
 def test_run_housner_writes_csv_whose_peaks_give_mu(capsys, examples_dir, tmp_path):
     out_csv = tmp_path / "r.csv"
     code, out, _ = run_cli(

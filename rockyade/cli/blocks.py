@@ -50,40 +50,58 @@ def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str
         scene = load_scene(args.scene)
         specs = [b for b in scene.blocks if args.block in (None, b.name)]
         if not specs:
-            raise InputError("block", f"no block {args.block!r} in {args.scene}")
+            raise InputError("--block", f"no block {args.block!r} in {args.scene}")
         out = []
         for b in specs:
             overrides = {k: getattr(b, k) for k in ("alpha_rad", "p_rad_s", "mu") if getattr(b, k) is not None}
             out.append((b.name, b.block(), overrides))
         return out
     if args.thickness is None:
-        raise InputError("thickness", "is required with dimensions (--thickness, m)")
+        raise InputError("--thickness", "is required with dimensions (m)")
     if args.vertices:
         try:
             verts = [[float(c) for c in pair.split(",")] for pair in args.vertices.split()]
         except ValueError:
-            raise InputError("vertices", 'must look like "x,y x,y x,y" (metres)') from None
+            raise InputError("--vertices", 'must look like "x,y x,y x,y" (metres)') from None
     else:
         if args.height is None:
-            raise InputError("height", "is required with --width (m)")
-        verts = (
-            chamfered_rectangle_vertices(args.width, args.height, args.chamfer)
-            if args.chamfer
-            else rectangle_vertices(args.width, args.height)
-        )
+            raise InputError("--height", "is required with --width (m)")
         for name in ("width", "height"):
             value = getattr(args, name)
             if not value > 0:
-                raise InputError(name, f"must be > 0 m, got {value}")
-    block = Block.polygon(
-        verts,
-        args.thickness,
-        mass_kg=args.mass,
-        density_kg_m3=args.density,
-        inertia_kgm2=args.inertia,
-        name="block",
-    )
+                raise InputError(f"--{name}", f"must be > 0 m, got {value}")
+    options = {**_BLOCK_OPTIONS, "vertices_m": "--vertices" if args.vertices else "--width/--height"}
+    try:
+        if not args.vertices:
+            verts = (
+                chamfered_rectangle_vertices(args.width, args.height, args.chamfer)
+                if args.chamfer
+                else rectangle_vertices(args.width, args.height)
+            )
+        block = Block.polygon(
+            verts,
+            args.thickness,
+            mass_kg=args.mass,
+            density_kg_m3=args.density,
+            inertia_kgm2=args.inertia,
+            name="block",
+        )
+    except InputError as exc:
+        message = exc.message
+        for field, option in options.items():
+            message = message.replace(field, option)
+        raise InputError(options.get(exc.field, exc.field), message) from None
     return [("block", block, {})]
+
+
+#: Block.polygon's field names as this command's options (its messages name the options).
+_BLOCK_OPTIONS = {
+    "mass_kg": "--mass",
+    "density_kg_m3": "--density",
+    "inertia_kgm2": "--inertia",
+    "thickness_m": "--thickness",
+    "chamfer_m": "--chamfer",
+}
 
 
 def _is_rectangle(vertices_m: Any) -> bool:
@@ -149,13 +167,13 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 
     if not 0.0 < args.friction_angle < 90.0:
-        raise InputError("friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
+        raise InputError("--friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
     if args.from_identified is not None:
         from rockyade.cli.identify import calibrate_identified
 
         return calibrate_identified(args, _blocks_from_args(args))
     if args.specimen is None or args.scene or args.width or args.vertices:
-        raise InputError("specimen", "is required: 1, 2, 3, 4, upper or lower (--scene, dimensions: with --from)")
+        raise InputError("--specimen", "is required: 1, 2, 3, 4, upper or lower (--scene, dimensions: with --from)")
     spec = paper.specimen(args.specimen)
     block = spec.block()
     if args.parameters == "experimental":
@@ -194,7 +212,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     print(f"{spec.label}, {args.parameters} parameters: alpha = {a:.4g} rad, p = {p:.4g} 1/s, mu = {mu:.4g}")
     print(f"  K = Ks   = {cal.K_N_per_m:.6g} N/m (Eq 10: {cal.K_paper:.6g}, read as {cal.stiffness_reading})")
     print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
-    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14: the number of p in 1/s), Rayleigh a = 0")
+    print(
+        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14: the number of p in 1/s), "
+        "Rayleigh a = 0"
+    )
     print(f"  b_eq     = {cal.b_eq_m:.6g} m (Eq 11; 2 b_eq = {2 * cal.b_eq_m:.4g} m)")
     print(f"  dt       = {cal.dt_eq7_s:.6g} s (Eq 7, frac 0.1)")
     print(f"  friction = {cal.friction_angle_deg:g} deg, cohesion = 0 Pa")
@@ -205,7 +226,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     for note in result["notes"]:
         print(f"  note: {note}")
     return 0
-
 
 
 def register(sub: Any) -> None:

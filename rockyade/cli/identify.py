@@ -122,7 +122,10 @@ def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, 
         )
     else:
         print(f"  beta     = {result['beta_s']:.6g} s (Eq 13, Gamma = {result['gamma']:.6g})")
-    print(f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14: the number of p in 1/s)")
+    print(
+        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz "
+        "(Eq 14: the number of p in 1/s)"
+    )
     print(f"  b_eq     = {result['b_eq_m']:.6g} m (Eq 11); dt = {result['dt_s']:.6g} s (Eq 7)")
     for note in result["notes"]:
         print(f"  note: {note}")
