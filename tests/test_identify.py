@@ -157,6 +157,27 @@ def test_too_few_impacts_is_reported_not_returned(tmp_path, monkeypatch, capsys)
     assert "alpha_rad cannot be identified" in err and "too few impacts" in err
 
 
+def test_record_cut_before_any_impact_says_what_it_cannot_tell(tmp_path, monkeypatch, capsys):
+    """The first 199 rows of the example (no impact yet): every reason is a whole sentence, and
+    the sensor offset, whose interval is enormous, prints as not identified, not as a value."""
+    lines = MEASURED.read_text().splitlines()[:200]
+    (tmp_path / "short.csv").write_text("\n".join(lines) + "\n")
+    monkeypatch.chdir(tmp_path)
+    assert main(["identify", "short.csv"]) == 1
+    out, err = capsys.readouterr()
+    assert "needed to measure the energy an impact takes away" in err
+    assert all(not line.rstrip().endswith((" at", " for")) for line in err.splitlines())
+    offset_line = next(line for line in out.splitlines() if "sensor offset" in line)
+    assert "sensor offset not identified" in offset_line and "from theta" not in offset_line
+    assert main(["identify", "short.csv", "--json"]) == 1
+    data = json.loads(capsys.readouterr().out)
+    lo, hi = data["offset_rad_ci"]
+    assert hi - lo > 1.0  # the JSON's interval is what the text calls not identified
+    assert main(["identify", str(MEASURED)]) == 0
+    out = capsys.readouterr().out
+    assert "from theta = 0.12" in out and "sensor offset 0.001984 rad [" in out
+
+
 def test_too_noisy_or_weak_records_are_reported():
     """Noise of 1.3 % of alpha on a small release: the intervals exceed 10 % and say why; noise
     of a third of the swing: no impact can be located at all."""

@@ -333,13 +333,13 @@ def _unidentifiable(fit, ci, cov, n_impacts, rms, history, max_rel, lo, hi, x) -
         rel = half / abs(value) if value else math.inf
         if n_impacts < MIN_IMPACTS[name]:
             why = (
-                "the amplitude dependence of the period that separates alpha from p"
+                "for the amplitude dependence of the period that separates alpha from p"
                 if name != "mu"
-                else "an impact to lose energy at"
+                else "to measure the energy an impact takes away"
             )
             out[name] = (
                 f"too few impacts: {n_impacts} observable above the noise (peak > {OBSERVABLE_PEAK_RMS:g} x rms "
-                f"residual {rms:.3g} rad) in a {span:.3g} s record, {MIN_IMPACTS[name]} needed for {why}"
+                f"residual {rms:.3g} rad) in a {span:.3g} s record, {MIN_IMPACTS[name]} needed {why}"
             )
         elif not math.isfinite(rel) or rel > max_rel:
             if rms > 0.05 * theta0:

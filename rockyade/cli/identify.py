@@ -74,14 +74,32 @@ def _print_text(result: Any) -> None:
         lo, hi = result.ci[name]
         value = getattr(fit, name)
         print(f"  {label:5s} = {value:.{digits}f} {units[name]:3s}  95 % interval [{lo:.{digits}f}, {hi:.{digits}f}]")
-    print(
-        f"  release at t = {fit.release_time_s:.4f} s from theta = {fit.theta0_rad:.5g} rad; "
-        f"sensor offset {fit.offset_rad:.4g} rad"
-    )
+    print("  " + "; ".join(_start_lines(result)))
     print(
         f"  rms residual {result.rms_residual_rad:.3g} rad; {result.n_impacts} impacts above the noise; "
         f"intervals: {result.ci_method}"
     )
+
+
+def _start_lines(result: Any) -> list[str]:
+    """Release time, release tilt and sensor offset with their 95 % intervals (the JSON's), or
+    "not identified" where the interval is wider than ``max_relative_ci`` of the record's
+    duration (release time) or of its rotation range (offset; the tilt is measured from it)."""
+    import numpy as np
+
+    h, fit, ci, limit = result.history, result.fit, result.ci, result.max_relative_ci
+    t_lo, t_hi = ci["release_time_s"]
+    o_lo, o_hi = ci["offset_rad"]
+    rotation_range = float(np.ptp(h.theta_rad)) if h.theta_rad.size else 0.0
+    offset_known = 0.5 * (o_hi - o_lo) <= limit * rotation_range
+    if 0.5 * (t_hi - t_lo) <= limit * h.duration_s:
+        release = f"release at t = {fit.release_time_s:.4f} s [{t_lo:.4f}, {t_hi:.4f}]"
+    else:
+        release = f"release time not identified (95 % interval +/-{0.5 * (t_hi - t_lo):.3g} s)"
+    if not offset_known:
+        return [release, f"release tilt and sensor offset not identified (offset +/-{0.5 * (o_hi - o_lo):.3g} rad)"]
+    release += f" from theta = {fit.theta0_rad:.5g} rad"
+    return [release, f"sensor offset {fit.offset_rad:.4g} rad [{o_lo:.4g}, {o_hi:.4g}]"]
 
 
 def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
