@@ -233,3 +233,37 @@ def test_motion_help(sub):
         [sys.executable, "-m", "rockyade.cli", "motion", sub, "--help"], capture_output=True, text=True
     )
     assert proc.returncode == 0 and "usage:" in proc.stdout
+
+
+OUTPUT_UNDER_A_FILE = [
+    ["build", "column", "--out", "afile/c.toml"],
+    ["build", "column", "--out", "c.toml", "--draw", "afile/c.png"],
+    ["identify", "{measured}", "--out", "afile/i.json"],
+    ["identify", "{measured}", "--plot", "afile/figs"],
+    ["identify", "{measured}", "--plot", "afile"],
+    ["yade-script", "{scene}", "--out", "afile/y"],
+    ["uncertainty", "{study}", "--out", "afile/u"],
+    ["run", "{scene}", "--out", "afile/r.csv"],
+    ["motion", "synth", "--type", "1", "--ground", "A", "--ag", "2", "--seed", "1", "--out", "afile"],
+    ["batch", "{sweep}", "--out", "afile"],
+]
+
+
+@pytest.mark.parametrize("argv", OUTPUT_UNDER_A_FILE, ids=[" ".join(a[:1] + a[-2:]) for a in OUTPUT_UNDER_A_FILE])
+def test_an_output_under_a_file_is_refused_before_any_work(argv, capsys, tmp_path, monkeypatch):
+    """Every --out/--plot/--draw whose folder is a file: one line naming the option, exit 2,
+    and nothing written (as ``run`` does)."""
+    from tests.conftest import EXAMPLES
+
+    paths = {
+        "measured": EXAMPLES / "measured" / "specimen1_free_rocking.csv",
+        "scene": EXAMPLES / "specimen1_free.toml",
+        "study": EXAMPLES / "studies" / "uncertainty_specimen1.toml",
+        "sweep": EXAMPLES / "studies" / "harmonic_sweep.toml",
+    }
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "afile").write_text("a file, not a folder\n")
+    code, _, err = run_cli(capsys, *[a.format(**paths) for a in argv])
+    option = next(a for a in argv if a.startswith("--") and "afile" in argv[argv.index(a) + 1])
+    assert code == 2 and err.startswith(f"rockyade: error: {option}: ") and err.count("\n") == 1, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]

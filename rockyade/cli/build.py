@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.common import check_output_file
 from rockyade.errors import InputError
 
 
@@ -414,8 +415,9 @@ def cmd_build(args: argparse.Namespace) -> int:
 
     kind = args.kind
     out = Path(args.out)
-    if out.suffix.lower() not in (".toml", ".json"):
-        raise InputError("--out", f"must end in .toml or .json, got {out.name!r}")
+    check_output_file(out, "--out", (".toml", ".json"))
+    if args.draw:
+        check_output_file(args.draw, "--draw", ".png")
     kwargs = _generator_kwargs(args, kind)
     kwargs["motion"] = _motion_table(args, out)
     kwargs["contact"] = _contact_table(args, kind, _unit_height(args, kind))

@@ -33,18 +33,29 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
 
 def check_output_dir(path: Path, option: str) -> None:
     """Refuse an output directory that cannot be created or written (InputError naming
-    ``option``), before any work; nothing is created here."""
+    ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here."""
+    option = _flag(option)
+    if path.is_file():
+        raise InputError(option, f"{path} is a file; give a directory")
     _check_dir(path, option, f"cannot write into {path}")
 
 
-def check_output_file(path: Path, option: str, suffix: str | None = None) -> None:
+def check_output_file(path: Path, option: str, suffix: str | tuple[str, ...] | None = None) -> None:
     """Refuse an output file whose folder cannot be created or written, or (``suffix``, e.g.
-    ``".png"``) whose name does not end as the file it will be (no scene overwritten by a plot)."""
+    ``".png"`` or ``(".toml", ".json")``) whose name does not end as the file it will be (no
+    scene overwritten by a plot)."""
+    option = _flag(option)
     if path.is_dir():
         raise InputError(option, f"{path} is a directory; give a file name")
-    if suffix is not None and path.suffix.lower() != suffix:
-        raise InputError(option, f"must be a {suffix} file, got {path}")
+    suffixes = (suffix,) if isinstance(suffix, str) else suffix
+    if suffixes is not None and path.suffix.lower() not in suffixes:
+        raise InputError(option, f"must be a {' or '.join(suffixes)} file, got {path}")
     _check_dir(path.parent if str(path.parent) else Path("."), option, f"cannot write {path}")
+
+
+def _flag(option: str) -> str:
+    """The option as typed on the command line: ``out`` -> ``--out``."""
+    return option if option.startswith("-") else "--" + option.replace("_", "-")
 
 
 def _check_dir(path: Path, option: str, what: str) -> None:

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import json_out
+from rockyade.cli.common import check_output_dir, check_output_file, json_out
 from rockyade.errors import InputError
 
 
@@ -25,6 +25,10 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from rockyade.analysis.identify import identify
     from rockyade.analysis.measurement import read_measurement
 
+    if args.out:
+        check_output_file(args.out, "--out", ".json")
+    if args.plot:
+        check_output_dir(args.plot, "--plot")
     history = read_measurement(
         args.measured,
         time_column=args.time_column,
