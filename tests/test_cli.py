@@ -267,3 +267,26 @@ def test_an_output_under_a_file_is_refused_before_any_work(argv, capsys, tmp_pat
     option = next(a for a in argv if a.startswith("--") and "afile" in argv[argv.index(a) + 1])
     assert code == 2 and err.startswith(f"rockyade: error: {option}: ") and err.count("\n") == 1, err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["afile"]
+
+
+@pytest.mark.parametrize(
+    ("command", "study", "typo", "key"),
+    [
+        ("batch", "harmonic_sweep.toml", "solver", "solvers"),
+        ("uncertainty", "uncertainty_specimen1.toml", "solver", "solvers"),
+        ("uncertainty", "uncertainty_specimen1.toml", "theta_over_alpha_level", "theta_over_alpha_levels"),
+    ],
+)
+def test_study_file_misspelt_key_gets_did_you_mean(command, study, typo, key, capsys, tmp_path):
+    """A study file reads its keys like a scene file: a misspelt optional key is named with the
+    key it resembles, not only the list of allowed keys."""
+    from tests.conftest import EXAMPLES
+
+    text = (EXAMPLES / "studies" / study).read_text()
+    studies = tmp_path / "examples" / "studies"
+    studies.mkdir(parents=True)
+    (tmp_path / "examples" / "specimen1_harmonic.toml").symlink_to(EXAMPLES / "specimen1_harmonic.toml")
+    (tmp_path / "examples" / "specimen3_free.toml").symlink_to(EXAMPLES / "specimen3_free.toml")
+    (studies / study).write_text(text.replace(f"\n{key} =", f"\n{typo} =", 1))
+    code, _, err = run_cli(capsys, command, str(studies / study), "--out", str(tmp_path / "out"))
+    assert code == 2 and f"{typo}: unknown key; did you mean {key}?" in err and err.count("\n") == 1, err

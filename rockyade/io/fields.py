@@ -195,15 +195,14 @@ class TableReader:
         return TableReader(value, self.field(key), self.source)
 
     def finish(self) -> None:
-        """Reject keys that were never read."""
+        """Reject keys that were never read (naming the allowed key a misspelt one resembles)."""
         unknown = sorted(set(self.table) - self.used)
         if unknown:
             allowed = ", ".join(sorted(self.used)) or "(none)"
-            raise InputError(
-                self.field(unknown[0]),
-                f"unknown key; allowed keys here: {allowed}",
-                self.source,
-            )
+            key = unknown[0]
+            close = difflib.get_close_matches(key, sorted(self.used), n=1, cutoff=0.8) if isinstance(key, str) else []
+            hint = f"did you mean {close[0]}? " if close else ""
+            raise InputError(self.field(key), f"unknown key; {hint}allowed keys here: {allowed}", self.source)
 
 
 def _short(value: Any, limit: int = 60) -> str:
