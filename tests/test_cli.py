@@ -290,3 +290,16 @@ def test_study_file_misspelt_key_gets_did_you_mean(command, study, typo, key, ca
     (studies / study).write_text(text.replace(f"\n{key} =", f"\n{typo} =", 1))
     code, _, err = run_cli(capsys, command, str(studies / study), "--out", str(tmp_path / "out"))
     assert code == 2 and f"{typo}: unknown key; did you mean {key}?" in err and err.count("\n") == 1, err
+
+
+def test_motion_info_plot_says_what_it_wrote(capsys, tmp_path, monkeypatch):
+    """Like every command that writes a file: 'wrote PATH' (on stderr after --json, so that
+    stdout stays one JSON document)."""
+    from tests.conftest import EXAMPLES
+
+    record = str(EXAMPLES / "records" / "ricker_pulse_T0.5s.AT2")
+    monkeypatch.chdir(tmp_path)
+    code, out, _ = run_cli(capsys, "motion", "info", record, "--plot", "x.png")
+    assert code == 0 and out.splitlines()[-1] == "wrote x.png" and (tmp_path / "x.png").stat().st_size > 0
+    code, out, err = run_cli(capsys, "motion", "info", record, "--plot", "y.png", "--json")
+    assert code == 0 and json.loads(out)["npts"] == 1001 and err.strip() == "wrote y.png"

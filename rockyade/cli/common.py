@@ -21,6 +21,13 @@ def json_out(data: Any) -> None:
     print(json_text(data))
 
 
+def print_wrote(path: Path, json_mode: bool = False) -> None:
+    """``wrote PATH`` on stdout, or on stderr after ``--json`` (stdout stays one JSON document)."""
+    import sys
+
+    print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
+
+
 def add_allow_large(p: argparse.ArgumentParser) -> None:
     """``--allow-large``: run above the documented cost limits (docs/reliability.md)."""
     p.add_argument(

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_dir, check_output_file, json_out
+from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
 
 
@@ -56,8 +56,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         json_out(data)
     else:
         _print_text(result)
-        for path in [args.out, *figures] if args.out else figures:
-            print(f"wrote {path}")
+    for path in [args.out, *figures] if args.out else figures:
+        print_wrote(path, args.json)
     if result.unidentifiable:
         for name, why in result.unidentifiable.items():
             print(f"rockyade: {name} cannot be identified from this record: {why}", file=sys.stderr)

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_dir, check_output_file, json_out
+from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
 
 #: Period range of ``motion spectrum``, s.
@@ -62,6 +62,8 @@ def cmd_info(args: argparse.Namespace) -> int:
         print(f"  {rec.npts} samples at dt = {rec.dt_s:g} s ({rec.duration_s:g} s), units in file: {rec.units_in_file}")
         pga_g = rec.pga_m_s2 / STANDARD_GRAVITY
         print(f"  PGA = {rec.pga_m_s2:.4g} m/s^2 ({pga_g:.4g} g, standard gravity) at t = {rec.pga_time_s:g} s")
+    if args.plot:
+        print_wrote(args.plot, args.json)
     return 0
 
 
@@ -232,6 +234,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         _print_report(report)
     if args.plot:
         _plot_report(records, target, report, args.plot)
+        print_wrote(args.plot, args.json)
     return 0 if report["compatible"] else 1
 
 
