@@ -188,14 +188,25 @@ def _check_settlement(
     height = heights[worst]
     if pen[worst] > MAX_SETTLEMENT_FRACTION * height:
         names = bodies[c.a].name + ("-base" if c.b < 0 else f"-{bodies[c.b].name}")
-        field_name = "contact.K_N_per_m" if scene.contact.explicit_stiffness else "contact.stiffness_scale"
         k = joints.params[joints.joint_for(c.a, c.b)].K_N_per_m
+        factor = pen[worst] / (MAX_SETTLEMENT_FRACTION * height)
+        if scene.contact.jkn_Pa_per_m is not None:
+            field_name = "contact.jkn_Pa_per_m"
+            advice = (
+                f"raise jkn_Pa_per_m (now {scene.contact.jkn_Pa_per_m:.4g} Pa/m) at least {factor:.2g} times, "
+                "or the [[joints]] override of this pair"
+            )
+        elif scene.contact.explicit_stiffness:
+            field_name = "contact.K_N_per_m"
+            advice = f"raise K_N_per_m at least {factor:.2g} times"
+        else:
+            field_name = "contact.stiffness_scale"
+            advice = "raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') or check the units"
         raise InputError(
             field_name,
             f"K = {k:.4g} N/m lets the joint {names} sink {pen[worst]:.3g} m under the static load, above "
             f"{MAX_SETTLEMENT_FRACTION:g} of the block height ({MAX_SETTLEMENT_FRACTION * height:.3g} m): the blocks "
-            "sink into each other. Raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') "
-            "or check the units",
+            f"sink into each other; {advice}",
         )
     return float(pen.max())
 
