@@ -174,6 +174,16 @@ def _initial_state(scene: Scene, bodies: tuple[DemBody, ...], contacts: list[Res
     return pos0, ang0, vel0, angvel0
 
 
+def _calibration_label(scene: Scene) -> str:
+    """Where the joints' stiffness comes from, as the result's metadata says it."""
+    c = scene.contact
+    if c.jkn_Pa_per_m is not None:
+        return "udec (jkn_Pa_per_m)"
+    if c.K_N_per_m is not None:
+        return "explicit (K_N_per_m)"
+    return c.calibration
+
+
 def _check_settlement(
     springs, bodies: tuple[DemBody, ...], contacts: list[RestContact], joints: JointTable, scene: Scene, g: float
 ) -> float:
@@ -306,10 +316,11 @@ def build_dem_model(
         mass_damping_1_s=scene.contact.mass_damping_1_s,
         g=g,
         scene_hash=scene.scene_hash,
-        calibration=scene.contact.calibration,
+        calibration=_calibration_label(scene),
         static_settlement_m=settlement,
         w_max_rad_s=w_max,
         stop_angle_rad=stop_angles([b.contact_vertices_m for b in bodies], fixed),
         stop_on_overturn=not scene.positioned,
         rest_contacts=tuple(contacts),
+        base_at_rest=scene.motion.type,
     )
