@@ -25,6 +25,8 @@ from rockyade.scene.generators import arch, rocking_frame, stack, wall, write_sc
 from rockyade.scene.placement import placed_blocks, rotation_matrix
 from rockyade.solvers import get_solver
 
+from .conftest import EXAMPLES
+
 
 def _png_size(path) -> tuple[int, int]:
     assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -76,11 +78,11 @@ def test_moving_polygon_rotates_about_the_pivot_and_keeps_the_block_rigid():
     expected = (rest - rest[0]) @ rotation_matrix(0.2).T + rest[0]
     np.testing.assert_allclose(moved[0], expected, atol=1e-12)
     np.testing.assert_allclose(moved[1], placed[1].vertices_m, atol=0.0)
-    # magnified display: R(3 theta)(v - c) + c + 3 (x, y)
-    c = np.asarray(placed[0].centroid_m)
-    shift = 3.0 * np.array([result.frame["b01_x_m"].iat[k], result.frame["b01_y_m"].iat[k]])
+    # magnified display: every vertex's displacement x3; the pivot stays where it is (the
+    # block does not leave its support, as R(3 theta)(v - c) + c + 3 (x, y) made it do)
     big = moving_polygons(placed, result, k, scale=3.0)[0]
-    np.testing.assert_allclose(big, (rest - c) @ rotation_matrix(0.6).T + c + shift, atol=1e-12)
+    np.testing.assert_allclose(big, rest + 3.0 * (expected - rest), atol=1e-12)
+    np.testing.assert_allclose(big[0], rest[0], atol=1e-12)
 
 
 def test_sample_index_refuses_times_outside_the_run():
@@ -189,3 +191,13 @@ def test_run_and_draw_commands_write_snapshots_from_relative_paths(tmp_path, mon
     assert main(["draw", "../block.toml", "--out", "p.png", "--snapshots", "0.5"]) == 2
     assert "--result: is required" in capsys.readouterr().err
     assert main(["run", "../block.toml", "--animation", "r.avi"]) == 2
+
+
+def test_draw_refuses_a_result_of_another_scene_before_writing(tmp_path, capsys):
+    frame = EXAMPLES / "assemblies/frame.toml"
+    single = tmp_path / "single.csv"
+    assert main(["run", str(EXAMPLES / "specimen1_free.toml"), "--solver", "housner", "--out", str(single)]) == 0
+    out = tmp_path / "drawn" / "frame.png"
+    code = main(["draw", str(frame), "--out", str(out), "--result", str(single), "--snapshots", "0.5"])
+    assert code == 2 and "no history of the scene's block(s) column_left" in capsys.readouterr().err
+    assert not out.exists() and not out.parent.exists()

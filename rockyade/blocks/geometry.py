@@ -78,7 +78,11 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
         raise InputError(field_name, "all vertices are the same point")
     area = polygon_section_area(arr / scale)  # the checks on a polygon of unit size: no underflow
     if abs(area) <= LEVEL_TOL:
-        raise InputError(field_name, "the vertices enclose no area (they lie on one line)")
+        raise InputError(
+            field_name,
+            "the vertices enclose no area: they lie on one line, or the outline crosses itself so that "
+            "its parts cancel (a bow tie): give the vertices in order around a convex polygon",
+        )
     if area < 0:
         arr = arr[::-1].copy()
     unit = arr / scale

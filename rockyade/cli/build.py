@@ -407,6 +407,20 @@ def _summary(scene) -> str:
     )
 
 
+def _check_the_dem_takes_it(scene: Any) -> None:
+    """Build the DEM model (joints, statics) before writing: a scene that ``run`` would refuse
+    (joints too soft for the wall's weight) is refused here, naming the option to change."""
+    if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
+        return  # the matched stage runs the DEM: too slow for a check; run checks it
+    from rockyade.dem.build import build_dem_model
+
+    try:
+        build_dem_model(scene)
+    except InputError as exc:
+        flag = {"contact.jkn_Pa_per_m": "--jkn-pa-per-m"}.get(exc.field, exc.field)
+        raise InputError(flag, f"{exc.message} (nothing written)") from None
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -427,6 +441,7 @@ def cmd_build(args: argparse.Namespace) -> int:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
     scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
+    _check_the_dem_takes_it(scene)
     summary = _summary(scene)
     header = "\n".join(
         [
@@ -552,19 +567,34 @@ def cmd_draw(args: argparse.Namespace) -> int:
     if out.suffix.lower() != ".png":
         raise InputError("--out", f"must be a .png file, got {out.name!r}")
     check_run_drawings(args)
+    result = _result_of(scene, args) if args.snapshots or args.animation else None
     skipped = draw_assembly(scene, out, title=args.title, labels=not args.no_labels)
     note = f" ({skipped} block names too small to print)" if skipped and not args.no_labels else ""
     print(f"wrote {out}{note}")
-    if args.snapshots or args.animation:
-        if args.result is None:
-            raise InputError("--result", "is required with --snapshots or --animation: a result CSV of this scene")
-        from rockyade.result import Result
-
-        result = Result.read(args.result)
+    if result is not None:
         if result.meta.get("scene_hash") not in (None, scene.scene_hash):
             print(f"note: {args.result} was computed from another version of this scene (scene hash differs)")
         write_run_drawings(args, scene, result, out)
     return 0
+
+
+def _result_of(scene: Any, args: argparse.Namespace) -> Any:
+    """The --result to draw, read and checked against the scene before anything is written."""
+    if args.result is None:
+        raise InputError("--result", "is required with --snapshots or --animation: a result CSV of this scene")
+    from rockyade.result import Result
+
+    result = Result.read(args.result)
+    moving = [b.name for b in scene.blocks if not b.fixed]
+    missing = [name for name in moving if name not in result.blocks]
+    if missing:
+        shown = ", ".join(missing[:5]) + (f" and {len(missing) - 5} more" if len(missing) > 5 else "")
+        raise InputError(
+            "--result",
+            f"{args.result} has no history of the scene's block(s) {shown}: it is a result of another scene "
+            f"(its blocks: {', '.join(result.blocks[:5])})",
+        )
+    return result
 
 
 # ---------------------------------------------------------------------- parser

@@ -7,7 +7,9 @@ Both the reference DEM solver and the matched calibration run models through her
 from __future__ import annotations
 
 import math
+import sys
 import time
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -186,11 +188,24 @@ def simulate_model(
 _WARM: list[bool] = []
 
 
+def _compiled_kernel_cached() -> bool:
+    """True when numba's on-disk cache holds the kernel (next to the module, where numba puts
+    it when that folder is writable; elsewhere the note below may show once per process)."""
+    cache = Path(kernel.__file__).parent / "__pycache__"
+    return any(cache.glob("kernel.simulate-*.nbi"))
+
+
 def _warm_up() -> None:
     """Run the kernel once on a tiny problem so that its loading is not timed."""
     if _WARM:
         return
     _WARM.append(True)
+    if not _compiled_kernel_cached():
+        print(
+            "rockyade: compiling the DEM kernel (numba, once per installation: 20-40 s) ...",
+            file=sys.stderr,
+            flush=True,
+        )
     square = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
     one = np.ones(1)
     zero = np.zeros(1)

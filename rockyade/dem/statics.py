@@ -17,6 +17,7 @@ moving bodies (fixed bodies and the base do not move) this gives a sparse stiffn
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -24,7 +25,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.linalg import eigh
-from scipy.sparse.linalg import ArpackNoConvergence, eigsh, spsolve
+from scipy.sparse.linalg import ArpackNoConvergence, MatrixRankWarning, eigsh, spsolve
 
 from rockyade.dem.joints import JointTable
 from rockyade.scene.placement import RestContact
@@ -180,7 +181,8 @@ def static_displacement(
         if not fx:
             f[springs.dof_of[i] + 1] = -m * g
     try:
-        with np.errstate(all="ignore"):
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", MatrixRankWarning)  # a mechanism: answered below
             u = spsolve(K, f)
     except (RuntimeError, ValueError):
         return None

@@ -2,9 +2,13 @@
 
 Blocks are drawn in the base frame (positions relative to the base, which is the hatched
 line y = 0): moving blocks in stone colour, fixed blocks (they move with the base) grey and
-hatched. A block's polygon at time t is R(k theta)(v - c) + c + k (x, y): v its vertices at
-rest, c its centroid at rest, and theta, x, y the Result's rotation and centroid
-displacement from rest; k is a display magnification (1: true scale).
+hatched. A block's polygon at time t is v + k (v(t) - v), v(t) = R(theta)(v - c) + c + (x, y):
+v its vertices at rest, c its centroid at rest, and theta, x, y the Result's rotation and
+centroid displacement from rest; k is a display magnification (1: true scale). Magnifying
+each vertex's displacement keeps blocks that touch at a corner touching there (a rocking
+column stays on its pivot); at large k theta the drawn blocks distort, which the titles say.
+Colours give each block's rotation from rest on a scale of at least
+:data:`MIN_COLOUR_SCALE_RAD`, so that elastic tilts of micro-radians stay pale.
 
 Names are written inside blocks at the largest size that fits (along the block's own base
 direction, or across it for tall blocks), and left out where that size would be below
@@ -63,7 +67,8 @@ def moving_polygons(placed: Sequence[PlacedBlock], result: Result, index: int, s
         dx = float(frame[column(b.name, "x_m", names)].iat[index])
         dy = float(frame[column(b.name, "y_m", names)].iat[index])
         c = np.asarray(b.centroid_m)
-        out.append((b.vertices_m - c) @ rotation_matrix(scale * theta).T + c + scale * np.array([dx, dy]))
+        moved = (b.vertices_m - c) @ rotation_matrix(theta).T + c + np.array([dx, dy])
+        out.append(b.vertices_m + scale * (moved - b.vertices_m))
     return out
 
 
@@ -296,9 +301,13 @@ def draw_assembly(scene, path: str | Path, title: str | None = None, labels: boo
     return skipped
 
 
+#: The colour scale of rotations spans at least this, rad.
+MIN_COLOUR_SCALE_RAD = 1e-3
+
+
 def _rotation_norm(placed, result, indices) -> float:
     peak = max(float(rotations(placed, result, i).max()) for i in indices)
-    return max(peak, 1e-6)
+    return max(peak, MIN_COLOUR_SCALE_RAD)
 
 
 def draw_snapshots(
@@ -354,7 +363,7 @@ def draw_snapshots(
     solver = result.meta.get("solver", "")
     heading = title or (_title(scene, None) + (f" ({solver})" if solver else ""))
     if scale != 1.0:
-        heading += f"; displacements and rotations x{scale:g}"
+        heading += f"; vertex displacements x{scale:g}"
     path = Path(path)
 
     def panel(ax, k: int) -> None:
