@@ -564,8 +564,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
 
     scene = load_scene(args.scene)
     out = Path(args.out)
-    if out.suffix.lower() != ".png":
-        raise InputError("--out", f"must be a .png file, got {out.name!r}")
+    check_output_file(out, "--out", ".png")
     check_run_drawings(args)
     result = _result_of(scene, args) if args.snapshots or args.animation else None
     skipped = draw_assembly(scene, out, title=args.title, labels=not args.no_labels)

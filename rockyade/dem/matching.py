@@ -218,8 +218,8 @@ def _match_cached(key: tuple) -> MatchedBeta:
     if target > mu_max * (1 + MU_RTOL):
         mu_low = mu_of(beta_max)
         raise CalibrationError(
-            f"target mu = {target:.4f} is above what the DEM reaches without damping ({mu_max:.4f}): "
-            f"the corner impacts alone lose more energy; reachable range [{mu_low:.4f}, {mu_max:.4f}]. "
+            f"target mu = {target:.6g} is above what the DEM reaches without damping ({mu_max:.6g}): "
+            f"the corner impacts alone lose more energy; reachable range [{mu_low:.6g}, {mu_max:.6g}]. "
             "Damping cannot add energy: check mu or the stiffness"
         )
     # bracket: increase beta until mu_eff falls below the target
@@ -232,14 +232,16 @@ def _match_cached(key: tuple) -> MatchedBeta:
         hi = min(4.0 * hi, beta_max)
         f_hi = mu_of(hi) - target
         mu_min = min(mu_min, f_hi + target)
-    if f_hi > 0:
+    if f_hi > MU_RTOL * target:  # as at the top: a target within the tolerance is reached
         raise CalibrationError(
-            f"target mu = {target:.4f} is below what the DEM reaches with the heaviest damping tried "
-            f"(beta = {beta_max:.3g} s, mu_eff = {mu_min:.4f}); reachable range [{mu_min:.4f}, {mu_max:.4f}]. "
+            f"target mu = {target:.6g} is below what the DEM reaches with the heaviest damping tried "
+            f"(beta = {beta_max:.3g} s, mu_eff = {mu_min:.6g}); reachable range [{mu_min:.6g}, {mu_max:.6g}]. "
             "Damping alone cannot dissipate that much at the corner impacts"
         )
     if abs(f_lo) <= MU_RTOL * target:
         beta = lo
+    elif f_hi >= 0.0:
+        beta = hi
     else:
         beta = brentq(lambda b: mu_of(b) - target, lo, hi, xtol=1e-9, rtol=1e-4, maxiter=60)
     achieved = mu_of(beta)
