@@ -334,8 +334,15 @@ class Recorder:
         self.start = time.perf_counter()
         self.written = False
         self.wait = True
+        self.own_time = 0.0  # spent in the recorder, s
 
     def __call__(self):
+        start = time.perf_counter()
+        self.record()
+        self.own_time += time.perf_counter() - start
+
+    def record(self):
+        """Record the state when this step is a sample (and follow the rotations)."""
         k = self.k
         if k >= self.ns or self.written:
             return
@@ -468,6 +475,7 @@ class Recorder:
             "n_filled": n,
             "iterations": O.iter,
             "wall_time_s": time.perf_counter() - self.start,
+            "recorder_time_s": self.own_time,
             "build_time_s": self.scene.get("_build_time_s"),
             "yade_version": __import__("yade.config", fromlist=["version"]).version,
             "dt_s": O.dt,
