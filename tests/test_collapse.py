@@ -117,6 +117,32 @@ def test_drums_carried_by_a_rocking_column_rock_and_do_not_slide():
     assert (states[:, top] == SLIDING).mean() < 0.05
 
 
+def test_a_falling_column_lands_from_the_bottom_up_after_tipping_as_one_body():
+    """8 drums, 0.25 g one-sine pulse of 1 s: the column tips as one body (every drum passes
+    alpha at the same sample) and lands bottom first; the old centroid-drop rule called the
+    top drums fallen while the column was still in the air, before they had tipped."""
+    data = load_scene(EXAMPLES / "assemblies/column_8_drums.toml").to_dict()
+    data.update(duration_s=6.0, motion={"type": "pulse", "shape": "sine", "amplitude_g": 0.25, "period_s": 1.0})
+    scene = scene_from_dict(data)
+    report = collapse_report(scene, run(scene, "reference")).set_index("block")
+    drums = [f"d0{k}" for k in range(1, 9)]
+    assert report.loc[drums, "fell"].all()
+    tipped = report.loc[drums, "tipped_time_s"].to_numpy()
+    falls = report.loc[drums, "fall_time_s"].to_numpy()
+    assert np.ptp(tipped) == 0.0 and (falls > tipped + 0.3).all()
+    assert (np.diff(falls) > 0).all(), falls  # bottom first
+    assert (report.loc[drums, "final_state"] == "fallen").all()
+
+
+def test_a_beam_on_rocking_columns_is_carried_and_a_block_that_never_tipped_has_no_tip_time():
+    scene = load_scene(EXAMPLES / "assemblies/frame.toml")
+    result = run(scene, "reference")
+    report = collapse_report(scene, result).set_index("block")
+    assert report.loc["beam", "final_state"] == "carried"  # it swings with the columns: not at rest
+    assert report.loc["column_left", "final_state"] == "rocking"
+    assert not report["fell"].any() and report["tipped_time_s"].isna().all()
+
+
 def _record_cases():
     """Specimen 2 (paper calibration) under records 1-10 of the paper's synthetic suite at two levels."""
     base = load_scene(EXAMPLES / "specimen2_record21.toml").to_dict()

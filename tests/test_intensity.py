@@ -107,3 +107,14 @@ def test_binomial_intervals():
     assert hi == 1.0 and lo == pytest.approx(0.025 ** (1 / 10), rel=1e-9)
     with pytest.raises(InputError):
         wilson_interval(3, 2)
+
+
+def test_fragility_of_collapses_that_do_not_grow_with_the_intensity_is_no_trend():
+    """One collapse at the lowest stripe and none above: the likelihood's maximum runs off to
+    beta -> infinity and a median far beyond the data (exp overflowed in the fit). Said as
+    'no trend', with the overall fraction as the probability."""
+    fit = fit_lognormal([1.0, 2.0, 3.0, 4.0], [1, 0, 0, 1], [10, 10, 10, 10])
+    assert fit.status == "no trend" and math.isnan(fit.median) and math.isnan(fit.beta)
+    assert fit.probability([0.5, 5.0]) == pytest.approx([0.05, 0.05])
+    rising = fit_lognormal([1.0, 2.0, 3.0, 4.0], [0, 2, 5, 9], [10, 10, 10, 10])
+    assert rising.status == "fitted" and 2.0 < rising.median < 4.0

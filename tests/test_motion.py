@@ -30,7 +30,7 @@ from rockyade.motion.synthetic import (
 )
 from rockyade.scene import scene_from_dict
 
-from .conftest import external_records_dir, free_scene_dict, needs_records
+from .conftest import EXAMPLES, external_records_dir, free_scene_dict, needs_records
 
 RECORDS = external_records_dir() or Path()
 needs_peer_records = needs_records(
@@ -403,6 +403,29 @@ def test_records_reproducible_alone_and_bit_identical(paper_records):
     assert not np.array_equal(records[0].accel_m_s2, records[1].accel_m_s2)
     different_seed = SuiteSpec(spec.target, seed=spec.seed + 1)
     assert not np.array_equal(generate_record(different_seed, 21).accel_m_s2, records[20].accel_m_s2)
+
+
+def test_records_cached_by_other_generator_code_are_never_reused(monkeypatch):
+    """The cache key holds the generator's code: version 2's exact spectra changed every
+    record, and a cache written by version 1 (same settings) gave 21 % different peaks."""
+    from rockyade.motion import synthetic
+
+    spec = paper_suite()
+    assert spec.as_dict()["generator_code"] == synthetic.generator_fingerprint()
+    key = spec.key
+    monkeypatch.setattr(synthetic, "generator_fingerprint", lambda: "0" * 16)
+    assert spec.key != key
+    monkeypatch.setattr(synthetic, "GENERATOR_VERSION", synthetic.GENERATOR_VERSION + 1)
+    assert len({key, spec.key}) == 2
+
+
+def test_the_shipped_example_record_is_the_generators_own(paper_records):
+    """examples/records/ec8_type2_D_record21.AT2 was written by this generator: the same samples
+    (to the file's printed digits) as record 21 of the paper suite generated now."""
+    _, records = paper_records
+    shipped = read_record(EXAMPLES / "records/ec8_type2_D_record21.AT2")
+    n = min(shipped.accel_m_s2.size, records[20].accel_m_s2.size)
+    assert np.allclose(shipped.accel_m_s2[:n], records[20].accel_m_s2[:n], rtol=1e-4, atol=1e-6 * 9.80665)
 
 
 def test_synthetic_scene_uses_the_cached_record(paper_records):

@@ -65,9 +65,10 @@ def test_peak_times_match_housner_with_the_dem_own_p(free_rocking):
 
 def test_energy_balance(free_rocking):
     """Energy balance error below 1 % of the initial potential energy at Eq 7's step for
-    specimens 1-3. The error is the penalty contacts switching on and off between steps
-    (first order in dt); specimen 4, stocky and stiff, is at 1.3 % and gets below 1 % at
-    half the step."""
+    specimens 1-3. The error is the explicit scheme's (first order in dt: contacts switching
+    on and off between steps, the shear spring loaded with the velocity of the step before);
+    specimen 4, stocky and stiff, slips at its corners at every impact: 3.3 % at Eq 7's step,
+    halving with the step (1.5 % at dt/2, 0.8 % at dt/4)."""
     key, scene, dem, _ = free_rocking
     pe0 = dem.meta["initial_potential_energy_J"]
     assert pe0 > 0
@@ -75,12 +76,12 @@ def test_energy_balance(free_rocking):
     if key != "4":
         assert error < 0.01
     else:
-        assert error < 0.015
+        assert error < 0.035
         model = build_matched_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2))
         finer_error = finer.meta["energy_balance_max_error_J"] / pe0
-        assert finer_error < 0.01
-        assert finer_error < 0.6 * error  # first order in dt
+        assert finer_error < 0.02
+        assert finer_error < 0.55 * error  # first order in dt
     frame = dem.frame
     assert frame["energy_dashpot_J"].iloc[-1] > 0 and (frame["energy_dashpot_J"].diff().dropna() >= -1e-9).all()
     assert (frame["energy_friction_J"].diff().dropna() >= -1e-12).all()
@@ -313,3 +314,27 @@ def test_run_many_in_parallel_equals_sequential():
     out = run_many([scenes[0], bad], workers=2)
     assert out[0].status == "completed" and out[1].status == "failed"
     assert "CalibrationError" in out[1].meta["failure_reason"]
+
+
+def test_friction_energy_of_a_sliding_block_is_coulomb_force_times_slip():
+    """A 1.0 x 0.2 m block under a constant 0.65 g, friction angle 30 deg: it slides at
+    (0.65 - tan 30) g; the friction dissipation is mu M g times the slip and the energy
+    balance closes (it was off by 50 times the base work: each slipping step also counted
+    the elastic energy of the trial step, (ks v dt)^2 / 2 ks, which grows as dt shrinks)."""
+    scene = scene_from_dict(
+        {
+            "duration_s": 1.0,
+            "sample_dt_s": 0.001,
+            "blocks": [{"name": "slab", "width_m": 1.0, "height_m": 0.2, "thickness_m": 0.5, "mass_kg": 250}],
+            "contact": {"calibration": "paper", "friction_angle_deg": 30.0},
+            "motion": {"type": "sampled", "t_s": [0.0, 0.001, 2.0], "accel_m_s2": [0.0, 0.65 * G, 0.65 * G]},
+        }
+    )
+    dem = reference.run_scene(scene)
+    x = dem.series("x_m")
+    slip = -x[-1]  # the block lags the table
+    assert slip == pytest.approx(0.5 * (0.65 - math.tan(math.radians(30.0))) * G * 1.0**2, rel=0.01)
+    friction = dem.frame["energy_friction_J"].to_numpy()
+    assert friction[-1] == pytest.approx(math.tan(math.radians(30.0)) * 250 * G * slip, rel=0.02)
+    base_work = abs(dem.frame["work_base_J"].to_numpy()[-1])
+    assert dem.meta["energy_balance_max_error_J"] < 0.02 * base_work

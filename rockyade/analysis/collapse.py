@@ -1,20 +1,26 @@
 """Collapse of an assembly: the state of every block over time, which blocks fell and when.
 
-Each moving block is, at each sample, in one of four states (codes in :data:`STATES`):
+Each moving block is, at each sample, in one of five states (codes in :data:`STATES`):
 
-* ``fallen``: it has left its base for good: from the first time it lies on another face
+* ``fallen``: it has come down for good, from the first of: it lies on another face
   (|theta| within ``LANDING_TOL_RAD`` of its landing angle, :mod:`rockyade.dem.overturn`:
-  the DEMs' overturn criterion) or its centroid has dropped by more than half the block's
-  height (it fell off something); a block that never lands but ends the run beyond its
-  tipping angle alpha (it leans on a neighbour or on the rubble) falls when it last passed
-  alpha. Once fallen, fallen to the end. The report also gives ``tipped_time_s``, when the
-  block last passed alpha before falling (from there gravity alone no longer brings it back);
+  the DEMs' overturn criterion); it ends the run dropped by more than ``DROP_FRACTION`` of
+  its height (carried down by the blocks under it, or fallen off them) and has stopped
+  descending (it hit something: vertical speed above -``LAND_SPEED_M_S``); it ends the run
+  beyond its tipping angle alpha, leaning on a neighbour or on rubble, and has stopped
+  turning after its last passage of alpha (``REST_SPIN_RAD_S``). A block still moving at
+  the end of the run falls at its last sample. Once fallen, fallen to the end. The report
+  also gives ``tipped_time_s``, when the block last passed alpha before falling (from there
+  gravity alone no longer brings it back; none for a block carried down or dropping flat);
 * ``sliding``: its base slides: the horizontal speed of the point of the block that was the
   middle of its base at rest exceeds ``SLIDE_SPEED_M_S`` while it is not rocking fast
   enough to explain it (rocking about a corner moves that point by b (1 - cos theta)), and,
   where the result records it (the reference DEM's ``slipping``), one of the block's
   contacts slips: a drum carried by the rocking drums under it moves fast but does not slide;
 * ``rocking``: |theta| above ``ROCK_FRACTION`` x alpha (and at least ``ROCK_MIN_RAD``);
+* ``carried``: none of the above, but it moves (its centroid faster than ``SLIDE_SPEED_M_S``
+  or it turns faster than ``REST_SPIN_RAD_S``): a beam on rocking columns, a course on a
+  rocking wall;
 * ``rest`` otherwise.
 
 The thresholds are stated here and in docs/assemblies.md; none depends on the solver, so
@@ -33,8 +39,8 @@ from numpy.typing import NDArray
 from rockyade.dem.overturn import LANDING_TOL_RAD, landing_angles
 from rockyade.result import Result
 
-STATES = ("rest", "rocking", "sliding", "fallen")
-REST, ROCKING, SLIDING, FALLEN = range(4)
+STATES = ("rest", "rocking", "sliding", "fallen", "carried")
+REST, ROCKING, SLIDING, FALLEN, CARRIED = range(5)
 
 #: Rocking: |theta| above this fraction of alpha ...
 ROCK_FRACTION = 0.01
@@ -44,6 +50,10 @@ ROCK_MIN_RAD = 1e-4
 SLIDE_SPEED_M_S = 0.01
 #: Fallen off: the centroid dropped by more than this fraction of the block height.
 DROP_FRACTION = 0.5
+#: A dropped block has landed when its centroid no longer descends faster than this, m/s.
+LAND_SPEED_M_S = 0.05
+#: A block leaning beyond alpha has come to rest when it turns slower than this, rad/s.
+REST_SPIN_RAD_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -119,7 +129,13 @@ def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeo
         slipping = _slipping(result, g.name)
         if slipping is not None:  # the DEM says whether a contact slips: a block carried
             sliding &= slipping  # by the rocking blocks under it does not slide
-        code = np.where(rocking, ROCKING, REST)
+        moving = np.zeros(n, dtype=bool)
+        if n > 1:
+            moving = (np.hypot(np.gradient(x, dt), np.gradient(y, dt)) > SLIDE_SPEED_M_S) | (
+                np.abs(np.gradient(theta, dt)) > REST_SPIN_RAD_S
+            )
+        code = np.where(moving, CARRIED, REST)
+        code = np.where(rocking, ROCKING, code)
         code = np.where(sliding, SLIDING, code)
         code = np.where(fallen, FALLEN, code)
         states[:, j] = code
@@ -139,27 +155,56 @@ def _fall_and_tip(
 ) -> tuple[int, int]:
     """Sample of the fall and of the tip that led to it (see module docstring), -1 if none.
 
+    The fall is when the block has come down: the first sample it lies on another face; or,
+    for a block that ends the run dropped by more than ``DROP_FRACTION`` of its height (it
+    was carried down by the blocks under it, or fell off them), the first sample of that
+    final drop at which it stops descending (it hit something); or, for a block that ends
+    the run beyond its tipping angle leaning on a neighbour or on rubble, the first sample
+    after its last passage of alpha at which it stops turning. Still moving at the end: the
+    last sample. The tip is the last passage of alpha before the fall (-1 if the block was
+    not beyond alpha when it fell: a block carried down or dropping flat).
+
     ``t_solver`` is the time at which the solver itself found the block overturned (between
     samples, ``meta["overturn_times_s"]``): a run that stops there ends before a sample shows it.
     """
     finite = np.isfinite(theta)
+    if not finite.any():
+        return -1, -1
+    last = int(np.flatnonzero(finite)[-1])
     landed = (theta >= g.landing_rad[0] - LANDING_TOL_RAD) | (theta <= -(g.landing_rad[1] - LANDING_TOL_RAD))
-    if t_solver is not None and finite.any():
-        landed |= t >= min(t_solver, float(t[np.flatnonzero(finite)[-1]]))
-    dropped = y < -DROP_FRACTION * g.height_m
+    if t_solver is not None:
+        landed |= t >= min(t_solver, float(t[last]))
     beyond = (np.abs(theta) > g.alpha_rad) & finite
-    hits = np.flatnonzero((landed | dropped) & finite)
-    last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
+    dt = float(t[1] - t[0]) if t.size > 1 else 1.0
+    hits = np.flatnonzero(landed & finite)
     if hits.size:
         fall = int(hits[0])
-    elif last >= 0 and beyond[last]:
-        fall = -2  # ends the run beyond alpha: falls when it last passed alpha
+    elif y[last] < -DROP_FRACTION * g.height_m:
+        up = np.flatnonzero(~(y[: last + 1] < -DROP_FRACTION * g.height_m))
+        start = int(up[-1]) + 1 if up.size else 0  # the final drop, to the end of the run
+        vy = np.gradient(y[: last + 1], dt) if last > 0 else np.zeros(1)
+        fall = _first_settled(vy, start, last, LAND_SPEED_M_S, -1)
+    elif beyond[last]:
+        below = np.flatnonzero(~beyond[: last + 1])
+        start = int(below[-1]) + 1 if below.size else 0
+        omega = np.gradient(theta[: last + 1], dt) if last > 0 else np.zeros(1)
+        fall = _first_settled(omega, start, last, REST_SPIN_RAD_S, 0)
     else:
         return -1, -1
-    end = fall if fall >= 0 else last
-    below = np.flatnonzero(~beyond[: end + 1])
+    if not beyond[fall]:
+        return fall, -1
+    below = np.flatnonzero(~beyond[: fall + 1])
     tip = int(below[-1]) + 1 if below.size else 0
-    return (tip if fall == -2 else fall), tip
+    return fall, tip
+
+
+def _first_settled(rate: NDArray[np.float64], start: int, last: int, limit: float, sign: int) -> int:
+    """First sample in [start, last] where a descent stops (``sign = -1``: rate >= -limit) or
+    a motion stops (``sign = 0``: |rate| <= limit); ``last`` if it never does."""
+    window = rate[start : last + 1]
+    ok = window >= -limit if sign < 0 else np.abs(window) <= limit
+    hit = np.flatnonzero(ok)
+    return start + int(hit[0]) if hit.size else last
 
 
 def _solver_fall_time(result: Result, name: str) -> float | None:

@@ -25,6 +25,10 @@ from scipy import optimize, stats
 
 from rockyade.errors import InputError
 
+#: Range of the fitted dispersion beta (log-standard deviation): below it the stripes are
+#: separated in all but name, above it the curve says nothing.
+MIN_BETA, MAX_BETA = 1e-3, 10.0
+
 
 @dataclass(frozen=True)
 class Fragility:
@@ -42,19 +46,27 @@ class Fragility:
         "fitted", or why not: "no collapse", "all collapse", or "separated" when no run
         collapses below the intensity of a run that does not (the likelihood then grows
         without bound as beta -> 0: the data fix a threshold, ``median``, not a slope;
-        ``beta`` is NaN).
+        ``beta`` is NaN), or "no trend" when the likelihood's maximum lies on the bounds of
+        the fit (beta beyond ``MAX_BETA`` or the median far outside the tested intensities:
+        collapses do not grow with the intensity; ``median`` and ``beta`` are NaN and the
+        probability is the overall fraction of collapses, ``fraction``).
+    fraction
+        Collapses over runs, all stripes together.
     """
 
     median: float
     beta: float
     n_points: int
     status: str = "fitted"
+    fraction: float = math.nan
 
     def probability(self, im: ArrayLike) -> np.ndarray:
         """P(collapse) at intensities ``im``."""
         x = np.asarray(im, dtype=float)
         if self.status == "separated":
             return (x > self.median).astype(float)
+        if self.status == "no trend":
+            return np.full(x.shape, self.fraction)
         if self.status != "fitted":
             return np.full(x.shape, 0.0 if self.status == "no collapse" else 1.0)
         with np.errstate(divide="ignore"):
@@ -98,10 +110,19 @@ def fit_lognormal(im: ArrayLike, n_collapse: ArrayLike, n_total: ArrayLike) -> F
     order = np.argsort(logx)
     cum = np.maximum.accumulate(frac[order])
     start_mu = float(np.interp(0.5, cum, logx[order])) if frac.max() >= 0.5 else float(logx.max())
+    # bounded: a nearly separated sample drives beta to 0 or the median far out (exp overflows)
+    bounds = [(float(logx.min()) - 5.0, float(logx.max()) + 5.0), (math.log(MIN_BETA), math.log(MAX_BETA))]
     best = optimize.minimize(
-        nll, [start_mu, math.log(0.4)], method="Nelder-Mead", options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000}
+        nll,
+        [start_mu, math.log(0.4)],
+        method="Nelder-Mead",
+        bounds=bounds,
+        options={"xatol": 1e-8, "fatol": 1e-10, "maxiter": 4000},
     )
     mu, log_beta = best.x
+    at_bound = any(min(v - lo, hi - v) < 1e-6 * max(1.0, abs(v)) for v, (lo, hi) in zip(best.x, bounds, strict=True))
+    if at_bound and log_beta > math.log(MIN_BETA) + 1e-6:
+        return Fragility(math.nan, math.nan, int(x.size), "no trend", float(k.sum() / n.sum()))
     return Fragility(float(math.exp(mu)), float(math.exp(log_beta)), int(x.size))
 
 

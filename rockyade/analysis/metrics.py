@@ -62,7 +62,9 @@ PER_BLOCK_LIMIT = 10
 def assembly_metrics(scene, result) -> dict[str, float]:
     """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
     ``n_blocks``, ``n_fallen``, ``fallen_fraction``, ``first_fall_time_s``, ``first_fallen_block``,
-    ``max_abs_theta_rad`` and its block, ``max_residual_displacement_m`` and its block."""
+    ``max_abs_theta_rad`` and its block, ``max_residual_displacement_m`` (at the end of the
+    run) and its block, ``n_moving_at_end`` (blocks whose final state is not rest or fallen:
+    their "residual" values are where they were when the run ended, not where they stopped)."""
     from rockyade.analysis.collapse import collapse_report
 
     report = collapse_report(scene, result)
@@ -81,4 +83,5 @@ def assembly_metrics(scene, result) -> dict[str, float]:
         "max_theta_block": str(report["block"].iloc[k_theta]) if k_theta >= 0 else "",
         "max_residual_displacement_m": float(residual.iloc[k_disp]) if k_disp >= 0 else math.nan,
         "max_residual_block": str(report["block"].iloc[k_disp]) if k_disp >= 0 else "",
+        "n_moving_at_end": int((~report["final_state"].isin(["rest", "fallen"])).sum()),
     }

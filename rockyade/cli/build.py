@@ -406,6 +406,20 @@ def _summary(scene) -> str:
     )
 
 
+def _check_the_dem_takes_it(scene: Any) -> None:
+    """Build the DEM model (joints, statics) before writing: a scene that ``run`` would refuse
+    (joints too soft for the wall's weight) is refused here, naming the option to change."""
+    if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
+        return  # the matched stage runs the DEM: too slow for a check; run checks it
+    from rockyade.dem.build import build_dem_model
+
+    try:
+        build_dem_model(scene)
+    except InputError as exc:
+        flag = {"contact.jkn_Pa_per_m": "--jkn-pa-per-m"}.get(exc.field, exc.field)
+        raise InputError(flag, f"{exc.message} (nothing written)") from None
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -425,6 +439,7 @@ def cmd_build(args: argparse.Namespace) -> int:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
     scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
+    _check_the_dem_takes_it(scene)
     summary = _summary(scene)
     header = "\n".join(
         [

@@ -81,7 +81,10 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         if a["n_fallen"]:
             line += f" (first {a['first_fallen_block']} at t = {a['first_fall_time_s']:.4g} s)"
         print(line + f"; max |theta| = {a['max_abs_theta_rad']:.4g} rad ({a['max_theta_block']})")
-        print(f"  largest residual displacement {a['max_residual_displacement_m']:.4g} m ({a['max_residual_block']})")
+        line = f"  largest residual displacement {a['max_residual_displacement_m']:.4g} m ({a['max_residual_block']})"
+        if a["n_moving_at_end"]:
+            line += f"; {a['n_moving_at_end']} block(s) still moving at the end: residuals are where they were then"
+        print(line)
         if len(scene.blocks) > PER_BLOCK_LIMIT:
             return
     for name, m in run_metrics(scene, result).items():

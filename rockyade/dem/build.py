@@ -174,6 +174,16 @@ def _initial_state(scene: Scene, bodies: tuple[DemBody, ...], contacts: list[Res
     return pos0, ang0, vel0, angvel0
 
 
+def _calibration_label(scene: Scene) -> str:
+    """Where the joints' stiffness comes from, as the result's metadata says it."""
+    c = scene.contact
+    if c.jkn_Pa_per_m is not None:
+        return "udec (jkn_Pa_per_m)"
+    if c.K_N_per_m is not None:
+        return "explicit (K_N_per_m)"
+    return c.calibration
+
+
 def _check_settlement(
     springs, bodies: tuple[DemBody, ...], contacts: list[RestContact], joints: JointTable, scene: Scene, g: float
 ) -> float:
@@ -188,14 +198,25 @@ def _check_settlement(
     height = heights[worst]
     if pen[worst] > MAX_SETTLEMENT_FRACTION * height:
         names = bodies[c.a].name + ("-base" if c.b < 0 else f"-{bodies[c.b].name}")
-        field_name = "contact.K_N_per_m" if scene.contact.explicit_stiffness else "contact.stiffness_scale"
         k = joints.params[joints.joint_for(c.a, c.b)].K_N_per_m
+        factor = pen[worst] / (MAX_SETTLEMENT_FRACTION * height)
+        if scene.contact.jkn_Pa_per_m is not None:
+            field_name = "contact.jkn_Pa_per_m"
+            advice = (
+                f"raise jkn_Pa_per_m (now {scene.contact.jkn_Pa_per_m:.4g} Pa/m) at least {factor:.2g} times, "
+                "or the [[joints]] override of this pair"
+            )
+        elif scene.contact.explicit_stiffness:
+            field_name = "contact.K_N_per_m"
+            advice = f"raise K_N_per_m at least {factor:.2g} times"
+        else:
+            field_name = "contact.stiffness_scale"
+            advice = "raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') or check the units"
         raise InputError(
             field_name,
             f"K = {k:.4g} N/m lets the joint {names} sink {pen[worst]:.3g} m under the static load, above "
             f"{MAX_SETTLEMENT_FRACTION:g} of the block height ({MAX_SETTLEMENT_FRACTION * height:.3g} m): the blocks "
-            "sink into each other. Raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') "
-            "or check the units",
+            f"sink into each other; {advice}",
         )
     return float(pen.max())
 
@@ -295,10 +316,11 @@ def build_dem_model(
         mass_damping_1_s=scene.contact.mass_damping_1_s,
         g=g,
         scene_hash=scene.scene_hash,
-        calibration=scene.contact.calibration,
+        calibration=_calibration_label(scene),
         static_settlement_m=settlement,
         w_max_rad_s=w_max,
         stop_angle_rad=stop_angles([b.contact_vertices_m for b in bodies], fixed),
         stop_on_overturn=not scene.positioned,
         rest_contacts=tuple(contacts),
+        base_at_rest=scene.motion.type,
     )

@@ -372,8 +372,9 @@ def simulate(
                         visc = 0.0
                         state = STATE_SLIP
                         if record_energy and ks[joint] > 0.0:
-                            # the return to the Coulomb limit releases stored spring energy
-                            d_fric += 0.5 * (s_trial * s_trial - smax * smax) / ks[joint]
+                            # the slip of this step, (|s_trial| - smax) / ks, against the force
+                            # the bodies feel, smax (as YADE's plastic dissipation)
+                            d_fric += smax * (abs(s_trial) - smax) / ks[joint]
                     else:
                         s_new = s_trial
                         visc = cs[joint] * vt
@@ -532,7 +533,7 @@ def simulate(
                         visc = 0.0
                         state = STATE_SLIP
                         if record_energy and ks[joint] > 0.0:
-                            d_fric += 0.5 * (s_trial * s_trial - smax * smax) / ks[joint]
+                            d_fric += smax * (abs(s_trial) - smax) / ks[joint]
                     else:
                         s_new = s_trial
                         visc = cs[joint] * vt

@@ -109,6 +109,13 @@ class DemModel:
     stop_angle_rad: np.ndarray | None = field(default=None, repr=False)
     stop_on_overturn: bool = True
     rest_contacts: tuple[RestContact, ...] = ()
+    base_at_rest: str = "free"
+
+    @property
+    def motion_label(self) -> str:
+        """What moves the base: the ground motion's label, or ``base_at_rest`` ("free"
+        rocking from a tilt, or "rest") when the base does not move."""
+        return self.motion.label if self.motion is not None else self.base_at_rest
 
     @property
     def n_steps(self) -> int:

@@ -16,11 +16,14 @@ Each record is generated on its own, so record i of a suite is reproducible alon
    end.
 
 Records are cached on disk (``$ROCKYADE_CACHE``, default ``~/.cache/rockyade``) under a hash
-of all settings and of ``GENERATOR_VERSION``.
+of all settings, ``GENERATOR_VERSION`` and the source code of the modules that make a record
+(:func:`generator_fingerprint`): a change of any of them (the exact spectra of version 2
+changed the matching, hence every record) can never reuse records of another version.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import math
@@ -38,7 +41,9 @@ from rockyade.motion.processing import baseline_correct, integrate
 from rockyade.motion.records import Record
 from rockyade.motion.spectra import response_spectrum
 
-GENERATOR_VERSION = 1
+GENERATOR_VERSION = 2
+#: The modules whose code decides a record's samples (their bytes enter the cache key).
+GENERATOR_MODULES = ("synthetic", "spectra", "processing", "ec8")
 #: The initial PSD is built for periods up to this, s (longer ones start empty).
 PSD_MAX_PERIOD_S = 10.0
 ENVELOPES = ("trapezoidal", "jennings")
@@ -129,6 +134,7 @@ class SuiteSpec:
         d = asdict(self)
         d["target"] = self.target.as_dict()
         d["generator_version"] = GENERATOR_VERSION
+        d["generator_code"] = generator_fingerprint()
         return d
 
     @property
@@ -249,6 +255,17 @@ def generate_record(spec: SuiteSpec, index: int) -> Record:
 
 
 # ---------------------------------------------------------------------- cache
+
+
+@functools.cache
+def generator_fingerprint() -> str:
+    """SHA-256 (16 hex digits) of the source of :data:`GENERATOR_MODULES`, read from the
+    installed package: records cached by other code are never taken for this code's."""
+    digest = hashlib.sha256()
+    package = Path(__file__).parent
+    for name in GENERATOR_MODULES:
+        digest.update((package / f"{name}.py").read_bytes())
+    return digest.hexdigest()[:16]
 
 
 def cache_dir() -> Path:

@@ -175,7 +175,7 @@ def run_model(
         "calibration": model.calibration,
         "contact": model.joint_summary(),
         "bodies": model.body_summary(),
-        "motion": model.motion.label if model.motion is not None else "free",
+        "motion": model.motion_label,
         "accel_definition": "absolute, mean over +/- one sample interval"
         + (f", zero-phase low-pass {accel_lowpass_hz:g} Hz" if accel_lowpass_hz else ""),
         **meta_energy,

@@ -291,7 +291,7 @@ def _parse(
         "calibration": model.calibration,
         "contact": model.joint_summary(),
         "bodies": model.body_summary(),
-        "motion": model.motion.label if model.motion is not None else "free",
+        "motion": model.motion_label,
         **extra,
     }
     return Result(frame, run_meta)
