@@ -34,8 +34,20 @@ The model, as the reference DEM's:
   after; one engine per distinct mass and direction);
 * NewtonIntegrator with damping 0 (its default is 0.2), gravity -g, O.dt as given;
 * a PyRunner *before* the other engines records every ``steps_per_sample`` steps, so the
-  sample at step n sees x_n and t_n = n dt; rotation is measured as the z component of
-  the axis-angle of ori * ori0.conjugate() (State.rot() can flip sign);
+  sample at step n sees x_n and t_n = n dt;
+* rotation is continuous from rest, as the reference DEM's: the driver accumulates the
+  change of each block's orientation (2 atan2(q_z, q_w) of ori * ori0.conjugate(), taken
+  as the smallest angle) at
+  every record and, between records, at least every ``track_period`` steps, chosen so that
+  MAX_SPIN_RAD_S x track_period x dt stays below ROTATION_STEP_MAX_RAD (< pi): the smallest
+  angle is then the true one unless the spin exceeds the blow-up limit (checked at each
+  call); an increment above ROTATION_STEP_MAX_RAD fails the run (it cannot be unwrapped);
+* at each record, per block, the contact points with a positive normal force (a vertex
+  sphere on the base: one point per vertex; between two blocks, the vertex spheres of
+  either block on the other's prism, at most 2 per pair: the ends of the reference DEM's
+  contact segment) and whether one of them slips: |elastic shear force| >= SLIP_RATIO x
+  tan(phi) x normal force (Law2_ScGeom_ViscElPhys_Basic clips it to that limit when
+  sliding);
 * a block has overturned when |theta| from rest reaches its stop angle (the landing angle
   of rockyade's overturn criterion, given in the data); the run stops there in a column
   scene (``stop_on_overturn``) and goes on in an assembly; it stops when a state is not
@@ -82,6 +94,11 @@ LIGHT_DENSITY = 1.0e-3
 # beyond these the state is a numerical blow-up, not rocking (as in the reference DEM)
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
+#: Largest rotation of a block between two rotation records, rad (below pi: the smallest
+#: angle between two orientations is then the rotation).
+ROTATION_STEP_MAX_RAD = 0.9 * math.pi
+#: A contact slips when its elastic shear force is at least this fraction of tan(phi) Fn.
+SLIP_RATIO = 1.0 - 1e-6
 
 
 def _material(values, density):
@@ -100,6 +117,14 @@ def _material(values, density):
 def _rotate(v, angle):
     c, s = math.cos(angle), math.sin(angle)
     return (c * v[0] - s * v[1], s * v[0] + c * v[1])
+
+
+def _orientation_angle(q):
+    """Angle of a rotation about z, rad, in (-2 pi, 2 pi] (q and -q are the same rotation).
+
+    Of the clump's orientation relative to its orientation at build (ori * ori0.conjugate()),
+    a rotation about z: the clump's own frame (its principal axes) need not be the block's."""
+    return 2.0 * math.atan2(q[2], q[3])
 
 
 def build(scene):
@@ -175,8 +200,8 @@ def build(scene):
             {
                 "id": clump_id,
                 "fixed": b["fixed"],
-                "vertex_ids": [member_ids[s:e] for s, e in vertex_members],
                 "ori0": state.ori.conjugate(),
+                "vertex_ids": [member_ids[s:e] for s, e in vertex_members],
                 "angle0": a0,
                 "rest": b["rest_angle_rad"],
                 "stop_angle": b["stop_angle_rad"] if b.get("stop_angle_rad") is not None else math.inf,
@@ -224,6 +249,7 @@ def _describe(clumps):
         "dt": O.dt,
         "recorder_first": type(runner).__name__ == "PyRunner",
         "recorder_period": runner.iterPeriod,
+        "rotation_track_period": globals()["rockyade_record"].track_period,
         "clumps": [],
     }
     for c in clumps:
@@ -281,13 +307,24 @@ class Recorder:
             "vpoint": np.full((ns, nb, 2), np.nan),
             "fn": np.zeros((ns, nb, maxv)),
             "state": np.zeros((ns, nb, maxv), dtype=np.int8),
+            "ncont": np.zeros((ns, nb), dtype=np.int32),
+            "slip": np.zeros((ns, nb), dtype=bool),
         }
+        # continuous rotation: last orientation angle seen and the rotation accumulated since
+        self.raw = [0.0] * nb
+        self.turned = [0.0] * nb
+        self.moving = [i for i, c in enumerate(clumps) if not c["fixed"]]
+        self.sps = scene["steps_per_sample"]
+        self.track_period = max(1, min(self.sps, int(ROTATION_STEP_MAX_RAD / (MAX_SPIN_RAD_S * scene["dt_s"]))))
+        self.max_rotation_step = 0.0
+        self.runner = None
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
         self.overturn_times = {}
         self.stop_on_overturn = scene.get("stop_on_overturn", True)
         self.max_depth_ratio = 0.0
         self.polyhedra = {c["prism"] for c in clumps if c["prism_is_polyhedra"]}
+        self.block_of_prism = {c["prism"]: i for i, c in enumerate(clumps)}
         self.vertex_of = {
             sid: (i, v, c["radius"])
             for i, c in enumerate(clumps)
@@ -297,16 +334,30 @@ class Recorder:
         self.start = time.perf_counter()
         self.written = False
         self.wait = True
+        self.own_time = 0.0  # spent in the recorder, s
 
     def __call__(self):
+        start = time.perf_counter()
+        self.record()
+        self.own_time += time.perf_counter() - start
+
+    def record(self):
+        """Record the state when this step is a sample (and follow the rotations)."""
         k = self.k
         if k >= self.ns or self.written:
+            return
+        step = O.iter
+        to_sample = k * self.sps - step
+        if not self.track():
+            return
+        if to_sample > 0:  # a rotation record between samples
+            if self.runner is not None:
+                self.runner.iterPeriod = min(to_sample, self.track_period)
             return
         rec = self.rec
         for i, c in enumerate(self.clumps):
             st = O.bodies[c["id"]].state
-            axis, angle = (st.ori * c["ori0"]).toAxisAngle()
-            theta = c["angle0"] + angle * axis[2]
+            theta = c["angle0"] + self.turned[i]
             x, y = st.pos[0], st.pos[1]
             w = st.angVel[2]
             finite = math.isfinite(x) and math.isfinite(y) and math.isfinite(theta)
@@ -325,16 +376,41 @@ class Recorder:
                     self.status, self.stop_time, self.stop_body = "overturned", O.time, i
         self.contact_forces(k)
         self.k = k + 1
+        if self.runner is not None:
+            self.runner.iterPeriod = min(self.sps, self.track_period)
         if self.status != "completed" or self.k >= self.ns:
             self.stop()
 
+    def track(self):
+        """Accumulate each moving block's rotation since the last call (the smallest angle
+        between the two orientations); False (the run failed) when a block spins beyond
+        MAX_SPIN_RAD_S or turned more than ROTATION_STEP_MAX_RAD: it cannot be unwrapped."""
+        raw, turned = self.raw, self.turned
+        for i in self.moving:
+            st = O.bodies[self.clumps[i]["id"]].state
+            now = _orientation_angle(st.ori * self.clumps[i]["ori0"])
+            step = math.remainder(now - raw[i], 2.0 * math.pi)
+            raw[i] = now
+            turned[i] += step
+            step = abs(step)
+            if step > self.max_rotation_step:
+                self.max_rotation_step = step
+            if not step <= ROTATION_STEP_MAX_RAD or abs(st.angVel[2]) > MAX_SPIN_RAD_S:
+                self.status, self.stop_time, self.stop_body = "failed", O.time, i
+                self.stop()
+                return False
+        return True
+
     def contact_forces(self, k):
-        """Normal force and state (1 stick, 2 slip) at each vertex: its copies' real contacts.
+        """Normal force and state (1 stick, 2 slip) at each vertex: its copies' real contacts;
+        per block, its contact points and whether one slips (see the module docstring).
 
         Also the deepest penetration seen against a Polyhedra prism, in sphere radii: at one
         radius the sphere's centre is inside the prism and YADE's contact loses its normal."""
         fn_k, state_k = self.rec["fn"][k], self.rec["state"][k]
-        vertex_of, polyhedra = self.vertex_of, self.polyhedra
+        ncont_k, slip_k = self.rec["ncont"][k], self.rec["slip"][k]
+        vertex_of, polyhedra, block_of_prism = self.vertex_of, self.polyhedra, self.block_of_prism
+        points = {}  # (block, other block or -1 for the base) -> vertices touching
         for inter in O.interactions:
             if not inter.isReal:
                 continue
@@ -351,13 +427,33 @@ class Recorder:
             if fn <= 0.0:
                 continue
             fn_k[i, v] += fn
-            s = 2 if phys.shearForce.norm() >= 0.9999 * fn * phys.tangensOfFrictionAngle else 1
-            if s > state_k[i, v]:
-                state_k[i, v] = s
+            slips = phys.shearForce.norm() >= SLIP_RATIO * fn * phys.tangensOfFrictionAngle
+            if slips:
+                state_k[i, v] = 2
+            elif state_k[i, v] == 0:
+                state_k[i, v] = 1
+            j = block_of_prism.get(other, -1)
+            key = (i, j) if j < 0 or i < j else (j, i)
+            touching = points.get(key)
+            if touching is None:
+                points[key] = {(i, v)}
+            else:
+                touching.add((i, v))
+            if slips:
+                slip_k[i] = True
+                if j >= 0:
+                    slip_k[j] = True
             if other in polyhedra:
                 depth = inter.geom.penetrationDepth / radius
                 if depth > self.max_depth_ratio:
                     self.max_depth_ratio = depth
+        for (a, b), touching in points.items():
+            if b < 0:  # the base: every vertex on it, as the reference DEM
+                ncont_k[a] += len(touching)
+            else:  # two blocks: at most the two ends of their contact segment
+                n = min(2, len(touching))
+                ncont_k[a] += n
+                ncont_k[b] += n
 
     def stop(self):
         """End of the run seen from inside it: pause, and write now unless the caller waits."""
@@ -379,10 +475,13 @@ class Recorder:
             "n_filled": n,
             "iterations": O.iter,
             "wall_time_s": time.perf_counter() - self.start,
+            "recorder_time_s": self.own_time,
             "build_time_s": self.scene.get("_build_time_s"),
             "yade_version": __import__("yade.config", fromlist=["version"]).version,
             "dt_s": O.dt,
             "max_polyhedra_penetration_over_radius": self.max_depth_ratio,
+            "max_rotation_step_rad": self.max_rotation_step,
+            "rotation_track_period_steps": self.track_period,
             "complete": True,
         }
         tmp = self.out_path + ".part"
@@ -416,8 +515,9 @@ def prepare(scene, out_path, csv_path=None):
     clumps = build(scene)
     recorder = Recorder(scene, clumps, out_path, csv_path)
     globals()["rockyade_record"] = recorder
+    recorder.runner = PyRunner(command="rockyade_record()", iterPeriod=scene["steps_per_sample"], initRun=True)
     O.engines = [
-        PyRunner(command="rockyade_record()", iterPeriod=scene["steps_per_sample"], initRun=True),
+        recorder.runner,
         ForceResetter(),
         InsertionSortCollider(
             [Bo1_Sphere_Aabb(), Bo1_Box_Aabb(), Bo1_Polyhedra_Aabb()], verletDist=0.2 * scene["min_sphere_radius_m"]

@@ -213,7 +213,7 @@ def _parse(
     try:
         with np.load(out_file, allow_pickle=False) as data:
             meta = json.loads(str(data["meta"]))
-            arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn")}
+            arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
     n = int(meta.get("n_filled", 0))
@@ -227,7 +227,8 @@ def _parse(
         return failed_result(
             "yade",
             model.scene_hash,
-            f"numerical instability in YADE at t = {t_stop} s (non-finite state or runaway speed)",
+            f"numerical instability in YADE at t = {t_stop} s (non-finite state, runaway speed or spin, or a "
+            "rotation between two records too large to follow)",
             **extra,
         )
     gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
@@ -244,7 +245,19 @@ def _parse(
             **extra,
         )
     extra["max_polyhedra_penetration_over_radius"] = depth
-    frame = dem_frame(model, arrays["pos"], arrays["ang"], arrays["angvel"], arrays["vpoint"], arrays["state"], lowpass)
+    extra["max_rotation_step_rad"] = meta.get("max_rotation_step_rad")
+    extra["rotation_track_period_steps"] = meta.get("rotation_track_period_steps")
+    frame = dem_frame(
+        model,
+        arrays["pos"],
+        arrays["ang"],
+        arrays["angvel"],
+        arrays["vpoint"],
+        arrays["state"],
+        lowpass,
+        n_contacts=arrays["ncont"],
+        slipping=arrays["slip"],
+    )
     names = model.names
     forces = {}
     for i, body in enumerate(model.bodies):
