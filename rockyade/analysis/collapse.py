@@ -15,7 +15,7 @@ Each moving block is, at each sample, in one of five states (codes in :data:`STA
 * ``sliding``: its base slides: the horizontal speed of the point of the block that was the
   middle of its base at rest exceeds ``SLIDE_SPEED_M_S`` while it is not rocking fast
   enough to explain it (rocking about a corner moves that point by b (1 - cos theta)), and,
-  where the result records it (the reference DEM's ``slipping``), one of the block's
+  where the result records it (both DEMs' ``slipping``; Housner has none), one of the block's
   contacts slips: a drum carried by the rocking drums under it moves fast but does not slide;
 * ``rocking``: |theta| above ``ROCK_FRACTION`` x alpha (and at least ``ROCK_MIN_RAD``);
 * ``carried``: none of the above, but it moves (its centroid faster than ``SLIDE_SPEED_M_S``
