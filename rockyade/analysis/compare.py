@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pandas as pd
 
-from rockyade.blocks.restitution import effective_restitution, find_peaks
+from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.result import Result
 from rockyade.scene import Scene
 
@@ -30,7 +30,7 @@ def _metrics(scene: Scene, result: Result, block: str, alpha: float) -> dict[str
     for k in range(N_PEAKS):
         out[f"peak{k + 1}_amplitude_rad"] = float(peaks.amplitude_rad[k]) if k < len(peaks) else math.nan
         out[f"peak{k + 1}_time_s"] = float(peaks.t_s[k]) if k < len(peaks) else math.nan
-    out["mu_eff"] = effective_restitution(peaks, alpha, N_PEAKS - 1) if scene.motion.type == "free" else math.nan
+    out["mu_eff"] = effective_restitution(peaks, alpha, MU_EFF_IMPACTS) if scene.motion.type == "free" else math.nan
     out["max_abs_theta_rad"] = float(np.nanmax(np.abs(theta))) if theta.size else math.nan
     overturned = result.status == "overturned" and result.meta.get("overturned_block") == block
     out["overturned"] = float(overturned)

@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 
-from rockyade.blocks.restitution import effective_restitution, find_peaks
+from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 
 
-def run_metrics(scene, result, n_impacts: int = 5) -> dict[str, dict[str, float]]:
+def run_metrics(scene, result, n_impacts: int = MU_EFF_IMPACTS) -> dict[str, dict[str, float]]:
     """Per-block summary of a run: peaks, max |theta|, effective mu, overturn.
 
     Parameters

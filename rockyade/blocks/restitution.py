@@ -105,6 +105,11 @@ def restitution_per_impact(peaks: Peaks | NDArray[np.float64], alpha: float) -> 
     return np.sqrt(v[1:] / v[:-1])
 
 
+#: Impacts over which rockyade reports an effective restitution (run, compare, the matched
+#: calibration and the paper study all use this one count, so their mu_eff agree).
+MU_EFF_IMPACTS = 4
+
+
 def effective_restitution(peaks: Peaks | NDArray[np.float64], alpha: float, n_impacts: int | None = None) -> float:
     """Mean effective restitution over the first ``n_impacts`` impacts (geometric mean).
 

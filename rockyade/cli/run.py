@@ -66,6 +66,7 @@ def _write_collapse(scene: Any, result: Any, path: Path) -> None:
 
 def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
     from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
+    from rockyade.blocks.restitution import MU_EFF_IMPACTS
 
     meta = result.meta
     wall = meta.get("wall_time_s", math.nan)
@@ -91,7 +92,7 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
         line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
         if not math.isnan(m["mu_eff"]):
-            line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, 5)} impacts"
+            line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, MU_EFF_IMPACTS)} impacts"
         print(line)
     if result.status == "overturned" and not scene.positioned:
         print(f"  overturned at t = {meta['overturn_time_s']:.4g} s ({meta.get('overturned_block')})")

@@ -23,7 +23,7 @@ from scipy.optimize import brentq
 
 from rockyade.blocks.classical import classical_parameters
 from rockyade.blocks.geometry import Block
-from rockyade.blocks.restitution import effective_restitution, find_peaks
+from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, G
 from rockyade.dem import kernel
 from rockyade.dem.build import build_dem_model
@@ -34,7 +34,7 @@ from rockyade.errors import CalibrationError
 from rockyade.scene import Scene, scene_from_dict
 
 #: Impacts after the release over which mu_eff is measured.
-N_IMPACTS = 4
+N_IMPACTS = MU_EFF_IMPACTS
 #: Relative tolerance on mu_eff (the issue asks for 0.2 %).
 MU_RTOL = 5e-4
 #: Largest beta tried, as a multiple of 1 / w_contact (xi = BETA_MAX_XI at the contact mode).

@@ -14,7 +14,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.blocks.restitution import effective_restitution, find_peaks
+from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.dem.matching import build_matched_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
@@ -36,7 +36,7 @@ from rockyade.studies.common import (
 )
 
 DURATION_S = 4.0
-N_IMPACTS = 4
+N_IMPACTS = MU_EFF_IMPACTS
 CALIBRATIONS = ("paper", "matched")
 
 
