@@ -101,13 +101,13 @@ def test_closed_pipe_ends_quietly():
         (["motion", "spectrum", "REC", "--t-max", "0.01"], "t-max"),
         (["compare", "SCENE", "--solvers", "housner", "--reference", "yade"], "reference"),
         (["compare", "SCENE", "--solvers", "housner,nope"], "solvers"),
-        (["calibrate", "--specimen", "1", "--friction-angle", "95"], "friction-angle"),
+        (["calibrate", "--specimen", "1", "--friction-angle", "95"], "--friction-angle"),
         (["batch", "STUDY", "--out", "o", "--executor", "dask", "--scheduler", "tcp://127.0.0.1:9",
           "--scheduler-timeout", "1"], "scheduler"),
         (["batch", "STUDY", "--out", "o", "--workers", "0"], "workers"),
-        (["run", "SCENE", "--out", "FILE/x.csv"], "out"),
-        (["tables", "--out", "FILE/tables"], "out"),
-        (["motion", "synth", "--type", "2", "--ground", "D", "--ag-s", "2.8", "--seed", "1", "--out", "FILE/s"], "out"),
+        (["run", "SCENE", "--out", "FILE/x.csv"], "--out"),
+        (["tables", "--out", "FILE/tables"], "--out"),
+        (["motion", "synth", "--type", "2", "--ground", "D", "--ag-s", "2.8", "--seed", "1", "--out", "FILE/s"], "--out"),
     ],
 )
 def test_clear_errors_name_the_option(tmp_path, capsys, argv, names):

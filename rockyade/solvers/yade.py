@@ -159,7 +159,8 @@ def run_model(
     if not yade_available():
         raise SolverUnavailableError(
             f"YADE is not installed (looked for {YADE_PYTHON} and {YADE_PY_DIR}/yade): "
-            "apt-get install -y --no-install-recommends yade"
+            "apt-get install -y --no-install-recommends yade, or set ROCKYADE_YADE_PYTHON to the Python "
+            "that runs YADE's modules"
         )
     timeout = check_timeout(timeout_s)
     timeout = timeout if timeout is not None else default_timeout(model)
@@ -186,11 +187,15 @@ def run_model(
 
 
 def _last_error_line(log_file: Path) -> str:
-    lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+    """The last error line of YADE's log ("" when it has none: a banner is not a reason)."""
+    try:
+        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+    except OSError:
+        return ""
     for line in reversed(lines):
         if "Error" in line or "Exception" in line:
             return line
-    return lines[-1] if lines else ""
+    return ""
 
 
 def _parse(
@@ -209,6 +214,7 @@ def _parse(
         reason = "YADE wrote no output file"
     if reason is not None:
         detail = _last_error_line(log_file)
+        extra["wall_time_s"] = total
         return failed_result("yade", model.scene_hash, f"{reason}: {detail}" if detail else reason, **extra)
     try:
         with np.load(out_file, allow_pickle=False) as data:

@@ -180,7 +180,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     report.note(
         f"Runs: Housner: {run_state(report, 'housner', len(exact))}; "
         + "; ".join(states)
-        + f" ({len(cases) - n_dem} DEM cases not run: "
+        + f" ({len(cases) - n_dem} DEM case(s) not run: "
         "matched calibration not reachable)."
     )
     report.table(
