@@ -107,7 +107,10 @@ def test_closed_pipe_ends_quietly():
         (["batch", "STUDY", "--out", "o", "--workers", "0"], "workers"),
         (["run", "SCENE", "--out", "FILE/x.csv"], "--out"),
         (["tables", "--out", "FILE/tables"], "--out"),
-        (["motion", "synth", "--type", "2", "--ground", "D", "--ag-s", "2.8", "--seed", "1", "--out", "FILE/s"], "--out"),
+        (
+            ["motion", "synth", "--type", "2", "--ground", "D", "--ag-s", "2.8", "--seed", "1", "--out", "FILE/s"],
+            "--out",
+        ),
     ],
 )
 def test_clear_errors_name_the_option(tmp_path, capsys, argv, names):
