@@ -38,6 +38,7 @@ def plot_uncertainty(
     fig, axes = new_figure(path, 1, 3, figsize=(16, 4.8))
     ax = axes[0]
     styles = ["--", ":", "-."]
+    markers = ["v", "^", "D"]
     for k, (solver, group) in enumerate(probabilities.groupby("solver")):
         c = _colour(solver, k)
         x = group["load_factor"].to_numpy()
@@ -45,7 +46,17 @@ def plot_uncertainty(
         ax.fill_between(x, group["p_overturn_lo"], group["p_overturn_hi"], color=c, alpha=0.18, lw=0)
         for j, level in enumerate(study.levels):
             col = level_column(level)
-            ax.plot(x, group[col], styles[j % 3], color=c, lw=1.0, label=f"{solver}: theta/alpha >= {level:g}")
+            ax.plot(  # open markers: a level's curve stays visible where it meets P(overturn)
+                x,
+                group[col],
+                styles[j % 3],
+                marker=markers[j % 3],
+                mfc="none",
+                ms=6 + 2 * j,
+                color=c,
+                lw=1.0,
+                label=f"{solver}: theta/alpha >= {level:g}",
+            )
     ax.set_xlabel("load factor")
     ax.set_ylabel("probability (95 % Wilson band)")
     ax.set_ylim(-0.02, 1.02)
@@ -99,7 +110,7 @@ def plot_uncertainty(
                 lw=0,
                 label=f"{solver}: 5-95 % over parameter samples",
             )
-            ax.plot(x, group["p_overturn_sample_median"], "-", color=c, lw=1.0)
+            ax.plot(x, group["p_overturn_sample_median"], "-", color=c, lw=1.0, label=f"{solver}: median sample")
             if group["p_overturn_nominal"].notna().any():
                 ax.plot(x, group["p_overturn_nominal"], "k*", ms=7, label="nominal block" if k == 0 else None)
         ax.set_ylabel("P(overturn) over the records, per parameter sample")
