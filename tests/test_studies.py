@@ -299,3 +299,38 @@ def test_overturning_scan_shows_progress(tmp_path, monkeypatch, capfd):
     err = capfd.readouterr().err
     assert "overturning: frequency scans" in err and "2/2" in err
     assert len(spectrum) == 1 and report.counts("overturning")
+
+
+def test_fragility_compares_yade_and_the_reference_run_for_run():
+    """The YADE subset's curve is fitted on three stripes; the report also puts both DEMs side
+    by side on the same runs, where they can be compared without a fit."""
+    rows = []
+    for record in (1, 2):
+        for lf, (y, r) in {
+            0.4: ("completed", "completed"),
+            1.2: ("overturned", "completed" if record == 1 else "overturned"),
+        }.items():
+            for solver, status in (("yade", y), ("reference", r)):
+                rows.append(
+                    {
+                        "base": "specimen2",
+                        "motion.record": record,
+                        "motion.load_factor": lf,
+                        "solver": solver,
+                        "status": status,
+                    }
+                )
+    rows.append(
+        {
+            "base": "specimen2",
+            "motion.record": 3,
+            "motion.load_factor": 1.2,
+            "solver": "reference",
+            "status": "overturned",
+        }
+    )
+    table = fragility_study.same_runs_table(pd.DataFrame(rows)).set_index("load_factor")
+    assert table.loc[0.4, "runs"] == 2 and table.loc[0.4, "same_outcome"] == 2
+    assert table.loc[1.2, "runs"] == 2  # record 3 has no YADE run: not compared
+    assert table.loc[1.2, "yade_overturned"] == 2 and table.loc[1.2, "reference_overturned"] == 1
+    assert table.loc[1.2, "same_outcome"] == 1
