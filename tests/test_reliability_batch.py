@@ -23,6 +23,7 @@ from rockyade.scene import load_scene
 from rockyade.studies.batch import comparable, expand, run_study_tasks
 
 from .conftest import EXAMPLES
+from .processes import alive, descendants
 
 # ---------------------------------------------------------------------- helpers
 
@@ -56,34 +57,7 @@ def _batch(folder: Path, *extra: str) -> subprocess.Popen[str]:
     )
 
 
-def _descendants(pid: int) -> set[int]:
-    """Every process below ``pid``."""
-    found: set[int] = set()
-    todo = [pid]
-    while todo:
-        parent = todo.pop()
-        try:
-            tasks = os.listdir(f"/proc/{parent}/task")
-        except OSError:
-            continue
-        for tid in tasks:
-            try:
-                children = Path(f"/proc/{parent}/task/{tid}/children").read_text().split()
-            except OSError:
-                continue
-            for child in map(int, children):
-                if child not in found:
-                    found.add(child)
-                    todo.append(child)
-    return found
 
-
-def _alive(pid: int) -> bool:
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
 
 
 def _wait_for(condition, timeout: float, what: str) -> None:
@@ -104,8 +78,8 @@ def _leftovers(out: Path) -> list[Path]:
 
 
 def _workers_of(proc: subprocess.Popen[str], count: int) -> set[int]:
-    _wait_for(lambda: len(_descendants(proc.pid)) >= count, 120, f"{count} worker processes")
-    return _descendants(proc.pid)
+    _wait_for(lambda: len(descendants(proc.pid)) >= count, 120, f"{count} worker processes")
+    return descendants(proc.pid)
 
 
 # ---------------------------------------------------------------------- Ctrl-C
@@ -116,7 +90,7 @@ def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
     proc = _batch(tmp_path, "--workers", "2")
     out = tmp_path / "out"
     _wait_for(lambda: len(_results(out)) >= 1, 300, "a first finished run")
-    workers = _descendants(proc.pid)
+    workers = descendants(proc.pid)
     os.killpg(proc.pid, signal.SIGINT)  # what the terminal does on Ctrl-C
     _stdout, stderr = proc.communicate(timeout=300)
     assert proc.returncode == 130, stderr
@@ -132,7 +106,7 @@ def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
     assert sorted(p.stem for p in _results(out)) == sorted(finished.run)  # running runs were let finish
     for run in finished.run:
         assert Result.read(out / "runs" / f"{run}.csv").status == "completed"
-    _wait_for(lambda: not any(_alive(p) for p in workers), 30, "the workers to end")
+    _wait_for(lambda: not any(alive(p) for p in workers), 30, "the workers to end")
     assert not _leftovers(out)
 
     stamps = {p.name: p.stat().st_mtime_ns for p in _results(out)}
@@ -171,7 +145,7 @@ def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path, executor):
     assert len(summary) == 4 and (summary.status == "unfinished").all()
     assert set(summary.failure_reason) == {"stopped by Ctrl-C", "not started: Ctrl-C"}
     assert (summary.failure_reason == "stopped by Ctrl-C").sum() == 2  # the two running runs
-    _wait_for(lambda: not any(_alive(p) for p in workers), 10, "the workers to end")
+    _wait_for(lambda: not any(alive(p) for p in workers), 10, "the workers to end")
     assert not _leftovers(tmp_path / "out")
 
 
@@ -180,11 +154,11 @@ def test_sigkilled_parent_takes_its_workers_and_resume_loses_nothing(tmp_path):
     proc = _batch(tmp_path, "--workers", "2")
     out = tmp_path / "out"
     _wait_for(lambda: len(_results(out)) >= 2, 300, "two finished runs")
-    workers = _descendants(proc.pid)
+    workers = descendants(proc.pid)
     assert workers
     proc.kill()  # SIGKILL: no handler, no clean-up
     proc.communicate(timeout=30)
-    _wait_for(lambda: not any(_alive(p) for p in workers), 10, "the orphaned workers to die")
+    _wait_for(lambda: not any(alive(p) for p in workers), 10, "the orphaned workers to die")
     done_before = {p.name: p.stat().st_mtime_ns for p in _results(out)}
 
     again = subprocess.run(
@@ -237,7 +211,7 @@ def _socket_inodes(pids: set[int]) -> set[str]:
 
 
 def _listening_sockets_of_tree(pid: int) -> set[str]:
-    return _listening_inodes() & _socket_inodes({pid, *_descendants(pid)})
+    return _listening_inodes() & _socket_inodes({pid, *descendants(pid)})
 
 
 def test_the_socket_poller_sees_a_listening_socket():

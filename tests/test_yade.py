@@ -31,6 +31,7 @@ from rockyade.solvers import housner, reference
 from rockyade.solvers import yade as yade_backend
 
 from .conftest import EXAMPLES
+from .processes import alive, descendants, require_yade
 
 PROBES = Path(__file__).parent / "yade_probes"
 
@@ -38,14 +39,8 @@ pytestmark = pytest.mark.yade
 
 
 @pytest.fixture(scope="module", autouse=True)
-def require_yade():
-    if not yade_backend.yade_available():
-        message = (
-            f"YADE is not installed ({yade_backend.YADE_PYTHON}, {yade_backend.YADE_PY_DIR}): apt-get install yade"
-        )
-        if os.environ.get("ROCKYADE_REQUIRE_YADE") == "1":
-            pytest.fail(message)
-        pytest.skip(message)
+def _yade_present():
+    require_yade()
 
 
 def _matched(example: str):
@@ -581,27 +576,6 @@ def test_study_file_yade_timeout(tmp_path):
         load_study(tmp_path / "bad.toml", tmp_path / "out")
 
 
-def _children(pid: int) -> list[int]:
-    """Processes whose parent is ``pid`` (from /proc)."""
-    out = []
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except OSError:
-            continue
-        if int(fields[1]) == pid:
-            out.append(int(stat.parent.name))
-    return out
-
-
-def _alive(pid: int) -> bool:
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
-
-
 def test_yade_dies_with_a_sigkilled_parent(tmp_path):
     """No clean-up code runs on SIGKILL: the kernel must end YADE with the rockyade process
     that started it (otherwise YADE runs on, an orphan, to the end of its simulation)."""
@@ -620,15 +594,15 @@ def test_yade_dies_with_a_sigkilled_parent(tmp_path):
         deadline = time.monotonic() + 60
         while not yade and time.monotonic() < deadline and parent.poll() is None:
             time.sleep(0.2)
-            yade = _children(parent.pid)
+            yade = sorted(descendants(parent.pid))
         assert yade, "rockyade never started YADE"
         time.sleep(0.5)
         parent.kill()
         parent.wait()
         deadline = time.monotonic() + 10
-        while any(_alive(p) for p in yade) and time.monotonic() < deadline:
+        while any(alive(p) for p in yade) and time.monotonic() < deadline:
             time.sleep(0.1)
-        assert not any(_alive(p) for p in yade), "YADE outlived the process that started it"
+        assert not any(alive(p) for p in yade), "YADE outlived the process that started it"
     finally:
         parent.kill()
         parent.wait()

@@ -8,7 +8,6 @@ ROCKYADE_REQUIRE_YADE is not set.
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import replace
 
 import numpy as np
@@ -21,19 +20,14 @@ from rockyade.solvers import reference
 from rockyade.solvers import yade as yade_backend
 
 from .conftest import EXAMPLES
+from .processes import require_yade
 
 pytestmark = pytest.mark.yade
 
 
 @pytest.fixture(scope="module", autouse=True)
-def require_yade():
-    if not yade_backend.yade_available():
-        message = (
-            f"YADE is not installed ({yade_backend.YADE_PYTHON}, {yade_backend.YADE_PY_DIR}): apt-get install yade"
-        )
-        if os.environ.get("ROCKYADE_REQUIRE_YADE") == "1":
-            pytest.fail(message)
-        pytest.skip(message)
+def _yade_present():
+    require_yade()
 
 
 # ------------------------------------------------------------------ rotation
