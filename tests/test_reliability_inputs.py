@@ -130,6 +130,11 @@ def test_unknown_key_is_named_with_its_likely_meaning():
     d["blocks"][0]["width_mm"] = d["blocks"][0].pop("width_m")
     message = _refused(d, "blocks[0].width_mm", "unknown key", "width_m")
     assert "did you mean width_m?" in message
+    # a key under another name, not a misspelling: the required key's error shows what was given
+    d = free_scene_dict()
+    d["motion"] = {"type": "record", "path": "x.AT2"}
+    message = _refused(d, "motion.file", "is required")
+    assert "also in this table: path" in message
 
 
 def test_numpy_arrays_and_scalars_are_accepted():

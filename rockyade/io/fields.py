@@ -108,6 +108,9 @@ class TableReader:
         close = difflib.get_close_matches(key, others, n=1, cutoff=0.8)
         if close:
             return self.error(close[0], f"unknown key; did you mean {key}? ({key} is required)")
+        if others:  # a key under another name ('path' for 'file'): show what the table holds
+            shown = ", ".join(sorted(others)[:8])
+            return self.error(key, f"is required (also in this table: {shown})")
         return self.error(key, "is required")
 
     def number(
