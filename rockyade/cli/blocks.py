@@ -204,28 +204,41 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     if args.json:
         json_out(result)
         return 0
-    if args.method == "matched":
-        beta_src = f"matched to mu; Eq 13 gives {cal.beta_eq13_s:.6g} s"
-    else:
-        beta_src = f"Eq 13, Gamma = {cal.gamma:.6g} (Eq 12)"
     a, p, mu = params["alpha_rad"], params["p_rad_s"], params["mu"]
     print(f"{spec.label}, {args.parameters} parameters: alpha = {a:.4g} rad, p = {p:.4g} 1/s, mu = {mu:.4g}")
-    print(f"  K = Ks   = {cal.K_N_per_m:.6g} N/m (Eq 10: {cal.K_paper:.6g}, read as {cal.stiffness_reading})")
+    print_calibration(result, args.method)
+    return 0
+
+
+def print_calibration(result: dict[str, Any], method: str) -> None:
+    """The text of a calibration: each DEM parameter with the equation it comes from.
+
+    ``result`` holds :meth:`ContactParameters.report`'s keys (and the matched stage's with
+    ``method = "matched"``); ``calibrate`` and ``calibrate --from`` print through this.
+    """
+    if method == "matched":
+        beta_src = f"matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s"
+    else:
+        beta_src = f"Eq 13, Gamma = {result['gamma']:.6g} (Eq 12)"
+    b_eq = result["b_eq_m"]
+    print(
+        f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10: {result['K_paper_units']:.6g}, "
+        f"read as {result['stiffness_scale']})"
+    )
     print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
     print(
-        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {cal.f_min_hz:.6g} Hz (Eq 14: the number of p in 1/s), "
-        "Rayleigh a = 0"
+        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14: the number of p "
+        "in 1/s), Rayleigh a = 0"
     )
-    print(f"  b_eq     = {cal.b_eq_m:.6g} m (Eq 11; 2 b_eq = {2 * cal.b_eq_m:.4g} m)")
-    print(f"  dt       = {cal.dt_eq7_s:.6g} s (Eq 7, frac 0.1)")
-    print(f"  friction = {cal.friction_angle_deg:g} deg, cohesion = 0 Pa")
-    print(f"  static settlement M g / K = {cal.settlement_m:.3g} m")
-    if args.method == "matched":
+    print(f"  b_eq     = {b_eq:.6g} m (Eq 11; 2 b_eq = {2 * b_eq:.4g} m)")
+    print(f"  dt       = {result['dt_s']:.6g} s (Eq 7, frac 0.1)")
+    print(f"  friction = {result['friction_angle_deg']:g} deg, cohesion = {result['cohesion_Pa']:g} Pa")
+    print(f"  static settlement M g / K = {result['settlement_m']:.3g} m")
+    if method == "matched":
         lo, hi = result["mu_reachable_min"], result["mu_reachable_max"]
         print(f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable {lo:.4f}-{hi:.4f}")
     for note in result["notes"]:
         print(f"  note: {note}")
-    return 0
 
 
 def register(sub: Any) -> None:

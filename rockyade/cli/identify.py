@@ -135,22 +135,9 @@ def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, 
         f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
         f"mu = {c['mu']:.5g}{interval('mu')}"
     )
-    print(f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10, read as {result['stiffness_scale']})")
-    if args.method == "matched":
-        print(f"  beta     = {result['beta_s']:.6g} s (matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s)")
-        print(
-            f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable "
-            f"{result['mu_reachable_min']:.4f}-{result['mu_reachable_max']:.4f}"
-        )
-    else:
-        print(f"  beta     = {result['beta_s']:.6g} s (Eq 13, Gamma = {result['gamma']:.6g})")
-    print(
-        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz "
-        "(Eq 14: the number of p in 1/s)"
-    )
-    print(f"  b_eq     = {result['b_eq_m']:.6g} m (Eq 11); dt = {result['dt_s']:.6g} s (Eq 7)")
-    for note in result["notes"]:
-        print(f"  note: {note}")
+    from rockyade.cli.blocks import print_calibration
+
+    print_calibration(result, args.method)
     return 0
 
 
