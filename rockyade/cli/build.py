@@ -51,6 +51,15 @@ def _floats(text: str) -> list[float]:
     return values
 
 
+#: Column-like kinds (column, stack) write an assembly or a column scene.
+LAYOUT_OPT = Opt(
+    "--layout",
+    "positioned",
+    "positioned: an assembly; column: a column scene (no positions)",
+    str,
+    ("positioned", "column"),
+)
+
 KINDS: dict[str, tuple[str, list[Opt]]] = {
     "wall": (
         "a dry masonry wall in running or stack bond, with openings (in-plane section)",
@@ -90,13 +99,7 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--thickness-m", None, "out-of-plane thickness, m (default: the diameter)"),
             Opt("--capital-width-m", None, "width of a capital block on top, m (with --capital-height-m)"),
             Opt("--capital-height-m", None, "height of the capital block, m"),
-            Opt(
-                "--layout",
-                "positioned",
-                "positioned: an assembly; column: a column scene (no positions)",
-                str,
-                ("positioned", "column"),
-            ),
+            LAYOUT_OPT,
         ],
     ),
     "arch": (
@@ -160,13 +163,7 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
                 str,
                 ("steps", "continuous"),
             ),
-            Opt(
-                "--layout",
-                "positioned",
-                "positioned: an assembly; column: a column scene (no positions)",
-                str,
-                ("positioned", "column"),
-            ),
+            LAYOUT_OPT,
         ],
     ),
     "restrained-wall": (
