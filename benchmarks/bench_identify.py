@@ -20,9 +20,9 @@ import time
 import numpy as np
 
 from rockyade import paper
-from rockyade.analysis.fragility import wilson_interval
-from rockyade.analysis.identify import CLASSICAL, identify, synthetic_measurement
-from rockyade.analysis.measurement import measured_history
+from rockyade.identification.fit import CLASSICAL, identify, synthetic_measurement
+from rockyade.identification.measurement import measured_history
+from rockyade.probability.fragility import wilson_interval
 
 RATES_HZ = (100.0, 200.0, 500.0, 1000.0)
 

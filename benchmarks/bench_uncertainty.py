@@ -30,10 +30,10 @@ import pandas as pd
 from matplotlib import colormaps
 
 from rockyade import paper
-from rockyade.analysis.fragility import Fragility
-from rockyade.analysis.identify import identify, synthetic_measurement
 from rockyade.figures.common import file_figure, save_figure
+from rockyade.identification.fit import identify, synthetic_measurement
 from rockyade.io.atomic import atomic_open, write_json
+from rockyade.probability.fragility import Fragility
 from rockyade.studies.uncertainty import run_uncertainty, uncertainty_study_from_dict
 
 SENSITIVITY_LOAD_FACTORS = [0.4, 0.6, 0.8, 1.0, 1.2, 1.4]

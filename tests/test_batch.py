@@ -11,9 +11,9 @@ import pandas as pd
 import pytest
 from scipy import stats
 
-from rockyade.analysis.fragility import fit_lognormal
 from rockyade.analysis.patterns import classify, classify_samples
 from rockyade.errors import InputError
+from rockyade.probability.fragility import fit_lognormal
 from rockyade.scene import load_scene
 from rockyade.studies.batch import comparable, expand, failures, load_study, run_study_tasks
 

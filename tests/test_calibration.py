@@ -7,7 +7,8 @@ import math
 import pytest
 
 from rockyade import paper
-from rockyade.blocks.calibration import (
+from rockyade.blocks.classical import classical_parameters
+from rockyade.calibration.equations import (
     equivalent_half_base_eq11,
     generalized_damping_factor_eq12,
     paper_calibration,
@@ -19,7 +20,6 @@ from rockyade.blocks.calibration import (
     time_step_eq7,
     xi_min_eq15,
 )
-from rockyade.blocks.classical import classical_parameters
 from rockyade.constants import G
 from rockyade.errors import CalibrationError, InputError
 

@@ -11,8 +11,9 @@ import pandas as pd
 import pytest
 
 from rockyade import paper
-from rockyade.analysis.identified import calibrate_from_identified, load_identified
-from rockyade.analysis.identify import (
+from rockyade.cli import main
+from rockyade.errors import InputError
+from rockyade.identification.fit import (
     CLASSICAL,
     FreeRockingFit,
     IdentificationError,
@@ -20,9 +21,8 @@ from rockyade.analysis.identify import (
     model_history,
     synthetic_measurement,
 )
-from rockyade.analysis.measurement import measured_history, read_measurement, rotation_from_leds
-from rockyade.cli import main
-from rockyade.errors import InputError
+from rockyade.identification.identified import calibrate_from_identified, load_identified
+from rockyade.identification.measurement import measured_history, read_measurement, rotation_from_leds
 from rockyade.solvers.housner import HousnerModel, solve
 from tests.conftest import EXAMPLES
 

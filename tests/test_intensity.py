@@ -9,12 +9,6 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from rockyade.analysis.fragility import (
-    clopper_pearson_interval,
-    fit_lognormal,
-    fit_lognormal_points,
-    wilson_interval,
-)
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
@@ -24,6 +18,12 @@ from rockyade.motion.intensity import (
     intensity_measures,
     scaled,
     significant_duration,
+)
+from rockyade.probability.fragility import (
+    clopper_pearson_interval,
+    fit_lognormal,
+    fit_lognormal_points,
+    wilson_interval,
 )
 
 

@@ -9,9 +9,9 @@ import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
+from rockyade.calibration.matched import build_matched_model, match_beta
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
-from rockyade.dem.matching import build_matched_model, match_beta
 from rockyade.errors import CalibrationError, InputError
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
@@ -345,7 +345,7 @@ def test_run_compare_and_the_matched_calibration_count_the_same_impacts():
     impacts, compare 0.91955 over 4, the matched calibration 4)."""
     from rockyade.analysis.compare import compare
     from rockyade.analysis.metrics import run_metrics
-    from rockyade.dem import matching
+    from rockyade.calibration import matched as matching
 
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
     dem = reference.run_scene(scene)

@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rockyade.analysis.exceedance import level_column
-from rockyade.analysis.fragility import wilson_interval
 from rockyade.cli import main
 from rockyade.errors import InputError
+from rockyade.probability.exceedance import level_column
+from rockyade.probability.fragility import wilson_interval
 from rockyade.studies.sampling import Marginal, draw_parameters, joint_from_identified
 from rockyade.studies.uncertainty import run_uncertainty, uncertainty_study_from_dict
 from tests.conftest import EXAMPLES

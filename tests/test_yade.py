@@ -23,12 +23,12 @@ import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.dem import yade_payload
-from rockyade.dem.matching import build_matched_model, match_beta
+from rockyade.calibration.matched import build_matched_model, match_beta
 from rockyade.result import Result
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.solvers import yade as yade_backend
+from rockyade.yade import payload as yade_payload
 
 from .conftest import EXAMPLES
 from .processes import alive, descendants, require_yade

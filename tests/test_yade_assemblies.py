@@ -18,15 +18,15 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
-from rockyade.dem.matching import build_matched_model
+from rockyade.calibration.matched import build_matched_model
 from rockyade.dem.statics import rest_springs, static_penetration
-from rockyade.dem.yade_contacts import BASE_BIT, N_LABELS, body_row, plan_contacts
-from rockyade.dem.yade_payload import scene_payload, sphere_radii
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix
 from rockyade.solvers import housner, reference
 from rockyade.solvers import yade as yade_backend
+from rockyade.yade.contacts import BASE_BIT, N_LABELS, body_row, plan_contacts
+from rockyade.yade.payload import scene_payload, sphere_radii
 
 from .processes import require_yade
 
@@ -110,7 +110,7 @@ def _wanted_and_used(model):
     materials = payload["materials"]
     prisms = [b["prism_mask"] for b in payload["bodies"]]
     plan = plan_contacts(model, sphere_radii(model))
-    from rockyade.dem.yade_contacts import flush_ends
+    from rockyade.yade.contacts import flush_ends
 
     flush = flush_ends(model)
     wanted, used = [], []

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rockyade.analysis.collapse import collapse_report
-from rockyade.dem.matching import build_matched_model
+from rockyade.calibration.matched import build_matched_model
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import reference
 from rockyade.solvers import yade as yade_backend

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from rockyade.analysis.identify import FreeRockingFit, model_history
+from rockyade.identification.fit import FreeRockingFit, model_history
 from rockyade.io.atomic import atomic_open
 
 SEED = 12

@@ -1,9 +1,6 @@
-"""Analysis of results and measurements: run metrics, collapse of assemblies, bi-block
-patterns, fragility and exceedance, cross-solver comparison, and the identification of
-alpha, p, mu from a measured free-rocking test (which fits Housner's exact solution).
-
-May import everything below it (scene, dem, solvers, result); never figures, studies or
-the CLI. Peaks and effective restitution live in :mod:`rockyade.blocks.restitution`.
+"""Analysis of results: run metrics, collapse of assemblies, bi-block patterns and
+cross-solver comparison. It reads Results; it runs no solver.
+Peaks and effective restitution live in :mod:`rockyade.blocks.restitution`.
 """
 
 from rockyade.analysis.metrics import run_metrics

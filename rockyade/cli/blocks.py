@@ -164,7 +164,7 @@ def cmd_params(args: argparse.Namespace) -> int:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
     from rockyade import paper
-    from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
+    from rockyade.calibration.equations import paper_calibration, xi_min_eq15
 
     if not 0.0 < args.friction_angle < 90.0:
         raise InputError("--friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
@@ -194,7 +194,7 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         **cal.report(),
     }
     if args.method == "matched":
-        from rockyade.dem.matching import match_beta
+        from rockyade.calibration.matched import match_beta
 
         matched = match_beta(
             block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle

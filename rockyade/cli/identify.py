@@ -22,8 +22,8 @@ def _led_columns(text: str | None) -> tuple[str, str] | None:
 
 def cmd_identify(args: argparse.Namespace) -> int:
     """Identify the classical parameters of a measured free-rocking record."""
-    from rockyade.analysis.identify import identify
-    from rockyade.analysis.measurement import read_measurement
+    from rockyade.identification.fit import identify
+    from rockyade.identification.measurement import read_measurement
 
     if args.out:
         check_output_file(args.out, "--out", ".json")
@@ -108,7 +108,7 @@ def _start_lines(result: Any) -> list[str]:
 
 def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
     """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
-    from rockyade.analysis.identified import calibrate_from_identified
+    from rockyade.identification.identified import calibrate_from_identified
 
     if len(blocks) != 1:
         raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")

@@ -10,7 +10,7 @@ placed at rest as the scene says (stacked, or at ``position_m`` rotated by
 Joints (:mod:`rockyade.dem.joints`): each moving block's own joint (paper Eqs 10-15,
 explicit values, or UDEC-style stiffness per area), and the joint of every pair touching
 at rest (bed, head, block-base, block-fixed). A matched calibration must have been
-resolved before (:mod:`rockyade.dem.matching`). The time step (Eq 7, kept below the
+resolved before (:mod:`rockyade.calibration.matched`). The time step (Eq 7, kept below the
 stability limit) and the static settlement come from the springs at rest
 (:mod:`rockyade.dem.statics`).
 """
@@ -24,9 +24,9 @@ from dataclasses import replace
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from rockyade.blocks.calibration import ContactParameters, time_step_eq7
 from rockyade.blocks.classical import frequency_parameter, inertia_for_frequency
 from rockyade.blocks.geometry import LEVEL_TOL, Block
+from rockyade.calibration.equations import ContactParameters, time_step_eq7
 from rockyade.constants import MAX_SETTLEMENT_FRACTION, G
 from rockyade.dem.joints import JointTable, MatchedBeta, own_joint, resolve_joints
 from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt
@@ -248,7 +248,7 @@ def build_dem_model(
         Damping constant for every joint, s (used by the matched calibration itself).
     matched
         Matched damping per block name, for ``calibration = "matched"``
-        (:func:`rockyade.dem.matching.matched_betas`).
+        (:func:`rockyade.calibration.matched.matched_betas`).
     """
     placed = placed_blocks(scene)
     supported = _supported_masses(scene)

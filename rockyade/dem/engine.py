@@ -15,9 +15,9 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.dem import kernel
-from rockyade.dem.broadphase import MARGIN_REL
 from rockyade.dem.model import DemModel
+from rockyade.kernel import simulation as kernel
+from rockyade.kernel.broadphase import MARGIN_REL
 
 #: A contact point keeps its shear spring when last step's point of the same pair lies within
 #: this fraction of the shortest edge of the two polygons.
@@ -25,7 +25,7 @@ FEATURE_TOL_REL = 0.25
 
 
 class KernelOutput(NamedTuple):
-    """Raw outputs of :func:`rockyade.dem.kernel.simulate` (see its docstring).
+    """Raw outputs of :func:`rockyade.kernel.simulation.simulate` (see its docstring).
 
     The first ten fields keep the order of earlier versions, so positional unpacking of
     ``pos, ang, ...`` keeps working.
@@ -192,7 +192,7 @@ def _compiled_kernel_cached() -> bool:
     """True when numba's on-disk cache holds the kernel (next to the module, where numba puts
     it when that folder is writable; elsewhere the note below may show once per process)."""
     cache = Path(kernel.__file__).parent / "__pycache__"
-    return any(cache.glob("kernel.simulate-*.nbi"))
+    return any(cache.glob("simulation.simulate-*.nbi"))
 
 
 def _warm_up() -> None:

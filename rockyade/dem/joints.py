@@ -30,7 +30,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.blocks.calibration import ContactParameters, paper_calibration, time_step_eq7
+from rockyade.calibration.equations import ContactParameters, paper_calibration, time_step_eq7
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.scene import BlockSpec, Scene
@@ -238,7 +238,7 @@ def own_joint(
             raise InputError(
                 "contact.calibration",
                 "matched: the damping must be matched before the model is built "
-                "(rockyade.dem.matching.build_matched_model, or the solvers, do it)",
+                "(rockyade.calibration.matched.build_matched_model, or the solvers, do it)",
             )
         beta = matched_beta.beta_s
     joint = paper_calibration(

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from rockyade.blocks.calibration import ContactParameters
+from rockyade.calibration.equations import ContactParameters
 from rockyade.dem.joints import JointTable
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion

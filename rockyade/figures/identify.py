@@ -10,8 +10,8 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from scipy import stats
 
-from rockyade.analysis.identify import CONFIDENCE, Identification, error_surface
 from rockyade.figures.common import new_figure, save_figure
+from rockyade.identification.fit import CONFIDENCE, Identification, error_surface
 
 
 def _value_text(result: Identification, name: str, unit: str, digits: int) -> str:

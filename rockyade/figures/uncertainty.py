@@ -9,10 +9,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rockyade.analysis.exceedance import level_column
-from rockyade.analysis.fragility import Fragility, wilson_interval
 from rockyade.figures.common import new_figure, save_figure
 from rockyade.motion.intensity import LABELS
+from rockyade.probability.exceedance import level_column
+from rockyade.probability.fragility import Fragility, wilson_interval
 
 SOLVER_COLOURS = {"housner": "C0", "reference": "C1", "yade": "C2"}
 

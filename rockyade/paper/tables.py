@@ -21,7 +21,8 @@ import math
 import pandas as pd
 
 from rockyade import paper
-from rockyade.blocks.calibration import (
+from rockyade.blocks.classical import classical_parameters
+from rockyade.calibration.equations import (
     equivalent_half_base_eq11,
     f_min_eq14,
     generalized_damping_factor_eq12,
@@ -30,7 +31,6 @@ from rockyade.blocks.calibration import (
     stiffness_eq10,
     xi_min_eq15,
 )
-from rockyade.blocks.classical import classical_parameters
 from rockyade.constants import G
 
 CONSISTENCY_TOL_PCT = 1.0
@@ -182,7 +182,7 @@ def dem_parameters_from_printed(key: str, which: str) -> dict[str, float]:
     if spec.chamfer_m:
         k2 = stiffness_eq8(block.mass_kg, geo.p_rad_s)
     else:
-        from rockyade.blocks.calibration import stiffness_eq9
+        from rockyade.calibration.equations import stiffness_eq9
 
         k2 = stiffness_eq9(block.mass_kg, geo.R_m, G)
     k = stiffness_eq10(k1, k2)

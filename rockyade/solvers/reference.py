@@ -32,12 +32,12 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.dem import kernel
+from rockyade.calibration.matched import build_matched_model
 from rockyade.dem.engine import simulate_model
 from rockyade.dem.frames import dem_frame, energy_gain
-from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, run_outcome
+from rockyade.kernel import simulation as kernel
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 

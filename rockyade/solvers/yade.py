@@ -1,7 +1,7 @@
 """The YADE backend: a scene's DEM model run by YADE in batch mode, parsed back.
 
 The DEM model (:mod:`rockyade.dem.model`, the same the reference DEM runs) is written as
-JSON data (:mod:`rockyade.dem.yade_payload`) and run by :mod:`rockyade.dem.yade_driver`
+JSON data (:mod:`rockyade.yade.payload`) and run by :mod:`rockyade.yade.driver`
 in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess:
 
 * no listening socket: the ``yade`` launcher (which opens a Python console on
@@ -34,19 +34,19 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
+from rockyade.calibration.matched import build_matched_model
 from rockyade.dem.frames import dem_frame, energy_gain
-from rockyade.dem.matching import build_matched_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, run_outcome
-from rockyade.dem.yade_payload import scene_payload
 from rockyade.errors import InputError, SolverUnavailableError
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.lifetime import child_dies_with_parent
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
+from rockyade.yade.payload import scene_payload
 
 #: The script YADE's Python runs, shipped inside the package.
-DRIVER = Path(__file__).resolve().parent.parent / "dem" / "yade_driver.py"
+DRIVER = Path(__file__).resolve().parent.parent / "yade" / "driver.py"
 YADE_PYTHON = os.environ.get("ROCKYADE_YADE_PYTHON", "/usr/bin/python3.11")
 YADE_PY_DIR = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
 

@@ -15,10 +15,10 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.analysis.fragility import Fragility, fit_lognormal
-from rockyade.dem.matching import build_matched_model
+from rockyade.calibration.matched import build_matched_model
 from rockyade.figures import new_figure, save_figure
 from rockyade.motion.synthetic import paper_suite, suite_record
+from rockyade.probability.fragility import Fragility, fit_lognormal
 from rockyade.scene import scene_from_dict
 from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.common import (

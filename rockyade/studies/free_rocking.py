@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
-from rockyade.dem.matching import build_matched_model
+from rockyade.calibration.matched import build_matched_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict

@@ -18,8 +18,8 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from rockyade.calibration.matched import build_matched_model
 from rockyade.constants import G
-from rockyade.dem.matching import build_matched_model
 from rockyade.figures import new_figure, save_figure
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner, reference

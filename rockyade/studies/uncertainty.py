@@ -215,7 +215,7 @@ def load_uncertainty_study(path: str | Path) -> UncertaintyStudy:
 
 def uncertainty_study_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> UncertaintyStudy:
     """Validate a study given as a dictionary (as read from TOML)."""
-    from rockyade.analysis.identified import load_identified
+    from rockyade.identification.identified import load_identified
 
     base_dir = base_dir or Path.cwd()
     r = TableReader(data, "", source)
@@ -409,7 +409,7 @@ def run_uncertainty(
     figure: bool = True,
 ) -> UncertaintyResult:
     """Draw the samples, run every task through the batch engine and write the report."""
-    from rockyade.analysis.exceedance import exceedance_table, fragility_table, spread_table
+    from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -286,7 +286,7 @@ def check_pad(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
 def check_wall(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """About 1,000 blocks at rest: they settle elastically to the linear statics of the joints
     (rockyade.dem.statics) and do not move beyond it."""
-    from rockyade.dem.matching import build_matched_model
+    from rockyade.calibration.matched import build_matched_model
     from rockyade.dem.statics import rest_springs, static_displacement
 
     data = wall(courses=32, units_per_course=32, motion=rest_motion(), duration_s=1.5, sample_dt_s=0.005)

@@ -1,8 +1,8 @@
-"""A DEM model as the JSON data the YADE driver (:mod:`rockyade.dem.yade_driver`) reads.
+"""A DEM model as the JSON data the YADE driver (:mod:`rockyade.yade.driver`) reads.
 
 Scenes are data, never code: no value is pasted into Python source for YADE. Everything
 about the contacts (sphere centres, their copies, materials and collision masks) is decided
-here (:mod:`rockyade.dem.yade_contacts`); the driver only builds what the data says.
+here (:mod:`rockyade.yade.contacts`); the driver only builds what the data says.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from rockyade.dem.model import DemModel
-from rockyade.dem.yade_contacts import BASE_BIT, plan_contacts
+from rockyade.yade.contacts import BASE_BIT, plan_contacts
 
 #: Radius of the vertex spheres: at least this fraction of the largest of the moving
 #: blocks' smallest dimensions ...

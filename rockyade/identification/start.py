@@ -21,9 +21,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import optimize
 
-from rockyade.analysis.free_rocking_model import FreeRockingFit, IdentificationError
-from rockyade.analysis.measurement import MeasuredHistory
 from rockyade.blocks.restitution import effective_restitution
+from rockyade.identification.measurement import MeasuredHistory
+from rockyade.identification.model import FreeRockingFit, IdentificationError
 from rockyade.solvers.housner import HousnerModel, solve
 
 

@@ -15,8 +15,8 @@ side it was tilted to, t_r the release time and o the sensor offset. The six unk
 exactly: the solver is advanced from the release to the first sample after it, then sampled
 on the measurement grid.
 
-Starting point: :func:`rockyade.analysis.identify_start.initial_guess` (peaks, zero crossings
-and exact Housner periods). The model: :mod:`rockyade.analysis.free_rocking_model`.
+Starting point: :func:`rockyade.identification.start.initial_guess` (peaks, zero crossings
+and exact Housner periods). The model: :mod:`rockyade.identification.model`.
 
 95 % intervals: Gauss-Newton covariance s^2 (J^T J)^-1 (J the Jacobian at the optimum,
 s^2 = SSR / (n - 6)) with Student's t quantile (Bates & Watts 1988, Ch. 2). When the
@@ -39,16 +39,16 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import optimize, stats
 
-from rockyade.analysis.free_rocking_model import (
+from rockyade.errors import InputError
+from rockyade.identification.measurement import MeasuredHistory
+from rockyade.identification.model import (
     FIT_PARAMETERS,
     FreeRockingFit,
     IdentificationError,
     model_history,
     synthetic_measurement,
 )
-from rockyade.analysis.identify_start import Guess, initial_guess
-from rockyade.analysis.measurement import MeasuredHistory
-from rockyade.errors import InputError
+from rockyade.identification.start import Guess, initial_guess
 
 __all__ = [
     "CLASSICAL",
@@ -238,7 +238,7 @@ def identify(
     Parameters
     ----------
     history
-        The measured rotation (:func:`rockyade.analysis.measurement.read_measurement`).
+        The measured rotation (:func:`rockyade.identification.measurement.read_measurement`).
     max_relative_ci
         A parameter whose 95 % half interval exceeds this fraction of its value is
         reported as unidentifiable.

@@ -2,7 +2,7 @@
 
 Usage::
 
-    python3.11 yade_driver.py SCENE.json RESULT.npz    # how rockyade runs it
+    python3.11 driver.py SCENE.json RESULT.npz    # how rockyade runs it
     yade -x run.py                                     # a `rockyade yade-script` folder:
     yade run.py                                        # scene.json beside run.py, writes
                                                        # result.npz and result.csv there
@@ -10,7 +10,7 @@ Usage::
 Runs inside Debian's /usr/bin/python3.11 with YADE's modules on the path and imports only
 the standard library, numpy and YADE. rockyade never uses the ``yade`` launcher, which
 opens a Python console and an XMLRPC server on all interfaces; a user may (it also gives
-the 3-D view). The scene is data prepared by rockyade (``rockyade.dem.yade_payload``):
+the 3-D view). The scene is data prepared by rockyade (``rockyade.yade.payload``):
 every contact decision (sphere places, copies, materials, masks) is in it.
 
 The model, as the reference DEM's:

@@ -20,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.analysis.measurement import MeasuredHistory, measured_history
 from rockyade.errors import RockyadeError
+from rockyade.identification.measurement import MeasuredHistory, measured_history
 from rockyade.solvers.housner import HousnerModel, solve
 
 #: The fitted unknowns, in the order of the parameter vector.

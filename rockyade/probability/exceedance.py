@@ -16,7 +16,7 @@ from collections.abc import Iterable
 import numpy as np
 import pandas as pd
 
-from rockyade.analysis.fragility import fit_lognormal_points, wilson_interval
+from rockyade.probability.fragility import fit_lognormal_points, wilson_interval
 
 #: Peak theta/alpha above which a run counts as rocking (for the spread factor).
 ROCKING_RATIO = 0.01

@@ -25,12 +25,12 @@ from rockyade.blocks.classical import classical_parameters
 from rockyade.blocks.geometry import Block
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, G
-from rockyade.dem import kernel
 from rockyade.dem.build import build_dem_model
 from rockyade.dem.engine import simulate_model
 from rockyade.dem.joints import MatchedBeta
 from rockyade.dem.model import DemModel
 from rockyade.errors import CalibrationError
+from rockyade.kernel import simulation as kernel
 from rockyade.scene import Scene, scene_from_dict
 
 #: Impacts after the release over which mu_eff is measured.
@@ -187,7 +187,7 @@ def match_beta(
 def _match_cached(key: tuple) -> MatchedBeta:
     verts, thickness, mass, inertia, alpha, p, mu, scale, friction, K = key
     block = Block.polygon(verts, thickness, mass_kg=mass, inertia_kgm2=inertia)
-    from rockyade.blocks.calibration import paper_calibration
+    from rockyade.calibration.equations import paper_calibration
 
     paper = paper_calibration(
         block, alpha_rad=alpha, p_rad_s=p, mu=mu, stiffness_scale=scale, friction_angle_deg=friction

@@ -9,12 +9,12 @@ joint of Section 4), at every contact point:
   only while sticking;
 * the shear memory is reset when the contact point opens.
 
-Contact points (:mod:`rockyade.dem.contacts`): every vertex below the base (the half-plane
+Contact points (:mod:`rockyade.kernel.contacts`): every vertex below the base (the half-plane
 y <= 0); and per pair of touching polygons one manifold of at most two points (reference
 face by the separating-axis test with hysteresis, incident edge clipped to its side
 planes), each point with the pair's joint K (``JointTable.joint_for``). Candidate pairs come
 from a sort-and-sweep broad phase over grown boxes, rebuilt only when a body has moved by
-more than its margin (:mod:`rockyade.dem.broadphase`), so a step costs O(bodies + pairs).
+more than its margin (:mod:`rockyade.kernel.broadphase`), so a step costs O(bodies + pairs).
 
 Shear memory of a pair's points: a point inherits the shear spring of last step's point of
 the same pair nearest to it (within a quarter of the shortest edge of the two polygons), as
@@ -43,8 +43,15 @@ import math
 import numba
 import numpy as np
 
-from rockyade.dem.broadphase import candidate_pairs, moved_beyond_margin, sweep_axis
-from rockyade.dem.contacts import HYSTERESIS_REL, NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
+from rockyade.kernel.broadphase import candidate_pairs, moved_beyond_margin, sweep_axis
+from rockyade.kernel.contacts import (
+    HYSTERESIS_REL,
+    NO_FACE,
+    clip_manifold,
+    incident_edge,
+    joint_for,
+    separating_axis_test,
+)
 
 # energy columns
 E_KIN, E_POT, E_EL, E_DASH, E_FRIC, W_BASE = range(6)

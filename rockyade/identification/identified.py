@@ -11,9 +11,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from rockyade.blocks.calibration import paper_calibration, xi_min_eq15
 from rockyade.blocks.classical import check_classical_overrides
 from rockyade.blocks.geometry import Block
+from rockyade.calibration.equations import paper_calibration, xi_min_eq15
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG
 from rockyade.errors import InputError
 
@@ -98,9 +98,9 @@ def calibrate_from_identified(
         A JSON file written by ``rockyade identify --out`` or a mapping with the same keys.
     method
         ``"paper"`` (damping from Eq 13) or ``"matched"`` (damping such that the reference
-        DEM's effective mu equals the identified mu, :func:`rockyade.dem.matching.match_beta`).
+        DEM's effective mu equals the identified mu, :func:`rockyade.calibration.matched.match_beta`).
     stiffness_scale, friction_angle_deg
-        As for :func:`rockyade.blocks.calibration.paper_calibration`.
+        As for :func:`rockyade.calibration.equations.paper_calibration`.
 
     Returns
     -------
@@ -124,7 +124,7 @@ def calibrate_from_identified(
         **cal.report(),
     }
     if method == "matched":
-        from rockyade.dem.matching import match_beta
+        from rockyade.calibration.matched import match_beta
 
         matched = match_beta(block, **params, stiffness_scale=stiffness_scale, friction_angle_deg=friction_angle_deg)
         result.update(matched.as_cli_dict())

@@ -1,0 +1,1 @@
+"""Probability: lognormal fragility fits and exceedance probabilities with their bands."""
