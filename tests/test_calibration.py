@@ -17,10 +17,10 @@ from rockyade.calibration.equations import (
     stiffness_eq8,
     stiffness_eq9,
     stiffness_eq10,
-    time_step_eq7,
     xi_min_eq15,
 )
 from rockyade.constants import G
+from rockyade.dem.model import time_step_eq7
 from rockyade.errors import CalibrationError, InputError
 
 

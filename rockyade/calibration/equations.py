@@ -3,7 +3,8 @@
 One function per equation of the paper, each citing its number:
 
 * Eq 6  Rayleigh constants a = xi w, b = xi / w from (xi_min, f_min);
-* Eq 7  time step dt = frac 2 sqrt(M_min / K_max);
+* Eq 7  time step dt = frac 2 sqrt(M_min / K_max): :func:`rockyade.dem.model.time_step_eq7`,
+  where the model chooses its time step;
 * Eq 8  K1 = M p^2;   Eq 9  K2 = M 3g/(4R) (M p_theory^2 for any polygon);
 * Eq 10 K = (K1 + K2) / 2;
 * Eq 11 b_eq = h tan(alpha);
@@ -17,12 +18,15 @@ M g / K ~ 0.7 m into its base (specimen 1). rockyade multiplies the paper's K by
 in every output, and refuses a static settlement M g / K above 1e-4 of the block height.
 Eqs 12-13 are evaluated with the paper's own (unscaled) K, as the paper fitted them; Eq 7
 uses the scaled K actually simulated.
+
+:func:`paper_calibration` puts them together into the joint the model runs
+(:class:`rockyade.dem.joints.ContactParameters`); :mod:`rockyade.calibration.calibrate`
+applies a scene's explicit values and the other methods.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
 
 from rockyade.blocks.classical import classical_parameters
 from rockyade.blocks.geometry import Block
@@ -34,6 +38,8 @@ from rockyade.constants import (
     STIFFNESS_SCALES,
     G,
 )
+from rockyade.dem.joints import ContactParameters
+from rockyade.dem.model import time_step_eq7
 from rockyade.errors import CalibrationError, InputError
 
 #: Range of Gamma / mu^2 covered by the paper's four specimens (Fig. 11), for a warning.
@@ -54,11 +60,6 @@ def rayleigh_constants_eq6(xi_min: float, f_min_hz: float) -> tuple[float, float
     """
     omega = 2.0 * math.pi * f_min_hz
     return xi_min * omega, xi_min / omega
-
-
-def time_step_eq7(mass_min_kg: float, k_max_N_per_m: float, frac: float = DEFAULT_TIME_STEP_FRAC) -> float:
-    """Critical time step of the central-difference scheme, s (paper Eq 7)."""
-    return frac * 2.0 * math.sqrt(mass_min_kg / k_max_N_per_m)
 
 
 def stiffness_eq8(mass_kg: float, p_rad_s: float) -> float:
@@ -166,89 +167,6 @@ def check_settlement(
 
 
 # ------------------------------------------------------------------ calibration
-
-
-@dataclass(frozen=True)
-class ContactParameters:
-    """Contact (joint) parameters of the interface beneath one block.
-
-    Attributes
-    ----------
-    K_N_per_m, Ks_N_per_m
-        Normal and shear stiffness per contact corner, N/m (scaled).
-    friction_angle_deg, cohesion_Pa
-        Coulomb parameters.
-    beta_s
-        Stiffness-proportional damping b, s: dashpots c_n = b K, c_s = b Ks.
-    rayleigh_a_1_s
-        Mass-proportional Rayleigh constant (0, paper Section 6.2).
-    xi_min, f_min_hz
-        Eq 15 damping ratio and Eq 14 frequency for ``beta_s``.
-    b_eq_m
-        Equivalent half base (Eq 11), m.
-    K_paper
-        Eq 10 value in the paper's units (before the stiffness scale).
-    stiffness_scale, stiffness_reading
-        Factor applied to the paper's K, and its name (e.g. "MN/m").
-    gamma
-        Eq 12 generalised damping factor.
-    beta_eq13_s
-        Eq 13's value of b, s (kept beside a matched or explicit beta).
-    method
-        "paper", "matched" or "explicit".
-    dt_eq7_s
-        Eq 7 time step for this block alone (M of the block, K above), s.
-    settlement_m
-        Static settlement M g / K, m.
-    notes
-        Provenance remarks (overrides, extrapolation of Eq 13, ...).
-    """
-
-    K_N_per_m: float
-    Ks_N_per_m: float
-    friction_angle_deg: float
-    cohesion_Pa: float
-    beta_s: float
-    rayleigh_a_1_s: float
-    xi_min: float
-    f_min_hz: float
-    b_eq_m: float
-    K_paper: float
-    stiffness_scale: float
-    stiffness_reading: str
-    gamma: float
-    beta_eq13_s: float | None
-    method: str
-    dt_eq7_s: float
-    settlement_m: float
-    notes: tuple[str, ...] = field(default=())
-
-    def as_dict(self) -> dict[str, object]:
-        """Plain dictionary, JSON-ready."""
-        d = asdict(self)
-        d["notes"] = list(self.notes)
-        return d
-
-    def report(self) -> dict[str, object]:
-        """The keys ``rockyade calibrate --json`` prints (names as the command documents them)."""
-        return {
-            "K_N_per_m": self.K_N_per_m,
-            "Ks_N_per_m": self.Ks_N_per_m,
-            "beta_s": self.beta_s,
-            "beta_eq13_s": self.beta_eq13_s,
-            "xi_min": self.xi_min,
-            "f_min_hz": self.f_min_hz,
-            "b_eq_m": self.b_eq_m,
-            "dt_s": self.dt_eq7_s,
-            "friction_angle_deg": self.friction_angle_deg,
-            "cohesion_Pa": self.cohesion_Pa,
-            "stiffness_scale": self.stiffness_reading,
-            "stiffness_scale_factor": self.stiffness_scale,
-            "K_paper_units": self.K_paper,
-            "gamma": self.gamma,
-            "settlement_m": self.settlement_m,
-            "notes": list(self.notes),
-        }
 
 
 def paper_calibration(

@@ -164,7 +164,8 @@ def cmd_params(args: argparse.Namespace) -> int:
 def cmd_calibrate(args: argparse.Namespace) -> int:
     """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
     from rockyade import paper
-    from rockyade.calibration.equations import paper_calibration, xi_min_eq15
+    from rockyade.calibration.calibrate import calibrate
+    from rockyade.scene import ContactSpec
 
     if not 0.0 < args.friction_angle < 90.0:
         raise InputError("--friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
@@ -183,9 +184,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
         cp = classical_parameters(block)
         params = {"alpha_rad": cp.alpha_rad, "p_rad_s": cp.p_rad_s, "mu": cp.mu}
-    cal = paper_calibration(
-        block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
+    contact = ContactSpec(
+        calibration=args.method, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
     )
+    cal = calibrate(block, contact, **params)
     result: dict[str, Any] = {
         "specimen": spec.key,
         "parameters": args.parameters,
@@ -193,14 +195,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "method": args.method,
         **cal.report(),
     }
-    if args.method == "matched":
-        from rockyade.calibration.matched import match_beta
-
-        matched = match_beta(
-            block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
-        )
-        result.update(matched.as_cli_dict())
-        result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)  # Eq 15 with the matched b
     if args.json:
         json_out(result)
         return 0
