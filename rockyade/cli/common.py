@@ -83,3 +83,39 @@ def total_time(args: argparse.Namespace) -> float:
 
     start = getattr(args, "started_at", None)
     return time.perf_counter() - start if start is not None else float("nan")
+
+
+def print_calibration(result: dict[str, Any], method: str) -> None:
+    """The text of a calibration: each DEM parameter with the equation it comes from.
+
+    Parameters
+    ----------
+    result
+        :meth:`rockyade.calibration.calibrate.Calibration.report`'s keys (K in N/m, beta and
+        dt in s, b_eq in m, ...); with ``method = "matched"`` the matching's too (its
+        achieved mu and reachable range are in the joint's notes).
+    method
+        ``"paper"`` or ``"matched"``.
+
+    ``calibrate`` and ``calibrate --from`` print through this.
+    """
+    if method == "matched":
+        beta_src = f"matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s"
+    else:
+        beta_src = f"Eq 13, Gamma = {result['gamma']:.6g} (Eq 12)"
+    b_eq = result["b_eq_m"]
+    print(
+        f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10: {result['K_paper_units']:.6g}, "
+        f"read as {result['stiffness_scale']})"
+    )
+    print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
+    print(
+        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14: the number of p "
+        "in 1/s), Rayleigh a = 0"
+    )
+    print(f"  b_eq     = {b_eq:.6g} m (Eq 11; 2 b_eq = {2 * b_eq:.4g} m)")
+    print(f"  dt       = {result['dt_s']:.6g} s (Eq 7, frac 0.1)")
+    print(f"  friction = {result['friction_angle_deg']:g} deg, cohesion = {result['cohesion_Pa']:g} Pa")
+    print(f"  static settlement M g / K = {result['settlement_m']:.3g} m")
+    for note in result["notes"]:
+        print(f"  note: {note}")

@@ -5,10 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:  # the parser stays fast: the identification is imported when the command runs
+    from rockyade.identification.fit import Identification
 
 
 def _led_columns(text: str | None) -> tuple[str, str] | None:
@@ -65,7 +68,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_text(result: Any) -> None:
+def _print_text(result: Identification) -> None:
     h = result.history
     fit = result.fit
     print(f"{h.source}: {h.t_s.size} samples at {h.rate_hz:.4g} Hz over {h.duration_s:.4g} s")
@@ -85,7 +88,7 @@ def _print_text(result: Any) -> None:
     )
 
 
-def _start_lines(result: Any) -> list[str]:
+def _start_lines(result: Identification) -> list[str]:
     """Release time, release tilt and sensor offset with their 95 % intervals (the JSON's), or
     "not identified" where the interval is wider than ``max_relative_ci`` of the record's
     duration (release time) or of its rotation range (offset; the tilt is measured from it)."""
@@ -104,41 +107,6 @@ def _start_lines(result: Any) -> list[str]:
         return [release, f"release tilt and sensor offset not identified (offset +/-{0.5 * (o_hi - o_lo):.3g} rad)"]
     release += f" from theta = {fit.theta0_rad:.5g} rad"
     return [release, f"sensor offset {fit.offset_rad:.4g} rad [{o_lo:.4g}, {o_hi:.4g}]"]
-
-
-def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
-    """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
-    from rockyade.identification.identified import calibrate_from_identified
-
-    if len(blocks) != 1:
-        raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")
-    name, block, _overrides = blocks[0]
-    result = calibrate_from_identified(
-        block,
-        args.from_identified,
-        method=args.method,
-        stiffness_scale=args.stiffness_scale,
-        friction_angle_deg=args.friction_angle,
-    )
-    result["block"] = name
-    result["from"] = str(args.from_identified)
-    if args.json:
-        json_out(result)
-        return 0
-    c, ci = result["classical"], result["classical_ci"]
-
-    def interval(key: str) -> str:
-        return f" [{ci[key][0]:.4g}, {ci[key][1]:.4g}]" if key in ci else ""
-
-    print(f"{name} ({block.mass_kg:.4g} kg), identified parameters from {args.from_identified}:")
-    print(
-        f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
-        f"mu = {c['mu']:.5g}{interval('mu')}"
-    )
-    from rockyade.cli.blocks import print_calibration
-
-    print_calibration(result, args.method)
-    return 0
 
 
 def register(sub: Any) -> None:
