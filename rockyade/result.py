@@ -11,6 +11,9 @@ Metadata keys: ``solver``, ``version``, ``scene_hash``, ``wall_time_s`` (the sol
 itself), ``status`` (completed | overturned | failed), ``overturn_time_s``,
 ``overturned_block``, ``failure_reason``, ``blocks``, ``sample_dt_s``, and the parameters
 actually used (``contact`` for the DEMs, ``classical`` for Housner).
+
+A Result knows nothing of figures: :mod:`rockyade.figures.histories` draws it
+(``HistoryDisplay.from_result(result)``, ``plot_result(result, ax=...)``).
 """
 
 from __future__ import annotations
@@ -82,27 +85,6 @@ class Result:
         if block is None:
             block = names[-1]
         return self.frame[column(block, quantity, names)].to_numpy()
-
-    # -------------------------------------------------------------- figures
-    def plot(
-        self,
-        quantity: str = "theta_rad",
-        ax: Any = None,
-        path: str | os.PathLike[str] | None = None,
-        label: str | None = None,
-        title: str = "",
-    ) -> tuple[Any, Any]:
-        """Plot a per-block quantity against time, one panel per block.
-
-        A thin wrapper of :func:`rockyade.figures.plot_results` (imported here, so that
-        results load without matplotlib). ``ax``: Axes to draw into (one per block), e.g.
-        to overlay several results; ``path``: PNG to write; ``label``: legend entry
-        (default: the solver). Returns ``(fig, ax)`` (``(fig, axes)`` for several blocks).
-        """
-        from rockyade.figures.histories import plot_results
-
-        name = label or str(self.meta.get("solver", "result"))
-        return plot_results({name: self}, path, title=title, quantity=quantity, ax=ax)
 
     # -------------------------------------------------------------- files
     def write(self, csv_path: str | os.PathLike[str], extra_meta: dict[str, Any] | None = None) -> Path:
