@@ -79,6 +79,16 @@ def calibration_method(contact: ContactSpec) -> str:
     ``calibration`` (``paper`` or ``matched``), an explicit ``beta_s`` making it ``paper``
     (nothing left to match).
 
+    Parameters
+    ----------
+    contact
+        The ``[contact]`` settings (stiffness in N/m or Pa/m, damping in s).
+
+    Returns
+    -------
+    str
+        One of :data:`METHODS`.
+
     Raises
     ------
     InputError
@@ -125,6 +135,12 @@ def calibrate(
         check of the paper's stiffness; default the block's mass.
     g
         Gravity, m/s^2.
+
+    Returns
+    -------
+    Calibration
+        The joint (its ``notes`` say where each value comes from), the method, and the
+        matching's result for ``matched``.
 
     Raises
     ------
@@ -240,7 +256,13 @@ def _with_explicit_values(joint: ContactParameters, c: ContactSpec, mass_kg: flo
 
 def supported_masses(scene: Scene) -> list[float]:
     """Mass resting on each block's base joint, kg: in a column the block and those above
-    it; in an assembly each block's own mass (the model's statics check the load paths)."""
+    it; in an assembly each block's own mass (the model's statics check the load paths).
+
+    Parameters
+    ----------
+    scene
+        A validated scene (blocks bottom to top).
+    """
     masses = [b.block().mass_kg for b in scene.blocks]
     if scene.positioned:
         return masses

@@ -125,7 +125,18 @@ def _is_rectangle(vertices_m: ArrayLike) -> bool:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    """Classical parameters of one or more blocks."""
+    """Classical parameters of one or more blocks (``rockyade params``).
+
+    Parameters
+    ----------
+    args
+        The parsed command line (one block input, ``--json``).
+
+    Returns
+    -------
+    int
+        Exit code (0).
+    """
     from rockyade.blocks.classical import classical_parameters
 
     out, rectangles = {}, {}
@@ -170,7 +181,19 @@ def cmd_params(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
+    """DEM contact parameters (``rockyade calibrate``: paper Eqs 7-15, or matched to mu).
+
+    Parameters
+    ----------
+    args
+        The parsed command line: ``--specimen`` (or a block with ``--from``),
+        ``--parameters``, ``--method``, ``--stiffness-scale``, ``--friction-angle`` (degrees).
+
+    Returns
+    -------
+    int
+        Exit code (0).
+    """
     from rockyade import paper
     from rockyade.calibration.calibrate import calibrate
     from rockyade.scene import ContactSpec
@@ -244,7 +267,13 @@ def _calibrate_identified(args: argparse.Namespace, blocks: list[NamedBlock]) ->
 
 
 def register(sub: Any) -> None:
-    """Add ``params`` and ``calibrate``."""
+    """Add ``params`` and ``calibrate``.
+
+    Parameters
+    ----------
+    sub
+        The subparsers of ``rockyade``'s parser.
+    """
     p = sub.add_parser(
         "params",
         help="classical parameters alpha, p, mu of a block",

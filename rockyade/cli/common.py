@@ -14,22 +14,42 @@ from rockyade.errors import InputError
 SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade")
 
 
-def json_out(data: Any) -> None:
-    """Print ``data`` as indented, sorted JSON (numpy values converted)."""
+def json_out(data: object) -> None:
+    """Print ``data`` as indented, sorted JSON (numpy values converted).
+
+    Parameters
+    ----------
+    data
+        JSON-ready values (dicts, lists, numbers, strings, numpy scalars and arrays).
+    """
     from rockyade.io.atomic import json_text
 
     print(json_text(data))
 
 
 def print_wrote(path: Path, json_mode: bool = False) -> None:
-    """``wrote PATH`` on stdout, or on stderr after ``--json`` (stdout stays one JSON document)."""
+    """``wrote PATH`` on stdout, or on stderr after ``--json`` (stdout stays one JSON document).
+
+    Parameters
+    ----------
+    path
+        The file written.
+    json_mode
+        The command prints JSON on stdout.
+    """
     import sys
 
     print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
 
 
 def add_allow_large(p: argparse.ArgumentParser) -> None:
-    """``--allow-large``: run above the documented cost limits (docs/reliability.md)."""
+    """``--allow-large``: run above the documented cost limits (docs/reliability.md).
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    """
     p.add_argument(
         "--allow-large",
         action="store_true",
@@ -40,7 +60,15 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
 
 def check_output_dir(path: Path, option: str) -> None:
     """Refuse an output directory that cannot be created or written (InputError naming
-    ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here."""
+    ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here.
+
+    Parameters
+    ----------
+    path
+        The directory.
+    option
+        The option that names it.
+    """
     option = _flag(option)
     if path.is_file():
         raise InputError(option, f"{path} is a file; give a directory")
@@ -50,7 +78,17 @@ def check_output_dir(path: Path, option: str) -> None:
 def check_output_file(path: Path, option: str, suffix: str | tuple[str, ...] | None = None) -> None:
     """Refuse an output file whose folder cannot be created or written, or (``suffix``, e.g.
     ``".png"`` or ``(".toml", ".json")``) whose name does not end as the file it will be (no
-    scene overwritten by a plot)."""
+    scene overwritten by a plot).
+
+    Parameters
+    ----------
+    path
+        The file.
+    option
+        The option that names it.
+    suffix
+        The suffix (or suffixes) it must have; None: any.
+    """
     option = _flag(option)
     if path.is_dir():
         raise InputError(option, f"{path} is a directory; give a file name")
@@ -78,7 +116,14 @@ def _check_dir(path: Path, option: str, what: str) -> None:
 
 
 def total_time(args: argparse.Namespace) -> float:
-    """Seconds since the command line started (imports of the command included)."""
+    """Seconds since the command line started (imports of the command included), s.
+
+    Parameters
+    ----------
+    args
+        The parsed command line (``started_at``: its ``time.perf_counter()`` at start);
+        NaN without it.
+    """
     import time
 
     start = getattr(args, "started_at", None)

@@ -24,7 +24,18 @@ def _led_columns(text: str | None) -> tuple[str, str] | None:
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    """Identify the classical parameters of a measured free-rocking record."""
+    """Identify the classical parameters of a measured free-rocking record (``rockyade identify``).
+
+    Parameters
+    ----------
+    args
+        The parsed command line: the record, its columns, ``--out``, ``--plot``, ``--json``.
+
+    Returns
+    -------
+    int
+        Exit code: 0, or 1 when a parameter cannot be identified.
+    """
     from rockyade.identification.fit import identify
     from rockyade.identification.measurement import read_measurement
 
@@ -110,7 +121,13 @@ def _start_lines(result: Identification) -> list[str]:
 
 
 def register(sub: Any) -> None:
-    """Add ``rockyade identify``."""
+    """Add ``rockyade identify``.
+
+    Parameters
+    ----------
+    sub
+        The subparsers of ``rockyade``'s parser.
+    """
     p = sub.add_parser(
         "identify",
         help="alpha, p, mu with 95 %% intervals from a measured free-rocking test",

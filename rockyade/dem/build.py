@@ -42,6 +42,18 @@ def contact_polygon(block: Block, alpha_rad: float | None) -> np.ndarray:
     Without an alpha override the polygon is the block's own. Vertices are returned in the
     block frame, counter-clockwise; a vertex that the moved corners leave inside the hull
     is dropped.
+
+    Parameters
+    ----------
+    block
+        The block (vertices in m, base on y = 0).
+    alpha_rad
+        The alpha override, rad; None keeps the block's own base.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) vertices, m, starting at the bottom-left corner.
     """
     verts = block.vertices_m.copy()
     if alpha_rad is None:
@@ -118,7 +130,18 @@ def _dem_body(
 
 
 def world_polygon(body: DemBody) -> np.ndarray:
-    """A body's contact polygon in the base frame at rest, m."""
+    """A body's contact polygon in the base frame at rest.
+
+    Parameters
+    ----------
+    body
+        The body (polygon relative to its centroid, rest centroid and angle).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) vertices, m.
+    """
     return body.contact_vertices_m @ rotation_matrix(body.rest_angle_rad).T + np.asarray(body.rest_centroid_m)
 
 

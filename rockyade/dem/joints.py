@@ -46,25 +46,25 @@ class ContactParameters:
     K_N_per_m, Ks_N_per_m
         Normal and shear stiffness per contact corner, N/m (scaled).
     friction_angle_deg, cohesion_Pa
-        Coulomb parameters.
+        Coulomb parameters: friction angle, degrees; cohesion, Pa.
     beta_s
         Stiffness-proportional damping b, s: dashpots c_n = b K, c_s = b Ks.
     rayleigh_a_1_s
         Mass-proportional Rayleigh constant (0, paper Section 6.2).
     xi_min, f_min_hz
-        Eq 15 damping ratio and Eq 14 frequency for ``beta_s``.
+        Eq 15 damping ratio (-) and Eq 14 frequency (Hz) for ``beta_s``.
     b_eq_m
         Equivalent half base (Eq 11), m.
     K_paper
         Eq 10 value in the paper's units (before the stiffness scale).
     stiffness_scale, stiffness_reading
-        Factor applied to the paper's K, and its name (e.g. "MN/m").
+        Factor applied to the paper's K (N/m per paper unit), and its name (e.g. "MN/m").
     gamma
-        Eq 12 generalised damping factor.
+        Eq 12 generalised damping factor (paper units).
     beta_eq13_s
         Eq 13's value of b, s (kept beside a matched or explicit beta).
     method
-        "paper", "matched" or "explicit".
+        "paper", "matched", "explicit" or "override" (a ``[[joints]]`` entry).
     dt_eq7_s
         Eq 7 time step for this block alone (M of the block, K above), s.
     settlement_m
@@ -154,6 +154,16 @@ class JointTable:
         The rule every DEM implements: the base joint against the base; a pair resolved at
         build time uses its joint; else the moving body's own joint against a fixed body,
         else the softer (lower K) of the two own joints, ties to the lower index.
+
+        Parameters
+        ----------
+        a, b
+            Body indices (bottom to top); ``b = -1`` for the base.
+
+        Returns
+        -------
+        int
+            Index into ``params``.
         """
         if b < 0:
             return int(self.base_joint[a])
@@ -169,7 +179,13 @@ class JointTable:
         return int(self.pair_a.size)
 
     def summary(self, names: Sequence[str]) -> dict[str, object]:
-        """JSON-ready description: the parameter sets and which joint each body and pair uses."""
+        """JSON-ready description: the parameter sets and which joint each body and pair uses.
+
+        Parameters
+        ----------
+        names
+            Body names, bottom to top.
+        """
         kinds: dict[str, int] = {}
         for kind in self.pair_kind:
             kinds[kind] = kinds.get(kind, 0) + 1
@@ -191,7 +207,24 @@ def default_pair_joint(
     params: Sequence[ContactParameters], own_joint: NDArray[np.int64], fixed: NDArray[np.bool_], a: int, b: int
 ) -> int:
     """Joint of two bodies that do not touch at rest (a < b): the moving body's own joint
-    against a fixed body, else the softer (lower K) of the two own joints, ties to ``a``."""
+    against a fixed body, else the softer (lower K) of the two own joints, ties to ``a``.
+
+    Parameters
+    ----------
+    params
+        The joint parameter sets (stiffness in N/m).
+    own_joint
+        (nb,) index into ``params`` of each body's own joint.
+    fixed
+        (nb,) bool, bodies that move with the base.
+    a, b
+        The two body indices, ``a < b``.
+
+    Returns
+    -------
+    int
+        Index into ``params``.
+    """
     if fixed[a]:
         return int(own_joint[b])
     if fixed[b]:
@@ -221,7 +254,17 @@ def udec_stiffness(jk_Pa_per_m: float, length_m: float, thickness_m: float) -> f
 def override_joint(
     base: ContactParameters, override: JointOverride, length_m: float, thickness_m: float
 ) -> ContactParameters:
-    """``base`` with the values of a ``[[joints]]`` entry applied."""
+    """``base`` with the values of a ``[[joints]]`` entry applied.
+
+    Parameters
+    ----------
+    base
+        The joint the pair would have without the entry.
+    override
+        The entry (K in N/m, jkn in Pa/m, beta in s, friction in degrees).
+    length_m, thickness_m
+        Length and thickness of the joint, m (stiffness per unit area: ``udec_stiffness``).
+    """
     changes: dict[str, object] = {}
     jkn, jks = override.get("jkn_Pa_per_m"), override.get("jks_Pa_per_m")
     if jkn is not None:

@@ -180,6 +180,11 @@ class DemModel:
     def with_dt(self, dt_s: float) -> DemModel:
         """The model with another time step (rounded down to divide the sample interval).
 
+        Parameters
+        ----------
+        dt_s
+            The time step wanted, s.
+
         Raises
         ------
         InputError
@@ -191,7 +196,20 @@ class DemModel:
 
 
 def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
-    """Refuse a time step above the stability limit."""
+    """Refuse a time step above the stability limit.
+
+    Parameters
+    ----------
+    dt_s
+        The time step asked for, s.
+    dt_stable_s
+        The stability limit of the explicit scheme, s.
+
+    Raises
+    ------
+    InputError
+        ``dt_s`` above ``dt_stable_s`` (field ``contact.dt_s``).
+    """
     if dt_s > dt_stable_s:
         raise InputError(
             "contact.dt_s",

@@ -85,7 +85,17 @@ class HistoryDisplay:
         path: str | Path | None = None,
         title: str = "",
     ) -> HistoryDisplay:
-        """Draw several results (``{label: Result}``) on the same panels; see :meth:`plot`."""
+        """Draw several results on the same panels.
+
+        Parameters
+        ----------
+        results
+            ``{label: Result}``, drawn in that order.
+        quantity
+            Per-block column, e.g. ``theta_rad`` (rad).
+        ax, path, title
+            As for :meth:`plot`.
+        """
         return cls(results, quantity).plot(ax, path=path, title=title)
 
     def plot(

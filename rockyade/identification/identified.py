@@ -26,7 +26,7 @@ METHODS = CALIBRATIONS
 
 
 def load_identified(
-    source: str | Path | Mapping[str, Any], *, field: str = "from", named_in: str | None = None
+    source: str | Path | Mapping[str, object], *, field: str = "from", named_in: str | None = None
 ) -> dict[str, Any]:
     """Identified values from a JSON file (or a mapping): alpha_rad, p_rad_s, mu and their intervals.
 
@@ -86,7 +86,7 @@ def load_identified(
 
 def calibrate_from_identified(
     block: Block,
-    identified: str | Path | Mapping[str, Any],
+    identified: str | Path | Mapping[str, object],
     *,
     method: str = "paper",
     stiffness_scale: float | str | None = None,
