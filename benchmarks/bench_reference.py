@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from rockyade.calibration.calibrate import calibrated_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.reference import run_many, run_model
 from rockyade.studies.common import block_table

@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from rockyade.calibration.calibrate import calibrated_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import yade as yade_backend

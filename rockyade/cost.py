@@ -109,7 +109,7 @@ def dem_time_step(scene: Scene) -> tuple[float, int]:
     and masses, not on the motion, so no motion is built); a matched calibration is
     estimated with the paper's damping (Eq 13), which the matching changes little.
     """
-    from rockyade.calibration.calibrate import calibrated_model
+    from rockyade.calibration.model import calibrated_model
     from rockyade.motion.spec import AtRest
 
     contact = scene.contact

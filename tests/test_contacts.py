@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.calibration.calibrate import calibrated_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.dem.engine import model_arrays, polygon_arrays, simulate_model
 from rockyade.dem.overturn import LANDING_TOL_RAD
 from rockyade.dem.statics import rest_springs, static_penetration

@@ -10,7 +10,8 @@ import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.calibration.calibrate import calibrate, calibrated_model
+from rockyade.calibration.calibrate import calibrate
+from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
 from rockyade.errors import CalibrationError, InputError

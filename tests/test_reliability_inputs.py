@@ -170,7 +170,7 @@ def _long(duration: float, sample_dt: float, **contact) -> dict:
 
 
 def test_cost_estimate_of_an_example_matches_the_model():
-    from rockyade.calibration.calibrate import calibrated_model
+    from rockyade.calibration.model import calibrated_model
 
     d = load_scene(EXAMPLES / "specimen1_harmonic.toml").to_dict()
     d["contact"]["calibration"] = "paper"

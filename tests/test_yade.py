@@ -23,7 +23,8 @@ import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.calibration.calibrate import calibrate, calibrated_model
+from rockyade.calibration.calibrate import calibrate
+from rockyade.calibration.model import calibrated_model
 from rockyade.result import Result
 from rockyade.scene import ContactSpec, load_scene, scene_from_dict
 from rockyade.solvers import housner, reference

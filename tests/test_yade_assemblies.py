@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
-from rockyade.calibration.calibrate import calibrated_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict

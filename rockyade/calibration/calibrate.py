@@ -1,9 +1,9 @@
-"""One calibration: the joint beneath a block, whatever the method, and the model built on it.
+"""One calibration: the joint beneath a block, whatever the method.
 
 Every caller computes a block's joint here: the model the DEM solvers run
-(:func:`calibrated_model`), ``rockyade calibrate`` and ``rockyade calibrate --from``
-(identified values, :mod:`rockyade.identification.identified`). The method follows from
-the scene's ``[contact]`` table (:func:`calibration_method`):
+(:func:`rockyade.calibration.model.calibrated_model`), ``rockyade calibrate`` and
+``rockyade calibrate --from`` (identified values, :mod:`rockyade.identification.identified`).
+The method follows from the scene's ``[contact]`` table (:func:`calibration_method`):
 
 * ``udec``: ``jkn_Pa_per_m`` given: K = jkn x (L / 2) x t per contact point, L the block's
   base width (the model builder gives each joint at rest its own length), beta explicit;
@@ -16,7 +16,8 @@ the scene's ``[contact]`` table (:func:`calibration_method`):
   mu equals mu (:mod:`rockyade.calibration.matching`), with xi_min by Eq 15 for that beta.
 
 The model builder (:mod:`rockyade.dem.build`) runs the joints it is given: it knows no
-calibration. :func:`calibrated_model` calibrates every moving block, then builds.
+calibration. The matching runs the reference DEM (numba): it is imported when a block is
+matched, so that the other methods stay quick to load.
 """
 
 from __future__ import annotations
@@ -24,19 +25,21 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rockyade.blocks.geometry import Block
 from rockyade.calibration.equations import paper_calibration, xi_min_eq15
-from rockyade.calibration.matching import MatchedBeta, match_beta
 from rockyade.constants import G
-from rockyade.dem.build import build_dem_model
 from rockyade.dem.joints import ContactParameters, udec_stiffness
-from rockyade.dem.model import DemModel, time_step_eq7
+from rockyade.dem.model import time_step_eq7
 from rockyade.errors import InputError
-from rockyade.scene import ContactSpec, Scene
+from rockyade.scene import ContactSpec
 from rockyade.scene.model import CALIBRATIONS
+
+if TYPE_CHECKING:
+    from rockyade.calibration.matching import MatchedBeta
 
 #: The calibration methods, as :func:`calibration_method` names them.
 METHODS = ("udec", "explicit", "paper", "matched")
@@ -179,6 +182,8 @@ def calibrate(
     joint = _with_explicit_values(joint, c, block.mass_kg)
     if method == "paper":
         return Calibration(joint, method)
+    from rockyade.calibration.matching import match_beta  # runs the reference DEM (numba)
+
     matched = match_beta(block, joint, **classical)
     note = (
         f"beta matched: reference DEM effective mu {matched.mu_eff:.5f} for target "
@@ -252,50 +257,3 @@ def _with_explicit_values(joint: ContactParameters, c: ContactSpec, mass_kg: flo
         notes.append("beta_s explicit")
     k = changes.get("K_N_per_m", joint.K_N_per_m)
     return replace(joint, **changes, notes=tuple(notes), dt_eq7_s=time_step_eq7(mass_kg, k, c.time_step_frac))
-
-
-def supported_masses(scene: Scene) -> list[float]:
-    """Mass resting on each block's base joint, kg: in a column the block and those above
-    it; in an assembly each block's own mass (the model's statics check the load paths).
-
-    Parameters
-    ----------
-    scene
-        A validated scene (blocks bottom to top).
-    """
-    masses = [b.block().mass_kg for b in scene.blocks]
-    if scene.positioned:
-        return masses
-    return [sum(masses[i:]) for i in range(len(masses))]
-
-
-def calibrated_model(scene: Scene, g: float = G) -> DemModel:
-    """The scene's DEM model, every moving block's joint calibrated first.
-
-    The stage every DEM solver calls: each moving block is calibrated by the scene's method
-    (:func:`calibrate`; a matched one runs short DEM models of the block alone first), then
-    the model is built with those joints (:func:`rockyade.dem.build.build_dem_model`).
-
-    Parameters
-    ----------
-    scene
-        A validated scene.
-    g
-        Gravity, m/s^2.
-    """
-    supported = supported_masses(scene)
-    joints = [
-        None
-        if spec.fixed
-        else calibrate(
-            spec.block(),
-            scene.contact,
-            alpha_rad=spec.alpha_rad,
-            p_rad_s=spec.p_rad_s,
-            mu=spec.mu,
-            supported_mass_kg=supported[i],
-            g=g,
-        ).joint
-        for i, spec in enumerate(scene.blocks)
-    ]
-    return build_dem_model(scene, joints, g=g)

@@ -409,7 +409,7 @@ def _check_the_dem_takes_it(scene: Any) -> None:
     (joints too soft for the wall's weight) is refused here, naming the option to change."""
     if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
         return  # the matched stage runs the DEM: too slow for a check; run checks it
-    from rockyade.calibration.calibrate import calibrated_model
+    from rockyade.calibration.model import calibrated_model
 
     try:
         calibrated_model(scene)

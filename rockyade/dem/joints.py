@@ -27,14 +27,17 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
-from rockyade.scene import Scene
-from rockyade.scene.model import JointOverride
-from rockyade.scene.placement import RestContact
+
+if TYPE_CHECKING:  # names only: the calibration imports this module without loading the scene machinery
+    from rockyade.scene import Scene
+    from rockyade.scene.model import JointOverride
+    from rockyade.scene.placement import RestContact
 
 
 @dataclass(frozen=True)

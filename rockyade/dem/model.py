@@ -23,14 +23,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rockyade.constants import DEFAULT_TIME_STEP_FRAC
 from rockyade.dem.joints import ContactParameters, JointTable
 from rockyade.errors import InputError
-from rockyade.motion.ground import GroundMotion
-from rockyade.scene.placement import RestContact
+
+if TYPE_CHECKING:  # names only: the calibration imports this module (Eq 7) without the motions and scenes
+    from rockyade.motion.ground import GroundMotion
+    from rockyade.scene.placement import RestContact
 
 #: Default time step = min(Eq 7, STABILITY_MARGIN * stability limit).
 STABILITY_MARGIN = 0.8
