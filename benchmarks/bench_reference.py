@@ -13,7 +13,7 @@ import time
 
 import numpy as np
 
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.reference import run_many, run_model
 from rockyade.studies.common import block_table
@@ -51,8 +51,8 @@ def harmonic_scene(freq: float, amp_m: float, duration: float = 10.0):
 
 
 def single_block() -> dict[str, float]:
-    model = build_matched_model(free_scene())
-    run_model(build_matched_model(free_scene(0.1)))  # JIT warm-up
+    model = calibrated_model(free_scene())
+    run_model(calibrated_model(free_scene(0.1)))  # JIT warm-up
     out = {}
     for energy in (False, True):
         best = math.inf

@@ -29,7 +29,7 @@ import time
 import tracemalloc
 from typing import Any
 
-from rockyade.dem.build import build_dem_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.solvers.reference import run_model
 
@@ -77,7 +77,7 @@ def scene_for(n: int, motion: str = "rest", duration_s: float = 0.2) -> Scene:
 def measure(scene: Scene, repeat: int = 3) -> dict[str, float]:
     """Build and run one scene with the reference DEM: the best of ``repeat`` timed runs."""
     start = time.perf_counter()
-    model = build_dem_model(scene)
+    model = calibrated_model(scene)
     build_s = time.perf_counter() - start
     run_model(model, record_energy=False, per_corner=False)  # warm-up (and numba's cache)
     walls = []

@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import yade as yade_backend
@@ -96,7 +96,7 @@ def assembly_costs(sizes=(10, 100), duration: float = 0.3) -> list[dict[str, obj
     build = _wall_builder()
     rows = []
     for n in sizes:
-        model = build_matched_model(build(n, duration))
+        model = calibrated_model(build(n, duration))
         nb = len(model.bodies)
         row: dict[str, object] = {"blocks": nb, "steps": model.n_steps, "dt_s": model.dt_s}
         y = yade_backend.run_model(model)
@@ -131,8 +131,8 @@ def main() -> None:
             else f"reference: {row['reference_error']}"
         )
         print(f"wall of {row['blocks']} blocks, {row['steps']} steps of {row['dt_s']:.3g} s: {yade}; {ref}")
-    model = build_matched_model(scene(20.0))
-    run_model(build_matched_model(scene(0.1)), record_energy=False)  # JIT warm-up
+    model = calibrated_model(scene(20.0))
+    run_model(calibrated_model(scene(0.1)), record_energy=False)  # JIT warm-up
     ref = min(run_model(model, record_energy=False).meta["wall_time_s"] for _ in range(3))
     y = yade_backend.run_model(model)
     assert y.ok, y.meta.get("failure_reason")

@@ -109,14 +109,14 @@ def dem_time_step(scene: Scene) -> tuple[float, int]:
     and masses, not on the motion, so no motion is built); a matched calibration is
     estimated with the paper's damping (Eq 13), which the matching changes little.
     """
-    from rockyade.dem.build import build_dem_model
+    from rockyade.calibration.model import calibrated_model
     from rockyade.motion.spec import AtRest
 
     contact = scene.contact
     if contact.calibration == "matched" and contact.beta_s is None:
         contact = dataclasses.replace(contact, calibration="paper")
     at_rest = dataclasses.replace(scene, motion=AtRest(), contact=contact)
-    model = build_dem_model(at_rest)
+    model = calibrated_model(at_rest)
     moving = sum(1 for b in model.bodies if not b.fixed)
     return float(model.dt_s), moving
 

@@ -11,6 +11,9 @@ Metadata keys: ``solver``, ``version``, ``scene_hash``, ``wall_time_s`` (the sol
 itself), ``status`` (completed | overturned | failed), ``overturn_time_s``,
 ``overturned_block``, ``failure_reason``, ``blocks``, ``sample_dt_s``, and the parameters
 actually used (``contact`` for the DEMs, ``classical`` for Housner).
+
+A Result knows nothing of figures: :mod:`rockyade.figures.histories` draws it
+(``HistoryDisplay.from_result(result)``, ``plot_result(result, ax=...)``).
 """
 
 from __future__ import annotations
@@ -38,7 +41,17 @@ CSV_FLOAT_FORMAT = "%.12g"
 
 
 def column(block: str, quantity: str, blocks: list[str] | tuple[str, ...]) -> str:
-    """Column name of ``quantity`` for ``block``: bare for one block, prefixed otherwise."""
+    """Column name of ``quantity`` for ``block``: bare for one block, prefixed otherwise.
+
+    Parameters
+    ----------
+    block
+        Block name.
+    quantity
+        Per-block quantity with its unit, e.g. ``theta_rad``.
+    blocks
+        Every block of the result.
+    """
     return quantity if len(blocks) == 1 else f"{block}_{quantity}"
 
 
@@ -77,32 +90,20 @@ class Result:
         return self.frame["t_s"].to_numpy()
 
     def series(self, quantity: str, block: str | None = None) -> np.ndarray:
-        """One per-block column as an array (``block`` defaults to the only/top block)."""
+        """One per-block column as an array (``block`` defaults to the only/top block).
+
+        Parameters
+        ----------
+        quantity
+            ``theta_rad`` (rad), ``omega_rad_s`` (rad/s), ``x_m``, ``y_m`` (m), ``ax_m_s2``,
+            ``ay_m_s2`` (m/s^2), or a solver's own per-block column.
+        block
+            Block name.
+        """
         names = self.blocks
         if block is None:
             block = names[-1]
         return self.frame[column(block, quantity, names)].to_numpy()
-
-    # -------------------------------------------------------------- figures
-    def plot(
-        self,
-        quantity: str = "theta_rad",
-        ax: Any = None,
-        path: str | os.PathLike[str] | None = None,
-        label: str | None = None,
-        title: str = "",
-    ) -> tuple[Any, Any]:
-        """Plot a per-block quantity against time, one panel per block.
-
-        A thin wrapper of :func:`rockyade.figures.plot_results` (imported here, so that
-        results load without matplotlib). ``ax``: Axes to draw into (one per block), e.g.
-        to overlay several results; ``path``: PNG to write; ``label``: legend entry
-        (default: the solver). Returns ``(fig, ax)`` (``(fig, axes)`` for several blocks).
-        """
-        from rockyade.figures.histories import plot_results
-
-        name = label or str(self.meta.get("solver", "result"))
-        return plot_results({name: self}, path, title=title, quantity=quantity, ax=ax)
 
     # -------------------------------------------------------------- files
     def write(self, csv_path: str | os.PathLike[str], extra_meta: dict[str, Any] | None = None) -> Path:
@@ -114,7 +115,14 @@ class Result:
         or the new one (:meth:`read` finds the new JSON in ``.<name>.json.pending`` if the
         kill fell between the two renames). Another process writing the same result is
         refused (:func:`rockyade.io.locking.output_lock`); temporary files are removed on
-        failure. ``extra_meta`` is merged into the metadata.
+        failure.
+
+        Parameters
+        ----------
+        csv_path
+            The CSV to write; the JSON goes beside it.
+        extra_meta
+            Merged into the metadata.
         """
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
@@ -148,7 +156,18 @@ class Result:
 
     @classmethod
     def read(cls, csv_path: str | os.PathLike[str]) -> Result:
-        """Read a result pair written by :meth:`write`, verifying it is complete."""
+        """Read a result pair written by :meth:`write`, verifying it is complete.
+
+        Parameters
+        ----------
+        csv_path
+            The CSV; its JSON lies beside it.
+
+        Raises
+        ------
+        InputError
+            A missing file, or a CSV that does not match its JSON (partial or stale).
+        """
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
         if not csv_path.is_file():
@@ -168,7 +187,13 @@ class Result:
 
 
 def pending_json_path(json_path: Path) -> Path:
-    """Where :meth:`Result.write` keeps the new JSON between its two renames."""
+    """Where :meth:`Result.write` keeps the new JSON between its two renames.
+
+    Parameters
+    ----------
+    json_path
+        The result's JSON.
+    """
     return json_path.parent / f".{json_path.name}.pending"
 
 
@@ -216,6 +241,11 @@ def settle_results(directory: str | os.PathLike[str]) -> None:
     """Commit or discard the pending JSONs and remove the temporary files killed writers left.
 
     Call it only while holding the directory's lock (no writer is active there).
+
+    Parameters
+    ----------
+    directory
+        The results' directory.
     """
     directory = Path(directory)
     for pending in directory.glob(".*.json.pending"):
@@ -225,7 +255,19 @@ def settle_results(directory: str | os.PathLike[str]) -> None:
 
 
 def failed_result(solver: str, scene_hash: str, reason: str, **extra: Any) -> Result:
-    """A Result with status ``failed``, no samples, and the reason."""
+    """A Result with status ``failed``, no samples, and the reason.
+
+    Parameters
+    ----------
+    solver
+        The solver's name.
+    scene_hash
+        The scene's hash.
+    reason
+        Why it failed (``failure_reason``).
+    **extra
+        More metadata.
+    """
     meta = {
         "solver": solver,
         "scene_hash": scene_hash,

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
+from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
-from rockyade.dem.build import build_dem_model
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import housner
 from rockyade.solvers.reference import run_model, run_scene
@@ -56,7 +56,7 @@ def test_flush_stacks_converge_when_the_step_is_halved(n, amplitude_g):
     alpha = math.atan(0.3 / (0.6 * n))
     free = {"type": "free", "theta0_rad": 0.5 * alpha, "block": "b0"}
     for motion, tolerance in ((free, 0.01), (pulse(amplitude_g), 0.02)):
-        model = build_dem_model(column_scene(n, 0.3, 0.6, motion, duration=4.5 if motion is free else 3.0))
+        model = calibrated_model(column_scene(n, 0.3, 0.6, motion, duration=4.5 if motion is free else 3.0))
         coarse = run_model(model, record_energy=False, record_contacts=False)
         fine = run_model(model.with_dt(model.dt_s / 2), record_energy=False, record_contacts=False)
         for run in (coarse, fine):
@@ -155,7 +155,7 @@ def test_rocking_frame_rocks_as_one_column_with_makris_p():
             "motion": motion,
         }
     )
-    model = build_dem_model(frame)
+    model = calibrated_model(frame)
     column = model.bodies[0]
     gamma = model.bodies[2].mass_kg / (2 * column.mass_kg)
     p_hat = column.p_rad_s * math.sqrt((1 + 2 * gamma) / (1 + 3 * gamma))

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.dem.build import build_dem_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.dem.joints import default_pair_joint
 from rockyade.errors import CalibrationError, InputError
 from rockyade.scene import load_scene, scene_from_dict
@@ -101,11 +101,11 @@ def test_explicit_contact_needs_no_classical_calibration():
     """A light, squat brick: Eq 13 has no value (sqrt(b) < 0) but explicit K and beta need none."""
     light = [brick("a", 0.0, 0.0, w=0.2, h=0.05, t=0.1)]
     with pytest.raises(CalibrationError):
-        build_dem_model(scene_from_dict(scene(light)))
-    model = build_dem_model(scene_from_dict(scene(light, contact={"K_N_per_m": 1e8, "beta_s": 1e-4})))
+        calibrated_model(scene_from_dict(scene(light)))
+    model = calibrated_model(scene_from_dict(scene(light, contact={"K_N_per_m": 1e8, "beta_s": 1e-4})))
     joint = model.joints.params[0]
     assert joint.K_N_per_m == 1e8 and joint.beta_s == 1e-4 and joint.method == "explicit"
-    model = build_dem_model(scene_from_dict(scene(light, contact={"calibration": "paper", "beta_s": 1e-4})))
+    model = calibrated_model(scene_from_dict(scene(light, contact={"calibration": "paper", "beta_s": 1e-4})))
     assert model.joints.params[0].beta_s == 1e-4  # the paper's K with an explicit beta: Eq 13 not needed
 
 
@@ -115,7 +115,7 @@ def test_joint_rules_bed_head_base_fixed():
     blocks[1]["density_kg_m3"] = 1000.0  # the softer of the two lower bricks (K ~ mass)
     blocks.append(brick("wall", 1.0, 0.0, w=0.2, h=0.6, fixed=True))
     blocks.append(brick("top", 0.75, 0.2, w=0.3, h=0.2))  # on c0_b, beside c1_m, against the fixed wall
-    model = build_dem_model(scene_from_dict(scene(blocks)))
+    model = calibrated_model(scene_from_dict(scene(blocks)))
     J = model.joints
     names = model.names
     idx = {n: i for i, n in enumerate(names)}
@@ -140,7 +140,7 @@ def test_joint_rules_bed_head_base_fixed():
 
 def test_udec_stiffness_per_area_and_overrides():
     jkn = 1e10  # Pa/m
-    model = build_dem_model(
+    model = calibrated_model(
         scene_from_dict(
             scene(
                 running_bond(),
@@ -177,7 +177,7 @@ def test_udec_needs_beta_and_not_both_stiffnesses():
 def test_statics_flush_stack_and_settlement_refusal():
     """Two equal blocks corner to corner: one joint (K per end), equal load at both ends."""
     stack = [brick("low", 0.0, 0.0, w=0.3, h=0.6), brick("up", 0.0, 0.6, w=0.3, h=0.6)]
-    model = build_dem_model(scene_from_dict(scene(stack)))
+    model = calibrated_model(scene_from_dict(scene(stack)))
     beds = [c for c in model.rest_contacts if c.b >= 0]
     assert len(beds) == 1 and beds[0].length_m == pytest.approx(0.3)
     weight = model.bodies[1].mass_kg * 9.81
@@ -190,7 +190,7 @@ def test_statics_flush_stack_and_settlement_refusal():
     joint_pen = pen[springs.contact[springs.normal] == model.rest_contacts.index(beds[0])]
     assert joint_pen == pytest.approx([weight / (2 * k)] * 2, rel=1e-9)
     with pytest.raises(InputError) as info:
-        build_dem_model(scene_from_dict(scene(stack, contact={"calibration": "paper", "stiffness_scale": "N/m"})))
+        calibrated_model(scene_from_dict(scene(stack, contact={"calibration": "paper", "stiffness_scale": "N/m"})))
     assert "sink" in str(info.value)
 
 
@@ -199,7 +199,8 @@ def test_free_rocking_in_an_assembly_tilts_the_block_and_what_rests_on_it():
     with pytest.raises(InputError) as info:
         scene_from_dict(scene(blocks, motion={"type": "free", "theta0_rad": 0.05}))
     assert info.value.field == "motion.block"
-    model = build_dem_model(scene_from_dict(scene(blocks, motion={"type": "free", "theta0_rad": 0.05, "block": "low"})))
+    released = scene(blocks, motion={"type": "free", "theta0_rad": 0.05, "block": "low"})
+    model = calibrated_model(scene_from_dict(released))
     assert model.ang0_rad.tolist() == [0.05, 0.05, 0.0]
     # both tilted about low's left base corner (-0.15, 0)
     r = model.pos0_m[1] - np.array([-0.15, 0.0])
@@ -207,7 +208,7 @@ def test_free_rocking_in_an_assembly_tilts_the_block_and_what_rests_on_it():
 
 
 def test_default_rule_matches_joint_for():
-    model = build_dem_model(scene_from_dict(scene(running_bond(3))))
+    model = calibrated_model(scene_from_dict(scene(running_bond(3))))
     J = model.joints
     for a in range(len(model.bodies)):
         for b in range(a + 1, len(model.bodies)):
@@ -224,5 +225,5 @@ def test_column_scenes_unchanged():
     for b in d["blocks"]:
         assert "position_m" not in b and "rotation_rad" not in b and "fixed" not in b
     assert "joints" not in d
-    model = build_dem_model(s)
+    model = calibrated_model(s)
     assert model.joints.pair_kind == ("bed",) and model.joints.n_pairs == 1

@@ -17,10 +17,10 @@ from rockyade.calibration.equations import (
     stiffness_eq8,
     stiffness_eq9,
     stiffness_eq10,
-    time_step_eq7,
     xi_min_eq15,
 )
 from rockyade.constants import G
+from rockyade.dem.model import time_step_eq7
 from rockyade.errors import CalibrationError, InputError
 
 
@@ -97,3 +97,32 @@ def test_table6_biblock_parameters():
         cal = paper_calibration(spec.block(), **spec.experimental)
         assert 2 * cal.b_eq_m == pytest.approx(paper.table(6).loc[key, "base_eq_2b_m"], abs=0.005)
         assert cal.K_paper == pytest.approx(paper.table(6).loc[key, "K_paper_N_per_m"], rel=0.03)
+
+
+@pytest.mark.parametrize(
+    ("contact", "method"),
+    [
+        ({"calibration": "paper"}, "paper"),
+        ({"calibration": "paper", "K_N_per_m": 5e9, "Ks_N_per_m": 2e9}, "paper"),
+        ({"calibration": "matched", "beta_s": 1e-4}, "paper"),
+        ({"K_N_per_m": 5e9, "beta_s": 1e-4}, "explicit"),
+        ({"jkn_Pa_per_m": 4e10, "beta_s": 1e-4}, "udec"),
+    ],
+    ids=["paper", "explicit K and Ks", "explicit beta", "explicit", "udec"],
+)
+def test_calibrate_gives_the_joint_the_model_runs(contact, method):
+    """One dispatch: the joint that calibrate() returns for a block is the one the model built
+    from its scene runs (the model is handed the joints, it calibrates nothing)."""
+    from rockyade.calibration.calibrate import calibrate, calibration_method
+    from rockyade.calibration.model import calibrated_model
+    from rockyade.scene import scene_from_dict
+
+    from .conftest import free_scene_dict
+
+    d = free_scene_dict()
+    d["contact"] = contact
+    scene = scene_from_dict(d)
+    spec = scene.blocks[0]
+    cal = calibrate(spec.block(), scene.contact, alpha_rad=spec.alpha_rad, p_rad_s=spec.p_rad_s, mu=spec.mu)
+    assert repr(calibrated_model(scene).bodies[0].joint) == repr(cal.joint)
+    assert cal.method == calibration_method(scene.contact) == method

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.dem.build import build_dem_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.dem.engine import model_arrays, polygon_arrays, simulate_model
 from rockyade.dem.overturn import LANDING_TOL_RAD
 from rockyade.dem.statics import rest_springs, static_penetration
@@ -163,7 +163,7 @@ def test_flush_stack_at_rest_splits_as_statics():
     """Two equal blocks, flush: each corner of the bed joint carries half the upper weight
     (within 1 %, and as the linear statics says); offset by 3 cm the split follows the
     statics too (both corners stay closed)."""
-    model = build_dem_model(scene([block("lower", 0.2, 0.6), block("upper", 0.2, 0.6)], duration=1.0))
+    model = calibrated_model(scene([block("lower", 0.2, 0.6), block("upper", 0.2, 0.6)], duration=1.0))
     result = run_model(model, record_energy=False)
     forces = bed_forces(model, result, 0, 1)
     weight = model.bodies[1].mass_kg * model.g
@@ -177,7 +177,7 @@ def test_flush_stack_at_rest_splits_as_statics():
     assert states == {**dict.fromkeys(states, "stick"), "upper_c2": "open", "upper_c3": "open"}
 
     offset = scene([block("lower", 0.2, 0.6, 0.0, 0.0), block("upper", 0.2, 0.6, 0.03, 0.6)], duration=1.0)
-    model = build_dem_model(offset)
+    model = calibrated_model(offset)
     result = run_model(model, record_energy=False, per_corner=False)
     forces = bed_forces(model, result, 0, 1)
     expected = statics_forces(model, (0, 1))  # from the left end to the right end of the joint
@@ -219,7 +219,7 @@ def test_kernel_joint_lookup_is_the_joint_table_rule():
         block("e", 0.2, 0.3, 2.0, 0.0, density_kg_m3=1800.0),
     ]
     joints = [{"blocks": ["c", "b"], "K_N_per_m": 3e7}]
-    model = build_dem_model(scene(blocks, joints=joints))
+    model = calibrated_model(scene(blocks, joints=joints))
     table = model.joints
     args = model_arrays(model)
     nb = len(model.bodies)
@@ -259,7 +259,7 @@ def test_pad_case_keeps_overlaps_below_a_millimetre():
     pad, lands on the lower block beside it (a pair that did not touch at rest) and kicks
     the pad out; no two bodies ever overlap by more than 1 mm."""
     sc = scene(PAD_BLOCKS, motion=PAD_PULSE, contact=EXPLICIT, duration=2.0, sample_dt=0.002)
-    model = build_dem_model(sc)
+    model = calibrated_model(sc)
     result = run_scene(sc)
     assert result.status == "completed"
     theta = result.series("theta_rad", "upper")
@@ -282,7 +282,7 @@ def test_broad_phase_and_coherence_do_not_change_the_results():
     """The pad case (rebuilds, a pair meeting in motion, a pad in flight): the same bits
     with every pair tested every step, and with every pair of bodies in the candidate list."""
     sc = scene(PAD_BLOCKS, motion=PAD_PULSE, contact=EXPLICIT, duration=1.4, sample_dt=0.002)
-    model = build_dem_model(sc)
+    model = calibrated_model(sc)
     args = model_arrays(model)
     flags = {"stop_on_overturn": True, "record_energy": False, "record_corners": False}
     runs = {
@@ -315,5 +315,5 @@ def test_assembly_runs_on_when_a_block_falls():
     column = scene([block("slender", 0.1, 1.0)], motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002)
     stopped = run_scene(column)
     assert stopped.status == "overturned" and stopped.meta["overturn_time_s"] == pytest.approx(t_fall, abs=1e-9)
-    out, _ = simulate_model(build_dem_model(column), False, stop_angle_rad=np.array([0.5]))
+    out, _ = simulate_model(calibrated_model(column), False, stop_angle_rad=np.array([0.5]))
     assert out.status == kernel.STATUS_OVERTURNED and out.t_stop < t_fall

@@ -1,5 +1,6 @@
 """The plotting API works in a notebook: no backend switch on import, (fig, ax) returned,
-``ax=`` honoured, files written without pyplot, ``Result.plot``."""
+``ax=`` honoured, files written without pyplot, a Result drawn by ``plot_result`` and
+``HistoryDisplay``."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from rockyade.errors import InputError
-from rockyade.figures import plot_accelerogram, plot_results, plot_spectra
+from rockyade.figures import HistoryDisplay, plot_accelerogram, plot_result, plot_results, plot_spectra
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import run
 
@@ -46,25 +47,39 @@ def test_writing_a_file_leaves_pyplot_alone(tmp_path, housner_result):
     assert (tmp_path / "r.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
-def test_result_plot_draws_into_the_axes_it_is_given(housner_result):
+def test_plot_result_draws_into_the_axes_it_is_given(housner_result):
     fig = Figure()
     ax = fig.subplots()
-    out_fig, out_ax = housner_result.plot(ax=ax, label="exact")
-    housner_result.plot(ax=ax, quantity="omega_rad_s", label="rate")
+    out_fig, out_ax = plot_result(housner_result, ax=ax, label="exact")
+    plot_result(housner_result, ax=ax, quantity="omega_rad_s", label="rate")
     assert out_fig is fig and out_ax is ax
     assert [line.get_label() for line in ax.lines if not line.get_label().startswith("_")] == ["exact", "rate"]
     np.testing.assert_array_equal(ax.lines[0].get_ydata(), housner_result.series("theta_rad"))
 
 
-def test_result_plot_without_axes_returns_a_pyplot_figure(housner_result):
+def test_plot_result_without_axes_returns_a_pyplot_figure(housner_result):
     """In a notebook (no ax, no file) the figure comes from pyplot, so it shows inline."""
     import matplotlib.pyplot as plt
 
-    fig, ax = housner_result.plot()
+    fig, ax = plot_result(housner_result)
     try:
         assert fig.number in plt.get_fignums() and ax.get_ylabel() == "specimen1: theta (rad)"
     finally:
         plt.close(fig)
+
+
+def test_history_display_keeps_what_it_drew_and_draws_again(housner_result, tmp_path):
+    """As scikit-learn's displays: built from a result it draws at once (``figure_``,
+    ``ax_``); ``plot`` draws the same curves elsewhere, and a path writes a PNG."""
+    first = Figure().subplots()
+    display = HistoryDisplay.from_result(housner_result, quantity="omega_rad_s", label="exact", ax=first)
+    assert display.ax_ is first and display.figure_ is first.figure
+    np.testing.assert_array_equal(first.lines[0].get_ydata(), housner_result.series("omega_rad_s"))
+    second = Figure().subplots()
+    assert display.plot(second, path=tmp_path / "h.png") is display
+    assert display.ax_ is second and second.get_ylabel() == "specimen1: omega_rad_s"
+    assert [line.get_label() for line in second.lines if not line.get_label().startswith("_")] == ["exact"]
+    assert (tmp_path / "h.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
 def test_motion_plots_accept_axes_and_return_them(tmp_path):
@@ -85,4 +100,4 @@ def test_wrong_number_of_axes_is_an_input_error(housner_result):
     with pytest.raises(InputError, match="ax: must be 3 matplotlib Axes"):
         plot_accelerogram([0, 1], [0, 1], [0, 1], [0, 1], ax=fig.subplots(1, 2))
     with pytest.raises(InputError, match="ax: must be 1 matplotlib Axes"):
-        housner_result.plot(ax=fig.subplots(1, 2))
+        plot_result(housner_result, ax=fig.subplots(1, 2))

@@ -3,21 +3,26 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.calibration.matched import build_matched_model, match_beta
+from rockyade.calibration.calibrate import calibrate
+from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
 from rockyade.errors import CalibrationError, InputError
-from rockyade.scene import load_scene, scene_from_dict
+from rockyade.scene import ContactSpec, load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.solvers.reference import run_many, run_model
 
 from .conftest import EXAMPLES
+
+#: The matched calibration of a block (``calibrate(block, MATCHED, ...).matched``).
+MATCHED = ContactSpec(calibration="matched")
 
 
 def _matched(example: str):
@@ -77,7 +82,7 @@ def test_energy_balance(free_rocking):
         assert error < 0.01
     else:
         assert error < 0.035
-        model = build_matched_model(scene)
+        model = calibrated_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2))
         finer_error = finer.meta["energy_balance_max_error_J"] / pe0
         assert finer_error < 0.02
@@ -154,7 +159,7 @@ def test_biblock_upper_block_matches_housner():
     assert np.max(np.abs(stack.series("theta_rad", "lower")[before])) < 1e-5
 
     upper = paper.specimen("upper")
-    beta = match_beta(upper.block(), **upper.experimental).beta_s
+    beta = calibrate(upper.block(), MATCHED, **upper.experimental).matched.beta_s
     d_rigid = scene.to_dict()
     d_rigid["blocks"][0]["mass_kg"] = 204_000
     d_rigid["contact"]["beta_s"] = beta
@@ -168,7 +173,7 @@ def test_results_converge_with_the_time_step():
     """Halving Eq 7's step: the first peak and the peak times change by < 0.5 %; the
     decay per impact changes by ~0.2 % (contact switching is first order in dt)."""
     scene = _matched("specimen1_free.toml")
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     a = run_model(model)
     b = run_model(model.with_dt(model.dt_s / 2))
     pa, pb = _peaks(a, alpha=0.235), _peaks(b, alpha=0.235)
@@ -181,13 +186,13 @@ def test_results_converge_with_the_time_step():
 
 def test_user_time_step_above_stability_limit_refused():
     d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
-    model = build_matched_model(scene_from_dict(d))
+    model = calibrated_model(scene_from_dict(d))
     d["contact"]["dt_s"] = 1.5 * model.dt_stable_s
     with pytest.raises(InputError) as info:
-        build_matched_model(scene_from_dict(d))
+        calibrated_model(scene_from_dict(d))
     assert info.value.field == "contact.dt_s" and "stability limit" in str(info.value)
     d["contact"]["dt_s"] = 0.5 * model.dt_stable_s
-    assert build_matched_model(scene_from_dict(d)).dt_source == "user"
+    assert calibrated_model(scene_from_dict(d)).dt_source == "user"
 
 
 def test_stability_limit_is_real():
@@ -205,7 +210,7 @@ def test_stability_limit_is_real():
         "accel_m_s2": [0.0, 0.0, 0.0],
         "accel_v_m_s2": [0.0, 98.1, 98.1],
     }
-    model = build_matched_model(scene_from_dict(d))
+    model = calibrated_model(scene_from_dict(d))
     limit = model.dt_stable_s
 
     def max_theta(steps: int) -> float:
@@ -222,7 +227,9 @@ def test_stability_limit_of_a_single_spring_matches_closed_form():
     """One block on its two base corners: the analysis reduces to known modes; with no
     damping the limit is 2 / w_max."""
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
-    model = build_dem_model(scene, beta_override=0.0)
+    b = scene.blocks[0]
+    joint = calibrate(b.block(), scene.contact, alpha_rad=b.alpha_rad, p_rad_s=b.p_rad_s, mu=b.mu).joint
+    model = build_dem_model(scene, [replace(joint, beta_s=0.0)])
     limit, w_max = model.dt_stable_s, model.w_max_rad_s
     assert limit == pytest.approx(2.0 / w_max)
     k = model.bodies[0].joint.K_N_per_m
@@ -240,7 +247,7 @@ def test_contact_polygon_uses_equivalent_base():
 
 def test_matched_beta_reports_range_and_eq13():
     s = paper.specimen(1)
-    m = match_beta(s.block(), **s.experimental)
+    m = calibrate(s.block(), MATCHED, **s.experimental).matched
     assert m.mu_min < 0.936 < m.mu_max
     assert m.mu_eff == pytest.approx(0.936, rel=0.002)
     assert m.beta_eq13_s == pytest.approx(1.98e-4, rel=3e-3)
@@ -252,7 +259,7 @@ def test_unreachable_target_fails_clearly():
     reaches even without damping: matching must fail and give the range."""
     s = paper.specimen("lower")
     with pytest.raises(CalibrationError, match="above what the DEM reaches without damping"):
-        match_beta(s.block(), **s.experimental)
+        calibrate(s.block(), MATCHED, **s.experimental)
 
 
 def test_every_example_runs(examples_dir):
@@ -345,7 +352,7 @@ def test_run_compare_and_the_matched_calibration_count_the_same_impacts():
     impacts, compare 0.91955 over 4, the matched calibration 4)."""
     from rockyade.analysis.compare import compare
     from rockyade.analysis.metrics import run_metrics
-    from rockyade.calibration import matched as matching
+    from rockyade.calibration import matching
 
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
     dem = reference.run_scene(scene)

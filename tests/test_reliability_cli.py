@@ -58,6 +58,22 @@ def test_params_json_imports_neither_pandas_nor_the_solvers():
     assert proc.stdout.strip() == "[]"
 
 
+def test_calibrate_json_imports_neither_numba_nor_the_motions():
+    """The paper's calibration is arithmetic: the one calibrate() takes a scene's ContactSpec,
+    which must not load the motion types (scipy, numba); only a matched one runs the DEM."""
+    proc = _python(
+        """
+        import sys, io, contextlib
+        from rockyade.cli import main
+        with contextlib.redirect_stdout(io.StringIO()):
+            assert main(["calibrate", "--specimen", "1", "--json"]) == 0
+        print(sorted(m for m in ("scipy", "numba", "pandas", "matplotlib", "rockyade.motion") if m in sys.modules))
+        """
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == "[]"
+
+
 def test_solver_names_of_the_parser_are_the_registry_s():
     from rockyade.cli.common import SOLVER_NAMES
     from rockyade.solvers import solver_names

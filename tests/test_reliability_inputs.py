@@ -170,13 +170,13 @@ def _long(duration: float, sample_dt: float, **contact) -> dict:
 
 
 def test_cost_estimate_of_an_example_matches_the_model():
-    from rockyade.dem.build import build_dem_model
+    from rockyade.calibration.model import calibrated_model
 
     d = load_scene(EXAMPLES / "specimen1_harmonic.toml").to_dict()
     d["contact"]["calibration"] = "paper"
     scene = scene_from_dict(d)
     est = estimate_cost(scene, "reference")
-    model = build_dem_model(scene)
+    model = calibrated_model(scene)
     assert est.integration_steps == model.n_steps
     assert est.motion_samples == model.motion.t_s.size
     assert est.output_samples == scene.n_samples and not est.over_limits()

@@ -23,15 +23,19 @@ import pytest
 
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.calibration.matched import build_matched_model, match_beta
+from rockyade.calibration.calibrate import calibrate
+from rockyade.calibration.model import calibrated_model
 from rockyade.result import Result
-from rockyade.scene import load_scene, scene_from_dict
+from rockyade.scene import ContactSpec, load_scene, scene_from_dict
 from rockyade.solvers import housner, reference
 from rockyade.solvers import yade as yade_backend
 from rockyade.yade import payload as yade_payload
 
 from .conftest import EXAMPLES
 from .processes import alive, descendants, require_yade
+
+#: The matched calibration of a block (``calibrate(block, MATCHED, ...).matched``).
+MATCHED = ContactSpec(calibration="matched")
 
 PROBES = Path(__file__).parent / "yade_probes"
 
@@ -81,7 +85,7 @@ def test_pitfall_default_damping():
 
 
 def _describe(scene, tmp_path) -> tuple[dict, object]:
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     path = tmp_path / "scene.yade.json"
     path.write_text(json.dumps(yade_payload.scene_payload(model)))
     out = subprocess.run(
@@ -200,7 +204,7 @@ def test_yade_run_listens_on_no_port(tmp_path):
     """A rockyade YADE run opens no listening socket; the same check finds the two servers
     that the stock ``yade`` launcher opens (so the check can fail)."""
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 8.0})
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     path = tmp_path / "s.yade.json"
     path.write_text(json.dumps(yade_payload.scene_payload(model)))
     ours, samples = _listening_while_running(
@@ -245,7 +249,7 @@ def test_free_rocking_yade_vs_reference(free_rocking):
     else:
         from rockyade.solvers.reference import run_model
 
-        model = build_matched_model(scene)
+        model = calibrated_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2), record_energy=False)
         pf = find_peaks(finer.t, finer.series("theta_rad"), 1e-3 * alpha)
         own = np.max(np.abs(pf.amplitude_rad[:5] / pr.amplitude_rad[:5] - 1))
@@ -337,7 +341,7 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
 def test_instability_inside_yade_gives_failed_result(tmp_path):
     """A time step far above the stability limit (forced past rockyade's own check) makes
     the state non-finite: status failed, with the reason."""
-    model = build_matched_model(
+    model = calibrated_model(
         scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 0.5})
     )
     steps = max(1, math.floor(model.sample_dt_s / (20 * model.dt_stable_s)))
@@ -357,7 +361,7 @@ def test_timeout_gives_failed_result(tmp_path):
 
 
 def test_partial_output_is_not_a_result(tmp_path):
-    model = build_matched_model(load_scene(EXAMPLES / "specimen1_free.toml"))
+    model = calibrated_model(load_scene(EXAMPLES / "specimen1_free.toml"))
     good = yade_backend.run_model(model, workdir=tmp_path, name="ok")
     assert good.ok
     npz = tmp_path / "ok.yade.npz"
@@ -428,9 +432,9 @@ def test_cli_compare_three_solvers(tmp_path, capsys):
 
 def test_matched_beta_comes_from_the_reference_dem():
     scene = _matched("specimen1_free.toml")
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     s = paper.specimen(1)
-    assert model.bodies[0].joint.beta_s == pytest.approx(match_beta(s.block(), **s.experimental).beta_s)
+    assert model.bodies[0].joint.beta_s == pytest.approx(calibrate(s.block(), MATCHED, **s.experimental).matched.beta_s)
     assert model.bodies[0].joint.method == "matched"
 
 
@@ -484,7 +488,7 @@ def test_cli_batch_with_relative_out(tmp_path, monkeypatch, capsys):
 
 
 def test_default_timeout_grows_with_the_work_and_is_capped():
-    model = build_matched_model(load_scene(EXAMPLES / "specimen1_free.toml"))
+    model = calibrated_model(load_scene(EXAMPLES / "specimen1_free.toml"))
     short = yade_backend.default_timeout(model)
     assert short == pytest.approx(yade_backend.TIMEOUT_STARTUP_S + yade_backend.TIMEOUT_PER_BODY_STEP_S * model.n_steps)
     longer = replace(model, n_samples=10 * model.n_samples)
@@ -553,7 +557,7 @@ def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
     )
     assert proc.returncode == 0, proc.stdout + proc.stderr
     scene = load_scene(Path("s3.json"))
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     by_hand = yade_backend._parse(model, Path("by_hand/result.npz"), None, Path("none.log"), 0.0, None)
     backend = yade_backend.run_scene(scene)
     assert by_hand.ok and backend.ok

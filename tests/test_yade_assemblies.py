@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
@@ -139,7 +139,7 @@ def test_plan_gives_every_pair_its_joint_up_to_30_blocks():
     under half units differ from full ones): every vertex meets every other block and the
     base with exactly the reference DEM's joint, halved at flush ends; the report says 0."""
     scene = running_bond(contact={"jkn_Pa_per_m": 1e11, "beta_s": 5e-5, "friction_angle_deg": 35.0})
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     assert len({p.K_N_per_m for p in model.joints.params}) >= 2
     wanted, used, report = _wanted_and_used(model)
     assert wanted == used
@@ -153,7 +153,7 @@ def test_plan_beyond_30_blocks_never_lets_a_block_through():
     only pairs that differ are a flush-end vertex meeting, in motion, a block that shares its
     flush partner's label (K/2 instead of K): the report counts them exactly, and they are
     at least two units apart at rest."""
-    model = build_matched_model(running_bond(courses=8, units=5))
+    model = calibrated_model(running_bond(courses=8, units=5))
     assert len(model.bodies) > N_LABELS
     wanted, used, report = _wanted_and_used(model)
     assert all(u is not None for w, u in zip(wanted, used, strict=True) if w is not None)
@@ -168,7 +168,7 @@ def test_plan_reports_the_pairs_that_differ_beyond_30_blocks():
     """With joints that differ per pair beyond 30 blocks, the report counts exactly the
     (vertex, block) pairs whose joint differs, all among pairs that do not touch at rest."""
     scene = running_bond(courses=8, units=5, contact={"jkn_Pa_per_m": 1e11, "beta_s": 5e-5})
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     wanted, used, report = _wanted_and_used(model)
     assert all(u is not None for w, u in zip(wanted, used, strict=True) if w is not None)
     differ = sum(w != u for w, u in zip(wanted, used, strict=True))
@@ -181,7 +181,7 @@ def test_plan_reports_the_pairs_that_differ_beyond_30_blocks():
 def test_sphere_places():
     """Base corners rest on the exact corner (tangent to the base), head-joint corners are
     inscribed (no sphere pokes into a neighbour), and each vertex has one radius of play."""
-    model = build_matched_model(running_bond(courses=1, units=2))
+    model = calibrated_model(running_bond(courses=1, units=2))
     payload = scene_payload(model)
     r = payload["min_sphere_radius_m"]
     left = payload["bodies"][0]
@@ -231,7 +231,7 @@ def test_flush_stack_is_one_joint_per_interface():
     so the load splits as the statics say (equal corners within 1 %), with YADE's reported
     normal forces; each interface carries the weight above it."""
     scene = flush_stack(3)
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     result = yade_backend.run_scene(scene)
     assert result.ok, result.meta.get("failure_reason")
     statics = _statics_end_forces(model)
@@ -251,7 +251,7 @@ def test_frame_at_rest_splits_its_load_as_the_statics():
     statics' (rest springs), within 2 % (YADE's inscribed corner spheres sit one sphere
     radius from the joint ends)."""
     scene = frame()
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     result = yade_backend.run_scene(scene)
     assert result.ok, result.meta.get("failure_reason")
     statics = _statics_end_forces(model)
@@ -264,7 +264,7 @@ def test_pad_case_blocks_do_not_pass_through_each_other():
     neighbour at rest): YADE keeps the overlap of any two blocks below 1 mm (the old
     backend let it sink 117 mm)."""
     scene = pad_case()
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     result = yade_backend.run_scene(scene)
     assert result.ok, result.meta.get("failure_reason")
     worst = _max_overlap(model, result)
@@ -351,7 +351,7 @@ def test_frame_rocks_like_one_column_with_p_hat():
     Under a one-sine pulse YADE's frame and Housner's column (p_hat, the column's alpha) reach
     the same first peak within 3 % and the first impact within 2 %."""
     scene, alpha = _frame_pulse()
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     columns, beam = model.bodies[:2], model.bodies[2]
     gamma = beam.mass_kg / sum(c.mass_kg for c in columns)
     p_hat = columns[0].p_rad_s * math.sqrt((1 + 2 * gamma) / (1 + 3 * gamma))
@@ -426,7 +426,7 @@ def _compare_with_reference(scene, names, alpha, floors):
     reason = _reference_runs_assemblies()
     if reason:
         pytest.skip(reason)
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     ref, ref_half = _dt_halved(lambda m: reference.run_model(m, record_energy=False), model)
     yade, yade_half = _dt_halved(yade_backend.run_model, model)
     for r in (ref, ref_half, yade, yade_half):

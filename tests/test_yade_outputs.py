@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rockyade.analysis.collapse import collapse_report
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import reference
 from rockyade.solvers import yade as yade_backend
@@ -53,7 +53,7 @@ def test_spinning_block_has_a_continuous_rotation(spin_rad_s, sample_dt_s):
             "motion": {"type": "rest"},
         }
     )
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     pos0 = model.pos0_m.copy()
     pos0[0, 1] += 10.0  # falls 4.9 m in 1 s: never lands
     model = replace(model, pos0_m=pos0, angvel0_rad_s=np.array([spin_rad_s]), stop_on_overturn=False)

@@ -2,7 +2,7 @@
 
     python examples/gallery/free_rocking_overlay.py [OUT_DIR]
 
-The same lines work in a notebook (the figure then shows inline): ``Result.plot`` draws
+The same lines work in a notebook (the figure then shows inline): ``plot_result`` draws
 into the Axes it is given, so several results share one plot.
 """
 
@@ -12,6 +12,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 
 from rockyade.analysis import effective_restitution, find_peaks
+from rockyade.figures import plot_result
 from rockyade.scene import load_scene
 from rockyade.solvers import run
 
@@ -25,7 +26,7 @@ for solver in ("housner", "reference"):
     result = run(scene, solver=solver)
     peaks = find_peaks(result.t, result.series("theta_rad"))
     mu = effective_restitution(peaks, alpha=scene.blocks[0].alpha_rad, n_impacts=4)
-    result.plot(ax=ax, label=f"{solver}: effective mu {mu:.3f}")
+    plot_result(result, ax=ax, label=f"{solver}: effective mu {mu:.3f}")
 ax.set_title("Specimen 1 released at 0.1175 rad (alpha / 2)")
 fig.savefig(out / "free_rocking_overlay.png", dpi=110, bbox_inches="tight")
 print(f"wrote {out / 'free_rocking_overlay.png'}")

@@ -38,6 +38,7 @@ from numpy.typing import NDArray
 
 from rockyade.dem.overturn import LANDING_TOL_RAD, landing_angles
 from rockyade.result import Result
+from rockyade.scene import Scene
 
 STATES = ("rest", "rocking", "sliding", "fallen", "carried")
 REST, ROCKING, SLIDING, FALLEN, CARRIED = range(5)
@@ -81,9 +82,17 @@ class BlockGeometry:
     base_mid_m: tuple[float, float]
 
 
-def block_geometry(scene, result: Result) -> list[BlockGeometry]:
-    """Geometry of the moving blocks, from the DEM's bodies in the result when it has them
-    (both DEMs record them), else from the scene (Housner: the block's own polygon)."""
+def block_geometry(scene: Scene, result: Result) -> list[BlockGeometry]:
+    """Geometry of the moving blocks (lengths in m, angles in rad), from the DEM's bodies in
+    the result when it has them (both DEMs record them), else from the scene (Housner: the
+    block's own polygon).
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result`` (its blocks, bottom to top).
+    result
+        The run's Result (any solver)."""
     bodies = result.meta.get("bodies") or {}
     out = []
     for spec in scene.blocks:
@@ -107,8 +116,15 @@ def _series(result: Result, quantity: str, name: str) -> NDArray[np.float64]:
     return np.asarray(result.series(quantity, name), dtype=float)
 
 
-def block_states(scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
-    """(n_samples, n_moving) state codes (see module docstring) and the blocks' geometry."""
+def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
+    """(n_samples, n_moving) state codes (see module docstring) and the blocks' geometry.
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result`` (its blocks, bottom to top).
+    result
+        The run's Result (any solver)."""
     geometry = block_geometry(scene, result)
     t = result.t
     n = t.size
@@ -227,13 +243,20 @@ def _fallen_mask(
     return mask
 
 
-def collapse_report(scene, result: Result) -> pd.DataFrame:
+def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
     """One row per moving block: whether and when it fell, time spent rocking and sliding,
     peak and residual rotation and displacement.
 
     Columns: ``block``, ``fell``, ``fall_time_s``, ``tipped_time_s``, ``max_abs_theta_rad``,
     ``max_theta_over_alpha``, ``residual_theta_rad``, ``residual_x_m``, ``residual_y_m``,
     ``rocking_time_s``, ``sliding_time_s``, ``final_state``.
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result`` (its blocks, bottom to top).
+    result
+        The run's Result (any solver).
     """
     states, geometry = block_states(scene, result)
     t = result.t
@@ -264,8 +287,15 @@ def collapse_report(scene, result: Result) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def state_frame(scene, result: Result) -> pd.DataFrame:
-    """The states as a DataFrame: ``t_s`` and one categorical column per moving block."""
+def state_frame(scene: Scene, result: Result) -> pd.DataFrame:
+    """The states as a DataFrame: ``t_s`` (s) and one categorical column per moving block.
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result`` (its blocks, bottom to top).
+    result
+        The run's Result (any solver)."""
     states, geometry = block_states(scene, result)
     data: dict[str, object] = {"t_s": result.t}
     for j, g in enumerate(geometry):

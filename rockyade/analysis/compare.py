@@ -39,7 +39,15 @@ def _metrics(scene: Scene, result: Result, block: str, alpha: float) -> dict[str
 
 
 def rms_difference(a: Result, b: Result, block: str) -> float:
-    """RMS of theta_a - theta_b over the samples both results have, rad."""
+    """RMS of theta_a - theta_b over the samples both results have, rad.
+
+    Parameters
+    ----------
+    a, b
+        The two results (sampled alike).
+    block
+        The block compared; NaN when either result lacks it.
+    """
     n = min(len(a.frame), len(b.frame))
     if n == 0 or block not in a.blocks or block not in b.blocks:
         return math.nan

@@ -7,9 +7,11 @@ import math
 import numpy as np
 
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
+from rockyade.result import Result
+from rockyade.scene import Scene
 
 
-def run_metrics(scene, result, n_impacts: int = MU_EFF_IMPACTS) -> dict[str, dict[str, float]]:
+def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -> dict[str, dict[str, float]]:
     """Per-block summary of a run: peaks, max |theta|, effective mu, overturn.
 
     Parameters
@@ -59,12 +61,20 @@ def run_metrics(scene, result, n_impacts: int = MU_EFF_IMPACTS) -> dict[str, dic
 PER_BLOCK_LIMIT = 10
 
 
-def assembly_metrics(scene, result) -> dict[str, float]:
+def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | str]:
     """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
     ``n_blocks``, ``n_fallen``, ``fallen_fraction``, ``first_fall_time_s``, ``first_fallen_block``,
     ``max_abs_theta_rad`` and its block, ``max_residual_displacement_m`` (at the end of the
     run) and its block, ``n_moving_at_end`` (blocks whose final state is not rest or fallen:
-    their "residual" values are where they were when the run ended, not where they stopped)."""
+    their "residual" values are where they were when the run ended, not where they stopped).
+    Times in s, angles in rad, displacements in m.
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result`` (its blocks, bottom to top).
+    result
+        The run's Result (any solver)."""
     from rockyade.analysis.collapse import collapse_report
 
     report = collapse_report(scene, result)

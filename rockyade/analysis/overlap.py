@@ -37,7 +37,20 @@ class Overlap:
 
 
 def polygons_at(result: Result, k: int) -> dict[str, np.ndarray]:
-    """Every body's contact polygon in the base frame at sample ``k`` (from the result's bodies)."""
+    """Every body's contact polygon in the base frame at sample ``k`` (from the result's bodies).
+
+    Parameters
+    ----------
+    result
+        A DEM result (its metadata records the bodies).
+    k
+        Sample index.
+
+    Returns
+    -------
+    dict
+        Body name -> (n, 2) vertices, m.
+    """
     out = {}
     for name, body in result.meta["bodies"].items():
         verts = np.asarray(body["contact_vertices_m"], dtype=float)
@@ -52,7 +65,15 @@ def polygons_at(result: Result, k: int) -> dict[str, np.ndarray]:
 
 
 def max_overlap(result: Result, every: int = 1) -> Overlap:
-    """The deepest overlap over the run's samples (every ``every``-th sample)."""
+    """The deepest overlap over the run's samples (every ``every``-th sample).
+
+    Parameters
+    ----------
+    result
+        A DEM result (its metadata records the bodies).
+    every
+        Stride over the samples (1: every sample).
+    """
     worst = Overlap(0.0, ("", ""), 0.0)
     for k in range(0, len(result.t), every):
         polys = polygons_at(result, k)

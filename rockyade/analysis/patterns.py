@@ -57,7 +57,15 @@ class PatternReport:
 def classify_samples(
     theta_lower: np.ndarray, theta_upper: np.ndarray, alpha_lower: float, alpha_upper: float
 ) -> np.ndarray:
-    """Class of every sample (array of "rest", "1", "2", "3", "4")."""
+    """Class of every sample (array of "rest", "1", "2", "3", "4").
+
+    Parameters
+    ----------
+    theta_lower, theta_upper
+        Rotations of the lower and upper block, rad (absolute).
+    alpha_lower, alpha_upper
+        Their slenderness angles, rad.
+    """
     phi = theta_upper - theta_lower
     lower = np.abs(theta_lower) > ROCK_FRACTION * alpha_lower
     upper = np.abs(phi) > ROCK_FRACTION * alpha_upper
@@ -124,7 +132,15 @@ def classify(
 
 
 def classify_result(scene: Scene, result: Result) -> PatternReport:
-    """Pattern classification of a two-block scene's result (blocks bottom to top)."""
+    """Pattern classification of a two-block scene's result (blocks bottom to top).
+
+    Parameters
+    ----------
+    scene
+        The two-block scene (its blocks' alpha, rad, and its motion).
+    result
+        The run's Result.
+    """
     if len(scene.blocks) != 2:
         raise ValueError("pattern classification is defined for two-block stacks")
     lower, upper = scene.blocks

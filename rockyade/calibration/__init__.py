@@ -1,6 +1,10 @@
 """Calibration: the DEM contact parameters of a block from its classical parameters.
 
-``equations`` (the paper's Eqs 5-15: stiffness, equivalent base, damping, time step) and
-``matched`` (the contact damping that makes the reference DEM lose the target energy,
-found by running the kernel on the block alone).
+``equations`` (the paper's Eqs 5-15: stiffness, equivalent base, damping), ``calibrate``
+(the one calibration of a block, whatever the method: paper, matched, explicit, UDEC-style),
+``matching`` (the contact damping that makes the reference DEM lose the target energy, found
+by running the model builder and the engine on the block alone) and ``model``
+(:func:`~rockyade.calibration.model.calibrated_model`, the stage every DEM solver calls:
+calibrate every moving block, then build the model). Sits above :mod:`rockyade.dem`, which
+runs the joints it is given.
 """

@@ -3,7 +3,8 @@
 One function per equation of the paper, each citing its number:
 
 * Eq 6  Rayleigh constants a = xi w, b = xi / w from (xi_min, f_min);
-* Eq 7  time step dt = frac 2 sqrt(M_min / K_max);
+* Eq 7  time step dt = frac 2 sqrt(M_min / K_max): :func:`rockyade.dem.model.time_step_eq7`,
+  where the model chooses its time step;
 * Eq 8  K1 = M p^2;   Eq 9  K2 = M 3g/(4R) (M p_theory^2 for any polygon);
 * Eq 10 K = (K1 + K2) / 2;
 * Eq 11 b_eq = h tan(alpha);
@@ -17,12 +18,15 @@ M g / K ~ 0.7 m into its base (specimen 1). rockyade multiplies the paper's K by
 in every output, and refuses a static settlement M g / K above 1e-4 of the block height.
 Eqs 12-13 are evaluated with the paper's own (unscaled) K, as the paper fitted them; Eq 7
 uses the scaled K actually simulated.
+
+:func:`paper_calibration` puts them together into the joint the model runs
+(:class:`rockyade.dem.joints.ContactParameters`); :mod:`rockyade.calibration.calibrate`
+applies a scene's explicit values and the other methods.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
 
 from rockyade.blocks.classical import classical_parameters
 from rockyade.blocks.geometry import Block
@@ -34,6 +38,8 @@ from rockyade.constants import (
     STIFFNESS_SCALES,
     G,
 )
+from rockyade.dem.joints import ContactParameters
+from rockyade.dem.model import time_step_eq7
 from rockyade.errors import CalibrationError, InputError
 
 #: Range of Gamma / mu^2 covered by the paper's four specimens (Fig. 11), for a warning.
@@ -44,6 +50,13 @@ EQ13_FITTED_RANGE = (7.0e2, 5.0e3)
 
 def rayleigh_constants_eq6(xi_min: float, f_min_hz: float) -> tuple[float, float]:
     """Rayleigh constants (a, b) from damping ratio and frequency (paper Eq 6).
+
+    Parameters
+    ----------
+    xi_min
+        Damping ratio at ``f_min_hz`` (-).
+    f_min_hz
+        Frequency of the minimum damping ratio, Hz.
 
     Returns
     -------
@@ -56,37 +69,69 @@ def rayleigh_constants_eq6(xi_min: float, f_min_hz: float) -> tuple[float, float
     return xi_min * omega, xi_min / omega
 
 
-def time_step_eq7(mass_min_kg: float, k_max_N_per_m: float, frac: float = DEFAULT_TIME_STEP_FRAC) -> float:
-    """Critical time step of the central-difference scheme, s (paper Eq 7)."""
-    return frac * 2.0 * math.sqrt(mass_min_kg / k_max_N_per_m)
-
-
 def stiffness_eq8(mass_kg: float, p_rad_s: float) -> float:
-    """K1 = M p^2, paper units (paper Eq 8)."""
+    """K1 = M p^2, in the paper's units (paper Eq 8).
+
+    Parameters
+    ----------
+    mass_kg
+        Block mass, kg.
+    p_rad_s
+        Frequency parameter p, 1/s.
+    """
     return mass_kg * p_rad_s**2
 
 
 def stiffness_eq9(mass_kg: float, R_m: float, g: float = G) -> float:
-    """K2 = M 3 g / (4 R), paper units (paper Eq 9; rectangles)."""
+    """K2 = M 3 g / (4 R), in the paper's units (paper Eq 9; rectangles).
+
+    Parameters
+    ----------
+    mass_kg
+        Block mass, kg.
+    R_m
+        Distance from the pivot to the centroid, m.
+    g
+        Gravity, m/s^2.
+    """
     return mass_kg * 3.0 * g / (4.0 * R_m)
 
 
 def stiffness_eq10(k1: float, k2: float) -> float:
-    """K = (K1 + K2) / 2, paper units (paper Eq 10)."""
+    """K = (K1 + K2) / 2, in the paper's units (paper Eq 10).
+
+    Parameters
+    ----------
+    k1, k2
+        Eq 8 and Eq 9 values, in the paper's units (read as N/m before the stiffness scale).
+    """
     return 0.5 * (k1 + k2)
 
 
 def equivalent_half_base_eq11(h_m: float, alpha_rad: float) -> float:
     """Equivalent half base b_eq = h tan(alpha), m (paper Eq 11).
 
-    ``h_m`` is the height of the centroid above the base (half the height of a rectangle).
+    Parameters
+    ----------
+    h_m
+        Height of the centroid above the base, m (half the height of a rectangle).
+    alpha_rad
+        Slenderness angle, rad.
     """
     return h_m * math.tan(alpha_rad)
 
 
 def generalized_damping_factor_eq12(k_paper: float, R_m: float) -> float:
-    """Gamma = K R (paper Eq 12), with the paper's unscaled K; for rectangles this equals
-    M/2 (R p^2 + 3/4 g)."""
+    """Generalised damping factor Gamma = K R (paper Eq 12), with the paper's unscaled K;
+    for rectangles this equals M/2 (R p^2 + 3/4 g).
+
+    Parameters
+    ----------
+    k_paper
+        Eq 10's K in the paper's units (before the stiffness scale).
+    R_m
+        Distance from the pivot to the centroid, m.
+    """
     return k_paper * R_m
 
 
@@ -94,6 +139,13 @@ def stiffness_damping_eq13(gamma: float, mu: float) -> float:
     """Stiffness-proportional damping constant b, s (paper Eq 13, empirical).
 
     sqrt(b) = 0.0057 ln(Gamma / mu^2) - 0.0336.
+
+    Parameters
+    ----------
+    gamma
+        Eq 12's Gamma (paper units).
+    mu
+        Coefficient of restitution (-).
 
     Raises
     ------
@@ -113,12 +165,26 @@ def stiffness_damping_eq13(gamma: float, mu: float) -> float:
 
 
 def f_min_eq14(p_rad_s: float) -> float:
-    """f_min = p (paper Eq 14): the paper sets the number in Hz equal to p in 1/s."""
+    """f_min = p, Hz (paper Eq 14): the paper sets the number in Hz equal to p in 1/s.
+
+    Parameters
+    ----------
+    p_rad_s
+        Frequency parameter p, 1/s.
+    """
     return p_rad_s
 
 
 def xi_min_eq15(b_s: float, f_min_hz: float) -> float:
-    """Damping ratio xi_min = 2 pi b f_min (paper Eq 15)."""
+    """Damping ratio xi_min = 2 pi b f_min (paper Eq 15).
+
+    Parameters
+    ----------
+    b_s
+        Stiffness-proportional damping constant b, s.
+    f_min_hz
+        Eq 14's frequency, Hz.
+    """
     return 2.0 * math.pi * b_s * f_min_hz
 
 
@@ -132,6 +198,16 @@ def stiffness_scale_factor(scale: float | str | None) -> tuple[float, str]:
     ----------
     scale
         ``"N/m"``, ``"kN/m"``, ``"MN/m"``, a positive number, or None (the default, MN/m).
+
+    Returns
+    -------
+    factor, name
+        The factor (N/m per paper unit) and its name, e.g. ``(1e6, "MN/m")``.
+
+    Raises
+    ------
+    InputError
+        Another name, or a number that is not finite and positive.
     """
     if scale is None:
         return DEFAULT_STIFFNESS_SCALE, "MN/m"
@@ -151,7 +227,26 @@ def stiffness_scale_factor(scale: float | str | None) -> tuple[float, str]:
 def check_settlement(
     supported_mass_kg: float, k_N_per_m: float, height_m: float, field_name: str, g: float = G
 ) -> float:
-    """Static settlement M g / K, m; raise InputError when above 1e-4 of the block height."""
+    """Static settlement M g / K, m.
+
+    Parameters
+    ----------
+    supported_mass_kg
+        Mass resting on the joint, kg.
+    k_N_per_m
+        Joint stiffness (scaled), N/m.
+    height_m
+        Block height, m.
+    field_name
+        Field the error names (e.g. ``contact.stiffness_scale``).
+    g
+        Gravity, m/s^2.
+
+    Raises
+    ------
+    InputError
+        When the settlement is above ``MAX_SETTLEMENT_FRACTION`` (1e-4) of the block height.
+    """
     settlement = supported_mass_kg * g / k_N_per_m
     limit = MAX_SETTLEMENT_FRACTION * height_m
     if settlement > limit:
@@ -166,89 +261,6 @@ def check_settlement(
 
 
 # ------------------------------------------------------------------ calibration
-
-
-@dataclass(frozen=True)
-class ContactParameters:
-    """Contact (joint) parameters of the interface beneath one block.
-
-    Attributes
-    ----------
-    K_N_per_m, Ks_N_per_m
-        Normal and shear stiffness per contact corner, N/m (scaled).
-    friction_angle_deg, cohesion_Pa
-        Coulomb parameters.
-    beta_s
-        Stiffness-proportional damping b, s: dashpots c_n = b K, c_s = b Ks.
-    rayleigh_a_1_s
-        Mass-proportional Rayleigh constant (0, paper Section 6.2).
-    xi_min, f_min_hz
-        Eq 15 damping ratio and Eq 14 frequency for ``beta_s``.
-    b_eq_m
-        Equivalent half base (Eq 11), m.
-    K_paper
-        Eq 10 value in the paper's units (before the stiffness scale).
-    stiffness_scale, stiffness_reading
-        Factor applied to the paper's K, and its name (e.g. "MN/m").
-    gamma
-        Eq 12 generalised damping factor.
-    beta_eq13_s
-        Eq 13's value of b, s (kept beside a matched or explicit beta).
-    method
-        "paper", "matched" or "explicit".
-    dt_eq7_s
-        Eq 7 time step for this block alone (M of the block, K above), s.
-    settlement_m
-        Static settlement M g / K, m.
-    notes
-        Provenance remarks (overrides, extrapolation of Eq 13, ...).
-    """
-
-    K_N_per_m: float
-    Ks_N_per_m: float
-    friction_angle_deg: float
-    cohesion_Pa: float
-    beta_s: float
-    rayleigh_a_1_s: float
-    xi_min: float
-    f_min_hz: float
-    b_eq_m: float
-    K_paper: float
-    stiffness_scale: float
-    stiffness_reading: str
-    gamma: float
-    beta_eq13_s: float | None
-    method: str
-    dt_eq7_s: float
-    settlement_m: float
-    notes: tuple[str, ...] = field(default=())
-
-    def as_dict(self) -> dict[str, object]:
-        """Plain dictionary, JSON-ready."""
-        d = asdict(self)
-        d["notes"] = list(self.notes)
-        return d
-
-    def report(self) -> dict[str, object]:
-        """The keys ``rockyade calibrate --json`` prints (names as the command documents them)."""
-        return {
-            "K_N_per_m": self.K_N_per_m,
-            "Ks_N_per_m": self.Ks_N_per_m,
-            "beta_s": self.beta_s,
-            "beta_eq13_s": self.beta_eq13_s,
-            "xi_min": self.xi_min,
-            "f_min_hz": self.f_min_hz,
-            "b_eq_m": self.b_eq_m,
-            "dt_s": self.dt_eq7_s,
-            "friction_angle_deg": self.friction_angle_deg,
-            "cohesion_Pa": self.cohesion_Pa,
-            "stiffness_scale": self.stiffness_reading,
-            "stiffness_scale_factor": self.stiffness_scale,
-            "K_paper_units": self.K_paper,
-            "gamma": self.gamma,
-            "settlement_m": self.settlement_m,
-            "notes": list(self.notes),
-        }
 
 
 def paper_calibration(
@@ -270,22 +282,33 @@ def paper_calibration(
     Parameters
     ----------
     block
-        The block (mass, geometry).
+        The block (mass in kg, geometry in m).
     alpha_rad, p_rad_s, mu
-        Classical parameters to calibrate with (e.g. the experimental ones); default: those
-        of the geometry.
+        Classical parameters to calibrate with (rad, 1/s, -; e.g. the experimental ones);
+        default: those of the geometry.
     stiffness_scale
         Reading of the paper's K (default "MN/m"), see module docstring.
     friction_angle_deg
-        Joint friction angle (paper: 30 degrees).
+        Joint friction angle, degrees (paper: 30).
     supported_mass_kg
-        Mass resting on the joint (block plus blocks above) for the settlement check;
+        Mass resting on the joint (block plus blocks above) for the settlement check, kg;
         default the block's mass.
     frac
-        Eq 7 fraction.
+        Eq 7 fraction of the critical time step (-).
+    g
+        Gravity, m/s^2.
+    field_prefix
+        Prefix of the field a settlement error names (``contact.``).
     beta_s
         An explicit damping constant, s: used instead of Eq 13, which is then only
         reported (and may be out of its range without failing).
+
+    Raises
+    ------
+    InputError
+        A bad stiffness scale, or a settlement above 1e-4 of the block height.
+    CalibrationError
+        Eq 13 without a value (``beta_s`` not given).
     """
     geometric = classical_parameters(block, g=g)
     used = classical_parameters(block, alpha_rad=alpha_rad, p_rad_s=p_rad_s, mu=mu, g=g)

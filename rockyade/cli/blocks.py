@@ -4,10 +4,18 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import json_out
+from rockyade.cli.common import json_out, print_calibration
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:  # the parser stays fast: blocks are imported when a command runs
+    from numpy.typing import ArrayLike
+
+    from rockyade.blocks.geometry import Block
+
+#: A block the arguments describe: its name, the block and its classical overrides (rad, 1/s, -).
+NamedBlock = tuple[str, "Block", dict[str, float]]
 
 #: Calibration methods offered by ``rockyade calibrate``.
 CALIBRATION_METHODS = ["paper", "matched"]
@@ -31,7 +39,7 @@ def _add_block_arguments(p: argparse.ArgumentParser) -> None:
     g.add_argument("--inertia", type=float, help="rotational inertia about the centroid, kg m^2")
 
 
-def _blocks_from_args(args: argparse.Namespace) -> list[tuple[str, Any, dict[str, float]]]:
+def _blocks_from_args(args: argparse.Namespace) -> list[NamedBlock]:
     """(name, Block, classical overrides) for each block the arguments describe."""
     from rockyade import paper
     from rockyade.blocks.geometry import Block, chamfered_rectangle_vertices, rectangle_vertices
@@ -104,7 +112,7 @@ _BLOCK_OPTIONS = {
 }
 
 
-def _is_rectangle(vertices_m: Any) -> bool:
+def _is_rectangle(vertices_m: ArrayLike) -> bool:
     """Four vertices on two x and two y values: the paper's Eqs 2-4 apply as printed."""
     import numpy as np
 
@@ -117,7 +125,18 @@ def _is_rectangle(vertices_m: Any) -> bool:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    """Classical parameters of one or more blocks."""
+    """Classical parameters of one or more blocks (``rockyade params``).
+
+    Parameters
+    ----------
+    args
+        The parsed command line (one block input, ``--json``).
+
+    Returns
+    -------
+    int
+        Exit code (0).
+    """
     from rockyade.blocks.classical import classical_parameters
 
     out, rectangles = {}, {}
@@ -162,16 +181,27 @@ def cmd_params(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    """DEM contact parameters (paper Eqs 7-15, or matched to mu)."""
+    """DEM contact parameters (``rockyade calibrate``: paper Eqs 7-15, or matched to mu).
+
+    Parameters
+    ----------
+    args
+        The parsed command line: ``--specimen`` (or a block with ``--from``),
+        ``--parameters``, ``--method``, ``--stiffness-scale``, ``--friction-angle`` (degrees).
+
+    Returns
+    -------
+    int
+        Exit code (0).
+    """
     from rockyade import paper
-    from rockyade.calibration.equations import paper_calibration, xi_min_eq15
+    from rockyade.calibration.calibrate import calibrate
+    from rockyade.scene import ContactSpec
 
     if not 0.0 < args.friction_angle < 90.0:
         raise InputError("--friction-angle", f"must be in (0, 90) degrees, got {args.friction_angle:g}")
     if args.from_identified is not None:
-        from rockyade.cli.identify import calibrate_identified
-
-        return calibrate_identified(args, _blocks_from_args(args))
+        return _calibrate_identified(args, _blocks_from_args(args))
     if args.specimen is None or args.scene or args.width or args.vertices:
         raise InputError("--specimen", "is required: 1, 2, 3, 4, upper or lower (--scene, dimensions: with --from)")
     spec = paper.specimen(args.specimen)
@@ -183,9 +213,10 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
 
         cp = classical_parameters(block)
         params = {"alpha_rad": cp.alpha_rad, "p_rad_s": cp.p_rad_s, "mu": cp.mu}
-    cal = paper_calibration(
-        block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
+    contact = ContactSpec(
+        calibration=args.method, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
     )
+    cal = calibrate(block, contact, **params)
     result: dict[str, Any] = {
         "specimen": spec.key,
         "parameters": args.parameters,
@@ -193,14 +224,6 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
         "method": args.method,
         **cal.report(),
     }
-    if args.method == "matched":
-        from rockyade.calibration.matched import match_beta
-
-        matched = match_beta(
-            block, **params, stiffness_scale=args.stiffness_scale, friction_angle_deg=args.friction_angle
-        )
-        result.update(matched.as_cli_dict())
-        result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)  # Eq 15 with the matched b
     if args.json:
         json_out(result)
         return 0
@@ -210,39 +233,47 @@ def cmd_calibrate(args: argparse.Namespace) -> int:
     return 0
 
 
-def print_calibration(result: dict[str, Any], method: str) -> None:
-    """The text of a calibration: each DEM parameter with the equation it comes from.
+def _calibrate_identified(args: argparse.Namespace, blocks: list[NamedBlock]) -> int:
+    """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
+    from rockyade.identification.identified import calibrate_from_identified
 
-    ``result`` holds :meth:`ContactParameters.report`'s keys (and the matched stage's with
-    ``method = "matched"``); ``calibrate`` and ``calibrate --from`` print through this.
-    """
-    if method == "matched":
-        beta_src = f"matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s"
-    else:
-        beta_src = f"Eq 13, Gamma = {result['gamma']:.6g} (Eq 12)"
-    b_eq = result["b_eq_m"]
-    print(
-        f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10: {result['K_paper_units']:.6g}, "
-        f"read as {result['stiffness_scale']})"
+    if len(blocks) != 1:
+        raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")
+    name, block, _overrides = blocks[0]
+    result = calibrate_from_identified(
+        block,
+        args.from_identified,
+        method=args.method,
+        stiffness_scale=args.stiffness_scale,
+        friction_angle_deg=args.friction_angle,
     )
-    print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
+    result["block"] = name
+    result["from"] = str(args.from_identified)
+    if args.json:
+        json_out(result)
+        return 0
+    c, ci = result["classical"], result["classical_ci"]
+
+    def interval(key: str) -> str:
+        return f" [{ci[key][0]:.4g}, {ci[key][1]:.4g}]" if key in ci else ""
+
+    print(f"{name} ({block.mass_kg:.4g} kg), identified parameters from {args.from_identified}:")
     print(
-        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14: the number of p "
-        "in 1/s), Rayleigh a = 0"
+        f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
+        f"mu = {c['mu']:.5g}{interval('mu')}"
     )
-    print(f"  b_eq     = {b_eq:.6g} m (Eq 11; 2 b_eq = {2 * b_eq:.4g} m)")
-    print(f"  dt       = {result['dt_s']:.6g} s (Eq 7, frac 0.1)")
-    print(f"  friction = {result['friction_angle_deg']:g} deg, cohesion = {result['cohesion_Pa']:g} Pa")
-    print(f"  static settlement M g / K = {result['settlement_m']:.3g} m")
-    if method == "matched":
-        lo, hi = result["mu_reachable_min"], result["mu_reachable_max"]
-        print(f"  matched  : reference DEM effective mu {result['mu_eff_matched']:.5f}; reachable {lo:.4f}-{hi:.4f}")
-    for note in result["notes"]:
-        print(f"  note: {note}")
+    print_calibration(result, args.method)
+    return 0
 
 
 def register(sub: Any) -> None:
-    """Add ``params`` and ``calibrate``."""
+    """Add ``params`` and ``calibrate``.
+
+    Parameters
+    ----------
+    sub
+        The subparsers of ``rockyade``'s parser.
+    """
     p = sub.add_parser(
         "params",
         help="classical parameters alpha, p, mu of a block",

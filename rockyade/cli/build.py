@@ -409,10 +409,10 @@ def _check_the_dem_takes_it(scene: Any) -> None:
     (joints too soft for the wall's weight) is refused here, naming the option to change."""
     if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
         return  # the matched stage runs the DEM: too slow for a check; run checks it
-    from rockyade.dem.build import build_dem_model
+    from rockyade.calibration.model import calibrated_model
 
     try:
-        build_dem_model(scene)
+        calibrated_model(scene)
     except InputError as exc:
         flag = {"contact.jkn_Pa_per_m": "--jkn-pa-per-m"}.get(exc.field, exc.field)
         raise InputError(flag, f"{exc.message} (nothing written)") from None

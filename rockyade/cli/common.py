@@ -14,22 +14,42 @@ from rockyade.errors import InputError
 SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade")
 
 
-def json_out(data: Any) -> None:
-    """Print ``data`` as indented, sorted JSON (numpy values converted)."""
+def json_out(data: object) -> None:
+    """Print ``data`` as indented, sorted JSON (numpy values converted).
+
+    Parameters
+    ----------
+    data
+        JSON-ready values (dicts, lists, numbers, strings, numpy scalars and arrays).
+    """
     from rockyade.io.atomic import json_text
 
     print(json_text(data))
 
 
 def print_wrote(path: Path, json_mode: bool = False) -> None:
-    """``wrote PATH`` on stdout, or on stderr after ``--json`` (stdout stays one JSON document)."""
+    """``wrote PATH`` on stdout, or on stderr after ``--json`` (stdout stays one JSON document).
+
+    Parameters
+    ----------
+    path
+        The file written.
+    json_mode
+        The command prints JSON on stdout.
+    """
     import sys
 
     print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
 
 
 def add_allow_large(p: argparse.ArgumentParser) -> None:
-    """``--allow-large``: run above the documented cost limits (docs/reliability.md)."""
+    """``--allow-large``: run above the documented cost limits (docs/reliability.md).
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    """
     p.add_argument(
         "--allow-large",
         action="store_true",
@@ -40,7 +60,15 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
 
 def check_output_dir(path: Path, option: str) -> None:
     """Refuse an output directory that cannot be created or written (InputError naming
-    ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here."""
+    ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here.
+
+    Parameters
+    ----------
+    path
+        The directory.
+    option
+        The option that names it.
+    """
     option = _flag(option)
     if path.is_file():
         raise InputError(option, f"{path} is a file; give a directory")
@@ -50,7 +78,17 @@ def check_output_dir(path: Path, option: str) -> None:
 def check_output_file(path: Path, option: str, suffix: str | tuple[str, ...] | None = None) -> None:
     """Refuse an output file whose folder cannot be created or written, or (``suffix``, e.g.
     ``".png"`` or ``(".toml", ".json")``) whose name does not end as the file it will be (no
-    scene overwritten by a plot)."""
+    scene overwritten by a plot).
+
+    Parameters
+    ----------
+    path
+        The file.
+    option
+        The option that names it.
+    suffix
+        The suffix (or suffixes) it must have; None: any.
+    """
     option = _flag(option)
     if path.is_dir():
         raise InputError(option, f"{path} is a directory; give a file name")
@@ -78,8 +116,51 @@ def _check_dir(path: Path, option: str, what: str) -> None:
 
 
 def total_time(args: argparse.Namespace) -> float:
-    """Seconds since the command line started (imports of the command included)."""
+    """Seconds since the command line started (imports of the command included), s.
+
+    Parameters
+    ----------
+    args
+        The parsed command line (``started_at``: its ``time.perf_counter()`` at start);
+        NaN without it.
+    """
     import time
 
     start = getattr(args, "started_at", None)
     return time.perf_counter() - start if start is not None else float("nan")
+
+
+def print_calibration(result: dict[str, Any], method: str) -> None:
+    """The text of a calibration: each DEM parameter with the equation it comes from.
+
+    Parameters
+    ----------
+    result
+        :meth:`rockyade.calibration.calibrate.Calibration.report`'s keys (K in N/m, beta and
+        dt in s, b_eq in m, ...); with ``method = "matched"`` the matching's too (its
+        achieved mu and reachable range are in the joint's notes).
+    method
+        ``"paper"`` or ``"matched"``.
+
+    ``calibrate`` and ``calibrate --from`` print through this.
+    """
+    if method == "matched":
+        beta_src = f"matched to mu; Eq 13 gives {result['beta_eq13_s']:.6g} s"
+    else:
+        beta_src = f"Eq 13, Gamma = {result['gamma']:.6g} (Eq 12)"
+    b_eq = result["b_eq_m"]
+    print(
+        f"  K = Ks   = {result['K_N_per_m']:.6g} N/m (Eq 10: {result['K_paper_units']:.6g}, "
+        f"read as {result['stiffness_scale']})"
+    )
+    print(f"  beta     = {result['beta_s']:.6g} s ({beta_src})")
+    print(
+        f"  xi_min   = {result['xi_min']:.6g} (Eq 15), f_min = {result['f_min_hz']:.6g} Hz (Eq 14: the number of p "
+        "in 1/s), Rayleigh a = 0"
+    )
+    print(f"  b_eq     = {b_eq:.6g} m (Eq 11; 2 b_eq = {2 * b_eq:.4g} m)")
+    print(f"  dt       = {result['dt_s']:.6g} s (Eq 7, frac 0.1)")
+    print(f"  friction = {result['friction_angle_deg']:g} deg, cohesion = {result['cohesion_Pa']:g} Pa")
+    print(f"  static settlement M g / K = {result['settlement_m']:.3g} m")
+    for note in result["notes"]:
+        print(f"  note: {note}")

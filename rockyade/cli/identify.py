@@ -5,10 +5,13 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:  # the parser stays fast: the identification is imported when the command runs
+    from rockyade.identification.fit import Identification
 
 
 def _led_columns(text: str | None) -> tuple[str, str] | None:
@@ -21,7 +24,18 @@ def _led_columns(text: str | None) -> tuple[str, str] | None:
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    """Identify the classical parameters of a measured free-rocking record."""
+    """Identify the classical parameters of a measured free-rocking record (``rockyade identify``).
+
+    Parameters
+    ----------
+    args
+        The parsed command line: the record, its columns, ``--out``, ``--plot``, ``--json``.
+
+    Returns
+    -------
+    int
+        Exit code: 0, or 1 when a parameter cannot be identified.
+    """
     from rockyade.identification.fit import identify
     from rockyade.identification.measurement import read_measurement
 
@@ -65,7 +79,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     return 0
 
 
-def _print_text(result: Any) -> None:
+def _print_text(result: Identification) -> None:
     h = result.history
     fit = result.fit
     print(f"{h.source}: {h.t_s.size} samples at {h.rate_hz:.4g} Hz over {h.duration_s:.4g} s")
@@ -85,7 +99,7 @@ def _print_text(result: Any) -> None:
     )
 
 
-def _start_lines(result: Any) -> list[str]:
+def _start_lines(result: Identification) -> list[str]:
     """Release time, release tilt and sensor offset with their 95 % intervals (the JSON's), or
     "not identified" where the interval is wider than ``max_relative_ci`` of the record's
     duration (release time) or of its rotation range (offset; the tilt is measured from it)."""
@@ -106,43 +120,14 @@ def _start_lines(result: Any) -> list[str]:
     return [release, f"sensor offset {fit.offset_rad:.4g} rad [{o_lo:.4g}, {o_hi:.4g}]"]
 
 
-def calibrate_identified(args: argparse.Namespace, blocks: list[tuple[str, Any, dict[str, float]]]) -> int:
-    """``rockyade calibrate --from identified.json``: DEM parameters from identified values."""
-    from rockyade.identification.identified import calibrate_from_identified
-
-    if len(blocks) != 1:
-        raise InputError("block", f"the scene has {len(blocks)} blocks: choose one with --block")
-    name, block, _overrides = blocks[0]
-    result = calibrate_from_identified(
-        block,
-        args.from_identified,
-        method=args.method,
-        stiffness_scale=args.stiffness_scale,
-        friction_angle_deg=args.friction_angle,
-    )
-    result["block"] = name
-    result["from"] = str(args.from_identified)
-    if args.json:
-        json_out(result)
-        return 0
-    c, ci = result["classical"], result["classical_ci"]
-
-    def interval(key: str) -> str:
-        return f" [{ci[key][0]:.4g}, {ci[key][1]:.4g}]" if key in ci else ""
-
-    print(f"{name} ({block.mass_kg:.4g} kg), identified parameters from {args.from_identified}:")
-    print(
-        f"  alpha = {c['alpha_rad']:.5g} rad{interval('alpha_rad')}, p = {c['p_rad_s']:.5g} 1/s{interval('p_rad_s')}, "
-        f"mu = {c['mu']:.5g}{interval('mu')}"
-    )
-    from rockyade.cli.blocks import print_calibration
-
-    print_calibration(result, args.method)
-    return 0
-
-
 def register(sub: Any) -> None:
-    """Add ``rockyade identify``."""
+    """Add ``rockyade identify``.
+
+    Parameters
+    ----------
+    sub
+        The subparsers of ``rockyade``'s parser.
+    """
     p = sub.add_parser(
         "identify",
         help="alpha, p, mu with 95 %% intervals from a measured free-rocking test",

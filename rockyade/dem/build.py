@@ -7,29 +7,26 @@ I_O = M g R / p^2 (Eq 8 does not do it: a stiff contact does not change p). Each
 placed at rest as the scene says (stacked, or at ``position_m`` rotated by
 ``rotation_rad``).
 
-Joints (:mod:`rockyade.dem.joints`): each moving block's own joint (paper Eqs 10-15,
-explicit values, or UDEC-style stiffness per area), and the joint of every pair touching
-at rest (bed, head, block-base, block-fixed). A matched calibration must have been
-resolved before (:mod:`rockyade.calibration.matched`). The time step (Eq 7, kept below the
-stability limit) and the static settlement come from the springs at rest
-(:mod:`rockyade.dem.statics`).
+Joints (:mod:`rockyade.dem.joints`): each moving block's own joint is given, as the
+calibration stage computed it (:func:`rockyade.calibration.model.calibrated_model`
+calibrates, then builds here); this module resolves the joint of every pair touching at
+rest (bed, head, block-base, block-fixed). The time step (Eq 7, kept below the stability
+limit) and the static settlement come from the springs at rest (:mod:`rockyade.dem.statics`).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
-from dataclasses import replace
+from collections.abc import Sequence
 
 import numpy as np
 from scipy.spatial import ConvexHull
 
 from rockyade.blocks.classical import frequency_parameter, inertia_for_frequency
 from rockyade.blocks.geometry import LEVEL_TOL, Block
-from rockyade.calibration.equations import ContactParameters, time_step_eq7
 from rockyade.constants import MAX_SETTLEMENT_FRACTION, G
-from rockyade.dem.joints import JointTable, MatchedBeta, own_joint, resolve_joints
-from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt
+from rockyade.dem.joints import ContactParameters, JointTable, resolve_joints
+from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt, time_step_eq7
 from rockyade.dem.overturn import stop_angles
 from rockyade.dem.statics import mass_vector, rest_springs, stability_limit, static_penetration
 from rockyade.errors import InputError
@@ -45,6 +42,18 @@ def contact_polygon(block: Block, alpha_rad: float | None) -> np.ndarray:
     Without an alpha override the polygon is the block's own. Vertices are returned in the
     block frame, counter-clockwise; a vertex that the moved corners leave inside the hull
     is dropped.
+
+    Parameters
+    ----------
+    block
+        The block (vertices in m, base on y = 0).
+    alpha_rad
+        The alpha override, rad; None keeps the block's own base.
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) vertices, m, starting at the bottom-left corner.
     """
     verts = block.vertices_m.copy()
     if alpha_rad is None:
@@ -121,17 +130,19 @@ def _dem_body(
 
 
 def world_polygon(body: DemBody) -> np.ndarray:
-    """A body's contact polygon in the base frame at rest, m."""
+    """A body's contact polygon in the base frame at rest.
+
+    Parameters
+    ----------
+    body
+        The body (polygon relative to its centroid, rest centroid and angle).
+
+    Returns
+    -------
+    numpy.ndarray
+        (n, 2) vertices, m.
+    """
     return body.contact_vertices_m @ rotation_matrix(body.rest_angle_rad).T + np.asarray(body.rest_centroid_m)
-
-
-def _supported_masses(scene: Scene) -> list[float]:
-    """Mass resting on each block's base joint in a column (the block and those above);
-    in an assembly each block's own mass (the statics check covers the load paths)."""
-    masses = [b.block().mass_kg for b in scene.blocks]
-    if scene.positioned:
-        return masses
-    return [sum(masses[i:]) for i in range(len(masses))]
 
 
 def _released_group(index: int, contacts: list[RestContact]) -> list[int]:
@@ -232,41 +243,43 @@ def _joint_height(c: RestContact, bodies: tuple[DemBody, ...]) -> float:
 
 def build_dem_model(
     scene: Scene,
+    joints: Sequence[ContactParameters | None],
     g: float = G,
-    beta_override: float | None = None,
-    matched: Mapping[str, MatchedBeta] | None = None,
 ) -> DemModel:
-    """Resolve a scene into the DEM model both DEM solvers run.
+    """Resolve a scene and its blocks' own joints into the DEM model both DEM solvers run.
 
     Parameters
     ----------
     scene
         A validated scene.
+    joints
+        The own joint of each block, bottom to top (None for a fixed block): the interface
+        beneath it, stiffness in N/m and damping in s, as the calibration stage computed it
+        (:func:`rockyade.calibration.calibrate.calibrate`).
     g
         Gravity, m/s^2.
-    beta_override
-        Damping constant for every joint, s (used by the matched calibration itself).
-    matched
-        Matched damping per block name, for ``calibration = "matched"``
-        (:func:`rockyade.calibration.matched.matched_betas`).
+
+    Raises
+    ------
+    InputError
+        Joints that do not match the blocks, a settlement above the limit, or a time step
+        above the stability limit.
     """
+    own = list(joints)
+    if len(own) != len(scene.blocks) or any(
+        (j is None) != spec.fixed for j, spec in zip(own, scene.blocks, strict=True)
+    ):
+        raise InputError(
+            "joints",
+            f"must give one joint per moving block and None per fixed block ({len(scene.blocks)} blocks), "
+            f"got {len(own)}",
+        )
     placed = placed_blocks(scene)
-    supported = _supported_masses(scene)
-    own: list[ContactParameters | None] = []
-    for i, spec in enumerate(scene.blocks):
-        if spec.fixed:
-            own.append(None)
-            continue
-        joint = own_joint(scene, i, supported[i], matched, g)
-        if beta_override is not None:
-            xi = 2 * math.pi * beta_override * joint.f_min_hz
-            joint = replace(joint, beta_s=beta_override, method="explicit", xi_min=xi)
-        own.append(joint)
     bodies = tuple(
         _dem_body(spec, i, own[i], placed[i], scene.output.accel_point, g) for i, spec in enumerate(scene.blocks)
     )
     contacts = rest_contacts(placed, [world_polygon(b) for b in bodies])
-    joints = resolve_joints(
+    table = resolve_joints(
         scene,
         own,
         contacts,
@@ -275,15 +288,15 @@ def build_dem_model(
     )
     centroids = np.array([b.rest_centroid_m for b in bodies], dtype=float)
     fixed = [b.fixed for b in bodies]
-    springs = rest_springs(centroids, fixed, contacts, joints)
+    springs = rest_springs(centroids, fixed, contacts, table)
     mass = mass_vector([b.mass_kg for b in bodies], [b.inertia_kgm2 for b in bodies], fixed)
     dt_stable, w_max = stability_limit(springs, mass, scene.contact.mass_damping_1_s)
-    settlement = _check_settlement(springs, bodies, contacts, joints, scene, g)
+    settlement = _check_settlement(springs, bodies, contacts, table, scene, g)
     pos0, ang0, vel0, angvel0 = _initial_state(scene, bodies, contacts)
     moving = [b for b in bodies if not b.fixed]
     dt_eq7 = time_step_eq7(
         min(b.mass_kg for b in moving),
-        max(p.K_N_per_m for p in joints.params),
+        max(p.K_N_per_m for p in table.params),
         scene.contact.time_step_frac,
     )
     if scene.contact.dt_s is not None:
@@ -299,7 +312,7 @@ def build_dem_model(
     steps = max(1, math.ceil(scene.sample_dt_s / dt_target - 1e-9))
     return DemModel(
         bodies=bodies,
-        joints=joints,
+        joints=table,
         motion=scene.motion.ground_motion(scene.duration_s),
         pos0_m=pos0,
         ang0_rad=ang0,

@@ -1,9 +1,11 @@
 """Joints of an assembly: the contact parameters of every contacting pair, counted once.
 
-Every moving block has its *own* joint: the paper's calibration of the interface beneath
-it (Eqs 10-15 from its classical parameters; or explicit ``[contact]`` values, which need
-no classical calibration; or UDEC-style stiffness per unit area). The pairs that touch at
-rest get their joint by documented rules (docs/assemblies.md):
+:class:`ContactParameters` is the joint the model runs. Every moving block has its *own*
+joint, the interface beneath it, which the calibration stage computes and hands to the
+model builder (:mod:`rockyade.calibration.calibrate`: the paper's Eqs 10-15 from its
+classical parameters, matched damping, explicit ``[contact]`` values or UDEC-style
+stiffness per unit area). The pairs that touch at rest get their joint by documented rules
+(docs/assemblies.md):
 
 * block - base, block - fixed block: the moving block's own joint;
 * bed joint (interface normal within 45 degrees of vertical): the upper block's own joint,
@@ -23,19 +25,102 @@ is one joint, never twice.
 
 from __future__ import annotations
 
-import math
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.calibration.equations import ContactParameters, paper_calibration, time_step_eq7
-from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.scene import BlockSpec, Scene
-from rockyade.scene.model import JointOverride
-from rockyade.scene.placement import RestContact
+
+if TYPE_CHECKING:  # names only: the calibration imports this module without loading the scene machinery
+    from rockyade.scene import Scene
+    from rockyade.scene.model import JointOverride
+    from rockyade.scene.placement import RestContact
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """Contact (joint) parameters of the interface beneath one block.
+
+    Attributes
+    ----------
+    K_N_per_m, Ks_N_per_m
+        Normal and shear stiffness per contact corner, N/m (scaled).
+    friction_angle_deg, cohesion_Pa
+        Coulomb parameters: friction angle, degrees; cohesion, Pa.
+    beta_s
+        Stiffness-proportional damping b, s: dashpots c_n = b K, c_s = b Ks.
+    rayleigh_a_1_s
+        Mass-proportional Rayleigh constant (0, paper Section 6.2).
+    xi_min, f_min_hz
+        Eq 15 damping ratio (-) and Eq 14 frequency (Hz) for ``beta_s``.
+    b_eq_m
+        Equivalent half base (Eq 11), m.
+    K_paper
+        Eq 10 value in the paper's units (before the stiffness scale).
+    stiffness_scale, stiffness_reading
+        Factor applied to the paper's K (N/m per paper unit), and its name (e.g. "MN/m").
+    gamma
+        Eq 12 generalised damping factor (paper units).
+    beta_eq13_s
+        Eq 13's value of b, s (kept beside a matched or explicit beta).
+    method
+        "paper", "matched", "explicit" or "override" (a ``[[joints]]`` entry).
+    dt_eq7_s
+        Eq 7 time step for this block alone (M of the block, K above), s.
+    settlement_m
+        Static settlement M g / K, m.
+    notes
+        Provenance remarks (overrides, extrapolation of Eq 13, ...).
+    """
+
+    K_N_per_m: float
+    Ks_N_per_m: float
+    friction_angle_deg: float
+    cohesion_Pa: float
+    beta_s: float
+    rayleigh_a_1_s: float
+    xi_min: float
+    f_min_hz: float
+    b_eq_m: float
+    K_paper: float
+    stiffness_scale: float
+    stiffness_reading: str
+    gamma: float
+    beta_eq13_s: float | None
+    method: str
+    dt_eq7_s: float
+    settlement_m: float
+    notes: tuple[str, ...] = field(default=())
+
+    def as_dict(self) -> dict[str, object]:
+        """Plain dictionary, JSON-ready."""
+        d = asdict(self)
+        d["notes"] = list(self.notes)
+        return d
+
+    def report(self) -> dict[str, object]:
+        """The keys ``rockyade calibrate --json`` prints (names as the command documents them)."""
+        return {
+            "K_N_per_m": self.K_N_per_m,
+            "Ks_N_per_m": self.Ks_N_per_m,
+            "beta_s": self.beta_s,
+            "beta_eq13_s": self.beta_eq13_s,
+            "xi_min": self.xi_min,
+            "f_min_hz": self.f_min_hz,
+            "b_eq_m": self.b_eq_m,
+            "dt_s": self.dt_eq7_s,
+            "friction_angle_deg": self.friction_angle_deg,
+            "cohesion_Pa": self.cohesion_Pa,
+            "stiffness_scale": self.stiffness_reading,
+            "stiffness_scale_factor": self.stiffness_scale,
+            "K_paper_units": self.K_paper,
+            "gamma": self.gamma,
+            "settlement_m": self.settlement_m,
+            "notes": list(self.notes),
+        }
 
 
 @dataclass(frozen=True)
@@ -72,6 +157,16 @@ class JointTable:
         The rule every DEM implements: the base joint against the base; a pair resolved at
         build time uses its joint; else the moving body's own joint against a fixed body,
         else the softer (lower K) of the two own joints, ties to the lower index.
+
+        Parameters
+        ----------
+        a, b
+            Body indices (bottom to top); ``b = -1`` for the base.
+
+        Returns
+        -------
+        int
+            Index into ``params``.
         """
         if b < 0:
             return int(self.base_joint[a])
@@ -87,7 +182,13 @@ class JointTable:
         return int(self.pair_a.size)
 
     def summary(self, names: Sequence[str]) -> dict[str, object]:
-        """JSON-ready description: the parameter sets and which joint each body and pair uses."""
+        """JSON-ready description: the parameter sets and which joint each body and pair uses.
+
+        Parameters
+        ----------
+        names
+            Body names, bottom to top.
+        """
         kinds: dict[str, int] = {}
         for kind in self.pair_kind:
             kinds[kind] = kinds.get(kind, 0) + 1
@@ -109,7 +210,24 @@ def default_pair_joint(
     params: Sequence[ContactParameters], own_joint: NDArray[np.int64], fixed: NDArray[np.bool_], a: int, b: int
 ) -> int:
     """Joint of two bodies that do not touch at rest (a < b): the moving body's own joint
-    against a fixed body, else the softer (lower K) of the two own joints, ties to ``a``."""
+    against a fixed body, else the softer (lower K) of the two own joints, ties to ``a``.
+
+    Parameters
+    ----------
+    params
+        The joint parameter sets (stiffness in N/m).
+    own_joint
+        (nb,) index into ``params`` of each body's own joint.
+    fixed
+        (nb,) bool, bodies that move with the base.
+    a, b
+        The two body indices, ``a < b``.
+
+    Returns
+    -------
+    int
+        Index into ``params``.
+    """
     if fixed[a]:
         return int(own_joint[b])
     if fixed[b]:
@@ -118,176 +236,43 @@ def default_pair_joint(
     return jb if params[jb].K_N_per_m < params[ja].K_N_per_m else ja
 
 
-# ---------------------------------------------------------------------- own joints
+# ---------------------------------------------------------------------- joints of pairs
 
 
-@dataclass(frozen=True)
-class MatchedBeta:
-    """Result of a matched calibration.
+def udec_stiffness(jk_Pa_per_m: float, length_m: float, thickness_m: float) -> float:
+    """K = jk x (L / 2) x t, N/m: a contact point's share of the joint area (UDEC's rule).
 
-    Attributes
+    Parameters
     ----------
-    beta_s
-        Matched stiffness-proportional damping, s.
-    mu_eff, mu_target
-        Achieved and target effective restitution.
-    mu_max, mu_min
-        Reachable range: mu_eff without damping and with the heaviest damping tried.
-    beta_max_s
-        Heaviest damping tried, s.
-    beta_eq13_s
-        The paper's empirical value (Eq 13), for comparison.
-    n_runs
-        DEM runs used.
-    n_impacts
-        Impacts averaged per run.
+    jk_Pa_per_m
+        Stiffness per unit area of the joint, Pa/m (normal or shear).
+    length_m
+        Length of the joint, m (each of its two end points takes half).
+    thickness_m
+        Thickness of the joint, m.
     """
-
-    beta_s: float
-    mu_eff: float
-    mu_target: float
-    mu_max: float
-    mu_min: float
-    beta_max_s: float
-    beta_eq13_s: float
-    n_runs: int
-    n_impacts: int
-
-    def as_cli_dict(self) -> dict[str, float]:
-        """Keys for ``rockyade calibrate --method matched --json``."""
-        return {
-            "beta_s": self.beta_s,
-            "beta_matched_s": self.beta_s,
-            "mu_eff_matched": self.mu_eff,
-            "mu_target": self.mu_target,
-            "mu_reachable_min": self.mu_min,
-            "mu_reachable_max": self.mu_max,
-            "beta_eq13_s": self.beta_eq13_s,
-            "matching_runs": self.n_runs,
-            "matching_impacts": self.n_impacts,
-        }
-
-
-
-def explicit_joint(
-    K: float, Ks: float, beta: float, friction_angle_deg: float, frac: float, mass_kg: float, notes: Sequence[str]
-) -> ContactParameters:
-    """A joint given by its values (no classical calibration)."""
-    return ContactParameters(
-        K_N_per_m=float(K),
-        Ks_N_per_m=float(Ks),
-        friction_angle_deg=float(friction_angle_deg),
-        cohesion_Pa=0.0,
-        beta_s=float(beta),
-        rayleigh_a_1_s=0.0,
-        xi_min=math.nan,
-        f_min_hz=math.nan,
-        b_eq_m=math.nan,
-        K_paper=math.nan,
-        stiffness_scale=1.0,
-        stiffness_reading="N/m (explicit)",
-        gamma=math.nan,
-        beta_eq13_s=None,
-        method="explicit",
-        dt_eq7_s=time_step_eq7(mass_kg, K, frac),
-        settlement_m=math.nan,
-        notes=tuple(notes),
-    )
-
-
-def _udec_stiffness(jk: float, length_m: float, thickness_m: float) -> float:
-    """K = jk x (L / 2) x t: a contact point's share of the joint area (UDEC's rule)."""
-    return jk * 0.5 * length_m * thickness_m
-
-
-def own_joint(
-    scene: Scene,
-    index: int,
-    supported_mass_kg: float,
-    matched: Mapping[str, MatchedBeta] | None,
-    g: float = G,
-) -> ContactParameters:
-    """The joint beneath block ``index`` on its own (see module docstring).
-
-    Raises
-    ------
-    InputError
-        A matched scene whose damping has not been matched yet, or a bad calibration input.
-    """
-    spec: BlockSpec = scene.blocks[index]
-    block = spec.block()
-    c = scene.contact
-    base_width = float(np.ptp(block.vertices_m[block.vertices_m[:, 1] <= 1e-9 * block.height_m, 0]))
-    if c.jkn_Pa_per_m is not None:
-        jks = c.jks_Pa_per_m if c.jks_Pa_per_m is not None else c.jkn_Pa_per_m
-        K = _udec_stiffness(c.jkn_Pa_per_m, base_width, block.thickness_m)
-        Ks = _udec_stiffness(jks, base_width, block.thickness_m)
-        note = f"UDEC-style: K = jkn x (L/2) x t with L = base width {base_width:.6g} m"
-        return explicit_joint(K, Ks, c.beta_s or 0.0, c.friction_angle_deg, c.time_step_frac, block.mass_kg, [note])
-    if c.K_N_per_m is not None and c.beta_s is not None:
-        Ks = c.Ks_N_per_m if c.Ks_N_per_m is not None else c.K_N_per_m
-        return explicit_joint(
-            c.K_N_per_m, Ks, c.beta_s, c.friction_angle_deg, c.time_step_frac, block.mass_kg, ["K and beta explicit"]
-        )
-    beta = c.beta_s
-    method_note = "beta_s explicit" if beta is not None else None
-    matched_beta = None
-    if beta is None and c.calibration == "matched":
-        matched_beta = (matched or {}).get(spec.name)
-        if matched_beta is None:
-            raise InputError(
-                "contact.calibration",
-                "matched: the damping must be matched before the model is built "
-                "(rockyade.calibration.matched.build_matched_model, or the solvers, do it)",
-            )
-        beta = matched_beta.beta_s
-    joint = paper_calibration(
-        block,
-        alpha_rad=spec.alpha_rad,
-        p_rad_s=spec.p_rad_s,
-        mu=spec.mu,
-        stiffness_scale=c.stiffness_scale,
-        friction_angle_deg=c.friction_angle_deg,
-        supported_mass_kg=supported_mass_kg if c.K_N_per_m is None else None,
-        frac=c.time_step_frac,
-        g=g,
-        beta_s=beta,
-    )
-    notes = list(joint.notes)
-    changes: dict[str, object] = {}
-    if c.K_N_per_m is not None:
-        changes.update(K_N_per_m=c.K_N_per_m, Ks_N_per_m=c.K_N_per_m)
-        notes.append("K_N_per_m explicit")
-    if c.Ks_N_per_m is not None:
-        changes["Ks_N_per_m"] = c.Ks_N_per_m
-        notes.append("Ks_N_per_m explicit")
-    if method_note:
-        notes.append(method_note)
-    if matched_beta is not None:
-        changes["method"] = "matched"
-        notes.append(
-            f"beta matched: reference DEM effective mu {matched_beta.mu_eff:.5f} for target "
-            f"{matched_beta.mu_target:.5f} (reachable {matched_beta.mu_min:.4f}-{matched_beta.mu_max:.4f}); "
-            f"Eq 13 gives {joint.beta_eq13_s:.4g} s"
-            if joint.beta_eq13_s is not None
-            else "beta matched (Eq 13 has no value here)"
-        )
-    if beta is not None:
-        changes["xi_min"] = 2.0 * math.pi * beta * joint.f_min_hz  # Eq 15 with this b
-    k = float(changes.get("K_N_per_m", joint.K_N_per_m))  # type: ignore[arg-type]
-    changes.update(notes=tuple(notes), dt_eq7_s=time_step_eq7(block.mass_kg, k, c.time_step_frac))
-    return replace(joint, **changes)  # type: ignore[arg-type]
+    return jk_Pa_per_m * 0.5 * length_m * thickness_m
 
 
 def override_joint(
     base: ContactParameters, override: JointOverride, length_m: float, thickness_m: float
 ) -> ContactParameters:
-    """``base`` with the values of a ``[[joints]]`` entry applied."""
+    """``base`` with the values of a ``[[joints]]`` entry applied.
+
+    Parameters
+    ----------
+    base
+        The joint the pair would have without the entry.
+    override
+        The entry (K in N/m, jkn in Pa/m, beta in s, friction in degrees).
+    length_m, thickness_m
+        Length and thickness of the joint, m (stiffness per unit area: ``udec_stiffness``).
+    """
     changes: dict[str, object] = {}
     jkn, jks = override.get("jkn_Pa_per_m"), override.get("jks_Pa_per_m")
     if jkn is not None:
-        changes["K_N_per_m"] = _udec_stiffness(jkn, length_m, thickness_m)
-        changes["Ks_N_per_m"] = _udec_stiffness(jks if jks is not None else jkn, length_m, thickness_m)
+        changes["K_N_per_m"] = udec_stiffness(jkn, length_m, thickness_m)
+        changes["Ks_N_per_m"] = udec_stiffness(jks if jks is not None else jkn, length_m, thickness_m)
     for key in ("K_N_per_m", "Ks_N_per_m", "beta_s", "friction_angle_deg"):
         value = override.get(key)
         if value is not None:
@@ -364,8 +349,8 @@ def resolve_joints(
             jks = scene.contact.jks_Pa_per_m or udec
             joint = replace(
                 joint,
-                K_N_per_m=_udec_stiffness(udec, base_length[i], thickness_m[i]),
-                Ks_N_per_m=_udec_stiffness(jks, base_length[i], thickness_m[i]),
+                K_N_per_m=udec_stiffness(udec, base_length[i], thickness_m[i]),
+                Ks_N_per_m=udec_stiffness(jks, base_length[i], thickness_m[i]),
             )
         if (i, -1) in overrides:
             joint = override_joint(joint, overrides.pop((i, -1)), base_length.get(i, base_width_m[i]), thickness_m[i])
@@ -389,8 +374,8 @@ def resolve_joints(
             jks = scene.contact.jks_Pa_per_m or udec
             joint = replace(
                 joint,
-                K_N_per_m=_udec_stiffness(udec, c.length_m, t),
-                Ks_N_per_m=_udec_stiffness(jks, c.length_m, t),
+                K_N_per_m=udec_stiffness(udec, c.length_m, t),
+                Ks_N_per_m=udec_stiffness(jks, c.length_m, t),
                 notes=(*joint.notes, f"UDEC-style {kind} joint, L = {c.length_m:.6g} m"),
             )
         if (a, b) in overrides:

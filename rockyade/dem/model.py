@@ -8,9 +8,9 @@ that they simulate exactly the same system:
   b_eq = h tan(alpha) (paper Eq 11) when alpha is overridden. When p is overridden the
   inertia is set so that the DEM rocks with that p: I_O = M g R / p^2 (Eq 8 does not do
   it: a stiff contact does not change p);
-* joints: the contact parameters of the interface beneath each block (paper Eqs 10-15,
-  or matched damping, or explicit values); a contact between two bodies uses the joint of
-  the upper one;
+* joints: the contact parameters of the interface beneath each block, as the calibration
+  stage gives them (:mod:`rockyade.calibration.calibrate`: paper Eqs 10-15, matched
+  damping, or explicit values), and which pair of bodies uses which (:mod:`rockyade.dem.joints`);
 * the initial state (rest, or the released block tilted about its pivot);
 * the time step: Eq 7 by default, checked against the stability limit of the explicit
   central-difference scheme for the linearised contact system at rest with its
@@ -23,17 +23,35 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rockyade.calibration.equations import ContactParameters
-from rockyade.dem.joints import JointTable
+from rockyade.constants import DEFAULT_TIME_STEP_FRAC
+from rockyade.dem.joints import ContactParameters, JointTable
 from rockyade.errors import InputError
-from rockyade.motion.ground import GroundMotion
-from rockyade.scene.placement import RestContact
+
+if TYPE_CHECKING:  # names only: the calibration imports this module (Eq 7) without the motions and scenes
+    from rockyade.motion.ground import GroundMotion
+    from rockyade.scene.placement import RestContact
 
 #: Default time step = min(Eq 7, STABILITY_MARGIN * stability limit).
 STABILITY_MARGIN = 0.8
+
+
+def time_step_eq7(mass_min_kg: float, k_max_N_per_m: float, frac: float = DEFAULT_TIME_STEP_FRAC) -> float:
+    """Time step of the central-difference scheme, dt = frac 2 sqrt(M_min / K_max), s (paper Eq 7).
+
+    Parameters
+    ----------
+    mass_min_kg
+        Smallest moving mass, kg.
+    k_max_N_per_m
+        Largest contact stiffness, N/m.
+    frac
+        Fraction of the critical step 2 sqrt(M / K) (the paper: 0.1).
+    """
+    return frac * 2.0 * math.sqrt(mass_min_kg / k_max_N_per_m)
 
 
 @dataclass(frozen=True)
@@ -165,6 +183,11 @@ class DemModel:
     def with_dt(self, dt_s: float) -> DemModel:
         """The model with another time step (rounded down to divide the sample interval).
 
+        Parameters
+        ----------
+        dt_s
+            The time step wanted, s.
+
         Raises
         ------
         InputError
@@ -176,7 +199,20 @@ class DemModel:
 
 
 def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
-    """Refuse a time step above the stability limit."""
+    """Refuse a time step above the stability limit.
+
+    Parameters
+    ----------
+    dt_s
+        The time step asked for, s.
+    dt_stable_s
+        The stability limit of the explicit scheme, s.
+
+    Raises
+    ------
+    InputError
+        ``dt_s`` above ``dt_stable_s`` (field ``contact.dt_s``).
+    """
     if dt_s > dt_stable_s:
         raise InputError(
             "contact.dt_s",

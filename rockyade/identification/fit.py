@@ -130,7 +130,14 @@ class Identification:
         return not self.unidentifiable
 
     def value(self, name: str) -> float | None:
-        """An identified value, or None when it is unidentifiable."""
+        """An identified value, or None when it is unidentifiable.
+
+        Parameters
+        ----------
+        name
+            ``alpha_rad`` (rad), ``p_rad_s`` (1/s), ``mu`` (-), ``release_time_s`` (s),
+            ``offset_rad`` (rad) or ``release_ratio`` (-).
+        """
         return None if name in self.unidentifiable else float(getattr(self.fit, name))
 
     def modelled(self) -> NDArray[np.float64]:
@@ -364,6 +371,15 @@ def error_surface(
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """RMS misfit over an alpha-p grid, the other unknowns held at the optimum (the paper's
     "minimized error surface").
+
+    Parameters
+    ----------
+    result
+        An identification (its history and optimum).
+    alpha_range, p_range
+        Grid bounds of alpha (rad) and p (1/s).
+    n
+        Grid points along each axis.
 
     Returns
     -------

@@ -1,6 +1,7 @@
 """Identified classical parameters read back (``rockyade identify --out``) and turned into DEM
-contact parameters: the paper's calibration (Eqs 7-15) or the matched one (the damping that
-makes the reference DEM's effective mu equal the identified mu).
+contact parameters by the one calibration (:func:`rockyade.calibration.calibrate.calibrate`):
+the paper's (Eqs 7-15) or the matched one (the damping that makes the reference DEM's
+effective mu equal the identified mu).
 """
 
 from __future__ import annotations
@@ -13,16 +14,19 @@ from typing import Any
 
 from rockyade.blocks.classical import check_classical_overrides
 from rockyade.blocks.geometry import Block
-from rockyade.calibration.equations import paper_calibration, xi_min_eq15
+from rockyade.calibration.calibrate import calibrate
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG
 from rockyade.errors import InputError
+from rockyade.scene import ContactSpec
+from rockyade.scene.model import CALIBRATIONS
 
 CLASSICAL_KEYS = ("alpha_rad", "p_rad_s", "mu")
-METHODS = ("paper", "matched")
+#: Calibration methods offered from identified values (the scene's ``contact.calibration``).
+METHODS = CALIBRATIONS
 
 
 def load_identified(
-    source: str | Path | Mapping[str, Any], *, field: str = "from", named_in: str | None = None
+    source: str | Path | Mapping[str, object], *, field: str = "from", named_in: str | None = None
 ) -> dict[str, Any]:
     """Identified values from a JSON file (or a mapping): alpha_rad, p_rad_s, mu and their intervals.
 
@@ -82,7 +86,7 @@ def load_identified(
 
 def calibrate_from_identified(
     block: Block,
-    identified: str | Path | Mapping[str, Any],
+    identified: str | Path | Mapping[str, object],
     *,
     method: str = "paper",
     stiffness_scale: float | str | None = None,
@@ -98,9 +102,11 @@ def calibrate_from_identified(
         A JSON file written by ``rockyade identify --out`` or a mapping with the same keys.
     method
         ``"paper"`` (damping from Eq 13) or ``"matched"`` (damping such that the reference
-        DEM's effective mu equals the identified mu, :func:`rockyade.calibration.matched.match_beta`).
-    stiffness_scale, friction_angle_deg
-        As for :func:`rockyade.calibration.equations.paper_calibration`.
+        DEM's effective mu equals the identified mu, :func:`rockyade.calibration.matching.match_beta`).
+    stiffness_scale
+        Reading of the paper's K (``"N/m"``, ``"kN/m"``, ``"MN/m"`` or a factor; None: MN/m).
+    friction_angle_deg
+        Joint friction angle, degrees.
 
     Returns
     -------
@@ -114,7 +120,12 @@ def calibrate_from_identified(
         raise InputError("method", f"must be one of {', '.join(METHODS)}, got {method!r}")
     values = load_identified(identified)
     params = {k: float(values[k]) for k in CLASSICAL_KEYS}
-    cal = paper_calibration(block, **params, stiffness_scale=stiffness_scale, friction_angle_deg=friction_angle_deg)
+    contact = ContactSpec(
+        calibration=method,
+        stiffness_scale="MN/m" if stiffness_scale is None else stiffness_scale,
+        friction_angle_deg=friction_angle_deg,
+    )
+    cal = calibrate(block, contact, **params)
     result: dict[str, Any] = {
         "classical": params,
         "classical_ci": {k: values[f"{k}_ci"] for k in CLASSICAL_KEYS if f"{k}_ci" in values},
@@ -123,12 +134,6 @@ def calibrate_from_identified(
         "mass_kg": block.mass_kg,
         **cal.report(),
     }
-    if method == "matched":
-        from rockyade.calibration.matched import match_beta
-
-        matched = match_beta(block, **params, stiffness_scale=stiffness_scale, friction_angle_deg=friction_angle_deg)
-        result.update(matched.as_cli_dict())
-        result["xi_min"] = xi_min_eq15(matched.beta_s, cal.f_min_hz)
     if not math.isfinite(result["beta_s"]):
         raise InputError("mu", f"no damping follows from mu = {params['mu']}")
     return result

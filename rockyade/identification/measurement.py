@@ -76,6 +76,17 @@ def measured_history(
 ) -> MeasuredHistory:
     """Validate samples and wrap them: finite, at least 20, equally spaced, >= 50 Hz.
 
+    Parameters
+    ----------
+    t_s
+        Sample times, s.
+    theta_rad
+        Measured rotation, rad (counter-clockwise positive).
+    source
+        Where the samples come from (a file name), for messages.
+    notes
+        How the rotation was derived (e.g. from LED displacements).
+
     Raises
     ------
     InputError

@@ -22,7 +22,7 @@ from numpy.typing import NDArray
 
 from rockyade.errors import RockyadeError
 from rockyade.identification.measurement import MeasuredHistory, measured_history
-from rockyade.solvers.housner import HousnerModel, solve
+from rockyade.solvers.housner import HousnerModel, Trajectory, solve
 
 #: The fitted unknowns, in the order of the parameter vector.
 FIT_PARAMETERS = ("alpha_rad", "p_rad_s", "mu", "release_time_s", "offset_rad", "release_ratio")
@@ -65,7 +65,15 @@ class FreeRockingFit:
 
     @classmethod
     def from_vector(cls, x: NDArray[np.float64], side: int) -> FreeRockingFit:
-        """Unknowns from a parameter vector."""
+        """Unknowns from a parameter vector.
+
+        Parameters
+        ----------
+        x
+            Values in the order of :data:`FIT_PARAMETERS` (rad, 1/s, -, s, rad, -).
+        side
+            The side the block was tilted to: +1 or -1.
+        """
         return cls(*(float(v) for v in x), side=side)
 
     @property
@@ -74,8 +82,21 @@ class FreeRockingFit:
         return self.side * self.release_ratio * self.alpha_rad
 
 
-def model_history(fit: FreeRockingFit, t0_s: float, dt_s: float, n: int, step_s: float | None = None):
+def model_history(
+    fit: FreeRockingFit, t0_s: float, dt_s: float, n: int, step_s: float | None = None
+) -> tuple[NDArray[np.float64], Trajectory | None, float]:
     """The modelled measurement at t0 + k dt (k = 0..n-1), and Housner's trajectory.
+
+    Parameters
+    ----------
+    fit
+        Values of the six unknowns.
+    t0_s, dt_s
+        Time of the first sample and the sampling interval, s.
+    n
+        Number of samples.
+    step_s
+        Largest step of Housner's solver, s (None: its default).
 
     Returns
     -------
@@ -133,6 +154,23 @@ def synthetic_measurement(
     The release happens at ``hold_s + release_offset_s`` (``release_offset_s`` lets the
     release fall between samples); the noise is Gaussian with standard deviation
     ``noise_rad`` from ``numpy.random.default_rng(seed)``.
+
+    Parameters
+    ----------
+    alpha_rad, p_rad_s, mu
+        The block's classical parameters (rad, 1/s, -).
+    theta0_rad
+        Release tilt, rad (its sign: the side tilted to).
+    rate_hz, duration_s
+        Sampling rate (Hz) and record length (s).
+    hold_s, release_offset_s
+        Hold before the release and the release's offset within a sample interval, s.
+    offset_rad, noise_rad
+        Sensor offset and noise standard deviation, rad.
+    seed
+        Seed of the noise.
+    source
+        Name of the record.
     """
     dt = 1.0 / rate_hz
     n = round(duration_s * rate_hz) + 1

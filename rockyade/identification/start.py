@@ -33,6 +33,18 @@ def quarter_period_p1(ratio: float, alpha_rad: float) -> float:
 
     Exact (Housner's nonlinear equation through the solver); it scales as 1/p. The
     linearised value is arccosh(1 / (1 - ratio)).
+
+    Parameters
+    ----------
+    ratio
+        theta_0 / alpha, in (0, 1).
+    alpha_rad
+        Slenderness angle, rad.
+
+    Returns
+    -------
+    float
+        Time to the first impact, s (for p = 1 rad/s).
     """
     linear = math.acosh(1.0 / (1.0 - ratio))
     model = HousnerModel.symmetric(alpha_rad, 1.0, 1.0)
@@ -76,6 +88,11 @@ def noise_level(theta: NDArray[np.float64]) -> float:
 
     The second difference of white noise has variance 6 sigma^2; the median absolute value
     (/0.6745) ignores the few samples at impacts and keeps the estimate robust.
+
+    Parameters
+    ----------
+    theta
+        Measured rotation at equally spaced samples, rad.
     """
     d2 = np.diff(theta, 2)
     return float(np.median(np.abs(d2)) / 0.6745 / math.sqrt(6.0))
@@ -175,6 +192,11 @@ def _alpha_p_from_half_periods(amplitudes: NDArray[np.float64], half_periods: ND
 
 def initial_guess(history: MeasuredHistory) -> Guess:
     """Starting values from the record's peaks and zero crossings (module docstring).
+
+    Parameters
+    ----------
+    history
+        The measured history (times in s, rotation in rad).
 
     Raises
     ------

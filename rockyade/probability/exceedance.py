@@ -23,7 +23,13 @@ ROCKING_RATIO = 0.01
 
 
 def level_column(level: float) -> str:
-    """Column name of P(max theta/alpha >= level), e.g. ``p_theta_alpha_ge_0.5``."""
+    """Column name of P(max theta/alpha >= level), e.g. ``p_theta_alpha_ge_0.5``.
+
+    Parameters
+    ----------
+    level
+        The level of theta/alpha (-).
+    """
     return f"p_theta_alpha_ge_{level:g}"
 
 
@@ -34,7 +40,18 @@ def _exceeds(frame: pd.DataFrame, level: float) -> np.ndarray:
 
 def exceedance_table(runs: pd.DataFrame, levels: Iterable[float], confidence: float = 0.95) -> pd.DataFrame:
     """Per solver and load factor: runs, failures, P(overturn) and P(theta/alpha >= level),
-    each with its Wilson interval (``_lo``, ``_hi``)."""
+    each with its Wilson interval (``_lo``, ``_hi``).
+
+    Parameters
+    ----------
+    runs
+        One row per run (module docstring): ``solver``, ``load_factor``, ``status``,
+        ``max_theta_over_alpha`` (-).
+    levels
+        Levels of theta/alpha (-), one probability column each (:func:`level_column`).
+    confidence
+        Two-sided level of the intervals.
+    """
     rows = []
     for (solver, lf), group in runs.groupby(["solver", "load_factor"], sort=True):
         done = group[group["status"] != "failed"]
@@ -52,7 +69,17 @@ def exceedance_table(runs: pd.DataFrame, levels: Iterable[float], confidence: fl
 
 
 def fragility_table(runs: pd.DataFrame, measures: Iterable[str]) -> pd.DataFrame:
-    """Lognormal fragility (maximum likelihood on individual runs) per solver and measure."""
+    """Lognormal fragility (maximum likelihood on individual runs) per solver and measure.
+
+    Parameters
+    ----------
+    runs
+        One row per run (module docstring): ``solver``, ``load_factor``, ``status``,
+        ``max_theta_over_alpha`` (-), and a column per measure.
+    measures
+        Intensity-measure columns (units as :mod:`rockyade.motion.intensity` names them,
+        e.g. ``pga_m_s2``).
+    """
     rows = []
     for solver, group in runs.groupby("solver", sort=True):
         done = group[group["status"] != "failed"]
@@ -83,6 +110,12 @@ def spread_table(runs: pd.DataFrame) -> pd.DataFrame:
     the 5 % and 95 % quantiles over samples of the peak theta/alpha; and
     ``theta_spread_factor``, the median of their ratio q95 / q05 over the records that rock
     in every sample (q05 >= ``ROCKING_RATIO``).
+
+    Parameters
+    ----------
+    runs
+        One row per run (module docstring): ``solver``, ``load_factor``, ``status``,
+        ``max_theta_over_alpha`` (-), ``sample``, ``nominal`` and ``record``.
     """
     rows = []
     done = runs[runs["status"] != "failed"].copy()

@@ -61,7 +61,13 @@ class Fragility:
     fraction: float = math.nan
 
     def probability(self, im: ArrayLike) -> np.ndarray:
-        """P(collapse) at intensities ``im``."""
+        """P(collapse) at intensities ``im``.
+
+        Parameters
+        ----------
+        im
+            Intensity-measure values, in the measure's units (e.g. m/s^2 for PGA).
+        """
         x = np.asarray(im, dtype=float)
         if self.status == "separated":
             return (x > self.median).astype(float)
@@ -176,7 +182,15 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
 
 
 def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n."""
+    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n.
+
+    Parameters
+    ----------
+    k, n
+        Successes and trials (n > 0).
+    confidence
+        Two-sided level.
+    """
     if n <= 0 or k < 0 or k > n:
         raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
     a = 1.0 - confidence

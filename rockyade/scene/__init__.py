@@ -4,7 +4,19 @@
 dictionaries read field by field). May import ``blocks``, ``motion`` and ``io``.
 """
 
-from rockyade.scene.loading import load_scene, scene_from_dict
+from typing import Any
+
 from rockyade.scene.model import BlockSpec, ContactSpec, OutputSpec, Scene
 
 __all__ = ["BlockSpec", "ContactSpec", "OutputSpec", "Scene", "load_scene", "scene_from_dict"]
+
+
+def __getattr__(name: str) -> Any:
+    """``load_scene`` and ``scene_from_dict``, imported when first used: reading a scene loads
+    every motion type (scipy, numba), which the scene's dataclasses alone do not need
+    (``rockyade calibrate`` builds a ``ContactSpec`` and stays quick)."""
+    if name in ("load_scene", "scene_from_dict"):
+        from rockyade.scene import loading
+
+        return getattr(loading, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -39,13 +39,15 @@ import math
 import re
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.blocks.classical import ClassicalParameters, classical_parameters
 from rockyade.blocks.geometry import Block
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC
 from rockyade.errors import InputError
-from rockyade.motion.spec import MotionSpec
+
+if TYPE_CHECKING:  # a name only: the dataclasses load without the motion types (scipy, numba)
+    from rockyade.motion.spec import MotionSpec
 
 #: Upper bounds that keep inputs physical (and the arithmetic finite).
 MAX_LENGTH_M = 1000.0

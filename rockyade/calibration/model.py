@@ -1,0 +1,58 @@
+"""The calibrated DEM model of a scene: the stage every DEM solver calls.
+
+Every moving block is calibrated by the scene's method
+(:func:`rockyade.calibration.calibrate.calibrate`; a matched one runs short DEM models of
+the block alone first), then the model is built with those joints
+(:func:`rockyade.dem.build.build_dem_model`, which knows no calibration).
+"""
+
+from __future__ import annotations
+
+from rockyade.calibration.calibrate import calibrate
+from rockyade.constants import G
+from rockyade.dem.build import build_dem_model
+from rockyade.dem.model import DemModel
+from rockyade.scene import Scene
+
+
+def supported_masses(scene: Scene) -> list[float]:
+    """Mass resting on each block's base joint, kg: in a column the block and those above
+    it; in an assembly each block's own mass (the model's statics check the load paths).
+
+    Parameters
+    ----------
+    scene
+        A validated scene (blocks bottom to top).
+    """
+    masses = [b.block().mass_kg for b in scene.blocks]
+    if scene.positioned:
+        return masses
+    return [sum(masses[i:]) for i in range(len(masses))]
+
+
+def calibrated_model(scene: Scene, g: float = G) -> DemModel:
+    """The scene's DEM model, every moving block's joint calibrated first (module docstring).
+
+    Parameters
+    ----------
+    scene
+        A validated scene.
+    g
+        Gravity, m/s^2.
+    """
+    supported = supported_masses(scene)
+    joints = [
+        None
+        if spec.fixed
+        else calibrate(
+            spec.block(),
+            scene.contact,
+            alpha_rad=spec.alpha_rad,
+            p_rad_s=spec.p_rad_s,
+            mu=spec.mu,
+            supported_mass_kg=supported[i],
+            g=g,
+        ).joint
+        for i, spec in enumerate(scene.blocks)
+    ]
+    return build_dem_model(scene, joints, g=g)
