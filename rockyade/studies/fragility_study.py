@@ -17,20 +17,14 @@ from matplotlib.figure import Figure
 from rockyade import paper
 from rockyade.calibration.matched import build_matched_model
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.probability.fragility import Fragility, fit_lognormal
+from rockyade.runner import run_jobs
 from rockyade.scene import scene_from_dict
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import (
-    SOLVER_LABELS,
-    SOLVER_STYLES,
-    Report,
-    block_table,
-    fmt,
-    run_each,
-    run_state,
-    scene_dict,
-)
+from rockyade.studies.report import Report, fmt, run_state
+from rockyade.studies.specimens import block_table, scene_dict
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
 RECORDS = tuple(range(1, 31))
@@ -57,7 +51,8 @@ def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
     """Generate the suite (cached; minutes the first time, with a progress bar) and the
     matched calibrations once, before workers fork."""
     suite = paper_suite()
-    run_each(range(1, suite.count + 1), lambda i: suite_record(suite, i), "fragility: synthetic suite")
+    numbers = range(1, suite.count + 1)
+    run_jobs(numbers, lambda i: suite_record(suite, i), progress=True, desc="fragility: synthetic suite")
     for key in specimens:
         build_matched_model(scene_from_dict(_base(key)))
 
