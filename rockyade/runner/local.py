@@ -67,10 +67,10 @@ def run_local(
                 kill_workers(pool)
                 killed = True
                 break
-            if broken:
+            if broken and failed is not None:  # the pool broke: its other running jobs are lost too
                 for future, i in list(running.items()):
                     running.pop(future)
-                    done(i, failed(jobs[i], WORKER_DIED))  # type: ignore[misc]
+                    done(i, failed(jobs[i], WORKER_DIED))
                 pool = replace_pool(pool, workers)
     except BaseException:
         kill_workers(pool)

@@ -44,11 +44,6 @@ class Task:
     def __post_init__(self) -> None:
         object.__setattr__(self, "scene_hash", self.scene.scene_hash)
 
-    @property
-    def solver_name(self) -> str:
-        """The solver's name."""
-        return self.solver.name
-
     def describe(self) -> str:
         """``run 3 (base = s, motion.record = 2)``: the run as named in errors."""
         labels = ", ".join(f"{k} = {v}" for k, v in self.labels.items())

@@ -14,7 +14,6 @@ name (from a command line or a study file) and refuses one the solver does not t
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkable
@@ -90,7 +89,3 @@ class SolverBase:
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """Itself: this solver keeps no files."""
         return self
-
-    def options(self) -> dict[str, Any]:
-        """The options this solver carries, by name."""
-        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}  # type: ignore[arg-type]
