@@ -3,7 +3,8 @@
 * Single block (specimen 1, paper calibration), 20 s of free rocking at Eq 7's step,
   after JIT warm-up: wall time and ns per block-step (with and without energy terms).
 * Batch API: 1,000 variants of specimen 1 under different harmonic base motions (10 s
-  each), in one ``run_many`` call on 1 and 2 threads: scenes per second.
+  each), through the runner (:func:`rockyade.runner.solve_scenes`) on 1 and 2 threads of
+  this process: scenes per second.
 """
 
 from __future__ import annotations
@@ -14,9 +15,10 @@ import time
 import numpy as np
 
 from rockyade.calibration.model import calibrated_model
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
-from rockyade.solvers.reference import run_many, run_model
-from rockyade.studies.common import block_table
+from rockyade.solvers.reference import ReferenceSolver, run_model
+from rockyade.studies.specimens import block_table
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 
@@ -71,11 +73,12 @@ def batch(n: int = 1000) -> dict[str, float]:
     freqs = rng.uniform(1.0, 7.0, n)
     amps = rng.uniform(0.5e-3, 8e-3, n)
     scenes = [harmonic_scene(f, a) for f, a in zip(freqs, amps, strict=True)]
-    run_many(scenes[:2], workers=2)  # warm-up
+    solver = ReferenceSolver(record_energy=False, record_contacts=False)
+    solve_scenes(solver, scenes[:2], executor=Executor("threads", 2))  # warm-up
     out = {}
     for workers in (1, 2):
         start = time.perf_counter()
-        results = run_many(scenes, workers=workers)
+        results = solve_scenes(solver, scenes, executor=Executor("threads", workers))
         wall = time.perf_counter() - start
         out[f"scenes_per_s_{workers}_workers"] = n / wall
         out[f"wall_s_{workers}_workers"] = wall

@@ -18,10 +18,12 @@ from pathlib import Path
 
 from rockyade.calibration.model import calibrated_model
 from rockyade.errors import InputError
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import yade as yade_backend
 from rockyade.solvers.reference import run_model
-from rockyade.studies.common import block_table
+from rockyade.solvers.yade import YadeSolver
+from rockyade.studies.specimens import block_table
+from rockyade.yade import backend as yade_backend
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 
@@ -149,7 +151,7 @@ def main() -> None:
     scenes = [scene(5.0, 0.05 + 0.01 * k) for k in range(8)]
     for workers in (1, 2):
         start = time.perf_counter()
-        results = yade_backend.run_many(scenes, workers=workers)
+        results = solve_scenes(YadeSolver(), scenes, executor=Executor("threads", workers))
         wall = time.perf_counter() - start
         ok = sum(r.ok for r in results)
         rate = 60 * len(scenes) / wall

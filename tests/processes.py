@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rockyade.solvers import yade as yade_backend
+from rockyade.yade import backend as yade_backend
 
 
 def require_yade() -> None:

@@ -13,8 +13,8 @@ from rockyade.blocks.restitution import find_peaks
 from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner
-from rockyade.solvers.reference import run_model, run_scene
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver, run_model
 
 DENSITY = 2400.0
 
@@ -88,8 +88,8 @@ def test_drum_column_uplifts_as_one_body():
     motion = {"type": "sampled", "t_s": [0.0, duration], "accel_m_s2": [0.0, rate * duration]}
     drums = column_scene(8, 0.3, 0.3, motion, duration)
     monolith = column_scene(1, 0.3, 2.4, motion, duration)
-    dem = run_scene(drums, record_energy=False, record_contacts=False)
-    exact = housner.run_scene(monolith)
+    dem = ReferenceSolver(record_energy=False, record_contacts=False).run(drums)
+    exact = HousnerSolver().run(monolith)
     assert dem.status == "completed"
 
     def level(result, name=None):
@@ -180,7 +180,7 @@ def test_rocking_frame_rocks_as_one_column_with_makris_p():
         }
     )
     dem = run_model(model, record_energy=False, record_contacts=False)
-    exact = housner.run_scene(single)
+    exact = HousnerSolver().run(single)
 
     def first_impact_and_peak(t, theta):
         start = int(np.argmax(np.abs(theta) > 1e-4)) + 5
@@ -196,7 +196,7 @@ def test_rocking_frame_rocks_as_one_column_with_makris_p():
         assert peak_dem == pytest.approx(peak_exact, rel=0.03)
     # a plain column (no beam) rocks with its own, larger p: the test tells them apart
     d = single.to_dict()
-    alone = housner.run_scene(scene_from_dict({**d, "blocks": [{**d["blocks"][0], "p_rad_s": column.p_rad_s}]}))
+    alone = HousnerSolver().run(scene_from_dict({**d, "blocks": [{**d["blocks"][0], "p_rad_s": column.p_rad_s}]}))
     t_alone, peak_alone = first_impact_and_peak(alone.t, alone.series("theta_rad"))
     assert t_alone / t_exact - 1 > 0.05 and peak_alone / peak_exact - 1 > 0.2
 
@@ -235,7 +235,7 @@ def test_thousand_block_wall_stands_under_gravity():
             "motion": {"type": "rest"},
         }
     )
-    result = run_scene(scene, record_energy=False)
+    result = ReferenceSolver(record_energy=False).run(scene)
     assert result.status == "completed" and result.meta["overturn_times_s"] == {}
     names = result.blocks
     x = np.array([result.series("x_m", n) for n in names])

@@ -39,8 +39,8 @@ def test_expand_grid_and_labels(tmp_path):
     assert len(tasks) == 2 * 2 * 2
     assert [t.index for t in tasks] == list(range(8))
     assert tasks[0].labels == {"base": "specimen3", "motion.theta0_rad": 0.03, "blocks.0.p_rad_s": 3.5}
-    assert {t.solver for t in tasks} == {"reference", "housner"}
-    assert tasks[0].scene["blocks"][0]["p_rad_s"] == 3.5
+    assert {t.solver.name for t in tasks} == {"reference", "housner"}
+    assert tasks[0].scene.blocks[0].p_rad_s == 3.5
 
 
 def test_batch_runs_isolates_failures_and_resumes(tmp_path):
@@ -184,13 +184,13 @@ def test_pattern_windows_thresholds_and_overturn():
 def test_pattern_of_a_real_stack_run():
     from rockyade.analysis.patterns import classify_result
     from rockyade.scene import scene_from_dict
-    from rockyade.solvers import reference
+    from rockyade.solvers.reference import ReferenceSolver
 
     d = load_scene(EXAMPLES / "biblock_free.toml").to_dict()
     d["motion"] = {"type": "harmonic", "amplitude_mm": 2.0, "frequency_hz": 6.0, "cycles": 8}
     d["duration_s"] = 3.0
     scene = scene_from_dict(d)
-    report = classify_result(scene, reference.run_scene(scene))
+    report = classify_result(scene, ReferenceSolver().run(scene))
     assert report.dominant == "4"  # 6 Hz / 2 mm: 2.8 m/s^2 lifts the upper block only
 
 

@@ -16,7 +16,7 @@ from rockyade.kernel import simulation as kernel
 from rockyade.kernel.contacts import NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix
-from rockyade.solvers.reference import run_model, run_scene
+from rockyade.solvers.reference import ReferenceSolver, run_model
 
 EXPLICIT = {"K_N_per_m": 1e8, "Ks_N_per_m": 1e8, "beta_s": 1e-4, "friction_angle_deg": 35.0}
 
@@ -197,8 +197,8 @@ def test_block_on_a_fixed_pedestal_rocks_as_on_the_base():
         contact=EXPLICIT,
         duration=2.0,
     )
-    a = run_scene(on_base)
-    b = run_scene(pedestal)
+    a = ReferenceSolver().run(on_base)
+    b = ReferenceSolver().run(pedestal)
     theta_a, theta_b = a.series("theta_rad"), b.series("theta_rad", "b")
     assert np.max(np.abs(theta_b - theta_a)) < 1e-3 * np.max(np.abs(theta_a))
     assert np.all(b.series("x_m", "ped") == 0.0) and np.all(b.series("theta_rad", "ped") == 0.0)
@@ -260,7 +260,7 @@ def test_pad_case_keeps_overlaps_below_a_millimetre():
     the pad out; no two bodies ever overlap by more than 1 mm."""
     sc = scene(PAD_BLOCKS, motion=PAD_PULSE, contact=EXPLICIT, duration=2.0, sample_dt=0.002)
     model = calibrated_model(sc)
-    result = run_scene(sc)
+    result = ReferenceSolver().run(sc)
     assert result.status == "completed"
     theta = result.series("theta_rad", "upper")
     assert np.max(np.abs(theta)) > math.atan2(0.1, 0.25)  # tilted far enough to reach the lower block
@@ -305,7 +305,7 @@ def test_assembly_runs_on_when_a_block_falls():
     column scenes stop at the first overturn, as before."""
     blocks = [block("slender", 0.1, 1.0, 0.0, 0.0), block("squat", 0.6, 0.3, 1.0, 0.0)]
     pulse = {"type": "pulse", "shape": "sine", "amplitude_g": 0.6, "period_s": 0.5}
-    result = run_scene(scene(blocks, motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002))
+    result = ReferenceSolver().run(scene(blocks, motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002))
     assert result.status == "overturned" and result.t[-1] == pytest.approx(2.5)
     assert set(result.meta["overturn_times_s"]) == {"slender"}
     t_fall = result.meta["overturn_times_s"]["slender"]
@@ -313,7 +313,7 @@ def test_assembly_runs_on_when_a_block_falls():
     theta = np.abs(result.series("theta_rad", "slender"))
     assert result.t[np.argmax(theta >= math.pi / 2 - LANDING_TOL_RAD)] == pytest.approx(t_fall, abs=0.002)
     column = scene([block("slender", 0.1, 1.0)], motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002)
-    stopped = run_scene(column)
+    stopped = ReferenceSolver().run(column)
     assert stopped.status == "overturned" and stopped.meta["overturn_time_s"] == pytest.approx(t_fall, abs=1e-9)
     out, _ = simulate_model(calibrated_model(column), False, stop_angle_rad=np.array([0.5]))
     assert out.status == kernel.STATUS_OVERTURNED and out.t_stop < t_fall

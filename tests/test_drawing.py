@@ -23,7 +23,7 @@ from rockyade.result import Result
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import arch, rocking_frame, stack, wall, write_scene
 from rockyade.scene.placement import placed_blocks, rotation_matrix
-from rockyade.solvers import get_solver
+from rockyade.solvers import make_solver
 
 from .conftest import EXAMPLES
 
@@ -102,7 +102,7 @@ def test_snapshots_and_animation_of_a_real_reference_run(tmp_path):
             motion={"type": "pulse", "shape": "sine", "amplitude_g": 0.4, "period_s": 0.4},
         )
     )
-    result = get_solver("reference")(scene)
+    result = make_solver("reference").run(scene)
     assert result.status == "completed"
     peak = max(np.abs(result.series("theta_rad", b)).max() for b in ("column_left", "column_right"))
     assert peak > 0.01  # the frame rocks: the snapshots show something

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rockyade.cost import estimate_cost
+from rockyade.runner.cost import estimate_cost
 from rockyade.scene import load_scene, scene_from_dict
 
 from .conftest import EXAMPLES
@@ -186,13 +186,13 @@ def _get(d: Any, path: tuple) -> Any:
 
 
 def _run(d: dict) -> None:
-    from rockyade.cost import check_cost
-    from rockyade.solvers import get_solver
+    from rockyade.runner.cost import check_cost
+    from rockyade.solvers import make_solver
 
     scene = scene_from_dict(d, source="fuzz.toml")
     for solver in ("housner", "reference"):
         check_cost(scene, solver)
-        result = get_solver(solver)(scene)
+        result = make_solver(solver).run(scene)
         assert result.status in ("completed", "overturned", "failed")
 
 

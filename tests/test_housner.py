@@ -12,8 +12,7 @@ from rockyade.blocks.restitution import effective_restitution, find_peaks, resti
 from rockyade.constants import G
 from rockyade.motion.ground import GroundMotion
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner
-from rockyade.solvers.housner import HousnerModel, solve
+from rockyade.solvers.housner import HousnerModel, HousnerSolver, solve
 
 from .conftest import free_scene_dict
 
@@ -117,7 +116,7 @@ def test_asymmetric_model_uses_both_pivots():
 
 def test_run_scene_csv_peak_decay_gives_mu(tmp_path):
     scene = scene_from_dict(free_scene_dict())
-    result = housner.run_scene(scene)
+    result = HousnerSolver().run(scene)
     out = tmp_path / "r.csv"
     result.write(out)
     from rockyade.result import Result
@@ -136,12 +135,12 @@ def test_run_scene_refuses_stacks(examples_dir):
     from rockyade.scene import load_scene
 
     with pytest.raises(InputError, match="one block"):
-        housner.run_scene(load_scene(examples_dir / "biblock_free.toml"))
+        HousnerSolver().run(load_scene(examples_dir / "biblock_free.toml"))
 
 
 def test_overturned_history_ends_at_overturn():
     scene = scene_from_dict(free_scene_dict(theta0=0.24, duration=5.0))
-    result = housner.run_scene(scene)
+    result = HousnerSolver().run(scene)
     assert result.status == "overturned"
     assert result.t[-1] <= result.meta["overturn_time_s"]
     assert result.meta["overturned_block"] == "specimen1"
@@ -152,6 +151,6 @@ def test_top_acceleration_at_rest_is_the_base_acceleration():
     a = 0.5 * np.sin(2 * math.pi * t)
     d = free_scene_dict(duration=1.0)
     d["motion"] = {"type": "sampled", "dt_s": 0.01, "accel_m_s2": a.tolist()}
-    result = housner.run_scene(scene_from_dict(d))
+    result = HousnerSolver().run(scene_from_dict(d))
     assert np.allclose(result.series("ax_m_s2"), np.interp(result.t, t, a), atol=1e-12)
     assert np.allclose(result.series("theta_rad"), 0.0)

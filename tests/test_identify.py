@@ -230,7 +230,7 @@ def test_identify_calibrate_matched_then_reference_dem_reproduces_mu(tmp_path):
     from the identified release tilt: its effective mu equals the identified mu within 0.5 %."""
     from rockyade.analysis.metrics import run_metrics
     from rockyade.scene import scene_from_dict
-    from rockyade.solvers import reference
+    from rockyade.solvers.reference import ReferenceSolver
 
     result = identify(read_measurement(MEASURED))
     spec = paper.specimen(1)
@@ -258,7 +258,7 @@ def test_identify_calibrate_matched_then_reference_dem_reproduces_mu(tmp_path):
                 "motion": {"type": "free", "theta0_rad": abs(ident["release_theta_rad"])},
             }
         )
-        run = reference.run_scene(scene, record_energy=False, record_contacts=False)
+        run = ReferenceSolver(record_energy=False, record_contacts=False).run(scene)
         return run_metrics(scene, run)["block"]["mu_eff"]
 
     mu_dem = dem_mu(cal["beta_s"])

@@ -15,9 +15,10 @@ from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.dem.build import build_dem_model, contact_polygon
 from rockyade.errors import CalibrationError, InputError
+from rockyade.runner import IN_THIS_THREAD, Executor, solve_scenes
 from rockyade.scene import ContactSpec, load_scene, scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.solvers.reference import run_many, run_model
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver, run_model
 
 from .conftest import EXAMPLES
 
@@ -40,8 +41,8 @@ def _peaks(result, block=None, alpha=0.1):
 def free_rocking(request):
     """Matched reference DEM and exact Housner for one specimen's free rocking."""
     scene = _matched(f"specimen{request.param}_free.toml")
-    dem = reference.run_scene(scene)
-    exact = housner.run_scene(scene)
+    dem = ReferenceSolver().run(scene)
+    exact = HousnerSolver().run(scene)
     return request.param, scene, dem, exact
 
 
@@ -104,7 +105,7 @@ def test_block_at_rest_stays_at_rest_and_uplifts_just_above():
             "dt_s": 0.005,
             "accel_m_s2": (factor * uplift * np.sin(2 * math.pi * 2 * t)).tolist(),
         }
-        results[factor] = reference.run_scene(scene_from_dict(d))
+        results[factor] = ReferenceSolver().run(scene_from_dict(d))
     below = results[0.95]
     theta = below.series("theta_rad")
     # only the elastic tilt of the contact springs (~ 3e-6 rad), no rocking, no drift
@@ -127,7 +128,7 @@ def test_sliding_with_the_coulomb_force():
         "contact": {"calibration": "paper", "friction_angle_deg": 10.0},
         "motion": {"type": "sampled", "t_s": [0.0, 0.05, 2.0], "accel_m_s2": [0.0, 3.0, 3.0]},
     }
-    result = reference.run_scene(scene_from_dict(d))
+    result = ReferenceSolver().run(scene_from_dict(d))
     t, x = result.t, result.series("x_m")
     late = t > 0.5
     a_rel = 2.0 * np.polyfit(t[late], x[late], 2)[0]
@@ -146,10 +147,10 @@ def test_biblock_upper_block_matches_housner():
     follows Housner with its own parameters over five peaks.
     """
     scene = load_scene(EXAMPLES / "biblock_free.toml")
-    stack = reference.run_scene(scene)
+    stack = ReferenceSolver().run(scene)
     d = scene.to_dict()
     single = dict(d, blocks=[d["blocks"][1]], motion={k: v for k, v in d["motion"].items() if k != "block"})
-    exact = housner.run_scene(scene_from_dict(single))
+    exact = HousnerSolver().run(scene_from_dict(single))
     up = stack.series("theta_rad", "upper")
     first_impact = stack.t[np.nonzero(np.sign(up[1:]) != np.sign(up[:-1]))[0][0]]
     exact_theta = exact.series("theta_rad")
@@ -163,7 +164,7 @@ def test_biblock_upper_block_matches_housner():
     d_rigid = scene.to_dict()
     d_rigid["blocks"][0]["mass_kg"] = 204_000
     d_rigid["contact"]["beta_s"] = beta
-    rigid = reference.run_scene(scene_from_dict(d_rigid))
+    rigid = ReferenceSolver().run(scene_from_dict(d_rigid))
     pd_, ph = _peaks(rigid, "upper", 0.229), _peaks(exact, alpha=0.229)
     assert np.max(np.abs(pd_.amplitude_rad[:5] / ph.amplitude_rad[:5] - 1)) < 0.02
     assert np.max(np.abs(pd_.t_s[:5] / ph.t_s[:5] - 1)) < 0.02
@@ -264,7 +265,7 @@ def test_unreachable_target_fails_clearly():
 
 def test_every_example_runs(examples_dir):
     for path in sorted(examples_dir.glob("*_free.toml")):
-        result = reference.run_scene(load_scene(path))
+        result = ReferenceSolver().run(load_scene(path))
         assert result.status == "completed"
         assert result.meta["dt_s"] <= result.meta["dt_stability_limit_s"]
         for name in result.blocks:
@@ -273,7 +274,7 @@ def test_every_example_runs(examples_dir):
 
 def test_outputs_schema_and_top_acceleration():
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
-    result = reference.run_scene(scene)
+    result = ReferenceSolver().run(scene)
     frame = result.frame
     for col in (
         "t_s",
@@ -292,12 +293,12 @@ def test_outputs_schema_and_top_acceleration():
     ):
         assert col in frame.columns
     assert frame["t_s"].iloc[0] == 0.0 and np.allclose(np.diff(frame["t_s"]), 0.001)
-    exact = housner.run_scene(scene)
+    exact = HousnerSolver().run(scene)
     # between impacts the top accelerations follow the rigid-body kinematics of Housner
     window = (result.t > 0.05) & (result.t < 0.25)
     assert np.allclose(result.series("ax_m_s2")[window], exact.series("ax_m_s2")[window], rtol=0.05, atol=0.05)
     filtered = scene_from_dict({**scene.to_dict(), "output": {"accel_lowpass_hz": 20.0}})
-    smooth = reference.run_scene(filtered)
+    smooth = ReferenceSolver().run(filtered)
     assert np.max(np.abs(smooth.series("ay_m_s2"))) < np.max(np.abs(result.series("ay_m_s2")))
 
 
@@ -307,8 +308,9 @@ def test_run_many_in_parallel_equals_sequential():
         scene_from_dict({**scene.to_dict(), "motion": {"type": "free", "theta0_rad": th}})
         for th in (0.05, 0.08, 0.1, 0.12)
     ]
-    parallel = run_many(scenes, workers=2)
-    serial = run_many(scenes, workers=1)
+    quiet = ReferenceSolver(record_energy=False, record_contacts=False)
+    parallel = solve_scenes(quiet, scenes, executor=Executor("threads", 2))
+    serial = solve_scenes(quiet, scenes, executor=IN_THIS_THREAD)
     for a, b in zip(parallel, serial, strict=True):
         np.testing.assert_array_equal(a.series("theta_rad"), b.series("theta_rad"))
     bad = scene_from_dict(
@@ -318,7 +320,7 @@ def test_run_many_in_parallel_equals_sequential():
             "blocks": [{**scene.to_dict()["blocks"][0], "mu": 0.999}],
         }
     )
-    out = run_many([scenes[0], bad], workers=2)
+    out = solve_scenes(quiet, [scenes[0], bad], executor=Executor("threads", 2))
     assert out[0].status == "completed" and out[1].status == "failed"
     assert "CalibrationError" in out[1].meta["failure_reason"]
 
@@ -337,7 +339,7 @@ def test_friction_energy_of_a_sliding_block_is_coulomb_force_times_slip():
             "motion": {"type": "sampled", "t_s": [0.0, 0.001, 2.0], "accel_m_s2": [0.0, 0.65 * G, 0.65 * G]},
         }
     )
-    dem = reference.run_scene(scene)
+    dem = ReferenceSolver().run(scene)
     x = dem.series("x_m")
     slip = -x[-1]  # the block lags the table
     assert slip == pytest.approx(0.5 * (0.65 - math.tan(math.radians(30.0))) * G * 1.0**2, rel=0.01)
@@ -355,7 +357,7 @@ def test_run_compare_and_the_matched_calibration_count_the_same_impacts():
     from rockyade.calibration import matching
 
     scene = load_scene(EXAMPLES / "specimen1_free.toml")
-    dem = reference.run_scene(scene)
+    dem = ReferenceSolver().run(scene)
     table = compare(scene, {"reference": dem})
     from_compare = float(table[(table.metric == "mu_eff") & (table.solver == "reference")]["value"].iloc[0])
     from_run = run_metrics(scene, dem)["specimen1"]["mu_eff"]

@@ -270,13 +270,11 @@ def test_full_disk_fails_one_run_and_the_batch_goes_on(tmp_path, monkeypatch):
     real_fsync = os.fsync
     victim = tasks[1]
 
-    from rockyade.scene import scene_from_dict
-
-    victim_hash = scene_from_dict(victim.scene).scene_hash
+    victim_hash = victim.scene_hash
 
     def fsync(fd: int) -> None:
         path = os.readlink(f"/proc/self/fd/{fd}")
-        if victim_hash in path and victim.solver in path:
+        if victim_hash in path and victim.solver.name in path:
             raise OSError(errno.ENOSPC, "No space left on device")
         real_fsync(fd)
 
@@ -287,7 +285,7 @@ def test_full_disk_fails_one_run_and_the_batch_goes_on(tmp_path, monkeypatch):
     assert "cannot write the result" in failed.failure_reason.iloc[0] and "disk full" in failed.failure_reason.iloc[0]
     assert (summary.drop(index=1).status == "completed").all()
     assert not _leftovers(tmp_path)
-    assert not list((tmp_path / "runs").glob(f"{victim_hash}_{victim.solver}.*"))
+    assert not list((tmp_path / "runs").glob(f"{victim_hash}_{victim.solver.name}.*"))
 
 
 def test_tiny_tmpfs_full_disk_is_a_clear_failure(tmp_path):

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from rockyade.cli import main
-from rockyade.cost import LIMITS, check_cost, estimate_cost
 from rockyade.errors import InputError
+from rockyade.runner.cost import LIMITS, check_cost, estimate_cost
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.scene.bounds import BOUNDS
 

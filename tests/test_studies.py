@@ -16,19 +16,15 @@ import pytest
 from matplotlib.colors import to_rgb
 
 from rockyade.constants import G
+from rockyade.dem.statics import column_uplift
+from rockyade.figures.styles import SOLVER_STYLES
 from rockyade.motion.analytic import Harmonic
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies import fragility_study, harmonic, overturning, paper, pattern_map
-from rockyade.studies.common import (
-    SOLVER_STYLES,
-    Report,
-    biblock_blocks,
-    block_table,
-    no_uplift_note,
-    scene_dict,
-    uplift_acceleration,
-)
+from rockyade.studies.report import Report, no_uplift_note
+from rockyade.studies.specimens import biblock_blocks, block_table, scene_dict
 
 ROCKYADE = Path(sys.executable).parent / "rockyade"
 
@@ -115,7 +111,7 @@ def test_all_runs_succeeded_is_stated(tmp_path):
 
 def test_uplift_of_one_block_is_g_tan_alpha():
     scene = scene_from_dict(scene_dict([block_table("3")], {"type": "free", "theta0_rad": 0.01}, 1.0))
-    up = uplift_acceleration(scene)
+    up = column_uplift(scene)
     assert up.accel_m_s2 == pytest.approx(G * math.tan(0.154), rel=1e-12)
     assert up.mechanism == "specimen3 rocking on the base"
 
@@ -127,7 +123,7 @@ def test_uplift_of_the_biblock_is_its_weakest_mechanism():
     upper_alone = G * math.tan(0.229)
     h_stack = (204 * 0.3 + 91 * (0.6 + 0.3)) / (204 + 91)
     stack = G * 0.3 * math.tan(0.366) / h_stack
-    up = uplift_acceleration(scene)
+    up = column_uplift(scene)
     assert up.accel_m_s2 == pytest.approx(min(upper_alone, stack), rel=1e-12)
     assert up.mechanism == "upper rocking on lower"
 
@@ -137,8 +133,8 @@ def _harmonic_case(key: str, freq: float, amp: float, cycles: int = 3) -> dict:
     d = scene_dict([block_table(key)], harmonic._motion(freq, amp) | {"cycles": cycles}, h.phases_s["end_s"] + 1.0)
     scene = scene_from_dict(d)
     results = {
-        "housner": housner.run_scene(scene),
-        "reference": reference.run_scene(scene, record_energy=False, record_contacts=False),
+        "housner": HousnerSolver().run(scene),
+        "reference": ReferenceSolver(record_energy=False, record_contacts=False).run(scene),
     }
     return {
         "name": f"specimen{key}_{freq:g}Hz_{amp:g}mm",

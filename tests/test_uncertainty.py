@@ -42,7 +42,7 @@ def _study(**changes) -> dict:
 
 def test_small_study_probabilities_match_independent_runs(tmp_path):
     from rockyade.scene import scene_from_dict
-    from rockyade.solvers import housner
+    from rockyade.solvers.housner import HousnerSolver
 
     study = uncertainty_study_from_dict(_study())
     result = run_uncertainty(study, tmp_path, workers=1, progress=False)
@@ -74,7 +74,7 @@ def test_small_study_probabilities_match_independent_runs(tmp_path):
     rec = int(one["record"].split("-")[1])
     motion = {"type": "synthetic", "suite": "paper", "record": rec, "load_factor": one["load_factor"]}
     scene = scene_from_dict({"duration_s": 20.0, "sample_dt_s": 0.01, "blocks": [block], "motion": motion})
-    direct = housner.run_scene(scene)
+    direct = HousnerSolver().run(scene)
     assert direct.status == one["status"]
     peak = np.max(np.abs(direct.series("theta_rad"))) / one["alpha_rad"]
     assert peak == pytest.approx(one["max_theta_over_alpha"], rel=1e-9)

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from rockyade.solvers import yade as yade_backend
+from rockyade.yade import backend as yade_backend
 
 from .conftest import EXAMPLES, ROOT
 

@@ -26,9 +26,12 @@ from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.calibration.calibrate import calibrate
 from rockyade.calibration.model import calibrated_model
 from rockyade.result import Result
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import ContactSpec, load_scene, scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.solvers import yade as yade_backend
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.yade import backend as yade_backend
 from rockyade.yade import payload as yade_payload
 
 from .conftest import EXAMPLES
@@ -226,7 +229,7 @@ def test_yade_run_listens_on_no_port(tmp_path):
 @pytest.fixture(scope="module", params=["1", "2", "3", "4"])
 def free_rocking(request):
     scene = _matched(f"specimen{request.param}_free.toml")
-    return request.param, scene, yade_backend.run_scene(scene), reference.run_scene(scene)
+    return request.param, scene, YadeSolver().run(scene), ReferenceSolver().run(scene)
 
 
 def test_free_rocking_yade_vs_reference(free_rocking):
@@ -263,7 +266,7 @@ def test_free_rocking_yade_vs_housner(free_rocking):
     key, scene, y, _ = free_rocking
     alpha = scene.blocks[0].alpha_rad
     mu_yade = effective_restitution(find_peaks(y.t, y.series("theta_rad"), 1e-3 * alpha), alpha, 4)
-    exact = housner.run_scene(scene)
+    exact = HousnerSolver().run(scene)
     mu_exact = effective_restitution(find_peaks(exact.t, exact.series("theta_rad"), 1e-3 * alpha), alpha, 4)
     assert mu_exact == pytest.approx(paper.specimen(key).experimental["mu"], rel=1e-4)
     assert mu_yade == pytest.approx(mu_exact, rel=0.01)
@@ -276,7 +279,7 @@ def test_theta_sign_follows_the_convention():
     d["motion"]["theta0_rad"] = -0.07
     d["duration_s"] = 1.5
     scene = scene_from_dict(d)
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.series("theta_rad")[0] == pytest.approx(-0.07)
     py, pr = (find_peaks(x.t, x.series("theta_rad"), 1e-4) for x in (y, r))
     assert py.theta_rad[0] > 0 and np.sign(py.theta_rad[:3]).tolist() == np.sign(pr.theta_rad[:3]).tolist()
@@ -286,7 +289,7 @@ def test_theta_sign_follows_the_convention():
 def test_harmonic_yade_vs_reference():
     """Specimen 1 on the shake table at 3.3 Hz, 6 mm: max |theta| within 5 %."""
     scene = load_scene(EXAMPLES / "specimen1_harmonic.toml")
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.status == r.status == "completed"
     my, mr = (np.max(np.abs(x.series("theta_rad"))) for x in (y, r))
     assert mr > 0.01  # it rocks
@@ -298,7 +301,7 @@ def test_biblock_upper_block_yade_vs_reference():
     """Free rocking of the upper block of the stack: YADE and the reference DEM within 3 %
     (first three peaks and their times, both blocks)."""
     scene = load_scene(EXAMPLES / "biblock_free.toml")
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.status == "completed", y.meta.get("failure_reason")
     py, pr = (find_peaks(x.t, x.series("theta_rad", "upper"), 1e-4) for x in (y, r))
     assert np.max(np.abs(py.amplitude_rad[:3] / pr.amplitude_rad[:3] - 1)) < 0.03
@@ -309,7 +312,7 @@ def test_biblock_upper_block_yade_vs_reference():
 
 def test_overturning_in_yade():
     scene = load_scene(EXAMPLES / "specimen1_pulse.toml")
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.status == r.status == "overturned"
     assert y.meta["overturn_time_s"] == pytest.approx(r.meta["overturn_time_s"], rel=0.02)
     assert y.t[-1] <= y.meta["overturn_time_s"] + 1e-9
@@ -328,7 +331,7 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
         return payload
 
     monkeypatch.setattr(yade_backend, "scene_payload", broken)
-    result = yade_backend.run_scene(scene, workdir=tmp_path, name="bad")
+    result = YadeSolver(workdir=tmp_path, stem="bad").run(scene)
     assert result.status == "failed" and not result.ok
     assert "exited with code 1" in result.meta["failure_reason"] and "KeyError" in result.meta["failure_reason"]
     assert Path(result.meta["log_path"]).is_file() and "Traceback" in Path(result.meta["log_path"]).read_text()
@@ -354,7 +357,7 @@ def test_instability_inside_yade_gives_failed_result(tmp_path):
 def test_timeout_gives_failed_result(tmp_path):
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 60.0})
     start = time.time()
-    result = yade_backend.run_scene(scene, workdir=tmp_path, name="slow", timeout_s=3.0)
+    result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=3.0).run(scene)
     assert time.time() - start < 30
     assert result.status == "failed" and result.meta["failure_reason"].startswith("timeout")
     assert not (tmp_path / "slow.yade.npz").exists()
@@ -380,8 +383,8 @@ def test_parallel_runs_do_not_interfere():
         scene_from_dict({**base, "duration_s": 1.5, "motion": {"type": "free", "theta0_rad": th}})
         for th in (0.03, 0.06)
     ]
-    parallel = yade_backend.run_many(scenes, workers=2)
-    serial = [yade_backend.run_scene(s) for s in scenes]
+    parallel = solve_scenes(YadeSolver(), scenes, executor=Executor("threads", 2))
+    serial = [YadeSolver().run(s) for s in scenes]
     for a, b in zip(parallel, serial, strict=True):
         assert a.ok and b.ok
         np.testing.assert_array_equal(a.series("theta_rad"), b.series("theta_rad"))
@@ -559,7 +562,7 @@ def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
     scene = load_scene(Path("s3.json"))
     model = calibrated_model(scene)
     by_hand = yade_backend._parse(model, Path("by_hand/result.npz"), None, Path("none.log"), 0.0, None)
-    backend = yade_backend.run_scene(scene)
+    backend = YadeSolver().run(scene)
     assert by_hand.ok and backend.ok
     np.testing.assert_array_equal(by_hand.series("theta_rad"), backend.series("theta_rad"))
     table = __import__("pandas").read_csv("by_hand/result.csv")
@@ -574,7 +577,7 @@ def test_study_file_yade_timeout(tmp_path):
     _short_scene_file(tmp_path)
     body = '\nsolvers = ["yade"]\n[base]\nfile = "s3.json"\n'
     (tmp_path / "ok.toml").write_text("yade_timeout_s = 90" + body)
-    assert {t.yade_timeout_s for t in load_study(tmp_path / "ok.toml", tmp_path / "out").tasks} == {90.0}
+    assert {t.solver.timeout_s for t in load_study(tmp_path / "ok.toml", tmp_path / "out").tasks} == {90.0}
     (tmp_path / "bad.toml").write_text("yade_timeout_s = -1" + body)
     with pytest.raises(InputError, match="yade_timeout_s"):
         load_study(tmp_path / "bad.toml", tmp_path / "out")

@@ -23,8 +23,11 @@ from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix
-from rockyade.solvers import housner, reference
-from rockyade.solvers import yade as yade_backend
+from rockyade.solvers import reference
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.yade import backend as yade_backend
 from rockyade.yade.contacts import BASE_BIT, N_LABELS, body_row, plan_contacts
 from rockyade.yade.payload import scene_payload, sphere_radii
 
@@ -232,7 +235,7 @@ def test_flush_stack_is_one_joint_per_interface():
     normal forces; each interface carries the weight above it."""
     scene = flush_stack(3)
     model = calibrated_model(scene)
-    result = yade_backend.run_scene(scene)
+    result = YadeSolver().run(scene)
     assert result.ok, result.meta.get("failure_reason")
     statics = _statics_end_forces(model)
     yade = _yade_end_forces(model, result)
@@ -252,7 +255,7 @@ def test_frame_at_rest_splits_its_load_as_the_statics():
     radius from the joint ends)."""
     scene = frame()
     model = calibrated_model(scene)
-    result = yade_backend.run_scene(scene)
+    result = YadeSolver().run(scene)
     assert result.ok, result.meta.get("failure_reason")
     statics = _statics_end_forces(model)
     yade = _yade_end_forces(model, result)
@@ -265,7 +268,7 @@ def test_pad_case_blocks_do_not_pass_through_each_other():
     backend let it sink 117 mm)."""
     scene = pad_case()
     model = calibrated_model(scene)
-    result = yade_backend.run_scene(scene)
+    result = YadeSolver().run(scene)
     assert result.ok, result.meta.get("failure_reason")
     worst = _max_overlap(model, result)
     assert worst < 1e-3
@@ -294,7 +297,7 @@ def _max_overlap(model, result) -> float:
 
 def _column_pulse(blocks):
     motion = {"type": "pulse", "shape": "sine", "amplitude_g": 0.4, "period_s": 0.5}
-    return yade_backend.run_scene(_scene(blocks, motion=motion, duration=1.5))
+    return YadeSolver().run(_scene(blocks, motion=motion, duration=1.5))
 
 
 def test_fixed_pedestal_and_rest_rotation_are_the_base_and_no_rotation():
@@ -318,7 +321,7 @@ def test_wall_beyond_30_blocks_stands():
     """A 44-block running-bond wall (shared mask labels) at rest: no block moves more than
     0.2 mm or turns more than 1e-3 rad."""
     scene = running_bond(courses=8, units=5, duration=0.2)
-    result = yade_backend.run_scene(scene)
+    result = YadeSolver().run(scene)
     assert result.ok, result.meta.get("failure_reason")
     names = result.meta["blocks"]
     assert len(names) > N_LABELS
@@ -355,7 +358,7 @@ def test_frame_rocks_like_one_column_with_p_hat():
     columns, beam = model.bodies[:2], model.bodies[2]
     gamma = beam.mass_kg / sum(c.mass_kg for c in columns)
     p_hat = columns[0].p_rad_s * math.sqrt((1 + 2 * gamma) / (1 + 3 * gamma))
-    result = yade_backend.run_scene(scene)
+    result = YadeSolver().run(scene)
     assert result.status in ("completed", "overturned"), result.meta.get("failure_reason")
     column = scene_from_dict(
         {
@@ -375,7 +378,7 @@ def test_frame_rocks_like_one_column_with_p_hat():
             "motion": scene.motion.to_dict(),
         }
     )
-    exact = housner.run_scene(column)
+    exact = HousnerSolver().run(column)
     peak_h, t_peak_h, impact_h = _first_peak_and_impact(exact.t, exact.series("theta_rad"), alpha)
     for name in ("left", "right"):
         peak, t_peak, impact = _first_peak_and_impact(result.t, result.series("theta_rad", name), alpha)
@@ -392,7 +395,7 @@ def _reference_runs_assemblies() -> str | None:
     """None when the reference DEM runs assemblies (fixed bodies, flush joints), else why not."""
     blocks = [_block("floor", 0.0, 0.0, 0.6, 0.1, fixed=True), _block("b", 0.0, 0.1, 0.3, 0.6)]
     try:
-        reference.run_scene(_scene(blocks, duration=0.002))
+        ReferenceSolver().run(_scene(blocks, duration=0.002))
     except InputError as exc:
         return f"the reference DEM does not run assemblies yet ({exc})"
     return None

@@ -17,7 +17,9 @@ from rockyade.analysis.collapse import collapse_report
 from rockyade.calibration.model import calibrated_model
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import reference
-from rockyade.solvers import yade as yade_backend
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.yade import backend as yade_backend
 
 from .conftest import EXAMPLES
 from .processes import require_yade
@@ -86,7 +88,7 @@ def test_sliding_slab_slips_in_yade_as_in_the_reference():
     """A squat slab (never rocks) on a base accelerating at 3 m/s^2 > g tan(10 deg): from the
     start of the plateau its two base corners slip, in YADE as in the reference DEM."""
     scene = _slab({"type": "sampled", "t_s": [0.0, 0.05, 2.0], "accel_m_s2": [0.0, 3.0, 3.0]})
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.ok, y.meta.get("failure_reason")
     for column in ("n_contacts", "slipping"):
         assert y.frame[column].dtype == r.frame[column].dtype
@@ -102,7 +104,7 @@ def test_slab_at_rest_does_not_slip():
     """At rest on the base both corners carry the weight and none slips (a flag that is
     always on, or always off, fails one of these two tests)."""
     scene = _slab({"type": "rest"})
-    y = yade_backend.run_scene(scene)
+    y = YadeSolver().run(scene)
     assert y.ok, y.meta.get("failure_reason")
     assert not y.frame["slipping"].any()
     # YADE's contacts at a sample are those of the step before (none at t = 0)
@@ -117,7 +119,7 @@ def test_drums_of_a_rocking_column_slide_as_briefly_as_in_the_reference():
     data = load_scene(EXAMPLES / "assemblies/column_8_drums.toml").to_dict()
     data.update(duration_s=3.0, motion={"type": "pulse", "shape": "sine", "amplitude_g": 0.25, "period_s": 1.0})
     scene = scene_from_dict(data)
-    y, r = yade_backend.run_scene(scene), reference.run_scene(scene)
+    y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.ok, y.meta.get("failure_reason")
     ry, rr = (collapse_report(scene, x).set_index("block") for x in (y, r))
     top_y, top_r = ry.loc["d08", "sliding_time_s"], rr.loc["d08", "sliding_time_s"]

@@ -15,30 +15,21 @@ def cmd_run(args: argparse.Namespace) -> int:
     """Run a scene through a solver."""
     import contextlib
 
-    from rockyade.cost import check_cost
     from rockyade.io.locking import output_lock
+    from rockyade.runner.cost import check_cost
     from rockyade.scene import load_scene
-    from rockyade.solvers import get_solver
 
     for option, suffix in (("out", ".csv"), ("plot", ".png")):
         if getattr(args, option):
             check_output_file(getattr(args, option), option, suffix)
+    [solver] = solvers_from_args([args.solver], args)
     scene = load_scene(args.scene)
     check_run_drawings(args)
-    check_cost(scene, args.solver, allow_large=args.allow_large)
-    solver = get_solver(args.solver)
-    timeout = None
-    if args.solver == "yade":
-        from rockyade.solvers.yade import check_timeout
-
-        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
+    check_cost(scene, solver, allow_large=args.allow_large)
+    if args.out:  # files the solver keeps (YADE's log and scene data) go beside the result
+        solver = solver.keeping_files(args.out.parent, args.out.stem)
     with output_lock(args.out) if args.out else contextlib.nullcontext():
-        if args.solver == "yade":
-            # YADE's log and scene data are kept beside the result
-            where = {"workdir": args.out.parent, "name": args.out.stem} if args.out else {}
-            result = solver(scene, timeout_s=timeout, **where)
-        else:
-            result = solver(scene)
+        result = solver.run(scene)
         if args.out:
             json_path = result.write(args.out)
             print(f"wrote {args.out} and {json_path}")
@@ -125,7 +116,7 @@ def cmd_tables(args: argparse.Namespace) -> int:
 
 
 def add_yade_timeout(p: Any) -> None:
-    """The ``--yade-timeout`` option (run, compare, batch)."""
+    """The ``--yade-timeout`` option (run, compare, batch): YADE's ``timeout_s``."""
     p.add_argument(
         "--yade-timeout",
         type=float,
@@ -133,6 +124,30 @@ def add_yade_timeout(p: Any) -> None:
         help="wall-clock limit of each YADE run (default: 60 s plus 50 us per block-step, at most one hour); "
         "the run is stopped and reported failed when it is reached",
     )
+
+
+#: Command-line options that set a solver's option: attribute of the arguments -> (option, flag).
+SOLVER_OPTION_FLAGS = {"yade_timeout": ("timeout_s", "--yade-timeout")}
+
+
+def solver_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, str]]:
+    """The solver options given on the command line, and the flags that name them in errors."""
+    options, flags = {}, {}
+    for attr, (option, flag) in SOLVER_OPTION_FLAGS.items():
+        value = getattr(args, attr, None)
+        if value is not None:
+            options[option] = value
+            flags[option] = flag
+    return options, flags
+
+
+def solvers_from_args(names: list[str], args: argparse.Namespace) -> list[Any]:
+    """The solvers ``names`` with the command line's solver options, each to the solvers that
+    take it (an option none of them takes is refused: ``--yade-timeout`` without yade)."""
+    from rockyade.solvers import make_solvers
+
+    options, flags = solver_options(args)
+    return make_solvers(names, options, flags)
 
 
 def register(sub: Any) -> None:

@@ -7,7 +7,7 @@ from pathlib import Path
 from typing import Any
 
 from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_dir, total_time
-from rockyade.cli.run import add_yade_timeout
+from rockyade.cli.run import add_yade_timeout, solver_options, solvers_from_args
 from rockyade.errors import InputError
 
 
@@ -23,36 +23,30 @@ def cmd_compare(args: argparse.Namespace) -> int:
         raise InputError(
             "reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}"
         )
-    timeout = None
-    if "yade" in solvers:
-        from rockyade.solvers.yade import check_timeout
-
-        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
     out: Path = args.out
     check_output_dir(out, "out")
+    runners = solvers_from_args(solvers, args)
 
     from rockyade.analysis.compare import compare
-    from rockyade.cost import check_cost
     from rockyade.figures import plot_results
     from rockyade.io.atomic import atomic_open
     from rockyade.io.locking import output_lock
+    from rockyade.runner.cost import check_cost
     from rockyade.scene import load_scene
-    from rockyade.solvers import get_solver
 
     scene = load_scene(args.scene)
-    for name in solvers:
-        check_cost(scene, name, allow_large=args.allow_large)
+    for solver in runners:
+        check_cost(scene, solver, allow_large=args.allow_large)
     stem = args.scene.stem
     results = {}
     out.mkdir(parents=True, exist_ok=True)
     with output_lock(out):
-        for name in solvers:
-            run = get_solver(name)
-            result = run(scene, workdir=out, name=stem, timeout_s=timeout) if name == "yade" else run(scene)
-            result.write(out / f"{stem}_{name}.csv")
-            results[name] = result
+        for solver in runners:
+            result = solver.keeping_files(out, stem).run(scene)  # YADE's files: <out>/<stem>.yade.*
+            result.write(out / f"{stem}_{solver.name}.csv")
+            results[solver.name] = result
             status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
-            print(f"{name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
+            print(f"{solver.name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
         table = compare(scene, results, args.reference)
         with atomic_open(out / f"{stem}_compare.csv") as fh:
             table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
@@ -78,36 +72,21 @@ def cmd_compare(args: argparse.Namespace) -> int:
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run a study file's grid of scenes."""
     check_output_dir(args.out, "out")
-    if not 1 <= args.workers <= 1024:
-        raise InputError("workers", f"must be in [1, 1024], got {args.workers}")
-    if not 0.1 <= args.scheduler_timeout <= 3600:
-        raise InputError("scheduler-timeout", f"must be in [0.1, 3600] s, got {args.scheduler_timeout:g}")
-    if args.scheduler and args.executor != "dask":
-        raise InputError("scheduler", "needs --executor dask")
-
+    from rockyade.runner import Executor
     from rockyade.studies.batch import failures, load_study, run_study_tasks
 
-    study = load_study(args.study, args.out)
+    how = Executor(args.executor, args.workers, args.scheduler, args.scheduler_timeout)  # checked before any work
+    study = load_study(args.study, args.out, *solver_options(args))
     tasks = list(study.tasks)
-    if args.yade_timeout is not None:
-        from dataclasses import replace
-
-        from rockyade.solvers.yade import check_timeout
-
-        timeout = check_timeout(args.yade_timeout, "--yade-timeout")
-        tasks = [replace(t, yade_timeout_s=timeout) for t in tasks]
     print(f"{study.name}: {len(tasks)} runs ({', '.join(study.solvers)}) -> {args.out}", flush=True)
     summary = run_study_tasks(
         tasks,
         args.out,
-        executor=args.executor,
-        workers=args.workers,
-        scheduler=args.scheduler,
+        executor=how,
         resume=args.resume,
         progress=not args.quiet,
         desc=study.name,
         allow_large=args.allow_large,
-        scheduler_timeout_s=args.scheduler_timeout,
     )
     failed = failures(summary)
     counts = summary["status"].value_counts().to_dict()
@@ -120,8 +99,8 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 def cmd_paper(args: argparse.Namespace) -> int:
     """Reproduce the paper: tables, figures and index.md; exit 1 when any run failed."""
-    from rockyade.studies.common import describe_failures
     from rockyade.studies.paper import PARTS, run_paper_study
+    from rockyade.studies.report import describe_failures
 
     parts = tuple(p.strip() for p in args.only.split(",")) if args.only else PARTS
     unknown = [p for p in parts if p not in PARTS]

@@ -24,7 +24,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
     solvers = ["reference"] if args.no_yade else ["reference", "yade"]
     if not args.no_yade:
-        from rockyade.solvers.yade import yade_available
+        from rockyade.yade.backend import yade_available
 
         if not yade_available():
             raise InputError("no-yade", "YADE is not installed here: install Debian's yade or pass --no-yade")

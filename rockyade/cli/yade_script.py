@@ -17,7 +17,7 @@ def cmd_yade_script(args: argparse.Namespace) -> int:
     """Write run.py and scene.json for YADE's own launcher."""
     from rockyade.cli.common import check_output_dir
     from rockyade.scene import load_scene
-    from rockyade.solvers.yade import write_script
+    from rockyade.yade.backend import write_script
 
     check_output_dir(args.out, "--out")
     paths = write_script(load_scene(args.scene), args.out)

@@ -12,6 +12,9 @@ moving bodies (fixed bodies and the base do not move) this gives a sparse stiffn
 * Settlement: K u = f (gravity) gives the static penetration of every contact point; it must
   stay small against the blocks (the paper's stiffness read as N/m sinks a block into its
   base, see the stiffness scale).
+
+And the rigid column's own statics: :func:`column_uplift`, the smallest horizontal base
+acceleration that lifts one of its blocks.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 import scipy.sparse as sp
@@ -27,8 +31,12 @@ from numpy.typing import NDArray
 from scipy.linalg import eigh
 from scipy.sparse.linalg import ArpackNoConvergence, MatrixRankWarning, eigsh, spsolve
 
+from rockyade.constants import G
 from rockyade.dem.joints import JointTable
 from rockyade.scene.placement import RestContact
+
+if TYPE_CHECKING:
+    from rockyade.scene import Scene
 
 #: Below this number of degrees of freedom the eigenproblem is solved densely.
 DENSE_DOF = 300
@@ -208,3 +216,54 @@ def static_penetration(
     u = np.concatenate([disp[i] for i, d in enumerate(springs.dof_of) if d >= 0])
     elongation = springs.B @ u
     return -elongation[springs.normal]
+
+
+@dataclass(frozen=True)
+class Uplift:
+    """The smallest horizontal base acceleration that lifts a block of a column (statics).
+
+    Attributes
+    ----------
+    accel_m_s2
+        Uplift acceleration of the weakest mechanism, m/s^2.
+    mechanism
+        Which blocks rock, as one body, on which joint.
+    """
+
+    accel_m_s2: float
+    mechanism: str
+
+
+def column_uplift(scene: Scene) -> Uplift:
+    """The uplift acceleration of a column of blocks (bottom to top): its weakest mechanism.
+
+    Each mechanism is blocks k..n rocking as one rigid body about a corner of block k's
+    base: a_up = g (b_k - |x_c - x_k|) / h_c, with b_k = h_k tan(alpha_k) the half base of
+    block k (its alpha, overrides included: paper Eq 11's equivalent base), x_k its
+    centroid, and (x_c, h_c) the centroid of blocks k..n above that base. For one block
+    this is Housner's g tan(alpha). A rigid column subject to a smaller acceleration does
+    not rock; a sequence of mechanisms of two moving bodies needs at least the smaller of
+    its two single-body values (the ratio of work terms is smallest on an extreme ray).
+    """
+    blocks = list(scene.blocks)
+    best = Uplift(math.inf, "")
+    base_y = np.cumsum([0.0] + [b.block().height_m for b in blocks])
+    for k, spec in enumerate(blocks):
+        params = spec.classical()
+        cx_k = spec.block().centroid_m[0] + spec.x_offset_m
+        half_base = params.centroid_height_m * math.tan(params.alpha_rad)
+        masses, xs, ys = [], [], []
+        for j in range(k, len(blocks)):
+            geo = blocks[j].block()
+            masses.append(geo.mass_kg)
+            xs.append(geo.centroid_m[0] + blocks[j].x_offset_m)
+            ys.append(base_y[j] - base_y[k] + geo.centroid_m[1] - geo.vertices_m[:, 1].min())
+        m = np.asarray(masses)
+        x_c, h_c = float(np.dot(m, xs) / m.sum()), float(np.dot(m, ys) / m.sum())
+        accel = G * (half_base - abs(x_c - cx_k)) / h_c
+        if accel < best.accel_m_s2:
+            names = [b.name for b in blocks[k:]]
+            on = "the base" if k == 0 else blocks[k - 1].name
+            who = names[0] if len(names) == 1 else " + ".join(names) + " as one body"
+            best = Uplift(accel, f"{who} rocking on {on}")
+    return best

@@ -4,7 +4,7 @@ The ranges keep the inputs physical for rocking blocks from a brick to a monumen
 the arithmetic finite (no subnormal lengths or masses, no frequency that asks for 10^30
 steps). A value outside its range is refused with an
 :class:`~rockyade.errors.InputError` naming the field and the range. The cost of a whole
-run (steps, samples, memory) is bounded separately (:mod:`rockyade.cost`).
+run (steps, samples, memory) is bounded separately (:mod:`rockyade.runner.cost`).
 """
 
 from __future__ import annotations

@@ -34,6 +34,7 @@ import functools
 import math
 import time
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numba
 import numpy as np
@@ -45,7 +46,9 @@ from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result, column
+from rockyade.runner.cost import CostEstimate, sample_cost
 from rockyade.scene import Scene
+from rockyade.solvers.base import SolverBase
 
 #: A block is declared at rest when an impact leaves it an energy that would lift it by
 #: less than REST_FRACTION * alpha.
@@ -531,53 +534,68 @@ def _warm_up() -> None:
     solve(HousnerModel.symmetric(0.2, 3.0, 0.9), GroundMotion(np.array([0.0, 0.1]), np.zeros(2)), 0.01, 0.01)
 
 
-def run_scene(scene: Scene) -> Result:
-    """Solve a single-block scene with Housner's equation and return a Result.
+@dataclass(frozen=True)
+class HousnerSolver(SolverBase):
+    """Housner's exact solution as a solver (single blocks on a rigid base; no options)."""
 
-    Raises
-    ------
-    InputError
-        If the scene has more than one block (the classical theory is for one block on a
-        rigid base).
-    """
-    if len(scene.blocks) != 1:
-        raise InputError(
-            "blocks",
-            f"the housner solver takes one block on a rigid base; this scene has {len(scene.blocks)} "
-            "(use the reference or yade solver for stacks)",
-            scene.source,
+    name: ClassVar[str] = "housner"
+
+    def run(self, scene: Scene) -> Result:
+        """Solve a single-block scene with Housner's equation and return a Result.
+
+        Raises
+        ------
+        InputError
+            If the scene has more than one block (the classical theory is for one block on
+            a rigid base).
+        """
+        if len(scene.blocks) != 1:
+            raise InputError(
+                "blocks",
+                f"the housner solver takes one block on a rigid base; this scene has {len(scene.blocks)} "
+                "(use the reference or yade solver for stacks)",
+                scene.source,
+            )
+        spec = scene.blocks[0]
+        cp = spec.classical()
+        model = HousnerModel.from_classical(cp)
+        motion = scene.motion.ground_motion(scene.duration_s)
+        _warm_up()
+        start = time.perf_counter()
+        traj = solve(
+            model,
+            motion,
+            scene.duration_s,
+            scene.motion.initial_theta_rad,
+            scene.motion.initial_omega_rad_s,
+            scene.sample_dt_s,
         )
-    spec = scene.blocks[0]
-    block = spec.block()
-    cp = spec.classical()
-    model = HousnerModel.from_classical(cp)
-    motion = scene.motion.ground_motion(scene.duration_s)
-    _warm_up()
-    start = time.perf_counter()
-    traj = solve(
-        model,
-        motion,
-        scene.duration_s,
-        scene.motion.initial_theta_rad,
-        scene.motion.initial_omega_rad_s,
-        scene.sample_dt_s,
-    )
-    wall = time.perf_counter() - start
-    frame = _frame(scene, block, model, motion, traj)
-    meta = {
-        "solver": "housner",
+        wall = time.perf_counter() - start
+        frame = _frame(scene, spec.block(), model, motion, traj)
+        return Result(frame, _meta(scene, cp, motion, traj, wall))
+
+    def estimate_cost(self, scene: Scene) -> CostEstimate:
+        """One step per output sample (:func:`rockyade.runner.cost.sample_cost`)."""
+        return sample_cost(scene, self.name)
+
+
+def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, traj: Trajectory, wall: float) -> dict:
+    """The Result's metadata: status, events (the first 200 of each) and the parameters."""
+    name = scene.blocks[0].name
+    return {
+        "solver": HousnerSolver.name,
         "version": f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
         "scene_hash": scene.scene_hash,
         "wall_time_s": wall,
         "status": traj.status,
         "overturn_time_s": traj.overturn_time_s,
-        "overturned_block": spec.name if traj.status == "overturned" else None,
+        "overturned_block": name if traj.status == "overturned" else None,
         "overturn_criterion": "|theta| reached pi/2",
         "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
-        "blocks": [spec.name],
+        "blocks": [name],
         "sample_dt_s": scene.sample_dt_s,
         "duration_s": scene.duration_s,
-        "classical": {spec.name: cp.as_dict()},
+        "classical": {name: cp.as_dict()},
         "n_impacts": traj.n_impacts,
         "impacts": traj.impacts[:200].tolist(),
         "peaks": traj.peaks[:200].tolist(),
@@ -585,7 +603,6 @@ def run_scene(scene: Scene) -> Result:
         "rest_fraction_of_alpha": REST_FRACTION,
         "motion": motion.label if motion is not None else "free",
     }
-    return Result(frame, meta)
 
 
 def _frame(scene: Scene, block, model: HousnerModel, motion: GroundMotion | None, traj: Trajectory) -> pd.DataFrame:

@@ -24,22 +24,75 @@ fell, the first time it did.
 from __future__ import annotations
 
 import time
-from collections.abc import Iterable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any, ClassVar
 
 import numba
 import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.calibration.matched import build_matched_model
-from rockyade.dem.engine import simulate_model
+from rockyade.calibration.model import calibrated_model
+from rockyade.dem.engine import KernelOutput, simulate_model
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, run_outcome
 from rockyade.kernel import simulation as kernel
-from rockyade.result import Result, failed_result
+from rockyade.result import Result
+from rockyade.runner.cost import CostEstimate, dem_cost
 from rockyade.scene import Scene
+from rockyade.solvers.base import SolverBase, check_flag
+
+_STATUS_NAMES = {
+    kernel.STATUS_COMPLETED: "completed",
+    kernel.STATUS_OVERTURNED: "overturned",
+    kernel.STATUS_FAILED: "failed",
+}
+
+
+@dataclass(frozen=True)
+class ReferenceSolver(SolverBase):
+    """The reference DEM as a solver.
+
+    Attributes
+    ----------
+    record_energy
+        Energy terms in the frame (``energy_*_J``, ``work_base_J``, the balance error).
+    record_contacts
+        ``n_contacts`` and ``slipping`` per block and, for columns, the state of every
+        corner.
+    """
+
+    name: ClassVar[str] = "reference"
+    OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag}
+    #: Kernel time per body-step, s (cost estimate; this project's benchmarks).
+    SECONDS_PER_BODY_STEP: ClassVar[float] = 150e-9
+
+    record_energy: bool = True
+    record_contacts: bool = True
+
+    def run(self, scene: Scene) -> Result:
+        """Run a scene with the reference DEM.
+
+        The returned ``wall_time_s`` is the kernel's; ``setup_time_s`` is the model build
+        (including a matched calibration when asked for).
+        """
+        start = time.perf_counter()
+        model = calibrated_model(scene)
+        setup = time.perf_counter() - start
+        result = run_model(
+            model,
+            record_energy=self.record_energy,
+            record_contacts=self.record_contacts,
+            accel_lowpass_hz=scene.output.accel_lowpass_hz,
+            per_corner=not scene.positioned,
+        )
+        result.meta["setup_time_s"] = setup
+        return result
+
+    def estimate_cost(self, scene: Scene) -> CostEstimate:
+        """Body-steps of the model's time step (:func:`rockyade.runner.cost.dem_cost`)."""
+        return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
 
 
 def run_model(
@@ -77,93 +130,107 @@ def run_model(
         stop_on_overturn = model.stop_on_overturn
     if stop_angle_rad is None:
         stop_angle_rad = model.stop_angle_rad
+    corners = record_contacts and per_corner
     out, wall = simulate_model(
-        model,
-        record_energy,
-        record_corners=record_contacts and per_corner,
-        stop_on_overturn=stop_on_overturn,
-        stop_angle_rad=stop_angle_rad,
+        model, record_energy, record_corners=corners, stop_on_overturn=stop_on_overturn, stop_angle_rad=stop_angle_rad
     )
-    pos_s, ang_s, angvel_s, vpoint_s = out.pos, out.ang, out.angvel, out.vpoint
     n = int(out.n_filled)
-    names = model.names
     frame = dem_frame(
         model,
-        pos_s[:n],
-        ang_s[:n],
-        angvel_s[:n],
-        vpoint_s[:n],
-        out.corner_states[:n] if record_contacts and per_corner else None,
+        out.pos[:n],
+        out.ang[:n],
+        out.angvel[:n],
+        out.vpoint[:n],
+        out.corner_states[:n] if corners else None,
         accel_lowpass_hz,
         n_contacts=out.n_contacts[:n] if record_contacts else None,
         slipping=out.slipping[:n] if record_contacts else None,
     )
-    energy_s, status, t_stop, stop_body = out.energy, out.status, out.t_stop, out.stop_body
     meta_energy: dict[str, float] = {}
     if record_energy and n:
-        e = energy_s[:n]
-        e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies if not b.fixed)
-        total = (
-            e[:, kernel.E_KIN]
-            + e[:, kernel.E_POT]
-            + e[:, kernel.E_EL]
-            + e[:, kernel.E_DASH]
-            + e[:, kernel.E_FRIC]
-            - e[:, kernel.W_BASE]
-        )
-        error = total - total[0]
-        energy = pd.DataFrame(
-            {
-                "energy_kinetic_J": e[:, kernel.E_KIN],
-                "energy_potential_J": e[:, kernel.E_POT] - e_pot_rest,
-                "energy_elastic_J": e[:, kernel.E_EL],
-                "energy_dashpot_J": e[:, kernel.E_DASH],
-                "energy_friction_J": e[:, kernel.E_FRIC],
-                "work_base_J": e[:, kernel.W_BASE],
-                "energy_balance_error_J": error,
-            }
-        )
+        energy, meta_energy = _energy_terms(model, out.energy[:n])
         frame = pd.concat([frame, energy], axis=1)
-        initial_pe = float(e[0, kernel.E_POT] - e_pot_rest)
-        meta_energy = {
-            "energy_balance_max_error_J": float(np.max(np.abs(error))),
-            "initial_potential_energy_J": initial_pe,
-        }
-    gain, t_blowup = energy_gain(model, pos_s[:n], ang_s[:n], angvel_s[:n])
-    status_name = {
-        kernel.STATUS_COMPLETED: "completed",
-        kernel.STATUS_OVERTURNED: "overturned",
-        kernel.STATUS_FAILED: "failed",
-    }[int(status)]
-    if t_blowup is not None and status_name != "failed":
-        status_name, t_stop = "failed", t_blowup
-    overturn_times = {names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)}
-    overturned_block = names[int(stop_body)] if status_name == "overturned" else None
-    if not stop_on_overturn and status_name == "completed":
-        status_name, t_first, overturned_block = run_outcome(overturn_times, names)
-        t_stop = t_first if t_first is not None else t_stop
+    outcome = _outcome(model, out, n, stop_on_overturn)
     meta = {
-        "solver": "reference",
+        "solver": ReferenceSolver.name,
         "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
         "scene_hash": model.scene_hash,
         "wall_time_s": wall,
-        "status": status_name,
-        "overturn_time_s": float(t_stop) if status_name == "overturned" else None,
-        "overturned_block": overturned_block,
+        **outcome,
         "overturn_criterion": CRITERION if model.stop_angle_rad is stop_angle_rad else "|theta| reached its stop angle",
-        "overturn_times_s": overturn_times,
         "broad_phase": {
             "rebuilds": int(out.n_builds),
             "max_candidate_pairs": int(out.max_pairs),
             "separating_axis_tests": int(out.n_tests),
         },
+        **_model_meta(model, wall),
+        "accel_definition": "absolute, mean over +/- one sample interval"
+        + (f", zero-phase low-pass {accel_lowpass_hz:g} Hz" if accel_lowpass_hz else ""),
+        **meta_energy,
+    }
+    return Result(frame, meta)
+
+
+def _energy_terms(model: DemModel, e: np.ndarray) -> tuple[pd.DataFrame, dict[str, float]]:
+    """The energy columns (potential energy from the rest state) and their summary."""
+    e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies if not b.fixed)
+    total = (
+        e[:, kernel.E_KIN]
+        + e[:, kernel.E_POT]
+        + e[:, kernel.E_EL]
+        + e[:, kernel.E_DASH]
+        + e[:, kernel.E_FRIC]
+        - e[:, kernel.W_BASE]
+    )
+    error = total - total[0]
+    energy = pd.DataFrame(
+        {
+            "energy_kinetic_J": e[:, kernel.E_KIN],
+            "energy_potential_J": e[:, kernel.E_POT] - e_pot_rest,
+            "energy_elastic_J": e[:, kernel.E_EL],
+            "energy_dashpot_J": e[:, kernel.E_DASH],
+            "energy_friction_J": e[:, kernel.E_FRIC],
+            "work_base_J": e[:, kernel.W_BASE],
+            "energy_balance_error_J": error,
+        }
+    )
+    summary = {
+        "energy_balance_max_error_J": float(np.max(np.abs(error))),
+        "initial_potential_energy_J": float(e[0, kernel.E_POT] - e_pot_rest),
+    }
+    return energy, summary
+
+
+def _outcome(model: DemModel, out: KernelOutput, n: int, stop_on_overturn: bool) -> dict[str, Any]:
+    """How the run ended: status, overturn time and block, per-block fall times, a failure's reason."""
+    names = model.names
+    gain, t_blowup = energy_gain(model, out.pos[:n], out.ang[:n], out.angvel[:n])
+    status, t_stop = _STATUS_NAMES[int(out.status)], out.t_stop
+    if t_blowup is not None and status != "failed":
+        status, t_stop = "failed", t_blowup
+    overturn_times = {names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)}
+    overturned_block = names[int(out.stop_body)] if status == "overturned" else None
+    if not stop_on_overturn and status == "completed":
+        status, t_first, overturned_block = run_outcome(overturn_times, names)
+        t_stop = t_first if t_first is not None else t_stop
+    return {
+        "status": status,
+        "overturn_time_s": float(t_stop) if status == "overturned" else None,
+        "overturned_block": overturned_block,
+        "overturn_times_s": overturn_times,
         "failure_reason": (
             f"numerical instability at t = {t_stop:.6g} s (energy created: {gain:.3g} x weight x height; or a "
             f"non-finite state, speed > {kernel.MAX_SPEED_M_S:g} m/s or spin > {kernel.MAX_SPIN_RAD_S:g} rad/s)"
-            if status_name == "failed"
+            if status == "failed"
             else None
         ),
-        "blocks": names,
+    }
+
+
+def _model_meta(model: DemModel, wall: float) -> dict[str, Any]:
+    """What the Result says about the model: blocks, sampling, time step, joints, bodies."""
+    return {
+        "blocks": model.names,
         "sample_dt_s": model.sample_dt_s,
         "duration_s": model.duration_s,
         "dt_s": model.dt_s,
@@ -176,54 +243,5 @@ def run_model(
         "contact": model.joint_summary(),
         "bodies": model.body_summary(),
         "motion": model.motion_label,
-        "accel_definition": "absolute, mean over +/- one sample interval"
-        + (f", zero-phase low-pass {accel_lowpass_hz:g} Hz" if accel_lowpass_hz else ""),
-        **meta_energy,
     }
-    return Result(frame, meta)
 
-
-def run_scene(scene: Scene, *, record_energy: bool = True, record_contacts: bool = True) -> Result:
-    """Run a scene with the reference DEM.
-
-    The returned ``wall_time_s`` is the kernel's; ``setup_time_s`` is the model build
-    (including a matched calibration when asked for).
-    """
-    start = time.perf_counter()
-    model = build_matched_model(scene)
-    setup = time.perf_counter() - start
-    result = run_model(
-        model,
-        record_energy=record_energy,
-        record_contacts=record_contacts,
-        accel_lowpass_hz=scene.output.accel_lowpass_hz,
-        per_corner=not scene.positioned,
-    )
-    result.meta["setup_time_s"] = setup
-    return result
-
-
-def _run_quiet(scene: Scene, record_energy: bool, record_contacts: bool) -> Result:
-    try:
-        return run_scene(scene, record_energy=record_energy, record_contacts=record_contacts)
-    except Exception as exc:  # one failed scene must not stop a batch
-        return failed_result("reference", scene.scene_hash, f"{type(exc).__name__}: {exc}")
-
-
-def run_many(
-    scenes: Iterable[Scene],
-    workers: int = 2,
-    *,
-    record_energy: bool = False,
-    record_contacts: bool = False,
-) -> list[Result]:
-    """Run many scenes in one call on ``workers`` threads (the kernel releases the GIL).
-
-    A scene that fails gives a Result with status ``failed`` and the reason; the others
-    are unaffected. Results come back in the order of ``scenes``.
-    """
-    scene_list: Sequence[Scene] = list(scenes)
-    if workers <= 1:
-        return [_run_quiet(s, record_energy, record_contacts) for s in scene_list]
-    with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(lambda s: _run_quiet(s, record_energy, record_contacts), scene_list))

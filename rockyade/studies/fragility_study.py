@@ -15,22 +15,16 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.probability.fragility import Fragility, fit_lognormal
+from rockyade.runner import run_jobs
 from rockyade.scene import scene_from_dict
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import (
-    SOLVER_LABELS,
-    SOLVER_STYLES,
-    Report,
-    block_table,
-    fmt,
-    run_each,
-    run_state,
-    scene_dict,
-)
+from rockyade.studies.report import Report, fmt, run_state
+from rockyade.studies.specimens import block_table, scene_dict
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
 RECORDS = tuple(range(1, 31))
@@ -57,9 +51,10 @@ def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
     """Generate the suite (cached; minutes the first time, with a progress bar) and the
     matched calibrations once, before workers fork."""
     suite = paper_suite()
-    run_each(range(1, suite.count + 1), lambda i: suite_record(suite, i), "fragility: synthetic suite")
+    numbers = range(1, suite.count + 1)
+    run_jobs(numbers, lambda i: suite_record(suite, i), progress=True, desc="fragility: synthetic suite")
     for key in specimens:
-        build_matched_model(scene_from_dict(_base(key)))
+        calibrated_model(scene_from_dict(_base(key)))
 
 
 def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
@@ -230,40 +225,12 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
             if sel.empty:
                 continue
             fit = sel.iloc[0]
-            colour = SOLVER_STYLES[solver]["color"]
             pts = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
             if pts.empty or not fit.status.startswith(("fitted", "no collapse", "all collapse")):
                 missing.append(_missing_curve(solver, fit))
                 continue
-            if fit.status == "fitted":
-                median = f"median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$"
-                if fit.extrapolated:
-                    median += " EXTRAPOLATED"
-                label = f"{SOLVER_LABELS[solver]}: {median}, beta {fmt(fit.beta, 2)}"
-            else:
-                label = f"{SOLVER_LABELS[solver]}: {fit.status} in the tested range, no fit"
-            if fit.failed_runs:
-                label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
-            elif fit.runs < fits[fits.specimen == specimen].runs.max():  # a subset (YADE): say how small
-                label += f" ({int(pts.n_records.max())} records x {len(pts)} load factors)"
-            ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
-            if fit.status == "fitted":
-                curve = Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x)
-                inside = x <= fit.largest_tested_pga_m_s2
-                ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
-                ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
-                if fit.extrapolated:  # the median on the dotted curve (an arrow at the edge when beyond it)
-                    inside_plot = fit.median_pga_m_s2 <= x_max
-                    ax.plot(
-                        min(fit.median_pga_m_s2, x_max),
-                        0.5,
-                        "D" if inside_plot else ">",
-                        color=colour,
-                        mfc="white",
-                        ms=6,
-                        mew=1.3,
-                        zorder=5,
-                    )
+            subset = fit.runs < fits[fits.specimen == specimen].runs.max()
+            _draw_fit(ax, solver, marker, fit, pts, subset, x, x_max)
         ax.axvspan(tested, x_max, color="0.92", lw=0, zorder=0)
         ax.text(
             x_max,
@@ -291,12 +258,7 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
     for ax in axes[:, 0]:
         ax.set_ylabel("fraction of records that overturn")
     save_figure(fig, report.out / name)
-    notes = []
-    for r in fits.itertuples():
-        if r.extrapolated:
-            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: median extrapolated beyond {fmt(tested, 3)} m/s^2")
-        if not r.status.startswith(("fitted", "no collapse", "all collapse")):
-            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: no curve ({r.status}{_reason(r)})")
+    notes = _caption_notes(fits, tested)
     report.figure(
         name,
         f"Collapse fragility of the specimens: fraction of the {len(RECORDS)} records that overturn the block "
@@ -305,6 +267,54 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
         + (" " + "; ".join(notes) + "." if notes else ""),
     )
     return fig
+
+
+def _draw_fit(ax, solver: str, marker: str, fit, pts: pd.DataFrame, subset: bool, x: np.ndarray, x_max: float) -> None:
+    """One solver's collapse fractions (points) and fitted curve (solid within its tested
+    range, dotted beyond), its median marked when extrapolated; ``subset``: fewer runs than
+    the other solvers (YADE), said in the legend."""
+    colour = SOLVER_STYLES[solver]["color"]
+    if fit.status == "fitted":
+        median = f"median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$"
+        if fit.extrapolated:
+            median += " EXTRAPOLATED"
+        label = f"{SOLVER_LABELS[solver]}: {median}, beta {fmt(fit.beta, 2)}"
+    else:
+        label = f"{SOLVER_LABELS[solver]}: {fit.status} in the tested range, no fit"
+    if fit.failed_runs:
+        label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
+    elif subset:  # say how small
+        label += f" ({int(pts.n_records.max())} records x {len(pts)} load factors)"
+    ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
+    if fit.status != "fitted":
+        return
+    curve = Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x)
+    inside = x <= fit.largest_tested_pga_m_s2
+    ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
+    ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
+    if fit.extrapolated:  # the median on the dotted curve (an arrow at the edge when beyond it)
+        inside_plot = fit.median_pga_m_s2 <= x_max
+        ax.plot(
+            min(fit.median_pga_m_s2, x_max),
+            0.5,
+            "D" if inside_plot else ">",
+            color=colour,
+            mfc="white",
+            ms=6,
+            mew=1.3,
+            zorder=5,
+        )
+
+
+def _caption_notes(fits: pd.DataFrame, tested: float) -> list[str]:
+    """What the caption says of extrapolated medians and missing curves."""
+    notes = []
+    for r in fits.itertuples():
+        if r.extrapolated:
+            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: median extrapolated beyond {fmt(tested, 3)} m/s^2")
+        if not r.status.startswith(("fitted", "no collapse", "all collapse")):
+            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: no curve ({r.status}{_reason(r)})")
+    return notes
 
 
 def _missing_curve(solver: str, fit) -> str:

@@ -15,25 +15,17 @@ from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, plot_solver
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.studies.common import (
-    PARAMETER_SETS,
-    SOLVER_LABELS,
-    Report,
-    block_alpha,
-    block_table,
-    fmt,
-    max_difference,
-    plot_solver,
-    run_each,
-    run_state,
-    run_yade,
-    scene_dict,
-)
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.studies.report import Report, fmt, max_difference, run_state
+from rockyade.studies.specimens import PARAMETER_SETS, block_alpha, block_table, scene_dict
 
 DURATION_S = 4.0
 N_IMPACTS = MU_EFF_IMPACTS
@@ -56,123 +48,23 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "experimental ones from Tables 3-4). Effective restitution over the first "
         f"{N_IMPACTS} impacts after the release.",
     )
-    cases = []
-    for key in paper.ALL_SPECIMENS:
-        for params in PARAMETER_SETS:
-            alpha = block_alpha(key, params)
-            for cal in CALIBRATIONS:
-                d = scene_dict(
-                    [block_table(key, params)], {"type": "free", "theta0_rad": alpha / 2}, DURATION_S, 0.002, cal
-                )
-                scene = scene_from_dict(d)
-                note, beta = "", math.nan
-                try:
-                    beta = build_matched_model(scene).bodies[0].joint.beta_s
-                except CalibrationError as exc:
-                    note = f"matched calibration not reachable: {exc}"
-                    scene = None
-                cases.append(
-                    {
-                        "key": key,
-                        "params": params,
-                        "calibration": cal,
-                        "alpha": alpha,
-                        "scene": scene,
-                        "beta_s": beta,
-                        "note": note,
-                    }
-                )
+    cases = _cases()
     runnable = [c for c in cases if c["scene"] is not None]
-    dem_results = run_each(
-        [c["scene"] for c in runnable],
-        lambda scene: reference.run_scene(scene, record_energy=False, record_contacts=False),
-        "free rocking: reference DEM",
-    )
-    for c, r in zip(runnable, dem_results, strict=True):
-        c["reference"] = r
+    scenes = [c["scene"] for c in runnable]
+    on = Executor("threads", workers)
+    dem = ReferenceSolver(record_energy=False, record_contacts=False)
+    solvers = {"reference": (dem, "free rocking: reference DEM")}
     if use_yade:
-        yade_results = run_yade([c["scene"] for c in runnable], workers, "free rocking: YADE")
-        for c, r in zip(runnable, yade_results, strict=True):
-            c["yade"] = r
+        solvers["yade"] = (YadeSolver(), "free rocking: YADE")
+    for name, (solver, desc) in solvers.items():
+        for c, r in zip(runnable, solve_scenes(solver, scenes, executor=on, progress=True, desc=desc), strict=True):
+            c[name] = r
     keys = [(key, params) for key in paper.ALL_SPECIMENS for params in PARAMETER_SETS]
-
-    def exact_run(key_params: tuple[str, str]):
-        key, params = key_params
-        alpha = block_alpha(key, params)
-        d = scene_dict([block_table(key, params)], {"type": "free", "theta0_rad": alpha / 2}, DURATION_S, 0.002)
-        return housner.run_scene(scene_from_dict(d))
-
-    exact = dict(zip(keys, run_each(keys, exact_run, "free rocking: Housner"), strict=True))
-    for (key, params), result in exact.items():
-        report.record_result(f"{paper.specimen(key).label}, {params}", result)
-    for c in cases:
-        label = f"{paper.specimen(c['key']).label}, {c['params']}, {c['calibration']} calibration"
-        for solver in ("reference", "yade"):
-            if c["scene"] is None and (solver == "reference" or use_yade):
-                report.record(label, solver, "not run", c["note"])
-            elif c.get(solver) is not None:
-                report.record_result(label, c[solver])
-    rows = []
-    for (key, params), result in exact.items():
-        alpha = block_alpha(key, params)
-        mu, first = _mu(result, alpha)
-        target = result.meta["classical"][next(iter(result.meta["classical"]))]["mu"]
-        rows.append(
-            {
-                "block": key,
-                "parameters": params,
-                "solver": "housner",
-                "calibration": "-",
-                "beta_s": math.nan,
-                "mu_target": target,
-                "mu_eff": mu,
-                "first_peak_rad": first,
-                "status": result.status,
-                "note": "",
-            }
-        )
-    for c in cases:
-        target = (
-            paper.specimen(c["key"]).experimental["mu"]
-            if c["params"] == "experimental"
-            else exact[(c["key"], c["params"])].meta["classical"][paper.specimen(c["key"]).name]["mu"]
-        )
-        for solver in ("reference", "yade"):
-            result = c.get(solver)
-            if result is None and (solver == "reference" or use_yade):
-                rows.append(
-                    {
-                        "block": c["key"],
-                        "parameters": c["params"],
-                        "solver": solver,
-                        "calibration": c["calibration"],
-                        "beta_s": math.nan,
-                        "mu_target": target,
-                        "mu_eff": math.nan,
-                        "first_peak_rad": math.nan,
-                        "status": "not run",
-                        "note": c["note"],
-                    }
-                )
-                continue
-            if result is None:
-                continue
-            mu, first = _mu(result, c["alpha"])
-            rows.append(
-                {
-                    "block": c["key"],
-                    "parameters": c["params"],
-                    "solver": solver,
-                    "calibration": c["calibration"],
-                    "beta_s": c["beta_s"],
-                    "mu_target": target,
-                    "mu_eff": mu,
-                    "first_peak_rad": first,
-                    "status": result.status,
-                    "note": result.meta.get("failure_reason") or "",
-                }
-            )
-    table = pd.DataFrame(rows)
+    exact_scenes = [_free_scene(key, params) for key, params in keys]
+    found = solve_scenes(HousnerSolver(), exact_scenes, executor=on, progress=True, desc="free rocking: Housner")
+    exact = dict(zip(keys, found, strict=True))
+    _record_runs(report, exact, cases, use_yade)
+    table = pd.DataFrame(_exact_rows(exact) + _dem_rows(cases, exact, use_yade))
     n_dem = len(runnable)
     states = [f"reference DEM: {run_state(report, 'reference', n_dem)}"]
     if use_yade:
@@ -192,6 +84,108 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     for key in paper.ALL_SPECIMENS:
         draw_figure(report, key, exact, cases, table)
     return table
+
+
+def _free_scene(key: str, params: str, calibration: str = "matched"):
+    """A specimen alone, released at alpha / 2."""
+    alpha = block_alpha(key, params)
+    motion = {"type": "free", "theta0_rad": alpha / 2}
+    return scene_from_dict(scene_dict([block_table(key, params)], motion, DURATION_S, 0.002, calibration))
+
+
+def _cases() -> list[dict]:
+    """Every specimen x parameter set x calibration, with its DEM scene (None where the
+    matched calibration cannot reach mu: the note says why) and its damping constant."""
+    cases = []
+    for key in paper.ALL_SPECIMENS:
+        for params in PARAMETER_SETS:
+            for cal in CALIBRATIONS:
+                scene = _free_scene(key, params, cal)
+                note, beta = "", math.nan
+                try:
+                    beta = calibrated_model(scene).bodies[0].joint.beta_s
+                except CalibrationError as exc:
+                    note = f"matched calibration not reachable: {exc}"
+                    scene = None
+                cases.append(
+                    {
+                        "key": key,
+                        "params": params,
+                        "calibration": cal,
+                        "alpha": block_alpha(key, params),
+                        "scene": scene,
+                        "beta_s": beta,
+                        "note": note,
+                    }
+                )
+    return cases
+
+
+def _record_runs(report: Report, exact: dict, cases: list[dict], use_yade: bool) -> None:
+    """Log every run in the report (a DEM case that could not run as "not run", with why)."""
+    for (key, params), result in exact.items():
+        report.record_result(f"{paper.specimen(key).label}, {params}", result)
+    for c in cases:
+        label = f"{paper.specimen(c['key']).label}, {c['params']}, {c['calibration']} calibration"
+        for solver in ("reference", "yade"):
+            if c["scene"] is None and (solver == "reference" or use_yade):
+                report.record(label, solver, "not run", c["note"])
+            elif c.get(solver) is not None:
+                report.record_result(label, c[solver])
+
+
+def _exact_rows(exact: dict) -> list[dict]:
+    """The table's rows of Housner's exact solutions."""
+    rows = []
+    for (key, params), result in exact.items():
+        mu, first = _mu(result, block_alpha(key, params))
+        target = result.meta["classical"][next(iter(result.meta["classical"]))]["mu"]
+        rows.append(
+            {
+                "block": key,
+                "parameters": params,
+                "solver": "housner",
+                "calibration": "-",
+                "beta_s": math.nan,
+                "mu_target": target,
+                "mu_eff": mu,
+                "first_peak_rad": first,
+                "status": result.status,
+                "note": "",
+            }
+        )
+    return rows
+
+
+def _dem_rows(cases: list[dict], exact: dict, use_yade: bool) -> list[dict]:
+    """The table's rows of the DEM runs (and of the cases that could not run)."""
+    rows = []
+    for c in cases:
+        target = (
+            paper.specimen(c["key"]).experimental["mu"]
+            if c["params"] == "experimental"
+            else exact[(c["key"], c["params"])].meta["classical"][paper.specimen(c["key"]).name]["mu"]
+        )
+        for solver in ("reference", "yade"):
+            result = c.get(solver)
+            if result is None and not (solver == "reference" or use_yade):
+                continue
+            mu, first = _mu(result, c["alpha"]) if result is not None else (math.nan, math.nan)
+            rows.append(
+                {
+                    "block": c["key"],
+                    "parameters": c["params"],
+                    "solver": solver,
+                    "calibration": c["calibration"],
+                    "beta_s": c["beta_s"] if result is not None else math.nan,
+                    "mu_target": target,
+                    "mu_eff": mu,
+                    "first_peak_rad": first,
+                    "status": result.status if result is not None else "not run",
+                    "note": (result.meta.get("failure_reason") or "") if result is not None else c["note"],
+                }
+            )
+    return rows
 
 
 def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> Figure:

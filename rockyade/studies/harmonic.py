@@ -19,26 +19,17 @@ from matplotlib.figure import Figure
 
 from rockyade.analysis.patterns import classify_result
 from rockyade.constants import G
+from rockyade.dem.statics import column_uplift
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, plot_solver, shade_harmonic_states
 from rockyade.motion.analytic import Harmonic
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.studies.common import (
-    SOLVER_LABELS,
-    Report,
-    biblock_blocks,
-    block_table,
-    fmt,
-    max_difference,
-    no_uplift_note,
-    plot_solver,
-    run_each,
-    run_state,
-    run_yade,
-    scene_dict,
-    shade_harmonic_states,
-    uplift_acceleration,
-)
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.studies.report import Report, fmt, max_difference, no_uplift_note, run_state
+from rockyade.studies.specimens import biblock_blocks, block_table, scene_dict
 
 CYCLES = 20
 RAMP_CYCLES = 2
@@ -60,72 +51,23 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         f"Table sines of {CYCLES} stationary cycles between {RAMP_CYCLES}-cycle ramps, then {TAIL_S:g} s of free "
         f"rocking. Shaded: transient (ramp and {SETTLE_CYCLES} cycles), stationary, free rocking.",
     )
-    cases = []
-    for key, freq, amp, fig in SINGLE:
-        h = Harmonic(amp, freq, CYCLES, RAMP_CYCLES)
-        d = scene_dict([block_table(key)], _motion(freq, amp), h.phases_s["end_s"] + TAIL_S, 0.002, "matched")
-        cases.append(
-            {
-                "name": f"specimen{key}_{freq:g}Hz_{amp:g}mm",
-                "fig": fig,
-                "scene": scene_from_dict(d),
-                "harmonic": h,
-                "solvers": ["housner", "reference", "yade"],
-            }
-        )
-    for freq, amp, fig in BIBLOCK:
-        h = Harmonic(amp, freq, CYCLES, RAMP_CYCLES)
-        d = scene_dict(biblock_blocks(), _motion(freq, amp), h.phases_s["end_s"] + TAIL_S, 0.002, "paper")
-        cases.append(
-            {
-                "name": f"biblock_{freq:g}Hz_{amp:g}mm",
-                "fig": fig,
-                "scene": scene_from_dict(d),
-                "harmonic": h,
-                "solvers": ["reference", "yade"],
-            }
-        )
-    for c in cases:
-        c["results"] = {}
-    exact = [c for c in cases if "housner" in c["solvers"]]
-    for c, r in zip(exact, run_each([c["scene"] for c in exact], housner.run_scene, "harmonic: Housner"), strict=True):
-        c["results"]["housner"] = r
-    dem = run_each(
-        [c["scene"] for c in cases],
-        lambda scene: reference.run_scene(scene, record_energy=False, record_contacts=False),
-        "harmonic: reference DEM",
-    )
-    for c, r in zip(cases, dem, strict=True):
-        c["results"]["reference"] = r
+    cases = _cases()
+    on = Executor("threads", workers)
+    dem = ReferenceSolver(record_energy=False, record_contacts=False)
+    solvers = [(HousnerSolver(), "Housner"), (dem, "reference DEM")]
     if use_yade:
-        for c, r in zip(cases, run_yade([c["scene"] for c in cases], workers, "harmonic: YADE"), strict=True):
-            c["results"]["yade"] = r
+        solvers.append((YadeSolver(), "YADE"))
+    for solver, who in solvers:
+        chosen = [c for c in cases if solver.name in c["solvers"]]
+        scenes = [c["scene"] for c in chosen]
+        found = solve_scenes(solver, scenes, executor=on, progress=True, desc=f"harmonic: {who}")
+        for c, r in zip(chosen, found, strict=True):
+            c["results"][solver.name] = r
     rows = []
     for c in cases:
-        uplift = uplift_acceleration(c["scene"])
-        for solver, r in c["results"].items():
+        for r in c["results"].values():
             report.record_result(f"{c['name']} ({c['fig']})", r)
-            row = {
-                "test": c["name"],
-                "paper": c["fig"],
-                "solver": solver,
-                "status": r.status,
-                "failure_reason": r.meta.get("failure_reason") or "",
-            }
-            row["table_accel_m_s2"] = c["harmonic"].accel_amplitude_m_s2
-            # a rigid column rocks only when the table acceleration exceeds its weakest uplift acceleration
-            row["uplift_accel_m_s2"] = uplift.accel_m_s2
-            row["uplift_mechanism"] = uplift.mechanism
-            row["accel_over_uplift"] = c["harmonic"].accel_amplitude_m_s2 / uplift.accel_m_s2
-            for spec in c["scene"].blocks:
-                alpha = spec.classical().alpha_rad
-                row[f"{spec.name}_accel_over_uplift"] = c["harmonic"].accel_amplitude_m_s2 / (G * np.tan(alpha))
-                theta = r.series("theta_rad", spec.name) if r.ok else np.array([np.nan])
-                row[f"{spec.name}_max_abs_theta_rad"] = float(np.nanmax(np.abs(theta)))
-                row[f"{spec.name}_max_theta_over_alpha"] = float(np.nanmax(np.abs(theta)) / alpha)
-            if len(c["scene"].blocks) == 2 and r.ok:
-                row["pattern"] = classify_result(c["scene"], r).dominant
-            rows.append(row)
+        rows += _rows(c)
         draw_figure(report, c)
     table = pd.DataFrame(rows)
     report.table(
@@ -148,6 +90,63 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     states = [f"{SOLVER_LABELS[s]}: {run_state(report, s, n)}" for s, n in _solver_counts(cases).items()]
     report.note("Runs: " + "; ".join(states) + ".")
     return table
+
+
+def _cases() -> list[dict]:
+    """The single-block tests (Housner, reference DEM, YADE) and the bi-block ones (the DEMs)."""
+    cases = []
+    for key, freq, amp, fig in SINGLE:
+        h = Harmonic(amp, freq, CYCLES, RAMP_CYCLES)
+        d = scene_dict([block_table(key)], _motion(freq, amp), h.phases_s["end_s"] + TAIL_S, 0.002, "matched")
+        name = f"specimen{key}_{freq:g}Hz_{amp:g}mm"
+        cases.append(_case(name, fig, d, h, ["housner", "reference", "yade"]))
+    for freq, amp, fig in BIBLOCK:
+        h = Harmonic(amp, freq, CYCLES, RAMP_CYCLES)
+        d = scene_dict(biblock_blocks(), _motion(freq, amp), h.phases_s["end_s"] + TAIL_S, 0.002, "paper")
+        cases.append(_case(f"biblock_{freq:g}Hz_{amp:g}mm", fig, d, h, ["reference", "yade"]))
+    return cases
+
+
+def _case(name: str, fig: str, scene: dict, harmonic: Harmonic, solvers: list[str]) -> dict:
+    return {
+        "name": name,
+        "fig": fig,
+        "scene": scene_from_dict(scene),
+        "harmonic": harmonic,
+        "solvers": solvers,
+        "results": {},
+    }
+
+
+def _rows(c: dict) -> list[dict]:
+    """The table's rows of one test: per solver, each block's largest rotation against its
+    uplift, the table acceleration against the column's weakest mechanism."""
+    uplift = column_uplift(c["scene"])
+    accel = c["harmonic"].accel_amplitude_m_s2
+    rows = []
+    for solver, r in c["results"].items():
+        row = {
+            "test": c["name"],
+            "paper": c["fig"],
+            "solver": solver,
+            "status": r.status,
+            "failure_reason": r.meta.get("failure_reason") or "",
+        }
+        row["table_accel_m_s2"] = accel
+        # a rigid column rocks only when the table acceleration exceeds its weakest uplift acceleration
+        row["uplift_accel_m_s2"] = uplift.accel_m_s2
+        row["uplift_mechanism"] = uplift.mechanism
+        row["accel_over_uplift"] = accel / uplift.accel_m_s2
+        for spec in c["scene"].blocks:
+            alpha = spec.classical().alpha_rad
+            row[f"{spec.name}_accel_over_uplift"] = accel / (G * np.tan(alpha))
+            theta = r.series("theta_rad", spec.name) if r.ok else np.array([np.nan])
+            row[f"{spec.name}_max_abs_theta_rad"] = float(np.nanmax(np.abs(theta)))
+            row[f"{spec.name}_max_theta_over_alpha"] = float(np.nanmax(np.abs(theta)) / alpha)
+        if len(c["scene"].blocks) == 2 and r.ok:
+            row["pattern"] = classify_result(c["scene"], r).dominant
+        rows.append(row)
+    return rows
 
 
 def _solver_counts(cases: list[dict]) -> dict[str, int]:

@@ -11,19 +11,22 @@ reference DEM (matched calibration); Housner also gives the full overturn map of
 from __future__ import annotations
 
 import math
-import multiprocessing
-from concurrent.futures import ProcessPoolExecutor, as_completed
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from rockyade.calibration.matched import build_matched_model
+from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
+from rockyade.runner import Executor, run_jobs
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, progress, run_state, scene_dict
+from rockyade.solvers.base import Solver
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.studies.report import Report, run_state
+from rockyade.studies.specimens import block_table, scene_dict
 
 FREQUENCY_RATIOS = tuple(np.round(np.arange(1.0, 10.01, 0.5), 2))
 STEP = 0.05
@@ -37,21 +40,16 @@ def _scene(ratio_a: float, ratio_w: float, alpha: float, p: float):
     return scene_from_dict(scene_dict([block_table("1")], motion, period + FREE_TIME_S, 0.002, "matched"))
 
 
-def _scan(args: tuple[str, float, float, float, bool]) -> list[dict]:
+def _scan(args: tuple[Solver, float, float, float, bool]) -> list[dict]:
     """Scan amplitudes upward at one frequency; stop at the first overturn unless ``full``."""
     solver, ratio_w, alpha, p, full = args
-    run = (
-        housner.run_scene
-        if solver == "housner"
-        else (lambda s: reference.run_scene(s, record_energy=False, record_contacts=False))
-    )
     rows = []
     ratio_a = 1.0 + STEP
     while ratio_a <= MAX_RATIO + 1e-9:
-        result = run(_scene(ratio_a, ratio_w, alpha, p))
+        result = solver.run(_scene(ratio_a, ratio_w, alpha, p))
         rows.append(
             {
-                "solver": solver,
+                "solver": solver.name,
                 "omega_ratio": ratio_w,
                 "amplitude_ratio": round(ratio_a, 4),
                 "overturned": result.status == "overturned",
@@ -74,21 +72,17 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     )
     block = block_table("1")
     alpha, p = block["alpha_rad"], block["p_rad_s"]
-    build_matched_model(_scene(2.0, 2.0, alpha, p))  # matched beta once, before the workers fork
-    jobs = [("housner", w, alpha, p, True) for w in FREQUENCY_RATIOS] + [
-        ("reference", w, alpha, p, False) for w in FREQUENCY_RATIOS
+    calibrated_model(_scene(2.0, 2.0, alpha, p))  # matched beta once, before the workers fork
+    dem = ReferenceSolver(record_energy=False, record_contacts=False)
+    jobs = [(HousnerSolver(), w, alpha, p, True) for w in FREQUENCY_RATIOS] + [
+        (dem, w, alpha, p, False) for w in FREQUENCY_RATIOS
     ]
-    ctx = multiprocessing.get_context("fork")
-    done: dict[int, list[dict]] = {}
-    with (
-        ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool,
-        progress(len(jobs), "overturning: frequency scans") as bar,
-    ):
-        futures = {pool.submit(_scan, job): k for k, job in enumerate(jobs)}
-        for future in as_completed(futures):
-            done[futures[future]] = future.result()
-            bar.update(1)
-    scan = pd.DataFrame([row for k in range(len(jobs)) for row in done[k]])
+    scans = run_jobs(
+        jobs, _scan, executor=Executor("local", workers), progress=True, desc="overturning: frequency scans"
+    )
+    if scans.unfinished:
+        raise KeyboardInterrupt
+    scan = pd.DataFrame([row for rows in scans.in_order() for row in rows])
     report.record_summary(
         scan,
         lambda row: f"pulse omega_p / p = {row['omega_ratio']:g}, a_p / (g tan alpha) = {row['amplitude_ratio']:g}",

@@ -19,7 +19,7 @@ from pathlib import Path
 
 from rockyade import __version__
 from rockyade.io.atomic import write_text
-from rockyade.studies.common import Report
+from rockyade.studies.report import Report
 
 PARTS = ("tables", "free", "harmonic", "random", "patterns", "sensitivity", "fragility", "overturning")
 

@@ -13,6 +13,8 @@ Cells on a region's boundary or outside both are "not reported".
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pandas as pd
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
@@ -20,7 +22,8 @@ from matplotlib.patches import Rectangle
 from rockyade.figures import new_figure, save_figure
 from rockyade.motion.analytic import Harmonic
 from rockyade.studies.batch import expand, run_study_tasks
-from rockyade.studies.common import Report, biblock_blocks, run_state, scene_dict
+from rockyade.studies.report import Report, run_state
+from rockyade.studies.specimens import biblock_blocks, scene_dict
 
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
@@ -85,7 +88,7 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
             save_history=False,
         )
     tasks = [
-        type(t)(i, t.scene, t.solver, {**t.labels, "frequency_hz": t.scene["motion"]["frequency_hz"]}, t.out_dir, False)
+        replace(t, index=i, labels={**t.labels, "frequency_hz": t.scene.motion.frequency_hz}, save_history=False)
         for i, t in enumerate(tasks)
     ]
     summary = run_study_tasks(tasks, report.out / "pattern_map_runs", workers=workers, desc="pattern map")

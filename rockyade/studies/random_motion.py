@@ -15,21 +15,14 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, plot_solver
+from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.studies.common import (
-    SOLVER_LABELS,
-    Report,
-    block_table,
-    fmt,
-    max_difference,
-    no_uplift_note,
-    plot_solver,
-    run_each,
-    run_state,
-    run_yade,
-    scene_dict,
-)
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.solvers.yade import YadeSolver
+from rockyade.studies.report import Report, fmt, max_difference, no_uplift_note, run_state
+from rockyade.studies.specimens import block_table, scene_dict
 
 CASES = (("2", 21, 0.6), ("3", 18, 0.5))
 DURATION_S = 25.0
@@ -50,14 +43,14 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         scene = scene_from_dict(scene_dict([block_table(key)], motion, DURATION_S, 0.005, "matched"))
         cases.append((key, record, factor, scene, {}))
     scenes = [c[3] for c in cases]
-    for case, r in zip(cases, run_each(scenes, housner.run_scene, "random: Housner"), strict=True):
-        case[4]["housner"] = r
-    dem = run_each(scenes, lambda s: reference.run_scene(s, record_energy=False), "random: reference DEM")
-    for case, r in zip(cases, dem, strict=True):
-        case[4]["reference"] = r
+    solvers = [(HousnerSolver(), "Housner"), (ReferenceSolver(record_energy=False), "reference DEM")]
     if use_yade:
-        for case, r in zip(cases, run_yade(scenes, workers, "random: YADE"), strict=True):
-            case[4]["yade"] = r
+        solvers.append((YadeSolver(), "YADE"))
+    on = Executor("threads", workers)
+    for solver, who in solvers:
+        found = solve_scenes(solver, scenes, executor=on, progress=True, desc=f"random: {who}")
+        for case, r in zip(cases, found, strict=True):
+            case[4][solver.name] = r
     for key, record, factor, scene, results in cases:
         alpha = scene.blocks[0].alpha_rad
         for solver, r in results.items():

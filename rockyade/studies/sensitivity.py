@@ -19,16 +19,21 @@ from rockyade import paper
 from rockyade.blocks.restitution import find_peaks
 from rockyade.errors import CalibrationError
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.scene import scene_from_dict
-from rockyade.solvers import housner, reference
-from rockyade.studies.common import SOLVER_LABELS, SOLVER_STYLES, Report, block_table, scene_dict
+from rockyade.solvers.base import Solver
+from rockyade.solvers.housner import HousnerSolver
+from rockyade.solvers.reference import ReferenceSolver
+from rockyade.studies.report import Report
+from rockyade.studies.specimens import block_table, scene_dict
 
 CHANGE = 0.05
 THETA0 = 0.1175
 PEAK = 5
+SOLVERS: tuple[Solver, ...] = (HousnerSolver(), ReferenceSolver(record_energy=False, record_contacts=False))
 
 
-def _responses(block: dict, solver: str, report: Report, label: str) -> dict[str, float]:
+def _responses(block: dict, solver: Solver, report: Report, label: str) -> dict[str, float]:
     """The three responses of one variant by one solver (NaN where a run failed); runs logged."""
     free = scene_from_dict(scene_dict([block], {"type": "free", "theta0_rad": THETA0}, 4.0, 0.001, "matched"))
     sine = scene_from_dict(
@@ -36,20 +41,15 @@ def _responses(block: dict, solver: str, report: Report, label: str) -> dict[str
             [block], {"type": "harmonic", "amplitude_mm": 6.0, "frequency_hz": 3.3, "cycles": 20}, 9.0, 0.002, "matched"
         )
     )
-    run = (
-        housner.run_scene
-        if solver == "housner"
-        else (lambda s: reference.run_scene(s, record_energy=False, record_contacts=False))
-    )
     out = {}
-    r = run(free)
+    r = solver.run(free)
     report.record_result(f"{label}, free rocking", r)
     peaks = find_peaks(r.t, r.series("theta_rad"), 1e-4) if r.ok else []
     out[f"free rocking: peak {PEAK} amplitude (rad)"] = (
         float(peaks.amplitude_rad[PEAK - 1]) if len(peaks) >= PEAK else math.nan
     )
     out[f"free rocking: peak {PEAK} time (s)"] = float(peaks.t_s[PEAK - 1]) if len(peaks) >= PEAK else math.nan
-    r = run(sine)
+    r = solver.run(sine)
     report.record_result(f"{label}, 3.3 Hz / 6 mm sine", r)
     out["3.3 Hz / 6 mm sine: max |theta| (rad)"] = float(np.max(np.abs(r.series("theta_rad")))) if r.ok else math.nan
     return out
@@ -63,27 +63,27 @@ def run(report: Report) -> pd.DataFrame:
     )
     base_block = block_table("1")
     rows = []
-    base = {s: _responses(base_block, s, report, "base parameters") for s in ("housner", "reference")}
+    base = {s.name: _responses(base_block, s, report, "base parameters") for s in SOLVERS}
     for parameter in ("alpha_rad", "p_rad_s", "mu"):
         for sign in (-1, 1):
             block = dict(base_block)
             block[parameter] = base_block[parameter] * (1 + sign * CHANGE)
-            for solver in ("housner", "reference"):
+            for solver in SOLVERS:
                 try:
                     values = _responses(block, solver, report, f"{parameter} {100 * sign * CHANGE:+g} %")
                     note = ""
                 except CalibrationError as exc:
-                    values = {k: math.nan for k in base[solver]}
+                    values = {k: math.nan for k in base[solver.name]}
                     note = f"DEM cannot be matched: {str(exc).split(':')[0]}"
-                    report.record(f"{parameter} {100 * sign * CHANGE:+g} %", solver, "not run", note)
+                    report.record(f"{parameter} {100 * sign * CHANGE:+g} %", solver.name, "not run", note)
                 for response, value in values.items():
-                    ref = base[solver][response]
+                    ref = base[solver.name][response]
                     rows.append(
                         {
                             "parameter": parameter,
                             "change_pct": 100 * sign * CHANGE,
                             "value_changed_to": block[parameter],
-                            "solver": solver,
+                            "solver": solver.name,
                             "response": response,
                             "value": value,
                             "base_value": ref,

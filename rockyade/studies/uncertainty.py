@@ -66,7 +66,7 @@ from rockyade.io.atomic import atomic_open, write_json
 from rockyade.io.fields import TableReader
 from rockyade.motion.intensity import INTENSITY_MEASURES, check_measure, intensity_measures, scaled
 from rockyade.solvers import solver_names
-from rockyade.studies.batch import Task, run_study_tasks
+from rockyade.studies.batch import BatchTask, batch_task, run_study_tasks
 from rockyade.studies.sampling import (
     PARAMETERS,
     JointNormal,
@@ -137,7 +137,7 @@ class UncertaintyStudy:
 def _block_table(r: TableReader, base_dir: Path) -> tuple[dict[str, Any], dict[str, float]]:
     """(block table without alpha/p/mu, nominal alpha/p/mu)."""
     from rockyade.scene import load_scene, scene_from_dict
-    from rockyade.studies.common import block_table
+    from rockyade.studies.specimens import block_table
 
     if r.has("specimen"):
         key = str(r.raw("specimen"))
@@ -305,10 +305,12 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
     return frame
 
 
-def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | Path) -> list[Task]:
+def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | Path) -> list[BatchTask]:
     """One batch task per (sample, record, load factor, solver)."""
     from rockyade.scene import scene_from_dict
+    from rockyade.solvers import make_solver
 
+    solvers = [make_solver(name) for name in study.solvers]
     motions = dict(study.motions)
     tasks = []
     index = 0
@@ -328,7 +330,6 @@ def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | P
                     },
                     source=study.source or None,
                 )
-                canonical = scene.to_dict()
                 labels = {
                     "base": study.name,
                     "sample": int(row.sample),
@@ -339,8 +340,8 @@ def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | P
                     "p_rad_s": float(row.p_rad_s),
                     "mu": float(row.mu),
                 }
-                for solver in study.solvers:
-                    tasks.append(Task(index, canonical, solver, labels, str(out_dir), False))
+                for solver in solvers:
+                    tasks.append(batch_task(index, solver, scene, labels, out_dir, save_history=False))
                     index += 1
     return tasks
 

@@ -286,12 +286,12 @@ def check_pad(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
 def check_wall(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """About 1,000 blocks at rest: they settle elastically to the linear statics of the joints
     (rockyade.dem.statics) and do not move beyond it."""
-    from rockyade.calibration.matched import build_matched_model
+    from rockyade.calibration.model import calibrated_model
     from rockyade.dem.statics import rest_springs, static_displacement
 
     data = wall(courses=32, units_per_course=32, motion=rest_motion(), duration_s=1.5, sample_dt_s=0.005)
     scene = scene_from_dict(data)
-    model = build_matched_model(scene)
+    model = calibrated_model(scene)
     fixed = [b.fixed for b in model.bodies]
     springs = rest_springs(model.pos0_m, fixed, list(model.rest_contacts), model.joints)
     static = static_displacement(springs, [b.mass_kg for b in model.bodies], fixed, model.g)

@@ -1,23 +1,26 @@
 """What a run will cost, estimated before it starts, and a refusal above documented limits.
 
-The estimate of a scene run by a solver (:func:`estimate_cost`):
+Each solver answers for its own runs (``solver.estimate_cost(scene)``) with the models
+here:
 
-* **integration steps**: for the DEMs (reference and YADE), the explicit time steps times
-  the moving bodies, with the time step the model will use (paper Eq 7, kept below the
-  stability limit, or ``contact.dt_s``); for Housner, the output samples;
+* **integration steps**: for the DEMs (:func:`dem_cost`, reference and YADE), the explicit
+  time steps times the moving bodies, with the time step the model will use (paper Eq 7,
+  kept below the stability limit, or ``contact.dt_s``); for Housner (:func:`sample_cost`),
+  the output samples;
 * **output samples** and **base-motion samples** (the motion as it is built: a harmonic
   motion at 400 points per cycle, a pulse at T/400, a record's samples);
 * **memory**, bytes: about 45 bytes per output value (the frame, its CSV text and the
   digest: measured on 1e6-sample runs of the Housner and reference solvers), 80 bytes per
   motion sample, and 250 MB for the interpreter, numpy, scipy, pandas and numba;
-* **wall time**, s: 150 ns per body-step for the reference DEM, 5 us for YADE, 1.5 us per
-  output value written (measured on this project's benchmarks; an order of magnitude).
+* **wall time**, s: a solver's seconds per body-step (150 ns for the reference DEM, 5 us
+  for YADE: each solver's ``SECONDS_PER_BODY_STEP``) and 1.5 us per output value written
+  (measured on this project's benchmarks; an order of magnitude).
 
 :func:`check_cost` refuses a run above :data:`LIMITS` with an
 :class:`~rockyade.errors.InputError` naming what is too large, by how much, and the input
 that sets it; ``allow_large=True`` (``--allow-large`` on ``run``, ``compare`` and
-``batch``) runs it anyway. The solver functions themselves do not check: the command line
-and :func:`rockyade.studies.batch.run_study_tasks` do.
+``batch``) runs it anyway. The solvers themselves do not check: the command line and the
+runner (:func:`rockyade.runner.run_tasks`, before any run starts) do.
 """
 
 from __future__ import annotations
@@ -26,10 +29,13 @@ import dataclasses
 import json
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.errors import InputError
 from rockyade.scene import Scene
+
+if TYPE_CHECKING:
+    from rockyade.solvers.base import Solver
 
 #: Documented limits of one run (docs/reliability.md); ``allow_large`` lifts them.
 LIMITS: dict[str, float] = {
@@ -42,9 +48,7 @@ LIMITS: dict[str, float] = {
 BYTES_PER_OUTPUT_VALUE = 45.0
 BYTES_PER_MOTION_SAMPLE = 80.0
 BASE_MEMORY_BYTES = 250.0e6
-SECONDS_PER_BODY_STEP = {"reference": 150e-9, "yade": 5e-6}
 SECONDS_PER_OUTPUT_VALUE = 1.5e-6
-DEM_SOLVERS = ("reference", "yade")
 
 
 @dataclass(frozen=True)
@@ -137,35 +141,47 @@ def _cached_dem_time_step(scene: Scene) -> tuple[float, int]:
     return _DT_CACHE[key]
 
 
-def estimate_cost(scene: Scene, solver: str) -> CostEstimate:
-    """Estimate the cost of running ``scene`` with ``solver`` (module docstring)."""
-    n_out = scene.n_samples
-    n_blocks = len(scene.blocks)
+def _estimate(
+    scene: Scene, solver: str, steps: float, dt: float, columns: int, run_time_s: float
+) -> CostEstimate:
+    values = float(scene.n_samples) * columns
     motion_samples = scene.motion.sample_count(scene.duration_s)
-    if solver in DEM_SOLVERS:
-        dt, moving = _cached_dem_time_step(scene)
-        steps_per_sample = max(1, math.ceil(scene.sample_dt_s / dt - 1e-9))
-        steps = float(n_out - 1) * steps_per_sample * max(1, moving)
-        corners = sum(len(b.vertices_m or ()) or 4 for b in scene.blocks)
-        columns = 2 + 6 * n_blocks + corners + 7
-        run_time = steps * SECONDS_PER_BODY_STEP[solver]
-    else:
-        dt = math.nan
-        steps = float(n_out)
-        columns = 2 + 6 * n_blocks
-        run_time = 0.0
-    values = float(n_out) * columns
     memory = BASE_MEMORY_BYTES + BYTES_PER_OUTPUT_VALUE * values + BYTES_PER_MOTION_SAMPLE * motion_samples
     return CostEstimate(
         solver=solver,
         integration_steps=steps,
         time_step_s=dt,
-        output_samples=n_out,
+        output_samples=scene.n_samples,
         output_columns=columns,
         motion_samples=motion_samples,
         memory_bytes=memory,
-        wall_time_s=run_time + SECONDS_PER_OUTPUT_VALUE * values,
+        wall_time_s=run_time_s + SECONDS_PER_OUTPUT_VALUE * values,
     )
+
+
+def dem_cost(scene: Scene, solver: str, seconds_per_body_step: float) -> CostEstimate:
+    """The cost of a DEM run: time steps x moving bodies at the model's time step, the
+    time history of every block and corner, ``seconds_per_body_step`` of the DEM (s)."""
+    dt, moving = _cached_dem_time_step(scene)
+    steps_per_sample = max(1, math.ceil(scene.sample_dt_s / dt - 1e-9))
+    steps = float(scene.n_samples - 1) * steps_per_sample * max(1, moving)
+    corners = sum(len(b.vertices_m or ()) or 4 for b in scene.blocks)
+    columns = 2 + 6 * len(scene.blocks) + corners + 7
+    return _estimate(scene, solver, steps, dt, columns, steps * seconds_per_body_step)
+
+
+def sample_cost(scene: Scene, solver: str) -> CostEstimate:
+    """The cost of a run whose work grows with its output samples (Housner's exact solution):
+    one 'step' per sample, the time history of every block."""
+    columns = 2 + 6 * len(scene.blocks)
+    return _estimate(scene, solver, float(scene.n_samples), math.nan, columns, 0.0)
+
+
+def estimate_cost(scene: Scene, solver: Solver | str) -> CostEstimate:
+    """Estimate the cost of running ``scene`` with ``solver`` (a Solver, or a solver's name)."""
+    from rockyade.solvers import as_solver
+
+    return as_solver(solver).estimate_cost(scene)
 
 
 _WHAT = {
@@ -176,30 +192,46 @@ _WHAT = {
 }
 
 
+def cost_refusal(
+    estimate: CostEstimate, source: str | None = None, label: str = "", limits: dict[str, float] | None = None
+) -> InputError | None:
+    """The error refusing a run whose ``estimate`` is above the limits, or None when it is within."""
+    limits = LIMITS if limits is None else limits
+    over = estimate.over_limits(limits)
+    if not over:
+        return None
+    name = over[0]
+    what, remedy = _WHAT[name]
+    value, limit = getattr(estimate, name), limits[name]
+    where = f"{label}: " if label else ""
+    return InputError(
+        "allow_large",
+        f"{where}the {estimate.solver} run needs {value:.3g} {what}, above the limit {limit:.3g} "
+        f"({estimate.describe()}); use {remedy}, or pass --allow-large (allow_large=True) to run it anyway",
+        source,
+    )
+
+
 def check_cost(
-    scene: Scene, solver: str, allow_large: bool = False, label: str = "", limits: dict[str, float] | None = None
+    scene: Scene,
+    solver: Solver | str,
+    allow_large: bool = False,
+    label: str = "",
+    limits: dict[str, float] | None = None,
 ) -> CostEstimate:
     """The cost estimate; raise InputError if it exceeds the limits and ``allow_large`` is False.
 
     Parameters
     ----------
+    solver
+        A Solver, or a solver's name.
     label
         Names the run in the error (e.g. a batch's run index and grid values).
     """
     estimate = estimate_cost(scene, solver)
-    over = estimate.over_limits(limits)
-    if over and not allow_large:
-        limits = LIMITS if limits is None else limits
-        name = over[0]
-        what, remedy = _WHAT[name]
-        value, limit = getattr(estimate, name), limits[name]
-        where = f"{label}: " if label else ""
-        raise InputError(
-            "allow_large",
-            f"{where}the {solver} run needs {value:.3g} {what}, above the limit {limit:.3g} "
-            f"({estimate.describe()}); use {remedy}, or pass --allow-large (allow_large=True) to run it anyway",
-            scene.source,
-        )
+    refusal = None if allow_large else cost_refusal(estimate, scene.source, label, limits)
+    if refusal is not None:
+        raise refusal
     return estimate
 
 
@@ -208,4 +240,14 @@ def estimate_dict(estimate: CostEstimate) -> dict[str, Any]:
     return dataclasses.asdict(estimate)
 
 
-__all__ = ["LIMITS", "CostEstimate", "check_cost", "dem_time_step", "estimate_cost", "estimate_dict"]
+__all__ = [
+    "LIMITS",
+    "CostEstimate",
+    "check_cost",
+    "cost_refusal",
+    "dem_cost",
+    "dem_time_step",
+    "estimate_cost",
+    "estimate_dict",
+    "sample_cost",
+]

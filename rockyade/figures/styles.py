@@ -1,0 +1,33 @@
+"""The studies' figure conventions: one look per solver, and the states of a harmonic test."""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: One look per solver in every study figure. The reference DEM is a wide translucent
+#: band, Housner a thin solid line and YADE a dashed line on top, so that curves that
+#: coincide stay visible (a dashed line inside a band) instead of hiding each other.
+SOLVER_STYLES: dict[str, dict[str, Any]] = {
+    "reference": {"color": "#f28e2b", "lw": 4.0, "alpha": 0.45, "ls": "-", "zorder": 2},
+    "housner": {"color": "#1f4e9c", "lw": 1.0, "alpha": 1.0, "ls": "-", "zorder": 3},
+    "yade": {"color": "#1b7837", "lw": 1.3, "alpha": 1.0, "ls": (0, (4, 3)), "zorder": 4},
+}
+SOLVER_LABELS = {"housner": "Housner (exact)", "reference": "reference DEM", "yade": "YADE"}
+
+
+def plot_solver(ax: Any, solver: str, t: Any, y: Any, label: str | None = None) -> None:
+    """Draw one solver's curve in its study style."""
+    ax.plot(t, y, label=label or SOLVER_LABELS.get(solver, solver), **SOLVER_STYLES[solver])
+
+
+def shade_harmonic_states(ax, phases: dict[str, float], t_end: float, settle_cycles: float, frequency: float) -> None:
+    """Shade the transient, stationary and free-rocking states of a harmonic test."""
+    transient_end = phases["ramp_up_end_s"] + settle_cycles / frequency
+    spans = (
+        (0.0, transient_end, "transient", "#f2d7b6"),
+        (transient_end, phases["end_s"], "stationary", "#d4e6f1"),
+        (phases["end_s"], t_end, "free rocking", "#d5f5e3"),
+    )
+    for start, end, label, colour in spans:
+        if end > start:
+            ax.axvspan(start, end, color=colour, alpha=0.5, lw=0, label=label)

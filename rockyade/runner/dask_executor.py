@@ -1,0 +1,132 @@
+"""Jobs on Dask: its threaded scheduler in this process, or a ``distributed`` cluster.
+
+Without a scheduler address the jobs run on Dask's threaded scheduler inside this process:
+no cluster starts and no socket opens (a ``distributed.LocalCluster`` would start HTTP
+servers). With an address (``tcp://``, ``tls://``, ...) they run on that cluster; Ctrl-C
+cancels what has not finished. Dask is optional: ``pip install 'rockyade[dask]'``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+from rockyade.errors import InputError
+from rockyade.runner.stopping import StopRequest
+from rockyade.runner.threads import Failed, call
+
+SCHEDULER_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc)://\S+$")
+
+
+def check_scheduler(address: str) -> str:
+    """A scheduler address as ``tcp://host:port`` (or tls, ucx, inproc).
+
+    Raises
+    ------
+    InputError
+        Anything else.
+    """
+    if not isinstance(address, str) or not SCHEDULER_ADDRESS.match(address):
+        raise InputError("scheduler", f"must be an address like tcp://host:8786 or tls://host:8786, got {address!r}")
+    return address
+
+
+def run_dask_in_process(
+    jobs: Sequence[Any],
+    fn: Callable[[Any], Any],
+    workers: int,
+    done: Callable[[int, Any], None],
+    failed: Failed | None,
+    stop: StopRequest,
+    started: set[int],
+) -> None:
+    """Dask's threaded scheduler on ``workers`` threads of this process; a stop request makes
+    the unstarted jobs return at once, unfinished."""
+    try:
+        import dask.threaded
+        from dask.callbacks import Callback
+    except ImportError:
+        raise InputError("executor", "the dask executor needs dask: pip install 'rockyade[dask]'") from None
+
+    unfinished = object()
+
+    def guarded(i: int) -> Any:
+        if stop.event.is_set():
+            return unfinished
+        started.add(i)
+        return i, call(fn, jobs[i], failed)
+
+    def posttask(key: Any, value: Any, dsk: Any, state: Any, worker_id: Any) -> None:
+        if value is not unfinished:
+            done(*value)
+
+    # the graph's arguments are positions: Dask never looks inside a job
+    graph = {f"run-{i}": (guarded, i) for i in range(len(jobs))}
+    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-dask")
+    clean = False
+    try:
+        with Callback(posttask=posttask):
+            dask.threaded.get(graph, list(graph), pool=pool)
+        clean = True
+    finally:
+        # after a second Ctrl-C the running jobs are threads that cannot be killed: the
+        # command line ends the process
+        pool.shutdown(wait=clean, cancel_futures=True)
+
+
+def run_dask_remote(
+    jobs: Sequence[Any],
+    fn: Callable[[Any], Any],
+    scheduler: str,
+    timeout_s: float,
+    done: Callable[[int, Any], None],
+    failed: Failed | None,
+    stop: StopRequest,
+    started: set[int],
+) -> None:
+    """A ``distributed`` cluster at ``scheduler``; Ctrl-C cancels what has not finished.
+
+    Raises
+    ------
+    InputError
+        No dask[distributed], a malformed address, or no scheduler answering within ``timeout_s``.
+    """
+    try:
+        from dask.distributed import Client
+        from dask.distributed import as_completed as dask_completed
+    except ImportError:
+        raise InputError(
+            "executor", "the dask executor needs dask[distributed]: pip install 'rockyade[dask]'"
+        ) from None
+    check_scheduler(scheduler)
+    try:
+        client = Client(scheduler, timeout=timeout_s)
+    except (OSError, TimeoutError) as exc:
+        raise InputError(
+            "scheduler", f"no Dask scheduler answered at {scheduler} within {timeout_s:g} s ({exc})"
+        ) from None
+    try:
+        futures = client.map(fn, list(jobs), pure=False)
+        position = {future.key: i for i, future in enumerate(futures)}
+        started.update(range(len(jobs)))  # the cluster decides when: cancelled ones count as stopped
+        pending = dask_completed(futures)
+        while not pending.is_empty():
+            batch = pending.next_batch(block=False)
+            for future in batch:
+                i = position[future.key]
+                try:
+                    value = future.result()
+                except Exception as exc:  # a worker lost, a value that does not pickle: this job fails
+                    if failed is None:
+                        raise
+                    value = failed(jobs[i], f"{type(exc).__name__}: {exc}")
+                done(i, value)
+            if stop.requested:
+                client.cancel([f for f in futures if not f.done()])
+                break
+            if not batch:
+                stop.event.wait(0.1)
+    finally:
+        client.close()

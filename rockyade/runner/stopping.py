@@ -1,0 +1,66 @@
+"""Ctrl-C during a run of many: the first stops dispatching, the second stops the running runs."""
+
+from __future__ import annotations
+
+import contextlib
+import signal
+import sys
+import threading
+from typing import Any
+
+
+class StopRequest:
+    """Counts Ctrl-C (SIGINT) while work runs: the first asks to stop dispatching, the second
+    to stop at once. Installed only in the main thread (elsewhere Python delivers no signal).
+
+    Parameters
+    ----------
+    raise_on_second
+        Raise KeyboardInterrupt on the second Ctrl-C (executors whose runs are threads of
+        this process cannot be killed: the caller then ends the process).
+    """
+
+    def __init__(self, raise_on_second: bool = False) -> None:
+        self.count = 0
+        self.event = threading.Event()
+        self.raise_on_second = raise_on_second
+        self._previous: Any = None
+        self._installed = False
+
+    @property
+    def requested(self) -> bool:
+        """A first Ctrl-C came: start no new run."""
+        return self.count >= 1
+
+    @property
+    def now(self) -> bool:
+        """A second Ctrl-C came: stop the running runs."""
+        return self.count >= 2
+
+    def _handler(self, signum: int, frame: Any) -> None:
+        self.count += 1
+        self.event.set()
+        if self.count == 1:
+            say("Ctrl-C: no new run starts; waiting for the running runs to finish (Ctrl-C again stops them now)")
+        elif self.count == 2:
+            say("Ctrl-C again: stopping the running runs now")
+            if self.raise_on_second:
+                raise KeyboardInterrupt
+
+    def __enter__(self) -> StopRequest:
+        if threading.current_thread() is threading.main_thread():
+            self._previous = signal.signal(signal.SIGINT, self._handler)
+            self._installed = True
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._installed:
+            signal.signal(signal.SIGINT, self._previous)
+            self._installed = False
+
+
+def say(message: str) -> None:
+    """A line on stderr, on a line of its own (below a progress bar); never raises."""
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(f"\n{message}\n")
+        sys.stderr.flush()

@@ -1,0 +1,66 @@
+"""Jobs in this process: in the calling thread (one worker) or on a pool of threads.
+
+The numba kernels release the GIL and a YADE run is a process of its own, so threads run
+solvers in parallel without the cost of worker processes (and ``fn`` need not pickle).
+Threads cannot be killed: after a second Ctrl-C the caller ends the process
+(:class:`~rockyade.runner.stopping.StopRequest` raises KeyboardInterrupt for it).
+"""
+
+from __future__ import annotations
+
+import collections
+from collections.abc import Callable, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from typing import Any
+
+from rockyade.runner.stopping import StopRequest
+
+#: The value of a job that raised or whose worker died, from the job and the reason.
+Failed = Callable[[Any, str], Any]
+
+
+def call(fn: Callable[[Any], Any], job: Any, failed: Failed | None) -> Any:
+    """``fn(job)``, or the failed value of the job if it raises (``failed`` None: it raises)."""
+    try:
+        return fn(job)
+    except Exception as exc:  # one failed job never stops the others
+        if failed is None:
+            raise
+        return failed(job, f"{type(exc).__name__}: {exc}")
+
+
+def run_threads(
+    jobs: Sequence[Any],
+    fn: Callable[[Any], Any],
+    workers: int,
+    done: Callable[[int, Any], None],
+    failed: Failed | None,
+    stop: StopRequest,
+    started: set[int],
+) -> None:
+    """Run ``fn(job)`` for every job on ``workers`` threads (1: in this thread, in order)."""
+    if workers == 1:
+        for i, job in enumerate(jobs):
+            if stop.requested:
+                return
+            started.add(i)
+            done(i, call(fn, job, failed))
+        return
+    pending = collections.deque(range(len(jobs)))
+    running: dict[Future[Any], int] = {}
+    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-run")
+    clean = False
+    try:
+        while pending or running:
+            while pending and len(running) < workers and not stop.requested:
+                i = pending.popleft()
+                started.add(i)
+                running[pool.submit(call, fn, jobs[i], failed)] = i
+            if not running:
+                break
+            finished, _ = wait(running, timeout=0.2, return_when=FIRST_COMPLETED)
+            for future in finished:
+                done(running.pop(future), future.result())
+        clean = True
+    finally:
+        pool.shutdown(wait=clean, cancel_futures=True)

@@ -1,0 +1,91 @@
+"""What a solver is: an object that turns a Scene into a Result, carrying its own options.
+
+A solver has a ``name`` (the registry's, :func:`rockyade.solvers.solver_names`), runs a
+scene (``run(scene) -> Result``), says what a run will cost before it starts
+(``estimate_cost(scene)``, :mod:`rockyade.runner.cost`) and places the files it keeps, if
+any (``keeping_files(folder, stem)``: YADE's scene data, output and log; the other solvers
+keep none and return themselves). Solver objects are frozen dataclasses: they pickle, so
+they travel to worker processes and Dask workers with the scene.
+
+Options are the dataclass's fields (e.g. ``ReferenceSolver(record_energy=False)``,
+``YadeSolver(timeout_s=600)``); :meth:`SolverBase.from_options` checks options given by
+name (from a command line or a study file) and refuses one the solver does not take.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkable
+
+from rockyade.errors import InputError
+
+if TYPE_CHECKING:
+    from rockyade.result import Result
+    from rockyade.runner.cost import CostEstimate
+    from rockyade.scene import Scene
+
+#: Checks an option's value: (value, field named in errors) -> the value to use.
+OptionCheck = Callable[[Any, str], Any]
+
+
+@runtime_checkable
+class Solver(Protocol):
+    """The interface every solver offers (see the module docstring)."""
+
+    name: str
+
+    def run(self, scene: Scene) -> Result:
+        """Run ``scene``; a failed run is a Result with status ``failed`` or an exception."""
+        ...
+
+    def estimate_cost(self, scene: Scene) -> CostEstimate:
+        """What running ``scene`` will cost (steps, samples, memory, time)."""
+        ...
+
+    def keeping_files(self, folder: str | Path, stem: str | None = None) -> Solver:
+        """This solver with the files it keeps in ``folder``, named ``stem`` (default: the
+        scene hash and the solver's name); itself when it keeps none."""
+        ...
+
+
+def check_flag(value: Any, field: str) -> bool:
+    """A true/false option."""
+    if not isinstance(value, bool):
+        raise InputError(field, f"must be true or false, got {value!r}")
+    return value
+
+
+class SolverBase:
+    """What the solvers share: options by name and no files kept (override both as needed).
+
+    Subclasses are frozen dataclasses whose fields are their options, with ``name`` and
+    ``OPTIONS`` (option -> :data:`OptionCheck`) as class attributes.
+    """
+
+    name: ClassVar[str] = ""
+    OPTIONS: ClassVar[Mapping[str, OptionCheck]] = {}
+
+    @classmethod
+    def from_options(cls, options: Mapping[str, Any], fields: Mapping[str, str] | None = None) -> Self:
+        """The solver with ``options`` checked; ``fields`` names them in errors (e.g.
+        ``{"timeout_s": "--yade-timeout"}``).
+
+        Raises
+        ------
+        InputError
+            An option this solver does not take, or a value out of its range.
+        """
+        fields = fields or {}
+        checked = {}
+        for key, value in options.items():
+            field = fields.get(key, key)
+            if key not in cls.OPTIONS:
+                takes = ", ".join(cls.OPTIONS) or "none"
+                raise InputError(field, f"is not an option of the {cls.name} solver (its options: {takes})")
+            checked[key] = cls.OPTIONS[key](value, field)
+        return cls(**checked)
+
+    def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
+        """Itself: this solver keeps no files."""
+        return self

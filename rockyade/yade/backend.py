@@ -1,0 +1,361 @@
+"""YADE's machinery: a DEM model run by YADE in batch mode, parsed back.
+
+The DEM model (:mod:`rockyade.dem.model`, the same the reference DEM runs) is written as
+JSON data (:mod:`rockyade.yade.payload`) and run by :mod:`rockyade.yade.driver`
+in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess:
+
+* no listening socket: the ``yade`` launcher (which opens a Python console on
+  0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used;
+* one OpenMP thread per run (``OMP_NUM_THREADS=1``), a timeout, stdout and stderr in a log
+  file next to the result;
+* a non-zero exit, a timeout, a Python exception inside YADE, a non-finite state, or a
+  missing or partial output file give a Result with status ``failed``, the reason and the
+  log path, never a Result that looks complete.
+
+Runs are independent (own files, own process), so several can go in parallel (the
+runner, :mod:`rockyade.runner`). The solver, :class:`rockyade.solvers.yade.YadeSolver`,
+turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
+:func:`write_script` gives YADE users the same scene as a script of their own.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import signal
+import subprocess
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from rockyade import __version__
+from rockyade.calibration.model import calibrated_model
+from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.model import DemModel
+from rockyade.dem.overturn import CRITERION, run_outcome
+from rockyade.errors import InputError, SolverUnavailableError
+from rockyade.io.atomic import write_json, write_text
+from rockyade.io.lifetime import child_dies_with_parent
+from rockyade.result import Result, failed_result
+from rockyade.scene import Scene
+from rockyade.yade.payload import scene_payload
+
+#: The script YADE's Python runs, shipped inside the package.
+DRIVER = Path(__file__).resolve().parent / "driver.py"
+YADE_PYTHON = os.environ.get("ROCKYADE_YADE_PYTHON", "/usr/bin/python3.11")
+YADE_PY_DIR = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
+
+
+def yade_available() -> bool:
+    """True when Debian's YADE and its Python are installed."""
+    return Path(YADE_PYTHON).is_file() and (Path(YADE_PY_DIR) / "yade" / "__init__.py").is_file()
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["OMP_NUM_THREADS"] = "1"
+    env.pop("DISPLAY", None)  # no GUI
+    env["ROCKYADE_YADE_PY"] = YADE_PY_DIR
+    env["PYTHONNOUSERSITE"] = "1"
+    return env
+
+
+# ---------------------------------------------------------------------- running
+
+#: Default timeout: start-up allowance plus this many seconds per body-step ...
+TIMEOUT_STARTUP_S = 60.0
+TIMEOUT_PER_BODY_STEP_S = 50e-6
+#: ... capped here unless a larger one is asked for (``--yade-timeout``, ``timeout_s``).
+TIMEOUT_CAP_S = 3600.0
+#: Largest timeout accepted, s (30 days).
+MAX_TIMEOUT_S = 30 * 86400.0
+
+
+def default_timeout(model: DemModel) -> float:
+    """Wall-clock limit of a YADE run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
+    body-step (about 5-20x what YADE needs), capped at TIMEOUT_CAP_S (one hour)."""
+    work = TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * model.n_steps * len(model.bodies)
+    return min(work, TIMEOUT_CAP_S)
+
+
+def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> float | None:
+    """A user timeout checked: None (the default) or a number of seconds in (0, MAX_TIMEOUT_S].
+
+    Raises
+    ------
+    InputError
+        Not a positive finite number of seconds within the limit.
+    """
+    if timeout_s is None:
+        return None
+    try:
+        value = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
+    if not (0.0 < value <= MAX_TIMEOUT_S):
+        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
+    return value
+
+
+def _run_process(cmd: list[str], log_file: Path, cwd: Path, timeout: float) -> str | None:
+    """Run YADE's Python; the reason it failed, or None. On timeout the process group is
+    killed (the driver and anything it started) and waited for: no orphan is left."""
+    with open(log_file, "w") as log:
+        proc = subprocess.Popen(
+            cmd,
+            stdout=log,
+            stderr=subprocess.STDOUT,
+            env=_env(),
+            cwd=cwd,
+            start_new_session=True,  # a group of its own: a timeout kills YADE and its children
+            preexec_fn=child_dies_with_parent(),  # ... and YADE dies with this process, even by SIGKILL
+        )
+        try:
+            code = proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            _kill_group(proc)
+            return f"timeout: YADE did not finish within {timeout:.6g} s and was stopped (raise it with --yade-timeout)"
+        except BaseException:  # Ctrl-C or any other interruption: never leave YADE running
+            _kill_group(proc)
+            raise
+    return None if code == 0 else f"YADE exited with code {code}"
+
+
+def _kill_group(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        proc.kill()
+    proc.wait()
+
+
+def run_model(
+    model: DemModel,
+    *,
+    workdir: str | Path | None = None,
+    name: str = "yade",
+    timeout_s: float | None = None,
+    accel_lowpass_hz: float | None = None,
+) -> Result:
+    """Run a DEM model in YADE and return a Result (status ``failed`` on any failure).
+
+    Parameters
+    ----------
+    model
+        The DEM model.
+    workdir
+        Where ``<name>.yade.json`` (the scene data), ``<name>.yade.npz`` (YADE's output)
+        and ``<name>.yade.log`` are kept (relative to the current folder, or absolute);
+        default a temporary directory, removed after a successful run and kept (its log
+        path in the Result) after a failed one.
+    timeout_s
+        Wall-clock limit of the YADE process, s (default :func:`default_timeout`).
+    """
+    if not yade_available():
+        raise SolverUnavailableError(
+            f"YADE is not installed (looked for {YADE_PYTHON} and {YADE_PY_DIR}/yade): "
+            "apt-get install -y --no-install-recommends yade, or set ROCKYADE_YADE_PYTHON to the Python "
+            "that runs YADE's modules"
+        )
+    timeout = check_timeout(timeout_s)
+    timeout = timeout if timeout is not None else default_timeout(model)
+    keep = workdir is not None
+    # absolute paths: the process runs in ``directory``, where a relative path would be
+    # taken relative to it a second time
+    directory = (Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
+    directory.mkdir(parents=True, exist_ok=True)
+    scene_file = directory / f"{name}.yade.json"
+    out_file = directory / f"{name}.yade.npz"
+    log_file = directory / f"{name}.yade.log"
+    for stale in (out_file, log_file):
+        stale.unlink(missing_ok=True)
+    payload = scene_payload(model)
+    write_json(scene_file, payload)
+    start = time.perf_counter()
+    reason = _run_process([YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)], log_file, directory, timeout)
+    total = time.perf_counter() - start
+    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, payload.get("contact_plan"))
+    result.meta["timeout_s"] = timeout
+    if result.ok and not keep:
+        shutil.rmtree(directory, ignore_errors=True)
+    return result
+
+
+def _last_error_line(log_file: Path) -> str:
+    """The last error line of YADE's log ("" when it has none: a banner is not a reason)."""
+    try:
+        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+    except OSError:
+        return ""
+    for line in reversed(lines):
+        if "Error" in line or "Exception" in line:
+            return line
+    return ""
+
+
+def _parse(
+    model: DemModel,
+    out_file: Path,
+    reason: str | None,
+    log_file: Path,
+    total: float,
+    lowpass: float | None,
+    contact_plan: dict | None = None,
+) -> Result:
+    """YADE's output file as a Result, or a failed Result saying why there is none.
+
+    Parameters
+    ----------
+    reason
+        Why the process failed (None: it exited normally).
+    total
+        Wall time of the whole process, s.
+    lowpass
+        Optional zero-phase low-pass of the output accelerations, Hz.
+    """
+    extra: dict[str, object] = {"log_path": str(log_file), "total_time_s": total}
+    if contact_plan is not None:
+        extra["yade_contacts"] = contact_plan
+    if reason is None and not out_file.is_file():
+        reason = "YADE wrote no output file"
+    if reason is not None:
+        detail = _last_error_line(log_file)
+        extra["wall_time_s"] = total
+        return failed_result("yade", model.scene_hash, f"{reason}: {detail}" if detail else reason, **extra)
+    try:
+        with np.load(out_file, allow_pickle=False) as data:
+            meta = json.loads(str(data["meta"]))
+            arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
+    problem = _output_problem(model, meta, arrays)
+    if problem is not None:
+        return failed_result("yade", model.scene_hash, problem, **extra)
+    extra["max_polyhedra_penetration_over_radius"] = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
+    extra["max_rotation_step_rad"] = meta.get("max_rotation_step_rad")
+    extra["rotation_track_period_steps"] = meta.get("rotation_track_period_steps")
+    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra))
+
+
+def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
+    """Why a complete-looking output is not a result (partial, short, unstable, a lost
+    contact normal), or None when it is one."""
+    n = int(meta.get("n_filled", 0))
+    if not meta.get("complete") or arrays["pos"].shape[0] != n:
+        return "partial YADE output"
+    status = meta["status"]
+    if status == "completed" and n != model.n_samples:
+        return f"YADE stopped early: {n} of {model.n_samples} samples"
+    if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
+        return (
+            f"numerical instability in YADE at t = {meta.get('stop_time_s')} s (non-finite state, runaway speed or "
+            "spin, or a rotation between two records too large to follow)"
+        )
+    gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
+    if t_blowup is not None:
+        return f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+    if float(meta.get("max_polyhedra_penetration_over_radius", 0.0)) >= 1.0:
+        return (
+            "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
+            "contact then loses its normal): the impact is too hard for these contact spheres"
+        )
+    return None
+
+
+def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None) -> pd.DataFrame:
+    """The common time history, plus the normal force of every contact vertex (``c<i>_fn_N``)."""
+    frame = dem_frame(
+        model,
+        arrays["pos"],
+        arrays["ang"],
+        arrays["angvel"],
+        arrays["vpoint"],
+        arrays["state"],
+        lowpass,
+        n_contacts=arrays["ncont"],
+        slipping=arrays["slip"],
+    )
+    names = model.names
+    forces = {}
+    for i, body in enumerate(model.bodies):
+        prefix = f"{body.name}_" if len(names) > 1 else ""
+        for v in range(len(body.contact_vertices_m)):
+            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
+
+
+def _run_meta(model: DemModel, meta: dict, total: float, extra: dict[str, object]) -> dict[str, object]:
+    """The Result's metadata: how the run ended (overturns per block) and what ran."""
+    names = model.names
+    status = meta["status"]
+    overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
+    overturn_time = meta["stop_time_s"] if status == "overturned" else None
+    overturned_block = names[meta["stop_body"]] if status == "overturned" else None
+    if not model.stop_on_overturn and status == "completed":
+        status, overturn_time, overturned_block = run_outcome(overturn_times, names)
+    return {
+        "solver": "yade",
+        "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",
+        "scene_hash": model.scene_hash,
+        "wall_time_s": meta["wall_time_s"],
+        "startup_time_s": total - meta["wall_time_s"],
+        "status": status,
+        "overturn_time_s": overturn_time,
+        "overturned_block": overturned_block,
+        "overturn_criterion": CRITERION,
+        "overturn_times_s": overturn_times,
+        "blocks": names,
+        "sample_dt_s": model.sample_dt_s,
+        "duration_s": model.duration_s,
+        "dt_s": meta["dt_s"],
+        "dt_source": model.dt_source,
+        "n_steps": model.n_steps,
+        "iterations": meta["iterations"],
+        "calibration": model.calibration,
+        "contact": model.joint_summary(),
+        "bodies": model.body_summary(),
+        "motion": model.motion_label,
+        **extra,
+    }
+
+
+def yade_model(scene: Scene) -> DemModel:
+    """The DEM model YADE runs for ``scene`` (the reference DEM's, matched calibration included).
+
+    Raises
+    ------
+    InputError
+        A scene YADE cannot run (mass-proportional damping).
+    """
+    if scene.contact.mass_damping_1_s:
+        raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
+    return calibrated_model(scene)
+
+
+def write_script(scene: Scene, directory: str | Path) -> dict[str, Path]:
+    """A standalone YADE script for a scene: ``run.py`` (the driver rockyade itself runs) and
+    ``scene.json`` (its data) in ``directory``, for YADE users who go on by hand.
+
+    ``yade -x run.py`` (batch) or ``yade run.py`` (with YADE's GUI and console) builds the
+    same scene and writes ``result.npz`` (what rockyade parses) and ``result.csv`` (t,
+    centroid and rotation of each block) beside the script; so does
+    ``/usr/bin/python3.11 run.py`` (Debian's Python) with YADE's modules on the path. The launcher opens a Python
+    console and an XMLRPC server on all interfaces (rockyade never uses it).
+
+    Returns
+    -------
+    dict
+        Paths of ``script`` and ``data``.
+    """
+    model = yade_model(scene)
+    out = Path(directory)
+    out.mkdir(parents=True, exist_ok=True)
+    data, script = out / "scene.json", out / "run.py"
+    write_json(data, scene_payload(model))
+    write_text(script, DRIVER.read_text())
+    return {"script": script, "data": data}
