@@ -1,0 +1,288 @@
+"""A mechanism followed at finite displacement, and its multiplier alpha(dk) by virtual work.
+
+The blocks that take part in a mechanism move as rigid bodies; blocks joined by a locked
+joint (neither end opens nor slips at rest) move together as one rigid group. Group g's
+material point X (rest position, base frame) is at C_g + t_g + R(theta_g) (X - C_g), C_g its
+centre of mass at rest, t_g its displacement and theta_g its rotation. The hinges (an
+interface end where the two bodies turn relative to each other without opening or
+slipping) stay joined: x_a(X) = x_b(X), a body not taking part (or the base, a fixed block)
+staying where it is. The velocities (vx, vy, omega) compatible with those joints
+form the null space of the constraints' Jacobian C(s) in the displaced configuration s;
+a one-degree-of-freedom mechanism has a one-dimensional null space (where it has more, the
+velocity nearest the last one is followed).
+
+The configuration is advanced by the midpoint rule in steps of the control displacement
+dk (the control point's horizontal displacement along the load), each step projected back
+onto the joints by Gauss-Newton, and at every configuration
+
+    alpha = (sum m_i g vy_i - sum F . v(p)) / (d sum m_i g vx_i)
+
+(the virtual work of gravity, the loads F at their points p and alpha m g d, zero), down to
+alpha = 0. This is the nonlinear kinematic analysis of NTC 2018 / Circolare 2019 C8.7.1
+(the multiplier of the mechanism at finite displacement). The joints are kept as they
+are at rest: no new contact is sought and a joint that slides is not followed (the code's
+nonlinear analysis is for rocking mechanisms).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rockyade.limit.lp import DIRECTIONS
+from rockyade.limit.mechanism import Mechanism
+from rockyade.limit.model import RigidBlockModel
+
+#: Largest rotation of any block in one step, rad.
+MAX_STEP_ROTATION_RAD = 2.0e-3
+#: Largest change of alpha in one step, as a fraction of alpha at rest.
+MAX_STEP_ALPHA = 5.0e-3
+MAX_STEPS = 20_000
+
+
+@dataclass(frozen=True)
+class CapacityCurve:
+    """alpha against the control point's displacement, from rest down to alpha = 0.
+
+    Attributes
+    ----------
+    dk_m
+        Horizontal displacement of the control point along the load, m (first 0).
+    alpha
+        Multiplier of the mechanism in each configuration (first: alpha0).
+    d0_m
+        dk at alpha = 0 (interpolated), m; None when the curve stops before (``stopped``).
+    stopped
+        Why the curve ended before alpha = 0, else None.
+    max_joint_gap_m
+        Largest distance apart of two joined points over the curve (the drift of the
+        integration), m.
+    """
+
+    dk_m: NDArray[np.float64]
+    alpha: NDArray[np.float64]
+    d0_m: float | None
+    stopped: str | None
+    max_joint_gap_m: float
+
+
+class _Kinematics:
+    """Positions, joint constraints and compatible velocities of the moving rigid groups.
+
+    Blocks joined by a locked interface (both ends active) move as one rigid group; a
+    group's state is the displacement (tx, ty) of its reference point (the members' centre
+    of mass) and its rotation theta. Only active points between different groups, or
+    between a group and the ground, constrain the motion.
+    """
+
+    def __init__(self, model: RigidBlockModel, mechanism: Mechanism) -> None:
+        self.model = model
+        members = [int(b) for b in np.flatnonzero(mechanism.moving)]
+        parent = {b: b for b in members}
+
+        def root(b: int) -> int:
+            while parent[b] != b:
+                parent[b] = parent[parent[b]]
+                b = parent[b]
+            return b
+
+        ends: dict[int, list[int]] = {}
+        for k, e in mechanism.active_points:
+            ends.setdefault(k, []).append(e)
+        for k, es in ends.items():
+            itf = model.interfaces[k]
+            if len(es) == 2 and itf.a in parent and itf.b in parent:
+                parent[root(itf.a)] = root(itf.b)
+        roots = sorted({root(b) for b in members})
+        self.group_of = {b: roots.index(root(b)) for b in members}
+        self.members = [np.array([b for b in members if self.group_of[b] == g]) for g in range(len(roots))]
+        masses = model.masses_kg
+        self.group_mass = np.array([masses[m].sum() for m in self.members])
+        self.refs = np.array(
+            [np.average(model.centroids_m[m], axis=0, weights=masses[m]) for m in self.members]
+        ).reshape(-1, 2)
+        self.points = []  # (rest point, group of a or -1, group of b or -1)
+        for k, es in ends.items():
+            itf = model.interfaces[k]
+            ga = self.group_of.get(itf.a, -1)
+            gb = self.group_of.get(itf.b, -1) if itf.b >= 0 else -1
+            if ga == gb:
+                continue  # inside a group (or between two bodies at rest)
+            for e in es:
+                self.points.append((itf.ends_m[e].copy(), ga, gb))
+
+    @property
+    def n_dof(self) -> int:
+        return 3 * len(self.members)
+
+    def place(self, s: NDArray[np.float64], group: int, rest: NDArray[np.float64]):
+        """Position of a group's material point and its arm R(theta)(X - ref) (None for the ground)."""
+        if group < 0:
+            return rest, None
+        t = s[3 * group : 3 * group + 2]
+        theta = s[3 * group + 2]
+        c, sn = np.cos(theta), np.sin(theta)
+        r = rest - self.refs[group]
+        arm = np.array([c * r[0] - sn * r[1], sn * r[0] + c * r[1]])
+        return self.refs[group] + t + arm, arm
+
+    def point_velocity(self, s, q, group: int, rest) -> NDArray[np.float64]:
+        """Velocity of a group's material point (rest position ``rest``)."""
+        _, arm = self.place(s, group, rest)
+        omega = q[3 * group + 2]
+        return q[3 * group : 3 * group + 2] + omega * np.array([-arm[1], arm[0]])
+
+    def initial_velocity(self, velocities: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The mechanism's block velocities as group velocities (of the reference points)."""
+        q = np.zeros(self.n_dof)
+        for g, members in enumerate(self.members):
+            i = int(members[0])
+            v = velocities[i]
+            r = self.refs[g] - self.model.centroids_m[i]
+            q[3 * g : 3 * g + 3] = (v[0] - v[2] * r[1], v[1] + v[2] * r[0], v[2])
+        return q
+
+    def constraints(self, s: NDArray[np.float64]):
+        """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
+        g = np.zeros(2 * len(self.points))
+        C = np.zeros((2 * len(self.points), self.n_dof))
+        for k, (rest, ga, gb) in enumerate(self.points):
+            xa, arm_a = self.place(s, ga, rest)
+            xb, arm_b = self.place(s, gb, rest)
+            g[2 * k : 2 * k + 2] = xa - xb
+            for group, arm, sign in ((ga, arm_a, 1.0), (gb, arm_b, -1.0)):
+                if group < 0:
+                    continue
+                C[2 * k, 3 * group] += sign
+                C[2 * k + 1, 3 * group + 1] += sign
+                C[2 * k, 3 * group + 2] += -sign * arm[1]
+                C[2 * k + 1, 3 * group + 2] += sign * arm[0]
+        return g, C
+
+    def velocity(self, s: NDArray[np.float64], previous: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """The compatible velocity nearest ``previous`` (unit norm), None when the joints lock."""
+        _, C = self.constraints(s)
+        if C.shape[0] == 0:
+            q = previous.copy()
+        else:
+            scale = np.ones(self.n_dof)
+            scale[2::3] = self.model.size_m  # rotations to lengths: comparable columns
+            _, sv, vt = np.linalg.svd(C / scale, full_matrices=True)
+            rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0))) if sv.size else 0
+            basis = vt[rank:].T  # orthonormal, in (vx, vy, omega * size)
+            if basis.shape[1] == 0:
+                return None
+            q = (basis @ (basis.T @ (previous * scale))) / scale
+        norm = np.linalg.norm(q)
+        if norm < 1e-12 * max(np.linalg.norm(previous), 1e-300):
+            return None
+        return q / norm
+
+    def project(self, s: NDArray[np.float64], iterations: int = 4) -> tuple[NDArray[np.float64], float]:
+        """``s`` moved back onto the joints (least-norm Gauss-Newton); and the gap left, m."""
+        for _ in range(iterations):
+            g, C = self.constraints(s)
+            if g.size == 0 or np.max(np.abs(g)) < 1e-13 * self.model.size_m:
+                break
+            s = s - np.linalg.lstsq(C, g, rcond=None)[0]
+        g, _ = self.constraints(s)
+        return s, float(np.max(np.abs(g))) if g.size else 0.0
+
+
+def _alpha(model: RigidBlockModel, kin: _Kinematics, s, q, direction: str) -> float:
+    """alpha by virtual work in configuration ``s`` with velocity ``q`` (module docstring).
+
+    A group's reference point is its centre of mass, so the work of its weight and of its
+    horizontal load are those of its mass M_g moving with the reference point's velocity.
+    """
+    d = DIRECTIONS[direction]
+    lifted = model.g * float(np.dot(kin.group_mass, q[1::3]))
+    pushed = d * model.g * float(np.dot(kin.group_mass, q[0::3]))
+    loads = 0.0
+    for load in model.loads:
+        group = kin.group_of.get(int(load.block), -1)
+        if group >= 0:
+            v = kin.point_velocity(s, q, group, np.asarray(load.point_m, dtype=float))
+            loads += float(np.dot(load.force_N, v))
+    return (lifted - loads) / pushed
+
+
+def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str, control_block: int) -> CapacityCurve:
+    """Follow ``mechanism`` from rest until alpha = 0 (module docstring).
+
+    Parameters
+    ----------
+    model, mechanism
+        The rigid-block model and a mechanism of it without sliding joints.
+    direction
+        "+x" or "-x", the load's sense (dk is measured along it).
+    control_block
+        Index of the block whose centroid is the control point k.
+    """
+    kin = _Kinematics(model, mechanism)
+    d = DIRECTIONS[direction]
+    group_k = kin.group_of[control_block]
+    c_k = model.centroids_m[control_block]
+    s = np.zeros(kin.n_dof)
+    q = kin.initial_velocity(mechanism.velocities)
+    dks, alphas = [0.0], []
+    q = kin.velocity(s, q)
+    if q is None:
+        return CapacityCurve(np.array([0.0]), np.array([np.nan]), None, "the joints lock the mechanism", 0.0)
+
+    def field(state, previous):
+        v = kin.velocity(state, previous)
+        if v is None:
+            return None
+        rate = d * kin.point_velocity(state, v, group_k, c_k)[0]
+        return None if rate <= 0 else v / rate  # per unit of dk
+
+    q = field(s, q)
+    if q is None:
+        return CapacityCurve(
+            np.array([0.0]), np.array([np.nan]), None, "the control point does not move along the load", 0.0
+        )
+    alpha0 = _alpha(model, kin, s, q, direction)
+    alphas.append(alpha0)
+    omega_max = max(float(np.max(np.abs(q[2::3]))), 1e-12)
+    h = MAX_STEP_ROTATION_RAD / omega_max
+    gap = 0.0
+    stopped = None
+    dk = 0.0
+    while len(dks) < MAX_STEPS:
+        q1 = field(s, q)
+        if q1 is None:
+            stopped = "the joints lock the mechanism or the control point turns back"
+            break
+        q2 = field(s + 0.5 * h * q1, q1)
+        if q2 is None:
+            stopped = "the joints lock the mechanism or the control point turns back"
+            break
+        trial, trial_gap = kin.project(s + h * q2)
+        q_new = field(trial, q2)
+        if q_new is None:
+            stopped = "the joints lock the mechanism or the control point turns back"
+            break
+        a_new = _alpha(model, kin, trial, q_new, direction)
+        if abs(a_new - alphas[-1]) > MAX_STEP_ALPHA * abs(alpha0) and h > 1e-9 * model.size_m:
+            h *= 0.5
+            continue
+        dk_new = d * float(kin.place(trial, group_k, c_k)[0][0] - c_k[0])
+        s, q, dk, gap = trial, q_new, dk_new, max(gap, trial_gap)
+        dks.append(dk)
+        alphas.append(a_new)
+        if a_new <= 0.0:
+            break
+        rot = MAX_STEP_ROTATION_RAD / max(float(np.max(np.abs(q[2::3]))), 1e-12)
+        h = min(2.0 * h, rot)
+    else:
+        stopped = f"alpha did not reach 0 in {MAX_STEPS} steps"
+    dk_arr, a_arr = np.array(dks), np.array(alphas)
+    d0 = None
+    if stopped is None and a_arr[-1] <= 0.0:
+        a1, a2 = a_arr[-2], a_arr[-1]
+        d1, d2 = dk_arr[-2], dk_arr[-1]
+        d0 = float(d1 + (d2 - d1) * a1 / (a1 - a2)) if a1 != a2 else float(d2)
+    return CapacityCurve(dk_arr, a_arr, d0, stopped, gap)
