@@ -146,3 +146,21 @@ def test_fc_scales_a0_star_and_is_checked():
     for bad in (0.5, 11.0, math.nan):
         with pytest.raises(InputError, match="FC"):
             limit_analysis(scene, fc=bad)
+
+
+def test_hinges_that_would_lock_a_wall_mechanism_open_on_the_way():
+    """A wall with a door and a window, no sliding: the mechanism's ten hinges are compatible at
+    rest to first order only; some open as it moves (hinges are unilateral) and alpha falls
+    smoothly to 0."""
+    from rockyade.scene import load_scene
+
+    from .conftest import EXAMPLES
+
+    result = limit_analysis(load_scene(EXAMPLES / "assemblies/wall_door_window.toml"), sliding=False)
+    curve = result.kinematic.curve
+    assert len(result.mechanism.hinges) == 10 and curve.opened
+    assert curve.alpha[0] == pytest.approx(result.load_multiplier, rel=1e-9)
+    assert np.all(np.diff(curve.alpha) < 0) and curve.alpha[-1] <= 0.0
+    assert curve.max_joint_gap_m < 1e-12 and result.kinematic.d0_star_m > 0
+    data = result.kinematic.to_dict()
+    assert data["curve"]["opened_hinges"] and data["curve"]["max_overlap_m"] >= 0.0

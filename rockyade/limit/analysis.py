@@ -78,7 +78,7 @@ class LimitResult:
     @property
     def notes(self) -> list[str]:
         """Caveats that apply to this answer."""
-        out = []
+        out = list(self.model.notes)
         if self.sliding_allowed:
             out.append(FRICTION_NOTE)
         if self.mechanism is not None and self.mechanism.slides:

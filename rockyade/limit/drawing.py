@@ -8,7 +8,8 @@ velocity at p, with s such that the largest vertex displacement is
 where it is on both blocks (the blocks turn about it), at the price of a slight distortion
 of blocks that turn (a rotation drawn to first order). Hinges are red dots, sliding joints
 thick blue lines, blocks that move orange, blocks at rest stone, fixed blocks grey and
-hatched.
+hatched. Where the nonlinear kinematic analysis reached alpha = 0, a second panel shows the
+capacity curve a*(d*) of the equivalent system with a0*, d0*, du* and the secant of Ts.
 """
 
 from __future__ import annotations
@@ -20,7 +21,9 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from rockyade.figures.assembly import (
+    FIGURE_WIDTH_IN,
     FIXED,
+    MAX_HEIGHT_IN,
     STONE,
     _bounds,
     _draw_blocks,
@@ -28,7 +31,7 @@ from rockyade.figures.assembly import (
     _figure_for,
     _setup_axes,
 )
-from rockyade.figures.common import save_figure
+from rockyade.figures.common import file_figure, save_figure
 from rockyade.limit.analysis import LimitResult
 from rockyade.limit.mechanism import point_velocity
 from rockyade.limit.report import plural
@@ -86,8 +89,12 @@ def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = No
     rest = list(model.polygons_m)
     moved, scale = displaced_polygons(result)
     bounds = _bounds(rest + moved)
-    fig, axes = _figure_for(bounds)
-    ax = axes[0, 0]
+    curve = result.kinematic.spectral() if result.kinematic is not None else None
+    if curve is None:
+        fig, axes = _figure_for(bounds)
+        ax = axes[0, 0]
+    else:
+        fig, ax, cax = _two_panels(bounds)
     _setup_axes(ax, bounds)
     fixed = [bool(f) for f in model.fixed]
     colours = []
@@ -136,8 +143,58 @@ def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = No
         heading += ": unstable, it cannot stand under gravity alone (no multiplier)"
     else:
         heading += ": no mechanism (lambda unbounded)"
-    ax.set_title(heading, fontsize=10)
+    if curve is None:
+        ax.set_title(heading, fontsize=10)
+    else:
+        fig.suptitle(heading, fontsize=10)
+        _draw_capacity(cax, result.kinematic, *curve)
     return save_figure(fig, path)
+
+
+def _two_panels(bounds):
+    """A figure with the assembly (left) and the capacity curve (right, narrower)."""
+    x0, x1, y0, y1 = bounds
+    aspect = (y1 - y0 + 0.2 * max(x1 - x0, y1 - y0)) / max(x1 - x0, 1e-9)
+    width = FIGURE_WIDTH_IN + 4.0
+    height = float(np.clip(FIGURE_WIDTH_IN * aspect, 4.0, MAX_HEIGHT_IN)) + 1.0
+    fig, axes = file_figure(1, 2, figsize=(width, height), layout="constrained", width_ratios=[2.6, 1.0])
+    return fig, axes[0], axes[1]
+
+
+def _draw_capacity(ax, kin, d_star: np.ndarray, a_star: np.ndarray) -> None:
+    """a*(d*) of the equivalent system with d0*, du*, ds* and the secant of Ts."""
+    keep = a_star >= 0.0
+    ax.plot(d_star[keep] * 1e3, a_star[keep], color="black", linewidth=1.5, label="a*(d*)")
+    ax.plot([0.0], [kin.a0_star_m_s2], "o", color=HINGE, label=f"a0* = {kin.a0_star_m_s2:.3g} m/s^2")
+    if kin.d0_star_m is not None:
+        ax.axvline(kin.d0_star_m * 1e3, color="0.5", linestyle=":", linewidth=1.0)
+        ax.axvline(
+            kin.du_star_m * 1e3, color=SLIDE, linestyle="--", linewidth=1.0, label=f"du* = {kin.du_star_m * 1e3:.3g} mm"
+        )
+        if kin.Ts_s is not None:
+            ax.plot(
+                [0.0, kin.ds_star_m * 1e3 * 2.5],
+                [0.0, kin.as_star_m_s2 * 2.5],
+                color=MOVING,
+                linewidth=1.2,
+                label=f"secant at ds*: Ts = {kin.Ts_s:.3g} s",
+            )
+            ax.plot([kin.ds_star_m * 1e3], [kin.as_star_m_s2], "s", color=MOVING)
+        ax.annotate(
+            f"d0* = {kin.d0_star_m * 1e3:.3g} mm",
+            (kin.d0_star_m * 1e3, 0.0),
+            textcoords="offset points",
+            xytext=(-4, 6),
+            ha="right",
+            fontsize=8,
+        )
+    ax.set_xlim(left=0.0)
+    ax.set_ylim(bottom=0.0, top=1.1 * kin.a0_star_m_s2)
+    ax.set_xlabel("d* (mm)")
+    ax.set_ylabel("a* (m/s^2)")
+    ax.set_title(f"equivalent system (e* = {kin.e_star:.3f}, FC = {kin.FC:g})", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="upper right")
 
 
 def _load_arrow(ax, bounds, direction: str) -> None:

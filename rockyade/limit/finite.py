@@ -11,6 +11,12 @@ form the null space of the constraints' Jacobian C(s) in the displaced configura
 a one-degree-of-freedom mechanism has a one-dimensional null space (where it has more, the
 velocity nearest the last one is followed).
 
+The hinges are unilateral: where keeping them all would lock the mechanism (they can be
+compatible at rest to first order only, as in walls whose hinges line up), the velocity is
+the one that keeps every hinge from slipping and from closing and minimises alpha (a
+small linear programme over the hinges, HiGHS), and the hinges it opens are released
+for good (how far their points later pass into each other is reported).
+
 The configuration is advanced by the midpoint rule in steps of the control displacement
 dk (the control point's horizontal displacement along the load), each step projected back
 onto the joints by Gauss-Newton, and at every configuration
@@ -59,6 +65,12 @@ class CapacityCurve:
     max_joint_gap_m
         Largest distance apart of two joined points over the curve (the drift of the
         integration), m.
+    opened
+        (interface, end) of the hinges that opened on the way (the mechanism's hinges are
+        unilateral: kept while they bear, released where keeping them all would lock it).
+    max_overlap_m
+        Largest distance by which the two points of a released hinge passed into each other
+        along its normal, m (no new contact is sought: a check that none was needed).
     """
 
     dk_m: NDArray[np.float64]
@@ -66,6 +78,8 @@ class CapacityCurve:
     d0_m: float | None
     stopped: str | None
     max_joint_gap_m: float
+    opened: tuple[tuple[int, int], ...] = ()
+    max_overlap_m: float = 0.0
 
 
 class _Kinematics:
@@ -77,8 +91,9 @@ class _Kinematics:
     between a group and the ground, constrain the motion.
     """
 
-    def __init__(self, model: RigidBlockModel, mechanism: Mechanism) -> None:
+    def __init__(self, model: RigidBlockModel, mechanism: Mechanism, direction: str) -> None:
         self.model = model
+        self.direction = direction
         members = [int(b) for b in np.flatnonzero(mechanism.moving)]
         parent = {b: b for b in members}
 
@@ -103,7 +118,8 @@ class _Kinematics:
         self.refs = np.array(
             [np.average(model.centroids_m[m], axis=0, weights=masses[m]) for m in self.members]
         ).reshape(-1, 2)
-        self.points = []  # (rest point, group of a or -1, group of b or -1)
+        self.points = []  # (rest point, group of a or -1, group of b or -1, rest normal b -> a)
+        self.hinge_of = []  # (interface, end) of each point
         for k, es in ends.items():
             itf = model.interfaces[k]
             ga = self.group_of.get(itf.a, -1)
@@ -111,7 +127,10 @@ class _Kinematics:
             if ga == gb:
                 continue  # inside a group (or between two bodies at rest)
             for e in es:
-                self.points.append((itf.ends_m[e].copy(), ga, gb))
+                self.points.append((itf.ends_m[e].copy(), ga, gb, itf.normal.copy()))
+                self.hinge_of.append((k, e))
+        self.active = np.ones(len(self.points), dtype=bool)
+        self.ever_opened: set[int] = set()
 
     @property
     def n_dof(self) -> int:
@@ -144,44 +163,119 @@ class _Kinematics:
             q[3 * g : 3 * g + 3] = (v[0] - v[2] * r[1], v[1] + v[2] * r[0], v[2])
         return q
 
+    def _rows(self, s: NDArray[np.float64], k: int):
+        """(x_a - x_b, its 2 x n Jacobian, the current normal) of point ``k``; the normal turns
+        with body b (the face a bears on)."""
+        rest, ga, gb, normal = self.points[k]
+        xa, arm_a = self.place(s, ga, rest)
+        xb, arm_b = self.place(s, gb, rest)
+        J = np.zeros((2, self.n_dof))
+        for group, arm, sign in ((ga, arm_a, 1.0), (gb, arm_b, -1.0)):
+            if group < 0:
+                continue
+            J[0, 3 * group] += sign
+            J[1, 3 * group + 1] += sign
+            J[0, 3 * group + 2] += -sign * arm[1]
+            J[1, 3 * group + 2] += sign * arm[0]
+        if gb >= 0:
+            c, sn = np.cos(s[3 * gb + 2]), np.sin(s[3 * gb + 2])
+            normal = np.array([c * normal[0] - sn * normal[1], sn * normal[0] + c * normal[1]])
+        return xa - xb, J, normal
+
     def constraints(self, s: NDArray[np.float64]):
         """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
-        g = np.zeros(2 * len(self.points))
-        C = np.zeros((2 * len(self.points), self.n_dof))
-        for k, (rest, ga, gb) in enumerate(self.points):
-            xa, arm_a = self.place(s, ga, rest)
-            xb, arm_b = self.place(s, gb, rest)
-            g[2 * k : 2 * k + 2] = xa - xb
-            for group, arm, sign in ((ga, arm_a, 1.0), (gb, arm_b, -1.0)):
-                if group < 0:
-                    continue
-                C[2 * k, 3 * group] += sign
-                C[2 * k + 1, 3 * group + 1] += sign
-                C[2 * k, 3 * group + 2] += -sign * arm[1]
-                C[2 * k + 1, 3 * group + 2] += sign * arm[0]
-        return g, C
+        rows = [self._rows(s, k) for k in np.flatnonzero(self.active)]
+        if not rows:
+            return np.zeros(0), np.zeros((0, self.n_dof))
+        return np.concatenate([r[0] for r in rows]), np.vstack([r[1] for r in rows])
+
+    def normal_gaps(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(x_a - x_b) . n at every point (> 0: open), m."""
+        out = np.empty(len(self.points))
+        for k in range(len(self.points)):
+            gap, _, normal = self._rows(s, k)
+            out[k] = gap @ normal
+        return out
+
+    def _null_space(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Orthonormal basis of the compatible velocities, in (vx, vy, omega x size)."""
+        _, C = self.constraints(s)
+        if C.shape[0] == 0:
+            return np.eye(self.n_dof)
+        _, sv, vt = np.linalg.svd(C / self.scale, full_matrices=True)
+        rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0))) if sv.size else 0
+        return vt[rank:].T
+
+    @property
+    def scale(self) -> NDArray[np.float64]:
+        out = np.ones(self.n_dof)
+        out[2::3] = self.model.size_m  # rotations to lengths: comparable columns
+        return out
+
+    def release(self, s: NDArray[np.float64]) -> NDArray[np.float64] | None:
+        """When the hinges kept lock the mechanism (they are compatible at rest only to first
+        order), let them open: a hinge is unilateral. The velocity that keeps every active hinge
+        from slipping and from closing (its opening rate >= 0) and minimises alpha (the virtual
+        work ratio, by HiGHS); the hinges it opens are released. None when there is none."""
+        from scipy.optimize import linprog
+
+        d = DIRECTIONS[self.direction]
+        eq, ub = [], []
+        index = np.flatnonzero(self.active)
+        rows = [self._rows(s, k) for k in index]
+        for _, J, n in rows:
+            t = np.array([-n[1], n[0]])
+            eq.append(t @ J)
+            ub.append(-(n @ J))
+        g = self.model.g
+        pushed = np.zeros(self.n_dof)
+        pushed[0::3] = d * g * self.group_mass
+        c = np.zeros(self.n_dof)
+        c[1::3] = g * self.group_mass
+        for load in self.model.loads:
+            group = self.group_of.get(int(load.block), -1)
+            if group < 0:
+                continue
+            _, arm = self.place(s, group, np.asarray(load.point_m, dtype=float))
+            fx, fy = load.force_N
+            c[3 * group] -= fx
+            c[3 * group + 1] -= fy
+            c[3 * group + 2] -= -fx * arm[1] + fy * arm[0]
+        A_eq = np.vstack([*eq, pushed]) if eq else pushed[None, :]
+        b_eq = np.zeros(A_eq.shape[0])
+        b_eq[-1] = 1.0
+        A_ub = np.vstack(ub) if ub else None
+        b_ub = np.zeros(len(ub)) if ub else None
+        res = linprog(c, A_ub=A_ub, b_ub=b_ub, A_eq=A_eq, b_eq=b_eq, bounds=(None, None), method="highs")
+        if res.status != 0:
+            return None
+        q = res.x
+        speed = max(float(np.max(np.abs(q * self.scale))), 1e-300)
+        for k, (_, J, n) in zip(index, rows, strict=True):
+            if n @ J @ q > 1e-7 * speed:
+                self.active[k] = False
+                self.ever_opened.add(int(k))
+        return q
 
     def velocity(self, s: NDArray[np.float64], previous: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """The compatible velocity nearest ``previous`` (unit norm), None when the joints lock."""
-        _, C = self.constraints(s)
-        if C.shape[0] == 0:
-            q = previous.copy()
-        else:
-            scale = np.ones(self.n_dof)
-            scale[2::3] = self.model.size_m  # rotations to lengths: comparable columns
-            _, sv, vt = np.linalg.svd(C / scale, full_matrices=True)
-            rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0))) if sv.size else 0
-            basis = vt[rank:].T  # orthonormal, in (vx, vy, omega * size)
+        basis = self._null_space(s)
+        if basis.shape[1] == 0:
+            target = self.release(s)
+            if target is None:
+                return None
+            basis = self._null_space(s)
             if basis.shape[1] == 0:
                 return None
-            q = (basis @ (basis.T @ (previous * scale))) / scale
+            previous = target
+        q = (basis @ (basis.T @ (previous * self.scale))) / self.scale
         norm = np.linalg.norm(q)
         if norm < 1e-12 * max(np.linalg.norm(previous), 1e-300):
             return None
         return q / norm
 
     def project(self, s: NDArray[np.float64], iterations: int = 4) -> tuple[NDArray[np.float64], float]:
-        """``s`` moved back onto the joints (least-norm Gauss-Newton); and the gap left, m."""
+        """``s`` moved back onto the active hinges (least-norm Gauss-Newton); and the gap left, m."""
         for _ in range(iterations):
             g, C = self.constraints(s)
             if g.size == 0 or np.max(np.abs(g)) < 1e-13 * self.model.size_m:
@@ -189,6 +283,13 @@ class _Kinematics:
             s = s - np.linalg.lstsq(C, g, rcond=None)[0]
         g, _ = self.constraints(s)
         return s, float(np.max(np.abs(g))) if g.size else 0.0
+
+    def released_overlap(self, s: NDArray[np.float64]) -> float:
+        """How far the points of released hinges have passed into each other (0 if none), m."""
+        if self.active.all():
+            return 0.0
+        gaps = self.normal_gaps(s)[~self.active]
+        return float(max(0.0, -gaps.min()))
 
 
 def _alpha(model: RigidBlockModel, kin: _Kinematics, s, q, direction: str) -> float:
@@ -221,7 +322,7 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     control_block
         Index of the block whose centroid is the control point k.
     """
-    kin = _Kinematics(model, mechanism)
+    kin = _Kinematics(model, mechanism, direction)
     d = DIRECTIONS[direction]
     group_k = kin.group_of[control_block]
     c_k = model.centroids_m[control_block]
@@ -248,7 +349,7 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     alphas.append(alpha0)
     omega_max = max(float(np.max(np.abs(q[2::3]))), 1e-12)
     h = MAX_STEP_ROTATION_RAD / omega_max
-    gap = 0.0
+    gap = overlap = 0.0
     stopped = None
     dk = 0.0
     while len(dks) < MAX_STEPS:
@@ -271,6 +372,7 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
             continue
         dk_new = d * float(kin.place(trial, group_k, c_k)[0][0] - c_k[0])
         s, q, dk, gap = trial, q_new, dk_new, max(gap, trial_gap)
+        overlap = max(overlap, kin.released_overlap(s))
         dks.append(dk)
         alphas.append(a_new)
         if a_new <= 0.0:
@@ -285,4 +387,5 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
         a1, a2 = a_arr[-2], a_arr[-1]
         d1, d2 = dk_arr[-2], dk_arr[-1]
         d0 = float(d1 + (d2 - d1) * a1 / (a1 - a2)) if a1 != a2 else float(d2)
-    return CapacityCurve(dk_arr, a_arr, d0, stopped, gap)
+    opened = tuple(kin.hinge_of[k] for k in sorted(kin.ever_opened))
+    return CapacityCurve(dk_arr, a_arr, d0, stopped, gap, opened, overlap)

@@ -127,6 +127,8 @@ class KinematicQuantities:
                 "dk_m": self.curve.dk_m.tolist(),
                 "alpha": self.curve.alpha.tolist(),
                 "max_joint_gap_m": self.curve.max_joint_gap_m,
+                "opened_hinges": [list(h) for h in self.curve.opened],
+                "max_overlap_m": self.curve.max_overlap_m,
             }
         return out
 

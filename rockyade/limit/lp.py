@@ -148,7 +148,11 @@ def equilibrium_system(model: RigidBlockModel, direction: str):
     return A, b, lam_col, np.array(free, dtype=bool), row_of, (w_ref, l_ref)
 
 
-def solve_equilibrium(model: RigidBlockModel, direction: str = "+x") -> LPSolution:
+#: HiGHS's methods as scipy names them ("highs" lets HiGHS choose; it picks the dual simplex).
+METHODS = ("highs", "highs-ds", "highs-ipm")
+
+
+def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str = "highs") -> LPSolution:
     """Maximise lambda subject to every moving block's equilibrium (module docstring).
 
     Parameters
@@ -157,7 +161,12 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x") -> LPSoluti
         The rigid-block model.
     direction
         "+x" or "-x": the sense of the horizontal force lambda m g.
+    method
+        HiGHS's method, one of :data:`METHODS` (the interior point method runs a crossover, so
+        its answer is a vertex as the simplex's: same multiplier, same kind of mechanism).
     """
+    if method not in METHODS:
+        raise InputError("method", f"must be one of {', '.join(METHODS)}, got {method!r}")
     A, b, lam_col, free, row_of, (w_ref, l_ref) = equilibrium_system(model, direction)
     n_cols = lam_col + 1
     c = np.zeros(n_cols)
@@ -168,7 +177,7 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x") -> LPSoluti
     for cap in (LAMBDA_CAP, None):
         upper = np.full(n_cols, np.inf)
         upper[lam_col] = np.inf if cap is None else cap
-        res = linprog(c, A_eq=A, b_eq=b, bounds=np.column_stack([lower, upper]), method="highs")
+        res = linprog(c, A_eq=A, b_eq=b, bounds=np.column_stack([lower, upper]), method=method)
         if res.status != 0 or cap is None or res.x[lam_col] < 0.999 * cap:
             break
     elapsed = time.perf_counter() - t0

@@ -114,6 +114,8 @@ class RigidBlockModel:
         External loads, ``block`` resolved to an index.
     g
         Acceleration of gravity, m/s^2.
+    notes
+        What of the scene the model leaves out (cohesion, classical overrides), said once each.
     """
 
     names: tuple[str, ...]
@@ -124,6 +126,7 @@ class RigidBlockModel:
     interfaces: tuple[Interface, ...]
     loads: tuple[PointLoad, ...] = ()
     g: float = G
+    notes: tuple[str, ...] = ()
 
     @property
     def n_blocks(self) -> int:
@@ -165,6 +168,21 @@ def _friction_of(scene, a: int, b: int, default_deg: float) -> float:
             if value is not None:
                 return float(value)
     return default_deg
+
+
+def _left_out(scene) -> tuple[str, ...]:
+    """Notes on what of the scene the rigid-block model does not use."""
+    notes = []
+    if scene.contact.cohesion_Pa:
+        notes.append(f"the scene's cohesion ({scene.contact.cohesion_Pa:g} Pa) is left out: joints carry no tension")
+    overridden = [b.name for b in scene.blocks if b.alpha_rad is not None]
+    if overridden:
+        shown = ", ".join(overridden[:5]) + (" ..." if len(overridden) > 5 else "")
+        notes.append(
+            f"alpha_rad given for {shown} is not used: limit analysis takes the blocks' geometry "
+            "(the corners are the pivots)"
+        )
+    return tuple(notes)
 
 
 def check_friction_angle(value: float, field: str = "friction_angle_deg") -> float:
@@ -276,6 +294,7 @@ def rigid_block_model(
             phi = _friction_of(scene, a, b, default)
         interfaces.append(Interface(a, b, np.asarray(c.ends_m, dtype=float), normal, phi if sliding else None, c.kind))
     return RigidBlockModel(
+        notes=_left_out(scene),
         names=names,
         masses_kg=masses,
         centroids_m=centroids,

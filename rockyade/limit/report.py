@@ -85,17 +85,18 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     else:
         joints = f"friction angle {result.friction_angle_deg:g} deg"
     lines = [
-        f"limit analysis of {source}: {model.n_blocks - n_fixed} moving blocks{fixed}, "
-        f"{len(model.interfaces)} joints; load lambda m g towards {result.direction}; joints: {joints}",
+        f"limit analysis of {source}: {plural(model.n_blocks - n_fixed, 'moving block')}{fixed}, "
+        f"{plural(len(model.interfaces), 'joint')}; load lambda m g towards {result.direction}; joints: {joints}",
     ]
     if model.loads:
         lines.append(f"external loads (without mass): {len(model.loads)}")
     if result.status == "unstable":
         lines.append("status: unstable: the assembly cannot stand under gravity (and its loads) alone: no")
         lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")
-        return lines
-    if result.status == "no_mechanism":
+    elif result.status == "no_mechanism":
         lines.append("status: no_mechanism: no horizontal acceleration makes it collapse (lambda is unbounded)")
+    if result.status != "collapse":
+        lines.extend(f"note: {note}" for note in result.model.notes)
         return lines
     lam = result.load_multiplier
     mech = result.mechanism
@@ -107,8 +108,8 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     n_moving = int(mech.moving.sum())
     opened = f", {plural(len(mech.separating), 'joint')} open without turning" if mech.separating else ""
     lines.append(
-        f"mechanism: {plural(n_moving, 'block')} move; {plural(len(mech.hinges), 'hinge')}, "
-        f"{plural(len(mech.sliding), 'sliding joint')}{opened}"
+        f"mechanism: {plural(n_moving, 'block')} move{'s' if n_moving == 1 else ''}; "
+        f"{plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')}{opened}"
     )
     for hinge in mech.hinges[:MAX_LISTED]:
         lines.append("  " + hinge_words(model, hinge))
@@ -133,6 +134,17 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
             f"du* = {_fmt(kin.du_star_m, ' m')}, ds* = {_fmt(kin.ds_star_m, ' m')}, "
             f"as* = {_fmt(kin.as_star_m_s2, ' m/s^2')}, Ts = {_fmt(kin.Ts_s, ' s')}"
         )
+        curve = kin.curve
+        if curve is not None and curve.opened:
+            lines.append(
+                f"  {plural(len(curve.opened), 'hinge')} of the mechanism opened on the way (keeping them all "
+                "would lock it)"
+            )
+        if curve is not None and curve.max_overlap_m > 1e-6 * model.size_m:
+            lines.append(
+                f"  note: points of opened hinges pass into each other by up to {curve.max_overlap_m * 1e3:.3g} mm "
+                "along the curve: new contacts are not followed"
+            )
     else:
         lines.append(f"  nonlinear: none ({kin.nonlinear_note})")
     for note in result.notes:
