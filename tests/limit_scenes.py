@@ -38,9 +38,7 @@ def course_wall_scene(courses: int, unit_length: float = 0.4, unit_height: float
     """A wall of ``courses`` equal courses of one unit each (``rockyade build wall
     --units-per-course 1 --bond stack``)."""
     return scene_from_dict(
-        wall(
-            courses=courses, units_per_course=1, bond="stack", unit_length_m=unit_length, unit_height_m=unit_height
-        )
+        wall(courses=courses, units_per_course=1, bond="stack", unit_length_m=unit_length, unit_height_m=unit_height)
     )
 
 

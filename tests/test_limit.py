@@ -319,3 +319,24 @@ def test_a_running_bond_panel_of_hundreds_of_blocks_is_solved_and_sound():
     # without sliding the whole wall turns about its toe: lambda = (L/2) / (H/2) = 12 / 2
     assert rocking.load_multiplier == pytest.approx(6.0, rel=1e-7)
     _assert_sound(rocking)
+
+
+def test_a_joint_that_opens_while_moving_along_is_not_sliding(examples_dir):
+    """The restrained wall pushed away from its restraint: the top leaves the restraint (its
+    opening exceeds tan(phi) times its tangential motion), so the mechanism is the wall turning
+    about its toe, lambda = b / h_c = 0.15 / 1.5, with no sliding joint."""
+    from rockyade.scene import load_scene
+
+    result = limit_analysis(load_scene(examples_dir / "assemblies/restrained_wall.toml"), direction="-x")
+    assert result.load_multiplier == pytest.approx(0.1, rel=EXACT)
+    assert not result.mechanism.slides and len(result.mechanism.separating) == 1
+    assert result.kinematic.d0_star_m is not None  # a rocking mechanism: the nonlinear curve is followed
+    _assert_sound(result)
+
+
+def test_what_the_model_leaves_out_is_said(examples_dir):
+    from rockyade.scene import load_scene
+
+    result = limit_analysis(load_scene(examples_dir / "specimen1_free.toml"), sliding=False)
+    assert any("alpha_rad given for specimen1 is not used" in note for note in result.notes)
+    assert result.load_multiplier == pytest.approx(0.25 / 1.0)  # the geometry's b / h_c, not tan(0.235)

@@ -1,7 +1,7 @@
-"""The code's kinematic quantities of a mechanism (NTC 2018 section 8.7.1 with its Circolare 2019
-C8.7.1; EN 1998-3 uses the same ideas).
+"""The code's kinematic quantities of a mechanism (the kinematic method of NTC 2018 for
+existing masonry, as its Circolare 2019 sets it out in C8.7.1; EN 1998-3 uses the same ideas).
 
-Linear kinematic analysis (Circolare C8.7.1.2.1):
+Linear kinematic analysis:
 
 * alpha0, the multiplier that activates the mechanism, by virtual work: the limit-analysis
   multiplier of the critical mechanism;
@@ -11,7 +11,7 @@ Linear kinematic analysis (Circolare C8.7.1.2.1):
 * the spectral acceleration that activates the mechanism a0* = alpha0 g / (e* FC), m/s^2,
   FC the confidence factor (1.35 for the limited knowledge level LC1).
 
-Nonlinear kinematic analysis (Circolare C8.7.1.2.2): alpha(dk) as the mechanism moves
+Nonlinear kinematic analysis: alpha(dk) as the mechanism moves
 (:mod:`rockyade.limit.finite`), dk the horizontal displacement of a control point k (here
 the centroid of the block with the largest virtual horizontal displacement, the highest
 one of a tie), down to alpha = 0 at dk,0; the equivalent single-degree-of-freedom system
@@ -39,9 +39,9 @@ from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism
 from rockyade.limit.model import RigidBlockModel
 
-#: The code's confidence factor for the limited knowledge level (LC1), NTC 2018 C8.5.4.
+#: The code's confidence factor FC for the limited knowledge level (LC1).
 DEFAULT_FC = 1.35
-#: du* = DU_FRACTION d0*, ds* = DS_FRACTION du* (Circolare 2019 C8.7.1.2.2).
+#: du* = DU_FRACTION d0*, ds* = DS_FRACTION du* (Circolare 2019 C8.7.1).
 DU_FRACTION = 0.4
 DS_FRACTION = 0.4
 
@@ -211,7 +211,10 @@ def kinematic_quantities(
             du = DU_FRACTION * d0
             ds = DS_FRACTION * du
             as_ = float(np.interp(ds, d_star, a_star))
-            values = {"d0": d0, "du": du, "ds": ds, "as": as_, "Ts": 2.0 * math.pi * math.sqrt(ds / as_)}
+            period = 2.0 * math.pi * math.sqrt(ds / as_) if as_ > 0.0 and ds > 0.0 else None
+            values = {"d0": d0, "du": du, "ds": ds, "as": as_, "Ts": period}
+            if period is None:
+                note = "the capacity curve has no positive a* at ds*: no secant period"
     return KinematicQuantities(
         alpha0=float(alpha0),
         M_star_kg=M_star,

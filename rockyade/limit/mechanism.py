@@ -12,8 +12,10 @@ normal part dv_n (opening, >= 0) and tangential part dv_t. An interface is
 * *locked* when dv = 0 at both ends (the two bodies move together: not listed);
 * a *hinge* when the bodies turn relative to each other about one end (dv = 0 there, the
   other end opens);
-* *sliding* when dv_t != 0 (with friction the LP's mechanism dilates: dv_n = tan(phi) |dv_t|);
-* *separating* when both ends open without relative turning.
+* *sliding* when an end slips on the friction cone (dv_t != 0 and, with the LP's associated
+  flow, dv_n = tan(phi) |dv_t|: it dilates);
+* *separating* otherwise: both ends leave each other (dv_n > tan(phi) |dv_t|), whether or not
+  the bodies also turn or move along the joint.
 
 Checks (:class:`MechanismChecks`): the mechanism is kinematically admissible to first
 order (no end closes: dv_n >= tan(phi) |dv_t| with friction, dv_n >= 0 and dv_t = 0
@@ -213,12 +215,13 @@ def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
     worst = 0.0
     for k, itf in enumerate(model.interfaces):
         rel = [relative_velocity(model, vel, itf, p) for p in itf.ends_m]
+        mu = None if itf.friction_angle_deg is None else math.tan(math.radians(itf.friction_angle_deg))
         for dn, dt in rel:
-            if itf.friction_angle_deg is None:
-                worst = max(worst, -dn, abs(dt))
-            else:
-                worst = max(worst, math.tan(math.radians(itf.friction_angle_deg)) * abs(dt) - dn)
+            worst = max(worst, -dn, abs(dt)) if mu is None else max(worst, mu * abs(dt) - dn)
         closed = [abs(dn) <= tol and abs(dt) <= tol for dn, dt in rel]
+        # an end slides when it slips on the friction cone (dv_n = tan(phi) |dv_t|); an end that
+        # opens by more than that has left the joint, whatever its tangential motion
+        slipping = [mu is not None and abs(dt) > tol and dn <= mu * abs(dt) + tol for dn, dt in rel]
         for e in range(2):
             if closed[e] and (moving[itf.a] or (itf.b >= 0 and moving[itf.b])):
                 active.append((k, e))
@@ -228,7 +231,7 @@ def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
         d_omega = float(vel[itf.a, 2] - omega_b)
         name_a, name_b = model.body_name(itf.a), model.body_name(itf.b)
         slip = 0.5 * (rel[0][1] + rel[1][1])
-        if abs(slip) > tol:
+        if any(slipping):
             mid = itf.ends_m.mean(axis=0)
             opening = 0.5 * (rel[0][0] + rel[1][0])
             sliding.append(Sliding(k, name_a, name_b, float(slip), float(opening), (float(mid[0]), float(mid[1]))))

@@ -59,12 +59,15 @@ def hinge_words(model: RigidBlockModel, hinge: Hinge) -> str:
     )
 
 
-def sliding_words(model: RigidBlockModel, slide: Sliding) -> str:
-    """One sliding joint as a sentence."""
+def sliding_words(model: RigidBlockModel, slide: Sliding, velocities: np.ndarray | None = None) -> str:
+    """One sliding joint as a sentence, told from the body that moves (a, or b when a is at rest)."""
     itf = model.interfaces[slide.interface]
-    other = "the base" if slide.b == "base" else slide.b
+    mover, other, sense = slide.a, slide.b, itf.tangent * np.sign(slide.slip)
+    if velocities is not None and slide.b != "base" and not np.any(velocities[itf.a]):
+        mover, other, sense = slide.b, slide.a, -sense
+    other = "the base" if other == "base" else other
     return (
-        f"{slide.a} slides {_towards(itf.tangent * np.sign(slide.slip))} on {other} "
+        f"{mover} slides {_towards(sense)} on {other} "
         f"(slip {abs(slide.slip):.3g}, opening {slide.opening:.3g} per unit displacement)"
     )
 
@@ -95,6 +98,11 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")
     elif result.status == "no_mechanism":
         lines.append("status: no_mechanism: no horizontal acceleration makes it collapse (lambda is unbounded)")
+        if not result.sliding_allowed:
+            lines.append(
+                "  without sliding a joint cannot open with a motion along it either (a block cannot lift off a "
+                "restraint it moves along): a finite friction angle lifts that restriction"
+            )
     if result.status != "collapse":
         lines.extend(f"note: {note}" for note in result.model.notes)
         return lines
@@ -106,7 +114,7 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} m/s^2)"
     )
     n_moving = int(mech.moving.sum())
-    opened = f", {plural(len(mech.separating), 'joint')} open without turning" if mech.separating else ""
+    opened = f", {plural(len(mech.separating), 'joint')} opening fully" if mech.separating else ""
     lines.append(
         f"mechanism: {plural(n_moving, 'block')} move{'s' if n_moving == 1 else ''}; "
         f"{plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')}{opened}"
@@ -116,14 +124,14 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     if len(mech.hinges) > MAX_LISTED:
         lines.append(f"  ... and {len(mech.hinges) - MAX_LISTED} more hinges (--json lists all)")
     for slide in mech.sliding[:MAX_LISTED]:
-        lines.append("  " + sliding_words(model, slide))
+        lines.append("  " + sliding_words(model, slide, mech.velocities))
     if len(mech.sliding) > MAX_LISTED:
         lines.append(f"  ... and {len(mech.sliding) - MAX_LISTED} more sliding joints (--json lists all)")
     lines.append(
         f"checks: kinematic constraints met to {mech.checks.max_closing:.1e}, virtual work zero to "
         f"{mech.checks.virtual_work_residual:.1e} (relative)"
     )
-    lines.append(f"kinematic quantities (NTC 2018 8.7.1, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
+    lines.append(f"kinematic quantities (NTC 2018, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
     lines.append(
         f"  alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f} "
         f"(of {kin.participating_mass_kg:.4g} kg moving); a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2"
