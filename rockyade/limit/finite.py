@@ -32,6 +32,7 @@ nonlinear analysis is for rocking mechanisms).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -307,7 +308,7 @@ def _alpha(model: RigidBlockModel, kin: _Kinematics, s, q, direction: str) -> fl
         if group >= 0:
             v = kin.point_velocity(s, q, group, np.asarray(load.point_m, dtype=float))
             loads += float(np.dot(load.force_N, v))
-    return (lifted - loads) / pushed
+    return (lifted - loads) / pushed if pushed > 0.0 else math.nan
 
 
 def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str, control_block: int) -> CapacityCurve:
@@ -351,7 +352,6 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     h = MAX_STEP_ROTATION_RAD / omega_max
     gap = overlap = 0.0
     stopped = None
-    dk = 0.0
     while len(dks) < MAX_STEPS:
         q1 = field(s, q)
         if q1 is None:
@@ -367,13 +367,15 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
             stopped = "the joints lock the mechanism or the control point turns back"
             break
         a_new = _alpha(model, kin, trial, q_new, direction)
+        if not math.isfinite(a_new):
+            stopped = "the load lambda m g no longer does work on the mechanism"
+            break
         if abs(a_new - alphas[-1]) > MAX_STEP_ALPHA * abs(alpha0) and h > 1e-9 * model.size_m:
             h *= 0.5
             continue
-        dk_new = d * float(kin.place(trial, group_k, c_k)[0][0] - c_k[0])
-        s, q, dk, gap = trial, q_new, dk_new, max(gap, trial_gap)
+        s, q, gap = trial, q_new, max(gap, trial_gap)
         overlap = max(overlap, kin.released_overlap(s))
-        dks.append(dk)
+        dks.append(d * float(kin.place(s, group_k, c_k)[0][0] - c_k[0]))
         alphas.append(a_new)
         if a_new <= 0.0:
             break

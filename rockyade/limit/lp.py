@@ -38,7 +38,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.optimize import linprog
 
-from rockyade.errors import InputError
+from rockyade.errors import InputError, SolverFailedError
 from rockyade.limit.model import RigidBlockModel
 
 #: The multiplier is first sought below this (a horizontal acceleration of 1,000 g); a
@@ -186,7 +186,7 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
     if res.status == 3:
         return LPSolution("no_mechanism", None, direction, None, None, None, elapsed, res.message)
     if res.status != 0:
-        raise RuntimeError(f"HiGHS could not solve the equilibrium programme: {res.message}")
+        raise SolverFailedError(f"HiGHS could not solve the equilibrium programme: {res.message}")
     x = res.x
     forces = x[:lam_col].reshape(len(model.interfaces), 2, 2) * w_ref  # (interface, end, column)
     normal = np.empty((len(model.interfaces), 2))

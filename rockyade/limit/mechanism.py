@@ -31,6 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.errors import SolverFailedError
 from rockyade.limit.lp import DIRECTIONS, LPSolution
 from rockyade.limit.model import Interface, RigidBlockModel
 
@@ -203,7 +204,7 @@ def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
     vel[model.fixed] = 0.0
     peak = float(np.max(np.abs(vel[:, 0])))
     if peak <= 0.0:
-        raise RuntimeError("the programme's mechanism does not move horizontally (degenerate dual)")
+        raise SolverFailedError("the programme's mechanism does not move horizontally (a degenerate dual)")
     vel /= peak
     size = model.size_m
     speed = np.maximum(np.hypot(vel[:, 0], vel[:, 1]), np.abs(vel[:, 2]) * size)
