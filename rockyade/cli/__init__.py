@@ -44,6 +44,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.identify",
     "rockyade.cli.uncertainty",
     "rockyade.cli.verify",
+    "rockyade.cli.limit",
 ]
 
 _T0 = time.perf_counter()  # the total wall time printed by ``rockyade run`` counts from here

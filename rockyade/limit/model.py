@@ -1,0 +1,306 @@
+"""The rigid-block model of a scene for limit analysis: blocks, interfaces, friction, loads.
+
+Every block of the scene is a rigid convex polygon placed as :func:`~rockyade.scene.placement.placed_blocks`
+places it; its weight m g acts at its centroid. Fixed blocks and the base are supports. Every
+interface at rest (:func:`~rockyade.scene.placement.rest_contacts`: two bodies sharing a segment)
+carries a contact force at each of its two ends: a normal force n >= 0 (no tension, no
+cohesion) and a tangential force t with |t| <= tan(phi) n (Coulomb), or any t at all when
+sliding is excluded. The resultant of the two end forces can lie anywhere on the interface,
+which is exactly what a no-tension joint of a rigid block can carry.
+
+External loads (:class:`PointLoad`) are forces without mass: a floor's reaction, an
+overburden. They enter the equilibrium as they are and do not take part in the horizontal
+acceleration (the seismic multiplier acts on the blocks' masses only).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rockyade.blocks.geometry import polygon_section
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.scene.placement import placed_blocks, rest_contacts
+
+#: The base's name in interfaces, hinges and output.
+BASE = "base"
+#: Largest load accepted, N (keeps the arithmetic finite; 1e12 N is a million tonnes-force).
+MAX_LOAD_N = 1.0e12
+
+
+@dataclass(frozen=True)
+class PointLoad:
+    """A force without mass applied to a block (a floor's reaction, an overburden).
+
+    Attributes
+    ----------
+    block
+        The block it acts on: its index in the scene's block list, or its name.
+    point_m
+        Point of application at rest, base frame, m (on or inside the block); it moves with
+        the block when the mechanism is followed at finite displacement.
+    force_N
+        Force vector (Fx, Fy), N (e.g. (0, -N) for a vertical load N). Its direction stays
+        the same when the block moves (a dead load).
+    """
+
+    block: int | str
+    point_m: tuple[float, float]
+    force_N: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Interface:
+    """A joint at rest between body ``a`` (moving) and body ``b`` (another block, or the base).
+
+    Attributes
+    ----------
+    a, b
+        Body indices; ``b = -1`` is the base. The normal points from ``b`` into ``a``; ``a``
+        is the moving body of a joint with a fixed one, else the upper body of a bed joint.
+    ends_m
+        (2, 2) the two ends of the shared segment, base frame, m.
+    normal
+        Unit normal from ``b`` into ``a``.
+    friction_angle_deg
+        Friction angle of the joint, degrees; None when sliding is excluded.
+    kind
+        "bed" or "head" (see :mod:`rockyade.scene.placement`).
+    """
+
+    a: int
+    b: int
+    ends_m: NDArray[np.float64]
+    normal: NDArray[np.float64]
+    friction_angle_deg: float | None
+    kind: str
+
+    @property
+    def tangent(self) -> NDArray[np.float64]:
+        """Unit tangent, the normal turned 90 degrees counter-clockwise."""
+        return np.array([-self.normal[1], self.normal[0]])
+
+    @property
+    def length_m(self) -> float:
+        """Length of the interface, m."""
+        return float(np.hypot(*(self.ends_m[1] - self.ends_m[0])))
+
+
+@dataclass(frozen=True)
+class RigidBlockModel:
+    """A scene as rigid blocks, interfaces and loads (module docstring).
+
+    Attributes
+    ----------
+    names
+        Block names, in the scene's order.
+    masses_kg
+        (nb,) block masses, kg.
+    centroids_m
+        (nb, 2) centroids at rest, base frame, m.
+    polygons_m
+        Block polygons at rest, base frame, m (counter-clockwise).
+    fixed
+        (nb,) True for blocks that move with the base.
+    interfaces
+        The joints at rest.
+    loads
+        External loads, ``block`` resolved to an index.
+    g
+        Acceleration of gravity, m/s^2.
+    notes
+        What of the scene the model leaves out (cohesion, classical overrides), said once each.
+    """
+
+    names: tuple[str, ...]
+    masses_kg: NDArray[np.float64]
+    centroids_m: NDArray[np.float64]
+    polygons_m: tuple[NDArray[np.float64], ...]
+    fixed: NDArray[np.bool_]
+    interfaces: tuple[Interface, ...]
+    loads: tuple[PointLoad, ...] = ()
+    g: float = G
+    notes: tuple[str, ...] = ()
+
+    @property
+    def n_blocks(self) -> int:
+        """Number of blocks (fixed ones included)."""
+        return len(self.names)
+
+    @property
+    def moving(self) -> NDArray[np.int64]:
+        """Indices of the blocks that are not fixed."""
+        return np.flatnonzero(~self.fixed)
+
+    @functools.cached_property
+    def size_m(self) -> float:
+        """Largest extent of the assembly, m (the length scale of tolerances)."""
+        pts = np.vstack(self.polygons_m)
+        return float(np.max(np.ptp(pts, axis=0)))
+
+    def body_name(self, index: int) -> str:
+        """Name of body ``index`` (``"base"`` for -1)."""
+        return BASE if index < 0 else self.names[index]
+
+
+def _mass(spec, polygon: NDArray[np.float64]) -> float:
+    """A block's mass, kg: its ``mass_kg``, else density x section area x thickness (as
+    :meth:`rockyade.blocks.geometry.Block.polygon` computes it)."""
+    if spec.mass_kg is not None:
+        return float(spec.mass_kg)
+    return float(spec.density_kg_m3) * polygon_section(polygon).area_m2 * float(spec.thickness_m)
+
+
+def _friction_of(scene, a: int, b: int, default_deg: float) -> float:
+    """The scene's friction angle of the joint between blocks ``a`` and ``b`` (-1: base), degrees:
+    a ``[[joints]]`` entry naming the pair, else ``default_deg``."""
+    na = scene.blocks[a].name
+    nb = BASE if b < 0 else scene.blocks[b].name
+    for joint in scene.joints:
+        if set(joint.blocks) == {na, nb}:
+            value = joint.get("friction_angle_deg")
+            if value is not None:
+                return float(value)
+    return default_deg
+
+
+def _left_out(scene) -> tuple[str, ...]:
+    """Notes on what of the scene the rigid-block model does not use."""
+    notes = []
+    if scene.contact.cohesion_Pa:
+        notes.append(f"the scene's cohesion ({scene.contact.cohesion_Pa:g} Pa) is left out: joints carry no tension")
+    overridden = [b.name for b in scene.blocks if b.alpha_rad is not None]
+    if overridden:
+        shown = ", ".join(overridden[:5]) + (" ..." if len(overridden) > 5 else "")
+        notes.append(
+            f"alpha_rad given for {shown} is not used: limit analysis takes the blocks' geometry "
+            "(the corners are the pivots)"
+        )
+    return tuple(notes)
+
+
+def check_friction_angle(value: float, field: str = "friction_angle_deg") -> float:
+    """A friction angle in [0, 90) degrees, else InputError naming ``field``."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InputError(field, f"must be a number of degrees in [0, 90), got {value!r}")
+    if not 0.0 <= value < 90.0:
+        raise InputError(field, f"must be in [0, 90) degrees, got {value:g}")
+    return float(value)
+
+
+def _resolve_loads(loads: Sequence[PointLoad], names: tuple[str, ...], polygons) -> tuple[PointLoad, ...]:
+    """Loads with their block as an index, checked: the block exists, the numbers are finite,
+    the point lies on or inside the block."""
+    out = []
+    for k, load in enumerate(loads):
+        field = f"loads[{k}]"
+        if not isinstance(load, PointLoad):
+            raise InputError(field, f"must be a PointLoad(block, point_m, force_N), got {type(load).__name__}")
+        block = load.block
+        if isinstance(block, str):
+            if block not in names:
+                shown = ", ".join(names[:10]) + (" ..." if len(names) > 10 else "")
+                raise InputError(f"{field}.block", f"no block named {block!r}; blocks: {shown}")
+            index = names.index(block)
+        elif isinstance(block, (int, np.integer)) and not isinstance(block, bool) and 0 <= block < len(names):
+            index = int(block)
+        else:
+            raise InputError(
+                f"{field}.block", f"must be a block name or an index in [0, {len(names) - 1}], got {block!r}"
+            )
+        point = _pair(load.point_m, f"{field}.point_m", "m", 1.0e3)
+        force = _pair(load.force_N, f"{field}.force_N", "N", MAX_LOAD_N)
+        poly = polygons[index]
+        size = float(np.max(np.ptp(poly, axis=0)))
+        if _outside(poly, np.asarray(point)) > 1e-9 * size:
+            raise InputError(
+                f"{field}.point_m",
+                f"({point[0]:g}, {point[1]:g}) m is not on block {names[index]} (a load acts on its block)",
+            )
+        out.append(PointLoad(index, point, force))
+    return tuple(out)
+
+
+def _pair(value, field: str, unit: str, bound: float) -> tuple[float, float]:
+    try:
+        x, y = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be two numbers ({unit}), got {value!r}") from None
+    if not (math.isfinite(x) and math.isfinite(y)) or max(abs(x), abs(y)) > bound:
+        raise InputError(field, f"must be two finite numbers within [-{bound:g}, {bound:g}] {unit}, got {value!r}")
+    return (x, y)
+
+
+def _outside(poly: NDArray[np.float64], point: NDArray[np.float64]) -> float:
+    """How far ``point`` lies outside the counter-clockwise convex polygon (<= 0: inside), m."""
+    edges = np.roll(poly, -1, axis=0) - poly
+    normals = np.column_stack([edges[:, 1], -edges[:, 0]])
+    normals /= np.hypot(normals[:, 0], normals[:, 1])[:, None]
+    return float(np.max(np.einsum("ij,ij->i", point - poly, normals)))
+
+
+def rigid_block_model(
+    scene,
+    loads: Sequence[PointLoad] = (),
+    friction_angle_deg: float | None = None,
+    sliding: bool = True,
+    g: float = G,
+) -> RigidBlockModel:
+    """The rigid-block model of a scene (module docstring).
+
+    Parameters
+    ----------
+    scene
+        A validated :class:`~rockyade.scene.Scene` (an assembly or a column).
+    loads
+        External loads, forces without mass (:class:`PointLoad`).
+    friction_angle_deg
+        Friction angle of every joint, degrees in [0, 90). None: each joint's own from the
+        scene (a ``[[joints]]`` entry for the pair, else ``[contact] friction_angle_deg``).
+    sliding
+        False: no joint slides (the tangential force is unbounded), whatever the friction.
+    g
+        Acceleration of gravity, m/s^2.
+
+    Returns
+    -------
+    RigidBlockModel
+    """
+    if friction_angle_deg is not None:
+        friction_angle_deg = check_friction_angle(friction_angle_deg)
+    placed = placed_blocks(scene)
+    names = tuple(b.name for b in placed)
+    polygons = tuple(np.asarray(b.vertices_m, dtype=float) for b in placed)
+    masses = np.array([_mass(spec, poly) for spec, poly in zip(scene.blocks, polygons, strict=True)])
+    centroids = np.array([b.centroid_m for b in placed], dtype=float)
+    fixed = np.array([b.fixed for b in placed], dtype=bool)
+    default = float(scene.contact.friction_angle_deg) if friction_angle_deg is None else friction_angle_deg
+    interfaces = []
+    for c in rest_contacts(placed):
+        a, b = c.a, c.b
+        normal = np.asarray(c.normal, dtype=float)
+        # the moving body first, else the upper body of a bed joint (the normal points into a)
+        if b >= 0 and (fixed[a] or (not fixed[b] and c.kind == "bed" and c.upper == b)):
+            a, b, normal = b, a, -normal
+        if friction_angle_deg is not None or not sliding:
+            phi = friction_angle_deg
+        else:
+            phi = _friction_of(scene, a, b, default)
+        interfaces.append(Interface(a, b, np.asarray(c.ends_m, dtype=float), normal, phi if sliding else None, c.kind))
+    return RigidBlockModel(
+        notes=_left_out(scene),
+        names=names,
+        masses_kg=masses,
+        centroids_m=centroids,
+        polygons_m=polygons,
+        fixed=fixed,
+        interfaces=tuple(interfaces),
+        loads=_resolve_loads(loads, names, polygons),
+        g=float(g),
+    )

@@ -1,0 +1,160 @@
+"""A limit analysis in words: the multiplier, the mechanism (who turns about which corner,
+which joints slide), the code's quantities and the checks, as ``rockyade limit`` prints them."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rockyade.limit.analysis import LimitResult
+from rockyade.limit.mechanism import Hinge, Sliding
+from rockyade.limit.model import RigidBlockModel
+
+#: Hinges and sliding joints listed in the text (the JSON lists all).
+MAX_LISTED = 20
+
+
+def end_name(model: RigidBlockModel, interface: int, end: int) -> str:
+    """'left'/'right' end of a bed joint (normal nearer vertical), 'lower'/'upper' of a head joint."""
+    itf = model.interfaces[interface]
+    here, there = itf.ends_m[end], itf.ends_m[1 - end]
+    if abs(itf.normal[1]) >= abs(itf.normal[0]):
+        return "left" if here[0] < there[0] else "right"
+    return "lower" if here[1] < there[1] else "upper"
+
+
+def plural(n: int, noun: str) -> str:
+    """``n`` and ``noun``, with an s unless n is 1."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
+def _num(value: float, scale: float = 1.0) -> str:
+    """A coordinate to 4 significant digits, rounding-level values (below 1e-12 x scale) as 0."""
+    return "0" if abs(value) < 1e-12 * max(scale, 1e-300) else f"{value:.4g}"
+
+
+def _towards(vector: np.ndarray) -> str:
+    """A direction in words: towards +x, towards -x, up, down, or an angle from +x."""
+    angle = float(np.degrees(np.arctan2(vector[1], vector[0])))
+    for target, word in (
+        (0.0, "towards +x"),
+        (180.0, "towards -x"),
+        (-180.0, "towards -x"),
+        (90.0, "up"),
+        (-90.0, "down"),
+    ):
+        if abs(angle - target) < 0.05:
+            return word
+    return f"at {angle:.1f} deg from +x"
+
+
+def hinge_words(model: RigidBlockModel, hinge: Hinge) -> str:
+    """One hinge as a sentence."""
+    sense = "clockwise" if hinge.relative_omega < 0 else "counter-clockwise"
+    other = "the base" if hinge.b == "base" else hinge.b
+    x, y = hinge.point_m
+    size = model.size_m
+    return (
+        f"{hinge.a} turns {sense} on {other} about ({_num(x, size)}, {_num(y, size)}) m, "
+        f"the {end_name(model, hinge.interface, hinge.end)} end of their joint"
+    )
+
+
+def sliding_words(model: RigidBlockModel, slide: Sliding, velocities: np.ndarray | None = None) -> str:
+    """One sliding joint as a sentence, told from the body that moves (a, or b when a is at rest)."""
+    itf = model.interfaces[slide.interface]
+    mover, other, sense = slide.a, slide.b, itf.tangent * np.sign(slide.slip)
+    if velocities is not None and slide.b != "base" and not np.any(velocities[itf.a]):
+        mover, other, sense = slide.b, slide.a, -sense
+    other = "the base" if other == "base" else other
+    return (
+        f"{mover} slides {_towards(sense)} on {other} "
+        f"(slip {abs(slide.slip):.3g}, opening {slide.opening:.3g} per unit displacement)"
+    )
+
+
+def _fmt(value: float | None, unit: str = "", digits: int = 4) -> str:
+    return "-" if value is None else f"{value:.{digits}g}{unit}"
+
+
+def text_report(result: LimitResult, source: str = "scene") -> list[str]:
+    """The lines ``rockyade limit`` prints."""
+    model = result.model
+    n_fixed = int(model.fixed.sum())
+    fixed = f", {n_fixed} fixed" if n_fixed else ""
+    if result.friction_angle_deg is None:
+        joints = "no sliding (tangential forces unbounded)"
+    elif result.friction_angle_deg == "scene":
+        joints = "each joint's friction angle from the scene"
+    else:
+        joints = f"friction angle {result.friction_angle_deg:g} deg"
+    lines = [
+        f"limit analysis of {source}: {plural(model.n_blocks - n_fixed, 'moving block')}{fixed}, "
+        f"{plural(len(model.interfaces), 'joint')}; load lambda m g towards {result.direction}; joints: {joints}",
+    ]
+    if model.loads:
+        lines.append(f"external loads (without mass): {len(model.loads)}")
+    if result.status == "unstable":
+        lines.append("status: unstable: the assembly cannot stand under gravity (and its loads) alone: no")
+        lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")
+    elif result.status == "no_mechanism":
+        lines.append("status: no_mechanism: no horizontal acceleration makes it collapse (lambda is unbounded)")
+        if not result.sliding_allowed:
+            lines.append(
+                "  without sliding a joint cannot open with a motion along it either (a block cannot lift off a "
+                "restraint it moves along): a finite friction angle lifts that restriction"
+            )
+    if result.status != "collapse":
+        lines.extend(f"note: {note}" for note in result.model.notes)
+        return lines
+    lam = result.load_multiplier
+    mech = result.mechanism
+    kin = result.kinematic
+    assert lam is not None and mech is not None and kin is not None
+    lines.append(
+        f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} m/s^2)"
+    )
+    n_moving = int(mech.moving.sum())
+    opened = f", {plural(len(mech.separating), 'joint')} opening fully" if mech.separating else ""
+    lines.append(
+        f"mechanism: {plural(n_moving, 'block')} move{'s' if n_moving == 1 else ''}; "
+        f"{plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')}{opened}"
+    )
+    for hinge in mech.hinges[:MAX_LISTED]:
+        lines.append("  " + hinge_words(model, hinge))
+    if len(mech.hinges) > MAX_LISTED:
+        lines.append(f"  ... and {len(mech.hinges) - MAX_LISTED} more hinges (--json lists all)")
+    for slide in mech.sliding[:MAX_LISTED]:
+        lines.append("  " + sliding_words(model, slide, mech.velocities))
+    if len(mech.sliding) > MAX_LISTED:
+        lines.append(f"  ... and {len(mech.sliding) - MAX_LISTED} more sliding joints (--json lists all)")
+    lines.append(
+        f"checks: kinematic constraints met to {mech.checks.max_closing:.1e}, virtual work zero to "
+        f"{mech.checks.virtual_work_residual:.1e} (relative)"
+    )
+    lines.append(f"kinematic quantities (NTC 2018, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
+    lines.append(
+        f"  alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f} "
+        f"(of {kin.participating_mass_kg:.4g} kg moving); a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2"
+    )
+    if kin.d0_star_m is not None:
+        lines.append(
+            f"  nonlinear (control point: centroid of {kin.control_block}): d0* = {_fmt(kin.d0_star_m, ' m')}, "
+            f"du* = {_fmt(kin.du_star_m, ' m')}, ds* = {_fmt(kin.ds_star_m, ' m')}, "
+            f"as* = {_fmt(kin.as_star_m_s2, ' m/s^2')}, Ts = {_fmt(kin.Ts_s, ' s')}"
+        )
+        curve = kin.curve
+        if curve is not None and curve.opened:
+            lines.append(
+                f"  {plural(len(curve.opened), 'hinge')} of the mechanism opened on the way (keeping them all "
+                "would lock it)"
+            )
+        if curve is not None and curve.max_overlap_m > 1e-6 * model.size_m:
+            lines.append(
+                f"  note: points of opened hinges pass into each other by up to {curve.max_overlap_m * 1e3:.3g} mm "
+                "along the curve: new contacts are not followed"
+            )
+    else:
+        lines.append(f"  nonlinear: none ({kin.nonlinear_note})")
+    for note in result.notes:
+        lines.append(f"note: {note}")
+    return lines
