@@ -44,7 +44,7 @@ def cmd_limit(args: argparse.Namespace) -> int:
     else:
         print("\n".join(text_report(result, str(args.scene))))
     if args.plot is not None:
-        from rockyade.limit.drawing import draw_mechanism
+        from rockyade.figures.limit import draw_mechanism
 
         draw_mechanism(result, args.plot, title=args.scene.name)
         print_wrote(args.plot, args.json)

@@ -4,7 +4,7 @@
 programme solved by HiGHS), ``mechanism`` (the collapse mechanism from the dual, checked),
 ``finite`` (the mechanism followed at finite displacement), ``kinematic`` (NTC 2018 /
 Circolare 2019 C8.7.1 quantities: alpha0, M*, e*, a0*, d0*, du*, Ts), ``analysis`` (all of
-it in one call), ``report`` (text and words), ``drawing`` (the mechanism drawn).
+it in one call) and ``report`` (text and words); the mechanism is drawn by :mod:`rockyade.figures.limit`.
 See docs/limit.md.
 """
 
