@@ -22,6 +22,7 @@ $(STAMP): pyproject.toml
 
 lint: setup
 	$(BIN)/ruff check .
+	$(BIN)/lint-imports
 
 test: setup lint
 	ROCKYADE_REQUIRE_YADE=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15

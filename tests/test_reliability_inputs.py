@@ -179,7 +179,7 @@ def test_cost_estimate_of_an_example_matches_the_model():
     model = calibrated_model(scene)
     assert est.integration_steps == model.n_steps
     assert est.motion_samples == model.motion.t_s.size
-    assert est.output_samples == scene.n_samples and not est.over_limits()
+    assert est.output_samples == scene.n_samples and not est.over_limits(LIMITS)
     assert estimate_cost(scene, "yade").wall_time_s > est.wall_time_s
 
 
@@ -196,7 +196,7 @@ def test_cost_above_the_limits_is_refused_unless_allowed(d, solver, what):
     with pytest.raises(InputError) as info:
         check_cost(scene, solver)
     assert info.value.field == "allow_large" and what in str(info.value) and "--allow-large" in str(info.value)
-    assert check_cost(scene, solver, allow_large=True).over_limits()
+    assert check_cost(scene, solver, allow_large=True).over_limits(LIMITS)
 
 
 def test_long_harmonic_motion_is_refused_by_its_samples():

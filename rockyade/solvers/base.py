@@ -22,8 +22,8 @@ from rockyade.errors import InputError
 
 if TYPE_CHECKING:
     from rockyade.result import Result
-    from rockyade.runner.cost import CostEstimate
     from rockyade.scene import Scene
+    from rockyade.solvers.cost import CostEstimate
 
 #: Checks an option's value: (value, field named in errors) -> the value to use.
 OptionCheck = Callable[[Any, str], Any]

@@ -46,9 +46,9 @@ from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result, column
-from rockyade.runner.cost import CostEstimate, sample_cost
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase
+from rockyade.solvers.cost import CostEstimate, sample_cost
 
 #: A block is declared at rest when an impact leaves it an energy that would lift it by
 #: less than REST_FRACTION * alpha.
@@ -575,7 +575,7 @@ class HousnerSolver(SolverBase):
         return Result(frame, _meta(scene, cp, motion, traj, wall))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """One step per output sample (:func:`rockyade.runner.cost.sample_cost`)."""
+        """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
         return sample_cost(scene, self.name)
 
 

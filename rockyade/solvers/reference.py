@@ -39,9 +39,9 @@ from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, run_outcome
 from rockyade.kernel import simulation as kernel
 from rockyade.result import Result
-from rockyade.runner.cost import CostEstimate, dem_cost
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.cost import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
     kernel.STATUS_COMPLETED: "completed",
@@ -91,7 +91,7 @@ class ReferenceSolver(SolverBase):
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Body-steps of the model's time step (:func:`rockyade.runner.cost.dem_cost`)."""
+        """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
         return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
 
 

@@ -15,9 +15,9 @@ from typing import Any, ClassVar
 
 from rockyade.errors import InputError
 from rockyade.result import Result
-from rockyade.runner.cost import CostEstimate, dem_cost
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase
+from rockyade.solvers.cost import CostEstimate, dem_cost
 from rockyade.yade.backend import check_timeout, run_model, yade_model
 
 
@@ -78,7 +78,7 @@ class YadeSolver(SolverBase):
         )
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Body-steps of the model's time step (:func:`rockyade.runner.cost.dem_cost`)."""
+        """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
         return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> YadeSolver:
