@@ -13,6 +13,7 @@ import tomllib
 from pathlib import Path
 from typing import Any
 
+from rockyade.blocks.geometry import MAX_POLYGON_VERTICES
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, STIFFNESS_SCALES
 from rockyade.errors import InputError
 from rockyade.io.fields import TableReader, plain_data
@@ -172,6 +173,10 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
         raw = r.raw("vertices_m")
         if not isinstance(raw, list) or len(raw) < 3 or not all(isinstance(v, list) and len(v) == 2 for v in raw):
             raise r.error("vertices_m", "must be a list of at least 3 [x, y] pairs in metres")
+        if len(raw) > MAX_POLYGON_VERTICES:  # refused before each vertex is checked
+            raise r.error(
+                "vertices_m", f"has {len(raw)} vertices, more than the {MAX_POLYGON_VERTICES} a block may have"
+            )
         sub = TableReader({f"v{i}": v for i, v in enumerate(raw)}, r.field("vertices_m"), source)
         vertices = tuple(tuple(sub.number_list(f"v{i}", min_len=2, unit="m")) for i in range(len(raw)))
         if max(abs(c) for v in vertices for c in v) > MAX_LENGTH_M:
