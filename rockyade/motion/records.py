@@ -353,6 +353,29 @@ def _accel(path: Path, values: list[float], unit: str) -> np.ndarray:
     return a
 
 
+def record_problem(t_s: np.ndarray, accel_m_s2: np.ndarray) -> str | None:
+    """What keeps samples from being a record, or None: the bounds every record passes,
+    whether read from a file or taken from the synthetic-record cache.
+
+    1-D float arrays of the same length, 2 to :data:`MAX_RECORD_SAMPLES` samples, times from 0
+    strictly increasing, finite accelerations within +/- :data:`MAX_ABS_ACCEL_M_S2` m/s^2.
+    """
+    if not all(isinstance(x, np.ndarray) and x.dtype == np.float64 and x.ndim == 1 for x in (t_s, accel_m_s2)):
+        return "times and accelerations must be 1-D float64 arrays"
+    if t_s.shape != accel_m_s2.shape:
+        return f"{t_s.size} times but {accel_m_s2.size} accelerations"
+    if not 2 <= t_s.size <= MAX_RECORD_SAMPLES:
+        return f"{t_s.size} samples, not in [2, {MAX_RECORD_SAMPLES}]"
+    if not (np.all(np.isfinite(t_s)) and t_s[0] == 0.0 and np.all(np.diff(t_s) > 0)):
+        return "times must start at 0 and increase strictly"
+    if not np.all(np.isfinite(accel_m_s2)):
+        return "contains NaN or infinite values"
+    worst = int(np.argmax(np.abs(accel_m_s2)))
+    if abs(accel_m_s2[worst]) > MAX_ABS_ACCEL_M_S2:
+        return f"sample {worst + 1} is {accel_m_s2[worst]:.4g} m/s^2, beyond +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2"
+    return None
+
+
 def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = None) -> Record:
     """Read a PEER NGA AT2 file (see module docstring).
 
