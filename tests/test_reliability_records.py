@@ -313,12 +313,28 @@ def test_at2_with_more_values_than_npts_is_refused_naming_the_line(tmp_path):
     assert info.value.line == 4 + 501 // 5 + 1 and f"line {info.value.line}" in message
 
 
-def test_a_third_column_is_refused_naming_the_line(tmp_path):
+@pytest.mark.parametrize("header", ["", "t_s,accel_g\n"])
+def test_a_third_column_is_refused_naming_the_line(tmp_path, header):
     path = tmp_path / "r.csv"
-    path.write_text("t_s,accel_g,extra\n0.00,0.1\n0.01,0.2,0.9\n0.02,0.3\n")
+    path.write_text(f"{header}0.00,0.1\n0.01,0.2,0.9\n0.02,0.3\n")
     with pytest.raises(RecordError) as info:
         read_record(path)
-    assert info.value.line == 3 and "holds 3 columns ('0.01,0.2,0.9')" in str(info.value)
+    assert info.value.line == 2 + bool(header) and "holds 3 columns ('0.01,0.2,0.9')" in str(info.value)
+
+
+def test_columns_a_header_names_are_read_and_rows_must_match_it(tmp_path):
+    """``motion synth`` writes t_s, accel_m_s2, vel_m_s, disp_m: named, so the reader knows what
+    it leaves out; a row with another count, or a second column not named as an acceleration,
+    is refused."""
+    path = tmp_path / "record_01.csv"
+    path.write_text("t_s,accel_m_s2,vel_m_s,disp_m\n0.00,0.1,0,0\n0.01,0.2,0.001,0\n0.02,0.3,0.003,0.00001\n")
+    np.testing.assert_array_equal(read_record(path).accel_m_s2, [0.1, 0.2, 0.3])
+    path.write_text("t_s,accel_m_s2,vel_m_s,disp_m\n0.00,0.1,0,0\n0.01,0.2,0.001\n")
+    with pytest.raises(RecordError, match=r"line 3: holds 3 values .* where the header \(line 1\) names 4"):
+        read_record(path)
+    path.write_text("t,v,a\n0.00,0.1,0\n0.01,0.2,0.001\n")
+    with pytest.raises(RecordError, match=r"line 1: the header names 3 columns \(t, v, a\) and the second, 'v'"):
+        read_record(path)
 
 
 def test_a_dt_that_disagrees_with_the_file_is_refused(tmp_path):

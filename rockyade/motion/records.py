@@ -16,7 +16,9 @@
   else commas, else blanks; decimal commas read where unambiguous,
   :mod:`rockyade.motion.columns`), ``#`` comments, an optional header line whose
   acceleration column may name its units (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``, ...).
-  A line with one number or with three or more is refused, saying what it holds.
+  A line with one number or with three or more is refused, saying what it holds; more
+  columns are read only when a header names each of them and the second as an
+  acceleration (``t_s,accel_m_s2,vel_m_s,disp_m``, as ``rockyade motion synth`` writes).
 * Single-column text: one acceleration per line at a given ``dt_s``; a file given ``dt_s``
   but no format is read as one column when its first data line holds one number.
 
@@ -519,6 +521,7 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
     header_line: int | None = None
     seen_data = False
     comma_numbers = True  # every data line is one number written with a decimal comma
+    width = 2  # values a line holds: time and acceleration, or as many as a header names
     for lineno, line in enumerate(lines, start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
@@ -529,6 +532,7 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
             if len(names) >= 2:
                 header_unit = header_units(names[1])
                 _check_header_quantity(path, lineno, names[1])
+                width = _named_width(path, lineno, names)
             continue
         comma_numbers = comma_numbers and bool(DECIMAL_COMMA.match(body))
         columns = _columns(path, lineno, body)
@@ -541,8 +545,11 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
                 f"holds one number ({body!r}), not two columns (time, acceleration): "
                 f"a one-column file needs {SINGLE_HINT}",
             )
-        if len(columns) > 2:
-            raise RecordError(path, lineno, _too_many_columns(body, columns))
+        if len(columns) != width:
+            if width == 2:
+                raise RecordError(path, lineno, _too_many_columns(body, columns))
+            named = f"where the header (line {header_line}) names {width}"
+            raise RecordError(path, lineno, f"holds {len(columns)} values ({body!r}) {named}")
         seen_data = True
         times.append(_number(path, lineno, columns[0], "time"))
         accel.append(_number(path, lineno, columns[1]))
@@ -569,6 +576,22 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
         _check_dt(path, column[worst + 1][1], float(steps[worst]), dt_s, "the time column steps by")
     a = _accel(path, accel, unit)
     return Record(t - t[0], a, unit, str(path), "", {"format": "csv"})
+
+
+def _named_width(path: Path, line: int, names: list[str]) -> int:
+    """Columns a header names: more than two only when its second names an acceleration
+    (``t_s,accel_m_s2,vel_m_s,disp_m`` as ``rockyade motion synth`` writes); the others are
+    then named, hence known to be left out."""
+    if len(names) == 2:
+        return 2
+    if header_units(names[1]) is None and not re.search(r"(?<![a-z])acc", names[1], re.I):
+        raise RecordError(
+            path,
+            line,
+            f"the header names {len(names)} columns ({', '.join(names)}) and the second, {names[1]!r}, is not named "
+            "as an acceleration (e.g. accel_m_s2): a record's columns are time (s) and acceleration",
+        )
+    return len(names)
 
 
 def _too_many_columns(body: str, columns: list[str]) -> str:
