@@ -222,3 +222,34 @@ def test_a_run_of_a_synthetic_scene_regenerates_a_damaged_entry(tmp_path, monkey
     assert main(["run", str(scene)]) == 0
     err = capsys.readouterr().err
     assert "not a readable .npz (BadZipFile" in err and "regenerated" in err
+
+
+def test_random_and_mutated_bytes_in_a_cache_file_are_damage_never_a_traceback(cache, generated):
+    """Hypothesis: any bytes in place of a cache file give CacheDamagedError (then a
+    regeneration), or, if they happen to be the file as written, the record itself."""
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+
+    pristine = cache.read_bytes()
+
+    @settings(max_examples=200, deadline=None, derandomize=True, database=None)
+    @given(
+        data=st.one_of(
+            st.binary(max_size=300),
+            st.builds(
+                lambda pos, chunk, cut: (pristine[:pos] + chunk + pristine[pos + cut :]),
+                st.integers(0, len(pristine)),
+                st.binary(max_size=8),
+                st.integers(0, 16),
+            ),
+        )
+    )
+    def check(data):
+        cache.write_bytes(data)
+        try:
+            rec = load_cached_record(cache, SPEC, 1)
+        except CacheDamagedError:
+            return
+        np.testing.assert_array_equal(rec.accel_m_s2, generated.accel_m_s2)
+
+    check()
