@@ -330,11 +330,16 @@ def test_columns_a_header_names_are_read_and_rows_must_match_it(tmp_path):
     path.write_text("t_s,accel_m_s2,vel_m_s,disp_m\n0.00,0.1,0,0\n0.01,0.2,0.001,0\n0.02,0.3,0.003,0.00001\n")
     np.testing.assert_array_equal(read_record(path).accel_m_s2, [0.1, 0.2, 0.3])
     path.write_text("t_s,accel_m_s2,vel_m_s,disp_m\n0.00,0.1,0,0\n0.01,0.2,0.001\n")
-    with pytest.raises(RecordError, match=r"line 3: holds 3 values .* where the header \(line 1\) names 4"):
+    with pytest.raises(RecordError, match=r"line 3: holds 3 values .* where the lines before hold 4"):
         read_record(path)
     path.write_text("t,v,a\n0.00,0.1,0\n0.01,0.2,0.001\n")
     with pytest.raises(RecordError, match=r"line 1: the header names 3 columns \(t, v, a\) and the second, 'v'"):
         read_record(path)
+    path.write_text("t_s,accel_m_s2\n0.00,0.1,0\n0.01,0.2,0.001\n")  # a header of two over three columns
+    with pytest.raises(RecordError, match=r"line 2: holds 3 columns"):
+        read_record(path)
+    path.write_text("time [s]   acceleration [g]\n0.00  0.1\n0.01  0.2\n")  # units in brackets stay with names
+    np.testing.assert_array_equal(read_record(path).accel_m_s2, np.array([0.1, 0.2]) * STANDARD_GRAVITY)
 
 
 def test_a_dt_that_disagrees_with_the_file_is_refused(tmp_path):

@@ -442,9 +442,17 @@ def _split(line: str) -> list[str]:
 
 
 def _header_names(line: str) -> list[str]:
-    """Column names of a header: split at commas, semicolons or tabs if it has any, else at spaces."""
-    parts = re.split(r"[,;\t]", line) if re.search(r"[,;\t]", line) else line.split()
-    return [p.strip() for p in parts if p.strip()]
+    """Column names of a header: split at commas, semicolons or tabs if it has any, else at
+    spaces, where a unit in brackets stays with its name (``time [s]  accel (g)``)."""
+    if re.search(r"[,;\t]", line):
+        return [p.strip() for p in re.split(r"[,;\t]", line) if p.strip()]
+    names: list[str] = []
+    for word in line.split():
+        if names and word[0] in "([":
+            names[-1] += f" {word}"
+        else:
+            names.append(word)
+    return names
 
 
 def _is_header(tokens: list[str]) -> bool:
@@ -521,7 +529,8 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
     header_line: int | None = None
     seen_data = False
     comma_numbers = True  # every data line is one number written with a decimal comma
-    width = 2  # values a line holds: time and acceleration, or as many as a header names
+    width: int | None = None  # values a line holds: two, or as many as a header names (first data line)
+    names: list[str] = []
     for lineno, line in enumerate(lines, start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
@@ -532,7 +541,6 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
             if len(names) >= 2:
                 header_unit = header_units(names[1])
                 _check_header_quantity(path, lineno, names[1])
-                width = _named_width(path, lineno, names)
             continue
         comma_numbers = comma_numbers and bool(DECIMAL_COMMA.match(body))
         columns = _columns(path, lineno, body)
@@ -545,11 +553,13 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
                 f"holds one number ({body!r}), not two columns (time, acceleration): "
                 f"a one-column file needs {SINGLE_HINT}",
             )
+        if width is None:
+            width = 2 if len(columns) == 2 else _named_width(path, lineno, body, columns, names, header_line)
         if len(columns) != width:
             if width == 2:
                 raise RecordError(path, lineno, _too_many_columns(body, columns))
-            named = f"where the header (line {header_line}) names {width}"
-            raise RecordError(path, lineno, f"holds {len(columns)} values ({body!r}) {named}")
+            before = f"where the lines before hold {width}"
+            raise RecordError(path, lineno, f"holds {len(columns)} values ({body!r}) {before}")
         seen_data = True
         times.append(_number(path, lineno, columns[0], "time"))
         accel.append(_number(path, lineno, columns[1]))
@@ -578,20 +588,22 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
     return Record(t - t[0], a, unit, str(path), "", {"format": "csv"})
 
 
-def _named_width(path: Path, line: int, names: list[str]) -> int:
-    """Columns a header names: more than two only when its second names an acceleration
-    (``t_s,accel_m_s2,vel_m_s,disp_m`` as ``rockyade motion synth`` writes); the others are
-    then named, hence known to be left out."""
-    if len(names) == 2:
-        return 2
+def _named_width(
+    path: Path, line: int, body: str, columns: list[str], names: list[str], header_line: int | None
+) -> int:
+    """The width of a first data line of three columns or more: accepted only when a header
+    names each column and the second as an acceleration (``t_s,accel_m_s2,vel_m_s,disp_m``, as
+    ``rockyade motion synth`` writes), so that what is left out is known; refused otherwise."""
+    if len(names) != len(columns):
+        raise RecordError(path, line, _too_many_columns(body, columns))
     if header_units(names[1]) is None and not re.search(r"(?<![a-z])acc", names[1], re.I):
         raise RecordError(
             path,
-            line,
+            header_line,
             f"the header names {len(names)} columns ({', '.join(names)}) and the second, {names[1]!r}, is not named "
             "as an acceleration (e.g. accel_m_s2): a record's columns are time (s) and acceleration",
         )
-    return len(names)
+    return len(columns)
 
 
 def _too_many_columns(body: str, columns: list[str]) -> str:
