@@ -153,10 +153,45 @@ def test_fuzz_scene_toml_bytes(data):
     outcome("scene TOML bytes", load)
 
 
+def _json_text(toml: bytes) -> bytes:
+    import tomllib
+
+    return json.dumps(tomllib.loads(toml.decode()), indent=1).encode()
+
+
+JSON_TEXTS = [_json_text(t) for t in TEXTS]
+#: Pieces that make JSON objects hold a key twice, among the usual damage.
+JSON_BYTES = st.one_of(
+    BYTES, st.sampled_from([b'"duration_s": 1.0, ', b'"type": "free", ', b'"name": "x", ', b"{", b"}"])
+)
+
+
+@fuzz_settings(300)
+@given(data=st.data())
+def test_fuzz_scene_json_bytes(data):
+    """Mutated JSON text (keys spliced in twice, bytes inserted or cut): a scene or one clean
+    error (a key given twice is one), never a traceback."""
+    text = bytearray(data.draw(st.sampled_from(JSON_TEXTS)))
+    for _ in range(data.draw(st.integers(1, 3))):
+        pos = data.draw(st.integers(0, len(text)))
+        if data.draw(st.booleans()):
+            text[pos:pos] = data.draw(JSON_BYTES)
+        else:
+            del text[pos : pos + data.draw(st.integers(1, 20))]
+
+    def load() -> None:
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "s.json"
+            path.write_bytes(bytes(text))
+            load_scene(path)
+
+    outcome("scene JSON bytes", load)
+
+
 @pytest.fixture(scope="module", autouse=True)
 def _print_counts():
     yield
-    for suite in ("scene dict", "scene JSON", "scene TOML bytes", "scene runs"):
+    for suite in ("scene dict", "scene JSON", "scene TOML bytes", "scene JSON bytes", "scene runs"):
         print("\n" + report(suite))
 
 

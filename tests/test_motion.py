@@ -128,11 +128,14 @@ def _write_at2(
 @pytest.mark.parametrize("variant", sorted(AT2_VARIANTS))
 @pytest.mark.parametrize("crlf", [False, True])
 def test_at2_header_variants(tmp_path, variant, crlf):
-    path = _write_at2(tmp_path / "r.AT2", AT2_VARIANTS[variant], crlf=crlf, extra=[9.9, 9.9])
+    path = _write_at2(tmp_path / "r.AT2", AT2_VARIANTS[variant], crlf=crlf)
     rec = read_at2(path)
     assert rec.npts == 6 and rec.dt_s == pytest.approx(0.01)
-    np.testing.assert_allclose(rec.accel_m_s2, np.array(AT2_DATA) * SG)  # values beyond NPTS ignored
+    np.testing.assert_allclose(rec.accel_m_s2, np.array(AT2_DATA) * SG)
     assert rec.units_in_file == "g"
+    path = _write_at2(tmp_path / "r.AT2", AT2_VARIANTS[variant], crlf=crlf, extra=[9.9, 9.9])
+    with pytest.raises(RecordError, match="NPTS = 6 in the header but the file holds 8 values"):
+        read_at2(path)  # values beyond NPTS were once ignored: header and data disagree
 
 
 @pytest.mark.parametrize(

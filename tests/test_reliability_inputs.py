@@ -216,3 +216,61 @@ def test_cli_refuses_a_large_run_before_running(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "allow_large:" in err and "1e+07 output samples" in err and "--allow-large" in err
     assert not (tmp_path / "r.csv").exists()
+
+
+# ---------------------------------------------------------------------- scene files: size, duplicates
+
+
+@pytest.mark.parametrize("suffix", [".toml", ".json"])
+def test_a_huge_scene_file_is_refused_at_once_with_its_size_and_the_cap(tmp_path, suffix):
+    """A 200 MB scene (about 1e8 inline samples) used to be refused after 207 s and 6.5 GB."""
+    import time
+
+    from rockyade.scene.loading import MAX_SCENE_BYTES
+
+    path = tmp_path / f"huge{suffix}"
+    with path.open("wb") as fh:  # sparse: 200 MB that cost no disk
+        fh.write(b"duration_s = 1.0\n" if suffix == ".toml" else b'{"duration_s": 1.0, "x": [')
+        fh.truncate(200_000_000)
+    start = time.perf_counter()
+    with pytest.raises(InputError) as info:
+        load_scene(path)
+    elapsed = time.perf_counter() - start
+    assert elapsed < 1.0
+    message = str(info.value)
+    assert str(path) in message and "200,000,000 bytes" in message and f"{MAX_SCENE_BYTES:,}" in message
+    assert main(["run", str(path)]) == 2
+
+
+def test_a_scene_just_under_the_cap_is_read(tmp_path, monkeypatch):
+    from rockyade.scene import loading
+
+    text = (EXAMPLES / "specimen1_free.toml").read_bytes()
+    path = tmp_path / "s.toml"
+    path.write_bytes(text)
+    monkeypatch.setattr(loading, "MAX_SCENE_BYTES", len(text))
+    assert load_scene(path).duration_s > 0
+    monkeypatch.setattr(loading, "MAX_SCENE_BYTES", len(text) - 1)
+    with pytest.raises(InputError, match=f"has {len(text)} bytes"):
+        load_scene(path)
+
+
+@pytest.mark.parametrize(
+    ("splice", "key"),
+    [(("{", '{"duration_s": 40.0, '), "duration_s"), (('"motion": {', '"motion": {"theta0_rad": 0.2, '), "theta0_rad")],
+)
+def test_json_scenes_with_a_key_twice_are_refused_naming_it(tmp_path, splice, key):
+    """TOML refuses a key given twice; JSON readers keep the last value: both refuse it now."""
+    import json
+
+    body = json.dumps(free_scene_dict()).replace(*splice, 1)
+    assert body.count(f'"{key}"') == 2
+    path = tmp_path / "s.json"
+    path.write_text(body)
+    with pytest.raises(InputError) as info:
+        load_scene(path)
+    assert f"the key '{key}' appears twice" in str(info.value) and str(path) in str(info.value)
+    toml = tmp_path / "s.toml"
+    toml.write_text(f"{key} = 1.0\n{key} = 2.0\n")
+    with pytest.raises(InputError, match="not valid TOML"):
+        load_scene(toml)

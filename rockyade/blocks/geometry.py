@@ -16,6 +16,14 @@ from rockyade.errors import InputError
 
 #: Relative tolerance used to decide that vertices lie on the base (or top) line.
 LEVEL_TOL = 1e-9
+#: Most vertices a block's polygon may have (a half-circle of 10,000 vertices is within
+#: 1e-8 of the true circle's area; the DEM's contact search grows with the vertex count).
+MAX_POLYGON_VERTICES = 10_000
+#: Simplification tolerance, relative to the block's size (the larger of its width and
+#: height): a vertex is dropped only if it lies within this distance of the outline without
+#: it, and only if the area changes by less than this fraction of itself and the centroid
+#: moves by less than this times the size.
+SIMPLIFY_TOL = 1e-9
 
 
 @dataclass(frozen=True)
@@ -64,13 +72,24 @@ def polygon_section(vertices: NDArray[np.float64]) -> PolygonSection:
 
 
 def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
-    """Validate a vertex list and return it as a counter-clockwise (n, 2) float array."""
+    """Validate a vertex list and return it as a counter-clockwise (n, 2) float array.
+
+    At most :data:`MAX_POLYGON_VERTICES` vertices. Vertices in the middle of an edge are
+    dropped (:func:`simplify_polygon`): relative to the block's size, and never changing its
+    area or centroid beyond :data:`SIMPLIFY_TOL`.
+    """
     try:
         arr = np.asarray(vertices, dtype=float)
     except (TypeError, ValueError) as exc:
         raise InputError(field_name, f"must be a list of [x, y] pairs in metres ({exc})") from None
     if arr.ndim != 2 or arr.shape[1] != 2 or arr.shape[0] < 3:
         raise InputError(field_name, "must be a list of at least 3 [x, y] pairs in metres")
+    if arr.shape[0] > MAX_POLYGON_VERTICES:
+        raise InputError(
+            field_name,
+            f"has {arr.shape[0]} vertices, more than the {MAX_POLYGON_VERTICES} a block may have: "
+            "sample its curved parts more coarsely",
+        )
     if not np.all(np.isfinite(arr)):
         raise InputError(field_name, "contains NaN or infinite coordinates")
     scale = float(np.max(np.ptp(arr, axis=0)))
@@ -90,12 +109,12 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
     lengths = np.hypot(edges[:, 0], edges[:, 1])
     if np.any(lengths <= LEVEL_TOL):
         raise InputError(field_name, "has repeated (coincident) vertices")
-    nxt = np.roll(edges, -1, axis=0)
-    turn = edges[:, 0] * nxt[:, 1] - edges[:, 1] * nxt[:, 0]
-    if np.any(turn < -LEVEL_TOL):
+    offset = _offsets(unit)
+    prev = np.roll(edges, 1, axis=0)
+    turn = prev[:, 0] * edges[:, 1] - prev[:, 1] * edges[:, 0]  # at each vertex
+    if np.any((turn < 0) & (offset > SIMPLIFY_TOL)):
         raise InputError(field_name, "polygon must be convex (vertices in order around it)")
-    keep = np.roll(np.abs(turn) > LEVEL_TOL, 1)
-    dot = edges[:, 0] * nxt[:, 0] + edges[:, 1] * nxt[:, 1]
+    dot = prev[:, 0] * edges[:, 0] + prev[:, 1] * edges[:, 1]
     winding = float(np.arctan2(turn, dot).sum()) / (2.0 * np.pi)
     if winding > 1.5:
         raise InputError(
@@ -103,7 +122,71 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
             f"the outline crosses itself (it winds {winding:.0f} times, e.g. a star): "
             "give the vertices in order around a convex polygon",
         )
-    return arr[keep].copy()
+    return arr[simplify_polygon(unit, offset)].copy()
+
+
+def _offsets(unit: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Distance of each vertex from the chord joining its two neighbours (same units)."""
+    before = np.roll(unit, 1, axis=0)
+    after = np.roll(unit, -1, axis=0)
+    return _distance_to_line(unit, before, after)
+
+
+def _distance_to_line(p: NDArray[np.float64], a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Distance of points ``p`` from the lines through ``a`` and ``b`` (row by row)."""
+    ab = b - a
+    ap = p - a
+    cross = ab[:, 0] * ap[:, 1] - ab[:, 1] * ap[:, 0]
+    return np.abs(cross) / np.maximum(np.hypot(ab[:, 0], ab[:, 1]), 1e-300)
+
+
+def simplify_polygon(unit: NDArray[np.float64], offset: NDArray[np.float64] | None = None) -> NDArray[np.bool_]:
+    """Which vertices of a counter-clockwise polygon to keep: those in the middle of an edge go.
+
+    Parameters
+    ----------
+    unit
+        (n, 2) vertices scaled to a unit size (divided by the larger of width and height).
+    offset
+        Distance of each vertex from its neighbours' chord (computed when not given).
+
+    Returns
+    -------
+    Boolean mask of the vertices kept.
+
+    Notes
+    -----
+    A vertex is dropped only if it lies within :data:`SIMPLIFY_TOL` (relative to the block's
+    size) of the outline *without* it: a finely sampled curve, each of whose vertices is
+    nearly on its neighbours' chord, keeps its vertices, because the chords of a run of
+    dropped vertices would cut the curve. If the simplified polygon's area differs from the
+    given one by more than :data:`SIMPLIFY_TOL` of itself, or its centroid moves by more
+    than :data:`SIMPLIFY_TOL` times the size, every vertex is kept.
+    """
+    n = unit.shape[0]
+    if offset is None:
+        offset = _offsets(unit)
+    keep = offset > SIMPLIFY_TOL
+    if np.count_nonzero(keep) < 3:  # a degenerate outline: start from its three farthest corners
+        keep[np.argsort(offset)[-3:]] = True
+    for _ in range(n):
+        kept = np.flatnonzero(keep)
+        dropped = np.flatnonzero(~keep)
+        if dropped.size == 0:
+            break
+        pos = np.searchsorted(kept, dropped)
+        after = kept[pos % kept.size]
+        before = kept[pos - 1]  # pos 0 wraps to the last kept vertex
+        far = _distance_to_line(unit[dropped], unit[before], unit[after]) > SIMPLIFY_TOL
+        if not np.any(far):
+            break
+        keep[dropped[far]] = True
+    if not keep.all():
+        given, simplified = polygon_section(unit), polygon_section(unit[keep])
+        moved = float(np.hypot(*np.subtract(given.centroid_m, simplified.centroid_m)))
+        if abs(simplified.area_m2 - given.area_m2) > SIMPLIFY_TOL * abs(given.area_m2) or moved > SIMPLIFY_TOL:
+            keep[:] = True
+    return keep
 
 
 def polygon_section_area(vertices: NDArray[np.float64]) -> float:

@@ -192,7 +192,11 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
 #: except density, duration and sample interval.
 COMMON: list[Opt] = [
     Opt("--density-kg-m3", 2400.0, "density of the blocks, kg/m^3"),
-    Opt("--duration-s", 3.0, "simulated time, s"),
+    Opt(
+        "--duration-s",
+        None,
+        "simulated time, s (default: with --motion record, the record's length plus 5 s of free rocking; else 3)",
+    ),
     Opt("--sample-dt-s", 0.002, "output sampling interval, s"),
     Opt(
         "--motion",
@@ -289,6 +293,17 @@ def _motion_table(args: argparse.Namespace, out: Path) -> dict[str, Any]:
         raise InputError("--record", f"file not found: {record}")
     relative = os.path.relpath(record.resolve(), out.resolve().parent)
     return record_motion(Path(relative).as_posix(), args.load_factor)
+
+
+def _default_duration(args: argparse.Namespace, motion: dict[str, Any]) -> float:
+    """--duration-s when not given: a record's length plus a tail of free rocking, else 3 s."""
+    from rockyade.scene.generators.common import default_duration_s
+
+    if motion.get("type") != "record":
+        return default_duration_s(motion)
+    duration = default_duration_s({**motion, "file": str(Path(args.record).resolve())})
+    print(f"duration_s = {duration:g} s: the record's length plus 5 s of free rocking (--duration-s to change)")
+    return duration
 
 
 def _contact_table(args: argparse.Namespace, kind: str, unit_height_m: float) -> dict[str, Any] | None:
@@ -431,6 +446,8 @@ def cmd_build(args: argparse.Namespace) -> int:
         check_output_file(args.draw, "--draw", ".png")
     kwargs = _generator_kwargs(args, kind)
     kwargs["motion"] = _motion_table(args, out)
+    if kwargs["duration_s"] is None:
+        kwargs["duration_s"] = _default_duration(args, kwargs["motion"])
     kwargs["contact"] = _contact_table(args, kind, _unit_height(args, kind))
     try:
         data = GENERATORS[kind](**kwargs)

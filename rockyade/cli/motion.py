@@ -22,13 +22,21 @@ def _read(args: argparse.Namespace):
 
 def _add_record_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("record", type=Path, help="record file: PEER .AT2, two-column time/acceleration, or one column")
-    p.add_argument("--format", choices=["at2", "csv", "single"], help="file format (default: by extension)")
+    p.add_argument(
+        "--format",
+        choices=["at2", "csv", "single"],
+        help="file format (default: from the content: a PEER header is at2, one number a line with --dt is single)",
+    )
     p.add_argument(
         "--units",
         help="units of the values when the file does not name them: g, m/s2, cm/s2 (default m/s2); "
         "units named in the file win, and a different --units is refused",
     )
-    p.add_argument("--dt", type=float, help="sampling interval of a single-column file, s")
+    p.add_argument(
+        "--dt",
+        type=float,
+        help="sampling interval of a one-column file, s (with an AT2 or two-column file it must match the file's)",
+    )
 
 
 def cmd_info(args: argparse.Namespace) -> int:

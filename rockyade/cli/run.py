@@ -24,6 +24,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             check_output_file(getattr(args, option), option, suffix)
     [solver] = solvers_from_args([args.solver], args)
     scene = load_scene(args.scene)
+    _warn_if_the_motion_is_cut(scene)
     check_run_drawings(args)
     check_cost(scene, solver, allow_large=args.allow_large)
     if args.out:  # files the solver keeps (YADE's log and scene data) go beside the result
@@ -43,6 +44,18 @@ def cmd_run(args: argparse.Namespace) -> int:
     write_run_drawings(args, scene, result, args.out or Path(Path(args.scene).stem + ".csv"))
     _print_summary(scene, result, total_time(args))
     return 0 if result.ok else 1
+
+
+def _warn_if_the_motion_is_cut(scene: Any) -> None:
+    """One warning line on stderr when the scene ends before its base motion does."""
+    import sys
+
+    from rockyade.motion.coverage import record_coverage
+
+    coverage = record_coverage(scene.motion, scene.duration_s)
+    if coverage["status"] == "cut":
+        where = f"{scene.source}: " if scene.source else ""
+        print(f"rockyade: warning: {where}{coverage['message']}", file=sys.stderr)
 
 
 def _write_collapse(scene: Any, result: Any, path: Path) -> None:

@@ -3,8 +3,11 @@ complete, and never leaves its temporary files behind when it fails.
 
 Every writer goes to a temporary file ``.<name>.<random>.tmp`` in the destination
 directory, flushes and fsyncs it, gives it the permissions the umask allows (as ``open``
-would: ``0o666 & ~umask``; ``mkstemp`` alone makes 0600), then renames it over the
-destination (``os.replace`` is atomic on POSIX filesystems) and fsyncs the directory. On
+would: ``0o666 & ~umask``), then renames it over the destination (``os.replace`` is atomic
+on POSIX filesystems, and replaces a link at the destination rather than writing where it
+points) and fsyncs the directory. The temporary file is created with
+``O_CREAT | O_EXCL | O_NOFOLLOW`` under a random name: a name that exists already (a file,
+or a link an attacker planted) is never opened, and another random name is tried. On
 any failure (a full disk, Ctrl-C) the temporary file is removed. A process killed with
 SIGKILL may leave one behind: :func:`remove_stale_temporaries` clears a directory that
 the caller holds the lock of (:mod:`rockyade.io.locking`).
@@ -13,15 +16,41 @@ the caller holds the lock of (:mod:`rockyade.io.locking`).
 from __future__ import annotations
 
 import contextlib
+import errno
 import json
 import os
-import tempfile
+import secrets
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
 
 #: Suffix of every temporary file written here.
 TEMP_SUFFIX = ".tmp"
+#: Random names tried for a temporary file before giving up (each taken one is skipped).
+TEMP_ATTEMPTS = 100
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+
+
+def _random_part() -> str:
+    """The random part of a temporary file's name (16 hex digits)."""
+    return secrets.token_hex(8)
+
+
+def create_temporary(dest: Path) -> tuple[int, Path]:
+    """Create ``.<name>.<random>.tmp`` beside ``dest`` exclusively, never through a link.
+
+    Returns the open descriptor (read-write, mode 0600 until the writer sets its own) and
+    the path. A name that exists, whatever it is, is skipped for another random one.
+    """
+    flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC
+    for _ in range(TEMP_ATTEMPTS):
+        tmp = dest.parent / f".{dest.name}.{_random_part()}{TEMP_SUFFIX}"
+        try:
+            return os.open(tmp, flags, 0o600), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(errno.EEXIST, f"no free temporary name after {TEMP_ATTEMPTS} tries", str(dest.parent))
 
 
 def current_umask() -> int:
@@ -54,8 +83,7 @@ def staged_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[tuple
         raise ValueError(f"mode must be 'w' or 'wb', not {mode!r}")
     dest = Path(path)
     dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=TEMP_SUFFIX, dir=dest.parent)
-    tmp = Path(tmp_name)
+    fd, tmp = create_temporary(dest)
     try:
         binary = "b" in mode
         with os.fdopen(fd, mode, encoding=None if binary else "utf-8", newline=None if binary else "") as fh:
@@ -109,9 +137,10 @@ def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
     """
     removed = []
     for path in Path(directory).glob(f".*{TEMP_SUFFIX}"):
-        with contextlib.suppress(FileNotFoundError):
-            path.unlink()
-            removed.append(path)
+        with contextlib.suppress(OSError):  # gone already, or a folder: left alone
+            if path.is_symlink() or path.is_file():
+                path.unlink()  # a link is removed itself, never what it points to
+                removed.append(path)
     return removed
 
 

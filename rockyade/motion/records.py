@@ -1,21 +1,32 @@
 """Readers of recorded accelerograms: a record is read exactly, or refused.
 
-* PEER NGA ``.AT2``: four header lines (database, event/station, units, sampling), then
-  the values in free format. The sampling line comes as ``NPTS=  5372, DT=   .0100 SEC,``
-  with or without the commas and trailing text, or in the old layout
-  ``  4000   .0100   NPTS, DT`` (two numbers first). Values beyond NPTS are ignored; CRLF
-  line ends are accepted. The units line names G, CM/S/S (or CM/SEC/SEC, GAL) or M/S/S.
-  A file with fewer than NPTS values, or whose last value is cut short (it lacks the
-  digits or the exponent every other value has), is refused as truncated.
-* Two-column text or CSV: time (s) and acceleration, comma / semicolon / whitespace
-  separated, ``#`` comments, an optional header line whose acceleration column may name
-  its units (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``, ...).
-* Single-column text: one acceleration per line at a given dt.
+* PEER NGA ``.AT2``: four header lines (database, event/station, quantity and units,
+  sampling), then the values in free format. The sampling line comes as
+  ``NPTS=  5372, DT=   .0100 SEC,`` with or without the commas and trailing text, or in the
+  old layout ``  4000   .0100   NPTS, DT`` (two numbers first). CRLF line ends are
+  accepted. The units line names G, CM/S/S (or CM/SEC/SEC, GAL) or M/S/S. The file must
+  hold exactly NPTS values: fewer, or a last value cut short (it lacks the digits or the
+  exponent every other value has), is refused as truncated; more is refused as a header
+  that disagrees with its data.
+* PEER velocity (VT2) and displacement (DT2) files, in either header layout
+  (:mod:`rockyade.motion.peer`), are refused whatever their extension, format or ``units``:
+  rockyade needs accelerations. A PEER acceleration file is read as AT2 whatever its
+  extension.
+* Two-column text or CSV: time (s) and acceleration, one separator per line (semicolons,
+  else commas, else blanks; decimal commas read where unambiguous,
+  :mod:`rockyade.motion.columns`), ``#`` comments, an optional header line whose
+  acceleration column may name its units (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``, ...).
+  A line with one number or with three or more is refused, saying what it holds; more
+  columns are read only when a header names each of them and the second as an
+  acceleration (``t_s,accel_m_s2,vel_m_s,disp_m``, as ``rockyade motion synth`` writes).
+* Single-column text: one acceleration per line at a given ``dt_s``; a file given ``dt_s``
+  but no format is read as one column when its first data line holds one number.
 
 Numbers are ASCII decimals, with an optional exponent written E or Fortran's D
 (``1.0D-02``); ``1_0``, non-ASCII digits, ``inf`` and ``nan`` are refused. A UTF-8 byte
 order mark is skipped. Units named by the file win: a different ``units`` argument is
-refused as a conflict. Values in g are converted with standard gravity, 9.80665 m/s^2
+refused as a conflict, and so is a ``dt_s`` that disagrees with the file's own sampling.
+Values in g are converted with standard gravity, 9.80665 m/s^2
 (:data:`rockyade.constants.STANDARD_GRAVITY`). Every bad file raises
 :class:`RecordError` naming the file and the line.
 """
@@ -31,6 +42,8 @@ import numpy as np
 
 from rockyade.constants import STANDARD_GRAVITY
 from rockyade.errors import InputError
+from rockyade.motion.columns import DECIMAL_COMMA, split_columns, with_point
+from rockyade.motion.peer import PeerHeader, peer_header
 
 #: factor to m/s^2 per unit name (a record "in g" means standard gravity)
 UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
@@ -56,6 +69,11 @@ UNIT_ALIASES = {
     "gal": "cm/s2",
 }
 FORMATS = ("at2", "csv", "single")
+#: Unit names of velocities and displacements (refused with a message saying so).
+VELOCITY_UNITS = ("cm/s", "cm/sec", "m/s", "m/sec", "mm/s", "in/s", "cm", "m", "mm")
+#: How the options that fix a file's reading are spelt in a scene and on the command line.
+SINGLE_HINT = 'format = "single" and its sampling interval dt_s (rockyade motion: --format single --dt)'
+TWO_COLUMN_HINT = 'format = "csv" (or no format) and no dt_s (rockyade motion: --format csv)'
 
 
 class RecordError(InputError):
@@ -71,6 +89,10 @@ class RecordError(InputError):
 def normalise_units(units: str, source: str = "units") -> str:
     """Canonical unit name (g, m/s2, cm/s2) or InputError."""
     key = units.strip().lower().replace(" ", "")
+    if key in VELOCITY_UNITS:
+        raise InputError(
+            source, f"{units!r} is a velocity unit: a record must hold accelerations, in g, m/s2 or cm/s2"
+        )
     if key not in UNIT_ALIASES:
         raise InputError(
             source, f"must be one of g, m/s2, cm/s2 (aliases: {', '.join(sorted(UNIT_ALIASES))}), got {units!r}"
@@ -265,6 +287,35 @@ def _read_lines(path: Path) -> list[str]:
     return _read_text(path).split("\n")
 
 
+def _head_lines(path: Path, count: int = 64) -> list[str]:
+    """The first ``count`` lines of a file (at most 64 KiB read), for format detection."""
+    try:
+        with path.open("rb") as fh:
+            data = fh.read(1 << 16)
+    except OSError:
+        return []
+    text = data.decode("utf-8-sig", errors="replace").replace("\r\n", "\n").replace("\r", "\n")
+    return text.split("\n")[:count]
+
+
+def _refuse_other_quantities(path: Path, lines: list[str], fmt: str) -> PeerHeader | None:
+    """Refuse a PEER velocity or displacement file, and a PEER acceleration file read as text
+    columns; return the PEER header of an acceleration file (None when there is none)."""
+    header = peer_header(lines)
+    if header is None:
+        return None
+    if header.quantity != "acceleration":
+        raise RecordError(path, header.line, header.refusal())
+    if fmt != "at2":
+        raise RecordError(
+            path,
+            header.line,
+            f"{header.description}, not {'two columns' if fmt == 'csv' else 'one column'}: "
+            'read it with format = "at2" (or no format; rockyade motion: --format at2)',
+        )
+    return header
+
+
 def _resolve_units(path: Path, line: int | None, in_file: str | None, given: str | None) -> str:
     """The units to use: the file's; ``given`` must agree with them (or stand in for none)."""
     wanted = normalise_units(given) if given else None
@@ -276,6 +327,17 @@ def _resolve_units(path: Path, line: int | None, in_file: str | None, given: str
             "drop the units option (the file's units are used) or fix the file",
         )
     return in_file or wanted or ""
+
+
+def _check_dt(path: Path, line: int | None, dt_file: float, dt_given: float | None, where: str) -> None:
+    """Refuse a ``dt_s`` that disagrees with the file's own sampling (relative 1e-6)."""
+    if dt_given is not None and not math.isclose(dt_given, dt_file, rel_tol=1e-6):
+        raise RecordError(
+            path,
+            line,
+            f"{where} {dt_file:g} s but dt_s = {dt_given:g} s was given: drop dt_s (the file's sampling is "
+            "used) or fix the file",
+        )
 
 
 def _accel(path: Path, values: list[float], unit: str) -> np.ndarray:
@@ -293,7 +355,30 @@ def _accel(path: Path, values: list[float], unit: str) -> np.ndarray:
     return a
 
 
-def read_at2(path: str | Path, units: str | None = None) -> Record:
+def record_problem(t_s: np.ndarray, accel_m_s2: np.ndarray) -> str | None:
+    """What keeps samples from being a record, or None: the bounds every record passes,
+    whether read from a file or taken from the synthetic-record cache.
+
+    1-D float arrays of the same length, 2 to :data:`MAX_RECORD_SAMPLES` samples, times from 0
+    strictly increasing, finite accelerations within +/- :data:`MAX_ABS_ACCEL_M_S2` m/s^2.
+    """
+    if not all(isinstance(x, np.ndarray) and x.dtype == np.float64 and x.ndim == 1 for x in (t_s, accel_m_s2)):
+        return "times and accelerations must be 1-D float64 arrays"
+    if t_s.shape != accel_m_s2.shape:
+        return f"{t_s.size} times but {accel_m_s2.size} accelerations"
+    if not 2 <= t_s.size <= MAX_RECORD_SAMPLES:
+        return f"{t_s.size} samples, not in [2, {MAX_RECORD_SAMPLES}]"
+    if not (np.all(np.isfinite(t_s)) and t_s[0] == 0.0 and np.all(np.diff(t_s) > 0)):
+        return "times must start at 0 and increase strictly"
+    if not np.all(np.isfinite(accel_m_s2)):
+        return "contains NaN or infinite values"
+    worst = int(np.argmax(np.abs(accel_m_s2)))
+    if abs(accel_m_s2[worst]) > MAX_ABS_ACCEL_M_S2:
+        return f"sample {worst + 1} is {accel_m_s2[worst]:.4g} m/s^2, beyond +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2"
+    return None
+
+
+def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = None) -> Record:
     """Read a PEER NGA AT2 file (see module docstring).
 
     Parameters
@@ -303,37 +388,50 @@ def read_at2(path: str | Path, units: str | None = None) -> Record:
     units
         Units of the values when the header does not name them (g, m/s2, cm/s2); if the
         header names other units the file is refused as a conflict.
+    dt_s
+        Optional sampling interval, s: refused unless it equals the header's DT.
     """
     path = Path(path)
     text = _read_text(path)
     lines = text.split("\n")
+    _refuse_other_quantities(path, lines, "at2")
     if len(lines) < 5:
         raise RecordError(path, len(lines), "an AT2 file needs 4 header lines and data")
     npts, dt = _parse_at2_sampling(lines[3], path, 4)
     file_units = _resolve_units(path, 3, _at2_units(lines[2]), units)
     if not file_units:
         raise RecordError(path, 3, f"cannot tell the units from {lines[2].strip()!r}; give units explicitly")
+    _check_dt(path, 4, dt, dt_s, "the header says DT =")
     tokens: list[tuple[str, int]] = []
     values: list[float] = []
-    more = False  # anything after the NPTS-th value
+    extra = 0  # values after the NPTS-th
+    first_extra_line = 0
     for lineno, line in enumerate(lines[4:], start=5):
         parts = line.replace(",", " ").split()
         if len(values) == npts:
-            more = more or bool(parts)
-            if more:
-                break
+            if parts and not extra:
+                first_extra_line = lineno
+            extra += len(parts)
             continue
-        for k, token in enumerate(parts):
+        take = parts[: npts - len(values)]
+        for token in take:
             values.append(_number(path, lineno, token))
             tokens.append((token, lineno))
-            if len(values) == npts:
-                more = k + 1 < len(parts)
-                break
+        if len(take) < len(parts):
+            first_extra_line = lineno
+            extra += len(parts) - len(take)
     if len(values) < npts:
         raise RecordError(
             path, len(lines), f"NPTS = {npts} in the header but the file holds {len(values)} values: truncated?"
         )
-    _check_not_cut(path, tokens, not more)
+    if extra:
+        raise RecordError(
+            path,
+            first_extra_line,
+            f"NPTS = {npts} in the header but the file holds {npts + extra} values (value {npts + 1} is on line "
+            f"{first_extra_line}): the header and the data disagree; fix NPTS or remove the extra values",
+        )
+    _check_not_cut(path, tokens, True)
     accel = _accel(path, values, file_units)
     title = lines[1].strip()
     return Record(np.arange(npts) * dt, accel, file_units, str(path), title, {"format": "at2", "dt_file_s": dt})
@@ -344,9 +442,17 @@ def _split(line: str) -> list[str]:
 
 
 def _header_names(line: str) -> list[str]:
-    """Column names of a header: split at commas, semicolons or tabs if it has any, else at spaces."""
-    parts = re.split(r"[,;\t]", line) if re.search(r"[,;\t]", line) else line.split()
-    return [p.strip() for p in parts if p.strip()]
+    """Column names of a header: split at commas, semicolons or tabs if it has any, else at
+    spaces, where a unit in brackets stays with its name (``time [s]  accel (g)``)."""
+    if re.search(r"[,;\t]", line):
+        return [p.strip() for p in re.split(r"[,;\t]", line) if p.strip()]
+    names: list[str] = []
+    for word in line.split():
+        if names and word[0] in "([":
+            names[-1] += f" {word}"
+        else:
+            names.append(word)
+    return names
 
 
 def _is_header(tokens: list[str]) -> bool:
@@ -356,8 +462,8 @@ def _is_header(tokens: list[str]) -> bool:
 
 
 _HEADER_UNITS = (
-    (re.compile(r"cm\s*/\s*s(?:ec)?\s*(?:\^?2|/\s*s(?:ec)?)|cm_s2|\bgals?\b", re.I), "cm/s2"),
-    (re.compile(r"(?<![a-z])m\s*/\s*s(?:ec)?\s*(?:\^?2|/\s*s(?:ec)?)|(?<![a-z])m_s2|mps2", re.I), "m/s2"),
+    (re.compile(r"cm\s*/\s*s(?:ec)?\s*(?:\^?2|²|/\s*s(?:ec)?)|cm_s2|\bgals?\b", re.I), "cm/s2"),
+    (re.compile(r"(?<![a-z])m\s*/\s*s(?:ec)?\s*(?:\^?2|²|/\s*s(?:ec)?)|(?<![a-z])m_s2|mps2", re.I), "m/s2"),
     (re.compile(r"(?:^|[_\s(\[])g(?:$|[)\]\s])|\bin\s+g\b", re.I), "g"),
 )
 
@@ -370,80 +476,188 @@ def header_units(name: str) -> str | None:
     return None
 
 
-def read_two_column(path: str | Path, units: str | None = None) -> Record:
-    """Read time (s) and acceleration columns (comma, semicolon or whitespace separated).
+#: Column names of a velocity or a displacement (when they name no acceleration unit).
+_OTHER_QUANTITY = (
+    (
+        re.compile(
+            r"(?<![a-z])vel(?:ocity)?(?![a-z])|(?<![a-z])c?m\s*/\s*s(?:ec)?(?![a-z0-9^/²])|(?<![a-z])c?m_s(?![a-z0-9])",
+            re.I,
+        ),
+        "a velocity",
+    ),
+    (re.compile(r"(?<![a-z])disp(?:lacement)?(?![a-z])|\(\s*c?mm?\s*\)|(?<![a-z])c?mm?$", re.I), "a displacement"),
+)
+
+
+def _check_header_quantity(path: Path, line: int, name: str) -> None:
+    """Refuse an acceleration column whose header names a velocity or a displacement."""
+    if header_units(name) is not None:
+        return
+    for pattern, what in _OTHER_QUANTITY:
+        if pattern.search(name):
+            raise RecordError(
+                path, line, f"the acceleration column is headed {name!r}, {what}: rockyade needs accelerations"
+            )
+
+
+def _columns(path: Path, lineno: int, body: str) -> list[str]:
+    """The columns of a data line; an empty column (two separators in a row) is refused."""
+    columns, separator = split_columns(body)
+    if len(columns) > 1 and "" in columns:
+        raise RecordError(path, lineno, f"an empty column between two {separator}s in {body!r}")
+    return columns
+
+
+def read_two_column(path: str | Path, units: str | None = None, dt_s: float | None = None) -> Record:
+    """Read time (s) and acceleration columns (module docstring: separators, decimal commas).
 
     Parameters
     ----------
     units
         Units of the accelerations when the header does not name them (default m/s2); a
         header naming other units is refused as a conflict.
+    dt_s
+        Optional sampling interval, s: refused unless the times are spaced by it.
     """
     path = Path(path)
-    text = _read_text(path)
+    lines = _read_text(path).split("\n")
+    _refuse_other_quantities(path, lines, "csv")
     times: list[float] = []
     accel: list[float] = []
     column: list[tuple[str, int]] = []
     header_unit: str | None = None
     header_line: int | None = None
     seen_data = False
-    last_row_width = 0
-    for lineno, line in enumerate(text.split("\n"), start=1):
+    comma_numbers = True  # every data line is one number written with a decimal comma
+    width: int | None = None  # values a line holds: two, or as many as a header names (first data line)
+    names: list[str] = []
+    for lineno, line in enumerate(lines, start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
             continue
-        tokens = _split(body)
-        if not seen_data and header_line is None and _is_header(tokens):
+        if not seen_data and header_line is None and _is_header(_split(body)):
             header_line = lineno  # a header: names only, no number at all
             names = _header_names(body)
             if len(names) >= 2:
                 header_unit = header_units(names[1])
+                _check_header_quantity(path, lineno, names[1])
             continue
+        comma_numbers = comma_numbers and bool(DECIMAL_COMMA.match(body))
+        columns = _columns(path, lineno, body)
+        if len(columns) == 1:
+            if seen_data:
+                raise RecordError(path, lineno, f"holds one number ({body!r}) where the lines before hold two")
+            raise RecordError(
+                path,
+                lineno,
+                f"holds one number ({body!r}), not two columns (time, acceleration): "
+                f"a one-column file needs {SINGLE_HINT}",
+            )
+        if width is None:
+            width = 2 if len(columns) == 2 else _named_width(path, lineno, body, columns, names, header_line)
+        if len(columns) != width:
+            if width == 2:
+                raise RecordError(path, lineno, _too_many_columns(body, columns))
+            before = f"where the lines before hold {width}"
+            raise RecordError(path, lineno, f"holds {len(columns)} values ({body!r}) {before}")
         seen_data = True
-        if len(tokens) < 2:
-            raise RecordError(path, lineno, f"expected two columns (time, acceleration), got {body!r}")
-        times.append(_number(path, lineno, tokens[0], "time"))
-        accel.append(_number(path, lineno, tokens[1]))
-        column.append((tokens[1], lineno))
-        last_row_width = len(tokens)
+        times.append(_number(path, lineno, columns[0], "time"))
+        accel.append(_number(path, lineno, columns[1]))
+        column.append((columns[1], lineno))
     if len(times) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
     if len(times) > MAX_RECORD_SAMPLES:
         raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
-    _check_not_cut(path, column, last_row_width == 2)
+    _check_not_cut(path, column, True)
     unit = _resolve_units(path, header_line, header_unit, units) or "m/s2"
     t = np.asarray(times)
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if bad.size:
-        raise RecordError(path, column[int(bad[0]) + 1][1], f"time must increase strictly (sample {int(bad[0]) + 2})")
+        message = f"time must increase strictly (sample {int(bad[0]) + 2})"
+        if comma_numbers:
+            message += (
+                f"; every line looks like one number written with a decimal comma ({column[0][0]!r} after the "
+                f"comma): a one-column file needs {SINGLE_HINT}"
+            )
+        raise RecordError(path, column[int(bad[0]) + 1][1], message)
+    if dt_s is not None:
+        steps = np.diff(t)
+        worst = int(np.argmax(np.abs(steps - dt_s)))
+        _check_dt(path, column[worst + 1][1], float(steps[worst]), dt_s, "the time column steps by")
     a = _accel(path, accel, unit)
     return Record(t - t[0], a, unit, str(path), "", {"format": "csv"})
+
+
+def _named_width(
+    path: Path, line: int, body: str, columns: list[str], names: list[str], header_line: int | None
+) -> int:
+    """The width of a first data line of three columns or more: accepted only when a header
+    names each column and the second as an acceleration (``t_s,accel_m_s2,vel_m_s,disp_m``, as
+    ``rockyade motion synth`` writes), so that what is left out is known; refused otherwise."""
+    if len(names) != len(columns):
+        raise RecordError(path, line, _too_many_columns(body, columns))
+    if header_units(names[1]) is None and not re.search(r"(?<![a-z])acc", names[1], re.I):
+        raise RecordError(
+            path,
+            header_line,
+            f"the header names {len(names)} columns ({', '.join(names)}) and the second, {names[1]!r}, is not named "
+            "as an acceleration (e.g. accel_m_s2): a record's columns are time (s) and acceleration",
+        )
+    return len(columns)
+
+
+def _too_many_columns(body: str, columns: list[str]) -> str:
+    """The message for a line of three or more columns (a decimal comma among commas said so)."""
+    message = (
+        f"holds {len(columns)} columns ({body!r}); a two-column record holds time (s) and acceleration only: "
+        "remove the other columns"
+    )
+    if "," in body and ";" not in body and "." not in body and len(columns) % 2 == 0:
+        message += (
+            "; if its numbers are written with decimal commas, the commas cannot also separate the columns: "
+            "separate them with ';' or a tab"
+        )
+    return message
 
 
 def read_single_column(path: str | Path, dt_s: float, units: str | None = None) -> Record:
     """Read one acceleration value per line, sampled at ``dt_s``.
 
-    An optional first line without any number is a header (it may name the units).
+    An optional first line without any number is a header (it may name the units). A value
+    may be written with a decimal comma (``0,0123``): in a one-column file it can be nothing
+    else.
     """
     path = Path(path)
     if not (isinstance(dt_s, (int, float)) and not isinstance(dt_s, bool) and math.isfinite(dt_s) and dt_s > 0):
         raise RecordError(path, None, f"dt must be > 0 s, got {dt_s!r}")
     if not DT_RANGE_S[0] <= dt_s <= DT_RANGE_S[1]:
         raise RecordError(path, None, f"dt must be in [{DT_RANGE_S[0]:g}, {DT_RANGE_S[1]:g}] s, got {dt_s!r}")
-    text = _read_text(path)
+    lines = _read_text(path).split("\n")
+    _refuse_other_quantities(path, lines, "single")
     values: list[float] = []
     column: list[tuple[str, int]] = []
     header_unit: str | None = None
     header_line: int | None = None
-    for lineno, line in enumerate(text.split("\n"), start=1):
+    for lineno, line in enumerate(lines, start=1):
         body = line.split("#", 1)[0].strip()
         if not body:
             continue
         if not values and header_line is None and _is_header(_split(body)):
             header_line, header_unit = lineno, header_units(body)
+            _check_header_quantity(path, lineno, body)
             continue
-        values.append(_number(path, lineno, body))
-        column.append((body, lineno))
+        token = with_point(body)
+        if token == body:
+            columns = _columns(path, lineno, body)
+            if len(columns) > 1:
+                raise RecordError(
+                    path,
+                    lineno,
+                    f"holds {len(columns)} numbers ({body!r}); a one-column file holds one acceleration per line: "
+                    f"for time and acceleration columns use {TWO_COLUMN_HINT}",
+                )
+        values.append(_number(path, lineno, token))
+        column.append((token, lineno))
     if len(values) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
     if len(values) > MAX_RECORD_SAMPLES:
@@ -470,9 +684,22 @@ def count_samples(path: str | Path, fmt: str | None = None) -> int:
         return 0
 
 
-def detect_format(path: str | Path) -> str:
-    """``at2`` for .AT2 files, ``csv`` otherwise (two columns)."""
-    return "at2" if Path(path).suffix.lower() == ".at2" else "csv"
+def detect_format(path: str | Path, dt_s: float | None = None) -> str:
+    """The format of a record file from its content, else its extension.
+
+    ``at2`` for a PEER header (whatever the extension) or a ``.AT2`` file; ``single`` when
+    ``dt_s`` is given and the first data line holds one number; ``csv`` otherwise.
+    """
+    path = Path(path)
+    head = _head_lines(path)
+    if path.suffix.lower() == ".at2" or peer_header(head) is not None:
+        return "at2"
+    if dt_s is not None:
+        for line in head:
+            body = line.split("#", 1)[0].strip()
+            if body and not _is_header(_split(body)):
+                return "single" if len(split_columns(body)[0]) == 1 else "csv"
+    return "csv"
 
 
 def read_record(
@@ -485,21 +712,22 @@ def read_record(
     path
         The file.
     fmt
-        "at2", "csv" (two columns) or "single" (one column, needs ``dt_s``); default by
-        extension.
+        "at2", "csv" (two columns) or "single" (one column, needs ``dt_s``); default from
+        the content (:func:`detect_format`).
     units
         Units of the values when the file does not name them (default m/s2 for text
         files); units the file names win, and a different value here is refused.
     dt_s
-        Sampling interval for single-column files, s.
+        Sampling interval for single-column files, s; with an AT2 or two-column file it must
+        agree with the file's own sampling.
     """
-    fmt = fmt or detect_format(path)
-    if fmt not in FORMATS:
+    if fmt is not None and fmt not in FORMATS:
         raise InputError("format", f"must be one of {', '.join(FORMATS)}, got {fmt!r}")
+    fmt = fmt or detect_format(path, dt_s)
     if fmt == "at2":
-        return read_at2(path, units)
+        return read_at2(path, units, dt_s)
     if fmt == "csv":
-        return read_two_column(path, units)
+        return read_two_column(path, units, dt_s)
     if dt_s is None:
-        raise InputError("dt_s", "a single-column record needs its sampling interval dt_s")
+        raise InputError("dt_s", f"a one-column record needs its sampling interval: {SINGLE_HINT}")
     return read_single_column(path, dt_s, units)

@@ -23,7 +23,7 @@ Scene tables (all take ``load_factor``, default 1)::
     file = "records/RSN6.AT2"   # relative to the scene file
     format = "at2"              # at2 | csv | single (default by extension)
     units = "g"                 # default: the AT2 header; m/s2 for text files
-    dt_s = 0.01                 # single-column files only
+    dt_s = 0.01                 # one-column files (read as such without format); else must match the file
     baseline = false            # zero final velocity and displacement
     bandpass_hz = [0.1, 25.0]   # optional zero-phase band-pass
     target_pga_m_s2 = 3.0       # optional: scale to this PGA (before load_factor)

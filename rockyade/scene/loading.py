@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import json
 import math
+import os
 import tomllib
 from pathlib import Path
 from typing import Any
 
+from rockyade.blocks.geometry import MAX_POLYGON_VERTICES
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, STIFFNESS_SCALES
 from rockyade.errors import InputError
 from rockyade.io.fields import TableReader, plain_data
@@ -31,6 +33,11 @@ from rockyade.scene.model import (
     Scene,
     _check_scene,
 )
+
+#: Largest scene (or study) file read, bytes. A scene is a small text file: 16 MiB hold about
+#: 1.5 million inline base-motion samples, which Python's TOML reader takes about 10 s to
+#: parse; a longer motion belongs in a record file (up to 512 MiB).
+MAX_SCENE_BYTES = 16 * 1024 * 1024
 
 
 def load_scene(path: str | Path) -> Scene:
@@ -53,10 +60,16 @@ def load_scene(path: str | Path) -> Scene:
 
 
 def parse_text_file(path: Path, field: str) -> Any:
-    """The table in a UTF-8 TOML or JSON file (by suffix); InputError naming the file otherwise."""
+    """The table in a UTF-8 TOML or JSON file (by suffix); InputError naming the file otherwise.
+
+    Files larger than :data:`MAX_SCENE_BYTES` are refused before they are read; a JSON
+    object with the same key twice is refused (JSON readers keep the last value silently,
+    TOML refuses it).
+    """
     source = str(path)
     try:
-        text = path.read_bytes().decode("utf-8-sig")
+        data = _read_capped(path, field)
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         byte = exc.object[exc.start]
         raise InputError(field, f"not UTF-8 text (byte {byte:#04x} at offset {exc.start})", source) from None
@@ -64,13 +77,54 @@ def parse_text_file(path: Path, field: str) -> Any:
         raise InputError(field, f"cannot read the file: {exc.strerror or exc}", source) from None
     kind = "JSON" if path.suffix.lower() == ".json" else "TOML"
     try:
-        return json.loads(text) if kind == "JSON" else tomllib.loads(text)
+        return json.loads(text, object_pairs_hook=_unique_keys) if kind == "JSON" else tomllib.loads(text)
+    except DuplicateKeyError as exc:
+        raise InputError(field, f"not valid JSON: {exc}", source) from None
     except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
         raise InputError(field, f"not valid {kind}: {exc}", source) from None
     except RecursionError:
         raise InputError(field, f"not valid {kind}: nested too deeply", source) from None
     except ValueError as exc:  # e.g. an integer literal too long to convert
         raise InputError(field, f"not valid {kind}: {exc}", source) from None
+
+
+def _read_capped(path: Path, field: str) -> bytes:
+    """The bytes of ``path``, refused at once (from its size, before reading) above the cap."""
+    with path.open("rb") as fh:
+        size = os.fstat(fh.fileno()).st_size
+        if size > MAX_SCENE_BYTES:
+            raise _too_large(path, field, size)
+        data = fh.read(MAX_SCENE_BYTES + 1)  # a file that grows while being read is cut here
+    if len(data) > MAX_SCENE_BYTES:
+        raise _too_large(path, field, len(data))
+    return data
+
+
+def _too_large(path: Path, field: str, size: int) -> InputError:
+    return InputError(
+        field,
+        f"the file has {size:,} bytes, more than the {MAX_SCENE_BYTES:,} ({MAX_SCENE_BYTES // 2**20} MiB) a "
+        "scene file may have: put a long base motion in a record file ([motion] type = \"record\")",
+        str(path),
+    )
+
+
+class DuplicateKeyError(ValueError):
+    """A JSON object that holds a key twice."""
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """``object_pairs_hook`` of :func:`json.loads`: a dict, or DuplicateKeyError naming the key."""
+    table: dict[str, Any] = {}
+    for key, value in pairs:
+        if key in table:
+            others = ", ".join(repr(k) for k in table if k != key)
+            raise DuplicateKeyError(
+                f"the key {key!r} appears twice in one object (beside {others or 'no other key'}): "
+                "JSON readers would keep the last value silently; keep one"
+            )
+        table[key] = value
+    return table
 
 
 def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None = None) -> Scene:
@@ -119,6 +173,10 @@ def _parse_block(table: Any, index: int, source: str | None) -> BlockSpec:
         raw = r.raw("vertices_m")
         if not isinstance(raw, list) or len(raw) < 3 or not all(isinstance(v, list) and len(v) == 2 for v in raw):
             raise r.error("vertices_m", "must be a list of at least 3 [x, y] pairs in metres")
+        if len(raw) > MAX_POLYGON_VERTICES:  # refused before each vertex is checked
+            raise r.error(
+                "vertices_m", f"has {len(raw)} vertices, more than the {MAX_POLYGON_VERTICES} a block may have"
+            )
         sub = TableReader({f"v{i}": v for i, v in enumerate(raw)}, r.field("vertices_m"), source)
         vertices = tuple(tuple(sub.number_list(f"v{i}", min_len=2, unit="m")) for i in range(len(raw)))
         if max(abs(c) for v in vertices for c in v) > MAX_LENGTH_M:

@@ -37,7 +37,6 @@ import numpy as np
 from rockyade.errors import InputError
 from rockyade.scene.generators.common import (
     DEFAULT_DENSITY_KG_M3,
-    DEFAULT_DURATION_S,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
     check_count,
@@ -125,7 +124,7 @@ def arch(
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """An arch of ``voussoirs`` voussoirs on two piers as a scene dictionary (module docstring).

@@ -16,7 +16,6 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generators.common import (
     DEFAULT_DENSITY_KG_M3,
-    DEFAULT_DURATION_S,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
     check_count,
@@ -95,7 +94,7 @@ def stack(
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """A stack of blocks of given sizes, bottom to top, centred on x = 0.
@@ -163,7 +162,7 @@ def drum_column(
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """A column of ``drums`` equal drums, optionally under a capital (abacus) block.

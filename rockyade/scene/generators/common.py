@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
+from pathlib import Path
 from typing import Any
 
 from rockyade.errors import InputError
@@ -18,6 +19,8 @@ from rockyade.scene.bounds import BOUNDS
 
 #: Defaults shared by the generators.
 DEFAULT_DENSITY_KG_M3 = 2400.0
+#: Simulated time of a generated scene whose motion has no length of its own to go by, s
+#: (a record's scene lasts the record plus a tail: :func:`default_duration_s`).
 DEFAULT_DURATION_S = 3.0
 DEFAULT_SAMPLE_DT_S = 0.002
 #: The placeholder base motion: a one-sine acceleration pulse (edit it in the scene file).
@@ -222,16 +225,61 @@ def record_motion(file: str, load_factor: float = 1.0, **options: Any) -> dict:
     return table
 
 
+def default_duration_s(motion: Mapping[str, Any] | None, base_dir: str | Path | None = None) -> float:
+    """The simulated time of a generated scene whose ``duration_s`` is not given, s.
+
+    For a ``record`` motion, the record's length plus
+    :data:`~rockyade.motion.coverage.RECORD_TAIL_S` (5 s) of free rocking, which decides
+    whether a block left rocking by the record's end overturns; the same for a ``synthetic``
+    record (its suite's length). Otherwise :data:`DEFAULT_DURATION_S` (3 s, enough for the
+    default pulse; ``rockyade run`` warns when a scene ends before its motion).
+
+    Parameters
+    ----------
+    motion
+        The ``[motion]`` table (None: the default pulse).
+    base_dir
+        Folder a relative record path is relative to (the scene file's folder; default the
+        current folder).
+    """
+    kind = motion.get("type") if isinstance(motion, Mapping) else None
+    if kind not in ("record", "synthetic"):
+        return DEFAULT_DURATION_S
+    from rockyade.motion.coverage import RECORD_TAIL_S
+    from rockyade.motion.spec import parse_motion
+    from rockyade.motion.types import RecordMotion, SyntheticMotion
+
+    folder = Path(base_dir) if base_dir is not None else Path.cwd()
+    try:
+        spec = parse_motion(dict(motion), base_dir=folder)
+    except InputError as exc:
+        raise InputError(
+            exc.field, f"{exc.message} (duration_s defaults to the record's length: give duration_s or fix the record)"
+        ) from None
+    length = 0.0
+    if isinstance(spec, SyntheticMotion):
+        length = spec.suite_spec().envelope.duration_s
+    elif isinstance(spec, RecordMotion):
+        length = spec.record().duration_s
+    return math.ceil(round((length + RECORD_TAIL_S) * 1000.0, 6)) / 1000.0  # to the ms above
+
+
 def scene_table(
     blocks: list[dict[str, Any]],
     *,
     contact: Mapping[str, Any],
     motion: Mapping[str, Any] | None,
-    duration_s: float,
+    duration_s: float | None,
     sample_dt_s: float,
     joints: list[dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
-    """The scene dictionary (keys in the order a reader expects them in the file)."""
+    """The scene dictionary (keys in the order a reader expects them in the file).
+
+    ``duration_s`` None: :func:`default_duration_s` of the motion (a record's length plus a
+    tail of free rocking, relative paths from the current folder).
+    """
+    if duration_s is None:
+        duration_s = default_duration_s(motion)
     check_number("duration_s", duration_s, 0.0, 1.0e5, lo_open=True, unit="s")
     check_number("sample_dt_s", sample_dt_s, 0.0, duration_s, lo_open=True, unit="s")
     data: dict[str, Any] = {

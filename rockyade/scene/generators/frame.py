@@ -24,7 +24,6 @@ from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.scene.generators.common import (
     DEFAULT_DENSITY_KG_M3,
-    DEFAULT_DURATION_S,
     DEFAULT_SAMPLE_DT_S,
     check_density,
     check_length,
@@ -64,7 +63,7 @@ def rocking_frame(
     gamma: float | None = None,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """The Makris & Vassiliou (2013) rocking frame as a scene dictionary (module docstring).

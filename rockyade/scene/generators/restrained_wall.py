@@ -29,7 +29,6 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generators.common import (
     DEFAULT_DENSITY_KG_M3,
-    DEFAULT_DURATION_S,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
     check_count,
@@ -58,7 +57,7 @@ def restrained_wall(
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """A wall restrained at the top as a scene dictionary (module docstring).

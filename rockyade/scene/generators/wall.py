@@ -33,7 +33,6 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generators.common import (
     DEFAULT_DENSITY_KG_M3,
-    DEFAULT_DURATION_S,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
     check_count,
@@ -204,7 +203,7 @@ def wall(
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float = DEFAULT_DURATION_S,
+    duration_s: float | None = None,
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
 ) -> dict[str, Any]:
     """A dry masonry wall in running or stack bond, as a scene dictionary (module docstring).
@@ -232,7 +231,10 @@ def wall(
         The ``[motion]`` and ``[contact]`` tables (default: a one-sine pulse; UDEC-style
         joints, :func:`~rockyade.scene.generators.common.udec_contact`).
     duration_s, sample_dt_s
-        Simulated time and output interval, s.
+        Simulated time and output interval, s. The default time is a record's length plus
+        :data:`~rockyade.motion.coverage.RECORD_TAIL_S` of free rocking for a ``record`` or
+        ``synthetic`` motion (:func:`~rockyade.scene.generators.common.default_duration_s`),
+        else 3 s.
 
     Returns
     -------
