@@ -30,7 +30,7 @@ class BaseState(NamedTuple):
     on_base: NDArray[np.bool_]  #: (nb,) a vertex of the body touched the base last step
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_base_state(nb: int, maxv: int) -> BaseState:
     """No vertex on the base."""
     return BaseState(np.zeros((nb, maxv)), np.zeros(nb, dtype=np.bool_))

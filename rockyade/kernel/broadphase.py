@@ -40,7 +40,7 @@ def sweep_axis(lo, hi) -> int:
     return 0 if spread[0] >= spread[1] else 1
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def initial_order(lo, hi):
     """The sweep axis (:func:`sweep_axis`) and the bodies sorted by their box centres along it
     ((nb,) int64), the starting order of :func:`candidate_pairs`."""

@@ -46,19 +46,19 @@ class Dashpots(NamedTuple):
     data: NDArray[np.float64]  #: (cap, 6) point x, y (m), normal and shear dashpot forces (N), normal x, y
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_totals():
     """Running energy totals at t = 0 (indices ``T_*``)."""
     return np.zeros(4)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_dashpots(cap: int) -> Dashpots:
     """Room for ``cap`` contact points."""
     return Dashpots(np.zeros((cap, 2), dtype=np.int64), np.zeros((cap, 6)))
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def dashpot_room(record_energy: bool, n_base: int, n_pairs: int, old: Dashpots) -> Dashpots:
     """``old``, or a larger buffer when ``n_base`` base points and two points per pair no
     longer fit (one entry without energy terms)."""

@@ -45,7 +45,7 @@ class Motion(NamedTuple):
     torque: NDArray[np.float64]  #: (nb,) N m
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def initial_motion(bodies, initial) -> Motion:
     """The state at t = 0 from :class:`rockyade.kernel.state.Initial` (copied; fixed bodies
     at rest)."""

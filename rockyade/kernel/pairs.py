@@ -43,7 +43,7 @@ class PairState(NamedTuple):
     ang_at_build: NDArray[np.float64]  #: (nb,) angles when the list was built, rad
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def carry_pairs(old: PairState, keys, pa, pb, joints, bodies, kin) -> PairState:
     """State of the new pair list ``keys`` (sorted, as ``old.keys``) built at the bodies'
     positions in ``kin``: the pairs that persist keep their faces and points; the coherence
@@ -75,7 +75,7 @@ def carry_pairs(old: PairState, keys, pa, pb, joints, bodies, kin) -> PairState:
                      np.zeros((n, 4)), kin.pos.copy(), kin.ang.copy())
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def no_pairs() -> PairState:
     """An empty pair list."""
     e = np.zeros(0, dtype=np.int64)

@@ -31,7 +31,7 @@ class World(NamedTuple):
     hi: NDArray[np.float64]  #: (nb, 2) upper corner of the tight box, m
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_world(nb: int, maxv: int) -> World:
     """Zeroed placement arrays for nb bodies of at most maxv vertices."""
     return World(

@@ -70,7 +70,7 @@ class Tally(NamedTuple):
     vstate: NDArray[np.int8]  #: (nb, maxv) worst state of the points at each vertex
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_samples(nb: int, maxv: int, n_samples: int, record_corners: bool) -> Samples:
     """NaN-filled samples (zero counts and states)."""
     return Samples(
@@ -86,7 +86,7 @@ def new_samples(nb: int, maxv: int, n_samples: int, record_corners: bool) -> Sam
     )
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_tally(nb: int, maxv: int) -> Tally:
     """An empty tally."""
     return Tally(np.zeros(nb, dtype=np.int32), np.zeros(nb, dtype=np.bool_), np.zeros((nb, maxv), dtype=np.int8))

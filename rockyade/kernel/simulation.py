@@ -147,7 +147,9 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
     samples = new_samples(nb, maxv, settings.n_steps // settings.steps_per_sample + 1, settings.record_corners)
     work = Work(kin, world, new_base_state(nb, maxv), pairs, dash, new_tally(nb, maxv), samples, new_totals(),
                 np.zeros((2, 3)))
-    step, hint, n_filled, n_tests, n_builds, max_pairs = 0, 0, 0, 0, 1, pairs.keys.size
+    # int64, not the literal 0: advance would be compiled twice, for Literal[int](0) and for int64
+    step, hint, n_filled = np.int64(0), np.int64(0), np.int64(0)
+    n_tests, n_builds, max_pairs = 0, 1, pairs.keys.size
     while True:
         # one stretch of steps per candidate list
         step, rebuild, status, t_stop, stop_body, hint, n_filled, tests = advance(
