@@ -87,7 +87,8 @@ def push_dashpot(dash, n: int, a: int, b: int, px: float, py: float, f_normal: f
 @numba.njit(cache=True, nogil=True, inline="always")
 def add_dashpot_work(e_dash: float, dash, n_contacts: int, kin, dt: float) -> float:
     """``e_dash`` plus this step's dashpot work at the kept points, with the step-mean
-    velocities (``kin``: :class:`rockyade.kernel.integration.Motion` after the kick), J."""
+    velocities (``kin``: :class:`rockyade.kernel.integration.Motion` after the kick), J;
+    ``dt`` the time step, s."""
     pos, vel, vel_prev, angvel, angvel_prev = kin.pos, kin.vel, kin.vel_prev, kin.angvel, kin.angvel_prev
     ab, data = dash.bodies, dash.data
     for c in range(n_contacts):
@@ -112,7 +113,8 @@ def add_dashpot_work(e_dash: float, dash, n_contacts: int, kin, dt: float) -> fl
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def add_base_work(w_base: float, bodies, kin, ah: float, av: float, dt: float) -> float:
-    """``w_base`` plus this step's work of the base frame's inertial force, J."""
+    """``w_base`` plus this step's work of the base frame's inertial force, J (``ah``, ``av``
+    the base acceleration, m/s^2; ``dt`` the time step, s)."""
     mass, moving, vel, vel_prev = bodies.mass, bodies.moving, kin.vel, kin.vel_prev
     for a in range(mass.size):
         if moving[a]:
@@ -125,7 +127,7 @@ def add_base_work(w_base: float, bodies, kin, ah: float, av: float, dt: float) -
 @numba.njit(cache=True, nogil=True, inline="always")
 def mechanical_energy(bodies, kin, g: float) -> tuple[float, float]:
     """Discrete kinetic energy of the leap-frog scheme and potential energy of the moving
-    bodies at t_n, J (module docstring)."""
+    bodies at t_n, J (module docstring; ``g`` gravity, m/s^2)."""
     mass, inertia, moving = bodies.mass, bodies.inertia, bodies.moving
     pos, vel, vel_prev, angvel, angvel_prev = kin.pos, kin.vel, kin.vel_prev, kin.angvel, kin.angvel_prev
     e_kin = 0.0

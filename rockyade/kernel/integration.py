@@ -63,7 +63,13 @@ def initial_motion(bodies, initial) -> Motion:
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def apply_body_loads(bodies, kin, g: float, ah: float, av: float) -> None:
-    """Start this step's forces from gravity and the base frame's inertia, m (-a_h, -g - a_v)."""
+    """Start this step's forces from gravity and the base frame's inertia, m (-a_h, -g - a_v).
+
+    Parameters
+    ----------
+    g, ah, av
+        Gravity and the horizontal and vertical base acceleration, m/s^2.
+    """
     mass, force, torque = bodies.mass, kin.force, kin.torque
     for a in range(mass.size):
         force[a, 0] = -mass[a] * ah
@@ -74,8 +80,23 @@ def apply_body_loads(bodies, kin, g: float, ah: float, av: float) -> None:
 @numba.njit(cache=True, nogil=True, inline="always")
 def kick(bodies, kin, dt: float, mass_damping: float, record_energy: bool, e_dash: float) -> float:
     """Velocities v_{n-1/2} -> v_{n+1/2} of the moving bodies (kept in ``vel_prev``) under
-    the forces and the mass-proportional damping; returns ``e_dash`` plus the damping's
-    dissipation with the step-mean velocities, J."""
+    the forces and the mass-proportional damping.
+
+    Parameters
+    ----------
+    dt
+        Time step, s.
+    mass_damping
+        Mass-proportional damping a, 1/s.
+    e_dash
+        Dashpot work so far, J.
+
+    Returns
+    -------
+    float
+        ``e_dash`` plus the damping's dissipation with the step-mean velocities (with
+        ``record_energy``), J.
+    """
     mass, inertia, moving = bodies.mass, bodies.inertia, bodies.moving
     vel, angvel, vel_prev, angvel_prev = kin.vel, kin.angvel, kin.vel_prev, kin.angvel_prev
     force, torque = kin.force, kin.torque
@@ -116,6 +137,8 @@ def drift(bodies, kin, samples, step: int, dt: float, stop_on_overturn: bool, st
     samples
         :class:`rockyade.kernel.recording.Samples`: ``overturn_time``, the first time each
         body reached its stop angle, s (NaN: never), is updated.
+    step, dt
+        The step just integrated (t_n = step dt) and the time step, s.
     status
         The run's status so far (``STATUS_COMPLETED``).
 

@@ -46,7 +46,7 @@ def place_body(a: int, kin, bodies, world) -> None:
     Parameters
     ----------
     kin
-        :class:`rockyade.kernel.integration.Motion` (``pos``, ``ang``).
+        :class:`rockyade.kernel.integration.Motion` (``pos``, m, and ``ang``, rad).
     bodies
         :class:`rockyade.kernel.state.Bodies` (``verts``, ``normals``, ``nverts``).
     world

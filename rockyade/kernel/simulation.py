@@ -21,6 +21,8 @@ Each step t_n = n dt, in this order:
    step costs O(bodies + pairs).
 
 The inputs are five records (:mod:`.state`); the output is an :class:`Output` record.
+:func:`simulate` allocates the working state (:class:`Work`) and rebuilds the candidate
+pairs; :func:`advance` runs the steps 1-8 (and the test of step 9) between two rebuilds.
 """
 
 from __future__ import annotations
