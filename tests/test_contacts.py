@@ -14,6 +14,7 @@ from rockyade.dem.overturn import LANDING_TOL_RAD
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.contacts import NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
+from rockyade.kernel.state import pack
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix
 from rockyade.solvers.reference import ReferenceSolver, run_model
@@ -286,9 +287,11 @@ def test_broad_phase_and_coherence_do_not_change_the_results():
     args = model_arrays(model)
     flags = {"stop_on_overturn": True, "record_energy": False, "record_corners": False}
     runs = {
-        "default": kernel.simulate(**args, coherent=True, **flags),
-        "every pair tested": kernel.simulate(**args, coherent=False, **flags),
-        "all pairs listed": kernel.simulate(**{**args, "margin": args["margin"] * 0 + 100.0}, coherent=True, **flags),
+        "default": kernel.simulate(*pack(args, coherent=True, **flags)),
+        "every pair tested": kernel.simulate(*pack(args, coherent=False, **flags)),
+        "all pairs listed": kernel.simulate(
+            *pack({**args, "margin": args["margin"] * 0 + 100.0}, coherent=True, **flags)
+        ),
     }
     base = runs["default"]
     assert base[13] > 1  # the candidate list was rebuilt

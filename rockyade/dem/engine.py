@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from rockyade.dem.model import DemModel
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.broadphase import MARGIN_REL
+from rockyade.kernel.state import pack
 
 #: A contact point keeps its shear spring when last step's point of the same pair lies within
 #: this fraction of the shortest edge of the two polygons.
@@ -25,7 +26,8 @@ FEATURE_TOL_REL = 0.25
 
 
 class KernelOutput(NamedTuple):
-    """Raw outputs of :func:`rockyade.kernel.simulation.simulate` (see its docstring).
+    """Raw outputs of :func:`rockyade.kernel.simulation.simulate` (the fields of
+    :class:`rockyade.kernel.recording.Output`).
 
     The first ten fields keep the order of earlier versions, so positional unpacking of
     ``pos, ang, ...`` keeps working.
@@ -94,7 +96,8 @@ def polygon_arrays(polygons: list[NDArray[np.float64]]) -> dict[str, NDArray]:
 
 
 def model_arrays(model: DemModel, stop_angle_rad: NDArray[np.float64] | None = None) -> dict[str, object]:
-    """The kernel's inputs for a model.
+    """The kernel's inputs for a model, as flat arrays (:func:`rockyade.kernel.state.pack`
+    makes the kernel's records of them).
 
     Parameters
     ----------
@@ -172,16 +175,16 @@ def simulate_model(
 
     The compiled kernel is loaded (or compiled) before the timer starts.
     """
-    args = model_arrays(model, stop_angle_rad)
+    records = pack(
+        model_arrays(model, stop_angle_rad),
+        stop_on_overturn=stop_on_overturn,
+        record_energy=record_energy,
+        record_corners=record_corners,
+        coherent=coherent,
+    )
     _warm_up()
     start = time.perf_counter()
-    out = kernel.simulate(
-        **args,
-        stop_on_overturn=bool(stop_on_overturn),
-        record_energy=bool(record_energy),
-        record_corners=bool(record_corners),
-        coherent=bool(coherent),
-    )
+    out = kernel.simulate(*records)
     return KernelOutput(*out), time.perf_counter() - start
 
 
@@ -206,40 +209,43 @@ def _warm_up() -> None:
             file=sys.stderr,
             flush=True,
         )
+    flags = {"stop_on_overturn": True, "record_energy": True, "record_corners": True, "coherent": True}
+    kernel.simulate(*pack(tiny_problem(), **flags))
+
+
+def tiny_problem() -> dict[str, object]:
+    """The flat arrays of a 0.2 m square resting on the base, two steps of 0.1 ms (the
+    kernel's warm-up)."""
     square = np.array([[-0.1, -0.1], [0.1, -0.1], [0.1, 0.1], [-0.1, 0.1]])
     one = np.ones(1)
     zero = np.zeros(1)
-    kernel.simulate(
-        mass=one,
-        inertia=one,
-        moving=np.ones(1, dtype=bool),
+    return {
+        "mass": one,
+        "inertia": one,
+        "moving": np.ones(1, dtype=bool),
         **polygon_arrays([square]),
-        kn=one * 1e6,
-        ks=one * 1e6,
-        cn=zero,
-        cs=zero,
-        tanphi=one,
-        base_joint=np.zeros(1, dtype=np.int64),
-        own_joint=np.zeros(1, dtype=np.int64),
-        pair_keys=np.zeros(0, dtype=np.int64),
-        pair_joint=np.zeros(0, dtype=np.int64),
-        mass_damping=0.0,
-        pos0=np.array([[0.0, 0.1]]),
-        ang0=zero,
-        vel0=np.zeros((1, 2)),
-        angvel0=zero,
-        rest_ang=zero,
-        stop_angle=one,
-        stop_on_overturn=True,
-        mt=np.zeros(0),
-        mah=np.zeros(0),
-        mav=np.zeros(0),
-        g=9.81,
-        dt=1e-4,
-        n_steps=2,
-        steps_per_sample=1,
-        accel_points=np.zeros((1, 2)),
-        record_energy=True,
-        record_corners=True,
-        coherent=True,
-    )
+        "kn": one * 1e6,
+        "ks": one * 1e6,
+        "cn": zero,
+        "cs": zero,
+        "tanphi": one,
+        "base_joint": np.zeros(1, dtype=np.int64),
+        "own_joint": np.zeros(1, dtype=np.int64),
+        "pair_keys": np.zeros(0, dtype=np.int64),
+        "pair_joint": np.zeros(0, dtype=np.int64),
+        "mass_damping": 0.0,
+        "pos0": np.array([[0.0, 0.1]]),
+        "ang0": zero,
+        "vel0": np.zeros((1, 2)),
+        "angvel0": zero,
+        "rest_ang": zero,
+        "stop_angle": one,
+        "mt": np.zeros(0),
+        "mah": np.zeros(0),
+        "mav": np.zeros(0),
+        "g": 9.81,
+        "dt": 1e-4,
+        "n_steps": 2,
+        "steps_per_sample": 1,
+        "accel_points": np.zeros((1, 2)),
+    }

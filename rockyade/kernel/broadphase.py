@@ -40,6 +40,17 @@ def sweep_axis(lo, hi) -> int:
     return 0 if spread[0] >= spread[1] else 1
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def initial_order(lo, hi):
+    """The sweep axis (:func:`sweep_axis`) and the bodies sorted by their box centres along it
+    ((nb,) int64), the starting order of :func:`candidate_pairs`."""
+    order = np.argsort(lo[:, 0] + hi[:, 0]).astype(np.int64)
+    axis = sweep_axis(lo, hi)
+    if axis == 1:
+        order = np.argsort(lo[:, 1] + hi[:, 1]).astype(np.int64)
+    return axis, order
+
+
 @numba.njit(cache=True, nogil=True)
 def insertion_sort(order, key) -> None:
     """Sort ``order`` in place by ``key[order]`` (linear when nearly sorted)."""
@@ -112,7 +123,7 @@ def candidate_pairs(lo, hi, margin, fixed, axis: int, order):
     return keys, pa, pb
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def moved_beyond_margin(pos, ang, ref_pos, ref_ang, radius, margin, moving) -> bool:
     """True when some moving body may have moved a point farther than its margin."""
     for i in range(pos.shape[0]):

@@ -1,12 +1,61 @@
-"""A base motion as every solver sees it: piecewise-linear base acceleration samples."""
+"""A base motion as every solver sees it: piecewise-linear base acceleration samples.
+
+:class:`GroundMotion` holds the samples; :func:`ground_acceleration` is the one compiled
+lookup of the base acceleration at a time t, shared by the reference DEM's kernel (which
+steps forward in time) and Housner's integrator (whose root finding goes back and forth).
+"""
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.integrate import cumulative_trapezoid
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def ground_acceleration(t: float, t_s, ah, av, hint: int) -> tuple[float, float, int]:
+    """Base acceleration at time ``t``: linear between samples, zero outside them.
+
+    Parameters
+    ----------
+    t
+        Time, s; any value, in any order from one call to the next.
+    t_s
+        (n,) strictly increasing sample times, s (n < 2: no motion, zero everywhere).
+    ah, av
+        (n,) horizontal and vertical base acceleration at ``t_s``, m/s^2.
+    hint
+        Index of the interval [t_s[j], t_s[j + 1]) found by the last call (0 at first). It
+        is checked, then its successor (a time stepper's next step), and only then is the
+        interval searched by bisection, so the answer never depends on the hint.
+
+    Returns
+    -------
+    ah, av
+        Base acceleration at ``t``, m/s^2: a_j + w (a_{j+1} - a_j) with
+        w = (t - t_j) / (t_{j+1} - t_j) on t_j <= t < t_{j+1}, the last sample itself at
+        t = t_{n-1}, and 0 for t < t_0 or t > t_{n-1} (``GroundMotion.horizontal``, as
+        ``numpy.interp`` with ``left = right = 0``).
+    hint
+        The interval used, to pass to the next call (unchanged when ``t`` is outside).
+    """
+    n = t_s.size
+    if n < 2 or t < t_s[0] or t > t_s[n - 1]:
+        return 0.0, 0.0, hint
+    if t == t_s[n - 1]:
+        return ah[n - 1], av[n - 1], n - 2
+    j = min(max(hint, 0), n - 2)
+    if t < t_s[j] or t >= t_s[j + 1]:
+        # t < t_s[n - 1] here: a successor interval exists whenever t >= t_s[j + 1]
+        if t >= t_s[j + 1] and t < t_s[j + 2]:
+            j += 1
+        else:
+            j = np.searchsorted(t_s, t, side="right") - 1
+    w = (t - t_s[j]) / (t_s[j + 1] - t_s[j])
+    return ah[j] + w * (ah[j + 1] - ah[j]), av[j] + w * (av[j + 1] - av[j]), j
 
 
 @dataclass(frozen=True)

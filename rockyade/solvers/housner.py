@@ -44,7 +44,7 @@ from rockyade import __version__
 from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.motion.ground import GroundMotion
+from rockyade.motion.ground import GroundMotion, ground_acceleration
 from rockyade.result import Result, column
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase
@@ -148,30 +148,17 @@ def _theta_dd(side, theta, ah, av, prm):
 
 
 @numba.njit(cache=True)
-def _ground(t, mt, mah, mav):
-    """Base acceleration (ah, av) at t: linear between samples, zero outside."""
-    n = mt.size
-    if n < 2 or t < mt[0] or t > mt[n - 1]:
-        return 0.0, 0.0
-    i = np.searchsorted(mt, t, side="right") - 1
-    if i >= n - 1:
-        return mah[n - 1], mav[n - 1]
-    w = (t - mt[i]) / (mt[i + 1] - mt[i])
-    return mah[i] + w * (mah[i + 1] - mah[i]), mav[i] + w * (mav[i + 1] - mav[i])
-
-
-@numba.njit(cache=True)
 def _rk4(t, th, om, h, side, prm, mt, mah, mav):
     """One classical Runge-Kutta step of size h; returns (theta, omega)."""
-    ah, av = _ground(t, mt, mah, mav)
+    ah, av, j = ground_acceleration(t, mt, mah, mav, 0)
     k1t = om
     k1w = _theta_dd(side, th, ah, av, prm)
-    ah, av = _ground(t + 0.5 * h, mt, mah, mav)
+    ah, av, j = ground_acceleration(t + 0.5 * h, mt, mah, mav, j)
     k2t = om + 0.5 * h * k1w
     k2w = _theta_dd(side, th + 0.5 * h * k1t, ah, av, prm)
     k3t = om + 0.5 * h * k2w
     k3w = _theta_dd(side, th + 0.5 * h * k2t, ah, av, prm)
-    ah, av = _ground(t + h, mt, mah, mav)
+    ah, av, _ = ground_acceleration(t + h, mt, mah, mav, j)
     k4t = om + h * k3w
     k4w = _theta_dd(side, th + h * k3t, ah, av, prm)
     return (
@@ -257,7 +244,7 @@ def _uplift(t0, t_end, mt, mah, mav, prm):
     tan_l = math.tan(prm[_AL])
     tan_r = math.tan(prm[_AR])
     g = prm[_G]
-    ah, av = _ground(t0, mt, mah, mav)
+    ah, av, _ = ground_acceleration(t0, mt, mah, mav, 0)
     fp = ah - (g + av) * tan_l
     fm = -ah - (g + av) * tan_r
     if fp > 0.0:
@@ -316,7 +303,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         theta_s[0] = th
         omega_s[0] = om
         side0 = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
-        ah, av = _ground(0.0, mt, mah, mav)
+        ah, av, _ = ground_acceleration(0.0, mt, mah, mav, 0)
         acc_s[0] = _theta_dd(side0, th, ah, av, prm)
         k = 1
     while t < duration:
@@ -386,7 +373,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
                 thk, omk = _rk4(t, th, om, tk - t, side, prm, mt, mah, mav)
             theta_s[k] = thk
             omega_s[k] = omk
-            ah, av = _ground(tk, mt, mah, mav)
+            ah, av, _ = ground_acceleration(tk, mt, mah, mav, 0)
             acc_s[k] = _theta_dd(side, thk, ah, av, prm)
             k += 1
         if event == 0:
