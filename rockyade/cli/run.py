@@ -85,6 +85,11 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         line = f"  {a['n_blocks']} moving blocks: {a['n_fallen']} fell"
         if a["n_fallen"]:
             line += f" (first {a['first_fallen_block']} at t = {a['first_fall_time_s']:.4g} s)"
+        if a["n_falling_at_end"]:
+            line += (
+                f", {a['n_falling_at_end']} still falling when the run ended (not counted as fallen: "
+                "a longer duration_s shows where they land)"
+            )
         print(line + f"; max |theta| = {a['max_abs_theta_rad']:.4g} rad ({a['max_theta_block']})")
         line = f"  largest residual displacement {a['max_residual_displacement_m']:.4g} m ({a['max_residual_block']})"
         if a["n_moving_at_end"]:
