@@ -18,7 +18,13 @@ from rockyade.analysis.collapse import (
     block_states,
     collapse_report,
 )
-from rockyade.analysis.metrics import assembly_metrics
+from rockyade.analysis.metrics import (
+    NO_WHOLE_ROTATION,
+    assembly_metrics,
+    run_metrics,
+    stack_order,
+    structure_rotation,
+)
 from rockyade.blocks.geometry import chamfered_rectangle_vertices, rectangle_vertices
 from rockyade.cli import main
 from rockyade.dem.build import contact_polygon
@@ -133,6 +139,14 @@ def test_drums_carried_by_a_rocking_column_rock_and_do_not_slide():
     assert rocking.sum() > 100  # the column rocks well beyond its elastic tilt
     assert (states[rocking, top] == ROCKING).mean() > 0.95
     assert (states[:, top] == SLIDING).mean() < 0.05
+    # issue "What users hit" 4: against its own alpha each drum looks safe; the column as one
+    # body (its centroid about its base corner, against the column's alpha) is near its limit
+    whole = structure_rotation(scene, dem)
+    drums = run_metrics(scene, dem)
+    assert whole["structure"] == "stack of 8"
+    assert whole["structure_alpha_rad"] == pytest.approx(math.atan(0.15 / 2.0), rel=1e-3)
+    assert whole["structure_max_theta_over_alpha"] > 0.9
+    assert max(m["max_theta_over_alpha"] for m in drums.values()) < 0.2
 
 
 def test_a_falling_column_lands_from_the_bottom_up_after_tipping_as_one_body():
@@ -217,10 +231,18 @@ def test_the_fall_rule_on_histories_it_decides_alone():
     assert run_outcome({}, ["a", "b"], {"a": still}, t) == ("completed", None, None)
 
 
-def test_a_beam_on_rocking_columns_is_carried_and_a_block_that_never_tipped_has_no_tip_time():
+def test_a_beam_on_rocking_columns_is_carried_and_a_block_that_never_tipped_has_no_tip_time(capsys):
     scene = load_scene(EXAMPLES / "assemblies/frame.toml")
     result = run(scene, "reference")
     report = collapse_report(scene, result).set_index("block")
+    # a frame is no stack: no whole-body alpha, and the summary says why and what to compare instead
+    assert stack_order(scene) is None and stack_order(load_scene(EXAMPLES / "assemblies/wall_5_courses.toml")) is None
+    whole = assembly_metrics(scene, result)
+    assert whole["structure"] == "none" and math.isnan(whole["structure_max_theta_over_alpha"])
+    assert whole["structure_note"] == NO_WHOLE_ROTATION
+    assert main(["run", str(EXAMPLES / "assemblies/frame.toml"), "--solver", "reference"]) == 0
+    out = capsys.readouterr().out
+    assert "as one body: not a single stack" in out and "against the collapse acceleration of 'rockyade limit" in out
     assert report.loc["beam", "final_state"] == "carried"  # it swings with the columns: not at rest
     assert report.loc["column_left", "final_state"] == "rocking"
     assert not report["fell"].any() and report["tipped_time_s"].isna().all()

@@ -91,7 +91,7 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
         ],
     ),
     "column": (
-        "a column of equal drums, optionally with a capital (abacus) block on top",
+        "a column of equal drums (round by default), optionally with a capital (abacus) block on top",
         [
             Opt("--drums", 8, "number of drums", int),
             Opt("--diameter-m", 0.3, "drum width in the plane of rocking, m"),
@@ -99,6 +99,14 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--thickness-m", None, "out-of-plane thickness, m (default: the diameter)"),
             Opt("--capital-width-m", None, "width of a capital block on top, m (with --capital-height-m)"),
             Opt("--capital-height-m", None, "height of the capital block, m"),
+            Opt(
+                "--section",
+                "round",
+                "round: cylinders (mass rho pi D^2/4 h and inertia m (3 r^2 + h^2)/12 written per drum); "
+                "square: prisms D x thickness",
+                str,
+                ("round", "square"),
+            ),
             LAYOUT_OPT,
         ],
     ),
