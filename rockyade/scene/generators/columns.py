@@ -124,7 +124,7 @@ def stack(
     layout
         "positioned" (an assembly) or "column" (a column scene).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
-        As for :func:`~rockyade.scene.generators.wall.wall`; the default contact is the
+        As for :func:`~rockyade.scene.generators.walls.wall`; the default contact is the
         paper's calibration (slender blocks).
     """
     if isinstance(widths_m, str) or not isinstance(widths_m, Sequence) or not widths_m:
@@ -181,7 +181,7 @@ def round_drum_mass_inertia(diameter_m: float, height_m: float, density_kg_m3: f
     return mass, mass * (3.0 * r * r + height_m * height_m) / 12.0
 
 
-def drum_column(
+def column(
     drums: int = 8,
     diameter_m: float = 0.3,
     drum_height_m: float = 0.5,
@@ -247,3 +247,7 @@ def drum_column(
         duration_s=duration_s,
         sample_dt_s=sample_dt_s,
     )
+
+
+#: The former name of :func:`column` (kept: scripts call it).
+drum_column = column
