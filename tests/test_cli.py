@@ -188,7 +188,7 @@ def test_motion_commands(capsys, tmp_path, monkeypatch):
     assert (tmp_path / "acc.png").stat().st_size > 1000
     code, _, _ = run_cli(capsys, "motion", "spectrum", str(rec), "--damping", "0.05", "--out", str(tmp_path / "s.csv"))
     spectrum = __import__("pandas").read_csv(tmp_path / "s.csv")
-    assert code == 0 and list(spectrum.columns) == ["period_s", "psa_m_s2"] and len(spectrum) == 100
+    assert code == 0 and list(spectrum.columns) == ["period_s", "psa_g", "psa_m_s2"] and len(spectrum) == 100
     out_dir = tmp_path / "suite"
     code, out, _ = run_cli(
         capsys,

@@ -224,7 +224,7 @@ COMMON: list[Opt] = [
         str,
         metavar="FILE",
     ),
-    Opt("--load-factor", 1.0, "record scale factor"),
+    Opt("--load-factor", 1.0, "multiplies the record's accelerations as read (its samples as in the file)"),
     Opt("--theta0-rad", 0.05, "free rocking: initial tilt, rad"),
     Opt("--free-block", None, "free rocking: the block tilted (with what rests on it)", str, metavar="NAME"),
     Opt(
