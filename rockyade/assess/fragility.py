@@ -264,7 +264,8 @@ def _default_levels(
     ratio = float(np.median(records["im_si"] / records["pga_m_s2"]))
     return (
         tuple(float(v) for v in pga_levels * ratio),
-        f"{text}, times the records' median {measure.name}/PGA = {ratio:.4g} {measure.si_unit} per m/s^2",
+        f"{text}, times the records' median {measure.name} / PGA = {ratio:.4g}"
+        + (" s" if measure.kind == "pgv" else ""),
     )
 
 

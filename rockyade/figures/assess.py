@@ -55,7 +55,7 @@ def plot_fragility(
     m, fit = result.measure, result.fit
     s = result.stripes
     x = s[m.si_column].to_numpy() / m.scale
-    top = float(max(x.max(), *(v / m.scale for v, *_ in marks or [])) * 1.25)
+    top = 1.25 * max([float(x.max()), *(v / m.scale for v, *_ in marks or [])])
     grid = np.linspace(top / 400, top, 400)
     f = fit.fragility
     if f.status == "fitted":
@@ -191,7 +191,11 @@ def _marks(a: Assessment) -> list[tuple[float, str, str, str]]:
 def draw_fragility(result: FragilityResult, path: str | Path, title: str | None = None) -> Path:
     """Write :func:`plot_fragility` as a PNG."""
     fig, ax = new_figure(path, figsize=(6.8, 4.6), layout="constrained")
-    plot_fragility(result, ax)
+    static = result.plan.static_acceleration_m_s2
+    marks = []
+    if result.measure.kind == "pga" and math.isfinite(static):
+        marks.append((static, f"static collapse, alpha0 g = {static / G:.3g} g (limit analysis)", "0.45", "--"))
+    plot_fragility(result, ax, marks=marks)
     if title:
         ax.set_title(title, fontsize=10)
     return save_figure(fig, path)
