@@ -388,3 +388,11 @@ def test_a_fragility_analysis_runs_through_the_runner_and_writes_one_row_per_run
     data = result.to_dict()
     assert data["measure"]["name"] == "pga" and len(data["stripes"]) == 4
     assert "as read" in data["load_factor"]
+
+
+def test_the_verify_checks_of_limit_analysis_the_code_and_the_fit_pass(tmp_path):
+    from rockyade.studies.verify import verify
+
+    table = verify(tmp_path, ["kinematic", "code", "fragility_fit"], ["reference"])
+    assert set(table["check"]) == {"kinematic", "code", "fragility_fit"}
+    assert len(table) >= 20 and table["passed"].all(), table[~table["passed"]].to_string()
