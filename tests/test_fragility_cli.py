@@ -183,6 +183,9 @@ def test_assess_text_and_files_with_the_dynamics(capsys, tmp_path, wall, records
     assert code == 0, text
     assert "NOT VERIFIED" in text and "a0* = alpha0 g / (e* FC) = 1.817 m/s^2" in text
     assert "at the code's demand (lambda = 1, ag = 0.25 g)" in text
+    # the code's verdict is printed before the runs start, the dynamic answer after them
+    assert text.index("code verdict:") < text.index("runs planned") < text.index("runs of housner done")
+    assert "dynamics: not run" not in text
     data = json.loads((out / "assess.json").read_text())
     assert data["dynamic"]["at_code_demand"]["n_runs"] == 2
     runs = pd.read_csv(out / "runs.csv")
@@ -215,6 +218,7 @@ def test_assess_at_height_uses_the_floor_demand(capsys, wall):
     )
     assert code == 0
     assert "Se(T1) psi gamma / q" in text and "Ct H^(3/4)" in text
+    assert text.rstrip().endswith("dynamics: not run (--static-only)")
 
 
 @pytest.mark.parametrize(

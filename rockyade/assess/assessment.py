@@ -342,9 +342,37 @@ def assess(
     if any(c.status == NOT_APPLICABLE for c in checks):
         out.notes.extend(f"{c.name}: not applicable ({c.reason})" for c in checks if c.status == NOT_APPLICABLE)
     if dynamic is not None:
-        executor = executor or Executor("local", 2)
-        plan = dynamic_plan(scene, site, dynamic, executor, progress)
-        if on_plan is not None:
-            on_plan(plan)
-        out.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress)
+        add_dynamics(out, scene, dynamic, executor, allow_large=allow_large, progress=progress, on_plan=on_plan)
     return out
+
+
+def add_dynamics(
+    assessment: Assessment,
+    scene: Scene,
+    settings: DynamicSettings,
+    executor: Executor | None = None,
+    *,
+    allow_large: bool = False,
+    progress: bool = True,
+    on_plan: Any = None,
+) -> Assessment:
+    """Run the dynamic part of an assessment (module docstring) and attach it; the same
+    assessment back.
+
+    Raises
+    ------
+    InputError
+        A mechanism at height; a run above the runner's cost limits (``allow_large``).
+    """
+    if assessment.position.at_height:
+        raise InputError(
+            "--static-only",
+            "the dynamic part shakes the scene's base with ground motions; a mechanism at height is shaken by its "
+            "floor (not modelled): pass --static-only for the code's check at height",
+        )
+    executor = executor or Executor("local", 2)
+    plan = dynamic_plan(scene, assessment.site, settings, executor, progress)
+    if on_plan is not None:
+        on_plan(plan)
+    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress)
+    return assessment

@@ -102,7 +102,8 @@ def _check_line(check: Check) -> str:
 
 
 def assessment_lines(a: Assessment, source: str) -> list[str]:
-    """The text of ``rockyade assess``."""
+    """The text of ``rockyade assess``: the mechanism, its quantities and the code's checks
+    (:func:`dynamic_lines` gives the dynamic part)."""
     lim, kin = a.limit, a.limit.kinematic
     lines = [
         f"assessment of {source}: NTC 2018 kinematic method (Circolare 2019 C8.7.1), FC = {a.fc:g}",
@@ -148,14 +149,18 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     # the friction caveat matters where joints slide (the limit analysis says so again then)
     lines += [f"note: {note}" for note in lim.notes if mech.slides or note != FRICTION_NOTE]
     lines += [f"note: {note}" for note in a.notes]
+    return lines
+
+
+def dynamic_lines(a: Assessment) -> list[str]:
+    """The dynamic part of ``rockyade assess``'s text (after its plan)."""
     if a.dynamic is None:
-        lines.append("dynamics: not run (--static-only)")
-        return lines
+        return ["dynamics: not run (--static-only)"]
+    site_ag = a.site.ag_m_s2 / G
+    cap = a.code_capacity_ag_m_s2
+    lines: list[str] = []
     d = a.dynamic
-    lines.append(
-        f"dynamics: {d.plan.stripes.solver.name}, {len(d.runs)} runs of {d.plan.stripes.motions.describe()} "
-        "(the plan above)"
-    )
+    lines.append(f"  {len(d.runs)} runs of {d.plan.stripes.solver.name} done")
     at = a.demand_fraction()
     assert at is not None
     lines.append(
@@ -171,7 +176,7 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
             else f"the code is NOT conservative for this wall (its capacity is {1 / ratio:.2f} x the dynamic median)"
         )
         lines.append(
-            f"dynamic median / code capacity = {d.fit.fragility.median / G:.4g} g / {cap / G:.4g} g = {ratio:.3g}: "
+            f"  dynamic median / code capacity = {d.fit.fragility.median / G:.4g} g / {cap / G:.4g} g = {ratio:.3g}: "
             + sense
         )
     return lines

@@ -72,8 +72,9 @@ def _dynamic(args: argparse.Namespace) -> Any:
 def cmd_assess(args: argparse.Namespace) -> int:
     """The checks, the dynamics, the text (or JSON), and with --out the files."""
     from rockyade.assess import assess
+    from rockyade.assess.assessment import add_dynamics
     from rockyade.assess.code import check_code
-    from rockyade.assess.report import assessment_lines
+    from rockyade.assess.report import assessment_lines, dynamic_lines
     from rockyade.limit.kinematic import check_fc
     from rockyade.limit.model import check_friction_angle
     from rockyade.scene import load_scene
@@ -94,11 +95,6 @@ def cmd_assess(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     direction = None if args.direction == "both" else args.direction
 
-    def on_plan(plan: Any) -> None:
-        if not args.json:
-            print(f"dynamics: {plan.runs_planned} runs planned")
-            print_plan(plan, args.workers)
-
     result = assess(
         scene,
         site,
@@ -108,18 +104,31 @@ def cmd_assess(args: argparse.Namespace) -> int:
         direction=direction,
         friction_angle_deg=friction,
         sliding=not args.no_sliding,
-        dynamic=dynamic,
-        executor=executor,
-        allow_large=args.allow_large,
-        progress=not args.quiet,
-        on_plan=on_plan,
     )
+    if not args.json:
+        print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
+    if dynamic is not None:
+
+        def on_plan(plan: Any) -> None:
+            if not args.json:
+                print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
+                print_plan(plan, args.workers, indent="  ")
+
+        add_dynamics(
+            result,
+            scene,
+            dynamic,
+            executor,
+            allow_large=args.allow_large,
+            progress=not args.quiet,
+            on_plan=on_plan,
+        )
+    if not args.json:
+        print("\n".join(dynamic_lines(result)))
     data = result.to_dict()
     data["scene"] = str(args.scene)
     if args.json:
         json_out(data)
-    else:
-        print("\n".join(assessment_lines(result, str(args.scene))))
     if args.out is not None:
         _write(args, result, data)
     return 0

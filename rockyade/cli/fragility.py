@@ -112,13 +112,12 @@ def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
     add_allow_large(p)
 
 
-def print_plan(plan: Any, workers: int, quiet: bool = False) -> None:
+def print_plan(plan: Any, workers: int, indent: str = "") -> None:
     """The plan and its cost, before anything runs."""
     from rockyade.assess.report import plan_lines
 
-    for line in plan_lines(plan):
-        print(line)
-    print(plan.cost_line(workers), flush=True)
+    for line in [*plan_lines(plan), plan.cost_line(workers)]:
+        print(indent + line, flush=True)
 
 
 def write_tables(out: Path, result: Any, prefix: str = "") -> list[str]:

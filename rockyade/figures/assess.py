@@ -82,8 +82,8 @@ def plot_fragility(
         ax.plot([m.shown(f.median)], [0.5], "o", color=CURVE, mfc="white", ms=6, zorder=5)
     elif f.status == "separated":
         ax.axvline(m.shown(f.median), color=CURVE, lw=1.4, label=f"threshold near {m.shown(f.median):.3g} {m.unit}")
-    lo = s["fraction"] - s["fraction_lo"]
-    hi = s["fraction_hi"] - s["fraction"]
+    lo = np.clip(s["fraction"] - s["fraction_lo"], 0.0, None)  # >= 0 (the interval's rounding)
+    hi = np.clip(s["fraction_hi"] - s["fraction"], 0.0, None)
     n = int(s["n_runs"].max()) if len(s) else 0
     ax.errorbar(
         x,
