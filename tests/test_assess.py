@@ -396,3 +396,15 @@ def test_the_verify_checks_of_limit_analysis_the_code_and_the_fit_pass(tmp_path)
     table = verify(tmp_path, ["kinematic", "code", "fragility_fit"], ["reference"])
     assert set(table["check"]) == {"kinematic", "code", "fragility_fit"}
     assert len(table) >= 20 and table["passed"].all(), table[~table["passed"]].to_string()
+
+
+def test_finite_or_null_makes_json_strict():
+    """A number that does not exist (NaN) or lies beyond the data (inf) is null, nested or not."""
+    import math
+
+    import numpy as np
+
+    from rockyade.assess.strict import finite_or_null
+
+    data = {"beta": math.nan, "band": (1.0, np.float64("inf")), "rows": [{"fraction": -math.inf, "n": 3}], "s": "x"}
+    assert finite_or_null(data) == {"beta": None, "band": [1.0, None], "rows": [{"fraction": None, "n": 3}], "s": "x"}

@@ -32,6 +32,15 @@ ASSESS_KEYS = (
 CHECK_KEYS = ("name", "demand", "capacity", "unit", "verdict", "source", "ag_capacity_g")
 
 
+def strict_json(text: str) -> dict:
+    """Parse as a strict parser would: NaN or Infinity is an error."""
+
+    def refuse(constant: str) -> None:
+        raise ValueError(f"not JSON: {constant}")
+
+    return json.loads(text, parse_constant=refuse)
+
+
 def run_cli(capsys, *argv: str) -> tuple[int, str, str]:
     code = main([str(a) for a in argv])
     out = capsys.readouterr()
@@ -68,7 +77,7 @@ def test_fragility_of_a_block_under_records_writes_every_output(capsys, tmp_path
     runs = pd.read_csv(out / "runs.csv")
     assert len(runs) == 8 and set(runs["solver"]) == {"housner"}
     assert not runs.loc[runs.pga_g == 0.2, "collapsed"].any()  # below g tan(alpha) = 0.25 g nothing moves
-    data = json.loads((out / "fragility.json").read_text())
+    data = strict_json((out / "fragility.json").read_text())
     assert data["measure"]["name"] == "pga" and data["fit"]["status"] in ("fitted", "separated", "no trend")
     assert data["collapse_rule"].startswith("the block overturns")
     assert data["levels_source"] == "given" and len(data["stripes"]) == 4
@@ -186,7 +195,7 @@ def test_assess_text_and_files_with_the_dynamics(capsys, tmp_path, wall, records
     # the code's verdict is printed before the runs start, the dynamic answer after them
     assert text.index("code verdict:") < text.index("runs planned") < text.index("runs of housner done")
     assert "dynamics: not run" not in text
-    data = json.loads((out / "assess.json").read_text())
+    data = strict_json((out / "assess.json").read_text())
     assert data["dynamic"]["at_code_demand"]["n_runs"] == 2
     runs = pd.read_csv(out / "runs.csv")
     assert sorted(runs["ag_g"].unique()) == pytest.approx([0.125, 0.25, 0.5])

@@ -46,6 +46,7 @@ from rockyade.assess.fragility import (
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, RecordFiles, ec8_suite
 from rockyade.assess.site import Position, Site
+from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
@@ -171,7 +172,7 @@ class Assessment:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (the code's quantities at the top; each check with its demand, capacity,
-        verdict and source)."""
+        verdict and source; strict: a number that does not exist is null)."""
         lim = self.limit.to_dict()
         out: dict[str, Any] = {
             "code": self.code,
@@ -214,7 +215,7 @@ class Assessment:
                 "check is met: above 1 the code is conservative for this wall, below 1 it is not",
             }
         out["notes"] = list(self.notes)
-        return out
+        return finite_or_null(out)
 
 
 def _limit(

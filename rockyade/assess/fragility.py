@@ -33,6 +33,7 @@ import pandas as pd
 from rockyade.assess.fit import StripeFit, fit_stripes, stripe_table
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
+from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
@@ -319,28 +320,31 @@ class FragilityResult:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """JSON-ready: the fit, the stripes, the records, how the levels were chosen."""
+        """JSON-ready (strict: a number that does not exist is null): the fit, the stripes, the
+        records, how the levels were chosen."""
         m, plan = self.measure, self.plan
-        return {
-            "scene": plan.stripes.scene.source,
-            "measure": m.to_dict(),
-            "solver": plan.stripes.solver.name,
-            "collapse_rule": collapse_rule(plan.stripes.scene, plan.stripes.fallen_blocks),
-            "motions": plan.stripes.motions.to_dict(),
-            "load_factor": "multiplies each record's accelerations as read (after the conversion of the file's "
-            "units to m/s^2)",
-            "levels_source": plan.levels_source,
-            "levels_added": [v / m.scale for v in self.levels_added],
-            "static_acceleration_m_s2": plan.static_acceleration_m_s2,
-            "sample_dt_s": plan.stripes.sample_dt_s,
-            "tail_s": plan.stripes.tail_s,
-            "runs": len(self.runs),
-            "failed_runs": self.failed,
-            "fit": self.fit.to_dict(m.scale, m.unit),
-            "stripes": self.stripes.to_dict(orient="records"),
-            "records": self.plan.records.to_dict(orient="records"),
-            "notes": list(plan.notes),
-        }
+        return finite_or_null(
+            {
+                "scene": plan.stripes.scene.source,
+                "measure": m.to_dict(),
+                "solver": plan.stripes.solver.name,
+                "collapse_rule": collapse_rule(plan.stripes.scene, plan.stripes.fallen_blocks),
+                "motions": plan.stripes.motions.to_dict(),
+                "load_factor": "multiplies each record's accelerations as read (after the conversion of the file's "
+                "units to m/s^2)",
+                "levels_source": plan.levels_source,
+                "levels_added": [v / m.scale for v in self.levels_added],
+                "static_acceleration_m_s2": plan.static_acceleration_m_s2,
+                "sample_dt_s": plan.stripes.sample_dt_s,
+                "tail_s": plan.stripes.tail_s,
+                "runs": len(self.runs),
+                "failed_runs": self.failed,
+                "fit": self.fit.to_dict(m.scale, m.unit),
+                "stripes": self.stripes.to_dict(orient="records"),
+                "records": self.plan.records.to_dict(orient="records"),
+                "notes": list(plan.notes),
+            }
+        )
 
 
 def run_fragility(
