@@ -125,7 +125,7 @@ def test_only_the_implemented_code_is_taken():
 
 
 def test_the_checks_of_a_free_standing_wall_match_the_hand_calculation():
-    """The worked example of docs/howto/is-this-wall-safe.md, by hand: a 0.25 m x 2.5 m wall,
+    """The hand calculation of docs/limit.md (the wall of docs/howto/is-this-wall-safe.md): a 0.25 m x 2.5 m wall,
     EC8 Type 1, ground B (S = 1.2, TB 0.15, TC 0.5, TD 2 s), ag = 0.25 g, FC 1.35, q = 2."""
     b, fc, q = 0.125, 1.35, 2.0
     result = limit_analysis(wall_scene(), fc=fc)

@@ -30,7 +30,7 @@ the tolerance, pass or fail):
   (lambda = b/h, e* = 1 and d0* = b of a block, e* of a wall of n courses, the minimum
   thickness of a semicircular arch approaching Milankovitch's t/R = 0.1075);
 * ``code``: the NTC 2018 checks of a free-standing wall against the hand calculation of
-  docs/howto/is-this-wall-safe.md;
+  docs/limit.md (the wall of docs/howto/is-this-wall-safe.md);
 * ``fragility_fit``: the lognormal fit of stripes and its bootstrap band recover the curve
   that synthetic outcomes were drawn from.
 
@@ -566,8 +566,8 @@ def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
 
 def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """The code's checks of a free-standing wall 0.25 m x 2.5 m against the hand calculation of
-    docs/howto/is-this-wall-safe.md: EC8 Type 1, ground B (S = 1.2, TC = 0.5 s), ag = 0.25 g,
-    FC = 1.35, q = 2."""
+    docs/limit.md ("A hand calculation", the wall of the how-to): EC8 Type 1, ground B (S = 1.2,
+    TC = 0.5 s), ag = 0.25 g, FC = 1.35, q = 2."""
     from rockyade.assess import Position, Site, code_checks
     from rockyade.limit import limit_analysis
 
@@ -577,7 +577,7 @@ def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     a0 = 0.1 * G / 1.35
     ts = kin.Ts_s
     sde = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2  # TC < Ts < TD
-    src = "hand calculation (docs/howto/is-this-wall-safe.md)"
+    src = "hand calculation (docs/limit.md)"
     rows = [
         Row(
             "code",
