@@ -309,3 +309,28 @@ def test_the_summary_says_how_much_of_the_record_s_pga_was_left_out(tmp_path):
     assert whole["motion_pga_left_out_fraction"] == 0.0 and whole["motion_time_left_out_s"] == 0.0
     meta = json.loads((tmp_path / "runs" / f"{short['run']}.json").read_text())
     assert meta["motion_coverage"]["status"] == "cut"
+
+
+def test_the_batch_command_refuses_a_large_grid_unless_allowed(tmp_path, monkeypatch, capsys):
+    from rockyade.cli import main
+
+    monkeypatch.setattr(batch, "MAX_RUNS", 1)
+    path = _study(tmp_path, f'solvers = ["housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
+                  '"motion.theta0_rad" = [0.01, 0.02]\n')
+    assert main(["batch", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
+    assert "2 runs, more than the limit of 1" in capsys.readouterr().err
+    assert main(["batch", str(path), "--out", str(tmp_path / "out"), "--quiet", "--allow-large"]) == 0
+
+
+@pytest.mark.parametrize("solver", ["housner", "reference"])
+def test_every_result_carries_its_motion_coverage(solver):
+    from rockyade.solvers import make_solver
+
+    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_record.toml").to_dict(), "duration_s": 1.0,
+                             "sample_dt_s": 0.01})
+    result = make_solver(solver).run(scene)
+    coverage = result.meta["motion_coverage"]
+    assert coverage["status"] == "cut" and coverage["time_left_out_s"] == pytest.approx(4.0)
+    assert coverage["message"].startswith("the scene ends at 1 s")
+    free = make_solver(solver).run(load_scene(EXAMPLES / "specimen3_free.toml"))
+    assert free.meta["motion_coverage"]["status"] == "no base motion"
