@@ -364,6 +364,9 @@ class Recorder:
         self.raw = [0.0] * nb
         self.turned = [0.0] * nb
         self.moving = [i for i, c in enumerate(clumps) if not c["fixed"]]
+        # each clump's State, fetched once (YADE updates it in place): a lookup is a
+        # boost.python call, and the recorder runs every sample
+        self.states = [O.bodies[c["id"]].state for c in clumps]
         self.sps = scene["steps_per_sample"]
         self.track_period = max(1, min(self.sps, int(ROTATION_STEP_MAX_RAD / (MAX_SPIN_RAD_S * scene["dt_s"]))))
         self.max_rotation_step = 0.0
@@ -406,12 +409,13 @@ class Recorder:
             return
         rec = self.rec
         for i, c in enumerate(self.clumps):
-            st = O.bodies[c["id"]].state
+            st = self.states[i]
             theta = c["angle0"] + self.turned[i]
-            x, y = st.pos[0], st.pos[1]
+            pos, vel = st.pos, st.vel  # one copy of each vector
+            x, y = pos[0], pos[1]
             w = st.angVel[2]
             finite = math.isfinite(x) and math.isfinite(y) and math.isfinite(theta)
-            if not finite or st.vel.norm() > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
+            if not finite or vel.norm() > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
                 self.status, self.stop_time, self.stop_body = "failed", O.time, i
                 self.stop()
                 return
@@ -419,7 +423,7 @@ class Recorder:
             rec["ang"][k, i] = theta
             rec["angvel"][k, i] = w
             px, py = _rotate(c["point"], theta)
-            rec["vpoint"][k, i] = (st.vel[0] - w * py, st.vel[1] + w * px)
+            rec["vpoint"][k, i] = (vel[0] - w * py, vel[1] + w * px)
             if not c["fixed"] and abs(theta - c["rest"]) >= c["stop_angle"] and i not in self.overturn_times:
                 self.overturn_times[i] = O.time
                 if self.stop_on_overturn and self.status == "completed":
@@ -437,7 +441,7 @@ class Recorder:
         MAX_SPIN_RAD_S or turned more than ROTATION_STEP_MAX_RAD: it cannot be unwrapped."""
         raw, turned = self.raw, self.turned
         for i in self.moving:
-            st = O.bodies[self.clumps[i]["id"]].state
+            st = self.states[i]
             now = _orientation_angle(st.ori * self.clumps[i]["ori0"])
             step = math.remainder(now - raw[i], 2.0 * math.pi)
             raw[i] = now
@@ -461,9 +465,7 @@ class Recorder:
         ncont_k, slip_k = self.rec["ncont"][k], self.rec["slip"][k]
         vertex_of, polyhedra, block_of_prism = self.vertex_of, self.polyhedra, self.block_of_prism
         points = {}  # (block, other block or -1 for the base) -> vertices touching
-        for inter in O.interactions:
-            if not inter.isReal:
-                continue
+        for inter in O.interactions.all(True):  # the real ones, in the container's order
             id1, id2 = inter.id1, inter.id2
             where = vertex_of.get(id1)
             other = id2
