@@ -4,6 +4,7 @@ write through a link, a full disk named and cleaned up."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -259,3 +260,56 @@ def test_a_full_disk_names_the_file_leaves_no_partial_output_and_resume_goes_on(
     assert "EXIT2=0" in out, out + proc.stderr
     assert "completed" in out.split("EXIT2=0", 1)[1]
     assert "Traceback" not in proc.stderr
+
+
+def _yade_batch(folder, runs: int, duration_s: float, *extra: str) -> subprocess.Popen[str]:
+    """`rockyade batch` of ``runs`` YADE runs of specimen 1 (harmonic, then free rocking until
+    ``duration_s``) started from ``folder`` as a terminal would (its own session)."""
+    scene = (EXAMPLES / "specimen1_harmonic.toml").read_text()
+    scene = scene.replace("duration_s = 12.0", f"duration_s = {duration_s}")
+    (folder / "scene.toml").write_text(scene)
+    amplitudes = ", ".join(f"{4.0 + 0.1 * i:.1f}" for i in range(runs))
+    (folder / "study.toml").write_text(
+        'name = "warm"\nsolvers = ["yade"]\n[base]\nfile = "scene.toml"\n'
+        f'[grid]\n"motion.amplitude_mm" = [{amplitudes}]\n'
+    )
+    return subprocess.Popen(
+        [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", "out", "--quiet", *extra],
+        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )
+
+
+@pytest.mark.parametrize(
+    ("executor", "presses"), [("local", 2), ("dask", 2), ("local", 1)], ids=["local-twice", "dask-twice", "local-once"]
+)
+def test_ctrl_c_in_a_batch_leaves_no_warm_yade_behind(tmp_path, executor, presses):
+    """Ctrl-C (once: the running runs finish; twice: they stop at once) in a batch of YADE runs:
+    the batch exits with 130 and none of its warm YADE workers (a session of their own, which
+    the terminal's Ctrl-C does not reach) outlives it."""
+    if executor == "dask":
+        pytest.importorskip("dask")
+    proc = _yade_batch(tmp_path, 4, 40.0 if presses == 2 else 8.0, "--workers", "2", "--executor", executor)
+    try:
+        deadline = time.monotonic() + 180
+        yade: set[int] = set()
+        while len(yade) < 2 and proc.poll() is None and time.monotonic() < deadline:
+            yade = {p for p in descendants(proc.pid) if "--serve" in cmdline(p) and "driver.py" in cmdline(p)}
+            time.sleep(0.1)
+        assert len(yade) == 2, "two warm YADE workers"
+        time.sleep(1.0)  # the runs are under way
+        for press in range(presses):
+            if press:
+                time.sleep(0.3)
+            os.killpg(proc.pid, signal.SIGINT)
+        _stdout, stderr = proc.communicate(timeout=120)
+        assert proc.returncode == 130 and "Traceback" not in stderr, stderr
+        deadline = time.monotonic() + 10
+        while any(alive(p) for p in yade) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(alive(p) for p in yade), "a warm YADE worker outlived its batch"
+        summary = (tmp_path / "out" / "summary.csv").read_text()
+        assert ("stopped by Ctrl-C" in summary) == (presses == 2)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
