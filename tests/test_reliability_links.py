@@ -85,7 +85,7 @@ def test_a_stale_lock_file_of_a_dead_process_is_reused(tmp_path):
     lock = tmp_path / ".r.csv.lock"
     lock.write_text("999999\n")  # left by a killed writer: its flock died with it
     with output_lock(tmp_path / "r.csv"):
-        assert lock.read_text() == f"{os.getpid()}\n"
+        assert lock.read_text().split()[0] == str(os.getpid())  # the PID, then the lock's token
     assert not lock.exists()
 
 
