@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rockyade.motion.types import HarmonicMotion
 from rockyade.result import Result
 from rockyade.scene import Scene
 
@@ -146,7 +147,7 @@ def classify_result(scene: Scene, result: Result) -> PatternReport:
     lower, upper = scene.blocks
     span = None
     motion = scene.motion
-    if motion.type == "harmonic":
+    if isinstance(motion, HarmonicMotion):
         phases = motion.harmonic.phases_s
         span = (phases["ramp_up_end_s"], min(phases["stationary_end_s"], float(result.t[-1])))
     overturned = None

@@ -138,6 +138,7 @@ def static_acceleration(scene: Scene) -> tuple[float, str]:
         if result.status == "unstable":
             raise SceneCannotStandError(scene.source)
         if result.status == "collapse":
+            assert result.load_multiplier is not None  # a collapse carries its multiplier (limit.lp)
             values.append(float(result.load_multiplier) * result.model.g)
     if not values:
         return math.nan, "no mechanism in either direction"

@@ -231,7 +231,7 @@ class StripePlan:
 
     def tasks(self, levels_si: Sequence[float], first_index: int = 0) -> list[StripeTask]:
         """One task per record and level (level by level)."""
-        out = []
+        out: list[StripeTask] = []
         for level in levels_si:
             for i in range(self.motions.count):
                 lf = self.load_factor(i, level)

@@ -316,8 +316,8 @@ class Block:
             _positive(mass_kg, f"{field_prefix}mass_kg")
             mass = float(mass_kg)
         else:
-            _positive(density_kg_m3, f"{field_prefix}density_kg_m3")
-            mass = float(density_kg_m3) * section.area_m2 * float(thickness_m)
+            density = _positive(density_kg_m3, f"{field_prefix}density_kg_m3")
+            mass = density * section.area_m2 * float(thickness_m)
         if inertia_kgm2 is not None:
             _positive(inertia_kgm2, f"{field_prefix}inertia_kgm2")
             inertia = float(inertia_kgm2)
@@ -390,9 +390,10 @@ class Block:
             )
 
 
-def _positive(value: object, field_name: str) -> None:
-    """Raise InputError unless ``value`` is a finite number > 0."""
+def _positive(value: object, field_name: str) -> float:
+    """``value`` as a float; InputError unless it is a finite number > 0."""
     if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
         raise InputError(field_name, f"must be a number > 0, got {value!r}")
     if not np.isfinite(value) or value <= 0:
         raise InputError(field_name, f"must be a finite number > 0, got {value!r}")
+    return float(value)

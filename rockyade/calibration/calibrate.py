@@ -171,7 +171,9 @@ def calibrate(
     classical = {"alpha_rad": alpha_rad, "p_rad_s": p_rad_s, "mu": mu}
     joint = paper_calibration(
         block,
-        **classical,
+        alpha_rad=alpha_rad,
+        p_rad_s=p_rad_s,
+        mu=mu,
         stiffness_scale=c.stiffness_scale,
         friction_angle_deg=c.friction_angle_deg,
         supported_mass_kg=supported_mass_kg if c.K_N_per_m is None else None,
@@ -246,14 +248,15 @@ def _with_explicit_values(joint: ContactParameters, c: ContactSpec, mass_kg: flo
     """The paper's joint with the contact's explicit K, Ks and beta noted (K, Ks replaced;
     beta was given to Eqs 14-15 already); Eq 7's time step for the K used."""
     notes = list(joint.notes)
-    changes: dict[str, float] = {}
+    k, ks = joint.K_N_per_m, joint.Ks_N_per_m
     if c.K_N_per_m is not None:
-        changes.update(K_N_per_m=c.K_N_per_m, Ks_N_per_m=c.K_N_per_m)
+        k = ks = c.K_N_per_m
         notes.append("K_N_per_m explicit")
     if c.Ks_N_per_m is not None:
-        changes["Ks_N_per_m"] = c.Ks_N_per_m
+        ks = c.Ks_N_per_m
         notes.append("Ks_N_per_m explicit")
     if c.beta_s is not None:
         notes.append("beta_s explicit")
-    k = changes.get("K_N_per_m", joint.K_N_per_m)
-    return replace(joint, **changes, notes=tuple(notes), dt_eq7_s=time_step_eq7(mass_kg, k, c.time_step_frac))
+    return replace(
+        joint, K_N_per_m=k, Ks_N_per_m=ks, notes=tuple(notes), dt_eq7_s=time_step_eq7(mass_kg, k, c.time_step_frac)
+    )

@@ -323,12 +323,13 @@ def paper_calibration(
     ratio = gamma / used.mu**2
     if not lo <= ratio <= hi:
         notes.append(f"Gamma/mu^2 = {ratio:.0f} outside the paper's data ({lo:.0f}-{hi:.0f}): Eq 13 is extrapolated")
+    beta_eq13: float | None
     if beta_s is None:
         beta = beta_eq13 = stiffness_damping_eq13(gamma, used.mu)
     else:
         beta = float(beta_s)
         try:
-            beta_eq13: float | None = stiffness_damping_eq13(gamma, used.mu)
+            beta_eq13 = stiffness_damping_eq13(gamma, used.mu)
         except CalibrationError:
             beta_eq13 = None
             notes.append("Eq 13 has no value here (sqrt(b) < 0); beta_s explicit")

@@ -188,7 +188,7 @@ def dem_effective_mu(
     out, _ = simulate_model(model, record_energy=False)
     ang, status, n_filled = out[1], int(out[6]), int(out[7])
     theta = ang[:n_filled, 0]
-    t = np.arange(n_filled) * model.sample_dt_s
+    t = np.arange(n_filled, dtype=float) * model.sample_dt_s
     peaks = find_peaks(t, theta, min_peak_rad=1e-3 * cp.alpha_rad)
     if len(peaks) < N_IMPACTS + 1 or status != kernel.STATUS_COMPLETED:
         return math.nan

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import re
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility import (
@@ -22,23 +22,26 @@ from rockyade.cli.fragility import (
 )
 from rockyade.errors import InputError
 
+if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
+    from rockyade.assess import DynamicSettings, Position, Site
+
 #: Exit code of a scene that cannot stand (the answer is not a number).
 EXIT_UNSTABLE = 1
 
 
-def _site(args: argparse.Namespace) -> Any:
+def _site(args: argparse.Namespace) -> Site:
     from rockyade.assess import Site, parse_acceleration
 
     return Site(args.spectrum_type, args.ground, parse_acceleration(args.ag, "--ag"), args.importance)
 
 
-def _position(args: argparse.Namespace) -> Any:
+def _position(args: argparse.Namespace) -> Position:
     from rockyade.assess import Position
 
     return Position(args.z, args.building_height, args.storeys, args.t1)
 
 
-def _dynamic(args: argparse.Namespace) -> Any:
+def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
     """The dynamic settings, or None with ``--static-only`` (which then takes no dynamic option)."""
     from rockyade.assess import DynamicSettings, records_in_folder
 

@@ -66,6 +66,7 @@ def _blocks_from_args(args: argparse.Namespace) -> list[NamedBlock]:
         return out
     if args.thickness is None:
         raise InputError("--thickness", "is required with dimensions (m)")
+    verts: ArrayLike  # [[x, y], ...], m
     if args.vertices:
         try:
             verts = [[float(c) for c in pair.split(",")] for pair in args.vertices.split()]
@@ -139,7 +140,8 @@ def cmd_params(args: argparse.Namespace) -> int:
     """
     from rockyade.blocks.classical import classical_parameters
 
-    out, rectangles = {}, {}
+    out: dict[str, dict[str, Any]] = {}  # block name -> its JSON object
+    rectangles: dict[str, bool] = {}
     for name, block, overrides in _blocks_from_args(args):
         cp = classical_parameters(block, **overrides)
         rectangles[name] = _is_rectangle(block.vertices_m)

@@ -5,10 +5,16 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_dir
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:  # the parser stays fast: these are imported when a command runs
+    from rockyade.assess import SyntheticSuite
+    from rockyade.assess.motions import MotionSet
+    from rockyade.runner import Executor
+    from rockyade.solvers.base import Solver
 
 #: Records of a synthetic suite, and its seed, by default.
 DEFAULT_COUNT = 20
@@ -26,7 +32,7 @@ def float_list(text: str, option: str) -> tuple[float, ...]:
     return values
 
 
-def executor_from(args: argparse.Namespace) -> Any:
+def executor_from(args: argparse.Namespace) -> Executor:
     """Local worker processes (``--workers``)."""
     from rockyade.runner import Executor
 
@@ -36,7 +42,7 @@ def executor_from(args: argparse.Namespace) -> Any:
         raise InputError("--workers", exc.message) from None
 
 
-def solver_from(args: argparse.Namespace) -> Any:
+def solver_from(args: argparse.Namespace) -> Solver | None:
     """The ``--solver`` with ``--yade-timeout`` (None: the default for the scene)."""
     if args.solver is None:
         if args.yade_timeout is not None:
@@ -48,7 +54,7 @@ def solver_from(args: argparse.Namespace) -> Any:
     return solver
 
 
-def suite_from(args: argparse.Namespace) -> Any:
+def suite_from(args: argparse.Namespace) -> SyntheticSuite:
     """The synthetic suite of ``--suite`` (ec8: ``--spectrum-type``, ``--ground``, ``--ag``)."""
     from rockyade.assess import ec8_suite, paper_suite_set, parse_acceleration
 
@@ -151,7 +157,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
             if getattr(args, option) is not None:
                 raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8, not to --records")
         refuse_suite_options_with_records(args)
-        motions = records_in_folder(args.records, args.units)
+        motions: MotionSet = records_in_folder(args.records, args.units)
     else:
         if args.units is not None:
             raise InputError("--units", "applies to --records")

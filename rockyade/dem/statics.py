@@ -196,7 +196,7 @@ def static_displacement(
         return None
     if not np.all(np.isfinite(u)):
         return None
-    residual = np.linalg.norm(K @ u - f) / max(np.linalg.norm(f), 1e-300)
+    residual = np.linalg.norm(K @ u - f) / max(float(np.linalg.norm(f)), 1e-300)
     if residual > 1e-6:
         return None
     out = np.zeros((len(fixed), 3))

@@ -501,13 +501,13 @@ def animation_writer_for(path: str | Path, fps: float):
     if suffix == ".gif":
         if not animation.writers.is_available("pillow"):
             raise InputError("animation", "writing a GIF needs Pillow, which is not installed (pip install pillow)")
-        return animation.PillowWriter(fps=fps)
+        return animation.PillowWriter(fps=fps)  # type: ignore[arg-type]  # any fps > 0 works; the stub says int
     if suffix == ".mp4":
         if not animation.writers.is_available("ffmpeg"):
             raise InputError(
                 "animation", "writing an MP4 needs ffmpeg, which is not installed here: write a .gif instead"
             )
-        return animation.FFMpegWriter(fps=fps)
+        return animation.FFMpegWriter(fps=fps)  # type: ignore[arg-type]  # any fps > 0 works; the stub says int
     raise InputError("animation", f"must end in .gif (Pillow) or .mp4 (ffmpeg), got {suffix or 'no suffix'!r}")
 
 

@@ -24,7 +24,7 @@ from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import VERIFIED
 from rockyade.assess.fragility import FragilityResult
 from rockyade.constants import G
-from rockyade.figures.common import new_figure, save_figure
+from rockyade.figures.common import figure_of, new_figure, save_figure
 
 CURVE = "#1f4e79"
 BAND = "#9ecae1"
@@ -51,7 +51,7 @@ def plot_fragility(
     if ax is None:
         fig, ax = new_figure(None, figsize=(6.4, 4.2))
     else:
-        fig = ax.figure
+        fig = figure_of(ax)
     m, fit = result.measure, result.fit
     s = result.stripes
     x = s[m.si_column].to_numpy() / m.scale
@@ -112,7 +112,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
     if ax is None:
         fig, ax = new_figure(None, figsize=(6.4, 4.2))
     else:
-        fig = ax.figure
+        fig = figure_of(ax)
     kin = a.limit.kinematic
     if kin is None:
         ax.text(0.5, 0.5, f"no mechanism ({a.limit.status})", ha="center", va="center", transform=ax.transAxes)
@@ -156,7 +156,10 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
                 zorder=6,
                 label=f"{c.name}: demand SDe(Ts = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})",
             )
-            ax.axvline(kin.du_star_m * 1e3, color=CURVE, ls="--", lw=1.2, label=f"du* = {kin.du_star_m * 1e3:.3g} mm")
+            if kin.du_star_m is not None:  # None when the mechanism has no ultimate displacement
+                ax.axvline(
+                    kin.du_star_m * 1e3, color=CURVE, ls="--", lw=1.2, label=f"du* = {kin.du_star_m * 1e3:.3g} mm"
+                )
             if kin.ds_star_m is not None and kin.as_star_m_s2 is not None:
                 ax.plot([kin.ds_star_m * 1e3], [kin.as_star_m_s2], "s", color=CURVE, ms=4)
             ymax = max(ymax, se)

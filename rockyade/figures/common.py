@@ -62,6 +62,13 @@ def axes_list(ax: Axes | Sequence[Axes] | np.ndarray, count: int, field_name: st
     return items
 
 
+def figure_of(ax: Axes) -> Figure:
+    """The Figure ``ax`` is drawn in: ``ax.figure``, or the top-level Figure when ``ax`` lies in
+    a SubFigure (only a Figure can be saved)."""
+    fig = ax.figure
+    return fig if isinstance(fig, Figure) else fig.figure
+
+
 def save_figure(fig: Figure, path: str | Path, dpi: int = 130) -> Path:
     """Write ``fig`` as PNG atomically (the file is complete or absent); return the path."""
     path = Path(path)

@@ -15,7 +15,7 @@ from pathlib import Path
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
 from rockyade.result import Result
 
 #: Line styles cycled over the results, so that overlapping curves stay distinguishable.
@@ -127,7 +127,7 @@ class HistoryDisplay:
             axes = list(grid[:, 0])
         else:
             axes = axes_list(ax, len(blocks))
-            fig = axes[0].figure
+            fig = figure_of(axes[0])
         for panel, block in zip(axes, blocks, strict=True):
             for i, (label, res) in enumerate(self.results.items()):
                 style = LINE_STYLES[i % len(LINE_STYLES)]

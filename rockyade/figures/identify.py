@@ -11,7 +11,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from scipy import stats
 
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
 from rockyade.identification.fit import CONFIDENCE, Identification, error_surface
 
 
@@ -47,28 +47,30 @@ def plot_fit(
     modelled = result.modelled()
     resid = h.theta_rad - modelled
     if ax is None:
-        fig, (ax, axr) = new_figure(
+        fig, (axh, axr) = new_figure(
             path, 2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
         )
     else:
-        ax, axr = axes_list(ax, 2)
-        fig = ax.figure
-    ax.plot(h.t_s, h.theta_rad, ".", ms=2.0, color="0.45", label=f"measured ({h.rate_hz:.4g} Hz)")
-    ax.plot(h.t_s, modelled, "-", lw=1.1, color="C3", label="Housner, identified parameters")
-    ax.axhline(result.fit.offset_rad, color="0.6", lw=0.6, ls="--", label=f"offset {result.fit.offset_rad:.3g} rad")
-    ax.axvline(
+        axh, axr = axes_list(ax, 2)
+        fig = figure_of(axh)
+    axh.plot(h.t_s, h.theta_rad, ".", ms=2.0, color="0.45", label=f"measured ({h.rate_hz:.4g} Hz)")
+    axh.plot(h.t_s, modelled, "-", lw=1.1, color="C3", label="Housner, identified parameters")
+    axh.axhline(result.fit.offset_rad, color="0.6", lw=0.6, ls="--", label=f"offset {result.fit.offset_rad:.3g} rad")
+    axh.axvline(
         result.fit.release_time_s, color="C0", lw=0.8, ls=":", label=f"release t = {result.fit.release_time_s:.4g} s"
     )
-    ax.set_ylabel("theta (rad)")
-    ax.grid(alpha=0.3)
-    ax.legend(loc="upper right", fontsize=8)
+    axh.set_ylabel("theta (rad)")
+    axh.grid(alpha=0.3)
+    axh.legend(loc="upper right", fontsize=8)
     pct = round(100 * CONFIDENCE)
     lines = [
         _value_text(result, "alpha_rad", " rad", 4),
         _value_text(result, "p_rad_s", " 1/s", 3),
         _value_text(result, "mu", "", 4),
     ]
-    ax.set_title(f"{Path(h.source).name or 'measurement'}: " + ";  ".join(lines) + f"  ({pct} % intervals)", fontsize=9)
+    axh.set_title(
+        f"{Path(h.source).name or 'measurement'}: " + ";  ".join(lines) + f"  ({pct} % intervals)", fontsize=9
+    )
     axr.plot(h.t_s, resid, lw=0.6, color="0.3")
     axr.axhline(0.0, color="C3", lw=0.6)
     axr.set_ylabel("measured - model (rad)")
@@ -90,7 +92,7 @@ def plot_fit(
         )
     if path is not None:
         save_figure(fig, path)
-    return fig, (ax, axr)
+    return fig, (axh, axr)
 
 
 def plot_error_surface(
@@ -128,7 +130,7 @@ def plot_error_surface(
         fig, ax = new_figure(path, figsize=(7.4, 5.8))
     else:
         ax = axes_list(ax, 1)[0]
-        fig = ax.figure
+        fig = figure_of(ax)
     levels = np.geomspace(rms.min(), rms.max(), 16)
     cs = ax.contourf(alphas, ps, rms, levels=levels, cmap="viridis_r", norm=_log_norm(levels))
     ax.contour(alphas, ps, rms, levels=levels, colors="k", linewidths=0.3)

@@ -17,6 +17,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
@@ -56,7 +57,7 @@ def displaced_polygons(result: LimitResult) -> tuple[list[np.ndarray], float]:
         return rest, 0.0
     vel = mech.velocities
     peak = 0.0
-    for i in np.flatnonzero(mech.moving):
+    for i in np.flatnonzero(mech.moving).tolist():
         v = np.array([point_velocity(vel[i], model.centroids_m[i], p) for p in rest[i]])
         peak = max(peak, float(np.max(np.hypot(v[:, 0], v[:, 1]))))
     omega = float(np.max(np.abs(vel[:, 2])))
@@ -122,7 +123,7 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
         _draw_rest_outline(ax, rest)
         colours = [MOVING if mech.moving[i] else STONE for i in range(model.n_blocks) if not fixed[i]]
     _draw_blocks(ax, moved, fixed, facecolors=colours or None)
-    handles = []
+    handles: list[Artist] = []
     if mech is not None:
         vel = mech.velocities
         for slide in mech.sliding:
@@ -153,7 +154,7 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
             handles.append(Line2D([], [], color=SLIDE, linewidth=3.0, label="sliding joint"))
         ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, framealpha=0.9)
     heading = title or "limit analysis"
-    if result.status == "collapse":
+    if result.status == "collapse" and mech is not None:  # a collapse always has its mechanism
         heading += (
             f": collapse at lambda = {result.load_multiplier:.4f} towards {result.direction} "
             f"({plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')})"
@@ -163,7 +164,7 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
         heading += ": unstable, it cannot stand under gravity alone (no multiplier)"
     else:
         heading += ": no mechanism (lambda unbounded)"
-    if cax is None:
+    if cax is None or curve is None:  # cax is made only with a capacity curve
         ax.set_title(heading, fontsize=10)
     else:
         fig.suptitle(heading, fontsize=10)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -9,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rockyade.constants import ACCEL_UNIT_LABELS
-from rockyade.figures.common import accel_scale, axes_list, new_figure, other_accel_axis, save_figure
+from rockyade.figures.common import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
 
 
 def plot_accelerogram(
@@ -34,7 +35,7 @@ def plot_accelerogram(
         axes = list(axes)
     else:
         axes = axes_list(ax, 3)
-        fig = axes[0].figure
+        fig = figure_of(axes[0])
     labels = (f"acceleration ({ACCEL_UNIT_LABELS[accel_unit]})", "velocity (m/s)", "displacement (m)")
     for panel, y, label in zip(axes, (np.asarray(accel) / scale, vel, disp), labels, strict=True):
         panel.plot(t, y, lw=0.7)
@@ -54,7 +55,7 @@ def plot_spectra(
     target: ArrayLike | None,
     mean: ArrayLike | None,
     path: str | Path | None = None,
-    individual: ArrayLike | None = None,
+    individual: Iterable[ArrayLike] | None = None,
     title: str = "",
     band: float = 0.1,
     ax: Any = None,

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from rockyade.constants import ACCEL_UNIT_LABELS, ACCEL_UNIT_TEXT, LOAD_FACTOR_LABEL
-from rockyade.figures.common import accel_scale, axes_list, new_figure, other_accel_axis, save_figure
+from rockyade.figures.common import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
 from rockyade.motion.intensity import LABELS
 from rockyade.probability.exceedance import level_column
 from rockyade.probability.fragility import Fragility, wilson_interval
@@ -63,7 +63,7 @@ def plot_uncertainty(
         fig, axes = new_figure(path, 1, 3, figsize=(16, 4.8))
     else:
         axes = axes_list(ax, 3)
-        fig = axes[0].figure
+        fig = figure_of(axes[0])
     ax = axes[0]
     styles = ["--", ":", "-."]
     markers = ["v", "^", "D"]

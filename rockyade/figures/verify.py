@@ -86,15 +86,15 @@ def plot_check(check: str, results: dict[str, Result], path: str | Path | None =
     else:
         for solver, result in results.items():
             exact = solver.startswith("housner")
-            for k, (name, legend) in enumerate(panels):
-                theta = _series(result, None if exact else name)
-                if theta is None or (exact and k > 0):
+            for k, (panel, legend) in enumerate(panels):
+                series = _series(result, None if exact else panel)
+                if series is None or (exact and k > 0):
                     continue
                 colour, style = ("k", ":") if exact else STYLES.get(solver, ("0.3", "-"))
                 width = 2.0 if exact else 1.1
                 ax.plot(
                     result.t,
-                    theta,
+                    series,
                     style,
                     color=colour if k == 0 or exact else f"C{k + 4}",
                     lw=width,

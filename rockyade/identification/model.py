@@ -74,7 +74,8 @@ class FreeRockingFit:
         side
             The side the block was tilted to: +1 or -1.
         """
-        return cls(*(float(v) for v in x), side=side)
+        alpha_rad, p_rad_s, mu, release_time_s, offset_rad, release_ratio = (float(v) for v in x)
+        return cls(alpha_rad, p_rad_s, mu, release_time_s, offset_rad, release_ratio, side=side)
 
     @property
     def theta0_rad(self) -> float:
@@ -186,4 +187,4 @@ def synthetic_measurement(
     theta = model_history(truth, 0.0, dt, n)[0]
     rng = np.random.default_rng(seed)
     theta = theta + noise_rad * rng.standard_normal(n)
-    return measured_history(np.arange(n) * dt, theta, source)
+    return measured_history(np.arange(n, dtype=float) * dt, theta, source)

@@ -118,7 +118,7 @@ class LimitResult:
             out["hinges"] = [h.to_dict() for h in mech.hinges]
             out["sliding"] = [s.to_dict() for s in mech.sliding]
             out["checks"] = mech.checks.to_dict()
-        if self.normal_N is not None:
+        if self.normal_N is not None and self.tangential_N is not None:  # both or neither
             out["contacts"] = [
                 {
                     "a": model.body_name(itf.a),
@@ -179,12 +179,13 @@ def limit_analysis(
     if angles == {None} or not model.interfaces:
         phi: float | str | None = None
     elif len(angles) == 1:
-        phi = float(next(iter(angles)))
+        phi = float(next(a for a in angles if a is not None))
     else:
         phi = "scene"
     sol = solve_equilibrium(model, direction)
     if sol.status != "collapse":
         return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s)
+    assert sol.load_multiplier is not None  # a "collapse" always carries its multiplier (lp.py)
     mech = mechanism_of(model, sol)
     kin = kinematic_quantities(model, mech, sol.load_multiplier, direction, fc=fc, nonlinear=nonlinear)
     return LimitResult(

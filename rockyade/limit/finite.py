@@ -185,7 +185,7 @@ class _Kinematics:
 
     def constraints(self, s: NDArray[np.float64]):
         """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
-        rows = [self._rows(s, k) for k in np.flatnonzero(self.active)]
+        rows = [self._rows(s, int(k)) for k in np.flatnonzero(self.active)]
         if not rows:
             return np.zeros(0), np.zeros((0, self.n_dof))
         return np.concatenate([r[0] for r in rows]), np.vstack([r[1] for r in rows])
@@ -223,7 +223,7 @@ class _Kinematics:
         d = DIRECTIONS[self.direction]
         eq, ub = [], []
         index = np.flatnonzero(self.active)
-        rows = [self._rows(s, k) for k in index]
+        rows = [self._rows(s, int(k)) for k in index]
         for _, J, n in rows:
             t = np.array([-n[1], n[0]])
             eq.append(t @ J)
@@ -271,7 +271,7 @@ class _Kinematics:
             previous = target
         q = (basis @ (basis.T @ (previous * self.scale))) / self.scale
         norm = np.linalg.norm(q)
-        if norm < 1e-12 * max(np.linalg.norm(previous), 1e-300):
+        if norm < 1e-12 * max(float(np.linalg.norm(previous)), 1e-300):
             return None
         return q / norm
 
@@ -328,9 +328,9 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     group_k = kin.group_of[control_block]
     c_k = model.centroids_m[control_block]
     s = np.zeros(kin.n_dof)
-    q = kin.initial_velocity(mechanism.velocities)
+    q0 = kin.initial_velocity(mechanism.velocities)
     dks, alphas = [0.0], []
-    q = kin.velocity(s, q)
+    q = kin.velocity(s, q0)
     if q is None:
         return CapacityCurve(np.array([0.0]), np.array([np.nan]), None, "the joints lock the mechanism", 0.0)
 

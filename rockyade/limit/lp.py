@@ -181,6 +181,7 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
         if res.status != 0 or cap is None or res.x[lam_col] < 0.999 * cap:
             break
     elapsed = time.perf_counter() - t0
+    assert res is not None  # the loop above runs at least once
     if res.status == 2:
         return LPSolution("unstable", None, direction, None, None, None, elapsed, res.message)
     if res.status == 3:

@@ -7,7 +7,7 @@ steps forward in time) and Housner's integrator (whose root finding goes back an
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -58,7 +58,7 @@ def ground_acceleration(t: float, t_s, ah, av, hint: int) -> tuple[float, float,
     return ah[j] + w * (ah[j + 1] - ah[j]), av[j] + w * (av[j + 1] - av[j]), j
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, init=False)
 class GroundMotion:
     """Horizontal (and optional vertical) base acceleration, linear between samples.
 
@@ -79,13 +79,15 @@ class GroundMotion:
 
     t_s: NDArray[np.float64]
     ah_m_s2: NDArray[np.float64]
-    av_m_s2: NDArray[np.float64] = field(default=None)  # type: ignore[assignment]
+    av_m_s2: NDArray[np.float64]
     label: str = ""
 
-    def __post_init__(self) -> None:
-        t = np.ascontiguousarray(self.t_s, dtype=float)
-        ah = np.ascontiguousarray(self.ah_m_s2, dtype=float)
-        av = np.zeros_like(ah) if self.av_m_s2 is None else np.ascontiguousarray(self.av_m_s2, dtype=float)
+    def __init__(self, t_s: ArrayLike, ah_m_s2: ArrayLike, av_m_s2: ArrayLike | None = None, label: str = "") -> None:
+        # Written out (not the dataclass's) so that the arguments may be any array-like and
+        # ``av_m_s2`` None (no vertical motion), while the attributes are always float arrays.
+        t = np.ascontiguousarray(t_s, dtype=float)
+        ah = np.ascontiguousarray(ah_m_s2, dtype=float)
+        av = np.zeros_like(ah) if av_m_s2 is None else np.ascontiguousarray(av_m_s2, dtype=float)
         if t.ndim != 1 or t.size < 2 or ah.shape != t.shape or av.shape != t.shape:
             raise ValueError("t_s, ah_m_s2 and av_m_s2 must be 1-D arrays of the same length >= 2")
         if not np.all(np.diff(t) > 0):
@@ -95,6 +97,7 @@ class GroundMotion:
         object.__setattr__(self, "t_s", t)
         object.__setattr__(self, "ah_m_s2", ah)
         object.__setattr__(self, "av_m_s2", av)
+        object.__setattr__(self, "label", label)
 
     @classmethod
     def uniform(cls, dt_s: float, ah: ArrayLike, av: ArrayLike | None = None, label: str = "") -> GroundMotion:
@@ -114,11 +117,11 @@ class GroundMotion:
 
     def horizontal(self, t: ArrayLike) -> NDArray[np.float64]:
         """Horizontal base acceleration at times ``t``, m/s^2."""
-        return np.interp(t, self.t_s, self.ah_m_s2, left=0.0, right=0.0)
+        return np.interp(np.asarray(t, dtype=float), self.t_s, self.ah_m_s2, left=0.0, right=0.0)
 
     def vertical(self, t: ArrayLike) -> NDArray[np.float64]:
         """Vertical base acceleration at times ``t``, m/s^2."""
-        return np.interp(t, self.t_s, self.av_m_s2, left=0.0, right=0.0)
+        return np.interp(np.asarray(t, dtype=float), self.t_s, self.av_m_s2, left=0.0, right=0.0)
 
     def velocity_displacement(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Horizontal base velocity (m/s) and displacement (m) at ``t_s``, from rest.

@@ -37,6 +37,7 @@ import math
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -158,7 +159,8 @@ class Record:
 
     def with_accel(self, accel: np.ndarray, note: str) -> Record:
         """A copy with other acceleration samples (processing history in ``extra``)."""
-        history = [*list(self.extra.get("processing", [])), note]  # type: ignore[arg-type]
+        done = cast("list[str]", self.extra.get("processing", []))  # only this method writes it: a list
+        history = [*done, note]
         return Record(
             self.t_s,
             np.asarray(accel, dtype=float),

@@ -218,7 +218,7 @@ def generate_record(spec: SuiteSpec, index: int) -> Record:
     rng = np.random.default_rng(np.random.SeedSequence(spec.seed, spawn_key=(index,)))
     n = round(spec.envelope.duration_s / spec.dt_s) + 1
     nfft = 1 << math.ceil(math.log2(2 * n))  # zero padding: no wrap-around
-    t = np.arange(n) * spec.dt_s
+    t = np.arange(n, dtype=float) * spec.dt_s
     freq_hz = np.fft.rfftfreq(nfft, spec.dt_s)
     omega = 2.0 * np.pi * freq_hz
     G = vanmarcke_psd(spec, omega)

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypeVar
 
 from rockyade.result import Result
 from rockyade.runner.executor import IN_THIS_THREAD, Executor
@@ -26,6 +26,9 @@ from rockyade.runner.tasks import Task, check_costs, failed_task, solve
 from rockyade.runner.threads import Failed
 from rockyade.scene import Scene
 from rockyade.solvers.base import Solver
+
+#: A kind of task (Task or a subclass carrying more, e.g. a batch row's parameters).
+TaskT = TypeVar("TaskT", bound=Task)
 
 
 @dataclass(frozen=True)
@@ -130,11 +133,11 @@ def run_jobs(
 
 
 def run_tasks(
-    tasks: Sequence[Task],
-    fn: Callable[[Task], Any] = solve,
+    tasks: Sequence[TaskT],
+    fn: Callable[[TaskT], Any] = solve,
     *,
     allow_large: bool = False,
-    failed: Callable[[Task, str], Any] = failed_task,
+    failed: Callable[[TaskT, str], Any] = failed_task,
     **options: Any,
 ) -> Outcome:
     """Check the tasks' costs (before any run: :func:`~rockyade.runner.tasks.check_costs`),

@@ -11,9 +11,19 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TypedDict
 
 from rockyade.constants import G
 from rockyade.errors import InputError, at_least, at_most
+
+
+class NumberBounds(TypedDict):
+    """The range keywords of :meth:`rockyade.io.fields.TableReader.number`."""
+
+    lo: float
+    hi: float
+    lo_open: bool
+    unit: str
 
 
 @dataclass(frozen=True)
@@ -25,7 +35,7 @@ class Bound:
     unit: str = ""
     lo_open: bool = False
 
-    def kwargs(self) -> dict[str, object]:
+    def kwargs(self) -> NumberBounds:
         """Keyword arguments of :meth:`rockyade.io.fields.TableReader.number`."""
         return {"lo": self.lo, "hi": self.hi, "lo_open": self.lo_open, "unit": self.unit}
 

@@ -39,7 +39,10 @@ OptionCheck = Callable[[Any, str], Any]
 class Solver(Protocol):
     """The interface every solver offers (see the module docstring)."""
 
-    name: str
+    @property
+    def name(self) -> str:
+        """The registry's name of this solver (a class attribute in :class:`SolverBase`)."""
+        ...
 
     def run(self, scene: Scene) -> Result:
         """Run ``scene``; a failed run is a Result with status ``failed`` or an exception."""
@@ -49,7 +52,7 @@ class Solver(Protocol):
         """What running ``scene`` will cost (steps, samples, memory, time)."""
         ...
 
-    def keeping_files(self, folder: str | Path, stem: str | None = None) -> Solver:
+    def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """This solver with the files it keeps in ``folder``, named ``stem`` (default: the
         scene hash and the solver's name); itself when it keeps none."""
         ...
@@ -103,7 +106,8 @@ class SolverBase:
         super().__init_subclass__(**kwargs)
         run = cls.__dict__.get("run")
         if run is not None and not getattr(run, "records_coverage", False):
-            cls.run = _with_coverage(run)  # type: ignore[attr-defined]
+            # Replacing each subclass's own run with its wrapped self is deliberate (class docstring).
+            cls.run = _with_coverage(run)  # type: ignore[method-assign,assignment]
 
     @classmethod
     def from_options(cls, options: Mapping[str, Any], fields: Mapping[str, str] | None = None) -> Self:
@@ -128,3 +132,13 @@ class SolverBase:
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """Itself: this solver keeps no files."""
         return self
+
+    if TYPE_CHECKING:  # declared for the checker only: every subclass defines both (Solver protocol)
+
+        def run(self, scene: Scene) -> Result:
+            """Run ``scene`` (defined by each subclass)."""
+            ...
+
+        def estimate_cost(self, scene: Scene) -> CostEstimate:
+            """What running ``scene`` will cost (defined by each subclass)."""
+            ...

@@ -21,6 +21,7 @@ from rockyade.figures import new_figure, save_figure
 from rockyade.figures.styles import SOLVER_LABELS, plot_solver
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
+from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
@@ -53,7 +54,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     scenes = [c["scene"] for c in runnable]
     on = Executor("threads", workers)
     dem = ReferenceSolver(record_energy=False, record_contacts=False)
-    solvers = {"reference": (dem, "free rocking: reference DEM")}
+    solvers: dict[str, tuple[Solver, str]] = {"reference": (dem, "free rocking: reference DEM")}
     if use_yade:
         solvers["yade"] = (YadeSolver(), "free rocking: YADE")
     for name, (solver, desc) in solvers.items():
@@ -103,7 +104,9 @@ def _cases() -> list[dict]:
                 scene = _free_scene(key, params, cal)
                 note, beta = "", math.nan
                 try:
-                    beta = calibrated_model(scene).bodies[0].joint.beta_s
+                    joint = calibrated_model(scene).bodies[0].joint
+                    assert joint is not None  # a calibrated model's bodies carry their joint
+                    beta = joint.beta_s
                 except CalibrationError as exc:
                     note = f"matched calibration not reachable: {exc}"
                     scene = None

@@ -124,6 +124,23 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
 
 
 def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> Figure:
+    """The overturning spectrum (``overturning_spectrum.png`` in the report's folder).
+
+    Parameters
+    ----------
+    report
+        The report the figure is written to.
+    scan
+        The runs scanned: one row per solver, frequency ratio and amplitude ratio (-), and
+        whether the block overturned.
+    spectrum
+        The minimum overturning amplitude ratio (-) against the frequency ratio (-).
+
+    Returns
+    -------
+    Figure
+        The figure, written as PNG.
+    """
     name = "overturning_spectrum.png"
     fig, ax = new_figure(report.out / name, figsize=(8.5, 5.5))
     housner_colour = SOLVER_STYLES["housner"]["color"]

@@ -21,6 +21,8 @@ from matplotlib.patches import Rectangle
 
 from rockyade.figures import new_figure, save_figure
 from rockyade.motion.analytic import Harmonic
+from rockyade.motion.spec import MotionSpec
+from rockyade.motion.types import HarmonicMotion
 from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.report import Report, run_state
 from rockyade.studies.specimens import biblock_blocks, scene_dict
@@ -60,6 +62,13 @@ def paper_pattern(freq: float, amp: float) -> str | None:
     return None
 
 
+def _frequency_hz(motion: MotionSpec) -> float:
+    """The frequency of a map cell's harmonic base motion, Hz."""
+    if not isinstance(motion, HarmonicMotion):
+        raise TypeError(f"the pattern map runs harmonic motions only, got {motion.type!r}")
+    return motion.frequency_hz
+
+
 def run(report: Report, workers: int = 2) -> pd.DataFrame:
     """Run the map; write ``pattern_map.csv`` and its figure; return the cells."""
     report.section(
@@ -88,7 +97,7 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
             save_history=False,
         )
     tasks = [
-        replace(t, index=i, labels={**t.labels, "frequency_hz": t.scene.motion.frequency_hz}, save_history=False)
+        replace(t, index=i, labels={**t.labels, "frequency_hz": _frequency_hz(t.scene.motion)}, save_history=False)
         for i, t in enumerate(tasks)
     ]
     summary = run_study_tasks(tasks, report.out / "pattern_map_runs", workers=workers, desc="pattern map")
@@ -106,7 +115,7 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
         "pattern_map.csv", cells, "dominant pattern of every cell (DEM) and the paper's, where it reports one."
     )
     reported = cells.dropna(subset=["pattern_paper"])
-    stats = {}
+    stats: dict[str, tuple[int, int]] = {}
     for pattern in ("2", "3"):
         sel = reported[reported.pattern_paper == pattern]
         stats[pattern] = (int(sel["agree"].astype(bool).sum()), len(sel))
@@ -114,7 +123,24 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     return cells
 
 
-def draw_figure(report: Report, cells: pd.DataFrame, stats) -> Figure:
+def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int, int]]) -> Figure:
+    """The map of rocking patterns over base-motion frequency (Hz) and amplitude (mm)
+    (``pattern_map.png`` in the report's folder), the paper's patterns beside the DEM's.
+
+    Parameters
+    ----------
+    report
+        The report the figure is written to.
+    cells
+        One row per frequency (Hz) and amplitude (mm): the DEM's dominant pattern and the paper's.
+    stats
+        Pattern -> (cells where the DEM agrees with the paper, cells in the paper's region).
+
+    Returns
+    -------
+    Figure
+        The figure, written as PNG.
+    """
     name = "pattern_map.png"
     fig, ax = new_figure(report.out / name, figsize=(10.5, 6))
     f_index = {f: i for i, f in enumerate(FREQUENCIES_HZ)}

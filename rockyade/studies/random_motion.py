@@ -16,8 +16,10 @@ from matplotlib.figure import Figure
 
 from rockyade.figures import new_figure, save_figure
 from rockyade.figures.styles import SOLVER_LABELS, plot_solver
+from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
-from rockyade.scene import scene_from_dict
+from rockyade.scene import Scene, scene_from_dict
+from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
@@ -37,13 +39,16 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "spectrum-compatible with the same target but are other realisations.",
     )
     rows = []
-    cases = []
+    cases: list[tuple[str, int, float, Scene, dict[str, Result]]] = []  # key, record, load factor, scene, results
     for key, record, factor in CASES:
         motion = {"type": "synthetic", "suite": "paper", "record": record, "load_factor": factor}
         scene = scene_from_dict(scene_dict([block_table(key)], motion, DURATION_S, 0.005, "matched"))
         cases.append((key, record, factor, scene, {}))
     scenes = [c[3] for c in cases]
-    solvers = [(HousnerSolver(), "Housner"), (ReferenceSolver(record_energy=False), "reference DEM")]
+    solvers: list[tuple[Solver, str]] = [
+        (HousnerSolver(), "Housner"),
+        (ReferenceSolver(record_energy=False), "reference DEM"),
+    ]
     if use_yade:
         solvers.append((YadeSolver(), "YADE"))
     on = Executor("threads", workers)
@@ -53,7 +58,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
             case[4][solver.name] = r
     for key, record, factor, scene, results in cases:
         alpha = scene.blocks[0].alpha_rad
-        for solver, r in results.items():
+        for solver_name, r in results.items():
             report.record_result(f"specimen {key}, record {record} x {factor}", r)
             theta = r.series("theta_rad") if r.ok else np.array([np.nan])
             rows.append(
@@ -61,7 +66,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                     "specimen": key,
                     "record": record,
                     "load_factor": factor,
-                    "solver": solver,
+                    "solver": solver_name,
                     "status": r.status,
                     "collapse": r.status == "overturned",
                     "overturn_time_s": r.meta.get("overturn_time_s"),
@@ -83,8 +88,32 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     return table
 
 
-def draw_figure(report: Report, key, record, factor, scene, results) -> Figure:
+def draw_figure(
+    report: Report, key: str, record: int, factor: float, scene: Scene, results: dict[str, Result]
+) -> Figure:
+    """One specimen under one synthetic record: the base acceleration (m/s^2) and each
+    solver's rotation over alpha (-) against time (s)
+    (``random_specimen<key>_record<record>.png`` in the report's folder).
+
+    Parameters
+    ----------
+    report
+        The report the figure is written to.
+    key, record, factor
+        The specimen, the record's number and its load factor (-).
+    scene
+        The scene that was run.
+    results
+        The Results, by solver name.
+
+    Returns
+    -------
+    Figure
+        The figure, written as PNG.
+    """
     gm = scene.motion.ground_motion(scene.duration_s)
+    alpha = scene.blocks[0].alpha_rad
+    assert gm is not None and alpha is not None  # a synthetic record; the specimens' measured alpha (specimens.py)
     name = f"random_specimen{key}_record{record}.png"
     note = no_uplift_note(scene, results)
     fig, axes = new_figure(
@@ -92,7 +121,6 @@ def draw_figure(report: Report, key, record, factor, scene, results) -> Figure:
     )
     axes[0].plot(gm.t_s, gm.ah_m_s2, color="0.3", lw=0.6)
     axes[0].set_ylabel("a_g (m/s$^2$)")
-    alpha = scene.blocks[0].alpha_rad
     for solver, r in results.items():
         if not r.ok:
             axes[1].plot([], [], color="red", ls="none", marker="x", label=f"{SOLVER_LABELS[solver]}: FAILED, no curve")

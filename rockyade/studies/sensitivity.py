@@ -41,14 +41,16 @@ def _responses(block: dict, solver: Solver, report: Report, label: str) -> dict[
             [block], {"type": "harmonic", "amplitude_mm": 6.0, "frequency_hz": 3.3, "cycles": 20}, 9.0, 0.002, "matched"
         )
     )
-    out = {}
+    out: dict[str, float] = {}
     r = solver.run(free)
     report.record_result(f"{label}, free rocking", r)
-    peaks = find_peaks(r.t, r.series("theta_rad"), 1e-4) if r.ok else []
-    out[f"free rocking: peak {PEAK} amplitude (rad)"] = (
-        float(peaks.amplitude_rad[PEAK - 1]) if len(peaks) >= PEAK else math.nan
-    )
-    out[f"free rocking: peak {PEAK} time (s)"] = float(peaks.t_s[PEAK - 1]) if len(peaks) >= PEAK else math.nan
+    peaks = find_peaks(r.t, r.series("theta_rad"), 1e-4) if r.ok else None
+    if peaks is not None and len(peaks) >= PEAK:
+        amplitude, time = float(peaks.amplitude_rad[PEAK - 1]), float(peaks.t_s[PEAK - 1])
+    else:
+        amplitude = time = math.nan
+    out[f"free rocking: peak {PEAK} amplitude (rad)"] = amplitude
+    out[f"free rocking: peak {PEAK} time (s)"] = time
     r = solver.run(sine)
     report.record_result(f"{label}, 3.3 Hz / 6 mm sine", r)
     out["3.3 Hz / 6 mm sine: max |theta| (rad)"] = float(np.max(np.abs(r.series("theta_rad")))) if r.ok else math.nan
@@ -108,6 +110,21 @@ def run(report: Report) -> pd.DataFrame:
 
 
 def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
+    """The change of each response (%) when alpha, p or mu changes by -5 % or +5 %, one panel
+    per response, Housner beside the reference DEM (``sensitivity.png`` in the report's folder).
+
+    Parameters
+    ----------
+    report
+        The report the figure is written to.
+    table
+        One row per response, solver, parameter and change (%): the response's relative change (%).
+
+    Returns
+    -------
+    Figure
+        The figure, written as PNG.
+    """
     responses = list(dict.fromkeys(table.response))
     name = "sensitivity.png"
     fig, axes = new_figure(report.out / name, 1, len(responses), figsize=(4.2 * len(responses), 4.2), sharey=True)

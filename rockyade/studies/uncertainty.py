@@ -298,7 +298,7 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
         labels = [lab for lab, _ in study.motions]
         frame["record"] = [labels[min(int(x * len(labels)), len(labels) - 1)] for x in u[:, 0]]
     if study.include_nominal:
-        nominal = {"sample": 0, "nominal": True, **study.nominal}
+        nominal: dict[str, object] = {"sample": 0, "nominal": True, **study.nominal}
         if extra:
             nominal["record"] = "all"
         frame = pd.concat([pd.DataFrame([nominal]), frame], ignore_index=True)
@@ -353,6 +353,7 @@ def record_measures(study: UncertaintyStudy) -> dict[str, dict[str, float]]:
     out = {}
     for label, table in study.motions:
         motion = parse_motion(dict(table, load_factor=1.0), study.source or None).ground_motion(study.duration_s)
+        assert motion is not None  # a record's motion always has a ground acceleration (None: free rocking)
         out[label] = intensity_measures(motion)
     return out
 

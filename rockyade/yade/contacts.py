@@ -388,7 +388,7 @@ def plan_contacts(model: DemModel, radii: NDArray[np.float64], n_labels: int = N
             used = chosen[labels]
             differ = (used != codes) & (np.arange(nb) != a) & ((codes >= 0) | (used >= 0))
             counts["vertex_body_pairs"] += nb - 1
-            for b in np.flatnonzero(differ):
+            for b in np.flatnonzero(differ).tolist():
                 at_rest = int(b) in neighbours[a]
                 counts["differ_at_rest" if at_rest else "differ_in_motion"] += 1
                 if int(b) not in gaps:

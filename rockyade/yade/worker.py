@@ -208,6 +208,8 @@ class YadeWorker:
     # ------------------------------------------------------------------ the end
 
     def alive(self) -> bool:
+        """True while the worker process runs and belongs to this process (not closed, not
+        inherited through a fork)."""
         return not self.closed and self.owner == os.getpid() and self.proc.poll() is None
 
     def wait_exit(self, deadline: float) -> int | None:
