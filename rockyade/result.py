@@ -25,15 +25,17 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from rockyade import __version__
 from rockyade.errors import InputError
 from rockyade.io.atomic import TEMP_SUFFIX, fsync_dir, json_text, remove_stale_temporaries, staged_file
 from rockyade.io.locking import output_lock
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 STATUSES = ("completed", "overturned", "failed")
 PER_BLOCK_QUANTITIES = ("theta_rad", "omega_rad_s", "x_m", "y_m", "ax_m_s2", "ay_m_s2")
@@ -180,6 +182,8 @@ class Result:
             raise InputError("result", f"{csv_path} does not match {json_path.name} (partial or stale)")
         from io import StringIO
 
+        import pandas as pd
+
         frame = pd.read_csv(StringIO(text))
         for key in ("csv_file", "csv_sha256", "columns"):
             meta.pop(key, None)
@@ -276,4 +280,6 @@ def failed_result(solver: str, scene_hash: str, reason: str, **extra: Any) -> Re
         "overturn_time_s": None,
         **extra,
     }
+    import pandas as pd
+
     return Result(pd.DataFrame({"t_s": pd.Series(dtype=float)}), meta)

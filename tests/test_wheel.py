@@ -62,6 +62,7 @@ def test_the_wheel_carries_the_package_data_and_runs_from_another_folder(install
     code = "from importlib.metadata import files; print([str(f) for f in files('rockyade')])"
     listed = _run([str(installed / "python"), "-c", code], tmp_path).stdout
     assert "licenses/LICENSE" in listed and "paper/data/table5_dem_single.csv" in listed
+    assert "rockyade/examples/specimen1_record.toml" in listed
     work = tmp_path / "elsewhere"
     work.mkdir()
     shutil.copy(EXAMPLES / "specimen1_free.toml", work / "scene.toml")
@@ -76,6 +77,13 @@ def test_the_wheel_carries_the_package_data_and_runs_from_another_folder(install
 
     _run([rockyade, "run", "scene.toml", "--solver", "housner", "--out", "sub/h.csv"], work)
     assert json.loads((work / "sub/h.json").read_text())["status"] == "completed"
+    # The examples come with the wheel: copied out, a scene that reads a record runs from there
+    listed = _run([rockyade, "examples", "--out", "ex"], work).stdout
+    assert "ex/records/ec8_type2_D_record21.AT2" in listed and "ex/studies/harmonic_sweep.toml" in listed
+    for name in ("specimen1_free.toml", "assemblies/frame.toml", "records/ricker_pulse_T0.5s.AT2"):
+        assert (work / "ex" / name).read_bytes() == (EXAMPLES / name).read_bytes()
+    _run([rockyade, "run", "specimen1_record.toml", "--solver", "housner", "--out", "r/rec.csv"], work / "ex")
+    assert json.loads((work / "ex/r/rec.json").read_text())["status"] == "completed"
     # YADE: the driver script and the payload come from the wheel; a relative output folder
     if not yade_backend.yade_available():
         message = f"YADE is not installed ({yade_backend.YADE_PYTHON}): apt-get install yade"

@@ -52,6 +52,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.limit",
     "rockyade.cli.fragility",
     "rockyade.cli.assess",
+    "rockyade.cli.examples",
 ]
 
 _T0 = time.perf_counter()  # the total wall time printed by ``rockyade run`` counts from here

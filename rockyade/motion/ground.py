@@ -12,7 +12,6 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.integrate import cumulative_trapezoid
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -131,6 +130,8 @@ class GroundMotion:
         """
         dt = np.diff(self.t_s)
         a0, a1 = self.ah_m_s2[:-1], self.ah_m_s2[1:]
+        from scipy.integrate import cumulative_trapezoid
+
         v = cumulative_trapezoid(self.ah_m_s2, self.t_s, initial=0.0)
         dd = v[:-1] * dt + dt * dt * (a0 / 3.0 + a1 / 6.0)
         d = np.concatenate([[0.0], np.cumsum(dd)])

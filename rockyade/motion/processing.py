@@ -17,8 +17,6 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy import signal
-from scipy.integrate import cumulative_trapezoid
 
 from rockyade.errors import InputError
 
@@ -30,6 +28,8 @@ MIN_CORNER_FRACTION = 1.0e-5
 def integrate(t: NDArray[np.float64], accel: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Velocity and displacement from rest, exact for piecewise-linear acceleration."""
     dt = np.diff(t)
+    from scipy.integrate import cumulative_trapezoid
+
     v = cumulative_trapezoid(accel, t, initial=0.0)
     dd = v[:-1] * dt + dt * dt * (accel[:-1] / 3.0 + accel[1:] / 6.0)
     return v, np.concatenate([[0.0], np.cumsum(dd)])
@@ -70,6 +70,8 @@ def bandpass(
         raise InputError("bandpass_hz", f"low corner {low_hz} Hz must be below the high corner {high_hz} Hz")
     if low_hz is None and high_hz is None:
         return np.asarray(accel, dtype=float).copy()
+    from scipy import signal
+
     if low_hz is not None and high_hz is not None:
         sos = signal.butter(order, [low_hz, high_hz], btype="bandpass", fs=fs, output="sos")
     elif low_hz is not None:
@@ -112,6 +114,8 @@ def lowpass_zero_phase(x: NDArray[np.float64], dt_s: float, cutoff_hz: float, or
         raise InputError(
             "output.accel_lowpass_hz", f"must be in [{lowest:g}, {nyquist:g}) Hz (Nyquist), got {cutoff_hz!r}"
         )
+    from scipy import signal
+
     sos = signal.butter(order, cutoff_hz, btype="low", fs=1.0 / dt_s, output="sos")
     if x.size <= 3 * (2 * len(sos) + 1):
         return x.copy()

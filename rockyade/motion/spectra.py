@@ -33,7 +33,6 @@ import math
 import numba
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import expm
 
 from rockyade.errors import InputError
 
@@ -51,6 +50,8 @@ def default_periods(t_min: float = 0.02, t_max: float = 4.0, n: int = 100) -> ND
 
 def _recurrence(omega: float, damping: float, h: float) -> NDArray[np.float64]:
     """(Phi, Gamma0, Gamma1) flattened: 4 + 2 + 2 numbers."""
+    from scipy.linalg import expm
+
     m = np.zeros((4, 4))
     m[0, 1] = 1.0
     m[1, 0] = -omega * omega
