@@ -330,8 +330,15 @@ def yade_model(scene: Scene) -> DemModel:
     Raises
     ------
     InputError
-        A scene YADE cannot run (mass-proportional damping).
+        A scene YADE cannot run (mass-proportional damping, point loads).
     """
+    if scene.loads:
+        raise InputError(
+            "loads",
+            f"the scene has {len(scene.loads)} point load(s) ([[loads]]): the yade solver does not apply them yet; "
+            "run it with the reference DEM (solver reference) or Housner (one block)",
+            scene.source,
+        )
     if scene.contact.mass_damping_1_s:
         raise InputError("contact.mass_damping_1_s", "mass-proportional damping is available in the reference DEM only")
     return calibrated_model(scene)
