@@ -173,8 +173,11 @@ def pushover_onset(curve: pd.DataFrame, scene: Scene, threshold_m: float = ONSET
                 continue
             t0, t1 = t_path[flat[0]], t_path[flat[0] + 1]
             inside = (t >= t0 - 1e-9) & (t <= t1 + 1e-9)
-            if not inside.any():  # the run stopped (an overturn) while rising to this level
-                return Onset(float(level), below, float(t[-1]), "the run ended while rising to this level")
+            if not inside.any():
+                if t.size and t[-1] < scene.duration_s - 1.5 * scene.sample_dt_s:  # it stopped early (an overturn)
+                    return Onset(float(level), below, float(t[-1]), "the run ended while rising to this level")
+                break  # the run's duration ends before this level
+
             span = u[inside]
             if np.max(np.abs(span - span[0])) > threshold_m or t[-1] < t1 - 1e-9:
                 grown = np.nonzero(np.abs(span - span[0]) > threshold_m)[0]
