@@ -201,9 +201,10 @@ COMMON: list[Opt] = [
     Opt(
         "--motion",
         "pulse",
-        "base motion: a pulse, a record file, free rocking of one block, or rest",
+        "base motion: a pulse, a record file, free rocking of one block, rest (a drop test), gravity-ramp "
+        "(the static check) or pushover (towards +x, lambda rising at 0.05 g/s)",
         str,
-        ("pulse", "record", "free", "rest"),
+        ("pulse", "record", "free", "rest", "gravity-ramp", "pushover"),
     ),
     Opt("--pulse-shape", "sine", "pulse shape", str, ("sine", "cosine", "ricker")),
     Opt("--amplitude-g", 0.3, "pulse amplitude, g"),
@@ -231,6 +232,27 @@ COMMON: list[Opt] = [
     Opt("--damping-ratio", 0.05, "udec: fraction of critical damping of a unit on its bed joint (sets beta_s)"),
     Opt("--friction-angle-deg", 30.0, "joint friction angle, deg"),
 ]
+
+#: Overburden options by kind (not generator parameters: :func:`rockyade.scene.generators.overburden.
+#: add_overburden` adds them as [[loads]] to the generated scene): kind -> (overburden kind, options).
+OVERBURDEN: dict[str, tuple[str, list[Opt]]] = {
+    "wall": ("line", [Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top course, N/m")]),
+    "restrained-wall": (
+        "section",
+        [
+            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
+            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
+        ],
+    ),
+    "column": (
+        "point",
+        [
+            Opt("--top-load-n", 0.0, "vertical load on the top block, N"),
+            Opt("--top-load-eccentricity-m", 0.0, "its distance from the top block's axis, m (> 0 towards +x)"),
+        ],
+    ),
+}
+OVERBURDEN["stack"] = OVERBURDEN["column"]
 
 #: Generator parameters among the common options.
 COMMON_PARAMS = ("density_kg_m3", "duration_s", "sample_dt_s")
@@ -282,6 +304,8 @@ def _motion_table(args: argparse.Namespace, out: Path) -> dict[str, Any]:
         return pulse_motion(args.amplitude_g, args.period_s, args.pulse_shape, args.cycles)
     if args.motion == "rest":
         return rest_motion()
+    if args.motion in ("gravity-ramp", "pushover"):
+        return {"type": args.motion}
     if args.motion == "free":
         if args.free_block is None:
             raise InputError("--free-block", "is required with --motion free: the name of the block to tilt")
@@ -375,7 +399,12 @@ def _flag_for(field: str, kind: str) -> str:
 
 def _flags(kind: str) -> dict[str, str]:
     """Generator parameter name -> CLI flag."""
-    return {opt.dest: opt.flag for opt in [*KINDS[kind][1], *COMMON]}
+    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
+    names = {opt.dest: opt.flag for opt in [*KINDS[kind][1], *extra, *COMMON]}
+    names.update({"overburden_N_per_m": "--overburden-n-per-m", "overburden_N": "--top-load-n"})
+    if kind in ("column", "stack"):
+        names["overburden_eccentricity_m"] = "--top-load-eccentricity-m"
+    return names
 
 
 def _cli_words(message: str, kind: str) -> str:
@@ -387,7 +416,8 @@ def _cli_words(message: str, kind: str) -> str:
 def _command_line(args: argparse.Namespace, kind: str) -> str:
     """The ``rockyade build`` command that makes this scene (options that differ from their default)."""
     words = ["rockyade", "build", kind]
-    for opt in [*KINDS[kind][1], *COMMON]:
+    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
+    for opt in [*KINDS[kind][1], *extra, *COMMON]:
         value = getattr(args, opt.dest)
         if value == opt.default or value is None:
             continue
@@ -433,6 +463,20 @@ def _check_the_dem_takes_it(scene: Any) -> None:
         raise InputError(flag, f"{exc.message} (nothing written)") from None
 
 
+def _with_overburden(args: argparse.Namespace, kind: str, data: dict[str, Any]) -> dict[str, Any]:
+    """The generated scene with the overburden options as [[loads]] (none given: unchanged)."""
+    if kind not in OVERBURDEN:
+        return data
+    from rockyade.scene.generators.overburden import add_overburden
+
+    how, _ = OVERBURDEN[kind]
+    if how == "point":
+        return add_overburden(data, how, force_N=args.top_load_n, eccentricity_m=args.top_load_eccentricity_m)
+    return add_overburden(
+        data, how, force_N_per_m=args.overburden_n_per_m, eccentricity_m=getattr(args, "overburden_eccentricity_m", 0.0)
+    )
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -451,6 +495,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     kwargs["contact"] = _contact_table(args, kind, _unit_height(args, kind))
     try:
         data = GENERATORS[kind](**kwargs)
+        data = _with_overburden(args, kind, data)
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
@@ -631,6 +676,10 @@ def register(sub: Any) -> None:
         )
         for opt in options:
             _add(k, opt)
+        if kind in OVERBURDEN:
+            loads = k.add_argument_group("overburden (forces without mass, written as [[loads]])")
+            for opt in OVERBURDEN[kind][1]:
+                _add(loads, opt)
         group = k.add_argument_group("material, time, motion and joints")
         for opt in COMMON:
             _add(group, opt)
