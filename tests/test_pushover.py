@@ -19,10 +19,12 @@ from rockyade.limit import limit_analysis
 from rockyade.motion.quasistatic import GravityRamp, Pushover, gravity_ramp_samples
 from rockyade.motion.spec import parse_motion
 from rockyade.scene import scene_from_dict
+from rockyade.scene.generators import restrained_wall
 from rockyade.scene.placement import placed_blocks
 from rockyade.solvers import run
 
 from .limit_scenes import arch_scene
+from .processes import require_yade
 
 MASS, WIDTH, HEIGHT = 1000.0, 0.4, 2.0
 
@@ -109,6 +111,55 @@ def test_the_control_point_is_the_top_blocks_top_centre():
     assert point[0] == pytest.approx(0.0, abs=1e-9)
     assert point[1] == pytest.approx(float(placed_blocks(scene)[index].vertices_m[:, 1].max()))
     assert point[1] == pytest.approx(max(float(b.vertices_m[:, 1].max()) for b in placed_blocks(scene)))
+
+
+@pytest.mark.parametrize("solver", ["housner", "reference", "yade"])
+def test_pushover_onset_of_a_block_is_b_over_h(solver):
+    """No load: lambda = b / h_c = 0.2 in Housner and both DEMs, onset within 2 % above."""
+    if solver == "yade":
+        require_yade()
+    expected = WIDTH / HEIGHT
+    scene = block_scene(pushover(expected))
+    onset = pushover_onset(capacity_curve(run(scene, solver), scene), scene)
+    assert expected <= onset.multiplier <= 1.02 * expected
+    assert onset.below <= expected * (1 + 1e-6)
+
+
+def three_hinge_multiplier(t, height, h1, h_r):
+    """The three-hinge mechanism of a wall of thickness t and height H restrained at its top
+    on its far face (+x) along the top h_r, split at h1, pushed towards the restraint; uniform
+    density (docs/assemblies.md, by virtual work). Hinges: the base's far corner, the near
+    corner at h1, and the lowest point of the contact with the restraint, D at H - h_r, which
+    slides up the (frictionless) restraint. Turning the lower block by -1 about (t/2, 0):
+    the upper block turns by w2 = h1 / (H - h_r - h1), and
+
+        lambda = [W1 t / 2 + W2 t (1 + w2 / 2)] / [W1 h1 / 2 + W2 (h1 - w2 h2 / 2)],
+
+    W_i the weights (proportional to the heights h1, h2 = H - h1)."""
+    h2 = height - h1
+    w2 = h1 / (height - h_r - h1)
+    return (h1 * t / 2 + h2 * t * (1 + w2 / 2)) / (h1 * h1 / 2 + h2 * (h1 - w2 * h2 / 2))
+
+
+@pytest.mark.parametrize("solver", ["reference", "yade"])
+def test_a_wall_restrained_at_its_top_forms_the_three_hinge_mechanism(solver):
+    """The paper's Fig. 2: a 0.3 x 3 m wall in two blocks (split at 1.5 m), a side restraint
+    0.3 m deep at its top, frictionless (a [[joints]] override): the limit analysis gives the
+    three-hinge multiplier 0.4857 (17/35), and both DEMs' pushover onset is within 2 % above it."""
+    if solver == "yade":
+        require_yade()
+    expected = three_hinge_multiplier(0.3, 3.0, 1.5, 0.3)
+    assert expected == pytest.approx(17 / 35, rel=1e-12)
+    motion = pushover(expected)
+    data = restrained_wall(blocks=2, split=0.5, restraint="side", motion=motion, duration_s=push_duration(motion))
+    data["joints"] = [{"blocks": ["wall_upper", "restraint"], "friction_angle_deg": 0.0}]
+    scene = scene_from_dict(data)
+    result = limit_analysis(scene, direction="+x")
+    assert result.load_multiplier == pytest.approx(expected, rel=1e-9)
+    assert {(h.a, h.b) for h in result.mechanism.hinges} >= {("wall_lower", "base"), ("wall_upper", "wall_lower")}
+    onset = pushover_onset(capacity_curve(run(scene, solver), scene, block="wall_lower", point_m=(-0.15, 1.5)), scene)
+    assert expected <= onset.multiplier <= 1.02 * expected
+    assert onset.below <= expected * (1 + 1e-6)
 
 
 @pytest.mark.parametrize("solver", ["housner", "reference"])
