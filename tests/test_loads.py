@@ -16,6 +16,8 @@ from rockyade.scene import scene_from_dict
 from rockyade.solvers import run
 from rockyade.solvers.housner import housner_model
 
+from .processes import require_yade
+
 MASS, WIDTH, HEIGHT = 1000.0, 0.4, 2.0
 W = MASS * G
 B, H_C = WIDTH / 2, HEIGHT / 2
@@ -166,9 +168,29 @@ def test_the_reference_dem_energy_balance_counts_the_loads_work():
     assert math.isfinite(result.meta["initial_potential_energy_J"])
 
 
-def test_yade_refuses_a_scene_with_loads():
-    from rockyade.yade.backend import yade_model
+def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem():
+    """The same release in YADE (the load a non-colliding clump member, its force summed with
+    its current arm): theta = 0 crossings within 0.5 % of the reference DEM's."""
+    require_yade()
+    scene = block_scene(top_load(0.1, 1500.0), {"type": "free", "theta0_rad": 0.06}, duration=1.6)
+    times = {}
+    for name in ("reference", "yade"):
+        result = run(scene, name)
+        assert result.meta["status"] == "completed"
+        theta = result.frame[result.frame.columns[result.frame.columns.str.contains("theta")][0]].to_numpy()
+        times[name] = first_crossings(theta, 0.001)
+    assert len(times["yade"]) == 3
+    np.testing.assert_allclose(times["yade"], times["reference"], rtol=5e-3)
 
-    with pytest.raises(InputError, match="point load") as info:
-        yade_model(block_scene(top_load(0.0, 100.0)))
+
+def test_yade_refuses_a_couple_without_resultant():
+    from rockyade.yade.backend import yade_model
+    from rockyade.yade.payload import scene_payload
+
+    couple = [
+        {"block": "pier", "point_m": [0.0, HEIGHT], "force_N": [100.0, 0.0]},
+        {"block": "pier", "point_m": [0.0, 0.0], "force_N": [-100.0, 0.0]},
+    ]
+    with pytest.raises(InputError, match="couple") as info:
+        scene_payload(yade_model(block_scene(couple)))
     assert info.value.field == "loads"
