@@ -250,3 +250,21 @@ def test_pushover_onset_threshold_is_checked():
     with pytest.raises(InputError, match="threshold_m"):
         pushover_onset(curve, scene, threshold_m=-1.0)
     assert math.isnan(pushover_onset(curve, scene).multiplier)
+
+
+def test_rockyade_run_writes_the_capacity_curve_of_a_pushover(tmp_path, capsys):
+    """`rockyade build ... --motion pushover` then `rockyade run --out`: <out>_capacity.csv,
+    lambda rising to the onset (continuous rise at 0.05 g/s: above b / h by the ramp's lag)."""
+    import pandas as pd
+
+    from rockyade.cli import main
+
+    scene_file = tmp_path / "pier.toml"
+    assert main(["build", "stack", "--widths-m", "0.4", "--heights-m", "2.0", "--motion", "pushover",
+                 "--duration-s", "8", "--out", str(scene_file)]) == 0
+    assert main(["run", str(scene_file), "--solver", "reference", "--out", str(tmp_path / "pier.csv")]) == 0
+    curve = pd.read_csv(tmp_path / "pier_capacity.csv")
+    assert list(curve.columns) == ["t_s", "lambda", "displacement_m", "control_x_m", "control_y_m"]
+    moved = curve[curve["displacement_m"] > 1e-3]
+    assert 0.2 <= moved["lambda"].iloc[0] <= 0.22
+    assert "capacity curve; onset lambda" in capsys.readouterr().out
