@@ -38,7 +38,7 @@ from rockyade import __version__
 from rockyade.calibration.model import calibrated_model
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
-from rockyade.dem.overturn import CRITERION, run_outcome
+from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import InputError, SolverUnavailableError
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.lifetime import child_dies_with_parent
@@ -244,7 +244,7 @@ def _parse(
             return _collapsed(model, meta, arrays, cut, total, extra, lowpass)
     if problem is not None:
         return _partial_failure(model, meta, arrays, problem, total, extra)
-    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra))
+    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
 
 
 #: Why a run with a deep sphere-polyhedron overlap fails (when it is not part of a collapse).
@@ -304,7 +304,7 @@ def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
     meta["overturn_times_s"] = {i: t for i, t in meta.get("overturn_times_s", {}).items() if float(t) <= t_cut + 1e-12}
     meta["status"] = "completed"  # re-decided below from the blocks' falls up to the cut
     arrays = _cut(arrays, keep)
-    out = _run_meta(model, meta, total, extra)
+    out = _run_meta(model, meta, total, extra, arrays)
     if out["status"] != "overturned":
         ang = arrays["ang"]
         first, block = math.inf, None
@@ -334,7 +334,7 @@ def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
         frame = _frame(model, arrays, None)
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
-    out = _run_meta(model, {**meta, "status": "failed"}, total, extra)
+    out = _run_meta(model, {**meta, "status": "failed"}, total, extra, arrays)
     out.update(status="failed", failure_reason=reason, overturn_time_s=None, overturned_block=None, partial=True,
                partial_samples=n)
     return Result(frame, out)
@@ -384,15 +384,19 @@ def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None
     return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
 
 
-def _run_meta(model: DemModel, meta: dict, total: float, extra: dict[str, object]) -> dict[str, object]:
+def _run_meta(
+    model: DemModel, meta: dict, total: float, extra: dict[str, object], arrays: dict[str, np.ndarray]
+) -> dict[str, object]:
     """The Result's metadata: how the run ended (overturns per block) and what ran."""
     names = model.names
     status = meta["status"]
     overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
     overturn_time = meta["stop_time_s"] if status == "overturned" else None
     overturned_block = names[meta["stop_body"]] if status == "overturned" else None
-    if not model.stop_on_overturn and status == "completed":
-        status, overturn_time, overturned_block = run_outcome(overturn_times, names)
+    if not model.stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
+        t = np.arange(arrays["ang"].shape[0]) * model.sample_dt_s
+        falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
+        status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     return {
         "solver": "yade",
         "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",
