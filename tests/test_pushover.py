@@ -144,15 +144,17 @@ def three_hinge_multiplier(t, height, h1, h_r):
 @pytest.mark.parametrize("solver", ["reference", "yade"])
 def test_a_wall_restrained_at_its_top_forms_the_three_hinge_mechanism(solver):
     """The paper's Fig. 2: a 0.3 x 3 m wall in two blocks (split at 1.5 m), a side restraint
-    0.3 m deep at its top, frictionless (a [[joints]] override): the limit analysis gives the
+    0.3 m deep at its top, frictionless (``restraint_friction_deg=0``: a [[joints]] override): the
+    limit analysis gives the
     three-hinge multiplier 0.4857 (17/35), and both DEMs' pushover onset is within 2 % above it."""
     if solver == "yade":
         require_yade()
     expected = three_hinge_multiplier(0.3, 3.0, 1.5, 0.3)
     assert expected == pytest.approx(17 / 35, rel=1e-12)
     motion = pushover(expected)
-    data = restrained_wall(blocks=2, split=0.5, restraint="side", motion=motion, duration_s=push_duration(motion))
-    data["joints"] = [{"blocks": ["wall_upper", "restraint"], "friction_angle_deg": 0.0}]
+    data = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion=motion,
+                           duration_s=push_duration(motion))
+    assert data["joints"] == [{"blocks": ["wall_upper", "restraint"], "friction_angle_deg": 0.0}]
     scene = scene_from_dict(data)
     result = limit_analysis(scene, direction="+x")
     assert result.load_multiplier == pytest.approx(expected, rel=1e-9)
@@ -268,3 +270,20 @@ def test_rockyade_run_writes_the_capacity_curve_of_a_pushover(tmp_path, capsys):
     moved = curve[curve["displacement_m"] > 1e-3]
     assert 0.2 <= moved["lambda"].iloc[0] <= 0.22
     assert "capacity curve; onset lambda" in capsys.readouterr().out
+
+
+def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_without_gap_is_said(tmp_path, capsys):
+    """The scene's 30 degrees at the restraint: without sliding there is no mechanism towards
+    it, and with (associated, dilatant) sliding the multiplier is far above the three-hinge
+    one (0.676 against 0.486); `rockyade build restrained-wall --restraint floor` with no gap warns
+    that the floor clamps the wall."""
+    from rockyade.cli import main
+
+    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", motion={"type": "rest"}))
+    assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
+    assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
+    assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0
+    assert "clamps it" in capsys.readouterr().err
+    assert main(["build", "restrained-wall", "--restraint", "floor", "--gap-m", "0.01",
+                 "--out", str(tmp_path / "g.toml")]) == 0
+    assert "clamps" not in capsys.readouterr().err

@@ -192,6 +192,12 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--restraint-width-m", 0.3, "restraint width (floor: reach past the far face), m"),
             Opt("--restraint-height-m", 0.3, "restraint height (floor: slab depth), m"),
             Opt("--gap-m", 0.0, "gap between the wall and the restraint, m"),
+            Opt(
+                "--restraint-friction-deg",
+                None,
+                "friction angle of the wall-restraint joint, deg (default: --friction-angle-deg); 0: a "
+                "frictionless restraint, which the three-hinge mechanism of Fig. 2 needs",
+            ),
         ],
     ),
 }
@@ -509,6 +515,14 @@ def cmd_build(args: argparse.Namespace) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
     scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
     _check_the_dem_takes_it(scene)
+    if kind == "restrained-wall" and args.restraint == "floor" and not args.gap_m:
+        import sys
+
+        print(
+            "rockyade: warning: --restraint floor with no --gap-m: the fixed floor rests on the wall's top and clamps "
+            "it (it cannot rise, hence cannot rock); leave a gap, or use --restraint side",
+            file=sys.stderr,
+        )
     summary = _summary(scene)
     header = "\n".join(
         [
