@@ -174,6 +174,24 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             LAYOUT_OPT,
         ],
     ),
+    "wall-section": (
+        "a wall's section out of its plane: height, thickness (through the section) and length (along the wall), "
+        "courses, a free or restrained top, an overburden",
+        [
+            Opt("--height-m", 3.0, "the wall's height, m"),
+            Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
+            Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
+            Opt("--courses", 1, "equal courses (1: one block)", int),
+            Opt("--top", "free", "free, or restrained by a fixed block on each side with a gap", str,
+                ("free", "restrained")),
+            Opt("--gap-m", 0.0, "restrained: gap between each face and its restraint (> 0), m"),
+            Opt("--restraint-height-m", 0.3, "restrained: depth of the restraints, m"),
+            Opt("--restraint-width-m", 0.3, "restrained: width of the restraints, m"),
+            Opt("--restraint-friction-deg", 0.0, "restrained: friction of the wall-restraint joints, deg (0: none)"),
+            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
+            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
+        ],
+    ),
     "restrained-wall": (
         "a wall restrained at its top by a fixed block (out-of-plane section, the paper's Fig. 2)",
         [
@@ -370,6 +388,7 @@ def _unit_height(args: argparse.Namespace, kind: str) -> float:
         "frame": lambda: args.beam_height_m,
         "stack": lambda: min(args.heights_m),
         "restrained-wall": lambda: args.wall_height_m * min(args.split, 1 - args.split),
+        "wall-section": lambda: args.height_m / args.courses,
     }[kind]()
 
 
@@ -685,7 +704,7 @@ def register(sub: Any) -> None:
     """Add ``build`` (one sub-command per kind) and ``draw``."""
     p = sub.add_parser(
         "build",
-        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall",
+        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
         description="Generate a scene file of a masonry assembly (every block placed by position_m) that you "
         "can read and edit. Options are SI, with units in their names.",
     )
