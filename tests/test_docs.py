@@ -136,7 +136,7 @@ def test_motion_type_table_lists_every_motion_type():
     from rockyade.motion.spec import MOTION_TYPES
 
     text = (ROOT / "docs/howto/run-a-scene.md").read_text()
-    listed = set(re.findall(r"^\| `(\w+)` \|", text.split("Motion types", 1)[1].split("\n\n", 2)[1], re.M))
+    listed = set(re.findall(r"^\| `([\w-]+)` \|", text.split("Motion types", 1)[1].split("\n\n", 2)[1], re.M))
     assert listed == set(MOTION_TYPES)
 
 

@@ -174,6 +174,24 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             LAYOUT_OPT,
         ],
     ),
+    "wall-section": (
+        "a wall's section out of its plane: height, thickness (through the section) and length (along the wall), "
+        "courses, a free or restrained top, an overburden",
+        [
+            Opt("--height-m", 3.0, "the wall's height, m"),
+            Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
+            Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
+            Opt("--courses", 1, "equal courses (1: one block)", int),
+            Opt("--top", "free", "free, or restrained by a fixed block on each side with a gap", str,
+                ("free", "restrained")),
+            Opt("--gap-m", 0.0, "restrained: gap between each face and its restraint (> 0), m"),
+            Opt("--restraint-height-m", 0.3, "restrained: depth of the restraints, m"),
+            Opt("--restraint-width-m", 0.3, "restrained: width of the restraints, m"),
+            Opt("--restraint-friction-deg", 0.0, "restrained: friction of the wall-restraint joints, deg (0: none)"),
+            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
+            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
+        ],
+    ),
     "restrained-wall": (
         "a wall restrained at its top by a fixed block (out-of-plane section, the paper's Fig. 2)",
         [
@@ -192,6 +210,12 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--restraint-width-m", 0.3, "restraint width (floor: reach past the far face), m"),
             Opt("--restraint-height-m", 0.3, "restraint height (floor: slab depth), m"),
             Opt("--gap-m", 0.0, "gap between the wall and the restraint, m"),
+            Opt(
+                "--restraint-friction-deg",
+                None,
+                "friction angle of the wall-restraint joint, deg (default: --friction-angle-deg); 0: a "
+                "frictionless restraint, which the three-hinge mechanism of Fig. 2 needs",
+            ),
         ],
     ),
 }
@@ -209,9 +233,10 @@ COMMON: list[Opt] = [
     Opt(
         "--motion",
         "pulse",
-        "base motion: a pulse, a record file, free rocking of one block, or rest",
+        "base motion: a pulse, a record file, free rocking of one block, rest (a drop test), gravity-ramp "
+        "(the static check) or pushover (towards +x, lambda rising at 0.05 g/s)",
         str,
-        ("pulse", "record", "free", "rest"),
+        ("pulse", "record", "free", "rest", "gravity-ramp", "pushover"),
     ),
     Opt("--pulse-shape", "sine", "pulse shape", str, ("sine", "cosine", "ricker")),
     Opt("--amplitude-g", 0.3, "pulse amplitude, g"),
@@ -239,6 +264,27 @@ COMMON: list[Opt] = [
     Opt("--damping-ratio", 0.05, "udec: fraction of critical damping of a unit on its bed joint (sets beta_s)"),
     Opt("--friction-angle-deg", 30.0, "joint friction angle, deg"),
 ]
+
+#: Overburden options by kind (not generator parameters: :func:`rockyade.scene.generators.overburden.
+#: add_overburden` adds them as [[loads]] to the generated scene): kind -> (overburden kind, options).
+OVERBURDEN: dict[str, tuple[str, list[Opt]]] = {
+    "wall": ("line", [Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top course, N/m")]),
+    "restrained-wall": (
+        "section",
+        [
+            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
+            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
+        ],
+    ),
+    "column": (
+        "point",
+        [
+            Opt("--top-load-n", 0.0, "vertical load on the top block, N"),
+            Opt("--top-load-eccentricity-m", 0.0, "its distance from the top block's axis, m (> 0 towards +x)"),
+        ],
+    ),
+}
+OVERBURDEN["stack"] = OVERBURDEN["column"]
 
 #: Generator parameters among the common options.
 COMMON_PARAMS = ("density_kg_m3", "duration_s", "sample_dt_s")
@@ -290,6 +336,8 @@ def _motion_table(args: argparse.Namespace, out: Path) -> dict[str, Any]:
         return pulse_motion(args.amplitude_g, args.period_s, args.pulse_shape, args.cycles)
     if args.motion == "rest":
         return rest_motion()
+    if args.motion in ("gravity-ramp", "pushover"):
+        return {"type": args.motion}
     if args.motion == "free":
         if args.free_block is None:
             raise InputError("--free-block", "is required with --motion free: the name of the block to tilt")
@@ -340,6 +388,7 @@ def _unit_height(args: argparse.Namespace, kind: str) -> float:
         "frame": lambda: args.beam_height_m,
         "stack": lambda: min(args.heights_m),
         "restrained-wall": lambda: args.wall_height_m * min(args.split, 1 - args.split),
+        "wall-section": lambda: args.height_m / args.courses,
     }[kind]()
 
 
@@ -383,7 +432,12 @@ def _flag_for(field: str, kind: str) -> str:
 
 def _flags(kind: str) -> dict[str, str]:
     """Generator parameter name -> CLI flag."""
-    return {opt.dest: opt.flag for opt in [*KINDS[kind][1], *COMMON]}
+    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
+    names = {opt.dest: opt.flag for opt in [*KINDS[kind][1], *extra, *COMMON]}
+    names.update({"overburden_N_per_m": "--overburden-n-per-m", "overburden_N": "--top-load-n"})
+    if kind in ("column", "stack"):
+        names["overburden_eccentricity_m"] = "--top-load-eccentricity-m"
+    return names
 
 
 def _cli_words(message: str, kind: str) -> str:
@@ -395,7 +449,8 @@ def _cli_words(message: str, kind: str) -> str:
 def _command_line(args: argparse.Namespace, kind: str) -> str:
     """The ``rockyade build`` command that makes this scene (options that differ from their default)."""
     words = ["rockyade", "build", kind]
-    for opt in [*KINDS[kind][1], *COMMON]:
+    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
+    for opt in [*KINDS[kind][1], *extra, *COMMON]:
         value = getattr(args, opt.dest)
         if value == opt.default or value is None:
             continue
@@ -441,6 +496,20 @@ def _check_the_dem_takes_it(scene: Any) -> None:
         raise InputError(flag, f"{exc.message} (nothing written)") from None
 
 
+def _with_overburden(args: argparse.Namespace, kind: str, data: dict[str, Any]) -> dict[str, Any]:
+    """The generated scene with the overburden options as [[loads]] (none given: unchanged)."""
+    if kind not in OVERBURDEN:
+        return data
+    from rockyade.scene.generators.overburden import add_overburden
+
+    how, _ = OVERBURDEN[kind]
+    if how == "point":
+        return add_overburden(data, how, force_N=args.top_load_n, eccentricity_m=args.top_load_eccentricity_m)
+    return add_overburden(
+        data, how, force_N_per_m=args.overburden_n_per_m, eccentricity_m=getattr(args, "overburden_eccentricity_m", 0.0)
+    )
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -459,11 +528,20 @@ def cmd_build(args: argparse.Namespace) -> int:
     kwargs["contact"] = _contact_table(args, kind, _unit_height(args, kind))
     try:
         data = GENERATORS[kind](**kwargs)
+        data = _with_overburden(args, kind, data)
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
     scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
     _check_the_dem_takes_it(scene)
+    if kind == "restrained-wall" and args.restraint == "floor" and not args.gap_m:
+        import sys
+
+        print(
+            "rockyade: warning: --restraint floor with no --gap-m: the fixed floor rests on the wall's top and clamps "
+            "it (it cannot rise, hence cannot rock); leave a gap, or use --restraint side",
+            file=sys.stderr,
+        )
     summary = _summary(scene)
     header = "\n".join(
         [
@@ -626,7 +704,7 @@ def register(sub: Any) -> None:
     """Add ``build`` (one sub-command per kind) and ``draw``."""
     p = sub.add_parser(
         "build",
-        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall",
+        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
         description="Generate a scene file of a masonry assembly (every block placed by position_m) that you "
         "can read and edit. Options are SI, with units in their names.",
     )
@@ -640,6 +718,10 @@ def register(sub: Any) -> None:
         )
         for opt in options:
             _add(k, opt)
+        if kind in OVERBURDEN:
+            loads = k.add_argument_group("overburden (forces without mass, written as [[loads]])")
+            for opt in OVERBURDEN[kind][1]:
+                _add(loads, opt)
         group = k.add_argument_group("material, time, motion and joints")
         for opt in COMMON:
             _add(group, opt)

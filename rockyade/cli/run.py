@@ -36,6 +36,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"wrote {args.out} and {json_path}")
             if scene.positioned and result.ok:
                 _write_collapse(scene, result, args.out.with_name(f"{args.out.stem}_collapse.csv"))
+            if scene.motion.type == "pushover" and len(result.frame):
+                _write_capacity(scene, result, args.out.with_name(f"{args.out.stem}_capacity.csv"))
     if args.plot:
         from rockyade.figures import plot_results
 
@@ -56,6 +58,18 @@ def _warn_if_the_motion_is_cut(scene: Any) -> None:
     if coverage["status"] == "cut":
         where = f"{scene.source}: " if scene.source else ""
         print(f"rockyade: warning: {where}{coverage['message']}", file=sys.stderr)
+
+
+def _write_capacity(scene: Any, result: Any, path: Path) -> None:
+    """A pushover's capacity curve (rockyade.analysis.capacity) and its onset, one line."""
+    from rockyade.analysis.capacity import capacity_curve, pushover_onset
+    from rockyade.io.atomic import atomic_open
+
+    curve = capacity_curve(result, scene)
+    with atomic_open(path) as fh:
+        curve.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
+    onset = pushover_onset(curve, scene)
+    print(f"wrote {path} (capacity curve; onset lambda = {onset.multiplier:.4g}: {onset.rule})")
 
 
 def _write_collapse(scene: Any, result: Any, path: Path) -> None:

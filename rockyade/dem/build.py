@@ -239,6 +239,38 @@ def _joint_height(c: RestContact, bodies: tuple[DemBody, ...]) -> float:
     return min(heights)
 
 
+# ---------------------------------------------------------------------- loads
+
+
+def load_arrays(scene: Scene, bodies: Sequence[DemBody]) -> tuple[np.ndarray, np.ndarray] | tuple[None, None]:
+    """Each body's point loads reduced for the kernel (:mod:`rockyade.kernel.point_loads`).
+
+    A load F at the base-frame point p acts on its body at r_b = R(-theta_rest) (p - c), its
+    arm from the centroid c in the body frame at angle 0 (the frame the kernel turns by the
+    body's angle).
+
+    Returns
+    -------
+    load_force, load_arm
+        (nb, 2) resultant (Fx, Fy), N, and (nb, 2) (M0, Q) = (sum r_b x F, sum r_b . F), N m;
+        (None, None) when the scene has no loads.
+    """
+    if not scene.loads:
+        return None, None
+    names = [b.name for b in bodies]
+    force = np.zeros((len(bodies), 2))
+    arm = np.zeros((len(bodies), 2))
+    for load in scene.loads:
+        i = names.index(load.block)
+        body = bodies[i]
+        r = rotation_matrix(-body.rest_angle_rad) @ (np.asarray(load.point_m) - np.asarray(body.rest_centroid_m))
+        fx, fy = load.force_N
+        force[i] += (fx, fy)
+        arm[i, 0] += r[0] * fy - r[1] * fx
+        arm[i, 1] += r[0] * fx + r[1] * fy
+    return force, arm
+
+
 # ---------------------------------------------------------------------- model
 
 
@@ -311,6 +343,7 @@ def build_dem_model(
             f"{STABILITY_MARGIN:g} x stability limit (Eq 7 above it)",
         )
     steps = max(1, math.ceil(scene.sample_dt_s / dt_target - 1e-9))
+    load_force, load_arm = load_arrays(scene, bodies)
     return DemModel(
         bodies=bodies,
         joints=table,
@@ -337,4 +370,6 @@ def build_dem_model(
         stop_on_overturn=not scene.positioned,
         rest_contacts=tuple(contacts),
         base_at_rest=scene.motion.type,
+        load_force_N=load_force,
+        load_arm_Nm=load_arm,
     )

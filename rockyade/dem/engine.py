@@ -144,6 +144,8 @@ def model_arrays(model: DemModel, stop_angle_rad: NDArray[np.float64] | None = N
         "n_steps": int(model.n_steps),
         "steps_per_sample": int(model.steps_per_sample),
         "accel_points": np.array([b.accel_point_m for b in bodies], dtype=float),
+        "load_force": np.zeros((nb, 2)) if model.load_force_N is None else np.asarray(model.load_force_N, dtype=float),
+        "load_arm": np.zeros((nb, 2)) if model.load_arm_Nm is None else np.asarray(model.load_arm_Nm, dtype=float),
     }
 
 
@@ -248,4 +250,6 @@ def tiny_problem() -> dict[str, object]:
         "n_steps": 2,
         "steps_per_sample": 1,
         "accel_points": np.zeros((1, 2)),
+        "load_force": np.zeros((1, 2)),
+        "load_arm": np.zeros((1, 2)),
     }

@@ -118,8 +118,39 @@ def energy_gain(model: DemModel, pos: np.ndarray, ang: np.ndarray, angvel: np.nd
         power = -body.mass_kg * (ah * v[:, 0] + av * v[:, 1])
         work += np.concatenate([[0.0], np.cumsum(0.5 * (power[1:] + power[:-1]) * dt)])
         scale += body.mass_kg * model.g * rest_y  # weight times centroid height above the base
+    work += load_work(model, pos, ang)
     if scale <= 0.0:
         return 0.0, None
     gain = (energy - energy[0] - work) / scale
     bad = np.nonzero(gain > ENERGY_GROWTH_LIMIT)[0]
     return float(np.nanmax(gain)), (float(t[bad[0]]) if bad.size else None)
+
+
+def load_work(model: DemModel, pos: np.ndarray, ang: np.ndarray) -> np.ndarray:
+    """Work done by the point loads from the first sample, J (zeros without loads).
+
+    A dead load F at a body point moving from x_i to x_{i+1} does the work F . (x_{i+1} - x_i);
+    its scale s = (g + a_v) / g (:mod:`rockyade.kernel.point_loads`) is taken as the mean of
+    the two samples' (exact when s is constant).
+
+    Parameters
+    ----------
+    pos, ang
+        (n, nb, 2) sampled centroids, m, and (n, nb) angles, rad.
+    """
+    n = pos.shape[0]
+    if model.load_force_N is None or n == 0:
+        return np.zeros(n)
+    t = np.arange(n) * model.sample_dt_s
+    av = model.motion.vertical(t) if model.motion is not None else np.zeros(n)
+    scale = (model.g + av) / model.g
+    potential = np.zeros(n)  # sum of F . x_point, J
+    for i, body in enumerate(model.bodies):
+        fx, fy = model.load_force_N[i]
+        m0, q = model.load_arm_Nm[i]
+        if body.fixed or not (fx or fy or m0 or q):
+            continue
+        # F . (R(ang) r_b) = cos(ang) (r_b . F) + sin(ang) (r_b x F) summed over the body's loads
+        potential += fx * pos[:, i, 0] + fy * pos[:, i, 1] + np.cos(ang[:, i]) * q + np.sin(ang[:, i]) * m0
+    steps = 0.5 * (scale[1:] + scale[:-1]) * np.diff(potential)
+    return np.concatenate([[0.0], np.cumsum(steps)])

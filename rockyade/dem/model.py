@@ -16,7 +16,9 @@ that they simulate exactly the same system:
   central-difference scheme for the linearised contact system at rest with its
   stiffness-proportional damping, dt <= (2 / w_max) (sqrt(1 + xi^2) - xi); a user time
   step above that limit is refused;
-* the base motion, as piecewise-linear acceleration samples.
+* the base motion, as piecewise-linear acceleration samples;
+* the scene's point loads (``[[loads]]``), reduced per body to a resultant and two moments
+  (:mod:`rockyade.kernel.point_loads`).
 """
 
 from __future__ import annotations
@@ -128,6 +130,10 @@ class DemModel:
     stop_on_overturn: bool = True
     rest_contacts: tuple[RestContact, ...] = ()
     base_at_rest: str = "free"
+    #: (nb, 2) resultant of each body's point loads, N, and (nb, 2) their (M0, Q), N m
+    #: (:mod:`rockyade.kernel.point_loads`); None: no loads
+    load_force_N: np.ndarray | None = field(default=None, repr=False)
+    load_arm_Nm: np.ndarray | None = field(default=None, repr=False)
 
     @property
     def motion_label(self) -> str:

@@ -5,7 +5,8 @@ Each step t_n = n dt, in this order:
 1. ground motion: the base acceleration a_h, a_v at t_n (:func:`rockyade.motion.ground.
    ground_acceleration`, linear between samples, zero outside them);
 2. placement: the moving bodies' polygons in the base frame (:mod:`.placement`);
-3. loads: gravity and the base frame's inertia, m (-a_h, -g - a_v) (:mod:`.integration`);
+3. loads: gravity and the base frame's inertia, m (-a_h, -g - a_v) (:mod:`.integration`),
+   and the point loads (:mod:`.point_loads`);
 4. base contacts: every vertex below y = 0 (:mod:`.base_contacts`);
 5. pair contacts: one manifold of at most two points per candidate pair (:mod:`.pair_contacts`,
    :mod:`.contacts`), each point with the pair's joint;
@@ -71,6 +72,7 @@ from rockyade.kernel.integration import (
 from rockyade.kernel.pair_contacts import pair_contacts
 from rockyade.kernel.pairs import PairState, build_pairs, no_pairs
 from rockyade.kernel.placement import World, new_world, place_bodies
+from rockyade.kernel.point_loads import apply_point_loads
 from rockyade.kernel.recording import (
     CORNER_TOL_REL,
     Output,
@@ -210,6 +212,7 @@ def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settin
         if step > 0:
             place_bodies(kin, bodies, world, True)
         apply_body_loads(bodies, kin, g, ah, av)
+        apply_point_loads(bodies, kin, g, av)
         if sampling:
             reset_tally(tally, record_corners)
         e_el_now, n_dash, d_fric = base_contacts(bodies, joints, settings, kin, world, base, tally, dash, sampling,

@@ -34,6 +34,10 @@ class Bodies(NamedTuple):
     rest_ang: NDArray[np.float64]  #: (nb,) orientation at rest (theta = angle - rest_ang), rad
     stop_angle: NDArray[np.float64]  #: (nb,) |theta| at which a body counts as overturned, rad
     accel_points: NDArray[np.float64]  #: (nb, 2) output point relative to the centroid, body frame, m
+    #: (nb, 2) resultant of the point loads, N (:mod:`rockyade.kernel.point_loads`; (0, 2): none)
+    load_force: NDArray[np.float64] = np.zeros((0, 2))
+    #: (nb, 2) their (M0, Q) = sums of r_b x F and r_b . F, N m (module point_loads)
+    load_arm: NDArray[np.float64] = np.zeros((0, 2))
 
 
 class Joints(NamedTuple):
@@ -110,6 +114,8 @@ def pack(
         rest_ang=_f(a["rest_ang"]),
         stop_angle=_f(a["stop_angle"]),
         accel_points=_f(a["accel_points"]),
+        load_force=_f(a.get("load_force", np.zeros((0, 2)))),
+        load_arm=_f(a.get("load_arm", np.zeros((0, 2)))),
     )
     joints = Joints(
         kn=_f(a["kn"]),

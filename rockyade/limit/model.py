@@ -245,6 +245,11 @@ def _outside(poly: NDArray[np.float64], point: NDArray[np.float64]) -> float:
     return float(np.max(np.einsum("ij,ij->i", point - poly, normals)))
 
 
+def scene_loads(scene) -> tuple[PointLoad, ...]:
+    """The scene's ``[[loads]]`` as :class:`PointLoad` (block by name, point and force as given)."""
+    return tuple(PointLoad(q.block, tuple(q.point_m), tuple(q.force_N)) for q in getattr(scene, "loads", ()))
+
+
 def rigid_block_model(
     scene,
     loads: Sequence[PointLoad] = (),
@@ -259,7 +264,8 @@ def rigid_block_model(
     scene
         A validated :class:`~rockyade.scene.Scene` (an assembly or a column).
     loads
-        External loads, forces without mass (:class:`PointLoad`).
+        External loads, forces without mass (:class:`PointLoad`), added to the scene's own
+        ``[[loads]]`` (which always act).
     friction_angle_deg
         Friction angle of every joint, degrees in [0, 90). None: each joint's own from the
         scene (a ``[[joints]]`` entry for the pair, else ``[contact] friction_angle_deg``).
@@ -301,6 +307,6 @@ def rigid_block_model(
         polygons_m=polygons,
         fixed=fixed,
         interfaces=tuple(interfaces),
-        loads=_resolve_loads(loads, names, polygons),
+        loads=_resolve_loads(scene_loads(scene) + tuple(loads), names, polygons),
         g=float(g),
     )

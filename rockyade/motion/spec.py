@@ -1,7 +1,7 @@
 """The ``[motion]`` table of a scene: one dataclass per motion type, parsed and validated.
 
-Types: ``rest`` (the base at rest, every block released from rest: does the assembly
-stand?), ``free`` (free rocking from an initial tilt) and ``sampled`` (base acceleration
+Types: ``rest`` (the base at rest, every block released from rest: a drop test; the
+static check is ``gravity-ramp``), ``free`` (free rocking from an initial tilt) and ``sampled`` (base acceleration
 samples given inline); :mod:`rockyade.motion.types` registers the shake-table, pulse,
 record and synthetic types.
 """
@@ -124,7 +124,13 @@ class FreeRocking(MotionSpec):
 
 @dataclass(frozen=True)
 class AtRest(MotionSpec):
-    """The base at rest and every block released from rest: gravity alone (does it stand?)."""
+    """The base at rest and every block released from rest: gravity alone.
+
+    This is a drop test, not a static check: the whole of gravity acts at t = 0 on joints that
+    carry nothing yet, and the blocks fall onto them (an arch slightly thicker than its
+    static limit can fall). The static check is ``gravity-ramp``
+    (:mod:`rockyade.motion.quasistatic`).
+    """
 
     type: ClassVar[str] = "rest"
 

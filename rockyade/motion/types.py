@@ -1,5 +1,7 @@
 """Scene motion types: harmonic, pulse, record and synthetic (registered in MOTION_TYPES).
 
+The quasi-static types ``gravity-ramp`` and ``pushover`` are in :mod:`rockyade.motion.quasistatic`.
+
 Scene tables (all take ``load_factor``, default 1)::
 
     [motion]                    # shake-table sine (paper Sections 3.3, 7)
@@ -50,6 +52,7 @@ from rockyade.motion.analytic import PULSE_SHAPES, Harmonic, Pulse
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.ground import GroundMotion
 from rockyade.motion.processing import bandpass, baseline_correct, scale_to_pga
+from rockyade.motion.quasistatic import GravityRamp, Pushover
 from rockyade.motion.records import (
     DT_RANGE_S,
     FORMATS,
@@ -271,7 +274,9 @@ MOTION_TYPES.update(
         PulseMotion.type: PulseMotion.parse,
         RecordMotion.type: RecordMotion.parse,
         SyntheticMotion.type: SyntheticMotion.parse,
+        GravityRamp.type: GravityRamp.parse,
+        Pushover.type: Pushover.parse,
     }
 )
 
-__all__ = ["HarmonicMotion", "PulseMotion", "RecordMotion", "SyntheticMotion"]
+__all__ = ["GravityRamp", "HarmonicMotion", "PulseMotion", "Pushover", "RecordMotion", "SyntheticMotion"]

@@ -6,9 +6,9 @@ dictionaries read field by field). May import ``blocks``, ``motion`` and ``io``.
 
 from typing import Any
 
-from rockyade.scene.model import BlockSpec, ContactSpec, OutputSpec, Scene
+from rockyade.scene.model import BlockSpec, ContactSpec, LoadSpec, OutputSpec, Scene
 
-__all__ = ["BlockSpec", "ContactSpec", "OutputSpec", "Scene", "load_scene", "scene_from_dict"]
+__all__ = ["BlockSpec", "ContactSpec", "LoadSpec", "OutputSpec", "Scene", "load_scene", "scene_from_dict"]
 
 
 def __getattr__(name: str) -> Any:

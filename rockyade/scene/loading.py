@@ -24,11 +24,13 @@ from rockyade.scene.model import (
     JOINT_OVERRIDE_KEYS,
     MAX_DURATION_S,
     MAX_LENGTH_M,
+    MAX_LOAD_N,
     MAX_SAMPLES,
     NAME_PATTERN,
     BlockSpec,
     ContactSpec,
     JointOverride,
+    LoadSpec,
     OutputSpec,
     Scene,
     _check_scene,
@@ -155,8 +157,9 @@ def scene_from_dict(data: Any, source: str | None = None, base_dir: Path | None 
             source,
         )
     joints = _parse_joints(top.raw("joints", []), source)
+    loads = _parse_loads(top.raw("loads", []), source)
     top.finish()
-    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source, joints)
+    scene = Scene(duration, sample_dt, blocks, contact, motion, output, source, joints, loads)
     _check_scene(scene)
     return scene
 
@@ -331,4 +334,27 @@ def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
             raise r.error("blocks", f"the joint overrides nothing: give one of {', '.join(JOINT_OVERRIDE_KEYS)}")
         r.finish()
         out.append(JointOverride((names[0], names[1]), tuple(values)))
+    return tuple(out)
+
+
+def _parse_loads(raw: Any, source: str | None) -> tuple[LoadSpec, ...]:
+    """The ``[[loads]]`` list (see scene.model.LoadSpec); the cross-checks are in ``_check_scene``."""
+    if not isinstance(raw, list):
+        raise InputError("loads", "must be a list of tables ([[loads]])", source)
+    out = []
+    for k, table in enumerate(raw):
+        r = TableReader(table, f"loads[{k}]", source)
+        block = r.string("block")
+        point = r.number_list("point_m", min_len=2, unit="m")
+        force = r.number_list("force_N", min_len=2, unit="N")
+        if len(point) != 2:
+            raise r.error("point_m", "must be [x, y] in metres (base frame at rest)")
+        if len(force) != 2:
+            raise r.error("force_N", "must be [fx, fy] in newtons")
+        if max(abs(c) for c in point) > MAX_LENGTH_M:
+            raise r.error("point_m", f"coordinates must be within +/-{MAX_LENGTH_M:g} m")
+        if max(abs(c) for c in force) > MAX_LOAD_N:
+            raise r.error("force_N", f"components must be within +/-{MAX_LOAD_N:g} N, got {force}")
+        r.finish()
+        out.append(LoadSpec(block, (float(point[0]), float(point[1])), (float(force[0]), float(force[1]))))
     return tuple(out)

@@ -28,6 +28,17 @@ A scene is data, never code. Layout::
 
     [output]                  # optional
     # accel_point = "top_centre" | [x, y] (block frame, m); accel_lowpass_hz = 20.0
+
+    [[loads]]                 # optional: constant forces without mass on named blocks
+    block = "specimen1"
+    point_m = [0.125, 1.0]    # point of application, base frame at rest, m (on the block)
+    force_N = [0.0, -2000.0]  # (fx, fy), N: a dead load (keeps its direction)
+
+A load is a force without mass: the horizontal base acceleration does not act on it (a floor
+whose mass shakes with the wall is a block). It is a weight carried by the block: it follows
+the apparent gravity, scaled by (g + a_v) / g, so that it ramps in with gravity under
+``gravity-ramp`` and ``pushover`` (a_v = -g at t = 0) and is constant under a horizontal motion.
+Its point is a material point of the block: it moves and turns with the block.
 """
 
 from __future__ import annotations
@@ -43,7 +54,7 @@ from typing import TYPE_CHECKING, Any
 
 from rockyade.blocks.classical import ClassicalParameters, classical_parameters
 from rockyade.blocks.geometry import Block
-from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC
+from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, G
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # a name only: the dataclasses load without the motion types (scipy, numba)
@@ -52,6 +63,13 @@ if TYPE_CHECKING:  # a name only: the dataclasses load without the motion types 
 #: Upper bounds that keep inputs physical (and the arithmetic finite).
 MAX_LENGTH_M = 1000.0
 MAX_DURATION_S = 1.0e5
+
+#: Largest load component, N (a million tonnes-force: keeps the arithmetic finite).
+MAX_LOAD_N = 1.0e10
+#: Largest load, as a multiple of the weight of the scene's moving blocks.
+MAX_LOAD_TO_WEIGHT = 1.0e4
+#: A load's point may lie outside its block by this fraction of the block's size.
+LOAD_POINT_TOL = 1e-6
 
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
 CALIBRATIONS = ("paper", "matched")
@@ -147,6 +165,25 @@ class JointOverride:
 
 
 @dataclass(frozen=True)
+class LoadSpec:
+    """One ``[[loads]]`` entry: a constant force without mass on a block (module docstring).
+
+    Attributes
+    ----------
+    block
+        The block's name.
+    point_m
+        Point of application at rest, base frame, m; a material point of the block.
+    force_N
+        (fx, fy), N; it keeps its direction when the block turns (a dead load).
+    """
+
+    block: str
+    point_m: tuple[float, float]
+    force_N: tuple[float, float]
+
+
+@dataclass(frozen=True)
 class OutputSpec:
     """The ``[output]`` table.
 
@@ -176,6 +213,7 @@ class Scene:
     output: OutputSpec = field(default_factory=OutputSpec)
     source: str | None = field(default=None, compare=False)
     joints: tuple[JointOverride, ...] = ()
+    loads: tuple[LoadSpec, ...] = ()
 
     # ------------------------------------------------------------------ queries
     @property
@@ -229,6 +267,10 @@ class Scene:
         }
         if self.joints:
             data["joints"] = [{"blocks": list(j.blocks), **dict(j.values)} for j in self.joints]
+        if self.loads:
+            data["loads"] = [
+                {"block": q.block, "point_m": list(q.point_m), "force_N": list(q.force_N)} for q in self.loads
+            ]
         return _drop_none(data)
 
     @functools.cached_property
@@ -278,6 +320,7 @@ def _check_scene(scene: Scene) -> None:
     else:
         _check_column(scene)
     _check_joints(scene, names)
+    _check_loads(scene, names)
 
 
 def _check_column(scene: Scene) -> None:
@@ -380,3 +423,59 @@ def _check_joints(scene: Scene, names: list[str]) -> None:
         seen.add(key)
         if joint.get("K_N_per_m") is not None and joint.get("jkn_Pa_per_m") is not None:
             raise InputError(f"joints[{k}].jkn_Pa_per_m", "give K_N_per_m or jkn_Pa_per_m, not both", scene.source)
+
+
+def _check_loads(scene: Scene, names: list[str]) -> None:
+    """[[loads]] act on existing moving blocks, at a point on the block, with a bounded force."""
+    if not scene.loads:
+        return
+    import difflib
+
+    from rockyade.scene.placement import placed_blocks
+
+    placed = placed_blocks(scene)
+    weight = sum(spec.block().mass_kg for spec in scene.blocks if not spec.fixed) * G
+    for k, load in enumerate(scene.loads):
+        field_name = f"loads[{k}]"
+        if load.block not in names:
+            close = difflib.get_close_matches(load.block, names, n=3, cutoff=0.6)
+            hint = f"; did you mean {', '.join(repr(c) for c in close)}?" if close else ""
+            shown = ", ".join(names[:10]) + (" ..." if len(names) > 10 else "")
+            raise InputError(
+                f"{field_name}.block", f"no block named {load.block!r}{hint} (blocks: {shown})", scene.source
+            )
+        index = names.index(load.block)
+        if scene.blocks[index].fixed:
+            raise InputError(
+                f"{field_name}.block",
+                f"{load.block} is fixed: a load on a fixed block goes straight to the base; load a block that moves",
+                scene.source,
+            )
+        magnitude = math.hypot(*load.force_N)
+        if magnitude > MAX_LOAD_TO_WEIGHT * weight:
+            raise InputError(
+                f"{field_name}.force_N",
+                f"|F| = {magnitude:.4g} N is more than {MAX_LOAD_TO_WEIGHT:g} times the weight of the moving blocks "
+                f"({weight:.4g} N): check the units (N, not kN per metre)",
+                scene.source,
+            )
+        block = placed[index]
+        outside = _outside(block.vertices_m, load.point_m)
+        if outside > LOAD_POINT_TOL * block.size_m:
+            raise InputError(
+                f"{field_name}.point_m",
+                f"({load.point_m[0]:g}, {load.point_m[1]:g}) m lies {outside:.4g} m outside block {load.block} "
+                f"(allowed: {LOAD_POINT_TOL:g} of its size); the point is in the base frame at rest",
+                scene.source,
+            )
+
+
+def _outside(poly: Any, point: tuple[float, float]) -> float:
+    """How far ``point`` lies outside the counter-clockwise convex polygon ``poly`` (<= 0: inside), m."""
+    import numpy as np
+
+    p = np.asarray(poly, dtype=float)
+    edges = np.roll(p, -1, axis=0) - p
+    normals = np.column_stack([edges[:, 1], -edges[:, 0]])
+    normals /= np.hypot(normals[:, 0], normals[:, 1])[:, None]
+    return float(np.max(np.einsum("ij,ij->i", np.asarray(point, dtype=float) - p, normals)))

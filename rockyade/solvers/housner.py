@@ -26,6 +26,36 @@ paper). Phases:
 
 Output samples are computed by exact Runge-Kutta sub-steps to each sample time, not by
 interpolation. The kernel is compiled by numba.
+
+Point loads (a scene's ``[[loads]]``; Eq 1 modified). A dead load F = (F_x, F_y) without mass
+at a material point of the block, at r_0 = (r_x, r_y) from the active pivot at rest, acts at
+r(theta) = R(theta) r_0 (R the rotation by theta, counter-clockwise). Its moment about the
+pivot is
+
+    M_F = r(theta) x F = cos(theta) (r_0 x F) - sin(theta) (r_0 . F) = A cos(theta) - B sin(theta),
+
+A = r_x F_y - r_y F_x and B = r_x F_x + r_y F_y (summed over the loads, each side with its own
+pivot). The load is a weight carried by the block: it follows the apparent gravity (scaled by
+(g + a_v) / g) and the horizontal base acceleration does not act on it (no mass). The
+block's inertia I_O is unchanged, so I_O theta'' = M_weight + M_inertia + s M_F with
+s = (g + a_v) / g; dividing by I_O = M g R / p^2 (Eq 3, which is also how an overridden p
+acts):
+
+    theta'' = (p_L^2 / g) [ -(g + a_v) sin(alpha_L - theta) + a_h cos(alpha_L - theta)
+                            + s (a_L cos(theta) - b_L sin(theta)) ]           (left pivot)
+    theta'' = (p_R^2 / g) [ +(g + a_v) sin(alpha_R + theta) + a_h cos(alpha_R + theta)
+                            + s (a_R cos(theta) - b_R sin(theta)) ]           (right pivot)
+
+with a = A / (M R) and b = B / (M R) (m/s^2, R the pivot-to-centroid distance of that side).
+At theta = 0 the block lifts about its left pivot when a_h > (g + a_v) (tan(alpha_L) -
+a_L / (g cos(alpha_L))), about its right one when -a_h > (g + a_v) (tan(alpha_R) + a_R /
+(g cos(alpha_R))): for a vertical load N at horizontal distance d inside the pivot
+(A = -N d on the left, so -a_L / (g cos(alpha_L)) = N d / (W h_c)) the multiplier is
+lambda = (W b + N d) / (W h_c), the statics of the block (W its weight, b and h_c the
+centroid's distances from the pivot). Between impacts the energy in units of M g R is
+omega^2 / (2 p^2) + cos(alpha - |theta|) - cos(alpha) - (a / g) sin(theta) + (b / g)
+(1 - cos(theta)); the return to rest compares the energy after an impact with that
+potential at REST_FRACTION alpha.
 """
 
 from __future__ import annotations
@@ -33,7 +63,7 @@ from __future__ import annotations
 import functools
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 import numba
@@ -76,6 +106,9 @@ class HousnerModel:
         > 0 to < 0) and back.
     g
         Gravity, m/s^2.
+    load_a_left, load_b_left, load_a_right, load_b_right
+        Point loads about each pivot, a = A / (M R) and b = B / (M R), m/s^2 (module
+        docstring, modified Eq 1); 0 without loads.
     """
 
     alpha_left: float
@@ -85,6 +118,10 @@ class HousnerModel:
     mu_left_to_right: float
     mu_right_to_left: float
     g: float = G
+    load_a_left: float = 0.0
+    load_b_left: float = 0.0
+    load_a_right: float = 0.0
+    load_b_right: float = 0.0
 
     @classmethod
     def from_classical(cls, cp: ClassicalParameters, g: float = G) -> HousnerModel:
@@ -129,22 +166,84 @@ class HousnerModel:
                 self.g,
                 self.p_left,
                 self.p_right,
+                self.load_a_left,
+                self.load_b_left,
+                self.load_a_right,
+                self.load_b_right,
+                float(self.loaded),
             ]
         )
+
+    @property
+    def loaded(self) -> bool:
+        """True when point loads act on the block."""
+        return any((self.load_a_left, self.load_b_left, self.load_a_right, self.load_b_right))
+
+    def uplift_multiplier(self, side: int) -> float:
+        """|a_h| / g at which the block at rest lifts about ``side`` (+1 left pivot, -1 right),
+        without vertical motion: tan(alpha) -/+ a / (g cos(alpha)) (module docstring)."""
+        if side > 0:
+            return math.tan(self.alpha_left) - self.load_a_left / (self.g * math.cos(self.alpha_left))
+        return math.tan(self.alpha_right) + self.load_a_right / (self.g * math.cos(self.alpha_right))
+
+    def with_loads(self, mass_kg: float, pivots_m, loads) -> HousnerModel:
+        """This model with point loads.
+
+        Parameters
+        ----------
+        mass_kg
+            The block's mass, kg.
+        pivots_m
+            ((x, y) of the left pivot, (x, y) of the right pivot), base frame, m.
+        loads
+            Each with ``point_m`` (base frame at rest, m) and ``force_N`` (N), e.g.
+            :class:`rockyade.scene.LoadSpec`.
+        """
+        moments = []
+        for pivot in pivots_m:
+            big_a = big_b = 0.0
+            for load in loads:
+                rx, ry = load.point_m[0] - pivot[0], load.point_m[1] - pivot[1]
+                fx, fy = load.force_N
+                big_a += rx * fy - ry * fx  # r_0 x F
+                big_b += rx * fx + ry * fy  # r_0 . F
+            moments.append((big_a, big_b))
+        r_left, r_right = self._radii(pivots_m)
+        return replace(
+            self,
+            load_a_left=moments[0][0] / (mass_kg * r_left),
+            load_b_left=moments[0][1] / (mass_kg * r_left),
+            load_a_right=moments[1][0] / (mass_kg * r_right),
+            load_b_right=moments[1][1] / (mass_kg * r_right),
+        )
+
+    def _radii(self, pivots_m) -> tuple[float, float]:
+        """R of each side from the pivots' spacing and the alphas: the centroid lies at
+        h_c tan(alpha_L) right of the left pivot and h_c tan(alpha_R) left of the right one."""
+        span = pivots_m[1][0] - pivots_m[0][0]
+        h_c = span / (math.tan(self.alpha_left) + math.tan(self.alpha_right))
+        return h_c / math.cos(self.alpha_left), h_c / math.cos(self.alpha_right)
 
 
 # ------------------------------------------------------------------ numba kernel
 
-_AL, _AR, _PL2G, _PR2G, _MULR, _MURL, _G, _PL, _PR = range(9)
+_AL, _AR, _PL2G, _PR2G, _MULR, _MURL, _G, _PL, _PR, _LAL, _LBL, _LAR, _LBR, _LOADED = range(14)
 
 
 @numba.njit(cache=True)
 def _theta_dd(side, theta, ah, av, prm):
+    """theta'' of Eq 1, with the point loads' moment when there are some (module docstring)."""
     if side > 0:
         a = prm[_AL] - theta
-        return prm[_PL2G] * (-(prm[_G] + av) * math.sin(a) + ah * math.cos(a))
+        acc = -(prm[_G] + av) * math.sin(a) + ah * math.cos(a)
+        if prm[_LOADED] != 0.0:
+            acc += (prm[_G] + av) / prm[_G] * (prm[_LAL] * math.cos(theta) - prm[_LBL] * math.sin(theta))
+        return prm[_PL2G] * acc
     a = prm[_AR] + theta
-    return prm[_PR2G] * ((prm[_G] + av) * math.sin(a) + ah * math.cos(a))
+    acc = (prm[_G] + av) * math.sin(a) + ah * math.cos(a)
+    if prm[_LOADED] != 0.0:
+        acc += (prm[_G] + av) / prm[_G] * (prm[_LAR] * math.cos(theta) - prm[_LBR] * math.sin(theta))
+    return prm[_PR2G] * acc
 
 
 @numba.njit(cache=True)
@@ -241,9 +340,10 @@ def _uplift(t0, t_end, mt, mah, mav, prm):
     n = mt.size
     if n < 2 or t0 >= mt[n - 1]:
         return -1.0, 0
-    tan_l = math.tan(prm[_AL])
-    tan_r = math.tan(prm[_AR])
     g = prm[_G]
+    # uplift multipliers (module docstring): tan(alpha) without loads
+    tan_l = math.tan(prm[_AL]) - prm[_LAL] / (g * math.cos(prm[_AL]))
+    tan_r = math.tan(prm[_AR]) + prm[_LAR] / (g * math.cos(prm[_AR]))
     ah, av, _ = ground_acceleration(t0, mt, mah, mav, 0)
     fp = ah - (g + av) * tan_l
     fm = -ah - (g + av) * tan_r
@@ -398,7 +498,13 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         p_new = prm[_PL] if new_side > 0 else prm[_PR]
         a_new = prm[_AL] if new_side > 0 else prm[_AR]
         lift = 0.5 * om_after * om_after / (p_new * p_new)
-        if lift < math.cos(a_new - rest_lift * alpha_min) - math.cos(a_new):
+        eps_rest = rest_lift * alpha_min
+        barrier = math.cos(a_new - eps_rest) - math.cos(a_new)
+        if prm[_LOADED] != 0.0:
+            la = prm[_LAL] if new_side > 0 else prm[_LAR]
+            lb = prm[_LBL] if new_side > 0 else prm[_LBR]
+            barrier += (-new_side * la * math.sin(eps_rest) + lb * (1.0 - math.cos(eps_rest))) / prm[_G]
+        if lift < barrier:
             om = 0.0
             resting = True
     return theta_s, omega_s, acc_s, impacts, peaks, uplifts, counts, status, t_over, t_alpha, k
@@ -474,7 +580,12 @@ def solve(
     prm = model._params()
     if step_s is None:
         step_s = 1.0 / (STEPS_PER_RADIAN * max(model.p_left, model.p_right))
-    if motion is None:
+    if motion is None and model.loaded:
+        # a base at rest, given as samples: the uplift test then sees a load that tips the block
+        mt = np.array([0.0, float(duration_s)])
+        mah = np.zeros(2)
+        mav = np.zeros(2)
+    elif motion is None:
         mt = np.zeros(0)
         mah = np.zeros(0)
         mav = np.zeros(0)
@@ -545,7 +656,7 @@ class HousnerSolver(SolverBase):
             )
         spec = scene.blocks[0]
         cp = spec.classical()
-        model = HousnerModel.from_classical(cp)
+        model = housner_model(scene)
         motion = scene.motion.ground_motion(scene.duration_s)
         _warm_up()
         start = time.perf_counter()
@@ -564,6 +675,23 @@ class HousnerSolver(SolverBase):
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
         return sample_cost(scene, self.name)
+
+
+def housner_model(scene: Scene, g: float = G) -> HousnerModel:
+    """The single block of ``scene`` as Housner's model, with its point loads (modified Eq 1).
+
+    The pivots are the base corners at the equivalent base x_c -/+ h_c tan(alpha) (the real
+    corners when alpha comes from the geometry), in the base frame at rest.
+    """
+    from rockyade.scene.placement import placed_blocks
+
+    spec = scene.blocks[0]
+    model = HousnerModel.from_classical(spec.classical(), g)
+    if not scene.loads:
+        return model
+    cx, cy = placed_blocks(scene)[0].centroid_m
+    pivots = ((cx - cy * math.tan(model.alpha_left), 0.0), (cx + cy * math.tan(model.alpha_right), 0.0))
+    return model.with_loads(spec.block().mass_kg, pivots, scene.loads)
 
 
 def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, traj: Trajectory, wall: float) -> dict:
@@ -589,6 +717,7 @@ def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, tr
         "uplift_times_s": traj.uplift_times_s[:200].tolist(),
         "rest_fraction_of_alpha": REST_FRACTION,
         "motion": motion.label if motion is not None else "free",
+        "loads": [{"block": q.block, "point_m": list(q.point_m), "force_N": list(q.force_N)} for q in scene.loads],
     }
 
 

@@ -34,7 +34,7 @@ import pandas as pd
 from rockyade import __version__
 from rockyade.calibration.model import calibrated_model
 from rockyade.dem.engine import KernelOutput, simulate_model
-from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.frames import dem_frame, energy_gain, load_work
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.kernel import simulation as kernel
@@ -148,7 +148,7 @@ def run_model(
     )
     meta_energy: dict[str, float] = {}
     if record_energy and n:
-        energy, meta_energy = _energy_terms(model, out.energy[:n])
+        energy, meta_energy = _energy_terms(model, out.energy[:n], out.pos[:n], out.ang[:n])
         frame = pd.concat([frame, energy], axis=1)
     outcome = _outcome(model, out, n, stop_on_overturn)
     meta = {
@@ -171,8 +171,12 @@ def run_model(
     return Result(frame, meta)
 
 
-def _energy_terms(model: DemModel, e: np.ndarray) -> tuple[pd.DataFrame, dict[str, float]]:
-    """The energy columns (potential energy from the rest state) and their summary."""
+def _energy_terms(
+    model: DemModel, e: np.ndarray, pos: np.ndarray, ang: np.ndarray
+) -> tuple[pd.DataFrame, dict[str, float]]:
+    """The energy columns (potential energy from the rest state) and their summary; with point
+    loads, their work (from the samples, :func:`rockyade.dem.frames.load_work`) is in the
+    balance and in ``work_loads_J``."""
     e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies if not b.fixed)
     total = (
         e[:, kernel.E_KIN]
@@ -182,6 +186,8 @@ def _energy_terms(model: DemModel, e: np.ndarray) -> tuple[pd.DataFrame, dict[st
         + e[:, kernel.E_FRIC]
         - e[:, kernel.W_BASE]
     )
+    loads_work = load_work(model, pos, ang)
+    total = total - loads_work
     error = total - total[0]
     energy = pd.DataFrame(
         {
@@ -191,6 +197,7 @@ def _energy_terms(model: DemModel, e: np.ndarray) -> tuple[pd.DataFrame, dict[st
             "energy_dashpot_J": e[:, kernel.E_DASH],
             "energy_friction_J": e[:, kernel.E_FRIC],
             "work_base_J": e[:, kernel.W_BASE],
+            **({"work_loads_J": loads_work} if model.load_force_N is not None else {}),
             "energy_balance_error_J": error,
         }
     )

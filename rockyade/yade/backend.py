@@ -27,6 +27,7 @@ turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
 from __future__ import annotations
 
 import json
+import math
 import os
 import shutil
 import tempfile
@@ -221,13 +222,110 @@ def _parse(
             arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
-    problem = _output_problem(model, meta, arrays)
-    if problem is not None:
-        return failed_result("yade", model.scene_hash, problem, **extra)
     extra["max_polyhedra_penetration_over_radius"] = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
     extra["max_rotation_step_rad"] = meta.get("max_rotation_step_rad")
     extra["rotation_track_period_steps"] = meta.get("rotation_track_period_steps")
+    problem = _output_problem(model, meta, arrays)
+    if problem == DEEP_OVERLAP:
+        cut = _collapse_before_overlap(model, meta, arrays)
+        if cut is not None:  # a collapse: kept up to the overlap, ended overturned
+            return _collapsed(model, meta, arrays, cut, total, extra, lowpass)
+    if problem is not None:
+        return _partial_failure(model, meta, arrays, problem, total, extra)
     return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
+
+
+#: Why a run with a deep sphere-polyhedron overlap fails (when it is not part of a collapse).
+DEEP_OVERLAP = (
+    "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
+    "contact then loses its normal): the impact is too hard for these contact spheres"
+)
+#: A block has fallen off when its centroid dropped by more than this fraction of its height
+#: (the collapse table's rule, rockyade.analysis.collapse.DROP_FRACTION).
+DROP_FRACTION = 0.5
+
+
+def _collapse_before_overlap(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> int | None:
+    """The samples to keep when a deep overlap is part of a collapse, or None (a blow-up).
+
+    The rule (docs/yade.md): at the last sample before the overlap (``deep_overlap_time_s``
+    of the driver; the end of the output when an older driver does not say), some moving block
+    has reached its landing angle, dropped by more than DROP_FRACTION of its height, or passed
+    its tipping angle alpha, and the energy has not grown up to then (no blow-up by
+    :func:`rockyade.dem.frames.energy_gain`).
+    """
+    n = int(meta.get("n_filled", 0))
+    when = meta.get("deep_overlap_time_s")
+    # the depth is measured at the samples: keep those before the one that saw it
+    keep = n if when is None else min(n, math.floor(float(when) / model.sample_dt_s + 1e-9))
+    if keep < 3:
+        return None
+    pos, ang, angvel = arrays["pos"][:keep], arrays["ang"][:keep], arrays["angvel"][:keep]
+    if not (np.all(np.isfinite(pos)) and np.all(np.isfinite(ang))):
+        return None
+    _, t_blowup = energy_gain(model, pos, ang, angvel)
+    if t_blowup is not None:
+        return None
+    stop = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(len(model.bodies), 0.5 * math.pi)
+    for i, body in enumerate(model.bodies):
+        if body.fixed:
+            continue
+        theta = np.abs(ang[:, i] - body.rest_angle_rad)
+        height = float(np.ptp(body.contact_vertices_m[:, 1]))
+        dropped = body.rest_centroid_m[1] - pos[:, i, 1] > DROP_FRACTION * height
+        alpha = body.alpha_rad if math.isfinite(body.alpha_rad) else stop[i]
+        if np.any(theta >= stop[i]) or np.any(dropped) or np.any(theta > alpha):
+            return keep
+    return None
+
+
+def _cut(arrays: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
+    return {k: v[:n] for k, v in arrays.items()}
+
+
+def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
+    """An assembly collapsing up to a deep overlap: its history to the overlap, status
+    ``overturned`` (the first block that landed, else the first past its tipping angle)."""
+    names = model.names
+    t_cut = (keep - 1) * model.sample_dt_s
+    meta = dict(meta)
+    meta["overturn_times_s"] = {i: t for i, t in meta.get("overturn_times_s", {}).items() if float(t) <= t_cut + 1e-12}
+    meta["status"] = "completed"  # re-decided below from the blocks' falls up to the cut
+    arrays = _cut(arrays, keep)
+    out = _run_meta(model, meta, total, extra, arrays)
+    if out["status"] != "overturned":
+        ang = arrays["ang"]
+        first, block = math.inf, None
+        for i, body in enumerate(model.bodies):
+            if body.fixed:
+                continue
+            over = np.flatnonzero(np.abs(ang[:, i] - body.rest_angle_rad) > body.alpha_rad)
+            if over.size and over[0] * model.sample_dt_s < first:
+                first, block = over[0] * model.sample_dt_s, names[i]
+        out.update(status="overturned", overturn_time_s=first if block else t_cut, overturned_block=block)
+    out["stopped_at_deep_overlap_s"] = t_cut
+    out["deep_overlap_note"] = (
+        "the run stopped at a deep sphere-polyhedron overlap after the assembly had started to collapse "
+        "(docs/yade.md): its history up to there is kept"
+    )
+    return Result(_frame(model, arrays, lowpass), out)
+
+
+def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
+    """A failed run that keeps what it recorded: status ``failed``, ``partial: true``, the
+    samples it has (never read as complete: its status is ``failed``)."""
+    n = min(int(meta.get("n_filled", 0)), arrays["pos"].shape[0])
+    if n == 0 or "wall_time_s" not in meta:
+        return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
+    arrays = _cut(arrays, n)
+    try:
+        frame = _frame(model, arrays, None)
+    except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
+        return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
+    out = _run_meta(model, {**meta, "status": "failed"}, total, extra, arrays)
+    out.update(status="failed", failure_reason=reason, overturn_time_s=None, overturned_block=None, partial=True,
+               partial_samples=n)
+    return Result(frame, out)
 
 
 def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
@@ -248,10 +346,7 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
     if t_blowup is not None:
         return f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
     if float(meta.get("max_polyhedra_penetration_over_radius", 0.0)) >= 1.0:
-        return (
-            "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
-            "contact then loses its normal): the impact is too hard for these contact spheres"
-        )
+        return DEEP_OVERLAP
     return None
 
 

@@ -212,6 +212,7 @@ def build(scene):
             vertex_members.append((start, len(members)))
         hz = b["prism_half_thickness_m"]
         box = b.get("prism_box")
+        prism_at = len(members)
         if box:  # a rectangle: a Box (cheaper contact, robust however deep a sphere goes)
             wx, wy = _rotate(box["center_m"], a0)
             members.append(
@@ -230,6 +231,10 @@ def build(scene):
                 corners += [Vector3(c0[0] + wx, c0[1] + wy, -hz), Vector3(c0[0] + wx, c0[1] + wy, hz)]
             members.append(utils.polyhedron(corners, material=O.materials[inert], mask=b["prism_mask"]))
         members.append(utils.sphere((c0[0], c0[1], 0.0), r, material=O.materials[helper_mat], mask=0))
+        load = b.get("load") if not b["fixed"] else None
+        if load is not None:  # a massless, non-colliding member at the load point: it turns with the block
+            lx, ly = _rotate(load["point_m"], a0)
+            members.append(utils.sphere((c0[0] + lx, c0[1] + ly, 0.0), r, material=O.materials[inert], mask=0))
         clump_id, member_ids = O.bodies.appendClumped(members)
         state = O.bodies[clump_id].state
         offset = (state.pos[0] - c0[0], state.pos[1] - c0[1])
@@ -258,7 +263,9 @@ def build(scene):
                 "point": b["accel_point_m"],
                 "mass": b["mass_kg"],
                 "radius": r,
-                "prism": member_ids[len(members) - 2],
+                "prism": member_ids[prism_at],
+                "load_id": member_ids[-1] if load is not None else None,
+                "load_force": load["force_N"] if load is not None else None,
                 "prism_is_polyhedra": not box,
             }
         )
@@ -285,6 +292,30 @@ def ground_engines(scene, clumps):
         for mass, ids in by_mass.items():
             mags = [0.0] + [-mass * a for a in values] + [0.0, 0.0]
             engines.append(InterpolatingDirectedForceEngine(ids=ids, times=times, magnitudes=mags, direction=direction))
+    return engines
+
+
+def load_engines(scene, clumps):
+    """Point loads: a force on each loaded block's load member (a clump sums its members' forces
+    with their current arms, so the torque follows the block's rotation), scaled by the
+    apparent gravity (g + a_v) / g as in the reference DEM (rockyade/kernel/point_loads.py)."""
+    engines = []
+    g = scene["g"]
+    motion = scene["motion"]
+    for c in clumps:
+        if c.get("load_id") is None:
+            continue
+        fx, fy = c["load_force"]
+        mag = math.hypot(fx, fy)
+        direction = Vector3(fx / mag, fy / mag, 0.0)
+        if motion is None or not any(motion["av_m_s2"]):
+            times, mags = [-1.0, 1.0e9], [mag, mag]
+        else:
+            t = list(motion["t_s"])
+            times = [t[0] - 1.0, *t, t[-1] + 1e-09, t[-1] + 1000000000.0]
+            mags = [mag] + [mag * (g + a) / g for a in motion["av_m_s2"]] + [mag, mag]
+        engines.append(InterpolatingDirectedForceEngine(ids=[c["load_id"]], times=times, magnitudes=mags,
+                                                        direction=direction))
     return engines
 
 
@@ -376,6 +407,7 @@ class Recorder:
         self.overturn_times = {}
         self.stop_on_overturn = scene.get("stop_on_overturn", True)
         self.max_depth_ratio = 0.0
+        self.deep_overlap_time = None  # the first sample that saw a sphere a radius deep in a prism
         self.polyhedra = {c["prism"] for c in clumps if c["prism_is_polyhedra"]}
         self.block_of_prism = {c["prism"]: i for i, c in enumerate(clumps)}
         self.vertex_of = {
@@ -429,6 +461,8 @@ class Recorder:
                 if self.stop_on_overturn and self.status == "completed":
                     self.status, self.stop_time, self.stop_body = "overturned", O.time, i
         self.contact_forces(k)
+        if self.deep_overlap_time is None and self.max_depth_ratio >= 1.0:
+            self.deep_overlap_time = O.time
         self.k = k + 1
         if self.runner is not None:
             self.runner.iterPeriod = min(self.sps, self.track_period)
@@ -532,6 +566,7 @@ class Recorder:
             "yade_version": __import__("yade.config", fromlist=["version"]).version,
             "dt_s": O.dt,
             "max_polyhedra_penetration_over_radius": self.max_depth_ratio,
+            "deep_overlap_time_s": self.deep_overlap_time,
             "max_rotation_step_rad": self.max_rotation_step,
             "rotation_track_period_steps": self.track_period,
             "complete": True,
@@ -585,6 +620,7 @@ def prepare(scene, out_path, csv_path=None):
             [Law2_ScGeom_ViscElPhys_Basic()],
         ),
         *ground_engines(scene, clumps),
+        *load_engines(scene, clumps),
         NewtonIntegrator(damping=0.0, gravity=Vector3(0.0, -scene["g"], 0.0)),
     ]
     scene["_build_time_s"] = time.perf_counter() - start

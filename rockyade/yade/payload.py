@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from rockyade.dem.model import DemModel
+from rockyade.errors import InputError
 from rockyade.yade.contacts import BASE_BIT, plan_contacts
 
 #: Radius of the vertex spheres: at least this fraction of the largest of the moving
@@ -59,6 +60,40 @@ def rectangle(vertices: np.ndarray, tol: float = 1e-9) -> dict[str, object] | No
     }
 
 
+def equivalent_loads(model: DemModel) -> list[dict[str, list[float]] | None]:
+    """Each body's point loads as one force at one body point, for YADE (None: no load).
+
+    The kernel's reduction (:mod:`rockyade.kernel.point_loads`: the resultant F and the sums
+    M0 = r_b x F, Q = r_b . F) is one force F at r = (Q F + M0 (F_y, -F_x)) / |F|^2 (then
+    r . F = Q and r x F = M0, so the torque cos(theta) M0 - sin(theta) Q is the same at every
+    angle). ``point_m`` is relative to the centroid, in the body frame at angle 0 (the frame
+    of ``vertices_m``), m; ``force_N`` in N.
+
+    Raises
+    ------
+    InputError
+        A body whose loads have no resultant but a moment (a pure couple).
+    """
+    out: list[dict[str, list[float]] | None] = [None] * len(model.bodies)
+    if model.load_force_N is None or model.load_arm_Nm is None:
+        return out
+    for i, body in enumerate(model.bodies):
+        fx, fy = (float(v) for v in model.load_force_N[i])
+        m0, q = (float(v) for v in model.load_arm_Nm[i])
+        f2 = fx * fx + fy * fy
+        if body.fixed or (f2 == 0.0 and m0 == 0.0 and q == 0.0):
+            continue
+        size = float(np.max(np.ptp(body.contact_vertices_m, axis=0)))
+        if f2 == 0.0 or math.hypot(m0, q) > 1e6 * size * math.sqrt(f2):
+            raise InputError(
+                "loads",
+                f"the loads on {body.name} are a couple without resultant: the yade solver applies one force "
+                "per block; use the reference DEM",
+            )
+        out[i] = {"point_m": [(q * fx + m0 * fy) / f2, (q * fy - m0 * fx) / f2], "force_N": [fx, fy]}
+    return out
+
+
 def scene_payload(model: DemModel) -> dict[str, object]:
     """The DEM model as the JSON data the YADE driver reads."""
     radii = sphere_radii(model)
@@ -78,6 +113,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
                 "factor": v.factor,
             }
         )
+    loads = equivalent_loads(model)
     bodies = []
     stop = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(len(model.bodies), 0.5 * math.pi)
     for i, b in enumerate(model.bodies):
@@ -102,6 +138,7 @@ def scene_payload(model: DemModel) -> dict[str, object]:
                 "vel0_m_s": model.vel0_m_s[i].tolist(),
                 "angvel0_rad_s": float(model.angvel0_rad_s[i]),
                 "accel_point_m": list(b.accel_point_m),
+                "load": loads[i],
             }
         )
     motion = model.motion

@@ -38,6 +38,7 @@ from rockyade.scene.generators.common import (
 )
 from rockyade.scene.generators.frames import frame, frame_frequency, frame_gamma, rocking_frame
 from rockyade.scene.generators.restrained_walls import restrained_wall
+from rockyade.scene.generators.wall_sections import wall_section
 from rockyade.scene.generators.walls import Opening, wall
 
 #: CLI kind -> generator.
@@ -48,6 +49,7 @@ GENERATORS: dict[str, Callable[..., dict[str, Any]]] = {
     "frame": frame,
     "stack": stack,
     "restrained-wall": restrained_wall,
+    "wall-section": wall_section,
 }
 
 
@@ -88,5 +90,6 @@ __all__ = [
     "tapered_widths",
     "udec_contact",
     "wall",
+    "wall_section",
     "write_scene",
 ]

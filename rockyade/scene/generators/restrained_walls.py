@@ -17,6 +17,12 @@ fixed block (it moves with the base) that restrains the top:
 for "floor"). The wall's length along its plane is the blocks' ``thickness_m``
 (``wall_length_m``).
 
+``restraint_friction_deg`` sets the friction of the joints between the wall and the
+restraint (a ``[[joints]]`` entry; default: the scene's). A restraint that holds the wall by
+friction locks the two-block wall: its upper block must slide up the restraint for the
+three-hinge mechanism of Fig. 2 to form; give 0 (a frictionless, or rolling, restraint; see
+docs/assemblies.md for the mechanism's multiplier).
+
 Block names: ``wall`` (or ``wall_lower``, ``wall_upper``) and ``restraint`` or ``floor``.
 """
 
@@ -54,6 +60,7 @@ def restrained_wall(
     restraint_width_m: float = 0.3,
     restraint_height_m: float = 0.3,
     gap_m: float = 0.0,
+    restraint_friction_deg: float | None = None,
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
@@ -78,6 +85,8 @@ def restrained_wall(
         Size of the restraining block, m ("floor": its reach past the far face and depth).
     gap_m
         Gap between the wall and the restraint, m.
+    restraint_friction_deg
+        Friction angle of the wall-restraint joints, degrees in [0, 90) (None: the scene's).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is the paper's calibration
         (slender wall blocks).
@@ -92,6 +101,8 @@ def restrained_wall(
     rh = exact(check_length("restraint_height_m", restraint_height_m))
     gap = exact(check_length("gap_m", gap_m, zero_ok=True))
     density = check_density("density_kg_m3", density_kg_m3)
+    if restraint_friction_deg is not None:
+        check_number("restraint_friction_deg", restraint_friction_deg, 0.0, 90.0, hi_open=True)
     zero = Fraction(0)
     if n == 1:
         wall_blocks = [rect_block("wall", T, H, zero, zero, length, density)]
@@ -111,10 +122,16 @@ def restrained_wall(
     else:
         slab = T + rw
         fixed = rect_block("floor", slab, rh, -T / 2 + slab / 2, H + gap, length, density, fixed=True)
+    joints = None
+    if restraint_friction_deg is not None:
+        # the top block touches the restraint at rest (side: its far face; floor: its top)
+        pair = [wall_blocks[-1]["name"], fixed["name"]]
+        joints = [{"blocks": pair, "friction_angle_deg": float(restraint_friction_deg)}]
     return scene_table(
         [*wall_blocks, fixed],
         contact=contact if contact is not None else paper_contact(),
         motion=motion,
         duration_s=duration_s,
         sample_dt_s=sample_dt_s,
+        joints=joints,
     )

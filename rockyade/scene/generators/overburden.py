@@ -1,0 +1,128 @@
+"""Overburden: the floor and roof loads a wall or a column carries at its top, as ``[[loads]]``.
+
+Three cases (``kind``):
+
+* ``"section"`` (a wall's section out of its plane: ``restrained-wall``): the load per metre
+  of wall ``force_N_per_m`` times the wall's length (the blocks' ``thickness_m``), vertical,
+  on the top block at ``eccentricity_m`` from the wall's axis (the top face's centre;
+  > 0 towards +x);
+* ``"line"`` (a wall in its plane: ``wall``): ``force_N_per_m`` times the length of each top
+  unit's top face, at its centre (an eccentricity would be out of the plane: refused);
+* ``"point"`` (a column or a stack): the force ``force_N`` on the top block at
+  ``eccentricity_m`` from its axis.
+
+The loads are forces without mass (:mod:`rockyade.scene.model`): a floor whose mass shakes
+with the wall is a block.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from rockyade.errors import InputError
+
+KINDS = ("section", "line", "point")
+#: Largest overburden per metre of wall, N/m (100 MN/m: far above any masonry wall's).
+MAX_N_PER_M = 1.0e8
+#: Largest point overburden, N.
+MAX_N = 1.0e9
+
+
+def _top_blocks(scene) -> list[Any]:
+    """The moving blocks whose tops are the highest (within 1e-9 of the size)."""
+    from rockyade.scene.placement import placed_blocks
+
+    placed = [b for b in placed_blocks(scene) if not b.fixed]
+    tops = np.array([float(b.vertices_m[:, 1].max()) for b in placed])
+    size = max(b.size_m for b in placed)
+    return [b for b, top in zip(placed, tops, strict=True) if top >= tops.max() - 1e-9 * size]
+
+
+def _top_face(block) -> tuple[float, float, float]:
+    """(x of its centre, y, length) of a block's top face, m."""
+    v = block.vertices_m
+    top = float(v[:, 1].max())
+    xs = v[v[:, 1] >= top - 1e-9 * max(1.0, block.size_m), 0]
+    return 0.5 * (float(xs.min()) + float(xs.max())), top, float(xs.max() - xs.min())
+
+
+def _check(name: str, value: float, bound: float, unit: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise InputError(name, f"must be a finite number of {unit}, got {value!r}")
+    if not 0.0 <= value <= bound:
+        raise InputError(name, f"must be in [0, {bound:g}] {unit} (a downward load), got {value:g}")
+    return float(value)
+
+
+def add_overburden(
+    scene_dict: dict[str, Any],
+    kind: str,
+    force_N_per_m: float = 0.0,
+    force_N: float = 0.0,
+    eccentricity_m: float = 0.0,
+) -> dict[str, Any]:
+    """``scene_dict`` with its overburden as ``[[loads]]`` (module docstring).
+
+    Parameters
+    ----------
+    scene_dict
+        A generated scene.
+    kind
+        "section", "line" or "point".
+    force_N_per_m
+        Vertical load per metre of wall, N/m (downwards; "section" and "line").
+    force_N
+        Vertical load, N (downwards; "point").
+    eccentricity_m
+        Distance of the load from the axis of the top block, m (> 0 towards +x).
+
+    Returns
+    -------
+    dict
+        A copy with ``loads`` appended to (nothing added for a zero load).
+
+    Raises
+    ------
+    InputError
+        A negative, absurd or non-finite load, or an eccentricity outside the top face.
+    """
+    from rockyade.scene import scene_from_dict
+
+    if kind not in KINDS:
+        raise InputError("overburden", f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
+    q = _check("overburden_N_per_m", force_N_per_m, MAX_N_PER_M, "N/m")
+    n = _check("overburden_N", force_N, MAX_N, "N")
+    if not math.isfinite(eccentricity_m):
+        raise InputError("overburden_eccentricity_m", f"must be a finite length in metres, got {eccentricity_m!r}")
+    if (q if kind != "point" else n) == 0.0:
+        return dict(scene_dict)
+    scene = scene_from_dict(scene_dict)
+    tops = _top_blocks(scene)
+    loads = list(scene_dict.get("loads", []))
+    if kind == "line":
+        if eccentricity_m != 0.0:
+            raise InputError(
+                "overburden_eccentricity_m",
+                "an in-plane wall's overburden has no eccentricity in its plane (an eccentricity across the wall's "
+                "thickness acts out of plane: build a wall section)",
+            )
+        for block in tops:
+            x, y, length = _top_face(block)
+            loads.append({"block": block.name, "point_m": [x, y], "force_N": [0.0, -q * length]})
+        return {**scene_dict, "loads": loads}
+    if len(tops) != 1:
+        raise InputError("overburden", f"needs one top block, found {len(tops)}: {[b.name for b in tops][:5]}")
+    block = tops[0]
+    x, y, length = _top_face(block)
+    if abs(eccentricity_m) > 0.5 * length + 1e-12:
+        raise InputError(
+            "overburden_eccentricity_m",
+            f"must lie on the top face of {block.name}: |e| <= {0.5 * length:g} m, got {eccentricity_m:g}",
+        )
+    spec = scene.blocks[block.index]
+    force = q * spec.thickness_m if kind == "section" else n
+    loads.append({"block": block.name, "point_m": [x + eccentricity_m, y], "force_N": [0.0, -force]})
+    return {**scene_dict, "loads": loads}

@@ -1,0 +1,289 @@
+"""Quasi-static motions (gravity-ramp, pushover) and the capacity curve.
+
+The onset measured: the first held level during whose hold the control point (the top
+block's top centre) moves by more than 1 mm (:func:`rockyade.analysis.capacity.pushover_onset`);
+levels are spaced 1 % of the expected multiplier, so the onset lies within 1 % above it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rockyade.analysis.capacity import capacity_curve, control_point, pushover_onset
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.limit import limit_analysis
+from rockyade.motion.quasistatic import GravityRamp, Pushover, gravity_ramp_samples
+from rockyade.motion.spec import parse_motion
+from rockyade.scene import scene_from_dict
+from rockyade.scene.generators import restrained_wall
+from rockyade.scene.placement import placed_blocks
+from rockyade.solvers import run
+
+from .limit_scenes import arch_scene
+from .processes import require_yade
+
+MASS, WIDTH, HEIGHT = 1000.0, 0.4, 2.0
+
+
+def pushover(expected: float, direction: str = "+x", hold_s: float = 0.4, levels: int = 6) -> dict:
+    """Held levels from 2 % below ``expected`` every 1 % of it."""
+    step = round(0.01 * expected, 6)
+    start = round(0.98 * expected, 6)
+    return {
+        "type": "pushover",
+        "direction": direction,
+        "rate_g_per_s": 0.05,
+        "max_lambda": round(start + levels * step, 6),
+        "start_lambda": start,
+        "step_lambda": step,
+        "hold_s": hold_s,
+    }
+
+
+def push_duration(motion: dict) -> float:
+    spec = parse_motion(motion)
+    t, _ = spec.lambda_path(0.0)
+    return float(t[-1]) + 0.5
+
+
+def test_gravity_ramp_brings_gravity_in_smoothly():
+    t, av = gravity_ramp_samples(2.0)
+    assert av[0] == -G and av[-1] == 0.0 and t[-1] == 2.0
+    assert np.all(np.diff(av) >= 0.0)
+    # zero rate at both ends (half-cosine)
+    assert abs(av[1] - av[0]) < 1e-3 * G and abs(av[-1] - av[-2]) < 1e-3 * G
+    motion = GravityRamp(2.0).ground_motion(5.0)
+    assert motion.vertical(np.array([1.0]))[0] == pytest.approx(-G / 2)
+    assert motion.vertical(np.array([4.0]))[0] == 0.0
+    assert np.all(motion.horizontal(np.linspace(0, 5, 11)) == 0.0)
+
+
+def test_pushover_path_holds_its_levels_and_pushes_the_way_it_says():
+    spec = parse_motion({"type": "pushover", "direction": "+x", "rate_g_per_s": 0.1, "max_lambda": 0.3,
+                         "start_lambda": 0.2, "step_lambda": 0.05, "hold_s": 1.0})
+    assert isinstance(spec, Pushover)
+    np.testing.assert_allclose(spec.levels(), [0.2, 0.25, 0.3])
+    motion = spec.ground_motion(20.0)
+    t0 = spec.push_start_s + 0.2 / 0.1
+    # the base accelerates towards -x for a push towards +x
+    assert motion.horizontal(np.array([t0 + 0.5]))[0] == pytest.approx(-0.2 * G)
+    assert motion.horizontal(np.array([t0 + 1.0 + 0.25]))[0] == pytest.approx(-0.225 * G)
+    assert motion.horizontal(np.array([19.0]))[0] == pytest.approx(-0.3 * G)
+    assert motion.vertical(np.array([0.0]))[0] == -G
+
+
+@pytest.mark.parametrize(
+    ("table", "field"),
+    [
+        ({"type": "pushover", "direction": "x"}, "motion.direction"),
+        ({"type": "pushover", "start_lambda": 2.0, "max_lambda": 1.0}, "motion.start_lambda"),
+        ({"type": "pushover", "step_lambda": 1e-6}, "motion.step_lambda"),
+        ({"type": "pushover", "step_lambda": 0.1, "hold_s": 0.0}, "motion.hold_s"),
+        ({"type": "gravity-ramp", "ramp_s": 0.0}, "motion.ramp_s"),
+    ],
+)
+def test_bad_quasi_static_motions_are_refused(table, field):
+    with pytest.raises(InputError) as info:
+        parse_motion(table)
+    assert info.value.field == field
+
+
+def block_scene(motion: dict, loads=(), duration: float | None = None):
+    return scene_from_dict(
+        {
+            "duration_s": duration or push_duration(motion),
+            "sample_dt_s": 0.002,
+            "blocks": [{"name": "pier", "width_m": WIDTH, "height_m": HEIGHT, "thickness_m": 1.0, "mass_kg": MASS}],
+            "motion": motion,
+            "loads": list(loads),
+        }
+    )
+
+
+def test_the_control_point_is_the_top_blocks_top_centre():
+    scene = arch_scene(0.15, 20)
+    index, point = control_point(scene)
+    assert not scene.blocks[index].fixed
+    assert point[0] == pytest.approx(0.0, abs=1e-9)
+    assert point[1] == pytest.approx(float(placed_blocks(scene)[index].vertices_m[:, 1].max()))
+    assert point[1] == pytest.approx(max(float(b.vertices_m[:, 1].max()) for b in placed_blocks(scene)))
+
+
+@pytest.mark.parametrize("solver", ["housner", "reference", "yade"])
+def test_pushover_onset_of_a_block_is_b_over_h(solver):
+    """No load: lambda = b / h_c = 0.2 in Housner and both DEMs, onset within 2 % above."""
+    if solver == "yade":
+        require_yade()
+    expected = WIDTH / HEIGHT
+    scene = block_scene(pushover(expected))
+    onset = pushover_onset(capacity_curve(run(scene, solver), scene), scene)
+    assert expected <= onset.multiplier <= 1.02 * expected
+    assert onset.below <= expected * (1 + 1e-6)
+
+
+def three_hinge_multiplier(t, height, h1, h_r):
+    """The three-hinge mechanism of a wall of thickness t and height H restrained at its top
+    on its far face (+x) along the top h_r, split at h1, pushed towards the restraint; uniform
+    density (docs/assemblies.md, by virtual work). Hinges: the base's far corner, the near
+    corner at h1, and the lowest point of the contact with the restraint, D at H - h_r, which
+    slides up the (frictionless) restraint. Turning the lower block by -1 about (t/2, 0):
+    the upper block turns by w2 = h1 / (H - h_r - h1), and
+
+        lambda = [W1 t / 2 + W2 t (1 + w2 / 2)] / [W1 h1 / 2 + W2 (h1 - w2 h2 / 2)],
+
+    W_i the weights (proportional to the heights h1, h2 = H - h1)."""
+    h2 = height - h1
+    w2 = h1 / (height - h_r - h1)
+    return (h1 * t / 2 + h2 * t * (1 + w2 / 2)) / (h1 * h1 / 2 + h2 * (h1 - w2 * h2 / 2))
+
+
+@pytest.mark.parametrize("solver", ["reference", "yade"])
+def test_a_wall_restrained_at_its_top_forms_the_three_hinge_mechanism(solver):
+    """The paper's Fig. 2: a 0.3 x 3 m wall in two blocks (split at 1.5 m), a side restraint
+    0.3 m deep at its top, frictionless (``restraint_friction_deg=0``: a [[joints]] override): the
+    limit analysis gives the
+    three-hinge multiplier 0.4857 (17/35), and both DEMs' pushover onset is within 2 % above it."""
+    if solver == "yade":
+        require_yade()
+    expected = three_hinge_multiplier(0.3, 3.0, 1.5, 0.3)
+    assert expected == pytest.approx(17 / 35, rel=1e-12)
+    motion = pushover(expected)
+    data = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion=motion,
+                           duration_s=push_duration(motion))
+    assert data["joints"] == [{"blocks": ["wall_upper", "restraint"], "friction_angle_deg": 0.0}]
+    scene = scene_from_dict(data)
+    result = limit_analysis(scene, direction="+x")
+    assert result.load_multiplier == pytest.approx(expected, rel=1e-9)
+    assert {(h.a, h.b) for h in result.mechanism.hinges} >= {("wall_lower", "base"), ("wall_upper", "wall_lower")}
+    onset = pushover_onset(capacity_curve(run(scene, solver), scene, block="wall_lower", point_m=(-0.15, 1.5)), scene)
+    assert expected <= onset.multiplier <= 1.02 * expected
+    assert onset.below <= expected * (1 + 1e-6)
+
+
+@pytest.mark.parametrize("solver", ["housner", "reference", "yade"])
+def test_pushover_onset_of_a_loaded_block_is_the_closed_form(solver):
+    """A top load N = 8 kN, 0.05 m right of the axis, pushed towards +x (rocking on the right
+    pivot, d = b - 0.05): lambda = (W b + N d) / (W h_c) = 0.3223; the limit analysis agrees,
+    and the onset lies within 2 % above it, the level before it at most at it."""
+    if solver == "yade":
+        require_yade()
+    n, x = 8000.0, 0.05
+    expected = (MASS * G * WIDTH / 2 + n * (WIDTH / 2 - x)) / (MASS * G * HEIGHT / 2)
+    motion = pushover(expected)
+    scene = block_scene(motion, [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n]}])
+    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(expected, rel=1e-6)
+    result = run(scene, solver)
+    curve = capacity_curve(result, scene)
+    onset = pushover_onset(curve, scene)
+    assert expected <= onset.multiplier <= 1.02 * expected
+    assert onset.below <= expected * (1 + 1e-6)
+    # before the push the block stood: the control point had not moved
+    before = curve["t_s"] < scene.motion.push_start_s + 0.5 * expected / 0.05
+    assert np.max(np.abs(curve["displacement_m"][before])) < 1e-4
+
+
+def test_pushover_onset_of_a_20_voussoir_arch_in_the_reference_dem_is_the_limit_analysis():
+    """t/R = 0.15 on fixed piers: the limit analysis gives 0.1494 (four hinges); the reference
+    DEM's onset is within 2 % of it."""
+    scene = arch_scene(0.15, 20)
+    expected = limit_analysis(scene, direction="+x").load_multiplier
+    motion = pushover(expected, levels=5)
+    pushed = scene.with_changes(motion=parse_motion(motion), duration_s=push_duration(motion))
+    result = run(pushed, "reference")
+    onset = pushover_onset(capacity_curve(result, pushed), pushed)
+    assert abs(onset.multiplier / expected - 1.0) <= 0.02
+    assert onset.below < expected * 1.005
+
+
+@pytest.mark.parametrize(
+    ("t_over_r", "motion", "stands"),
+    [
+        (0.108, {"type": "gravity-ramp", "ramp_s": 1.0}, True),
+        (0.108, {"type": "rest"}, False),
+        (0.106, {"type": "gravity-ramp", "ramp_s": 1.0}, False),
+    ],
+)
+def test_an_arch_just_above_its_static_limit_stands_under_gravity_ramp_and_falls_when_dropped(
+    t_over_r, motion, stands
+):
+    """The static limit of a 20-voussoir arch is t/R = 0.1073: at 0.108 it stands when gravity
+    is ramped in and falls when dropped (``rest``); at 0.106 it falls either way."""
+    scene = arch_scene(t_over_r, 20).with_changes(motion=parse_motion(motion), duration_s=2.5)
+    result = run(scene, "reference")
+    _check_arch(result, stands)
+
+
+@pytest.mark.parametrize(
+    ("t_over_r", "motion", "stands"),
+    [
+        (0.108, {"type": "gravity-ramp", "ramp_s": 1.0}, True),
+        (0.108, {"type": "rest"}, False),
+        (0.106, {"type": "gravity-ramp", "ramp_s": 1.0}, False),
+    ],
+)
+def test_the_same_arches_in_yade(t_over_r, motion, stands):
+    """As above in YADE (a falling arch ends overturned: docs/yade.md)."""
+    require_yade()
+    scene = arch_scene(t_over_r, 20).with_changes(motion=parse_motion(motion), duration_s=2.5)
+    result = run(scene, "yade")
+    if stands:
+        _check_arch(result, True)
+    else:
+        assert result.meta["status"] == "overturned", result.meta.get("failure_reason")
+        assert result.meta["overturn_times_s"] or result.meta.get("stopped_at_deep_overlap_s")
+
+
+def _check_arch(result, stands):
+    if stands:
+        assert result.meta["status"] == "completed" and not result.meta["overturn_times_s"]
+        assert max(np.max(np.abs(result.series("theta_rad", n))) for n in result.blocks) < 1e-3
+    else:
+        assert result.meta["status"] == "overturned"
+        assert len(result.meta["overturn_times_s"]) > 5
+
+
+def test_pushover_onset_threshold_is_checked():
+    scene = block_scene(pushover(0.2), duration=3.0)
+    curve = capacity_curve(run(scene, "housner"), scene)
+    with pytest.raises(InputError, match="threshold_m"):
+        pushover_onset(curve, scene, threshold_m=-1.0)
+    assert math.isnan(pushover_onset(curve, scene).multiplier)
+
+
+def test_rockyade_run_writes_the_capacity_curve_of_a_pushover(tmp_path, capsys):
+    """`rockyade build ... --motion pushover` then `rockyade run --out`: <out>_capacity.csv,
+    lambda rising to the onset (continuous rise at 0.05 g/s: above b / h by the ramp's lag)."""
+    import pandas as pd
+
+    from rockyade.cli import main
+
+    scene_file = tmp_path / "pier.toml"
+    assert main(["build", "stack", "--widths-m", "0.4", "--heights-m", "2.0", "--motion", "pushover",
+                 "--duration-s", "8", "--out", str(scene_file)]) == 0
+    assert main(["run", str(scene_file), "--solver", "reference", "--out", str(tmp_path / "pier.csv")]) == 0
+    curve = pd.read_csv(tmp_path / "pier_capacity.csv")
+    assert list(curve.columns) == ["t_s", "lambda", "displacement_m", "control_x_m", "control_y_m"]
+    moved = curve[curve["displacement_m"] > 1e-3]
+    assert 0.2 <= moved["lambda"].iloc[0] <= 0.22
+    assert "capacity curve; onset lambda" in capsys.readouterr().out
+
+
+def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_without_gap_is_said(tmp_path, capsys):
+    """The scene's 30 degrees at the restraint: without sliding there is no mechanism towards
+    it, and with (associated, dilatant) sliding the multiplier is far above the three-hinge
+    one (0.676 against 0.486); `rockyade build restrained-wall --restraint floor` with no gap warns
+    that the floor clamps the wall."""
+    from rockyade.cli import main
+
+    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", motion={"type": "rest"}))
+    assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
+    assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
+    assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0
+    assert "clamps it" in capsys.readouterr().err
+    assert main(["build", "restrained-wall", "--restraint", "floor", "--gap-m", "0.01",
+                 "--out", str(tmp_path / "g.toml")]) == 0
+    assert "clamps" not in capsys.readouterr().err
