@@ -28,6 +28,7 @@ import pandas as pd
 
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.motion.quasistatic import Pushover
 from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.scene.placement import placed_blocks
@@ -162,8 +163,8 @@ def pushover_onset(curve: pd.DataFrame, scene: Scene, threshold_m: float = ONSET
     u = curve["displacement_m"].to_numpy()
     lam = curve["lambda"].to_numpy()
     motion = scene.motion
-    levels = motion.levels() if hasattr(motion, "levels") else np.zeros(0)
-    if levels.size:
+    levels = motion.levels() if isinstance(motion, Pushover) else np.zeros(0)
+    if isinstance(motion, Pushover) and levels.size:
         t_path, lam_path = motion.lambda_path(scene.duration_s)
         below = math.nan
         for level in levels:

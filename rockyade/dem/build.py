@@ -107,7 +107,7 @@ def _dem_body(
     )
     if spec.fixed:
         nan = math.nan
-        return DemBody(inertia_kgm2=block.inertia_c_kgm2, alpha_rad=nan, p_rad_s=nan, R_m=nan, **common)  # type: ignore[arg-type]
+        return DemBody(inertia_kgm2=block.inertia_c_kgm2, alpha_rad=nan, p_rad_s=nan, R_m=nan, **common)
     xs = polygon[np.abs(polygon[:, 1]) <= LEVEL_TOL * max(block.height_m, 1.0), 0]
     pivot_left = np.array([xs.min(), 0.0])
     R = float(np.hypot(cx - pivot_left[0], cy))
@@ -126,7 +126,7 @@ def _dem_body(
             f"centroidal inertia set to {inertia:.6g} kg m^2 so that p = sqrt(M g R / I_O) = {spec.p_rad_s:g} 1/s"
         )
     p = frequency_parameter(block.mass_kg, R, inertia + block.mass_kg * R * R, g)
-    return DemBody(inertia_kgm2=inertia, alpha_rad=alpha, p_rad_s=p, R_m=R, notes=tuple(notes), **common)  # type: ignore[arg-type]
+    return DemBody(inertia_kgm2=inertia, alpha_rad=alpha, p_rad_s=p, R_m=R, notes=tuple(notes), **common)
 
 
 def world_polygon(body: DemBody) -> np.ndarray:

@@ -79,8 +79,10 @@ def dem_frame(
     if states is not None:
         for i, body in enumerate(model.bodies):
             prefix = f"{body.name}_" if len(names) > 1 else ""
-            for v in range(len(body.contact_vertices_m)):
-                data[f"{prefix}c{v}_state"] = pd.Categorical(STATE_NAMES[states[:, i, v]], categories=STATE_NAMES)
+            for corner in range(len(body.contact_vertices_m)):
+                data[f"{prefix}c{corner}_state"] = pd.Categorical(
+                    STATE_NAMES[states[:, i, corner]], categories=STATE_NAMES
+                )
     return pd.DataFrame(data)
 
 
@@ -139,7 +141,7 @@ def load_work(model: DemModel, pos: np.ndarray, ang: np.ndarray) -> np.ndarray:
         (n, nb, 2) sampled centroids, m, and (n, nb) angles, rad.
     """
     n = pos.shape[0]
-    if model.load_force_N is None or n == 0:
+    if model.load_force_N is None or model.load_arm_Nm is None or n == 0:
         return np.zeros(n)
     t = np.arange(n) * model.sample_dt_s
     av = model.motion.vertical(t) if model.motion is not None else np.zeros(n)

@@ -177,7 +177,7 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
 # to the inlined parts costs nothing; with reference counting, every array of a record passed
 # to a part inside a loop was counted up and down at each call (an atomic operation each, 15x
 # slower in all).
-@numba.njit(cache=True, nogil=True, _nrt=False)
+@numba.njit(cache=True, nogil=True, _nrt=False)  # type: ignore[call-overload]  # numba's stubs omit _nrt
 def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settings, work
             ) -> tuple[int, bool, int, float, int, int, int, int]:
     """Run steps from ``step0`` until the end, an early stop, or a body leaving its margin.

@@ -173,7 +173,11 @@ class SampledMotion(MotionSpec):
     def ground_motion(self, duration_s: float) -> GroundMotion:
         ah = np.array(self.accel_m_s2) * self.load_factor
         av = None if self.accel_v_m_s2 is None else np.array(self.accel_v_m_s2) * self.load_factor
-        t = np.arange(ah.size) * self.dt_s if self.t_s is None else np.array(self.t_s)
+        if self.t_s is not None:
+            t = np.array(self.t_s, dtype=float)
+        else:
+            assert self.dt_s is not None  # parse() requires one of t_s and dt_s
+            t = np.arange(ah.size, dtype=float) * self.dt_s
         return GroundMotion(t, ah, av, label=f"sampled ({ah.size} samples)")
 
     @classmethod

@@ -98,15 +98,25 @@ class BlockSpec:
 
     def block(self) -> Block:
         """The rigid block (geometry, mass, inertia)."""
-        kwargs = dict(
+        if self.vertices_m is not None:
+            return Block.polygon(
+                self.vertices_m,
+                self.thickness_m,
+                mass_kg=self.mass_kg,
+                density_kg_m3=self.density_kg_m3,
+                inertia_kgm2=self.inertia_kgm2,
+                name=self.name,
+            )
+        assert self.width_m is not None and self.height_m is not None  # loading requires them without vertices
+        return Block.rectangle(
+            self.width_m,
+            self.height_m,
+            self.thickness_m,
             mass_kg=self.mass_kg,
             density_kg_m3=self.density_kg_m3,
             inertia_kgm2=self.inertia_kgm2,
             name=self.name,
         )
-        if self.vertices_m is not None:
-            return Block.polygon(self.vertices_m, self.thickness_m, **kwargs)
-        return Block.rectangle(self.width_m, self.height_m, self.thickness_m, **kwargs)
 
     def classical(self) -> ClassicalParameters:
         """Classical parameters: the geometry's, with this block's overrides applied."""

@@ -144,7 +144,7 @@ def run_model(
     keep = workdir is not None
     # absolute paths: the process runs in ``directory``, where a relative path would be
     # taken relative to it a second time
-    directory = (Path(workdir) if keep else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
+    directory = (Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
     directory.mkdir(parents=True, exist_ok=True)
     scene_file = directory / f"{name}.yade.json"
     out_file = directory / f"{name}.yade.npz"
@@ -163,7 +163,9 @@ def run_model(
     total = time.perf_counter() - start
     if reason is not None:
         partial.unlink(missing_ok=True)  # a worker killed while writing
-    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, payload.get("contact_plan"))
+    plan = payload.get("contact_plan")
+    plan = plan if isinstance(plan, dict) else None
+    result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, plan)
     result.meta["timeout_s"] = timeout
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
@@ -382,7 +384,7 @@ def _run_meta(
     overturn_time = meta["stop_time_s"] if status == "overturned" else None
     overturned_block = names[meta["stop_body"]] if status == "overturned" else None
     if not model.stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
-        t = np.arange(arrays["ang"].shape[0]) * model.sample_dt_s
+        t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
         falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
         status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     return {

@@ -251,7 +251,7 @@ def default_duration_s(motion: Mapping[str, Any] | None, base_dir: str | Path | 
 
     folder = Path(base_dir) if base_dir is not None else Path.cwd()
     try:
-        spec = parse_motion(dict(motion), base_dir=folder)
+        spec = parse_motion(dict(motion or {}), base_dir=folder)
     except InputError as exc:
         raise InputError(
             exc.field, f"{exc.message} (duration_s defaults to the record's length: give duration_s or fix the record)"
