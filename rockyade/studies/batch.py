@@ -45,6 +45,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from rockyade.errors import BatchInterruptedError, InputError, os_error_message
@@ -52,8 +53,9 @@ from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
 from rockyade.io.locking import output_lock
 from rockyade.result import Result
-from rockyade.runner import Executor, Task, run_tasks, solve
+from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
+from rockyade.runner.groups import group_jobs
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
 from rockyade.solvers.base import Solver
@@ -98,8 +100,12 @@ def batch_task(
     out_dir: str | Path,
     save_history: bool = True,
 ) -> BatchTask:
-    """A batch run; the solver keeps its own files (if any) in ``<out_dir>/runs/<solver>/``."""
+    """A batch run; the solver keeps its own files (if any) in ``<out_dir>/runs/<solver>/``.
+    Without the history, a solver that records energy terms does not (they would be thrown
+    away)."""
     solver = as_solver(solver)
+    if not save_history and getattr(solver, "record_energy", False):
+        solver = replace(solver, record_energy=False)  # type: ignore[type-var]  # energy terms only for histories
     kept = solver.keeping_files(Path(out_dir) / "runs" / solver.name)
     return BatchTask(index, kept, scene, dict(labels), str(out_dir), save_history)
 
@@ -236,18 +242,7 @@ def run_task(task: BatchTask) -> dict[str, Any]:
     runs.mkdir(parents=True, exist_ok=True)
     name = run_name(task.scene_hash, task.solver.name)
     result = solve(task)
-    row: dict[str, Any] = {
-        "index": task.index,
-        "run": name,
-        "scene_hash": result.meta.get("scene_hash"),
-        "solver": task.solver.name,
-        **task.labels,
-        "status": result.status,
-        "failure_reason": result.meta.get("failure_reason") or "",
-        "overturn_time_s": result.meta.get("overturn_time_s"),
-        "overturned_block": result.meta.get("overturned_block") or "",
-        "wall_time_s": result.meta.get("wall_time_s"),
-    }
+    row = _status_row(task, result.meta)
     if result.ok:
         row.update(_metrics(task.scene, result))
     row["elapsed_s"] = time.perf_counter() - start
@@ -259,6 +254,80 @@ def run_task(task: BatchTask) -> dict[str, Any]:
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = _write_failure(task, row, exc)
     return row
+
+
+def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
+    """The summary row's leading and status columns of a run from its Result's metadata."""
+    return {
+        "index": task.index,
+        "run": run_name(task.scene_hash, task.solver.name),
+        "scene_hash": meta.get("scene_hash"),
+        "solver": task.solver.name,
+        **task.labels,
+        "status": meta["status"],
+        "failure_reason": meta.get("failure_reason") or "",
+        "overturn_time_s": meta.get("overturn_time_s"),
+        "overturned_block": meta.get("overturned_block") or "",
+        "wall_time_s": meta.get("wall_time_s"),
+    }
+
+
+# ---------------------------------------------------------------------- runs in groups
+
+
+def job_key(task: BatchTask) -> Any:
+    """The group of a task (:func:`rockyade.runner.groups.group_jobs`): runs without history
+    whose solver runs scenes of one structure together (``group_key``); None: it runs alone."""
+    key = getattr(task.solver, "group_key", None)
+    if task.save_history or key is None:
+        return None
+    k = key(task.scene)
+    return None if k is None else (task.out_dir, repr(task.solver), k)
+
+
+def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
+    """Run a job of :func:`job_key`'s group (or one task); its summary rows. Never raises:
+    should the group fail as a whole, its runs are run one by one."""
+    if len(job) == 1:
+        return [run_task(job[0])]
+    from rockyade.analysis.metrics import peak_metrics, uplift_threshold_rad
+
+    start = time.perf_counter()
+    first = job[0]
+    spec = first.scene.blocks[0]
+    alpha = spec.classical().alpha_rad
+    try:
+        runs = first.solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+    except Exception:  # a run of its own says what went wrong
+        return [run_task(task) for task in job]
+    elapsed = (time.perf_counter() - start) / len(job)
+    folder = Path(first.out_dir) / "runs"
+    folder.mkdir(parents=True, exist_ok=True)
+    free = first.scene.motion.type == "free"
+    rows = []
+    for task, one in zip(job, runs, strict=True):
+        row = _status_row(task, one.meta)
+        if one.status != "failed":
+            t = np.arange(one.theta_rad.size) * one.sample_dt_s
+            m = one.metrics
+            overturned = one.meta.get("overturned_block") == spec.name or spec.name in (
+                one.meta.get("overturn_times_s") or {}
+            )
+            row.update(
+                max_abs_theta_rad=m["max_abs_theta_rad"],
+                max_theta_over_alpha=m["max_abs_theta_rad"] / alpha,
+                **peak_metrics(t, one.theta_rad, alpha, free),
+                residual_theta_rad=m["residual_theta_rad"],
+                uplift_time_s=m["uplift_time_s"],
+                overturned=overturned,
+            )
+        row["elapsed_s"] = elapsed
+        try:
+            write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row})
+        except OSError as exc:
+            row = _write_failure(task, row, exc)
+        rows.append(row)
+    return rows
 
 
 def _metrics(scene: Scene, result: Result) -> dict[str, Any]:
@@ -402,30 +471,35 @@ def _run_locked(
             rows.append(done)
         else:
             todo.append(task)
-    outcome = run_tasks(
-        todo,
-        run_task,
+    check_costs(todo, allow_large)
+    n_grouped = sum(job_key(t) is not None for t in todo)
+    jobs = group_jobs(todo, job_key, min(MAX_RUNS_PER_JOB, max(1, -(-n_grouped // (4 * how.workers)))))
+    outcome = run_jobs(
+        jobs,
+        run_job,
         executor=how,
-        allow_large=allow_large,
-        failed=_crashed_row,
-        on_done=lambda _i, row: rows.append(row),
-        describe_failure=_failure_line,
+        failed=lambda job, reason: [_crashed_row(task, reason) for task in job],
+        on_done=lambda _i, job_rows: rows.extend(job_rows),
+        describe_failure=lambda job_rows: "\n".join(filter(None, map(_failure_line, job_rows))) or None,
         progress=progress,
         desc=desc,
         skipped=len(rows),
     )
     for i in outcome.unfinished:
         reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"
-        rows.append(_placeholder_row(todo[i], UNFINISHED, reason))
+        rows.extend(_placeholder_row(task, UNFINISHED, reason) for task in jobs[i])
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
     write_summary(summary, out)
     if outcome.stopped:
         if outcome.hard:
             _settle(out)
-        unfinished = len(outcome.unfinished)
+        unfinished = sum(len(jobs[i]) for i in outcome.unfinished)
         raise BatchInterruptedError(len(tasks) - unfinished, unfinished, str(out / "summary.csv"), hard=outcome.hard)
     return summary
 
+
+#: Most runs of one group in one job (groups are cut so that every worker gets jobs).
+MAX_RUNS_PER_JOB = 64
 
 LEADING_COLUMNS = ("index", "run", "scene_hash", "solver")
 STATUS_COLUMNS = ("status", "failure_reason", "overturn_time_s", "overturned_block", "wall_time_s", "elapsed_s")
@@ -468,7 +542,9 @@ __all__ = [
     "comparable",
     "expand",
     "failures",
+    "job_key",
     "load_study",
+    "run_job",
     "run_study_tasks",
     "run_task",
     "write_summary",
