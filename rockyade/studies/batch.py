@@ -21,6 +21,10 @@ summary (``summary.csv``, and ``summary.parquet`` when pyarrow is installed) has
 run: the grid values, status, failure reason, wall time and per-block metrics (see
 :func:`rockyade.analysis.run_metrics`, and the rocking pattern for stacks).
 
+A run's JSON is written atomically (a killed batch leaves whole files or none) but not synced
+to the disk by itself: the batch syncs once, at the summary checkpoint (after a power cut,
+a run whose file did not reach the disk is run again by ``resume``).
+
 A failed run never stops the batch: its row says why (a full disk too: the run fails with
 that reason and the batch goes on). ``resume`` skips runs whose JSON says they completed
 (or overturned) for the same scene hash and re-runs failed ones. The summary is sorted by
@@ -39,6 +43,7 @@ from __future__ import annotations
 import copy
 import itertools
 import json
+import os
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
@@ -250,7 +255,7 @@ def run_task(task: BatchTask) -> dict[str, Any]:
         if task.save_history and result.ok:
             result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
         else:
-            write_json(runs / f"{name}.json", {**result.meta, "summary": row})
+            write_json(runs / f"{name}.json", {**result.meta, "summary": row}, durable=False)
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = _write_failure(task, row, exc)
     return row
@@ -323,7 +328,7 @@ def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
             )
         row["elapsed_s"] = elapsed
         try:
-            write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row})
+            write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row}, durable=False)
         except OSError as exc:
             row = _write_failure(task, row, exc)
         rows.append(row)
@@ -421,6 +426,7 @@ def run_study_tasks(
     desc: str = "runs",
     allow_large: bool = False,
     scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
+    group_runs: bool = True,
 ) -> pd.DataFrame:
     """Run tasks and write the summary; return it (sorted by task order).
 
@@ -435,6 +441,9 @@ def run_study_tasks(
         Skip runs already completed for the same scene hash; re-run failed ones.
     allow_large
         Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost`.
+    group_runs
+        Run the runs that share a structure together (:func:`job_key`, :func:`run_job`; the
+        same rows); False: one run per job (benchmarks compare the two).
 
     Raises
     ------
@@ -448,7 +457,7 @@ def run_study_tasks(
     out.mkdir(parents=True, exist_ok=True)
     with output_lock(out, "out"):
         _settle(out)
-        return _run_locked(tasks, out, how, resume, progress, desc, allow_large)
+        return _run_locked(tasks, out, how, resume, progress, desc, allow_large, group_runs)
 
 
 def _settle(out: Path) -> None:
@@ -461,7 +470,14 @@ def _settle(out: Path) -> None:
 
 
 def _run_locked(
-    tasks: list[BatchTask], out: Path, how: Executor, resume: bool, progress: bool, desc: str, allow_large: bool
+    tasks: list[BatchTask],
+    out: Path,
+    how: Executor,
+    resume: bool,
+    progress: bool,
+    desc: str,
+    allow_large: bool,
+    group_runs: bool = True,
 ) -> pd.DataFrame:
     rows: list[dict[str, Any]] = []
     todo = []
@@ -472,8 +488,9 @@ def _run_locked(
         else:
             todo.append(task)
     check_costs(todo, allow_large)
-    n_grouped = sum(job_key(t) is not None for t in todo)
-    jobs = group_jobs(todo, job_key, min(MAX_RUNS_PER_JOB, max(1, -(-n_grouped // (4 * how.workers)))))
+    key = job_key if group_runs else (lambda _task: None)
+    n_grouped = sum(key(t) is not None for t in todo)
+    jobs = group_jobs(todo, key, min(MAX_RUNS_PER_JOB, max(1, -(-n_grouped // (4 * how.workers)))))
     outcome = run_jobs(
         jobs,
         run_job,
@@ -489,6 +506,7 @@ def _run_locked(
         reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"
         rows.extend(_placeholder_row(task, UNFINISHED, reason) for task in jobs[i])
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
+    os.sync()  # the runs' files reach the disk here, once, not at each run
     write_summary(summary, out)
     if outcome.stopped:
         if outcome.hard:
