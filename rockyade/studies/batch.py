@@ -106,13 +106,24 @@ def batch_task(
     save_history: bool = True,
 ) -> BatchTask:
     """A batch run; the solver keeps its own files (if any) in ``<out_dir>/runs/<solver>/``.
-    Without the history, a solver that records energy terms does not (they would be thrown
-    away)."""
+    Without the history, the solver records only what the summary reads (:func:`lean_solver`)."""
     solver = as_solver(solver)
-    if not save_history and getattr(solver, "record_energy", False):
-        solver = replace(solver, record_energy=False)  # type: ignore[type-var]  # energy terms only for histories
+    if not save_history:
+        solver = lean_solver(solver, scene)
     kept = solver.keeping_files(Path(out_dir) / "runs" / solver.name)
     return BatchTask(index, kept, scene, dict(labels), str(out_dir), save_history)
+
+
+def lean_solver(solver: Solver, scene: Scene) -> Solver:
+    """The solver of a run whose history is not kept: without energy terms, and for a column
+    without contact states (the summary reads neither; an assembly's collapse metrics read
+    the contacts' slipping)."""
+    changes = {}
+    if getattr(solver, "record_energy", False):
+        changes["record_energy"] = False
+    if getattr(solver, "record_contacts", False) and not scene.positioned:
+        changes["record_contacts"] = False
+    return replace(solver, **changes) if changes else solver  # type: ignore[type-var]
 
 
 # ---------------------------------------------------------------------- the study file
