@@ -10,6 +10,18 @@ G = 9.81
 #: keep :data:`G` = 9.81 as the paper computed them.
 STANDARD_GRAVITY = 9.80665
 
+#: Units in which accelerations are reported (printed summaries, figure axes), in m/s^2 per
+#: unit: "g" is standard gravity, as in the records. Engineers read PGA in g, so the
+#: commands about PGA report in g by default, with m/s^2 beside it.
+ACCEL_UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0}
+#: How each unit is written in figure labels (mathtext) and in plain text.
+ACCEL_UNIT_LABELS = {"g": "g", "m/s2": "m/s$^2$"}
+ACCEL_UNIT_TEXT = {"g": "g", "m/s2": "m/s^2"}
+
+#: A figure axis of load factors: a load factor multiplies the base accelerations as read
+#: (a record's samples as in its file; docs/conventions.md).
+LOAD_FACTOR_LABEL = "load factor (x the record's accelerations as read)"
+
 #: Stiffness scale applied to the paper's printed K (Tables 5-6 and Eq 10) by default.
 #: Read as N/m, Eq 10's K lets specimen 1 sink Mg/K ~ 0.7 m into its base; read as MN/m the
 #: static settlement is ~1 micrometre and the DEM rocks as Housner predicts (DESIGN.md).

@@ -82,3 +82,50 @@ def os_error_message(exc: OSError) -> str:
         what = "no space left on the device (disk full)"
     where = f"{exc.filename}: " if exc.filename else ""
     return f"{where}{what}"
+
+
+# ---------------------------------------------------------------------- numbers in messages
+#
+# A number a message states as a requirement must stay true once printed: a factor to raise
+# something by, or a lower bound, is rounded up; an upper bound or a limit not to exceed is
+# rounded down. "Raise K at least 1 times" (for 1.03) or "at least 1.3 times" (for 1.306)
+# sent users back with too little.
+
+
+def _directed(value: float, digits: int, rounding: str) -> str:
+    from decimal import Decimal
+
+    if value != value or value in (float("inf"), float("-inf")) or value == 0.0:
+        return f"{value:g}"
+    exact = Decimal(repr(float(value)))  # the shortest decimal that reads back as this float
+    step = Decimal(1).scaleb(exact.adjusted() - digits + 1)
+    rounded = exact.quantize(step, rounding=rounding)
+    return f"{float(rounded):.{digits}g}"
+
+
+def at_least(value: float, digits: int = 3) -> str:
+    """``value`` with ``digits`` significant digits, rounded up (towards +inf): a factor or
+    a lower bound that stays enough once printed.
+
+    Parameters
+    ----------
+    value
+        The number.
+    digits
+        Significant digits printed.
+    """
+    return _directed(value, digits, "ROUND_CEILING")
+
+
+def at_most(value: float, digits: int = 3) -> str:
+    """``value`` with ``digits`` significant digits, rounded down (towards -inf): an upper
+    bound or a limit that stays within once printed.
+
+    Parameters
+    ----------
+    value
+        The number.
+    digits
+        Significant digits printed.
+    """
+    return _directed(value, digits, "ROUND_FLOOR")

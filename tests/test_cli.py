@@ -188,7 +188,7 @@ def test_motion_commands(capsys, tmp_path, monkeypatch):
     assert (tmp_path / "acc.png").stat().st_size > 1000
     code, _, _ = run_cli(capsys, "motion", "spectrum", str(rec), "--damping", "0.05", "--out", str(tmp_path / "s.csv"))
     spectrum = __import__("pandas").read_csv(tmp_path / "s.csv")
-    assert code == 0 and list(spectrum.columns) == ["period_s", "psa_m_s2"] and len(spectrum) == 100
+    assert code == 0 and list(spectrum.columns) == ["period_s", "psa_g", "psa_m_s2"] and len(spectrum) == 100
     out_dir = tmp_path / "suite"
     code, out, _ = run_cli(
         capsys,
@@ -303,3 +303,28 @@ def test_motion_info_plot_says_what_it_wrote(capsys, tmp_path, monkeypatch):
     assert code == 0 and out.splitlines()[-1] == "wrote x.png" and (tmp_path / "x.png").stat().st_size > 0
     code, out, err = run_cli(capsys, "motion", "info", record, "--plot", "y.png", "--json")
     assert code == 0 and json.loads(out)["npts"] == 1001 and err.strip() == "wrote y.png"
+
+
+def test_a_mistyped_option_or_command_shows_that_commands_usage_and_the_nearest_name(capsys):
+    """Issue "What users hit" 14: ``--ouput`` printed the top-level usage with no suggestion."""
+    cases = [
+        (
+            ["motion", "spectrum", "rec.AT2", "--ouput", "s.csv"],
+            "usage: rockyade motion spectrum",
+            "did you mean --out?",
+        ),
+        (["run", "scene.toml", "--solvr", "housner"], "usage: rockyade run", "did you mean --solver?"),
+        (["rn", "scene.toml"], "usage: rockyade ", "did you mean 'run'?"),
+        (["motion", "spectrm", "rec.AT2"], "usage: rockyade motion ", "did you mean 'spectrum'?"),
+        (["motion", "info", "rec.AT2", "--accel-units", "gg"], "usage: rockyade motion info", "did you mean 'g'?"),
+    ]
+    for argv, usage, hint in cases:
+        with pytest.raises(SystemExit) as stopped:
+            main(argv)
+        err = capsys.readouterr().err
+        assert stopped.value.code == 2, argv
+        assert err.startswith(usage) and hint in err, (argv, err)
+    with pytest.raises(SystemExit) as stopped:  # nothing near: no guess
+        main(["motion", "info", "rec.AT2", "--zzzzzz"])
+    err = capsys.readouterr().err
+    assert stopped.value.code == 2 and "unrecognized arguments: --zzzzzz" in err and "did you mean" not in err

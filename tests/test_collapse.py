@@ -9,11 +9,35 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rockyade.analysis.collapse import FALLEN, REST, ROCKING, SLIDING, block_states, collapse_report
+from rockyade.analysis.collapse import (
+    FALLEN,
+    FALLING,
+    REST,
+    ROCKING,
+    SLIDING,
+    block_states,
+    collapse_report,
+)
+from rockyade.analysis.metrics import (
+    NO_WHOLE_ROTATION,
+    assembly_metrics,
+    run_metrics,
+    stack_order,
+    structure_rotation,
+)
 from rockyade.blocks.geometry import chamfered_rectangle_vertices, rectangle_vertices
+from rockyade.cli import main
 from rockyade.dem.build import contact_polygon
-from rockyade.dem.overturn import LANDING_TOL_RAD, first_overturn, landing_angles, overturn_thresholds
+from rockyade.dem.overturn import (
+    LANDING_TOL_RAD,
+    block_fall,
+    first_overturn,
+    landing_angles,
+    overturn_thresholds,
+    run_outcome,
+)
 from rockyade.scene import load_scene, scene_from_dict
+from rockyade.scene.generators import write_scene
 from rockyade.solvers import run
 
 from .conftest import EXAMPLES
@@ -115,6 +139,14 @@ def test_drums_carried_by_a_rocking_column_rock_and_do_not_slide():
     assert rocking.sum() > 100  # the column rocks well beyond its elastic tilt
     assert (states[rocking, top] == ROCKING).mean() > 0.95
     assert (states[:, top] == SLIDING).mean() < 0.05
+    # issue "What users hit" 4: against its own alpha each drum looks safe; the column as one
+    # body (its centroid about its base corner, against the column's alpha) is near its limit
+    whole = structure_rotation(scene, dem)
+    drums = run_metrics(scene, dem)
+    assert whole["structure"] == "stack of 8"
+    assert whole["structure_alpha_rad"] == pytest.approx(math.atan(0.15 / 2.0), rel=1e-3)
+    assert whole["structure_max_theta_over_alpha"] > 0.9
+    assert max(m["max_theta_over_alpha"] for m in drums.values()) < 0.2
 
 
 def test_a_falling_column_lands_from_the_bottom_up_after_tipping_as_one_body():
@@ -134,10 +166,83 @@ def test_a_falling_column_lands_from_the_bottom_up_after_tipping_as_one_body():
     assert (report.loc[drums, "final_state"] == "fallen").all()
 
 
-def test_a_beam_on_rocking_columns_is_carried_and_a_block_that_never_tipped_has_no_tip_time():
+def _falling_column(duration_s: float) -> dict:
+    data = load_scene(EXAMPLES / "assemblies/column_8_drums.toml").to_dict()
+    data.update(duration_s=duration_s, motion={"type": "pulse", "shape": "sine", "amplitude_g": 0.25, "period_s": 1.0})
+    return data
+
+
+def test_a_run_that_ends_while_blocks_fall_says_falling_and_its_status_follows_the_table(tmp_path, capsys):
+    """Issue "What users hit" 3: a run that ended while the drums were in the air marked them
+    fallen at the last sample while its status said completed ("8 fell", completed); a run
+    ended just after the first drum landed said overturned. One rule now: a block still
+    falling at the end is falling (not fallen), and the status is overturned exactly when
+    the table holds a fallen block, in the solver's metadata, the table, the batch metrics
+    and the printed line alike."""
+    long_run = scene_from_dict(_falling_column(6.0))
+    full = collapse_report(long_run, run(long_run, "reference"))
+    tip, first, last = full["tipped_time_s"].max(), full["fall_time_s"].min(), full["fall_time_s"].max()
+    assert full["fell"].all() and tip < first < last
+    # ended in mid-air: every drum beyond alpha and still turning
+    in_air = scene_from_dict(_falling_column(round(0.5 * (tip + first), 3)))
+    result = run(in_air, "reference")
+    report = collapse_report(in_air, result)
+    assert result.status == "completed" and result.meta["overturned_block"] is None
+    assert not report["fell"].any() and report["falling_at_end"].all()
+    assert (report["final_state"] == "falling").all() and report["tipped_time_s"].notna().all()
+    states, _ = block_states(in_air, result)
+    assert FALLEN not in states and (states[-1] == FALLING).all()
+    metrics = assembly_metrics(in_air, result)
+    assert metrics["n_fallen"] == 0 and metrics["n_falling_at_end"] == 8
+    # ended after some drums landed: those fell, the run overturned at the first of them
+    landing = scene_from_dict(_falling_column(round(0.5 * (first + last), 3)))
+    result = run(landing, "reference")
+    report = collapse_report(landing, result).set_index("block")
+    fell = report.index[report["fell"]]
+    assert 0 < len(fell) < 8 and report.loc[~report["fell"], "falling_at_end"].all()
+    assert result.status == "overturned" and result.meta["overturned_block"] == report["fall_time_s"].idxmin()
+    assert result.meta["overturn_time_s"] == pytest.approx(report["fall_time_s"].min(), abs=landing.sample_dt_s)
+    # the printed line says the same as the table and the status
+    scene_file = tmp_path / "column.toml"
+    write_scene(scene_file, _falling_column(in_air.duration_s))
+    assert main(["run", str(scene_file), "--solver", "reference"]) == 0
+    out = capsys.readouterr().out
+    assert "status completed" in out and "0 fell, 8 still falling when the run ended" in out
+
+
+def test_the_fall_rule_on_histories_it_decides_alone():
+    """block_fall on made histories: a block dropped by more than half its height is falling
+    while it descends and fallen once it stops; leaning beyond alpha, fallen once it stops
+    turning; the run's status follows (a drop counts, with no face on the ground)."""
+    t = np.arange(0.0, 2.0, 0.01)
+    theta = np.zeros_like(t)
+    y = np.where(t < 1.0, 0.0, -2.0 * (t - 1.0) ** 2)  # free fall from t = 1 s, never stopped
+    landing, height = (math.pi / 2, math.pi / 2), 1.0
+    still = block_fall(t, theta, y, 0.2, landing, height)
+    assert not still.fell and still.falling_at_end and t[still.falling] == pytest.approx(1.51, abs=0.011)
+    y_landed = np.maximum(y, -0.8)  # it hits something at 0.8 m down
+    landed = block_fall(t, theta, y_landed, 0.2, landing, height)
+    assert landed.fell and t[landed.fall] > 1.6 and landed.tip == -1
+    lean = np.where(t < 1.0, 0.3 * t, 0.3)  # passes alpha = 0.2 at 0.67 s, stops at 0.3 rad
+    leaning = block_fall(t, lean, np.zeros_like(t), 0.2, landing, height)
+    assert leaning.fell and t[leaning.tip] == pytest.approx(0.67, abs=0.011) and t[leaning.fall] >= 1.0
+    falls = {"a": still, "b": landed}
+    assert run_outcome({}, ["a", "b"], falls, t) == ("overturned", float(t[landed.fall]), "b")
+    assert run_outcome({}, ["a", "b"], {"a": still}, t) == ("completed", None, None)
+
+
+def test_a_beam_on_rocking_columns_is_carried_and_a_block_that_never_tipped_has_no_tip_time(capsys):
     scene = load_scene(EXAMPLES / "assemblies/frame.toml")
     result = run(scene, "reference")
     report = collapse_report(scene, result).set_index("block")
+    # a frame is no stack: no whole-body alpha, and the summary says why and what to compare instead
+    assert stack_order(scene) is None and stack_order(load_scene(EXAMPLES / "assemblies/wall_5_courses.toml")) is None
+    whole = assembly_metrics(scene, result)
+    assert whole["structure"] == "none" and math.isnan(whole["structure_max_theta_over_alpha"])
+    assert whole["structure_note"] == NO_WHOLE_ROTATION
+    assert main(["run", str(EXAMPLES / "assemblies/frame.toml"), "--solver", "reference"]) == 0
+    out = capsys.readouterr().out
+    assert "as one body: not a single stack" in out and "against the collapse acceleration of 'rockyade limit" in out
     assert report.loc["beam", "final_state"] == "carried"  # it swings with the columns: not at rest
     assert report.loc["column_left", "final_state"] == "rocking"
     assert not report["fell"].any() and report["tipped_time_s"].isna().all()

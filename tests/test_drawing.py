@@ -13,11 +13,13 @@ from rockyade.cli import main
 from rockyade.errors import InputError
 from rockyade.figures.assembly import (
     animate,
+    animation_times,
     animation_writer_for,
     draw_assembly,
-    draw_snapshots,
+    drawn_names,
     moving_polygons,
     sample_index,
+    write_snapshots,
 )
 from rockyade.result import Result
 from rockyade.scene import scene_from_dict
@@ -53,14 +55,18 @@ def _rocking_result(scene, theta: np.ndarray, t: np.ndarray, pivot_block: str) -
 
 def test_draw_writes_a_png_with_names_and_counts_the_names_left_out(tmp_path):
     small = scene_from_dict(wall(courses=3, units_per_course=4, openings=[(0.4, 0.0, 0.4, 0.2)]))
-    assert draw_assembly(small, tmp_path / "wall.png") == 0
+    _, ax = draw_assembly(small, tmp_path / "wall.png")
+    assert sorted(drawn_names(ax)) == sorted(b.name for b in small.blocks)
     width, height = _png_size(tmp_path / "wall.png")
     assert width > 800 and 0.3 < height / width < 0.8  # a wide wall gives a wide figure
     big = scene_from_dict(wall(courses=40, units_per_course=25))  # 1,020 blocks: names too small to read
-    assert draw_assembly(big, tmp_path / "big.png") == len(big.blocks)
-    assert draw_assembly(big, tmp_path / "big_nolabels.png", labels=False) == 0
+    _, ax = draw_assembly(big, tmp_path / "big.png")
+    assert drawn_names(ax) == [] and "names too small to print" in ax.get_title()
+    _, ax = draw_assembly(big, tmp_path / "big_nolabels.png", labels=False)
+    assert drawn_names(ax) == [] and "too small" not in ax.get_title()
     fixed = scene_from_dict(arch(voussoirs=7, piers="fixed"))
-    assert draw_assembly(fixed, tmp_path / "arch.png") == 0
+    _, ax = draw_assembly(fixed, tmp_path / "arch.png")
+    assert len(drawn_names(ax)) == len(fixed.blocks)
     _png_size(tmp_path / "arch.png")
 
 
@@ -106,14 +112,14 @@ def test_snapshots_and_animation_of_a_real_reference_run(tmp_path):
     assert result.status == "completed"
     peak = max(np.abs(result.series("theta_rad", b)).max() for b in ("column_left", "column_right"))
     assert peak > 0.01  # the frame rocks: the snapshots show something
-    grid = draw_snapshots(scene, result, [0.2, 0.4, 0.6], tmp_path / "snap.png")
+    grid = write_snapshots(scene, result, [0.2, 0.4, 0.6], tmp_path / "snap.png")
     assert grid == [tmp_path / "snap.png"]
     width, height = _png_size(grid[0])
     assert width > height  # three panels side by side
-    files = draw_snapshots(scene, result, [0.3, 0.5], tmp_path / "one.png", layout="files", scale=2.0)
+    files = write_snapshots(scene, result, [0.3, 0.5], tmp_path / "one.png", layout="files", scale=2.0)
     assert [p.name for p in files] == ["one_t0.300s.png", "one_t0.500s.png"]
-    frames = animate(scene, result, tmp_path / "run.gif", fps=10.0)
-    assert frames == 7
+    _, _, anim = animate(scene, result, tmp_path / "run.gif", fps=10.0)
+    assert len(animation_times(result, 10.0, 1.0)) == 7 and anim is not None
     with Image.open(tmp_path / "run.gif") as im:
         assert im.n_frames == 7
         first = np.asarray(im.convert("RGB")).copy()

@@ -101,3 +101,126 @@ def test_wrong_number_of_axes_is_an_input_error(housner_result):
         plot_accelerogram([0, 1], [0, 1], [0, 1], [0, 1], ax=fig.subplots(1, 2))
     with pytest.raises(InputError, match="ax: must be 1 matplotlib Axes"):
         plot_result(housner_result, ax=fig.subplots(1, 2))
+
+
+# ------------------------------------------------------------------ every plot function (issue "What users hit" 9)
+
+
+def _synthetic_frame_result(scene):
+    """A made-up run of a scene: every moving block turns by 0.01 sin(pi t) about its centroid."""
+    import pandas as pd
+
+    from rockyade.result import Result
+
+    t = np.linspace(0.0, 1.0, 21)
+    data = {"t_s": t, "ag_m_s2": np.zeros_like(t)}
+    names = [b.name for b in scene.blocks]
+    for name in names:
+        data[f"{name}_theta_rad"] = 0.01 * np.sin(np.pi * t)
+        data[f"{name}_x_m"] = data[f"{name}_y_m"] = np.zeros_like(t)
+    return Result(pd.DataFrame(data), {"status": "completed", "blocks": names, "solver": "synthetic"})
+
+
+_ANIMATIONS: list = []
+
+
+def _kept(fig_ax_anim):
+    """(fig, ax) of animate, its animation kept alive (matplotlib warns when one is dropped unseen)."""
+    _ANIMATIONS.append(fig_ax_anim[2])
+    return fig_ax_anim[:2]
+
+
+def test_every_plot_function_returns_fig_and_ax_and_draws_into_given_axes(tmp_path, housner_result):
+    """draw_assembly, draw_snapshots and animate wrote files only and returned a count or paths;
+    every plot function of rockyade.figures now returns its figure and Axes, takes ``ax=``,
+    writes nothing without a path and leaves pyplot alone when it draws into given Axes."""
+    import types
+
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    from rockyade.figures.assembly import animate, draw_assembly, draw_snapshots
+    from rockyade.figures.identify import plot_error_surface, plot_fit
+    from rockyade.figures.limit import draw_mechanism
+    from rockyade.figures.uncertainty import plot_uncertainty
+    from rockyade.figures.verify import plot_check
+    from rockyade.identification.fit import identify
+    from rockyade.identification.measurement import read_measurement
+    from rockyade.limit.analysis import limit_analysis
+    from rockyade.probability.exceedance import level_column
+    from rockyade.scene.generators import frame, stack
+
+    from .conftest import EXAMPLES
+
+    scene = scene_from_dict(frame())
+    result = _synthetic_frame_result(scene)
+    limit = limit_analysis(scene_from_dict(stack(widths_m=[0.4, 0.3], heights_m=0.8)))
+    ident = identify(read_measurement(EXAMPLES / "measured" / "specimen1_free_rocking.csv"))
+    study = types.SimpleNamespace(measures=["pga_m_s2"], levels=[0.5], name="s", samples=2)
+    probabilities = pd.DataFrame(
+        {
+            "solver": ["housner"] * 2,
+            "load_factor": [0.5, 1.0],
+            "p_overturn": [0.1, 0.6],
+            "p_overturn_lo": [0.0, 0.3],
+            "p_overturn_hi": [0.4, 0.8],
+            level_column(0.5): [0.3, 0.9],
+        }
+    )
+    runs = pd.DataFrame(
+        {
+            "solver": ["housner"] * 4,
+            "status": ["completed", "overturned", "completed", "overturned"],
+            "pga_m_s2": [1.0, 4.0, 2.0, 5.0],
+            "load_factor": [0.5, 1.0, 0.5, 1.0],
+            "max_theta_over_alpha": [0.2, 3.0, 0.4, 3.0],
+        }
+    )
+    fragility = pd.DataFrame(
+        {"solver": ["housner"], "measure": ["pga_m_s2"], "status": ["fitted"], "median": [2.9], "beta": [0.4]}
+    ).assign(n_runs=4)
+    calls = {
+        "draw_assembly": (lambda ax, path=None: draw_assembly(scene, path, ax=ax), 1),
+        "draw_snapshots": (lambda ax, path=None: draw_snapshots(scene, result, [0.5], path, ax=ax), 1),
+        "animate": (lambda ax, path=None: _kept(animate(scene, result, path, fps=5.0, ax=ax)), 1),
+        "draw_mechanism": (lambda ax, path=None: draw_mechanism(limit, path, ax=ax), 1),
+        "plot_fit": (lambda ax, path=None: plot_fit(ident, path, ax=ax), 2),
+        "plot_error_surface": (lambda ax, path=None: plot_error_surface(ident, path, n=7, ax=ax), 1),
+        "plot_uncertainty": (
+            lambda ax, path=None: plot_uncertainty(study, probabilities, runs, fragility, None, path, ax=ax),
+            3,
+        ),
+        "plot_check": (lambda ax, path=None: plot_check("pad", {"housner": housner_result}, path, ax=ax), 1),
+    }
+    before = plt.get_fignums()
+    for name, (call, n_axes) in calls.items():
+        mine = Figure()
+        axes = mine.subplots(1, n_axes, squeeze=False)[0].tolist()
+        fig, ax = call(axes[0] if n_axes == 1 else axes)
+        assert fig is mine, name
+        drawn = [ax] if n_axes == 1 else list(ax)
+        assert drawn == axes and any(a.has_data() or a.images or a.collections for a in drawn), name
+        assert not list(tmp_path.iterdir()), name  # no path: no file
+    assert plt.get_fignums() == before  # into given Axes: pyplot never saw a figure
+    # with a path (and no Axes) each writes its file; an animation needs .gif or .mp4
+    for name, (call, _) in calls.items():
+        path = tmp_path / (f"{name}.gif" if name == "animate" else f"{name}.png")
+        fig, _ = call(None, path)
+        assert path.stat().st_size > 0 and isinstance(fig, Figure), name
+    assert plt.get_fignums() == before  # figures for files are drawn outside pyplot
+
+
+def test_no_module_selects_a_backend_or_shows_a_figure():
+    """Notebook-first: no call of ``matplotlib.use``, ``switch_backend`` or ``.show()`` anywhere in the package."""
+    import ast
+    from pathlib import Path
+
+    import rockyade
+
+    for path in Path(rockyade.__file__).parent.rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+                called = node.func.attr
+                owner = ast.unparse(node.func.value)
+                assert called not in ("show", "switch_backend"), f"{path}: {owner}.{called}()"
+                assert not (called == "use" and owner.endswith("matplotlib")), f"{path}: {owner}.use()"

@@ -20,6 +20,7 @@ from rockyade.scene import load_scene, scene_from_dict
 from rockyade.scene.generators import (
     GENERATORS,
     arch,
+    column,
     drum_column,
     frame_frequency,
     frame_gamma,
@@ -332,6 +333,61 @@ def test_drum_column_stacks_equal_drums_flush_and_both_layouts_place_them_alike(
     assert tops == pytest.approx([0.45 * k for k in range(1, 9)] + [3.8], abs=FLUSH)
     beds = [c for c in rest_contacts(positioned) if c.b >= 0]
     assert [round(c.length_m, 12) for c in beds] == [0.3] * 8
+
+
+def test_round_drums_carry_a_cylinders_mass_and_inertia_into_housner_and_both_dems():
+    """Issue "What users hit" 4: drums were square prisms (six 0.8 x 1 m drums of 2700 kg/m^3:
+    10,368 kg instead of the cylinders' 8,143 kg). A round drum now writes m = rho pi D^2/4 h
+    and I = m (3 r^2 + h^2)/12, and the solvers read them: Housner's p and both DEMs' bodies."""
+    from rockyade.calibration.model import calibrated_model
+    from rockyade.scene.generators import round_drum_mass_inertia
+    from rockyade.solvers import run
+    from rockyade.yade.payload import scene_payload
+
+    round_column = scene_from_dict(column(drums=6, diameter_m=0.8, drum_height_m=1.0, density_kg_m3=2700))
+    square = scene_from_dict(
+        column(drums=6, diameter_m=0.8, drum_height_m=1.0, density_kg_m3=2700, section="square")
+    )
+    assert sum(b.block().mass_kg for b in round_column.blocks) == pytest.approx(8143.0, abs=0.5)
+    assert sum(b.block().mass_kg for b in square.blocks) == pytest.approx(10368.0)
+    mass, inertia = round_drum_mass_inertia(0.8, 1.0, 2700.0)
+    assert mass == pytest.approx(2700 * math.pi * 0.16) and inertia == pytest.approx(mass * (3 * 0.16 + 1.0) / 12)
+    drum = round_column.blocks[0]
+    assert drum.block().inertia_c_kgm2 == pytest.approx(inertia)
+    classical = drum.classical()
+    i_o = inertia + mass * classical.R_m**2  # about the pivot corner
+    assert classical.p_rad_s == pytest.approx(math.sqrt(mass * 9.81 * classical.R_m / i_o))
+    body = calibrated_model(round_column).bodies[0]
+    assert (body.mass_kg, body.inertia_kgm2, body.p_rad_s) == pytest.approx((mass, inertia, classical.p_rad_s))
+    payload = scene_payload(calibrated_model(round_column))["bodies"][0]  # what YADE is given
+    assert (payload["mass_kg"], payload["inertia_kgm2"]) == pytest.approx((mass, inertia))
+    # one round drum rocking freely: Housner and the reference DEM cross zero together
+    data = column(1, diameter_m=0.8, drum_height_m=2.0, density_kg_m3=2700, duration_s=1.0)
+    data.update(sample_dt_s=0.001, motion={"type": "free", "theta0_rad": 0.1, "block": "d01"})
+    one = scene_from_dict(data)
+    crossings = []
+    for solver in ("housner", "reference"):
+        theta = run(one, solver).series("theta_rad")
+        crossings.append(int(np.flatnonzero(np.sign(theta[:-1]) != np.sign(theta[1:]))[0]))
+    assert abs(crossings[0] - crossings[1]) <= 2  # samples of 1 ms (measured: the same sample)
+
+
+def test_generators_import_under_the_names_the_cli_uses():
+    """Issue "What users hit" 10: ``from rockyade.scene.generators import column`` gave the
+    module; every kind of ``rockyade build`` is now a function of its own name (modules are
+    plural, so none hides a function), and the former names still work."""
+    import importlib
+
+    import rockyade.scene.generators as generators
+
+    assert set(GENERATORS) == set(KINDS)
+    for kind, function in GENERATORS.items():
+        name = kind.replace("-", "_")
+        assert getattr(generators, name) is function and inspect.isfunction(function), kind
+        assert function.__name__ == name
+    for module in ("walls", "columns", "arches", "frames", "restrained_walls"):
+        assert inspect.ismodule(importlib.import_module(f"rockyade.scene.generators.{module}"))
+    assert generators.drum_column is generators.column and generators.rocking_frame is generators.frame
 
 
 def test_continuous_taper_has_straight_sides():

@@ -1,22 +1,27 @@
 """Collapse of an assembly: the state of every block over time, which blocks fell and when.
 
-Each moving block is, at each sample, in one of five states (codes in :data:`STATES`):
+Each moving block is, at each sample, in one of six states (codes in :data:`STATES`):
 
-* ``fallen``: it has come down for good, from the first of: it lies on another face
-  (|theta| within ``LANDING_TOL_RAD`` of its landing angle, :mod:`rockyade.dem.overturn`:
-  the DEMs' overturn criterion); it ends the run dropped by more than ``DROP_FRACTION`` of
-  its height (carried down by the blocks under it, or fallen off them) and has stopped
-  descending (it hit something: vertical speed above -``LAND_SPEED_M_S``); it ends the run
-  beyond its tipping angle alpha, leaning on a neighbour or on rubble, and has stopped
-  turning after its last passage of alpha (``REST_SPIN_RAD_S``). A block still moving at
-  the end of the run falls at its last sample. Once fallen, fallen to the end. The report
-  also gives ``tipped_time_s``, when the block last passed alpha before falling (from there
-  gravity alone no longer brings it back; none for a block carried down or dropping flat);
-* ``sliding``: its base slides: the horizontal speed of the point of the block that was the
-  middle of its base at rest exceeds ``SLIDE_SPEED_M_S`` while it is not rocking fast
-  enough to explain it (rocking about a corner moves that point by b (1 - cos theta)), and,
-  where the result records it (both DEMs' ``slipping``; Housner has none), one of the block's
-  contacts slips: a drum carried by the rocking drums under it moves fast but does not slide;
+* ``fallen``: it has come down for good (:func:`rockyade.dem.overturn.block_fall`, the rule
+  the DEMs' run status follows too), from the first of: it lies on another face (|theta|
+  within ``LANDING_TOL_RAD`` of its landing angle); it ends the run dropped by more than
+  ``DROP_FRACTION`` of its height (carried down by the blocks under it, or fallen off them)
+  and has stopped descending (it hit something: vertical speed above -``LAND_SPEED_M_S``);
+  it ends the run beyond its tipping angle alpha, leaning on a neighbour or on rubble, and
+  has stopped turning after its last passage of alpha (``REST_SPIN_RAD_S``). Once fallen,
+  fallen to the end;
+* ``falling``: on its way down: from its last passage of alpha before it fell (from there
+  gravity alone no longer brings it back; ``tipped_time_s``), or for a block carried down or
+  dropping flat from when it last went below half its height, until it has fallen. A block
+  still descending or turning beyond alpha when the run ends is ``falling`` to the end: it
+  has not fallen within the run, and a longer run says where it lands;
+* ``sliding``: its base slides on what it rests on: the point of the block that was the
+  middle of its base at rest moves along the joint, relative to the block (or base) under
+  it, faster than ``SLIDE_SPEED_M_S`` beyond what its rocking on that block explains
+  (rocking about a corner moves that point by b (1 - cos theta)), on every block it rests
+  on, and, where the result records it (both DEMs' ``slipping``; Housner has none), one of
+  its contacts slips. A drum carried by the rocking drums under it moves fast with them but
+  does not slide on them;
 * ``rocking``: |theta| above ``ROCK_FRACTION`` x alpha (and at least ``ROCK_MIN_RAD``);
 * ``carried``: none of the above, but it moves (its centroid faster than ``SLIDE_SPEED_M_S``
   or it turns faster than ``REST_SPIN_RAD_S``): a beam on rocking columns, a course on a
@@ -36,25 +41,47 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from rockyade.dem.overturn import LANDING_TOL_RAD, landing_angles
+from rockyade.dem.overturn import (
+    DROP_FRACTION,
+    LAND_SPEED_M_S,
+    LANDING_TOL_RAD,
+    REST_SPIN_RAD_S,
+    Fall,
+    block_fall,
+    landing_angles,
+)
 from rockyade.result import Result
 from rockyade.scene import Scene
+from rockyade.scene.placement import placed_blocks, rest_contacts
 
-STATES = ("rest", "rocking", "sliding", "fallen", "carried")
-REST, ROCKING, SLIDING, FALLEN, CARRIED = range(5)
+STATES = ("rest", "rocking", "sliding", "fallen", "carried", "falling")
+REST, ROCKING, SLIDING, FALLEN, CARRIED, FALLING = range(6)
+
+__all__ = [
+    "CARRIED",
+    "DROP_FRACTION",
+    "FALLEN",
+    "FALLING",
+    "LANDING_TOL_RAD",
+    "LAND_SPEED_M_S",
+    "REST",
+    "REST_SPIN_RAD_S",
+    "ROCKING",
+    "SLIDING",
+    "STATES",
+    "BlockGeometry",
+    "block_geometry",
+    "block_states",
+    "collapse_report",
+    "state_frame",
+]
 
 #: Rocking: |theta| above this fraction of alpha ...
 ROCK_FRACTION = 0.01
 #: ... and above this absolute rotation (the contacts' elastic tilt is ~1e-5 rad).
 ROCK_MIN_RAD = 1e-4
-#: Sliding: horizontal speed of the base's middle point above this, m/s.
+#: Sliding: speed of the base's middle point along the joint it rests on above this, m/s.
 SLIDE_SPEED_M_S = 0.01
-#: Fallen off: the centroid dropped by more than this fraction of the block height.
-DROP_FRACTION = 0.5
-#: A dropped block has landed when its centroid no longer descends faster than this, m/s.
-LAND_SPEED_M_S = 0.05
-#: A block leaning beyond alpha has come to rest when it turns slower than this, rad/s.
-REST_SPIN_RAD_S = 0.05
 
 
 @dataclass(frozen=True)
@@ -130,21 +157,17 @@ def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[B
     n = t.size
     states = np.zeros((n, len(geometry)), dtype=np.int8)
     dt = float(t[1] - t[0]) if n > 1 else 1.0
+    supports, centroids = _supports(scene)
     for j, g in enumerate(geometry):
         theta = _series(result, "theta_rad", g.name)
         x = _series(result, "x_m", g.name)
         y = _series(result, "y_m", g.name)
-        fallen = _fallen_mask(theta, y, g, t, _solver_fall_time(result, g.name))
-        # the rest-frame middle of the base, rotated with the block, relative to its rest place
-        c, s = np.cos(theta), np.sin(theta)
-        bx = x + c * g.base_mid_m[0] - s * g.base_mid_m[1] - g.base_mid_m[0]
-        speed = np.abs(np.gradient(bx, dt)) if n > 1 else np.zeros(n)
+        fall = block_fall_of(g, result)
         rocking = np.abs(theta) > max(ROCK_MIN_RAD, ROCK_FRACTION * g.alpha_rad)
-        rocking_speed = np.abs(np.gradient(theta, dt)) * abs(g.base_mid_m[1]) * np.abs(np.sin(theta)) if n > 1 else 0.0
-        sliding = speed > SLIDE_SPEED_M_S + rocking_speed
+        sliding = _sliding(result, g, supports.get(g.name, []), centroids, dt)
         slipping = _slipping(result, g.name)
-        if slipping is not None:  # the DEM says whether a contact slips: a block carried
-            sliding &= slipping  # by the rocking blocks under it does not slide
+        if slipping is not None:  # the DEM says whether a contact slips
+            sliding &= slipping
         moving = np.zeros(n, dtype=bool)
         if n > 1:
             moving = (np.hypot(np.gradient(x, dt), np.gradient(y, dt)) > SLIDE_SPEED_M_S) | (
@@ -153,103 +176,143 @@ def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[B
         code = np.where(moving, CARRIED, REST)
         code = np.where(rocking, ROCKING, code)
         code = np.where(sliding, SLIDING, code)
-        code = np.where(fallen, FALLEN, code)
+        if fall.falling >= 0:
+            code[fall.falling :] = FALLING
+        if fall.fell:
+            code[fall.fall :] = FALLEN
         states[:, j] = code
     return states, geometry
 
 
+@dataclass(frozen=True)
+class _Support:
+    """A joint a block rests on at rest: the block (or base, None) under it, the joint's
+    middle (base frame, m) and its direction (unit vector along the joint)."""
+
+    below: str | None
+    point_m: tuple[float, float]
+    tangent: tuple[float, float]
+
+
+def _supports(scene: Scene) -> tuple[dict[str, list[_Support]], dict[str, tuple[float, float]]]:
+    """Per moving block, the joints it rests on: its bed joints with a block or the base
+    under it; a block without one (a voussoir between radial joints) takes all its joints.
+    And every block's centroid at rest (base frame, m)."""
+    placed = placed_blocks(scene)
+    contacts = rest_contacts(placed)
+    out: dict[str, list[_Support]] = {}
+    touching: dict[str, list[_Support]] = {}
+    for c in contacts:
+        mid = tuple(0.5 * (np.asarray(c.ends_m[0]) + np.asarray(c.ends_m[1])))
+        tangent = (c.normal[1], -c.normal[0])
+        pairs = [(c.a, c.b), (c.b, c.a)] if c.b >= 0 else [(c.a, -1)]
+        for me, other in pairs:
+            if placed[me].fixed:
+                continue
+            below = None if other < 0 or placed[other].fixed else placed[other].name
+            support = _Support(below, (float(mid[0]), float(mid[1])), tangent)
+            touching.setdefault(placed[me].name, []).append(support)
+            if c.kind == "bed" and c.upper == me:
+                out.setdefault(placed[me].name, []).append(support)
+    for b in placed:
+        if not b.fixed and b.name not in out:
+            out[b.name] = touching.get(b.name, [])
+    return out, {b.name: b.centroid_m for b in placed}
+
+
+def _material_point(
+    result: Result, name: str | None, point_m: NDArray[np.float64], centroid_m: tuple[float, float]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Path (x, y) of the material point of block ``name`` that was at ``point_m`` at rest,
+    and the block's rotation; the base (None) does not move in the base frame."""
+    n = result.t.size
+    if name is None:
+        return np.full(n, point_m[0]), np.full(n, point_m[1]), np.zeros(n)
+    theta = _series(result, "theta_rad", name)
+    rx, ry = point_m[0] - centroid_m[0], point_m[1] - centroid_m[1]
+    c, s = np.cos(theta), np.sin(theta)
+    x = centroid_m[0] + _series(result, "x_m", name) + c * rx - s * ry
+    y = centroid_m[1] + _series(result, "y_m", name) + s * rx + c * ry
+    return x, y, theta
+
+
+def _sliding(
+    result: Result,
+    g: BlockGeometry,
+    supports: list[_Support],
+    centroids: dict[str, tuple[float, float]],
+    dt: float,
+) -> NDArray[np.bool_]:
+    """Samples at which the block slides on every joint it rests on (see module docstring)."""
+    n = result.t.size
+    if n < 2:
+        return np.zeros(n, dtype=bool)
+    if not supports:  # in the air at rest: against the base
+        supports = [_Support(None, (0.0, 0.0), (1.0, 0.0))]
+    sliding = np.ones(n, dtype=bool)
+    for sup in supports:
+        point = np.asarray(sup.point_m, dtype=float)
+        xj, yj, thj = _material_point(result, g.name, point, centroids[g.name])
+        xs, ys, ths = _material_point(result, sup.below, point, centroids[sup.below] if sup.below else (0.0, 0.0))
+        # the joint's direction turns with the block under it
+        tx = np.cos(ths) * sup.tangent[0] - np.sin(ths) * sup.tangent[1]
+        ty = np.sin(ths) * sup.tangent[0] + np.cos(ths) * sup.tangent[1]
+        along = tx * (xj - xs) + ty * (yj - ys)
+        speed = np.abs(np.gradient(along, dt))
+        relative = thj - ths
+        rocking_speed = np.abs(np.gradient(relative, dt)) * abs(g.base_mid_m[1]) * np.abs(np.sin(relative))
+        sliding &= speed > SLIDE_SPEED_M_S + rocking_speed
+    return sliding
+
+
 def _slipping(result: Result, name: str) -> NDArray[np.bool_] | None:
-    """The reference DEM's per-block slip flag (one of the block's contact points slips), if recorded."""
+    """The DEMs' per-block slip flag (one of the block's contact points slips), if recorded."""
     try:
         return np.asarray(result.series("slipping", name), dtype=bool)
     except KeyError:
         return None
 
 
-def _fall_and_tip(
-    theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry, t: NDArray[np.float64], t_solver: float | None
-) -> tuple[int, int]:
-    """Sample of the fall and of the tip that led to it (see module docstring), -1 if none.
+def block_fall_of(g: BlockGeometry, result: Result) -> Fall:
+    """:func:`rockyade.dem.overturn.block_fall` of one block of a result (sample indices).
 
-    The fall is when the block has come down: the first sample it lies on another face; or,
-    for a block that ends the run dropped by more than ``DROP_FRACTION`` of its height (it
-    was carried down by the blocks under it, or fell off them), the first sample of that
-    final drop at which it stops descending (it hit something); or, for a block that ends
-    the run beyond its tipping angle leaning on a neighbour or on rubble, the first sample
-    after its last passage of alpha at which it stops turning. Still moving at the end: the
-    last sample. The tip is the last passage of alpha before the fall (-1 if the block was
-    not beyond alpha when it fell: a block carried down or dropping flat).
-
-    ``t_solver`` is the time at which the solver itself found the block overturned (between
-    samples, ``meta["overturn_times_s"]``): a run that stops there ends before a sample shows it.
-    """
-    finite = np.isfinite(theta)
-    if not finite.any():
-        return -1, -1
-    last = int(np.flatnonzero(finite)[-1])
-    landed = (theta >= g.landing_rad[0] - LANDING_TOL_RAD) | (theta <= -(g.landing_rad[1] - LANDING_TOL_RAD))
-    if t_solver is not None:
-        landed |= t >= min(t_solver, float(t[last]))
-    beyond = (np.abs(theta) > g.alpha_rad) & finite
-    dt = float(t[1] - t[0]) if t.size > 1 else 1.0
-    hits = np.flatnonzero(landed & finite)
-    if hits.size:
-        fall = int(hits[0])
-    elif y[last] < -DROP_FRACTION * g.height_m:
-        up = np.flatnonzero(~(y[: last + 1] < -DROP_FRACTION * g.height_m))
-        start = int(up[-1]) + 1 if up.size else 0  # the final drop, to the end of the run
-        vy = np.gradient(y[: last + 1], dt) if last > 0 else np.zeros(1)
-        fall = _first_settled(vy, start, last, LAND_SPEED_M_S, -1)
-    elif beyond[last]:
-        below = np.flatnonzero(~beyond[: last + 1])
-        start = int(below[-1]) + 1 if below.size else 0
-        omega = np.gradient(theta[: last + 1], dt) if last > 0 else np.zeros(1)
-        fall = _first_settled(omega, start, last, REST_SPIN_RAD_S, 0)
-    else:
-        return -1, -1
-    if not beyond[fall]:
-        return fall, -1
-    below = np.flatnonzero(~beyond[: fall + 1])
-    tip = int(below[-1]) + 1 if below.size else 0
-    return fall, tip
-
-
-def _first_settled(rate: NDArray[np.float64], start: int, last: int, limit: float, sign: int) -> int:
-    """First sample in [start, last] where a descent stops (``sign = -1``: rate >= -limit) or
-    a motion stops (``sign = 0``: |rate| <= limit); ``last`` if it never does."""
-    window = rate[start : last + 1]
-    ok = window >= -limit if sign < 0 else np.abs(window) <= limit
-    hit = np.flatnonzero(ok)
-    return start + int(hit[0]) if hit.size else last
+    Parameters
+    ----------
+    g
+        The block (:func:`block_geometry`).
+    result
+        The run's Result (any solver)."""
+    return block_fall(
+        result.t,
+        _series(result, "theta_rad", g.name),
+        _series(result, "y_m", g.name),
+        g.alpha_rad,
+        g.landing_rad,
+        g.height_m,
+        _solver_fall_time(result, g.name),
+    )
 
 
 def _solver_fall_time(result: Result, name: str) -> float | None:
-    times = result.meta.get("overturn_times_s") or {}
-    if name in times:
-        return float(times[name])
+    """When the solver found the block lying on another face (between samples), s."""
+    if "overturn_times_s" in result.meta:  # both DEMs: per block
+        times = result.meta["overturn_times_s"] or {}
+        return float(times[name]) if name in times else None
     if result.meta.get("overturned_block") == name and result.meta.get("overturn_time_s") is not None:
         return float(result.meta["overturn_time_s"])
     return None
-
-
-def _fallen_mask(
-    theta: NDArray[np.float64], y: NDArray[np.float64], g: BlockGeometry, t: NDArray[np.float64], t_solver: float | None
-) -> NDArray[np.bool_]:
-    """True from the sample where the block fell for good."""
-    mask = np.zeros(theta.size, dtype=bool)
-    fall, _ = _fall_and_tip(theta, y, g, t, t_solver)
-    if fall >= 0:
-        mask[fall:] = True
-    return mask
 
 
 def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
     """One row per moving block: whether and when it fell, time spent rocking and sliding,
     peak and residual rotation and displacement.
 
-    Columns: ``block``, ``fell``, ``fall_time_s``, ``tipped_time_s``, ``max_abs_theta_rad``,
-    ``max_theta_over_alpha``, ``residual_theta_rad``, ``residual_x_m``, ``residual_y_m``,
-    ``rocking_time_s``, ``sliding_time_s``, ``final_state``.
+    Columns: ``block``, ``fell`` (it came down within the run), ``fall_time_s``,
+    ``falling_at_end`` (the run ended while it was still falling: not fallen),
+    ``tipped_time_s`` (its last passage of alpha before it fell, or before the end while
+    falling), ``max_abs_theta_rad``, ``max_theta_over_alpha``, ``residual_theta_rad``,
+    ``residual_x_m``, ``residual_y_m``, ``rocking_time_s``, ``sliding_time_s``,
+    ``final_state``. Times in s, angles in rad, displacements in m.
 
     Parameters
     ----------
@@ -265,15 +328,15 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
     for j, g in enumerate(geometry):
         theta = _series(result, "theta_rad", g.name)
         finite = np.isfinite(theta)
-        fell = np.flatnonzero(states[:, j] == FALLEN)
         last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
-        _, tip = _fall_and_tip(theta, _series(result, "y_m", g.name), g, t, _solver_fall_time(result, g.name))
+        fall = block_fall_of(g, result)
         rows.append(
             {
                 "block": g.name,
-                "fell": bool(fell.size),
-                "fall_time_s": float(t[fell[0]]) if fell.size else math.nan,
-                "tipped_time_s": float(t[tip]) if fell.size and tip >= 0 else math.nan,
+                "fell": fall.fell,
+                "fall_time_s": float(t[fall.fall]) if fall.fell else math.nan,
+                "falling_at_end": fall.falling_at_end,
+                "tipped_time_s": float(t[fall.tip]) if fall.tip >= 0 else math.nan,
                 "max_abs_theta_rad": float(np.nanmax(np.abs(theta))) if finite.any() else math.nan,
                 "max_theta_over_alpha": float(np.nanmax(np.abs(theta)) / g.alpha_rad) if finite.any() else math.nan,
                 "residual_theta_rad": float(theta[last]) if last >= 0 else math.nan,

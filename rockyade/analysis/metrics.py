@@ -1,10 +1,12 @@
-"""Per-block summary metrics of a run (the rows of batch summaries and CLI reports)."""
+"""Summary metrics of a run (the rows of batch summaries and CLI reports): per block, per
+assembly (collapse), and of a stack as one body (:func:`structure_rotation`)."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.result import Result
@@ -29,18 +31,28 @@ def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -
         block name -> ``max_abs_theta_rad``, ``max_theta_over_alpha``, ``n_peaks``,
         ``first_peak_rad``, ``mu_eff`` (free rocking only; NaN otherwise or without two
         peaks), ``residual_theta_rad``,
-        ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool).
+        ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool: in an assembly,
+        it fell by the collapse table's rule, :mod:`rockyade.analysis.collapse`).
     """
     out: dict[str, dict[str, float]] = {}
     t = result.t
     free = scene.motion.type == "free"
+    fell: dict[str, bool] = {}
+    if scene.positioned and result.ok:
+        from rockyade.analysis.collapse import collapse_report
+
+        report = collapse_report(scene, result)
+        fell = dict(zip(report["block"], report["fell"], strict=True))
     for spec in scene.blocks:
         if spec.fixed:
             continue
         alpha = spec.classical().alpha_rad
         theta = result.series("theta_rad", spec.name)
-        overturned = result.meta.get("overturned_block") == spec.name or spec.name in (
-            result.meta.get("overturn_times_s") or {}
+        overturned = (
+            fell[spec.name]
+            if spec.name in fell
+            else result.meta.get("overturned_block") == spec.name
+            or spec.name in (result.meta.get("overturn_times_s") or {})
         )
         out[spec.name] = {**theta_metrics(t, theta, alpha), **peak_metrics(t, theta, alpha, free, n_impacts),
                           "overturned": overturned}
@@ -90,11 +102,16 @@ PER_BLOCK_LIMIT = 10
 
 def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | str]:
     """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
-    ``n_blocks``, ``n_fallen``, ``fallen_fraction``, ``first_fall_time_s``, ``first_fallen_block``,
-    ``max_abs_theta_rad`` and its block, ``max_residual_displacement_m`` (at the end of the
-    run) and its block, ``n_moving_at_end`` (blocks whose final state is not rest or fallen:
-    their "residual" values are where they were when the run ended, not where they stopped).
-    Times in s, angles in rad, displacements in m.
+    ``n_blocks``, ``n_fallen`` (blocks that came down within the run), ``fallen_fraction``,
+    ``first_fall_time_s``, ``first_fallen_block``, ``n_falling_at_end`` (blocks still falling
+    when the run ended: not counted as fallen), ``max_abs_theta_rad`` and its block,
+    ``max_residual_displacement_m`` (at the end of the run) and its block, ``n_moving_at_end``
+    (blocks whose final state is not rest or fallen: their "residual" values are where they
+    were when the run ended, not where they stopped), and the whole's own measure
+    (:func:`structure_rotation`: ``structure``, ``structure_alpha_rad``,
+    ``structure_max_theta_rad``, ``structure_max_theta_over_alpha``, ``structure_note``).
+    Times in s, angles in rad, displacements in m. The run's status is ``overturned`` exactly when ``n_fallen`` > 0
+    (both DEMs decide it by the same rule, :func:`rockyade.dem.overturn.run_outcome`).
 
     Parameters
     ----------
@@ -107,7 +124,7 @@ def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | st
     report = collapse_report(scene, result)
     fallen = report[report["fell"]]
     residual = np.hypot(report["residual_x_m"], report["residual_y_m"])
-    first = fallen.sort_values("fall_time_s").iloc[0] if len(fallen) else None
+    first = fallen.sort_values("fall_time_s", kind="stable").iloc[0] if len(fallen) else None
     k_theta = int(np.nanargmax(report["max_abs_theta_rad"])) if len(report) else -1
     k_disp = int(np.nanargmax(residual)) if len(report) else -1
     return {
@@ -116,9 +133,137 @@ def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | st
         "fallen_fraction": float(len(fallen) / max(len(report), 1)),
         "first_fall_time_s": float(first["fall_time_s"]) if first is not None else math.nan,
         "first_fallen_block": str(first["block"]) if first is not None else "",
+        "n_falling_at_end": int(report["falling_at_end"].sum()) if len(report) else 0,
         "max_abs_theta_rad": float(report["max_abs_theta_rad"].iloc[k_theta]) if k_theta >= 0 else math.nan,
         "max_theta_block": str(report["block"].iloc[k_theta]) if k_theta >= 0 else "",
         "max_residual_displacement_m": float(residual.iloc[k_disp]) if k_disp >= 0 else math.nan,
         "max_residual_block": str(report["block"].iloc[k_disp]) if k_disp >= 0 else "",
         "n_moving_at_end": int((~report["final_state"].isin(["rest", "fallen"])).sum()),
+        **structure_rotation(scene, result),
     }
+
+
+#: Why an assembly that is not a stack has no whole-body rotation measure (docs/assemblies.md).
+NO_WHOLE_ROTATION = (
+    "not a single stack: a wall, an arch or a frame fails by a mechanism of some of its blocks, not by "
+    "rocking as one body, so it has no whole-body alpha"
+)
+
+
+def stack_order(scene: Scene) -> list[str] | None:
+    """The moving blocks bottom to top when they form one stack (the bottom one on the base,
+    each other on the one below it alone, no fixed block, no head joint); else None.
+
+    Parameters
+    ----------
+    scene
+        Any scene (a column scene is a stack by construction)."""
+    from rockyade.scene.placement import placed_blocks, rest_contacts
+
+    if any(spec.fixed for spec in scene.blocks):
+        return None
+    if not scene.positioned:
+        return [spec.name for spec in scene.blocks]
+    placed = placed_blocks(scene)
+    below: dict[int, list[int]] = {}
+    for c in rest_contacts(placed):
+        if c.kind != "bed":
+            return None
+        lower = -1 if c.b < 0 else (c.b if c.upper == c.a else c.a)
+        below.setdefault(c.upper, []).append(lower)
+    order, current = [], -1
+    for _ in placed:
+        above = [k for k, lows in below.items() if lows == [current]]
+        if len(above) != 1:
+            return None
+        current = above[0]
+        order.append(current)
+    if sorted(order) != list(range(len(placed))):
+        return None
+    return [placed[k].name for k in order]
+
+
+def structure_rotation(scene: Scene, result: Result) -> dict[str, float | str]:
+    """A stack's rotation as one body: the turn of the line from its base corner to the
+    centroid of all its blocks, against that line's angle from the vertical at rest (the
+    whole's alpha: a rigid stack turned by it has its centroid over the corner).
+
+    For one block this is its theta against its alpha; for drums that rock as one body, each
+    drum's theta against the column's alpha, whereas each drum's own alpha is much larger
+    (a drum 0.8 m wide and 1 m tall has alpha = 0.675 rad; six of them, 0.133 rad).
+
+    Parameters
+    ----------
+    scene
+        The scene that produced ``result``.
+    result
+        The run's Result (any solver).
+
+    Returns
+    -------
+    dict
+        ``structure``: "stack of N" or "none"; ``structure_alpha_rad`` (towards the side of
+        the peak), ``structure_max_theta_rad`` (signed: counter-clockwise about the left
+        corner > 0), ``structure_max_theta_over_alpha``; NaN and ``structure_note`` saying why
+        for an assembly that is not a stack (:data:`NO_WHOLE_ROTATION`). Angles in rad.
+    """
+    nan = {
+        "structure": "none",
+        "structure_alpha_rad": math.nan,
+        "structure_max_theta_rad": math.nan,
+        "structure_max_theta_over_alpha": math.nan,
+        "structure_note": "",
+    }
+    order = stack_order(scene)
+    if order is None:
+        return {**nan, "structure_note": NO_WHOLE_ROTATION}
+    if not result.ok or result.t.size == 0:
+        return {**nan, "structure": f"stack of {len(order)}", "structure_note": "the run failed"}
+    from rockyade.scene.placement import placed_blocks
+
+    placed = {b.name: b for b in placed_blocks(scene)}
+    bodies = result.meta.get("bodies") or {}
+    specs = {spec.name: spec for spec in scene.blocks}
+    mass = np.array([float(bodies[n]["mass_kg"]) if n in bodies else specs[n].block().mass_kg for n in order])
+    rest = np.array([placed[n].centroid_m for n in order])
+    g0 = mass @ rest / mass.sum()
+    moved = np.stack(
+        [rest[k] + np.column_stack([result.series("x_m", n), result.series("y_m", n)]) for k, n in enumerate(order)]
+    )
+    g = np.einsum("k,knd->nd", mass, moved) / mass.sum()
+    left, right = _base_corners(placed[order[0]], bodies.get(order[0]))
+    alpha_left = math.atan2(g0[0] - left[0], g0[1] - left[1])
+    alpha_right = math.atan2(right[0] - g0[0], g0[1] - right[1])
+    about_left = np.arctan2(-(g[:, 0] - left[0]), g[:, 1] - left[1]) + alpha_left  # > 0: CCW, towards -x
+    about_right = np.arctan2(-(g[:, 0] - right[0]), g[:, 1] - right[1]) - alpha_right  # < 0: CW
+    theta = np.where(g[:, 0] <= g0[0], about_left, about_right)
+    if len(order) == 1:  # one block: its own alpha (the DEM's, or a measured override)
+        name = order[0]
+        own = bodies[name]["alpha_rad"] if name in bodies else specs[name].classical().alpha_rad
+        alpha_left = alpha_right = float(own)
+    finite = np.isfinite(theta)
+    if not finite.any():
+        return {**nan, "structure": f"stack of {len(order)}", "structure_note": "no finite sample"}
+    k = int(np.nanargmax(np.abs(theta)))
+    alpha = alpha_left if theta[k] >= 0 else alpha_right
+    return {
+        "structure": f"stack of {len(order)}",
+        "structure_alpha_rad": float(alpha),
+        "structure_max_theta_rad": float(theta[k]),
+        "structure_max_theta_over_alpha": float(abs(theta[k]) / alpha),
+        "structure_note": "",
+    }
+
+
+def _base_corners(block, body: dict | None) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Left and right base corners of the bottom block at rest, base frame, m: the DEM's (its
+    base corners may sit at the equivalent base b_eq, paper Eq 11) when the result has them."""
+    if body is not None:
+        poly = np.asarray(body["contact_vertices_m"], dtype=float)
+        c, s = math.cos(body["rest_angle_rad"]), math.sin(body["rest_angle_rad"])
+        poly = poly @ np.array([[c, s], [-s, c]]) + np.asarray(body["rest_centroid_m"], dtype=float)
+    else:
+        poly = np.asarray(block.vertices_m, dtype=float)
+    low = poly[:, 1] <= poly[:, 1].min() + 1e-9 * max(float(np.ptp(poly[:, 1])), 1.0)
+    base = poly[low]
+    return base[np.argmin(base[:, 0])], base[np.argmax(base[:, 0])]

@@ -40,7 +40,7 @@ from rockyade.constants import (
 )
 from rockyade.dem.joints import ContactParameters
 from rockyade.dem.model import time_step_eq7
-from rockyade.errors import CalibrationError, InputError
+from rockyade.errors import CalibrationError, InputError, at_least, at_most
 
 #: Range of Gamma / mu^2 covered by the paper's four specimens (Fig. 11), for a warning.
 EQ13_FITTED_RANGE = (7.0e2, 5.0e3)
@@ -252,8 +252,8 @@ def check_settlement(
     if settlement > limit:
         raise InputError(
             field_name,
-            f"K = {k_N_per_m:.4g} N/m gives a static settlement M g / K = {settlement:.3g} m, "
-            f"above {MAX_SETTLEMENT_FRACTION:g} of the block height ({limit:.3g} m): the block "
+            f"K = {k_N_per_m:.4g} N/m gives a static settlement M g / K = {at_least(settlement)} m, "
+            f"above {MAX_SETTLEMENT_FRACTION:g} of the block height ({at_most(limit)} m): the block "
             "sinks into its base. Raise the stiffness (the paper's K reads as MN/m: "
             "stiffness_scale = 'MN/m') or check the units",
         )

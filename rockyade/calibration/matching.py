@@ -30,7 +30,7 @@ from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, f
 from rockyade.dem.build import build_dem_model
 from rockyade.dem.engine import simulate_model
 from rockyade.dem.joints import ContactParameters
-from rockyade.errors import CalibrationError
+from rockyade.errors import CalibrationError, at_least, at_most
 from rockyade.kernel import simulation as kernel
 from rockyade.scene import Scene, scene_from_dict
 
@@ -271,8 +271,9 @@ def _match(
     if target > mu_max * (1 + MU_RTOL):
         mu_low = mu_of(beta_max)
         raise CalibrationError(
-            f"target mu = {target:.6g} is above what the DEM reaches without damping ({mu_max:.6g}): "
-            f"the corner impacts alone lose more energy; reachable range [{mu_low:.6g}, {mu_max:.6g}]. "
+            f"target mu = {target:.6g} is above what the DEM reaches without damping ({at_most(mu_max, 6)}): "
+            "the corner impacts alone lose more energy; reachable range "
+            f"[{at_least(mu_low, 6)}, {at_most(mu_max, 6)}]. "
             "Damping cannot add energy: check mu or the stiffness"
         )
     # bracket: increase beta until mu_eff falls below the target
@@ -288,7 +289,8 @@ def _match(
     if f_hi > MU_RTOL * target:  # as at the top: a target within the tolerance is reached
         raise CalibrationError(
             f"target mu = {target:.6g} is below what the DEM reaches with the heaviest damping tried "
-            f"(beta = {beta_max:.3g} s, mu_eff = {mu_min:.6g}); reachable range [{mu_min:.6g}, {mu_max:.6g}]. "
+            f"(beta = {beta_max:.3g} s, mu_eff = {at_least(mu_min, 6)}); reachable range "
+            f"[{at_least(mu_min, 6)}, {at_most(mu_max, 6)}]. "
             "Damping alone cannot dissipate that much at the corner impacts"
         )
     if abs(f_lo) <= MU_RTOL * target:

@@ -8,6 +8,9 @@ Exit codes: 0 success, 1 a run failed (or a file could not be written), 2 bad in
 message names the field or option), 3 a solver that is not available here, 130 stopped by
 Ctrl-C, 141 the output pipe was closed (e.g. ``rockyade tables | head -1``).
 
+A mistyped option or command name is answered with the usage of the command it was given
+to and the nearest name ("did you mean --out?"), exit 2 (:class:`CommandParser`).
+
 Building the parser imports no solver, numpy, scipy, numba, pandas or matplotlib: command
 modules import them inside their command functions, so ``rockyade --help`` answers at once.
 """
@@ -16,11 +19,13 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import difflib
 import os
+import re
 import sys
 import time
 from collections.abc import Callable, Sequence
-from typing import Any
+from typing import Any, NoReturn
 
 from rockyade import __version__
 from rockyade.errors import (
@@ -54,11 +59,55 @@ EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports a process stopped by 
 EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports ``yes | head -1``
 
 
+class CommandParser(argparse.ArgumentParser):
+    """An argument parser whose errors name the nearest choice: ``invalid choice: 'rn'``
+    (a command, a sub-command or an option's value) adds "did you mean 'run'?". Sub-command
+    parsers are of this class too (``add_subparsers`` makes them of their parent's class)."""
+
+    def error(self, message: str) -> NoReturn:
+        """Print this parser's usage and ``message`` (with the nearest choice), exit 2."""
+        found = re.search(r"invalid choice: '([^']*)' \(choose from (.*)\)", message)
+        if found:
+            choices = re.findall(r"'([^']*)'", found.group(2))
+            near = difflib.get_close_matches(found.group(1), choices, n=1, cutoff=0.5)
+            if near:
+                message += f"; did you mean {near[0]!r}?"
+        super().error(message)
+
+
+def command_parser(parser: argparse.ArgumentParser, argv: Sequence[str]) -> argparse.ArgumentParser:
+    """The (sub-)command parser that ``argv`` reaches: ``motion spectrum ...`` gives the
+    parser of ``rockyade motion spectrum``."""
+    current = parser
+    for token in argv:
+        subs = [a for a in current._actions if isinstance(a, argparse._SubParsersAction)]
+        if not subs:
+            break
+        if token in subs[0].choices:
+            current = subs[0].choices[token]
+    return current
+
+
+def unknown_arguments(parser: argparse.ArgumentParser, argv: Sequence[str], extras: Sequence[str]) -> NoReturn:
+    """Refuse arguments no command knows with the usage of the command they were given to
+    and, for an option, the nearest of its options (exit 2)."""
+    target = command_parser(parser, argv)
+    message = f"unrecognized arguments: {' '.join(extras)}"
+    options = [s for action in target._actions for s in action.option_strings]
+    for extra in extras:
+        if extra.startswith("-"):
+            near = difflib.get_close_matches(extra.split("=", 1)[0], options, n=1, cutoff=0.6)
+            if near:
+                message += f" (did you mean {near[0]}?)"
+                break
+    target.error(message)
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command."""
     import importlib
 
-    parser = argparse.ArgumentParser(
+    parser = CommandParser(
         prog="rockyade",
         description="Seismic rocking of rigid blocks: classical (Housner) parameters, exact "
         "Housner solver, DEM calibration from the classical parameters, reference DEM and YADE.",
@@ -93,7 +142,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    argv = list(sys.argv[1:] if argv is None else argv)
+    args, extras = parser.parse_known_args(argv)
+    if extras:
+        unknown_arguments(parser, argv, extras)
     args.started_at = _T0
     if hasattr(args, "stiffness_scale") and isinstance(args.stiffness_scale, str):
         args.stiffness_scale = _coerce_scale(args.stiffness_scale)

@@ -91,7 +91,7 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
         ],
     ),
     "column": (
-        "a column of equal drums, optionally with a capital (abacus) block on top",
+        "a column of equal drums (round by default), optionally with a capital (abacus) block on top",
         [
             Opt("--drums", 8, "number of drums", int),
             Opt("--diameter-m", 0.3, "drum width in the plane of rocking, m"),
@@ -99,6 +99,14 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--thickness-m", None, "out-of-plane thickness, m (default: the diameter)"),
             Opt("--capital-width-m", None, "width of a capital block on top, m (with --capital-height-m)"),
             Opt("--capital-height-m", None, "height of the capital block, m"),
+            Opt(
+                "--section",
+                "round",
+                "round: cylinders (mass rho pi D^2/4 h and inertia m (3 r^2 + h^2)/12 written per drum); "
+                "square: prisms D x thickness",
+                str,
+                ("round", "square"),
+            ),
             LAYOUT_OPT,
         ],
     ),
@@ -216,7 +224,7 @@ COMMON: list[Opt] = [
         str,
         metavar="FILE",
     ),
-    Opt("--load-factor", 1.0, "record scale factor"),
+    Opt("--load-factor", 1.0, "multiplies the record's accelerations as read (its samples as in the file)"),
     Opt("--theta0-rad", 0.05, "free rocking: initial tilt, rad"),
     Opt("--free-block", None, "free rocking: the block tilted (with what rests on it)", str, metavar="NAME"),
     Opt(
@@ -545,7 +553,7 @@ def write_run_drawings(args: argparse.Namespace, scene, result, base: Path) -> N
     if not result.ok or result.t.size == 0:
         print("no snapshots or animation: the run failed")
         return
-    from rockyade.figures.assembly import animate, draw_snapshots
+    from rockyade.figures.assembly import animate, animation_times, write_snapshots
 
     if args.snapshots:
         times = parse_times(args.snapshots)
@@ -557,7 +565,7 @@ def write_run_drawings(args: argparse.Namespace, scene, result, base: Path) -> N
         if kept:
             path = base.with_name(f"{base.stem}_snapshots.png")
             try:
-                written = draw_snapshots(scene, result, kept, path, args.snapshot_layout, args.snapshot_scale)
+                written = write_snapshots(scene, result, kept, path, args.snapshot_layout, args.snapshot_scale)
             except InputError as exc:
                 raise InputError(
                     f"--snapshot-{exc.field}" if exc.field in ("scale", "layout") else "--snapshots", exc.message
@@ -565,15 +573,15 @@ def write_run_drawings(args: argparse.Namespace, scene, result, base: Path) -> N
             print("wrote " + ", ".join(str(p) for p in written))
     if args.animation:
         try:
-            frames = animate(scene, result, args.animation, fps=args.fps, speed=args.speed, scale=args.snapshot_scale)
+            animate(scene, result, args.animation, fps=args.fps, speed=args.speed, scale=args.snapshot_scale)
         except InputError as exc:
             raise InputError(f"--{exc.field}", exc.message) from None
-        print(f"wrote {args.animation} ({frames} frames)")
+        print(f"wrote {args.animation} ({len(animation_times(result, args.fps, args.speed))} frames)")
 
 
 def cmd_draw(args: argparse.Namespace) -> int:
     """Draw a scene at rest; with --result, snapshots and an animation of that run."""
-    from rockyade.figures.assembly import draw_assembly
+    from rockyade.figures.assembly import draw_assembly, drawn_names
     from rockyade.scene import load_scene
 
     scene = load_scene(args.scene)
@@ -581,7 +589,8 @@ def cmd_draw(args: argparse.Namespace) -> int:
     check_output_file(out, "--out", ".png")
     check_run_drawings(args)
     result = _result_of(scene, args) if args.snapshots or args.animation else None
-    skipped = draw_assembly(scene, out, title=args.title, labels=not args.no_labels)
+    _, ax = draw_assembly(scene, out, title=args.title, labels=not args.no_labels)
+    skipped = len(scene.blocks) - len(drawn_names(ax))
     note = f" ({skipped} block names too small to print)" if skipped and not args.no_labels else ""
     print(f"wrote {out}{note}")
     if result is not None:

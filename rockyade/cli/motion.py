@@ -39,6 +39,25 @@ def _add_record_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _add_accel_units(p: argparse.ArgumentParser) -> None:
+    """``--accel-units``: the unit accelerations are printed and plotted in (g by default)."""
+    p.add_argument(
+        "--accel-units",
+        choices=["g", "m/s2"],
+        default="g",
+        help="unit of the accelerations printed and plotted: g (standard gravity, 9.80665 m/s^2; the default) "
+        "or m/s2; the other unit is given beside it",
+    )
+
+
+def _accel_text(value_m_s2: float, unit: str) -> str:
+    """An acceleration in ``unit`` with the other unit in parentheses."""
+    from rockyade.constants import STANDARD_GRAVITY
+
+    g_text, si_text = f"{value_m_s2 / STANDARD_GRAVITY:.4g} g", f"{value_m_s2:.4g} m/s^2"
+    return f"{g_text} ({si_text})" if unit == "g" else f"{si_text} ({g_text})"
+
+
 def cmd_info(args: argparse.Namespace) -> int:
     """Summary of a record."""
     from rockyade.constants import STANDARD_GRAVITY
@@ -62,14 +81,16 @@ def cmd_info(args: argparse.Namespace) -> int:
         from rockyade.motion.processing import integrate
 
         v, d = integrate(rec.t_s, rec.accel_m_s2)
-        plot_accelerogram(rec.t_s, rec.accel_m_s2, v, d, args.plot, title=rec.title or str(args.record))
+        plot_accelerogram(
+            rec.t_s, rec.accel_m_s2, v, d, args.plot, title=rec.title or str(args.record), accel_unit=args.accel_units
+        )
     if args.json:
         json_out(info)
     else:
         print(f"{args.record}: {rec.title}")
         print(f"  {rec.npts} samples at dt = {rec.dt_s:g} s ({rec.duration_s:g} s), units in file: {rec.units_in_file}")
-        pga_g = rec.pga_m_s2 / STANDARD_GRAVITY
-        print(f"  PGA = {rec.pga_m_s2:.4g} m/s^2 ({pga_g:.4g} g, standard gravity) at t = {rec.pga_time_s:g} s")
+        pga = _accel_text(rec.pga_m_s2, args.accel_units)
+        print(f"  PGA = {pga} at t = {rec.pga_time_s:g} s (g: standard gravity)")
     if args.plot:
         print_wrote(args.plot, args.json)
     return 0
@@ -79,6 +100,7 @@ def cmd_spectrum(args: argparse.Namespace) -> int:
     """Pseudo-acceleration response spectrum of a record."""
     import pandas as pd
 
+    from rockyade.constants import STANDARD_GRAVITY
     from rockyade.motion.spectra import default_periods, response_spectrum
 
     lo, hi = SPECTRUM_PERIODS_S
@@ -98,7 +120,9 @@ def cmd_spectrum(args: argparse.Namespace) -> int:
         raise InputError("record", "the response spectrum needs a uniformly sampled record")
     periods = default_periods(args.t_min, args.t_max, args.n)
     periods, psa = response_spectrum(rec.accel_m_s2, rec.dt_s, periods, args.damping)
-    table = pd.DataFrame({"period_s": periods, "psa_m_s2": psa})
+    table = pd.DataFrame({"period_s": periods, "psa_m_s2": psa, "psa_g": psa / STANDARD_GRAVITY})
+    if args.accel_units == "g":
+        table = table[["period_s", "psa_g", "psa_m_s2"]]
     if args.out:
         from rockyade.io.atomic import atomic_open
 
@@ -109,7 +133,12 @@ def cmd_spectrum(args: argparse.Namespace) -> int:
         from rockyade.figures import plot_spectra
 
         plot_spectra(
-            periods, None, psa, args.plot, title=f"{rec.title or args.record}, {100 * args.damping:g} % damping"
+            periods,
+            None,
+            psa,
+            args.plot,
+            title=f"{rec.title or args.record}, {100 * args.damping:g} % damping",
+            accel_unit=args.accel_units,
         )
         print(f"wrote {args.plot}")
     if not args.out:
@@ -257,8 +286,9 @@ def register(sub: Any) -> None:
 
     p = msub.add_parser("info", help="summary of a record", description="Samples, dt, duration, PGA of a record.")
     _add_record_arguments(p)
-    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument("--json", action="store_true", help="print JSON (pga_m_s2 and pga_g)")
     p.add_argument("--plot", type=Path, help="PNG of acceleration, velocity and displacement")
+    _add_accel_units(p)
     p.set_defaults(func=cmd_info)
 
     p = msub.add_parser(
@@ -271,8 +301,9 @@ def register(sub: Any) -> None:
     p.add_argument("--t-min", type=float, default=0.02, help="shortest period, s")
     p.add_argument("--t-max", type=float, default=4.0, help="longest period, s")
     p.add_argument("-n", type=int, default=100, help="number of periods (log-spaced)")
-    p.add_argument("--out", type=Path, help="CSV with period_s, psa_m_s2")
+    p.add_argument("--out", type=Path, help="CSV with period_s, psa_g and psa_m_s2")
     p.add_argument("--plot", type=Path, help="PNG of the spectrum")
+    _add_accel_units(p)
     p.set_defaults(func=cmd_spectrum)
 
     p = msub.add_parser(

@@ -85,13 +85,23 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         line = f"  {a['n_blocks']} moving blocks: {a['n_fallen']} fell"
         if a["n_fallen"]:
             line += f" (first {a['first_fallen_block']} at t = {a['first_fall_time_s']:.4g} s)"
+        if a["n_falling_at_end"]:
+            line += (
+                f", {a['n_falling_at_end']} still falling when the run ended (not counted as fallen: "
+                "a longer duration_s shows where they land)"
+            )
         print(line + f"; max |theta| = {a['max_abs_theta_rad']:.4g} rad ({a['max_theta_block']})")
         line = f"  largest residual displacement {a['max_residual_displacement_m']:.4g} m ({a['max_residual_block']})"
         if a["n_moving_at_end"]:
             line += f"; {a['n_moving_at_end']} block(s) still moving at the end: residuals are where they were then"
         print(line)
+        _print_structure(a, result, scene)
         if len(scene.blocks) > PER_BLOCK_LIMIT:
             return
+    elif len(scene.blocks) > 1:
+        from rockyade.analysis.metrics import structure_rotation
+
+        _print_structure(structure_rotation(scene, result), result, scene)
     for name, m in run_metrics(scene, result).items():
         theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
         line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
@@ -100,6 +110,27 @@ def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
         print(line)
     if result.status == "overturned" and not scene.positioned:
         print(f"  overturned at t = {meta['overturn_time_s']:.4g} s ({meta.get('overturned_block')})")
+
+
+def _print_structure(m: dict[str, Any], result: Any, scene: Any) -> None:
+    """The whole's own measure: a stack's rotation about its base corner against its alpha,
+    or, for an assembly that has none, its peak base acceleration to set against the
+    collapse acceleration of ``rockyade limit`` (the per-block ratios use each block's own alpha)."""
+    if m["structure"] == "none":
+        from rockyade.constants import G
+
+        peak = float(abs(result.frame["ag_m_s2"]).max()) if "ag_m_s2" in result.frame else math.nan
+        source = f" {Path(scene.source).name}" if scene.source else ""
+        print(
+            f"  as one body: {m['structure_note']}; set its peak base acceleration, {peak / G:.3g} g "
+            f"({peak:.4g} m/s^2), against the collapse acceleration of 'rockyade limit{source}'"
+        )
+    elif math.isfinite(m["structure_max_theta_rad"]):
+        print(
+            f"  as one body ({m['structure']}): max rotation about its base corner "
+            f"{abs(m['structure_max_theta_rad']):.4g} rad = {m['structure_max_theta_over_alpha']:.3g} of its own "
+            f"alpha {m['structure_alpha_rad']:.4g} rad (the ratios below use each block's own alpha)"
+        )
 
 
 def cmd_tables(args: argparse.Namespace) -> int:

@@ -106,7 +106,7 @@ def cmd_paper(args: argparse.Namespace) -> int:
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
         raise InputError("only", f"parts must be among {', '.join(PARTS)}, got {unknown}")
-    report = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade)
+    report = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade, accel_unit=args.accel_units)
     failed = report.failures()
     print(f"wrote {report.index_path}")
     print("runs per part: " + "; ".join(_part_line(report, part) for part in parts))
@@ -169,6 +169,13 @@ def register(sub: Any) -> None:
         "--only", help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning"
     )
     p.add_argument("--no-yade", action="store_true", help="skip the YADE runs")
+    p.add_argument(
+        "--accel-units",
+        choices=["g", "m/s2"],
+        default="g",
+        help="unit of the fragility figure's PGA axis: g (standard gravity; the default) or m/s2, the other "
+        "unit on the opposite axis (the CSV files keep m/s^2)",
+    )
     p.set_defaults(func=cmd_paper)
 
     p = sub.add_parser(

@@ -37,9 +37,10 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
         scheduler=args.scheduler,
         resume=args.resume,
         progress=not args.quiet,
+        accel_unit=args.accel_units,
     )
     p = result.probabilities
-    print("P(overturn) per load factor [95 % Wilson band]:")
+    print("P(overturn) per load factor (x the records' accelerations as read) [95 % Wilson band]:")
     for row in p.itertuples(index=False):
         print(
             f"  {row.solver:9s} x{row.load_factor:<5g} {row.p_overturn:.3f} [{row.p_overturn_lo:.3f}, "
@@ -47,9 +48,10 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
         )
     print("fragility (lognormal, maximum likelihood):")
     for row in result.fragility.itertuples(index=False):
-        fit = f"median {row.median:.4g}, beta {row.beta:.3g}" if row.status == "fitted" else row.status
+        median = _measure_text(row.median, row.measure, args.accel_units)
+        fit = f"median {median}, beta {row.beta:.3g}" if row.status == "fitted" else row.status
         if row.status == "separated":
-            fit += f" (every overturning run is above every other: a threshold near {row.median:.4g}, no slope)"
+            fit += f" (every overturning run is above every other: a threshold near {median}, no slope)"
         print(f"  {row.solver:9s} {row.measure:24s} {fit}")
     if result.spread is not None:
         print("spread caused by the parameters alone (per-sample P(overturn) 5-95 %, nominal):")
@@ -68,13 +70,24 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def _measure_text(value: float, measure: str, unit: str) -> str:
+    """An intensity value as printed: a PGA in ``unit`` with the other unit beside it."""
+    if measure != "pga_m_s2":
+        return f"{value:.4g}"
+    from rockyade.constants import STANDARD_GRAVITY
+
+    g_text, si_text = f"{value / STANDARD_GRAVITY:.4g} g", f"{value:.4g} m/s^2"
+    return f"{g_text} ({si_text})" if unit == "g" else f"{si_text} ({g_text})"
+
+
 def register(sub: Any) -> None:
     """Add ``rockyade uncertainty``."""
     p = sub.add_parser(
         "uncertainty",
         help="probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)",
         description="Draw alpha, p, mu (normal, lognormal, uniform, or an identification's joint normal) by "
-        "Latin hypercube, run every sample under the records and load factors with each solver (batch engine, "
+        "Latin hypercube, run every sample under the records and load factors (each multiplies the records' "
+        "accelerations as read) with each solver (batch engine, "
         "local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 % Wilson bands, fragility "
         "fits against intensity measures and the spread due to the parameters. See docs/identification.md.",
     )
@@ -87,4 +100,11 @@ def register(sub: Any) -> None:
     p.add_argument("--scheduler", help="Dask scheduler address (default: an in-process cluster)")
     p.add_argument("--resume", action="store_true", help="skip runs already completed")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument(
+        "--accel-units",
+        choices=["g", "m/s2"],
+        default="g",
+        help="unit of PGA medians and axes: g (standard gravity, 9.80665 m/s^2; the default) or m/s2; the other "
+        "unit is given beside it (the CSV files keep m/s^2, named so)",
+    )
     p.set_defaults(func=cmd_uncertainty)

@@ -29,7 +29,7 @@ from rockyade.dem.joints import ContactParameters, JointTable, resolve_joints
 from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt, time_step_eq7
 from rockyade.dem.overturn import stop_angles
 from rockyade.dem.statics import mass_vector, rest_springs, stability_limit, static_penetration
-from rockyade.errors import InputError
+from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import BlockSpec, Scene
 from rockyade.scene.placement import PlacedBlock, RestContact, placed_blocks, rest_contacts, rotation_matrix
 
@@ -210,24 +210,25 @@ def _check_settlement(
     if pen[worst] > MAX_SETTLEMENT_FRACTION * height:
         names = bodies[c.a].name + ("-base" if c.b < 0 else f"-{bodies[c.b].name}")
         k = joints.params[joints.joint_for(c.a, c.b)].K_N_per_m
-        factor = pen[worst] / (MAX_SETTLEMENT_FRACTION * height)
+        factor = pen[worst] / (MAX_SETTLEMENT_FRACTION * height)  # the settlement goes as 1/K
         if scene.contact.jkn_Pa_per_m is not None:
             field_name = "contact.jkn_Pa_per_m"
+            jkn = scene.contact.jkn_Pa_per_m
             advice = (
-                f"raise jkn_Pa_per_m (now {scene.contact.jkn_Pa_per_m:.4g} Pa/m) at least {factor:.2g} times, "
-                "or the [[joints]] override of this pair"
+                f"raise jkn_Pa_per_m from {jkn:.4g} to at least {at_least(jkn * factor)} Pa/m "
+                f"({at_least(factor)} times), or the [[joints]] override of this pair"
             )
         elif scene.contact.explicit_stiffness:
             field_name = "contact.K_N_per_m"
-            advice = f"raise K_N_per_m at least {factor:.2g} times"
+            advice = f"raise K_N_per_m at least {at_least(factor)} times"
         else:
             field_name = "contact.stiffness_scale"
             advice = "raise the stiffness (the paper's K reads as MN/m: stiffness_scale = 'MN/m') or check the units"
         raise InputError(
             field_name,
-            f"K = {k:.4g} N/m lets the joint {names} sink {pen[worst]:.3g} m under the static load, above "
-            f"{MAX_SETTLEMENT_FRACTION:g} of the block height ({MAX_SETTLEMENT_FRACTION * height:.3g} m): the blocks "
-            f"sink into each other; {advice}",
+            f"K = {k:.4g} N/m lets the joint {names} sink {at_least(pen[worst])} m under the static load, above "
+            f"{MAX_SETTLEMENT_FRACTION:g} of the block height ({at_most(MAX_SETTLEMENT_FRACTION * height)} m): the "
+            f"blocks sink into each other; {advice}",
         )
     return float(pen.max())
 

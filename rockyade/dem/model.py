@@ -29,7 +29,7 @@ import numpy as np
 
 from rockyade.constants import DEFAULT_TIME_STEP_FRAC
 from rockyade.dem.joints import ContactParameters, JointTable
-from rockyade.errors import InputError
+from rockyade.errors import InputError, at_least, at_most
 
 if TYPE_CHECKING:  # names only: the calibration imports this module (Eq 7) without the motions and scenes
     from rockyade.motion.ground import GroundMotion
@@ -216,6 +216,6 @@ def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
     if dt_s > dt_stable_s:
         raise InputError(
             "contact.dt_s",
-            f"{dt_s:.4g} s is above the stability limit {dt_stable_s:.4g} s of the explicit scheme "
+            f"{at_least(dt_s, 4)} s is above the stability limit {at_most(dt_stable_s, 4)} s of the explicit scheme "
             "for these contacts (stiffness and damping); use a smaller time step or leave it to Eq 7",
         )

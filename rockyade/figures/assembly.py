@@ -13,6 +13,14 @@ Colours give each block's rotation from rest on a scale of at least
 Names are written inside blocks at the largest size that fits (along the block's own base
 direction, or across it for tall blocks), and left out where that size would be below
 :data:`MIN_LABEL_PT` (e.g. the units of a 1,000-block wall in one figure).
+
+As every plot function of :mod:`rockyade.figures`: :func:`draw_assembly` and
+:func:`draw_snapshots` return ``(fig, ax)`` (``(fig, axes)`` for several panels) and take
+``ax=`` to draw into your own Axes; :func:`animate` returns ``(fig, ax, animation)``. With a
+``path`` the figure is drawn by Agg outside pyplot and written atomically; with neither
+``path`` nor ``ax`` it comes from pyplot on your backend (inline in a notebook). Nothing
+here selects a backend or calls ``plt.show()``. :func:`write_snapshots` writes the PNGs of
+``rockyade run --snapshots`` (a grid, or one file per time).
 """
 
 from __future__ import annotations
@@ -21,15 +29,19 @@ import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.collections import PolyCollection
 from matplotlib.colors import LinearSegmentedColormap, Normalize
+from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from numpy.typing import NDArray
 
 from rockyade.errors import InputError
-from rockyade.figures.common import file_figure, save_figure
+from rockyade.figures.common import axes_list, new_figure, save_figure
 from rockyade.result import Result, column
 from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
 
@@ -45,6 +57,8 @@ FIGURE_WIDTH_IN = 10.0
 #: Colours of moving blocks by |rotation|: stone at rest, dark red at the largest rotation shown.
 ROTATION_CMAP = LinearSegmentedColormap.from_list("stone_to_red", [STONE, "#e8a15c", "#c0392b", "#5e0d0d"])
 MAX_HEIGHT_IN = 8.0
+#: The ``gid`` of the block names drawn (:func:`drawn_names`).
+NAME_GID = "block-name"
 
 
 # ---------------------------------------------------------------------- geometry
@@ -209,15 +223,20 @@ def _label_blocks(fig, ax, placed: Sequence[PlacedBlock]) -> int:
             fontsize=max(min(size, common), MIN_LABEL_PT),
             color="#2b241b",
             zorder=5,
+            gid=NAME_GID,
             bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1.0) if b.fixed else None,
         )
     return skipped
 
 
 def _figure_for(
-    bounds: tuple[float, float, float, float], panels: tuple[int, int] = (1, 1), width_in: float = FIGURE_WIDTH_IN
+    bounds: tuple[float, float, float, float],
+    panels: tuple[int, int] = (1, 1),
+    width_in: float = FIGURE_WIDTH_IN,
+    path: str | Path | None = "file",
 ):
-    """A figure whose panels fit the drawing's aspect within ``width_in`` x MAX_HEIGHT_IN."""
+    """A figure whose panels fit the drawing's aspect within ``width_in`` x MAX_HEIGHT_IN:
+    outside pyplot (Agg) when it is for a file (``path`` not None), else pyplot's."""
     xlim, ylim, _ = _limits(bounds)
     aspect = (ylim[1] - ylim[0]) / (xlim[1] - xlim[0])
     rows, cols = panels
@@ -229,8 +248,15 @@ def _figure_for(
     width = max(panel_w * cols + 1.2, 4.5)
     height = panel_h * rows + 0.35 * rows + 0.8
     shared = rows * cols > 1
-    return file_figure(
-        rows, cols, figsize=(width, height), squeeze=False, sharex=shared, sharey=shared, layout="constrained"
+    return new_figure(
+        None if path is None else Path(str(path)),
+        rows,
+        cols,
+        figsize=(width, height),
+        squeeze=False,
+        sharex=shared,
+        sharey=shared,
+        layout="constrained",
     )
 
 
@@ -261,30 +287,51 @@ def _title(scene, label: str | None) -> str:
 # ---------------------------------------------------------------------- figures
 
 
-def draw_assembly(scene, path: str | Path, title: str | None = None, labels: bool = True) -> int:
-    """Draw a scene's blocks at rest with their names; write a PNG.
+def drawn_names(ax) -> list[str]:
+    """The block names written in ``ax`` by :func:`draw_assembly` (those that fitted).
+
+    Parameters
+    ----------
+    ax
+        The Axes :func:`draw_assembly` drew into.
+    """
+    return [t.get_text() for t in ax.texts if t.get_gid() == NAME_GID]
+
+
+def draw_assembly(
+    scene, path: str | Path | None = None, title: str | None = None, labels: bool = True, *, ax=None
+) -> tuple[Figure, Axes]:
+    """Draw a scene's blocks at rest with their names.
 
     Parameters
     ----------
     scene
         A validated :class:`~rockyade.scene.Scene`.
     path
-        PNG file to write.
+        PNG file to write (atomically); None writes nothing.
     title
-        Figure title (default: the scene file name and block counts).
+        Axes title (default: the scene file name and block counts; when names had to be
+        left out, a second line names the bottom-left and top-right blocks).
     labels
-        Write block names (where they fit).
+        Write block names (where they fit; :func:`drawn_names` lists those written).
+    ax
+        Axes to draw into (equal aspect, limits and ground set here); None: a new figure
+        (pyplot's without ``path``, so that it shows in a notebook).
 
     Returns
     -------
-    int
-        Number of block names left out because they would be too small to read.
+    fig, ax
+        The figure and its Axes.
     """
     placed = placed_blocks(scene)
     polygons = [b.vertices_m for b in placed]
     bounds = _bounds(polygons)
-    fig, axes = _figure_for(bounds)
-    ax = axes[0, 0]
+    if ax is None:
+        fig, axes = _figure_for(bounds, path=path)
+        ax = axes[0, 0]
+    else:
+        ax = axes_list(ax, 1)[0]
+        fig = ax.figure
     _setup_axes(ax, bounds)
     _draw_blocks(ax, polygons, [b.fixed for b in placed])
     skipped = _label_blocks(fig, ax, placed) if labels else 0
@@ -297,8 +344,9 @@ def draw_assembly(scene, path: str | Path, title: str | None = None, labels: boo
             "(all in the scene file)"
         )
     ax.set_title(heading, fontsize=10)
-    save_figure(fig, path)
-    return skipped
+    if path is not None:
+        save_figure(fig, path)
+    return fig, ax
 
 
 #: The colour scale of rotations spans at least this, rad.
@@ -314,12 +362,13 @@ def draw_snapshots(
     scene,
     result: Result,
     times_s: Sequence[float],
-    path: str | Path,
-    layout: str = "grid",
+    path: str | Path | None = None,
+    *,
     scale: float = 1.0,
     title: str | None = None,
-) -> list[Path]:
-    """Draw the moving assembly at chosen times.
+    ax=None,
+) -> tuple[Figure, Any]:
+    """Draw the moving assembly at chosen times, one panel per time, coloured by rotation.
 
     Parameters
     ----------
@@ -330,22 +379,20 @@ def draw_snapshots(
     times_s
         Times to draw, s (the nearest samples are used).
     path
-        ``layout = "grid"``: the PNG of all panels; ``"files"``: a name from which one PNG per
-        time is made, ``<stem>_t<time>s.png``.
-    layout
-        "grid" or "files".
+        PNG to write (atomically); None writes nothing.
     scale
         Display magnification k of displacements and rotations (1: true scale).
     title
         Figure title (default: scene file name and solver).
+    ax
+        Axes to draw into, one per time (one Axes for one time); None: a new figure of
+        panels (pyplot's without ``path``).
 
     Returns
     -------
-    list of Path
-        Files written.
+    fig, axes
+        The figure and its Axes (one Axes for one time, else a list in the order of ``times_s``).
     """
-    if layout not in ("grid", "files"):
-        raise InputError("layout", f"must be grid or files, got {layout!r}")
     if not times_s:
         raise InputError("times", "give at least one time")
     if not (math.isfinite(scale) and scale > 0):
@@ -354,56 +401,80 @@ def draw_snapshots(
     indices = [sample_index(result, float(t)) for t in times_s]
     frames = [moving_polygons(placed, result, i, scale) for i in indices]
     rest = [b.vertices_m for b in placed]
-    bounds = _bounds(rest + [p for f in frames for p in f])
-    bounds = _clip_bounds(bounds, _bounds(rest))
+    bounds = _clip_bounds(_bounds(rest + [p for f in frames for p in f]), _bounds(rest))
     norm = Normalize(0.0, _rotation_norm(placed, result, indices))
-    cmap = ROTATION_CMAP
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
     solver = result.meta.get("solver", "")
     heading = title or (_title(scene, None) + (f" ({solver})" if solver else ""))
     if scale != 1.0:
         heading += f"; vertex displacements x{scale:g}"
-    path = Path(path)
-
-    def panel(ax, k: int) -> None:
-        _setup_axes(ax, bounds)
-        _draw_rest_outline(ax, rest)
-        colours = cmap(norm(rotations(placed, result, indices[k])[moving_idx]))
-        _draw_blocks(ax, frames[k], fixed, facecolors=colours)
-        ax.set_title(f"t = {result.t[indices[k]]:.3f} s", fontsize=10)
-
-    def colourbar(fig, axes) -> None:
-        mappable = ScalarMappable(norm=norm, cmap=cmap)
-        bar = fig.colorbar(mappable, ax=axes, shrink=0.8, pad=0.02)
-        bar.set_label("|rotation from rest| (rad)")
-
-    written: list[Path] = []
-    if layout == "grid":
-        n = len(indices)
+    n = len(indices)
+    if ax is None:
         aspect = (bounds[1] - bounds[0]) / max(bounds[3] - bounds[2], 1e-9)
         cols = min(n, 3 if aspect < 1.3 else 2 if aspect < 2.6 else 1)
         rows = math.ceil(n / cols)
-        fig, axes = _figure_for(bounds, (rows, cols), width_in=FIGURE_WIDTH_IN + 1.0)
-        for k in range(rows * cols):
-            ax = axes.flat[k]
-            if k < n:
-                panel(ax, k)
-            else:
-                ax.set_visible(False)
-        colourbar(fig, axes)
-        fig.suptitle(heading + "\nrest positions dashed; positions relative to the base", fontsize=10)
-        save_figure(fig, path)
-        written.append(path)
+        fig, grid = _figure_for(bounds, (rows, cols), width_in=FIGURE_WIDTH_IN + 1.0, path=path)
+        panels = list(grid.flat)
+        for extra in panels[n:]:
+            extra.set_visible(False)
+        panels = panels[:n]
     else:
-        for k, i in enumerate(indices):
-            fig, axes = _figure_for(bounds, width_in=FIGURE_WIDTH_IN + 1.0)
-            panel(axes[0, 0], k)
-            colourbar(fig, axes)
-            fig.suptitle(heading, fontsize=10)
-            out = path.with_name(f"{path.stem}_t{result.t[i]:.3f}s.png")
-            save_figure(fig, out)
-            written.append(out)
+        panels = axes_list(ax, n)
+        fig = panels[0].figure
+    for k, panel in enumerate(panels):
+        _setup_axes(panel, bounds)
+        _draw_rest_outline(panel, rest)
+        colours = ROTATION_CMAP(norm(rotations(placed, result, indices[k])[moving_idx]))
+        _draw_blocks(panel, frames[k], fixed, facecolors=colours)
+        panel.set_title(f"t = {result.t[indices[k]]:.3f} s", fontsize=10)
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=ROTATION_CMAP), ax=panels, shrink=0.8, pad=0.02)
+    bar.set_label("|rotation from rest| (rad)")
+    fig.suptitle(heading + ("\nrest positions dashed; positions relative to the base" if n > 1 else ""), fontsize=10)
+    if path is not None:
+        save_figure(fig, path)
+    return fig, panels[0] if n == 1 else panels
+
+
+def write_snapshots(
+    scene,
+    result: Result,
+    times_s: Sequence[float],
+    path: str | Path,
+    layout: str = "grid",
+    scale: float = 1.0,
+    title: str | None = None,
+) -> list[Path]:
+    """Write snapshots of a run as PNG: one grid of panels (``layout = "grid"``, ``path``) or
+    one file per time (``"files"``, ``<stem>_t<time>s.png`` beside ``path``).
+
+    Parameters
+    ----------
+    scene, result, times_s, scale, title
+        As for :func:`draw_snapshots`.
+    path
+        The PNG (grid) or the name the files are made from (files).
+    layout
+        "grid" or "files".
+
+    Returns
+    -------
+    list of Path
+        Files written.
+    """
+    if layout not in ("grid", "files"):
+        raise InputError("layout", f"must be grid or files, got {layout!r}")
+    path = Path(path)
+    if layout == "grid":
+        draw_snapshots(scene, result, times_s, path, scale=scale, title=title)
+        return [path]
+    if not times_s:
+        raise InputError("times", "give at least one time")
+    written = []
+    for t in times_s:
+        out = path.with_name(f"{path.stem}_t{result.t[sample_index(result, float(t))]:.3f}s.png")
+        draw_snapshots(scene, result, [t], out, scale=scale, title=title)
+        written.append(out)
     return written
 
 
@@ -440,19 +511,47 @@ def animation_writer_for(path: str | Path, fps: float):
     raise InputError("animation", f"must end in .gif (Pillow) or .mp4 (ffmpeg), got {suffix or 'no suffix'!r}")
 
 
+def animation_times(result: Result, fps: float, speed: float, max_frames: int = 600) -> NDArray[np.float64]:
+    """Simulated times of the frames of :func:`animate`, s: every ``speed / fps`` seconds, or
+    further apart so that there are at most ``max_frames``.
+
+    Parameters
+    ----------
+    result
+        The run.
+    fps
+        Frames per second of the animation.
+    speed
+        Simulated seconds per second of animation.
+    max_frames
+        Upper bound on the number of frames.
+    """
+    t = result.t
+    if t.size == 0:
+        raise InputError("animation", "the result has no samples (the run failed)")
+    step = max(speed / fps, (t[-1] - t[0]) / max(max_frames - 1, 1))
+    return np.arange(t[0], t[-1] + 0.5 * step, step)
+
+
 def animate(
     scene,
     result: Result,
-    path: str | Path,
+    path: str | Path | None = None,
     fps: float = 20.0,
     speed: float = 1.0,
     scale: float = 1.0,
     max_frames: int = 600,
-) -> int:
-    """An animation of the run (GIF through Pillow, MP4 through ffmpeg); return the frame count.
+    *,
+    ax=None,
+):
+    """An animation of the run; written as GIF (Pillow) or MP4 (ffmpeg) when ``path`` is given.
 
     Parameters
     ----------
+    scene, result
+        The scene and its run.
+    path
+        .gif or .mp4 to write (next to it, then renamed into place); None writes nothing.
     fps
         Frames per second of the animation.
     speed
@@ -460,7 +559,16 @@ def animate(
     scale
         Display magnification of displacements and rotations.
     max_frames
-        Upper bound on the number of frames (the time step between frames grows to fit).
+        Upper bound on the number of frames (the time step between frames grows to fit;
+        :func:`animation_times`).
+    ax
+        Axes to animate in; None: a new figure (pyplot's without ``path``).
+
+    Returns
+    -------
+    fig, ax, animation
+        The figure, its Axes and the :class:`matplotlib.animation.FuncAnimation` (keep it: in
+        Jupyter, ``IPython.display.HTML(animation.to_jshtml())`` plays it).
     """
     from matplotlib import animation
 
@@ -468,43 +576,45 @@ def animate(
         raise InputError("fps", f"must be a number > 0, got {fps!r}")
     if not (math.isfinite(speed) and speed > 0):
         raise InputError("speed", f"must be a number > 0, got {speed!r}")
-    writer = animation_writer_for(path, fps)
+    writer = animation_writer_for(path, fps) if path is not None else None
     t = result.t
-    if t.size == 0:
-        raise InputError("animation", "the result has no samples (the run failed)")
-    step = max(speed / fps, (t[-1] - t[0]) / max(max_frames - 1, 1))
-    times = np.arange(t[0], t[-1] + 0.5 * step, step)
+    times = animation_times(result, fps, speed, max_frames)
     indices = [int(np.argmin(np.abs(t - x))) for x in times]
     placed = placed_blocks(scene)
     rest = [b.vertices_m for b in placed]
     frames = [moving_polygons(placed, result, i, scale) for i in indices]
     bounds = _clip_bounds(_bounds(rest + [p for f in frames for p in f]), _bounds(rest))
-    fig, axes = _figure_for(bounds, width_in=8.0)
-    ax = axes[0, 0]
+    if ax is None:
+        fig, axes = _figure_for(bounds, width_in=8.0, path=path)
+        ax = axes[0, 0]
+    else:
+        ax = axes_list(ax, 1)[0]
+        fig = ax.figure
     _setup_axes(ax, bounds)
     _draw_rest_outline(ax, rest)
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
     norm = Normalize(0.0, _rotation_norm(placed, result, indices))
-    cmap = ROTATION_CMAP
     coll = _draw_blocks(ax, frames[0], fixed)
     clock = ax.set_title("", fontsize=10)
     note = f" (motion x{scale:g})" if scale != 1.0 else ""
 
     def update(k: int):
         coll.set_verts([p for p, f in zip(frames[k], fixed, strict=True) if not f])
-        coll.set_facecolor(cmap(norm(rotations(placed, result, indices[k])[moving_idx])))
+        coll.set_facecolor(ROTATION_CMAP(norm(rotations(placed, result, indices[k])[moving_idx])))
         clock.set_text(f"{_title(scene, None)}\nt = {t[indices[k]]:.2f} s{note}")
         return coll, clock
 
+    update(0)
     anim = animation.FuncAnimation(fig, update, frames=len(indices), blit=False)
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    # writers need a file name: write beside the target, then rename it in place (atomic)
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        anim.save(str(tmp), writer=writer, dpi=90)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return len(indices)
+    if path is not None:
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        # writers need a file name: write beside the target, then rename it in place (atomic)
+        tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
+        try:
+            anim.save(str(tmp), writer=writer, dpi=90)
+            os.replace(tmp, path)
+        finally:
+            tmp.unlink(missing_ok=True)
+    return fig, ax, anim

@@ -19,10 +19,11 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from rockyade.constants import ACCEL_UNIT_LABELS, ACCEL_UNITS
 from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open
 
-__all__ = ["axes_list", "file_figure", "new_figure", "save_figure"]
+__all__ = ["accel_scale", "axes_list", "file_figure", "new_figure", "other_accel_axis", "save_figure"]
 
 
 def new_figure(path: str | Path | None = None, nrows: int = 1, ncols: int = 1, **subplots: Any) -> tuple[Figure, Any]:
@@ -67,3 +68,45 @@ def save_figure(fig: Figure, path: str | Path, dpi: int = 130) -> Path:
     with atomic_open(path, "wb") as fh:
         fig.savefig(fh, format="png", dpi=dpi, bbox_inches="tight")
     return path
+
+
+def accel_scale(unit: str, field_name: str = "accel_unit") -> float:
+    """m/s^2 per ``unit`` ("g": standard gravity, or "m/s2"); InputError for another unit.
+
+    Parameters
+    ----------
+    unit
+        "g" or "m/s2".
+    field_name
+        The option or argument that gave it (named in the error).
+    """
+    if unit not in ACCEL_UNITS:
+        raise InputError(field_name, f"must be one of {', '.join(ACCEL_UNITS)}, got {unit!r}")
+    return ACCEL_UNITS[unit]
+
+
+def other_accel_axis(ax: Axes, unit: str, which: str = "x", what: str = "") -> Any:
+    """A secondary axis (top or right) giving the accelerations of ``ax`` in the other unit:
+    a figure in g shows m/s^2 as well, and the reverse.
+
+    Parameters
+    ----------
+    ax
+        Axes whose ``which`` axis holds accelerations in ``unit``.
+    unit
+        "g" or "m/s2".
+    which
+        "x" (the secondary axis on top) or "y" (on the right).
+    what
+        What the axis holds (e.g. "PGA"), for its label.
+    """
+    other = "m/s2" if unit == "g" else "g"
+    factor = accel_scale(unit) / accel_scale(other)
+    functions = (lambda v: v * factor, lambda v: v / factor)
+    if which == "x":
+        axis = ax.secondary_xaxis("top", functions=functions)
+        axis.set_xlabel(f"{what} ({ACCEL_UNIT_LABELS[other]})".strip(), fontsize=8)
+    else:
+        axis = ax.secondary_yaxis("right", functions=functions)
+        axis.set_ylabel(f"{what} ({ACCEL_UNIT_LABELS[other]})".strip(), fontsize=8)
+    return axis

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -10,7 +11,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from scipy import stats
 
-from rockyade.figures.common import new_figure, save_figure
+from rockyade.figures.common import axes_list, new_figure, save_figure
 from rockyade.identification.fit import CONFIDENCE, Identification, error_surface
 
 
@@ -22,12 +23,36 @@ def _value_text(result: Identification, name: str, unit: str, digits: int) -> st
     return f"{name.split('_')[0]} = {v:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]{unit}"
 
 
-def plot_fit(result: Identification, path: str | Path) -> tuple[Figure, tuple[Axes, Axes]]:
-    """Measured rotation, the fitted Housner history and the residuals (two panels)."""
+def plot_fit(
+    result: Identification, path: str | Path | None = None, *, ax: Sequence[Axes] | None = None
+) -> tuple[Figure, tuple[Axes, Axes]]:
+    """Measured rotation (rad), the fitted Housner history and the residuals against time (s).
+
+    Parameters
+    ----------
+    result
+        The identification.
+    path
+        PNG to write (atomically); None writes nothing.
+    ax
+        Two Axes to draw into (the histories, the residuals); None: a new figure (pyplot's
+        without ``path``).
+
+    Returns
+    -------
+    fig, (ax, ax_residual)
+        The figure and its two Axes.
+    """
     h = result.history
     modelled = result.modelled()
     resid = h.theta_rad - modelled
-    fig, (ax, axr) = new_figure(path, 2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]})
+    if ax is None:
+        fig, (ax, axr) = new_figure(
+            path, 2, 1, figsize=(10, 6.2), sharex=True, gridspec_kw={"height_ratios": [3, 1.3]}
+        )
+    else:
+        ax, axr = axes_list(ax, 2)
+        fig = ax.figure
     ax.plot(h.t_s, h.theta_rad, ".", ms=2.0, color="0.45", label=f"measured ({h.rate_hz:.4g} Hz)")
     ax.plot(h.t_s, modelled, "-", lw=1.1, color="C3", label="Housner, identified parameters")
     ax.axhline(result.fit.offset_rad, color="0.6", lw=0.6, ls="--", label=f"offset {result.fit.offset_rad:.3g} rad")
@@ -63,13 +88,33 @@ def plot_fit(result: Identification, path: str | Path) -> tuple[Figure, tuple[Ax
             color="C3",
             wrap=True,
         )
-    save_figure(fig, path)
+    if path is not None:
+        save_figure(fig, path)
     return fig, (ax, axr)
 
 
-def plot_error_surface(result: Identification, path: str | Path, n: int = 41) -> tuple[Figure, Axes]:
-    """RMS misfit over the alpha-p plane (other unknowns at the optimum), with the optimum and
-    the joint 95 % confidence ellipse of (alpha, p)."""
+def plot_error_surface(
+    result: Identification, path: str | Path | None = None, n: int = 41, *, ax: Axes | None = None
+) -> tuple[Figure, Axes]:
+    """RMS misfit (rad) over the alpha (rad) - p (1/s) plane (other unknowns at the optimum),
+    with the optimum and the joint 95 % confidence ellipse of (alpha, p).
+
+    Parameters
+    ----------
+    result
+        The identification.
+    path
+        PNG to write (atomically); None writes nothing.
+    n
+        Grid points along each axis.
+    ax
+        Axes to draw into; None: a new figure (pyplot's without ``path``).
+
+    Returns
+    -------
+    fig, ax
+        The figure and its Axes.
+    """
     fit = result.fit
     cov = result.covariance[:2, :2]
     sa, sp = (math.sqrt(max(cov[i, i], 0.0)) for i in range(2))
@@ -79,7 +124,11 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
     alphas, ps, rms = error_surface(
         result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n
     )
-    fig, ax = new_figure(path, figsize=(7.4, 5.8))
+    if ax is None:
+        fig, ax = new_figure(path, figsize=(7.4, 5.8))
+    else:
+        ax = axes_list(ax, 1)[0]
+        fig = ax.figure
     levels = np.geomspace(rms.min(), rms.max(), 16)
     cs = ax.contourf(alphas, ps, rms, levels=levels, cmap="viridis_r", norm=_log_norm(levels))
     ax.contour(alphas, ps, rms, levels=levels, colors="k", linewidths=0.3)
@@ -96,7 +145,8 @@ def plot_error_surface(result: Identification, path: str | Path, n: int = 41) ->
         fontsize=9,
     )
     ax.legend(loc="upper right", fontsize=8)
-    save_figure(fig, path)
+    if path is not None:
+        save_figure(fig, path)
     return fig, ax
 
 

@@ -17,9 +17,11 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
+from rockyade.errors import InputError
 from rockyade.figures.assembly import (
     FIGURE_WIDTH_IN,
     FIXED,
@@ -31,7 +33,7 @@ from rockyade.figures.assembly import (
     _figure_for,
     _setup_axes,
 )
-from rockyade.figures.common import file_figure, save_figure
+from rockyade.figures.common import axes_list, new_figure, save_figure
 from rockyade.limit.analysis import LimitResult
 from rockyade.limit.mechanism import point_velocity
 from rockyade.limit.report import plural
@@ -71,8 +73,9 @@ def displaced_polygons(result: LimitResult) -> tuple[list[np.ndarray], float]:
     return out, scale
 
 
-def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = None) -> Path:
-    """Draw the assembly at rest and along its collapse mechanism; write a PNG.
+def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: str | None = None, *, ax=None):
+    """Draw the assembly at rest and along its collapse mechanism (axes in m), and where the
+    nonlinear kinematic analysis reached alpha = 0 its capacity curve a* (m/s^2) against d* (mm).
 
     Parameters
     ----------
@@ -80,9 +83,18 @@ def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = No
         A :class:`~rockyade.limit.analysis.LimitResult` (any status: without a mechanism
         the assembly is drawn at rest, titled with the status).
     path
-        PNG file to write.
+        PNG file to write (atomically); None writes nothing.
     title
         First line of the title (default: "limit analysis").
+    ax
+        One Axes (the mechanism alone) or two (the mechanism and the capacity curve) to draw
+        into; None: a new figure (pyplot's without ``path``), with both panels when there is
+        a capacity curve.
+
+    Returns
+    -------
+    fig, ax
+        The figure and the mechanism's Axes, or ``(fig, (ax, capacity_ax))`` with two panels.
     """
     model = result.model
     mech = result.mechanism
@@ -90,11 +102,19 @@ def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = No
     moved, scale = displaced_polygons(result)
     bounds = _bounds(rest + moved)
     curve = result.kinematic.spectral() if result.kinematic is not None else None
-    if curve is None:
-        fig, axes = _figure_for(bounds)
+    cax = None
+    if ax is not None:
+        given = [ax] if isinstance(ax, Axes) else list(ax)
+        panels = axes_list(given, len(given))
+        if len(panels) not in (1, 2):
+            raise InputError("ax", f"must be 1 or 2 matplotlib Axes, got {len(panels)}")
+        ax, cax = panels[0], (panels[1] if len(panels) == 2 and curve is not None else None)
+        fig = ax.figure
+    elif curve is None:
+        fig, axes = _figure_for(bounds, path=path)
         ax = axes[0, 0]
     else:
-        fig, ax, cax = _two_panels(bounds)
+        fig, ax, cax = _two_panels(bounds, path)
     _setup_axes(ax, bounds)
     fixed = [bool(f) for f in model.fixed]
     colours = []
@@ -143,21 +163,23 @@ def draw_mechanism(result: LimitResult, path: str | Path, title: str | None = No
         heading += ": unstable, it cannot stand under gravity alone (no multiplier)"
     else:
         heading += ": no mechanism (lambda unbounded)"
-    if curve is None:
+    if cax is None:
         ax.set_title(heading, fontsize=10)
     else:
         fig.suptitle(heading, fontsize=10)
         _draw_capacity(cax, result.kinematic, *curve)
-    return save_figure(fig, path)
+    if path is not None:
+        save_figure(fig, path)
+    return (fig, ax) if cax is None else (fig, (ax, cax))
 
 
-def _two_panels(bounds):
+def _two_panels(bounds, path: str | Path | None):
     """A figure with the assembly (left) and the capacity curve (right, narrower)."""
     x0, x1, y0, y1 = bounds
     aspect = (y1 - y0 + 0.2 * max(x1 - x0, y1 - y0)) / max(x1 - x0, 1e-9)
     width = FIGURE_WIDTH_IN + 4.0
     height = float(np.clip(FIGURE_WIDTH_IN * aspect, 4.0, MAX_HEIGHT_IN)) + 1.0
-    fig, axes = file_figure(1, 2, figsize=(width, height), layout="constrained", width_ratios=[2.6, 1.0])
+    fig, axes = new_figure(path, 1, 2, figsize=(width, height), layout="constrained", width_ratios=[2.6, 1.0])
     return fig, axes[0], axes[1]
 
 

@@ -5,9 +5,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 from numpy.typing import ArrayLike
 
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.constants import ACCEL_UNIT_LABELS
+from rockyade.figures.common import accel_scale, axes_list, new_figure, other_accel_axis, save_figure
 
 
 def plot_accelerogram(
@@ -18,23 +20,27 @@ def plot_accelerogram(
     path: str | Path | None = None,
     title: str = "",
     ax: Any = None,
+    accel_unit: str = "m/s2",
 ) -> tuple[Any, Any]:
-    """Acceleration (m/s^2), velocity (m/s) and displacement (m) of a record against time (s).
+    """Acceleration (m/s^2 given), velocity (m/s) and displacement (m) of a record against time (s).
 
-    ``ax``: three Axes to draw into. ``path``: PNG to write. Returns ``(fig, axes)``.
+    ``ax``: three Axes to draw into. ``path``: PNG to write. ``accel_unit``: "m/s2" or "g"
+    (standard gravity), the unit the acceleration is drawn in (the other unit on the right).
+    Returns ``(fig, axes)``.
     """
+    scale = accel_scale(accel_unit)
     if ax is None:
         fig, axes = new_figure(path, 3, 1, figsize=(9, 6.5), sharex=True)
         axes = list(axes)
     else:
         axes = axes_list(ax, 3)
         fig = axes[0].figure
-    for panel, y, label in zip(
-        axes, (accel, vel, disp), ("acceleration (m/s$^2$)", "velocity (m/s)", "displacement (m)"), strict=True
-    ):
+    labels = (f"acceleration ({ACCEL_UNIT_LABELS[accel_unit]})", "velocity (m/s)", "displacement (m)")
+    for panel, y, label in zip(axes, (np.asarray(accel) / scale, vel, disp), labels, strict=True):
         panel.plot(t, y, lw=0.7)
         panel.set_ylabel(label)
         panel.grid(alpha=0.3)
+    other_accel_axis(axes[0], accel_unit, "y")
     axes[-1].set_xlabel("time t (s)")
     if title:
         fig.suptitle(title)
@@ -53,14 +59,20 @@ def plot_spectra(
     band: float = 0.1,
     ax: Any = None,
     damping: float | None = None,
+    accel_unit: str = "m/s2",
 ) -> tuple[Any, Any]:
-    """Pseudo-acceleration spectra (m/s^2) against period (s, log axis).
+    """Pseudo-acceleration spectra (m/s^2 given) against period (s, log axis).
 
     ``target`` with a +/- ``band`` (fraction), ``mean`` (the suite mean, or the spectrum
     of one record), and ``individual`` spectra in light grey; any may be None. ``ax``:
     Axes to draw into. ``path``: PNG to write. ``damping``: the ratio, named on the axis
-    when given. Returns ``(fig, ax)``.
+    when given. ``accel_unit``: "m/s2" or "g" (standard gravity), the unit drawn (the other
+    on the right). Returns ``(fig, ax)``.
     """
+    scale = accel_scale(accel_unit)
+    target = None if target is None else np.asarray(target) / scale
+    mean = None if mean is None else np.asarray(mean) / scale
+    individual = None if individual is None else [np.asarray(psa) / scale for psa in individual]
     if ax is None:
         fig, ax = new_figure(path, figsize=(8, 5))
     else:
@@ -79,7 +91,8 @@ def plot_spectra(
     ax.set_xscale("log")
     ax.set_xlabel("period T (s)")
     damping_note = f", {100 * damping:g} % damping" if damping is not None else ""
-    ax.set_ylabel(f"pseudo-acceleration PSA (m/s$^2$){damping_note}")
+    ax.set_ylabel(f"pseudo-acceleration PSA ({ACCEL_UNIT_LABELS[accel_unit]}){damping_note}")
+    other_accel_axis(ax, accel_unit, "y", "PSA")
     ax.grid(alpha=0.3, which="both")
     ax.legend()
     if title:

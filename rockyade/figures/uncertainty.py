@@ -9,7 +9,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rockyade.figures.common import new_figure, save_figure
+from rockyade.constants import ACCEL_UNIT_LABELS, ACCEL_UNIT_TEXT, LOAD_FACTOR_LABEL
+from rockyade.figures.common import accel_scale, axes_list, new_figure, other_accel_axis, save_figure
 from rockyade.motion.intensity import LABELS
 from rockyade.probability.exceedance import level_column
 from rockyade.probability.fragility import Fragility, wilson_interval
@@ -27,15 +28,42 @@ def plot_uncertainty(
     runs: pd.DataFrame,
     fragility: pd.DataFrame,
     spread: pd.DataFrame | None,
-    path: str | Path,
+    path: str | Path | None = None,
     n_bins: int = 8,
+    *,
+    ax: Any = None,
+    accel_unit: str = "g",
 ) -> tuple[Any, Any]:
     """Three panels: P(overturn) and P(theta/alpha >= level) against the load factor with 95 %
     Wilson bands; the fragility against the study's first intensity measure (binned fractions
     with their bands, and the fitted lognormal curve); per-sample P(overturn) against the
-    nominal block (pairing "all"), or the peak theta/alpha of every run."""
+    nominal block (pairing "all"), or the peak theta/alpha of every run.
+
+    Parameters
+    ----------
+    study, probabilities, runs, fragility, spread
+        The study and its tables (:func:`rockyade.studies.uncertainty.run_uncertainty`).
+    path
+        PNG to write (atomically); None writes nothing.
+    n_bins
+        Bins of the intensity measure for the fractions of the fragility panel.
+    ax
+        Three Axes to draw into; None: a new figure (pyplot's without ``path``).
+    accel_unit
+        "g" (default) or "m/s2": the unit of a PGA axis (the other unit on the opposite side).
+
+    Returns
+    -------
+    fig, axes
+        The figure and its three Axes.
+    """
     measure = study.measures[0]
-    fig, axes = new_figure(path, 1, 3, figsize=(16, 4.8))
+    scale = accel_scale(accel_unit) if measure == "pga_m_s2" else 1.0
+    if ax is None:
+        fig, axes = new_figure(path, 1, 3, figsize=(16, 4.8))
+    else:
+        axes = axes_list(ax, 3)
+        fig = axes[0].figure
     ax = axes[0]
     styles = ["--", ":", "-."]
     markers = ["v", "^", "D"]
@@ -57,7 +85,7 @@ def plot_uncertainty(
                 lw=1.0,
                 label=f"{solver}: theta/alpha >= {level:g}",
             )
-    ax.set_xlabel("load factor")
+    ax.set_xlabel(LOAD_FACTOR_LABEL)
     ax.set_ylabel("probability (95 % Wilson band)")
     ax.set_ylim(-0.02, 1.02)
     ax.set_title(f"{study.name}: {study.samples} parameter samples x records", fontsize=9)
@@ -67,7 +95,7 @@ def plot_uncertainty(
     ax = axes[1]
     for k, (solver, group) in enumerate(runs[runs["status"] != "failed"].groupby("solver")):
         c = _colour(solver, k)
-        x = group[measure].to_numpy(dtype=float)
+        x = group[measure].to_numpy(dtype=float) / scale
         y = (group["status"] == "overturned").to_numpy()
         edges = np.unique(np.quantile(x, np.linspace(0, 1, n_bins + 1)))
         idx = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, edges.size - 2)
@@ -82,14 +110,25 @@ def plot_uncertainty(
             ax.errorbar(xm, kk / n, yerr=yerr, fmt="s", color=c, ms=4, capsize=2)
         row = fragility[(fragility["solver"] == solver) & (fragility["measure"] == measure)]
         if len(row) and row.iloc[0]["status"] == "fitted":
-            fit = Fragility(float(row.iloc[0]["median"]), float(row.iloc[0]["beta"]), int(row.iloc[0]["n_runs"]))
+            fit = Fragility(
+                float(row.iloc[0]["median"]) / scale, float(row.iloc[0]["beta"]), int(row.iloc[0]["n_runs"])
+            )
             xs = np.geomspace(max(x.min(), 1e-6) * 0.8, x.max() * 1.2, 200)
+            unit = f" {ACCEL_UNIT_TEXT[accel_unit]}" if measure == "pga_m_s2" else ""
             ax.plot(
-                xs, fit.probability(xs), "-", color=c, label=f"{solver}: median {fit.median:.3g}, beta {fit.beta:.2f}"
+                xs,
+                fit.probability(xs),
+                "-",
+                color=c,
+                label=f"{solver}: median {fit.median:.3g}{unit}, beta {fit.beta:.2f}",
             )
         else:
             ax.plot([], [], "-", color=c, label=f"{solver}: {row.iloc[0]['status'] if len(row) else 'no fit'}")
-    ax.set_xlabel(LABELS.get(measure, measure))
+    if measure == "pga_m_s2":
+        ax.set_xlabel(f"PGA ({ACCEL_UNIT_LABELS[accel_unit]})")
+        other_accel_axis(ax, accel_unit, "x", "PGA")
+    else:
+        ax.set_xlabel(LABELS.get(measure, measure))
     ax.set_ylabel("P(overturn)")
     ax.set_ylim(-0.02, 1.02)
     ax.set_title("fragility: binned fractions (95 % bands) and lognormal MLE fit", fontsize=9)
@@ -116,7 +155,7 @@ def plot_uncertainty(
         ax.set_ylabel("P(overturn) over the records, per parameter sample")
         ax.set_ylim(-0.02, 1.02)
         ax.set_title("spread caused by alpha, p, mu alone (same records)", fontsize=9)
-        ax.set_xlabel("load factor")
+        ax.set_xlabel(LOAD_FACTOR_LABEL)
     else:
         done = runs[runs["status"] != "failed"]
         for k, (solver, group) in enumerate(done.groupby("solver")):
@@ -131,8 +170,9 @@ def plot_uncertainty(
             )
         ax.set_ylabel("peak theta / alpha (every run)")
         ax.set_title("peak rotation of every run", fontsize=9)
-        ax.set_xlabel("load factor")
+        ax.set_xlabel(LOAD_FACTOR_LABEL)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
-    save_figure(fig, path)
+    if path is not None:
+        save_figure(fig, path)
     return fig, axes

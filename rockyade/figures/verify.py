@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rockyade.figures.common import new_figure, save_figure
+from rockyade.figures.common import axes_list, new_figure, save_figure
 from rockyade.result import Result
 
 #: check -> (title, [(block in the DEM results or None for a single-block result, legend)])
@@ -38,10 +38,32 @@ def _series(result: Result, name: str | None, quantity: str = "theta_rad") -> np
     return None
 
 
-def plot_check(check: str, results: dict[str, Result], path: str | Path):
-    """theta(t) of the blocks a check compares, one curve per solver (closed forms in black)."""
+def plot_check(check: str, results: dict[str, Result], path: str | Path | None = None, *, ax=None):
+    """theta(t) (rad against s) of the blocks a check compares, one curve per solver (closed
+    forms in black).
+
+    Parameters
+    ----------
+    check
+        The check's name (:data:`PANELS`).
+    results
+        ``{solver: Result}``.
+    path
+        PNG to write (atomically); None writes nothing.
+    ax
+        Axes to draw into; None: a new figure (pyplot's without ``path``).
+
+    Returns
+    -------
+    fig, ax
+        The figure and its Axes.
+    """
     title, panels = PANELS.get(check, (check, []))
-    fig, ax = new_figure(path, figsize=(9, 4.2))
+    if ax is None:
+        fig, ax = new_figure(path, figsize=(9, 4.2))
+    else:
+        ax = axes_list(ax, 1)[0]
+        fig = ax.figure
     if check == "wall":
         for solver, result in results.items():
             theta = np.column_stack([np.abs(result.series("theta_rad", b)) for b in result.blocks])
@@ -83,5 +105,6 @@ def plot_check(check: str, results: dict[str, Result], path: str | Path):
     ax.set_title(title, fontsize=10)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    save_figure(fig, path)
+    if path is not None:
+        save_figure(fig, path)
     return fig, ax

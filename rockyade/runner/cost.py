@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from rockyade.errors import InputError
+from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import Scene
 from rockyade.solvers.cost import CostEstimate
 
@@ -56,7 +56,7 @@ def cost_refusal(
     where = f"{label}: " if label else ""
     return InputError(
         "allow_large",
-        f"{where}the {estimate.solver} run needs {value:.3g} {what}, above the limit {limit:.3g} "
+        f"{where}the {estimate.solver} run needs {at_least(value)} {what}, above the limit {at_most(limit)} "
         f"({estimate.describe()}); use {remedy}, or pass --allow-large (allow_large=True) to run it anyway",
         source,
     )

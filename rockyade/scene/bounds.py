@@ -13,7 +13,7 @@ import math
 from dataclasses import dataclass
 
 from rockyade.constants import G
-from rockyade.errors import InputError
+from rockyade.errors import InputError, at_least, at_most
 
 
 @dataclass(frozen=True)
@@ -104,7 +104,8 @@ def check_block_ranges(block: object, spec: object, field_prefix: str, source: s
         if not lo <= inertia <= hi:
             raise InputError(
                 f"{field_prefix}inertia_kgm2",
-                f"must be in [{lo:.4g}, {hi:.4g}] kg m^2 ({INERTIA_MIN_FRACTION:g} to 1 times M r^2, r = "
+                f"must be in [{at_least(lo, 4)}, {at_most(hi, 4)}] kg m^2 ({INERTIA_MIN_FRACTION:g} to 1 times "
+                "M r^2, r = "
                 f"{math.sqrt(r_max2):.4g} m the farthest vertex from the centroid), got {inertia:g}",
                 source,
             )
@@ -116,7 +117,8 @@ def check_block_ranges(block: object, spec: object, field_prefix: str, source: s
         if not lo <= p <= hi:
             raise InputError(
                 f"{field_prefix}p_rad_s",
-                f"must be in [{lo:.4g}, {hi:.4g}] rad/s ({P_MIN_FRACTION:g} to {P_MAX_FRACTION:g} times "
+                f"must be in [{at_least(lo, 4)}, {at_most(hi, 4)}] rad/s ({P_MIN_FRACTION:g} to "
+                f"{P_MAX_FRACTION:g} times "
                 f"sqrt(g / R) = {p_limit:.4g}: p^2 = M g R / I_O and I_O >= M R^2), got {p:g}",
                 source,
             )

@@ -38,7 +38,7 @@ from rockyade.calibration.model import calibrated_model
 from rockyade.dem.engine import KernelOutput, model_arrays, simulate_model, warm_up
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
-from rockyade.dem.overturn import CRITERION, run_outcome
+from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.runs import simulate_runs
 from rockyade.kernel.single import single_body
@@ -340,8 +340,10 @@ def _outcome(model: DemModel, out: KernelOutput, n: int, stop_on_overturn: bool)
         status, t_stop = "failed", t_blowup
     overturn_times = {names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)}
     overturned_block = names[int(out.stop_body)] if status == "overturned" else None
-    if not stop_on_overturn and status == "completed":
-        status, t_first, overturned_block = run_outcome(overturn_times, names)
+    if not stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
+        t = np.arange(n) * model.sample_dt_s
+        falls = body_falls(model.bodies, t, out.pos[:n], out.ang[:n], overturn_times)
+        status, t_first, overturned_block = run_outcome(overturn_times, names, falls, t)
         t_stop = t_first if t_first is not None else t_stop
     return {
         "status": status,

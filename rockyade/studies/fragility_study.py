@@ -16,7 +16,9 @@ from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.calibration.model import calibrated_model
+from rockyade.constants import ACCEL_UNIT_LABELS
 from rockyade.figures import new_figure, save_figure
+from rockyade.figures.common import accel_scale, other_accel_axis
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.probability.fragility import Fragility, fit_lognormal
@@ -129,8 +131,9 @@ def same_runs_table(summary: pd.DataFrame, solver: str = "yade", reference: str 
     return table
 
 
-def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame:
-    """Run the fragility batches; write their CSVs and figure; return the fits."""
+def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str = "g") -> pd.DataFrame:
+    """Run the fragility batches; write their CSVs and figure (PGA in ``accel_unit``, "g" or
+    "m/s2", the other unit on the top axis); return the fits."""
     plan = (
         f"{len(RECORDS)} records x load factors {LOAD_FACTORS[0]}-{LOAD_FACTORS[-1]} per specimen (experimental "
         "parameters, matched calibration), reference DEM and Housner"
@@ -204,19 +207,21 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         "fitted lognormal fragility: median (PGA and load factor) and beta, "
         "per specimen and solver (YADE: subset, see above).",
     )
-    draw_figure(report, stripes, fits)
+    draw_figure(report, stripes, fits, accel_unit)
     return fits
 
 
-def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Figure:
+def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame, accel_unit: str = "g") -> Figure:
     """Per specimen: collapse fractions (points), fitted curves (solid over the tested range,
-    dotted beyond it), extrapolated medians flagged and missing curves explained."""
+    dotted beyond it), extrapolated medians flagged and missing curves explained; PGA in
+    ``accel_unit`` ("g", standard gravity, or "m/s2"), the other unit on the top axis."""
     specimens = sorted(set(fits.specimen))
     name = "fragility.png"
+    unit = accel_scale(accel_unit)
     fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 8.5), sharex=True, sharey=True)
-    tested = LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2
+    tested = LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2 / unit
     x_max = 1.35 * tested  # room to show where an extrapolated curve goes
-    x = np.linspace(0.05, x_max, 300)
+    x = np.linspace(0.05 / unit, x_max, 300)
     markers = {"reference": "o", "housner": "s", "yade": "^"}
     for ax, specimen in zip(axes.ravel(), specimens, strict=False):
         missing = []
@@ -230,7 +235,7 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
                 missing.append(_missing_curve(solver, fit))
                 continue
             subset = fit.runs < fits[fits.specimen == specimen].runs.max()
-            _draw_fit(ax, solver, marker, fit, pts, subset, x, x_max)
+            _draw_fit(ax, solver, marker, fit, pts, subset, x, x_max, accel_unit)
         ax.axvspan(tested, x_max, color="0.92", lw=0, zorder=0)
         ax.text(
             x_max,
@@ -254,7 +259,12 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
             if "no curve" in text.get_text():
                 text.set_color("#b2182b")
     for ax in axes[-1]:
-        ax.set_xlabel("PGA of the scaled suite, load factor x ag S (m/s$^2$)")
+        ax.set_xlabel(
+            f"PGA of the scaled suite, load factor x ag S ({ACCEL_UNIT_LABELS[accel_unit]}); the load factor "
+            "multiplies the records' accelerations as read"
+        )
+    for ax in axes[0]:
+        other_accel_axis(ax, accel_unit, "x", "PGA")
     for ax in axes[:, 0]:
         ax.set_ylabel("fraction of records that overturn")
     save_figure(fig, report.out / name)
@@ -269,13 +279,24 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame) -> Fi
     return fig
 
 
-def _draw_fit(ax, solver: str, marker: str, fit, pts: pd.DataFrame, subset: bool, x: np.ndarray, x_max: float) -> None:
+def _draw_fit(
+    ax,
+    solver: str,
+    marker: str,
+    fit,
+    pts: pd.DataFrame,
+    subset: bool,
+    x: np.ndarray,
+    x_max: float,
+    accel_unit: str = "g",
+) -> None:
     """One solver's collapse fractions (points) and fitted curve (solid within its tested
     range, dotted beyond), its median marked when extrapolated; ``subset``: fewer runs than
-    the other solvers (YADE), said in the legend."""
+    the other solvers (YADE), said in the legend. ``x`` and ``x_max`` in ``accel_unit``."""
     colour = SOLVER_STYLES[solver]["color"]
+    unit = accel_scale(accel_unit)
     if fit.status == "fitted":
-        median = f"median {fmt(fit.median_pga_m_s2, 3)} m/s$^2$"
+        median = f"median {fmt(fit.median_pga_m_s2 / unit, 3)} {ACCEL_UNIT_LABELS[accel_unit]}"
         if fit.extrapolated:
             median += " EXTRAPOLATED"
         label = f"{SOLVER_LABELS[solver]}: {median}, beta {fmt(fit.beta, 2)}"
@@ -285,17 +306,17 @@ def _draw_fit(ax, solver: str, marker: str, fit, pts: pd.DataFrame, subset: bool
         label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
     elif subset:  # say how small
         label += f" ({int(pts.n_records.max())} records x {len(pts)} load factors)"
-    ax.plot(pts.pga_m_s2, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
+    ax.plot(pts.pga_m_s2 / unit, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
     if fit.status != "fitted":
         return
-    curve = Fragility(fit.median_pga_m_s2, fit.beta, int(fit.stripes)).probability(x)
-    inside = x <= fit.largest_tested_pga_m_s2
+    curve = Fragility(fit.median_pga_m_s2 / unit, fit.beta, int(fit.stripes)).probability(x)
+    inside = x <= fit.largest_tested_pga_m_s2 / unit
     ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
     ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
     if fit.extrapolated:  # the median on the dotted curve (an arrow at the edge when beyond it)
-        inside_plot = fit.median_pga_m_s2 <= x_max
+        inside_plot = fit.median_pga_m_s2 / unit <= x_max
         ax.plot(
-            min(fit.median_pga_m_s2, x_max),
+            min(fit.median_pga_m_s2 / unit, x_max),
             0.5,
             "D" if inside_plot else ">",
             color=colour,

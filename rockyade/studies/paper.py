@@ -44,8 +44,11 @@ def run_tables(report: Report) -> None:
         )
 
 
-def run_paper_study(out: str | Path, workers: int = 2, parts: tuple[str, ...] = PARTS, use_yade: bool = True) -> Report:
+def run_paper_study(
+    out: str | Path, workers: int = 2, parts: tuple[str, ...] = PARTS, use_yade: bool = True, accel_unit: str = "g"
+) -> Report:
     """Run the chosen parts; return the report (``index_path``, ``runs``, ``failures()``).
+    ``accel_unit``: "g" (default) or "m/s2", the unit of the fragility figure's PGA axis.
 
     A part that raises is logged as a failed run with its error (the traceback goes to
     ``<part>_error.log``), and the next part runs.
@@ -70,7 +73,7 @@ def run_paper_study(out: str | Path, workers: int = 2, parts: tuple[str, ...] = 
         "random": lambda: random_motion.run(report, workers, use_yade),
         "patterns": lambda: pattern_map.run(report, workers),
         "sensitivity": lambda: sensitivity.run(report),
-        "fragility": lambda: fragility_study.run(report, workers, use_yade),
+        "fragility": lambda: fragility_study.run(report, workers, use_yade, accel_unit),
         "overturning": lambda: overturning.run(report, workers),
     }
     for part in PARTS:

@@ -408,8 +408,10 @@ def run_uncertainty(
     resume: bool = False,
     progress: bool = True,
     figure: bool = True,
+    accel_unit: str = "g",
 ) -> UncertaintyResult:
-    """Draw the samples, run every task through the batch engine and write the report."""
+    """Draw the samples, run every task through the batch engine and write the report
+    (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure)."""
     from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
 
     out = Path(out)
@@ -444,7 +446,7 @@ def run_uncertainty(
         from rockyade.figures.uncertainty import plot_uncertainty
 
         fig_path = out / "uncertainty.png"
-        plot_uncertainty(study, probabilities, sampled, fragility, spread, fig_path)
+        plot_uncertainty(study, probabilities, sampled, fragility, spread, fig_path, accel_unit=accel_unit)
     write_json(
         out / "uncertainty.json",
         {

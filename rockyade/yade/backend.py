@@ -37,7 +37,7 @@ from rockyade import __version__
 from rockyade.calibration.model import calibrated_model
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
-from rockyade.dem.overturn import CRITERION, run_outcome
+from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import InputError, SolverUnavailableError
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.lifetime import child_dies_with_parent
@@ -239,7 +239,7 @@ def _parse(
     extra["max_polyhedra_penetration_over_radius"] = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
     extra["max_rotation_step_rad"] = meta.get("max_rotation_step_rad")
     extra["rotation_track_period_steps"] = meta.get("rotation_track_period_steps")
-    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra))
+    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
 
 
 def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
@@ -289,15 +289,19 @@ def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None
     return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
 
 
-def _run_meta(model: DemModel, meta: dict, total: float, extra: dict[str, object]) -> dict[str, object]:
+def _run_meta(
+    model: DemModel, meta: dict, total: float, extra: dict[str, object], arrays: dict[str, np.ndarray]
+) -> dict[str, object]:
     """The Result's metadata: how the run ended (overturns per block) and what ran."""
     names = model.names
     status = meta["status"]
     overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
     overturn_time = meta["stop_time_s"] if status == "overturned" else None
     overturned_block = names[meta["stop_body"]] if status == "overturned" else None
-    if not model.stop_on_overturn and status == "completed":
-        status, overturn_time, overturned_block = run_outcome(overturn_times, names)
+    if not model.stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
+        t = np.arange(arrays["ang"].shape[0]) * model.sample_dt_s
+        falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
+        status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     return {
         "solver": "yade",
         "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",

@@ -1,17 +1,22 @@
 """Generators of masonry assemblies: plain scene dictionaries a user can write and edit.
 
-Each generator returns the dictionary of a positioned scene (every block placed by
-``position_m``; see docs/assemblies.md), which :func:`rockyade.scene.scene_from_dict`
+Each generator returns the dictionary of a scene (every block placed by ``position_m``, or
+a column scene; see docs/assemblies.md), which :func:`rockyade.scene.scene_from_dict`
 validates and :func:`write_scene` writes as TOML (or JSON)::
 
     from rockyade.scene.generators import wall, write_scene
     scene = wall(courses=5, units_per_course=6, openings=[(1.0, 0.0, 0.6, 0.6)])
     write_scene("wall.toml", scene)
 
-Modules: ``wall`` (dry walls, running or stack bond, openings), ``column`` (drum columns,
-stacks), ``arch`` (semicircular and pointed arches on piers), ``frame`` (the rocking frame
-of Makris & Vassiliou 2013), ``restrained_wall`` (a wall restrained at its top, the
-paper's Fig. 2), ``common`` (exact numbers, block tables, motions and contacts).
+The generators carry the names of ``rockyade build KIND``: :func:`wall`, :func:`column`,
+:func:`stack`, :func:`arch`, :func:`frame`, :func:`restrained_wall` (``restrained-wall``);
+:data:`GENERATORS` maps each kind to its function. Their modules are named in the plural so
+that no module hides a function of the same name: ``walls`` (dry walls, running or stack
+bond, openings), ``columns`` (drum columns, stacks), ``arches`` (semicircular and pointed
+arches on piers), ``frames`` (the rocking frame of Makris & Vassiliou 2013),
+``restrained_walls`` (a wall restrained at its top, the paper's Fig. 2), ``common`` (exact
+numbers, block tables, motions and contacts). ``drum_column`` and ``rocking_frame`` are the
+former names of :func:`column` and :func:`frame`.
 """
 
 from __future__ import annotations
@@ -21,8 +26,8 @@ from pathlib import Path
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.arch import arch
-from rockyade.scene.generators.column import drum_column, stack, tapered_widths
+from rockyade.scene.generators.arches import arch
+from rockyade.scene.generators.columns import column, drum_column, round_drum_mass_inertia, stack, tapered_widths
 from rockyade.scene.generators.common import (
     free_motion,
     paper_contact,
@@ -31,16 +36,16 @@ from rockyade.scene.generators.common import (
     rest_motion,
     udec_contact,
 )
-from rockyade.scene.generators.frame import frame_frequency, frame_gamma, rocking_frame
-from rockyade.scene.generators.restrained_wall import restrained_wall
-from rockyade.scene.generators.wall import Opening, wall
+from rockyade.scene.generators.frames import frame, frame_frequency, frame_gamma, rocking_frame
+from rockyade.scene.generators.restrained_walls import restrained_wall
+from rockyade.scene.generators.walls import Opening, wall
 
 #: CLI kind -> generator.
 GENERATORS: dict[str, Callable[..., dict[str, Any]]] = {
     "wall": wall,
-    "column": drum_column,
+    "column": column,
     "arch": arch,
-    "frame": rocking_frame,
+    "frame": frame,
     "stack": stack,
     "restrained-wall": restrained_wall,
 }
@@ -66,7 +71,9 @@ __all__ = [
     "GENERATORS",
     "Opening",
     "arch",
+    "column",
     "drum_column",
+    "frame",
     "frame_frequency",
     "frame_gamma",
     "free_motion",
@@ -76,6 +83,7 @@ __all__ = [
     "rest_motion",
     "restrained_wall",
     "rocking_frame",
+    "round_drum_mass_inertia",
     "stack",
     "tapered_widths",
     "udec_contact",

@@ -37,7 +37,7 @@ from rockyade.scene.generators.common import (
 
 
 def frame_gamma(scene: Mapping[str, Any]) -> float:
-    """gamma = beam mass / mass of both columns of a frame scene made by :func:`rocking_frame`."""
+    """gamma = beam mass / mass of both columns of a frame scene made by :func:`frame`."""
     mass = {}
     for b in scene["blocks"]:
         mass[b["name"]] = b["density_kg_m3"] * b["width_m"] * b["height_m"] * b["thickness_m"]
@@ -51,7 +51,7 @@ def frame_frequency(column_width_m: float, column_height_m: float, gamma: float,
     return p * math.sqrt((1.0 + 2.0 * gamma) / (1.0 + 3.0 * gamma))
 
 
-def rocking_frame(
+def frame(
     column_width_m: float = 0.25,
     column_height_m: float = 1.5,
     span_m: float = 1.5,
@@ -119,3 +119,7 @@ def rocking_frame(
         duration_s=duration_s,
         sample_dt_s=sample_dt_s,
     )
+
+
+#: The former name of :func:`frame` (kept: scripts call it).
+rocking_frame = frame
