@@ -50,6 +50,8 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.uncertainty",
     "rockyade.cli.verify",
     "rockyade.cli.limit",
+    "rockyade.cli.fragility",
+    "rockyade.cli.assess",
 ]
 
 _T0 = time.perf_counter()  # the total wall time printed by ``rockyade run`` counts from here

@@ -10,7 +10,7 @@ from typing import Any
 from rockyade.cli.common import check_output_dir
 from rockyade.errors import InputError
 
-CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline")
+CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline", "kinematic", "code", "fragility_fit")
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -47,8 +47,10 @@ def register(sub: Any) -> None:
         "verify",
         help="verification report: assemblies in both DEMs against closed forms and each other",
         description="Rocking frame (Makris & Vassiliou p_hat), 8-drum column uplift, pad case overlaps, a "
-        "1,000-block wall at rest, reference DEM against YADE, and this version's single-block and bi-block "
-        "baseline. Writes verify.csv, a figure per check and index.md; exits 1 if any check fails.",
+        "1,000-block wall at rest, reference DEM against YADE, this version's single-block and bi-block "
+        "baseline, the limit analysis' kinematic quantities and the code's checks against closed forms and a hand "
+        "calculation, and the fragility fit recovering a known curve. Writes verify.csv, a figure per check and "
+        "index.md; exits 1 if any check fails.",
     )
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--only", help=f"comma-separated checks among {', '.join(CHECKS)} (default: all)")

@@ -25,7 +25,16 @@ the tolerance, pass or fail):
   here, against dt/2 changes of 2.7 % and 0.2 %);
 * ``baseline``: the paper's single blocks and bi-block (free rocking, harmonic, pulse):
   first five peaks and effective restitution against the values this version's first
-  release computed (``data/baseline_0_1.csv``): peaks within 1 %, mu_eff within 0.2 %.
+  release computed (``data/baseline_0_1.csv``): peaks within 1 %, mu_eff within 0.2 %;
+* ``kinematic``: limit analysis and the code's kinematic quantities against closed forms
+  (lambda = b/h, e* = 1 and d0* = b of a block, e* of a wall of n courses, the minimum
+  thickness of a semicircular arch approaching Milankovitch's t/R = 0.1075);
+* ``code``: the NTC 2018 checks of a free-standing wall against the hand calculation of
+  docs/limit.md (the wall of docs/howto/is-this-wall-safe.md);
+* ``fragility_fit``: the lognormal fit of stripes and its bootstrap band recover the curve
+  that synthetic outcomes were drawn from.
+
+The last three run no solver (the limit-analysis programme and the fit only).
 """
 
 from __future__ import annotations
@@ -48,10 +57,10 @@ from rockyade.constants import G
 from rockyade.io.atomic import atomic_open, write_text
 from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.scene.generators import drum_column, pulse_motion, rest_motion, rocking_frame, wall
+from rockyade.scene.generators import arch, drum_column, pulse_motion, rest_motion, rocking_frame, stack, wall
 from rockyade.solvers import run
 
-CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline")
+CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline", "kinematic", "code", "fragility_fit")
 
 
 @dataclass(frozen=True)
@@ -444,6 +453,238 @@ def check_baseline(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     return rows, {}
 
 
+# ---------------------------------------------------------------------- limit analysis and the code
+
+
+def _block_scene(width: float, height: float) -> Scene:
+    """One block on the base (a column scene), 1 m thick, 1800 kg/m^3, friction 30 degrees."""
+    return scene_from_dict(
+        stack(widths_m=[width], heights_m=height, thickness_m=1.0, density_kg_m3=1800.0, layout="column")
+    )
+
+
+def _arch_minimum_thickness(voussoirs: int, tol: float = 2e-5) -> float:
+    """t/R of a semicircular arch of mean radius 1 m on fixed piers below which it cannot stand
+    (the programme's status 'unstable' under gravity), by bisection."""
+    from rockyade.limit import rigid_block_model
+    from rockyade.limit.lp import solve_equilibrium
+
+    def stands(t_over_r: float) -> bool:
+        data = arch(
+            span_m=2.0 - t_over_r,
+            ring_depth_m=t_over_r,
+            voussoirs=voussoirs,
+            pier_width_m=2.0 * t_over_r,
+            pier_height_m=0.5,
+            piers="fixed",
+            motion=rest_motion(),
+        )
+        return solve_equilibrium(rigid_block_model(scene_from_dict(data), sliding=False)).status == "collapse"
+
+    lo, hi = 0.09, 0.13
+    while hi - lo > tol:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if stands(mid) else (mid, hi)
+    return 0.5 * (lo + hi)
+
+
+def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """Limit analysis and the code's kinematic quantities against closed forms: lambda = b/h,
+    e* = 1 and d0* = b of a block; e* of a wall of n courses turning as one about its toe,
+    (1/4) / (1/3 - 1/(12 n^2)) -> 0.75; the minimum thickness of a semicircular arch
+    approaching Milankovitch's t/R = 0.1075 (60 voussoirs: 0.10745, docs/limit.md)."""
+    from rockyade.limit import limit_analysis
+
+    rows = []
+    for width, height in ((0.25, 2.5), (0.4, 2.0), (1.0, 0.5)):
+        res = limit_analysis(_block_scene(width, height), sliding=False)
+        kin = res.kinematic
+        label = f"block {width:g} x {height:g} m"
+        rows += [
+            Row(
+                "kinematic",
+                "limit",
+                f"{label}: lambda",
+                res.load_multiplier,
+                width / height,
+                "b/h",
+                "1e-9",
+                _rel(res.load_multiplier, width / height) <= 1e-9,
+            ),
+            Row(
+                "kinematic",
+                "limit",
+                f"{label}: e*",
+                kin.e_star,
+                1.0,
+                "a block: 1",
+                "1e-9",
+                abs(kin.e_star - 1.0) <= 1e-9,
+            ),
+            Row(
+                "kinematic",
+                "limit",
+                f"{label}: d0* (m)",
+                kin.d0_star_m,
+                width / 2,
+                "b (centroid over the pivot)",
+                "1e-6",
+                _rel(kin.d0_star_m, width / 2) <= 1e-6,
+            ),
+        ]
+    for n in (2, 5, 10):
+        data = wall(courses=n, units_per_course=1, bond="stack", unit_length_m=0.4, unit_height_m=0.5)
+        kin = limit_analysis(scene_from_dict(data), sliding=False).kinematic
+        expected = 0.25 / (1.0 / 3.0 - 1.0 / (12.0 * n * n))
+        rows.append(
+            Row(
+                "kinematic",
+                "limit",
+                f"wall of {n} courses turning as one: e*",
+                kin.e_star,
+                expected,
+                "(1/4) / (1/3 - 1/(12 n^2))",
+                "1e-9",
+                _rel(kin.e_star, expected) <= 1e-9,
+            )
+        )
+    t60 = _arch_minimum_thickness(60)
+    rows.append(
+        Row(
+            "kinematic",
+            "limit",
+            "semicircular arch, 60 voussoirs: minimum t/R",
+            t60,
+            0.1075,
+            "Milankovitch (the inscribed polygonal arch approaches it from below)",
+            "2e-4",
+            abs(t60 - 0.1075) <= 2e-4,
+        )
+    )
+    return rows, {}
+
+
+def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The code's checks of a free-standing wall 0.25 m x 2.5 m against the hand calculation of
+    docs/limit.md ("A hand calculation", the wall of the how-to): EC8 Type 1, ground B (S = 1.2,
+    TC = 0.5 s), ag = 0.25 g, FC = 1.35, q = 2."""
+    from rockyade.assess import Position, Site, code_checks
+    from rockyade.limit import limit_analysis
+
+    kin = limit_analysis(_block_scene(0.25, 2.5), fc=1.35).kinematic
+    ag, S, q = 0.25 * G, 1.2, 2.0
+    linear, nonlinear = code_checks(kin, Site(1, "B", ag), Position())
+    a0 = 0.1 * G / 1.35
+    ts = kin.Ts_s
+    sde = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2  # TC < Ts < TD
+    src = "hand calculation (docs/limit.md)"
+    rows = [
+        Row(
+            "code",
+            "assess",
+            "a0* = alpha0 g / (e* FC) (m/s^2)",
+            kin.a0_star_m_s2,
+            a0,
+            src,
+            "1e-12",
+            _rel(kin.a0_star_m_s2, a0) <= 1e-12,
+        ),
+        Row(
+            "code",
+            "assess",
+            "linear demand ag S / q (m/s^2)",
+            linear.demand,
+            ag * S / q,
+            src,
+            "1e-12",
+            _rel(linear.demand, ag * S / q) <= 1e-12,
+        ),
+        Row(
+            "code",
+            "assess",
+            "code capacity of the linear check, ag = a0* q / S (m/s^2)",
+            linear.ag_capacity_m_s2,
+            a0 * q / S,
+            src,
+            "1e-12",
+            _rel(linear.ag_capacity_m_s2, a0 * q / S) <= 1e-12,
+        ),
+        Row("code", "assess", "du* = 0.4 b (m)", kin.du_star_m, 0.05, src, "1e-6", _rel(kin.du_star_m, 0.05) <= 1e-6),
+        Row(
+            "code",
+            "assess",
+            "nonlinear demand SDe(Ts) = 2.5 ag S TC / Ts (Ts / 2 pi)^2 (m)",
+            nonlinear.demand,
+            sde,
+            src,
+            "1e-12",
+            _rel(nonlinear.demand, sde) <= 1e-12,
+        ),
+        Row(
+            "code",
+            "assess",
+            "verdict (1: verified)",
+            float(linear.status == "verified"),
+            0.0,
+            "a0* = 0.727 < 1.472 m/s^2: not verified",
+            "exact",
+            linear.status == "not verified",
+        ),
+    ]
+    return rows, {}
+
+
+def check_fragility_fit(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The lognormal fit of the stripes and its bootstrap band recover a known curve: 400 records,
+    each collapsing above its own capacity drawn from lognormal(median 2, beta 0.4) (seed 11), at
+    9 levels from 0.5 to 8."""
+    from scipy import stats
+
+    from rockyade.assess.fit import fit_stripes
+
+    rng = np.random.default_rng(11)
+    levels = np.geomspace(0.5, 8.0, 9)
+    capacity = 2.0 * np.exp(0.4 * rng.standard_normal(400))
+    runs = pd.DataFrame(
+        [
+            {"record_index": r, "level": float(x), "status": "completed", "collapsed": bool(x >= capacity[r])}
+            for x in levels
+            for r in range(capacity.size)
+        ]
+    )
+    fit = fit_stripes(runs, "level")
+    f = fit.fragility
+    truth = stats.norm.cdf(np.log(fit.grid_si / 2.0) / 0.4)
+    covered = float(np.mean((fit.band_lo - 0.02 <= truth) & (truth <= fit.band_hi + 0.02)))
+    lo, hi = fit.median_interval_si
+    src = "the lognormal the outcomes were drawn from"
+    rows = [
+        Row("fragility_fit", "assess", "median", f.median, 2.0, src, "5 %", _rel(f.median, 2.0) <= 0.05),
+        Row("fragility_fit", "assess", "beta", f.beta, 0.4, src, "12 %", _rel(f.beta, 0.4) <= 0.12),
+        Row(
+            "fragility_fit",
+            "assess",
+            "90 % band of the median holds the true median (1: yes)",
+            float(lo < 2.0 < hi),
+            1.0,
+            src,
+            "exact",
+            lo < 2.0 < hi,
+        ),
+        Row(
+            "fragility_fit",
+            "assess",
+            "fraction of the curve's grid inside the 90 % band (within 0.02)",
+            covered,
+            1.0,
+            src,
+            ">= 0.9",
+            covered >= 0.9,
+        ),
+    ]
+    return rows, {}
+
+
 CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Result]]]] = {
     "frame": check_frame,
     "drums": check_drums,
@@ -451,6 +692,9 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "wall": check_wall,
     "agreement": check_agreement,
     "baseline": check_baseline,
+    "kinematic": check_kinematic,
+    "code": check_code,
+    "fragility_fit": check_fragility_fit,
 }
 
 

@@ -1,0 +1,379 @@
+"""A verdict on a wall: the code's kinematic checks, and the rocking dynamics beside them.
+
+1. The mechanism and its quantities by limit analysis (:func:`rockyade.limit.limit_analysis`:
+   alpha0, M*, e*, a0*, the capacity curve, d0*, du*, Ts), in the direction given or, by
+   default, in both, keeping the one with the smaller a0* (the earthquake shakes both ways).
+2. The code's checks against the site (:mod:`rockyade.assess.code`).
+3. Unless asked not to, the dynamic answer: the same scene under a spectrum-compatible
+   suite scaled to the site (:func:`rockyade.assess.motions.ec8_suite`, the site's EC8
+   spectrum) or under the user's records, each scaled to the site's PGA ag S (EN 1998-1
+   3.2.1: ag S is the expected peak ground acceleration on the site's ground), at load
+   factors lambda on that scaling (stripes; lambda = 1 is the code's demand). The intensity
+   of a run is lambda ag (:mod:`rockyade.assess.measures`, ``ag``). Reported: the fraction
+   of the records that collapse the wall at the code's demand (lambda = 1), the fragility
+   median and beta in ag, and the ratio of that median to the code's capacity expressed in
+   the same ag (the largest ag at which one of its checks is met): above 1 the code is
+   conservative for this wall, below 1 it is not.
+
+A mechanism at a height of a building is shaken by its floor, not by the ground: the
+dynamic part runs ground motions at the scene's base, so it is refused there (the code's
+check at height stands alone).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from rockyade.assess.code import (
+    NOT_APPLICABLE,
+    Check,
+    check_code,
+    code_capacity_ag,
+    code_checks,
+    verdict,
+)
+from rockyade.assess.fragility import (
+    FragilityPlan,
+    FragilityResult,
+    SceneCannotStandError,
+    default_solver,
+    run_fragility,
+)
+from rockyade.assess.measures import Measure
+from rockyade.assess.motions import MotionSet, RecordFiles, ec8_suite
+from rockyade.assess.site import Position, Site
+from rockyade.assess.strict import finite_or_null
+from rockyade.assess.stripes import (
+    DEFAULT_SAMPLE_DT_S,
+    DEFAULT_TAIL_S,
+    StripePlan,
+    check_fallen_blocks,
+    record_measures,
+)
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.limit import DEFAULT_FC, LimitResult, limit_analysis
+from rockyade.runner import Executor
+from rockyade.scene import Scene
+from rockyade.solvers import as_solver
+from rockyade.solvers.base import Solver
+
+#: Default load factors on the site's scaling (1: the code's demand), ratio sqrt 2.
+DEFAULT_LOAD_FACTORS = (0.35, 0.5, 0.71, 1.0, 1.41, 2.0, 2.83)
+#: Records of the default suite, and its seed.
+DEFAULT_COUNT = 20
+DEFAULT_SEED = 1
+#: The keys of the code's quantities at the top of the JSON.
+QUANTITY_KEYS = ("alpha0", "e_star", "M_star_kg", "a0_star_m_s2", "d0_star_m", "du_star_m", "Ts_s")
+
+
+@dataclass(frozen=True)
+class DynamicSettings:
+    """The dynamic part of an assessment.
+
+    Attributes
+    ----------
+    records
+        The user's records (each scaled to the site's ag S at lambda = 1), or None for a
+        synthetic suite compatible with the site's spectrum.
+    count, seed
+        The suite's records and seed.
+    solver
+        A Solver or a name (default: Housner for a single block, the reference DEM otherwise).
+    load_factors
+        lambda on the site's scaling; 1 is always added.
+    extend
+        Extend the stripes while the median is outside them (:mod:`rockyade.assess.fragility`).
+    fallen_blocks, sample_dt_s, tail_s
+        As :func:`rockyade.assess.fragility.fragility_plan` takes them.
+    """
+
+    records: RecordFiles | None = None
+    count: int = DEFAULT_COUNT
+    seed: int = DEFAULT_SEED
+    solver: Solver | str | None = None
+    load_factors: tuple[float, ...] = DEFAULT_LOAD_FACTORS
+    extend: bool = True
+    fallen_blocks: int = 1
+    sample_dt_s: float = DEFAULT_SAMPLE_DT_S
+    tail_s: float = DEFAULT_TAIL_S
+
+
+def check_load_factors(values: tuple[float, ...]) -> tuple[float, ...]:
+    """Load factors in (0, 100], 2 to 50 of them, sorted with 1 among them."""
+    if not 1 <= len(values) <= 50:
+        raise InputError("--load-factors", f"needs 1 to 50 values, got {len(values)}")
+    bad = [v for v in values if not (math.isfinite(v) and 0.0 < v <= 100.0)]
+    if bad:
+        raise InputError("--load-factors", f"must be in (0, 100], got {bad[0]:g}")
+    return tuple(sorted({float(v) for v in values} | {1.0}))
+
+
+@dataclass
+class Assessment:
+    """The answer of :func:`assess` (module docstring).
+
+    Attributes
+    ----------
+    code
+        ``ntc2018``.
+    fc
+        The confidence factor FC.
+    site, position
+        The demand's inputs.
+    limit
+        The governing limit analysis (its mechanism and the code's quantities).
+    other_direction
+        The other direction's limit analysis (when both were solved), for the record.
+    checks
+        The code's checks.
+    dynamic
+        The fragility in ag (None with ``static_only``).
+    """
+
+    code: str
+    fc: float
+    site: Site
+    position: Position
+    limit: LimitResult
+    other_direction: LimitResult | None
+    checks: list[Check]
+    dynamic: FragilityResult | None = None
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def verdict(self) -> str:
+        """``verified``, ``not verified``, ``not applicable`` or ``no mechanism``."""
+        if self.limit.status == "no_mechanism":
+            return "no mechanism"
+        return verdict(self.checks)
+
+    @property
+    def code_capacity_ag_m_s2(self) -> float:
+        """The largest ag at which a check is met, m/s^2 (:func:`rockyade.assess.code.code_capacity_ag`)."""
+        return code_capacity_ag(self.checks)
+
+    def demand_fraction(self) -> dict[str, float] | None:
+        """Collapses at the code's demand (lambda = 1): count, runs, fraction, Wilson 95 %."""
+        if self.dynamic is None:
+            return None
+        return self.dynamic.fraction_at(self.site.ag_m_s2)
+
+    @property
+    def median_over_code(self) -> float:
+        """The dynamic median ag over the code's capacity ag (NaN where either is missing)."""
+        if self.dynamic is None or not self.dynamic.fit.fitted:
+            return math.nan
+        return self.dynamic.fit.fragility.median / self.code_capacity_ag_m_s2
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (the code's quantities at the top; each check with its demand, capacity,
+        verdict and source; strict: a number that does not exist is null)."""
+        lim = self.limit.to_dict()
+        out: dict[str, Any] = {
+            "code": self.code,
+            "FC": self.fc,
+            "status": self.limit.status,
+            "verdict": self.verdict,
+            "verdict_rule": "verified when one of the checks that apply is met (the linear check with q and the "
+            "nonlinear check are two ways of checking the mechanism)",
+            "site": self.site.to_dict(),
+            "position": self.position.to_dict(),
+            "direction": self.limit.direction,
+            "load_multiplier": self.limit.load_multiplier,
+        }
+        out.update({k: lim.get(k) for k in QUANTITY_KEYS})
+        out["kinematic"] = lim.get("kinematic")
+        out["mechanism"] = {k: lim[k] for k in ("mechanism", "hinges", "sliding", "friction_angle_deg")}
+        out["limit_notes"] = lim["notes"]
+        if self.other_direction is not None:
+            o = self.other_direction
+            out["other_direction"] = {
+                "direction": o.direction,
+                "status": o.status,
+                "alpha0": o.load_multiplier,
+                "a0_star_m_s2": o.kinematic.a0_star_m_s2 if o.kinematic is not None else None,
+            }
+        out["checks"] = [c.to_dict() for c in self.checks]
+        cap = self.code_capacity_ag_m_s2
+        out["code_capacity_ag_m_s2"] = cap
+        out["code_capacity_ag_g"] = cap / G
+        out["dynamic"] = None
+        if self.dynamic is not None:
+            fit = self.dynamic.fit
+            out["dynamic"] = {
+                **self.dynamic.to_dict(),
+                "at_code_demand": self.demand_fraction(),
+                "median_ag_g": fit.fragility.median / G,
+                "beta": fit.fragility.beta,
+                "median_over_code_capacity": self.median_over_code,
+                "median_over_code_capacity_meaning": "the dynamic median ag over the largest ag at which a code "
+                "check is met: above 1 the code is conservative for this wall, below 1 it is not",
+            }
+        out["notes"] = list(self.notes)
+        return finite_or_null(out)
+
+
+def _limit(
+    scene: Scene, direction: str | None, friction_angle_deg: float | None, sliding: bool, fc: float
+) -> tuple[LimitResult, LimitResult | None]:
+    """(governing, other): the direction given, or both keeping the smaller a0*."""
+    directions = [direction] if direction else ["+x", "-x"]
+    results = [
+        limit_analysis(scene, d, friction_angle_deg=friction_angle_deg, sliding=sliding, fc=fc) for d in directions
+    ]
+    if any(r.status == "unstable" for r in results):
+        raise SceneCannotStandError(scene.source)
+    collapsing = [r for r in results if r.status == "collapse"]
+    if not collapsing:
+        return results[0], (results[1] if len(results) > 1 else None)
+    best = min(collapsing, key=lambda r: r.kinematic.a0_star_m_s2 if r.kinematic is not None else math.inf)
+    other = next((r for r in results if r is not best), None)
+    return best, other
+
+
+def dynamic_plan(
+    scene: Scene, site: Site, settings: DynamicSettings, executor: Executor, progress: bool = True
+) -> FragilityPlan:
+    """The stripes in ag (module docstring); records generated or read now, nothing run."""
+    solver = as_solver(settings.solver or default_solver(scene))
+    fallen = check_fallen_blocks(scene, settings.fallen_blocks)
+    motions: MotionSet
+    if settings.records is None:
+        motions = ec8_suite(site.spectrum_type, site.ground, site.ag_m_s2, settings.count, settings.seed)
+    else:
+        motions = settings.records
+    table = record_measures(motions, None, executor, progress)
+    table.insert(0, "record", [motions.label(i) for i in range(motions.count)])
+    if settings.records is None:
+        im = np.full(motions.count, site.ag_m_s2)  # the suite's own ag
+        how = f"the suite's target ag = {site.ag_m_s2 / G:.4g} g for every record"
+    else:
+        im = table["pga_m_s2"].to_numpy() / site.S  # scaled so that PGA = ag S at lambda = 1
+        how = f"each record's PGA / S (S = {site.S:g}): lambda = 1 scales its PGA to ag S"
+    table["im_si"] = im
+    measure = Measure("ag")
+    stripes = StripePlan(
+        scene,
+        motions,
+        measure,
+        tuple(float(v) for v in im),
+        tuple(float(v) for v in table["duration_s"]),
+        solver,
+        fallen,
+        settings.sample_dt_s,
+        settings.tail_s,
+    )
+    factors = check_load_factors(settings.load_factors)
+    levels = tuple(f * site.ag_m_s2 for f in factors)
+    for level in levels:
+        for i in range(motions.count):
+            stripes.load_factor(i, level)
+    source = f"load factors {', '.join(f'{f:g}' for f in factors)} on the site's scaling ({how})"
+    return FragilityPlan(stripes, table, levels, source, settings.extend)
+
+
+def assess(
+    scene: Scene,
+    site: Site,
+    *,
+    code: str = "ntc2018",
+    position: Position | None = None,
+    fc: float = DEFAULT_FC,
+    direction: str | None = None,
+    friction_angle_deg: float | None = None,
+    sliding: bool = True,
+    dynamic: DynamicSettings | None = None,
+    executor: Executor | None = None,
+    allow_large: bool = False,
+    progress: bool = True,
+    on_plan: Any = None,
+) -> Assessment:
+    """The code's verdict on a scene's mechanism and the dynamics beside it (module docstring).
+
+    Parameters
+    ----------
+    scene
+        The wall (any scene).
+    site
+        The site's spectrum.
+    code
+        ``ntc2018``.
+    position
+        At ground level (default) or at a height of a building.
+    fc
+        The confidence factor FC (default 1.35).
+    direction
+        ``+x``, ``-x``, or None for both (the smaller a0* governs).
+    friction_angle_deg, sliding
+        The joints of the limit analysis (:func:`rockyade.limit.limit_analysis`).
+    dynamic
+        The dynamic part's settings; None: the code's checks only.
+    executor
+        Where the runs go (default: 2 local processes).
+    allow_large
+        Run above the runner's cost limits.
+    on_plan
+        Called with the dynamic plan before anything runs (to print its cost).
+
+    Raises
+    ------
+    SceneCannotStandError
+        The scene cannot stand under gravity.
+    InputError
+        Bad input; the dynamic part for a mechanism at height.
+    """
+    check_code(code)
+    position = position or Position()
+    if dynamic is not None and position.at_height:
+        raise InputError(
+            "--static-only",
+            "the dynamic part shakes the scene's base with ground motions; a mechanism at height is shaken by its "
+            "floor (not modelled): pass --static-only for the code's check at height",
+        )
+    best, other = _limit(scene, direction, friction_angle_deg, sliding, fc)
+    checks = code_checks(best.kinematic, site, position) if best.kinematic is not None else []
+    out = Assessment(code, fc, site, position, best, other, checks)
+    if best.status == "no_mechanism":
+        out.notes.append("no horizontal acceleration makes the scene collapse statically: no code check")
+    if any(c.status == NOT_APPLICABLE for c in checks):
+        out.notes.extend(f"{c.name}: not applicable ({c.reason})" for c in checks if c.status == NOT_APPLICABLE)
+    if dynamic is not None:
+        add_dynamics(out, scene, dynamic, executor, allow_large=allow_large, progress=progress, on_plan=on_plan)
+    return out
+
+
+def add_dynamics(
+    assessment: Assessment,
+    scene: Scene,
+    settings: DynamicSettings,
+    executor: Executor | None = None,
+    *,
+    allow_large: bool = False,
+    progress: bool = True,
+    on_plan: Any = None,
+) -> Assessment:
+    """Run the dynamic part of an assessment (module docstring) and attach it; the same
+    assessment back.
+
+    Raises
+    ------
+    InputError
+        A mechanism at height; a run above the runner's cost limits (``allow_large``).
+    """
+    if assessment.position.at_height:
+        raise InputError(
+            "--static-only",
+            "the dynamic part shakes the scene's base with ground motions; a mechanism at height is shaken by its "
+            "floor (not modelled): pass --static-only for the code's check at height",
+        )
+    executor = executor or Executor("local", 2)
+    plan = dynamic_plan(scene, assessment.site, settings, executor, progress)
+    if on_plan is not None:
+        on_plan(plan)
+    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress)
+    return assessment

@@ -1,0 +1,230 @@
+"""The code's checks of a mechanism: the kinematic method of NTC 2018 (Circolare 2019 C8.7.1).
+
+The capacity side is :mod:`rockyade.limit.kinematic` (alpha0, M*, e*, a0*, d0*, du*, Ts);
+here the demand of the site (:class:`~rockyade.assess.site.Site`, EN 1998-1's elastic
+spectrum Se(T), :mod:`rockyade.motion.ec8`) and the comparison:
+
+* linear kinematic analysis, a mechanism at ground level: a0* >= ag S / q;
+* nonlinear kinematic analysis, a mechanism at ground level: du* >= SDe(Ts), with the
+  elastic displacement spectrum SDe(T) = Se(T) (T / 2 pi)^2 (EN 1998-1 3.2.2.2, Eq 3.7, for
+  T up to 4 s);
+* linear kinematic analysis, a mechanism at height Z of a building of height H, N storeys
+  and period T1: a0* >= Se(T1) psi(Z) gamma / q, psi(Z) = Z / H, gamma = 3 N / (2 N + 1);
+
+with the behaviour factor q = 2 (Circolare 2019 C8.7.1; the same checks as Circolare 2009
+C8A.4). The linear and the nonlinear analyses are two ways of checking the same mechanism
+(the linear one, with q, the simpler and more conservative): the mechanism is verified when
+one of the checks that apply is met. Every demand is proportional to ag, so each check also
+gives the ag at which it is met exactly, ag_capacity = ag x capacity / demand: the code's
+capacity in the units of the site's shaking. The nonlinear check at height (with the floor
+spectrum) is not implemented.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from rockyade.assess.site import Position, Site
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.limit.kinematic import KinematicQuantities
+
+#: Codes whose checks are implemented.
+CODES = ("ntc2018",)
+#: Behaviour factor of the linear kinematic check (Circolare 2019 C8.7.1).
+Q_FACTOR = 2.0
+#: The clause every check comes from.
+CLAUSE = "NTC 2018, Circolare 2019 C8.7.1 (kinematic analysis of local mechanisms; as Circolare 2009 C8A.4)"
+
+VERIFIED, NOT_VERIFIED, NOT_APPLICABLE = "verified", "not verified", "not applicable"
+
+
+def check_code(code: str) -> str:
+    """``code`` if implemented, else InputError naming the codes."""
+    if code not in CODES:
+        raise InputError("--code", f"must be one of {', '.join(CODES)}, got {code!r}")
+    return code
+
+
+def displacement_spectrum(site: Site, period_s: float) -> float:
+    """SDe(T) = Se(T) (T / 2 pi)^2, m (EN 1998-1 Eq 3.7)."""
+    se = float(site.spectrum.psa([period_s])[0])
+    return se * (period_s / (2.0 * math.pi)) ** 2
+
+
+@dataclass(frozen=True)
+class Check:
+    """One check of the code.
+
+    Attributes
+    ----------
+    name
+        What is checked (``linear, ground level``, ...).
+    quantity
+        The capacity compared (``a0*``, ``du*``).
+    inequality
+        The check as the code writes it.
+    demand, capacity
+        Its two sides, in ``unit`` (NaN when it does not apply).
+    unit
+        ``m/s^2`` or ``m``.
+    status
+        ``verified``, ``not verified`` or ``not applicable``.
+    terms
+        The numbers the demand is made of (ag, S, q, Se(T), psi, gamma, Ts, ...).
+    ag_capacity_m_s2
+        The site's ag at which capacity = demand, m/s^2 (NaN when it does not apply).
+    reason
+        Why it does not apply (else empty).
+    source
+        Clause and equations.
+    """
+
+    name: str
+    quantity: str
+    inequality: str
+    demand: float
+    capacity: float
+    unit: str
+    status: str
+    terms: dict[str, float] = field(default_factory=dict)
+    ag_capacity_m_s2: float = math.nan
+    reason: str = ""
+    source: str = CLAUSE
+
+    @property
+    def applies(self) -> bool:
+        """True when the check could be made."""
+        return self.status != NOT_APPLICABLE
+
+    @property
+    def ratio(self) -> float:
+        """capacity / demand (>= 1: verified)."""
+        return self.capacity / self.demand if self.applies and self.demand > 0 else math.nan
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready (the demand and capacity with their unit, the verdict, its source)."""
+        return {
+            "name": self.name,
+            "quantity": self.quantity,
+            "inequality": self.inequality,
+            "demand": self.demand,
+            "capacity": self.capacity,
+            "unit": self.unit,
+            "capacity_over_demand": self.ratio,
+            "verdict": self.status,
+            "terms": dict(self.terms),
+            "ag_capacity_m_s2": self.ag_capacity_m_s2,
+            "ag_capacity_g": self.ag_capacity_m_s2 / G,
+            "reason": self.reason,
+            "source": self.source,
+        }
+
+
+def _check(name: str, quantity: str, inequality: str, demand: float, capacity: float, unit: str, **kw: Any) -> Check:
+    status = VERIFIED if capacity >= demand else NOT_VERIFIED
+    return Check(name, quantity, inequality, demand, capacity, unit, status, **kw)
+
+
+def _not_applicable(name: str, quantity: str, inequality: str, unit: str, reason: str) -> Check:
+    return Check(name, quantity, inequality, math.nan, math.nan, unit, NOT_APPLICABLE, reason=reason)
+
+
+def code_checks(kin: KinematicQuantities, site: Site, position: Position, q: float = Q_FACTOR) -> list[Check]:
+    """The checks of a mechanism's kinematic quantities against the site's demand (module docstring).
+
+    Parameters
+    ----------
+    kin
+        The mechanism's quantities (:func:`rockyade.limit.kinematic_quantities`).
+    site
+        The site's spectrum.
+    position
+        At ground level, or at a height of a building.
+    q
+        Behaviour factor of the linear check (2).
+    """
+    ag, S = site.ag_m_s2, site.S
+    a0 = kin.a0_star_m_s2
+    checks = []
+    if not position.at_height:
+        demand = ag * S / q
+        checks.append(
+            _check(
+                "linear, ground level",
+                "a0*",
+                "a0* >= ag S / q",
+                demand,
+                a0,
+                "m/s^2",
+                terms={"ag_m_s2": ag, "S": S, "q": q},
+                ag_capacity_m_s2=ag * a0 / demand,
+                source=f"{CLAUSE}; q = {q:g}",
+            )
+        )
+        name, inequality = "nonlinear, ground level", "du* >= SDe(Ts)"
+        if kin.du_star_m is None or kin.Ts_s is None:
+            checks.append(
+                _not_applicable(name, "du*", inequality, "m", f"no capacity curve to alpha = 0 ({kin.nonlinear_note})")
+            )
+        elif kin.Ts_s > 4.0:
+            checks.append(
+                _not_applicable(name, "du*", inequality, "m", f"Ts = {kin.Ts_s:.3g} s is beyond the spectrum's 4 s")
+            )
+        else:
+            sde = displacement_spectrum(site, kin.Ts_s)
+            checks.append(
+                _check(
+                    name,
+                    "du*",
+                    inequality,
+                    sde,
+                    kin.du_star_m,
+                    "m",
+                    terms={
+                        "Ts_s": kin.Ts_s,
+                        "Se_Ts_m_s2": float(site.spectrum.psa([kin.Ts_s])[0]),
+                        "ag_m_s2": ag,
+                        "S": S,
+                    },
+                    ag_capacity_m_s2=ag * kin.du_star_m / sde,
+                    source=f"{CLAUSE}; SDe(T) = Se(T) (T / 2 pi)^2, EN 1998-1 3.2.2.2 Eq 3.7",
+                )
+            )
+        return checks
+    T1 = position.period_s
+    se_t1 = float(site.spectrum.psa([T1])[0])
+    psi, gamma = position.psi, position.gamma
+    demand = se_t1 * psi * gamma / q
+    checks.append(
+        _check(
+            "linear, at height",
+            "a0*",
+            "a0* >= Se(T1) psi(Z) gamma / q",
+            demand,
+            a0,
+            "m/s^2",
+            terms={"Se_T1_m_s2": se_t1, "T1_s": T1, "psi": psi, "gamma": gamma, "q": q, "ag_m_s2": ag, "S": S},
+            ag_capacity_m_s2=ag * a0 / demand,
+            source=f"{CLAUSE}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g}; T1: {position.period_source}",
+        )
+    )
+    return checks
+
+
+def verdict(checks: list[Check]) -> str:
+    """``verified`` when a check that applies is met, ``not verified`` when none is,
+    ``not applicable`` when none applies (module docstring)."""
+    made = [c for c in checks if c.applies]
+    if not made:
+        return NOT_APPLICABLE
+    return VERIFIED if any(c.status == VERIFIED for c in made) else NOT_VERIFIED
+
+
+def code_capacity_ag(checks: list[Check]) -> float:
+    """The largest ag at which a check that applies is met, m/s^2: the code's capacity in
+    the site's shaking (NaN when none applies)."""
+    values = [c.ag_capacity_m_s2 for c in checks if c.applies]
+    return max(values) if values else math.nan

@@ -1,0 +1,182 @@
+"""Fragility analyses and assessments in words, as ``rockyade fragility`` and ``rockyade assess``
+print them."""
+
+from __future__ import annotations
+
+import math
+
+from rockyade.assess.assessment import Assessment
+from rockyade.assess.code import NOT_APPLICABLE, VERIFIED, Check
+from rockyade.assess.fragility import FragilityPlan, FragilityResult
+from rockyade.assess.stripes import collapse_rule
+from rockyade.constants import G
+from rockyade.limit.analysis import FRICTION_NOTE
+from rockyade.limit.report import hinge_words, plural, sliding_words
+
+
+def _pct(x: float) -> str:
+    return "-" if math.isnan(x) else f"{100 * x:.0f} %"
+
+
+def plan_lines(plan: FragilityPlan) -> list[str]:
+    """What a fragility analysis will run: records, load factors, levels, collapse, solver."""
+    s, m = plan.stripes, plan.measure
+    levels = ", ".join(f"{m.shown(v):.3g}" for v in plan.levels_si)
+    lines = [
+        f"records: {s.motions.describe()}; a load factor multiplies a record's accelerations as read",
+        f"stripes of {m.name} ({m.unit}): {levels} ({plan.levels_source})"
+        + ("; extended while the median is outside them" if plan.extend else ""),
+        f"runs: {s.solver.name}, each record's duration + {s.tail_s:g} s, sampled at {s.sample_dt_s:g} s; "
+        f"collapse: {collapse_rule(s.scene, s.fallen_blocks)}",
+    ]
+    lines.extend(f"note: {n}" for n in plan.notes)
+    return lines
+
+
+def fit_lines(result: FragilityResult, what: str = "") -> list[str]:
+    """The stripes and the fit."""
+    m, fit = result.measure, result.fit
+    lines = [f"stripes ({m.name} in {m.unit}: collapses / runs, fraction, 95 % Wilson interval):"]
+    for r in result.stripes.itertuples(index=False):
+        level = getattr(r, m.si_column) / m.scale
+        failed = f", {r.n_failed} failed" if r.n_failed else ""
+        lines.append(
+            f"  {level:8.4g}: {r.n_collapse:3d} / {r.n_runs:<3d} {_pct(r.fraction):>5} "
+            f"[{_pct(r.fraction_lo)}, {_pct(r.fraction_hi)}]{failed}"
+        )
+    f = fit.fragility
+    name = f"{what}{m.name}"
+    if f.status == "fitted":
+        lo, hi = (v / m.scale for v in fit.median_interval_si)
+        b_lo, b_hi = fit.beta_interval
+        band = f" (90 % bootstrap {lo:.3g}-{hi:.3g})" if not math.isnan(lo) else " (no bootstrap band)"
+        beta_band = f" ({b_lo:.2g}-{b_hi:.2g})" if not math.isnan(b_lo) else ""
+        lines.append(
+            f"lognormal fit: median {name} = {m.shown(f.median):.4g} {m.unit}{band}, beta = {f.beta:.3g}{beta_band}"
+        )
+        if fit.extrapolated:
+            lines.append("  note: the median is outside the tested levels: the curve is extrapolated there")
+    elif f.status == "separated":
+        lines.append(
+            f"no slope: every collapsing run is above every other, a threshold near {name} = "
+            f"{m.shown(f.median):.4g} {m.unit} (more records or closer levels give a curve)"
+        )
+    else:
+        lines.append(f"no fit: {f.status}")
+    if result.levels_added:
+        added = ", ".join(f"{m.shown(v):.3g}" for v in result.levels_added)
+        lines.append(f"levels added to bracket the median: {added} {m.unit}")
+    if result.failed:
+        reasons = result.runs.loc[result.runs.status == "failed", "failure_reason"].astype(str)
+        lines.append(
+            f"{result.failed} of {len(result.runs)} runs failed (left out of every count); the most frequent "
+            f"reason: {reasons.value_counts().index[0]}"
+        )
+    return lines
+
+
+def fragility_lines(result: FragilityResult, source: str) -> list[str]:
+    """The text of ``rockyade fragility``."""
+    return [f"fragility of {source}", *plan_lines(result.plan), *fit_lines(result)]
+
+
+def _check_line(check: Check) -> str:
+    unit = check.unit
+    if check.status == NOT_APPLICABLE:
+        return f"  {check.name}: {check.inequality}: not applicable ({check.reason})"
+    t = check.terms
+    if check.quantity == "a0*" and "T1_s" not in t:
+        demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}"
+    elif check.quantity == "a0*":
+        demand = (
+            f"Se(T1) psi gamma / q = {t['Se_T1_m_s2']:.4g} x {t['psi']:.4g} x {t['gamma']:.4g} / {t['q']:g} = "
+            f"{check.demand:.4g} {unit} (T1 = {t['T1_s']:.3g} s)"
+        )
+    else:
+        demand = f"SDe(Ts = {t['Ts_s']:.4g} s) = Se (Ts / 2 pi)^2 = {check.demand:.4g} {unit}"
+    word = "verified" if check.status == VERIFIED else "NOT VERIFIED"
+    return (
+        f"  {check.name}: {check.quantity} = {check.capacity:.4g} {unit} against {demand}: {word} "
+        f"(capacity / demand {check.ratio:.3g}; met up to ag = {check.ag_capacity_m_s2 / G:.4g} g)"
+    )
+
+
+def assessment_lines(a: Assessment, source: str) -> list[str]:
+    """The text of ``rockyade assess``: the mechanism, its quantities and the code's checks
+    (:func:`dynamic_lines` gives the dynamic part)."""
+    lim, kin = a.limit, a.limit.kinematic
+    lines = [
+        f"assessment of {source}: NTC 2018 kinematic method (Circolare 2019 C8.7.1), FC = {a.fc:g}",
+        f"site: {a.site.describe()}; mechanism {a.position.describe()}",
+    ]
+    if lim.status == "no_mechanism":
+        lines.append("limit analysis: no horizontal acceleration makes it collapse (no mechanism): no code check")
+        return lines
+    assert kin is not None and lim.mechanism is not None and lim.load_multiplier is not None
+    mech, model = lim.mechanism, lim.model
+    other = ""
+    if a.other_direction is not None and a.other_direction.load_multiplier is not None:
+        o = a.other_direction
+        o_a0 = o.kinematic.a0_star_m_s2 if o.kinematic is not None else math.nan
+        other = f"; towards {o.direction}: alpha0 = {o.load_multiplier:.4f}, a0* = {o_a0:.4g} m/s^2"
+    n = int(mech.moving.sum())
+    joints = f"{plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')}"
+    lines.append(
+        f"mechanism (limit analysis, load towards {lim.direction}{other}): {plural(n, 'block')} "
+        f"move{'s' if n == 1 else ''}, {joints}"
+    )
+    lines += ["  " + hinge_words(model, h) for h in mech.hinges[:5]]
+    lines += ["  " + sliding_words(model, s, mech.velocities) for s in mech.sliding[:5]]
+    lines.append(
+        f"kinematic quantities: alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f}; "
+        f"a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2"
+    )
+    if kin.d0_star_m is not None:
+        lines.append(
+            f"  nonlinear: d0* = {kin.d0_star_m:.4g} m, du* = 0.4 d0* = {kin.du_star_m:.4g} m, ds* = "
+            f"{kin.ds_star_m:.4g} m, as* = {kin.as_star_m_s2:.4g} m/s^2, Ts = 2 pi sqrt(ds*/as*) = {kin.Ts_s:.4g} s"
+        )
+    else:
+        lines.append(f"  nonlinear: none ({kin.nonlinear_note})")
+    lines.append("checks:")
+    lines += [_check_line(c) for c in a.checks]
+    cap = a.code_capacity_ag_m_s2
+    site_ag = a.site.ag_m_s2 / G
+    lines.append(
+        f"code verdict: {a.verdict.upper() if a.verdict != VERIFIED else 'verified'}"
+        + (f" (the code's capacity is ag = {cap / G:.4g} g; the site's ag is {site_ag:.4g} g)" if cap == cap else "")
+    )
+    # the friction caveat matters where joints slide (the limit analysis says so again then)
+    lines += [f"note: {note}" for note in lim.notes if mech.slides or note != FRICTION_NOTE]
+    lines += [f"note: {note}" for note in a.notes]
+    return lines
+
+
+def dynamic_lines(a: Assessment) -> list[str]:
+    """The dynamic part of ``rockyade assess``'s text (after its plan)."""
+    if a.dynamic is None:
+        return ["dynamics: not run (--static-only)"]
+    site_ag = a.site.ag_m_s2 / G
+    cap = a.code_capacity_ag_m_s2
+    lines: list[str] = []
+    d = a.dynamic
+    lines.append(f"  {len(d.runs)} runs of {d.plan.stripes.solver.name} done")
+    at = a.demand_fraction()
+    assert at is not None
+    lines.append(
+        f"  at the code's demand (lambda = 1, ag = {site_ag:.4g} g): {at['n_collapse']} of {at['n_runs']} records "
+        f"collapse the wall ({_pct(at['fraction'])}, 95 % Wilson {_pct(at['fraction_lo'])}-{_pct(at['fraction_hi'])})"
+    )
+    lines += ["  " + line for line in fit_lines(d, what="")]
+    ratio = a.median_over_code
+    if not math.isnan(ratio):
+        sense = (
+            f"the code is conservative for this wall (its capacity is {1 / ratio:.2f} of the dynamic median)"
+            if ratio >= 1
+            else f"the code is NOT conservative for this wall (its capacity is {1 / ratio:.2f} x the dynamic median)"
+        )
+        lines.append(
+            f"  dynamic median / code capacity = {d.fit.fragility.median / G:.4g} g / {cap / G:.4g} g = {ratio:.3g}: "
+            + sense
+        )
+    return lines

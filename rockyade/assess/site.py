@@ -1,0 +1,247 @@
+"""The site and the place of a mechanism in its building: what the code's demand depends on.
+
+The site's elastic spectrum is EN 1998-1's (Section 3.2.2.2, :mod:`rockyade.motion.ec8`): a
+spectrum type (1 or 2), a ground type (A-E) and the design ground acceleration on type A
+ground ag = gamma_I agR (EN 1998-1 3.2.1(3): agR the reference peak ground acceleration,
+gamma_I the importance factor).
+
+A mechanism sits at ground level (the default) or at a height Z of a building of height H,
+N storeys and fundamental period T1 (the demand is then the floor's: Circolare 2019
+C8.7.1). Without a given T1 it is the code's simplified estimate T1 = Ct H^(3/4) with
+Ct = 0.05 (EN 1998-1 4.3.3.2.2(3), Eq 4.6, "all other structures", buildings up to 40 m;
+NTC 2008 7.3.3.2, Eq 7.3.5 gives the same C1 = 0.050).
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Any
+
+from rockyade.constants import G
+from rockyade.errors import InputError
+from rockyade.motion.ec8 import EC8_GROUND, ElasticSpectrum
+
+#: Largest design ground acceleration accepted, in g: above it the number is a typing error.
+MAX_AG_G = 1.0
+#: Range of the importance factor gamma_I (EN 1998-1 4.2.5: 0.8 to 1.4 for classes I-IV).
+IMPORTANCE_RANGE = (0.5, 2.0)
+#: Ct of the simplified period T1 = Ct H^(3/4) (EN 1998-1 Eq 4.6).
+CT_MASONRY = 0.05
+#: The simplified period holds for buildings up to this height, m (EN 1998-1 4.3.3.2.2(3)).
+MAX_T1_FORMULA_HEIGHT_M = 40.0
+#: Largest building height and storey count accepted.
+MAX_BUILDING_HEIGHT_M = 300.0
+MAX_STOREYS = 100
+
+_ACCEL = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(g|m/s2|m/s\^2|m/s\*\*2)\s*$")
+
+
+def parse_acceleration(text: str | float, field: str = "--ag", max_g: float = MAX_AG_G) -> float:
+    """An acceleration given with its unit, ``"0.25g"`` or ``"2.45m/s2"``, in m/s^2.
+
+    Parameters
+    ----------
+    text
+        The value and its unit (``g``, taken as 9.81 m/s^2 as the project's g, or ``m/s2``);
+        a bare number is refused (0.25 would be 0.25 m/s^2 or 0.25 g).
+    field
+        The option named in errors.
+    max_g
+        Largest value accepted, in g.
+
+    Raises
+    ------
+    InputError
+        No unit, not a number, <= 0 or above ``max_g``.
+    """
+    match = _ACCEL.match(str(text))
+    if match is None:
+        raise InputError(
+            field,
+            f"must be an acceleration with its unit, e.g. 0.25g or 2.45m/s2 (in (0, {max_g:g}] g), got {text!r}",
+        )
+    value = float(match.group(1)) * (G if match.group(2) == "g" else 1.0)
+    if not (math.isfinite(value) and 0.0 < value <= max_g * G):
+        raise InputError(field, f"must be in (0, {max_g:g}] g (0 to {max_g * G:.4g} m/s^2), got {text!r}")
+    return value
+
+
+@dataclass(frozen=True)
+class Site:
+    """The site's elastic spectrum (EN 1998-1 3.2.2.2).
+
+    Attributes
+    ----------
+    spectrum_type
+        1 or 2 (EN 1998-1 3.2.2.2(2)).
+    ground
+        Ground type A-E (Table 3.1).
+    agR_m_s2
+        Reference peak ground acceleration on type A ground, m/s^2.
+    importance
+        Importance factor gamma_I.
+    """
+
+    spectrum_type: int
+    ground: str
+    agR_m_s2: float
+    importance: float = 1.0
+
+    def __post_init__(self) -> None:
+        if self.spectrum_type not in EC8_GROUND:
+            raise InputError("--spectrum-type", f"must be 1 or 2 (EN 1998-1 3.2.2.2), got {self.spectrum_type!r}")
+        ground = str(self.ground).upper()
+        if ground not in EC8_GROUND[1]:
+            raise InputError("--ground", f"must be one of A, B, C, D, E (EN 1998-1 Table 3.1), got {self.ground!r}")
+        object.__setattr__(self, "ground", ground)
+        ag = self.agR_m_s2
+        if not (isinstance(ag, (int, float)) and math.isfinite(ag) and 0.0 < ag <= MAX_AG_G * G):
+            raise InputError("--ag", f"must be in (0, {MAX_AG_G:g}] g, got {ag!r} m/s^2")
+        lo, hi = IMPORTANCE_RANGE
+        gi = self.importance
+        if isinstance(gi, bool) or not (isinstance(gi, (int, float)) and math.isfinite(gi) and lo <= gi <= hi):
+            raise InputError("--importance", f"must be in [{lo:g}, {hi:g}] (gamma_I, EN 1998-1 4.2.5), got {gi!r}")
+        if self.ag_m_s2 > MAX_AG_G * G:
+            raise InputError("--importance", f"gamma_I agR = {self.ag_m_s2 / G:.3g} g is above {MAX_AG_G:g} g")
+
+    @property
+    def ag_m_s2(self) -> float:
+        """Design ground acceleration ag = gamma_I agR, m/s^2."""
+        return self.importance * self.agR_m_s2
+
+    @property
+    def spectrum(self) -> ElasticSpectrum:
+        """The 5 % damped elastic spectrum at ag."""
+        return ElasticSpectrum.ec8(self.spectrum_type, self.ground, ag_m_s2=self.ag_m_s2)
+
+    @property
+    def S(self) -> float:
+        """Soil factor S (EN 1998-1 Tables 3.2, 3.3)."""
+        return EC8_GROUND[self.spectrum_type][self.ground][0]
+
+    def describe(self) -> str:
+        """One line: type, ground, ag, gamma_I, S."""
+        gi = f" x gamma_I {self.importance:g}" if self.importance != 1.0 else ""
+        return (
+            f"EC8 Type {self.spectrum_type} spectrum, ground {self.ground} (S = {self.S:g}), "
+            f"ag = {self.ag_m_s2 / G:.4g} g{gi} ({self.ag_m_s2:.4g} m/s^2)"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the inputs and the spectrum's parameters."""
+        return {
+            "spectrum_type": self.spectrum_type,
+            "ground": self.ground,
+            "agR_m_s2": self.agR_m_s2,
+            "importance_factor": self.importance,
+            "ag_m_s2": self.ag_m_s2,
+            "ag_g": self.ag_m_s2 / G,
+            "spectrum": self.spectrum.as_dict(),
+            "source": "EN 1998-1 3.2.2.2 (Eqs 3.2-3.5, Tables 3.2 and 3.3); ag = gamma_I agR (3.2.1(3))",
+        }
+
+
+@dataclass(frozen=True)
+class Position:
+    """Where the mechanism is: at ground level, or at a height of a building.
+
+    Attributes
+    ----------
+    z_m
+        Height above the foundation of the mechanism (the centroid of the weights that
+        move, Circolare 2019 C8.7.1), m; None: at ground level.
+    building_height_m
+        Height H of the building, m.
+    storeys
+        Number of storeys N.
+    T1_s
+        Fundamental period of the building, s (None: the simplified formula, module docstring).
+    """
+
+    z_m: float | None = None
+    building_height_m: float | None = None
+    storeys: int | None = None
+    T1_s: float | None = None
+
+    def __post_init__(self) -> None:
+        given = [v is not None for v in (self.z_m, self.building_height_m, self.storeys)]
+        if any(given) and not all(given):
+            raise InputError("--z", "a mechanism at height needs --z, --building-height and --storeys together")
+        if self.T1_s is not None and self.z_m is None:
+            raise InputError("--t1", "applies to a mechanism at height (with --z, --building-height, --storeys)")
+        if self.z_m is None:
+            return
+        H = self.building_height_m
+        if not (isinstance(H, (int, float)) and math.isfinite(H) and 0.0 < H <= MAX_BUILDING_HEIGHT_M):
+            raise InputError("--building-height", f"must be in (0, {MAX_BUILDING_HEIGHT_M:g}] m, got {H!r}")
+        z = self.z_m
+        if not (isinstance(z, (int, float)) and math.isfinite(z) and 0.0 < z <= H):
+            raise InputError("--z", f"must be in (0, H] with H = {H:g} m (--building-height), got {z!r}")
+        n = self.storeys
+        if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_STOREYS:
+            raise InputError("--storeys", f"must be an integer in [1, {MAX_STOREYS}], got {n!r}")
+        t1 = self.T1_s
+        if t1 is not None and not (isinstance(t1, (int, float)) and math.isfinite(t1) and 0.0 < t1 <= 4.0):
+            raise InputError("--t1", f"must be in (0, 4] s (the EC8 spectrum is defined up to 4 s), got {t1!r}")
+
+    @property
+    def at_height(self) -> bool:
+        """True for a mechanism at a height of a building."""
+        return self.z_m is not None
+
+    @property
+    def psi(self) -> float:
+        """psi(Z) = Z / H (Circolare 2019 C8.7.1)."""
+        assert self.z_m is not None and self.building_height_m is not None
+        return self.z_m / self.building_height_m
+
+    @property
+    def gamma(self) -> float:
+        """gamma = 3 N / (2 N + 1), the modal participation factor (Circolare 2019 C8.7.1)."""
+        assert self.storeys is not None
+        return 3.0 * self.storeys / (2.0 * self.storeys + 1.0)
+
+    @property
+    def period_s(self) -> float:
+        """T1, s: given, or Ct H^(3/4) (module docstring)."""
+        if self.T1_s is not None:
+            return float(self.T1_s)
+        assert self.building_height_m is not None
+        return CT_MASONRY * self.building_height_m**0.75
+
+    @property
+    def period_source(self) -> str:
+        """Where T1 comes from."""
+        if self.T1_s is not None:
+            return "given (--t1)"
+        source = f"T1 = Ct H^(3/4), Ct = {CT_MASONRY:g} (EN 1998-1 4.3.3.2.2(3), Eq 4.6; NTC 2008 7.3.3.2, Eq 7.3.5)"
+        if self.building_height_m is not None and self.building_height_m > MAX_T1_FORMULA_HEIGHT_M:
+            source += f"; note: the formula is for buildings up to {MAX_T1_FORMULA_HEIGHT_M:g} m"
+        return source
+
+    def describe(self) -> str:
+        """One line."""
+        if not self.at_height:
+            return "at ground level"
+        return (
+            f"at Z = {self.z_m:g} m of a {self.building_height_m:g} m building of {self.storeys} storeys "
+            f"(psi = Z/H = {self.psi:.4g}, gamma = 3N/(2N+1) = {self.gamma:.4g}, T1 = {self.period_s:.4g} s: "
+            f"{self.period_source})"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready."""
+        if not self.at_height:
+            return {"at": "ground level"}
+        return {
+            "at": "height",
+            "z_m": self.z_m,
+            "building_height_m": self.building_height_m,
+            "storeys": self.storeys,
+            "psi": self.psi,
+            "gamma": self.gamma,
+            "T1_s": self.period_s,
+            "T1_source": self.period_source,
+        }

@@ -1,0 +1,216 @@
+"""``rockyade assess``: the code's kinematic checks of a wall, and the rocking dynamics beside
+them (docs/howto/is-this-wall-safe.md)."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+from typing import Any
+
+from rockyade.cli.common import check_output_dir, json_out, print_wrote
+from rockyade.cli.fragility import (
+    DEFAULT_COUNT,
+    add_run_options,
+    count_and_seed,
+    executor_from,
+    float_list,
+    print_plan,
+    refuse_suite_options_with_records,
+    solver_from,
+    write_tables,
+)
+from rockyade.errors import InputError
+
+#: Exit code of a scene that cannot stand (the answer is not a number).
+EXIT_UNSTABLE = 1
+
+
+def _site(args: argparse.Namespace) -> Any:
+    from rockyade.assess import Site, parse_acceleration
+
+    return Site(args.spectrum_type, args.ground, parse_acceleration(args.ag, "--ag"), args.importance)
+
+
+def _position(args: argparse.Namespace) -> Any:
+    from rockyade.assess import Position
+
+    return Position(args.z, args.building_height, args.storeys, args.t1)
+
+
+def _dynamic(args: argparse.Namespace) -> Any:
+    """The dynamic settings, or None with ``--static-only`` (which then takes no dynamic option)."""
+    from rockyade.assess import DynamicSettings, records_in_folder
+
+    if args.static_only:
+        for option in ("records", "solver", "load_factors", "count", "seed", "units", "yade_timeout"):
+            if getattr(args, option) is not None:
+                raise InputError("--" + option.replace("_", "-"), "applies to the dynamic part, not with --static-only")
+        return None
+    records = None
+    if args.records is not None:
+        refuse_suite_options_with_records(args)
+        records = records_in_folder(args.records, args.units)
+    elif args.units is not None:
+        raise InputError("--units", "applies to --records")
+    count, seed = count_and_seed(args)
+    settings: dict[str, Any] = {
+        "records": records,
+        "count": count,
+        "seed": seed,
+        "solver": solver_from(args),
+        "extend": not args.no_extend,
+        "fallen_blocks": args.fallen_blocks,
+        "sample_dt_s": args.sample_dt,
+        "tail_s": args.tail,
+    }
+    if args.load_factors is not None:
+        settings["load_factors"] = float_list(args.load_factors, "--load-factors")
+    return DynamicSettings(**settings)
+
+
+def cmd_assess(args: argparse.Namespace) -> int:
+    """The checks, the dynamics, the text (or JSON), and with --out the files."""
+    from rockyade.assess import assess
+    from rockyade.assess.assessment import add_dynamics
+    from rockyade.assess.code import check_code
+    from rockyade.assess.report import assessment_lines, dynamic_lines
+    from rockyade.limit.kinematic import check_fc
+    from rockyade.limit.model import check_friction_angle
+    from rockyade.scene import load_scene
+
+    check_code(args.code)
+    if args.out is not None:
+        check_output_dir(args.out, "--out")
+    try:
+        fc = check_fc(args.fc)
+    except InputError as exc:
+        raise InputError("--fc", exc.message) from None
+    friction = None
+    if args.friction_angle_deg is not None:
+        friction = check_friction_angle(args.friction_angle_deg, "--friction-angle-deg")
+    site, position = _site(args), _position(args)
+    dynamic = _dynamic(args)
+    executor = executor_from(args)
+    scene = load_scene(args.scene)
+    direction = None if args.direction == "both" else args.direction
+
+    result = assess(
+        scene,
+        site,
+        code=args.code,
+        position=position,
+        fc=fc,
+        direction=direction,
+        friction_angle_deg=friction,
+        sliding=not args.no_sliding,
+    )
+    if not args.json:
+        print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
+    if dynamic is not None:
+
+        def on_plan(plan: Any) -> None:
+            if not args.json:
+                print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
+                print_plan(plan, args.workers, indent="  ")
+
+        add_dynamics(
+            result,
+            scene,
+            dynamic,
+            executor,
+            allow_large=args.allow_large,
+            progress=not args.quiet,
+            on_plan=on_plan,
+        )
+    if not args.json:
+        print("\n".join(dynamic_lines(result)))
+    data = result.to_dict()
+    data["scene"] = str(args.scene)
+    if args.json:
+        json_out(data)
+    if args.out is not None:
+        _write(args, result, data)
+    return 0
+
+
+def _write(args: argparse.Namespace, result: Any, data: dict[str, Any]) -> None:
+    from rockyade.figures.assess import draw_assessment
+    from rockyade.io.atomic import write_json
+    from rockyade.io.locking import output_lock
+
+    out: Path = args.out
+    out.mkdir(parents=True, exist_ok=True)
+    with output_lock(out, "--out"):
+        written = []
+        if result.dynamic is not None:
+            written += write_tables(out, result.dynamic)
+        write_json(out / "assess.json", data)
+        written.append("assess.json")
+        draw_assessment(result, out / "assess.png", title=args.scene.name)
+        written.append("assess.png")
+    print_wrote(Path(f"{', '.join(written)} in {out}"), args.json)
+
+
+def register(sub: Any) -> None:
+    """Add ``rockyade assess``."""
+    p = sub.add_parser(
+        "assess",
+        help="the code's kinematic checks of a wall (NTC 2018) and the rocking dynamics beside them",
+        description="The collapse mechanism and the kinematic quantities by limit analysis (alpha0, M*, e*, a0*, "
+        "d0*, du*, Ts), the checks of NTC 2018 (Circolare 2019 C8.7.1) against the site's EC8 spectrum, and, "
+        "unless --static-only, the same scene under a spectrum-compatible suite scaled to the site (or your "
+        "records), at stripes of load factors on that scaling: the fraction of records that collapse it at the "
+        "code's demand, the fragility median and beta in ag, and their ratio to the code's capacity. Exit 0 with "
+        "a verdict (verified or not), 1 when the scene cannot stand, 2 on bad input. See "
+        "docs/howto/is-this-wall-safe.md.",
+    )
+    p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
+    p.add_argument("--code", default="ntc2018", help="the code whose checks are made: ntc2018 (default)")
+    p.add_argument("--spectrum-type", type=int, required=True, help="EC8 elastic spectrum type: 1 or 2")
+    p.add_argument("--ground", required=True, help="EC8 ground type: A, B, C, D or E")
+    p.add_argument(
+        "--ag",
+        required=True,
+        help="reference peak ground acceleration on type A ground, with its unit: 0.25g or 2.45m/s2 (g = 9.81 m/s^2)",
+    )
+    p.add_argument("--importance", type=float, default=1.0, help="importance factor gamma_I, in [0.5, 2] (default 1)")
+    p.add_argument("--fc", type=float, default=1.35, help="the code's confidence factor FC, in [1, 10] (default 1.35)")
+    p.add_argument(
+        "--direction",
+        choices=("both", "+x", "-x"),
+        default="both",
+        help="the sense of the static load (default both: the smaller a0* governs)",
+    )
+    joints = p.add_mutually_exclusive_group()
+    joints.add_argument(
+        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 90)"
+    )
+    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
+    height = p.add_argument_group("a mechanism at height (default: at ground level)")
+    height.add_argument("--z", type=float, metavar="M", help="height of the mechanism above the foundation, m")
+    height.add_argument("--building-height", type=float, metavar="M", help="height H of the building, m")
+    height.add_argument("--storeys", type=int, metavar="N", help="storeys N of the building")
+    height.add_argument(
+        "--t1", type=float, metavar="S", help="period T1 of the building, s (default Ct H^(3/4), Ct = 0.05)"
+    )
+    dyn = p.add_argument_group("the dynamics beside the code")
+    dyn.add_argument("--static-only", action="store_true", help="the code's checks only, no runs")
+    dyn.add_argument(
+        "--records",
+        type=Path,
+        metavar="DIR",
+        help="your records (a folder of .at2/.csv/.txt/.dat files), each scaled to PGA = ag S at load factor 1 "
+        "(default: a synthetic suite compatible with the site's spectrum)",
+    )
+    dyn.add_argument(
+        "--load-factors",
+        help="stripes: load factors on the site's scaling, comma-separated (1, the code's demand, is always run; "
+        "default 0.35, 0.5, 0.71, 1, 1.41, 2, 2.83, extended to bracket the median)",
+    )
+    p.add_argument("--out", type=Path, help="write assess.json, assess.png and the runs' CSVs in this directory")
+    p.add_argument("--json", action="store_true", help="print the answer as JSON")
+    add_run_options(p, f"records of the site's synthetic suite (default {DEFAULT_COUNT})")
+    # "-x" is a value of --direction, not an option
+    p._negative_number_matcher = re.compile(r"^-x$|^-\d+$|^-\d*\.\d+$")
+    p.set_defaults(func=cmd_assess)

@@ -1,0 +1,220 @@
+"""Figures of :mod:`rockyade.assess`: a fragility curve, and an assessment (the code's capacity
+curve with the demand beside the fragility in ag).
+
+* :func:`plot_fragility`: the fraction of records that collapse at each stripe (points, 95 %
+  Wilson bars), the lognormal fit (solid over the tested levels, dotted beyond), its 90 %
+  bootstrap band, the median marked;
+* :func:`plot_capacity`: the code's capacity curve a*(d*) of the equivalent system, a0*,
+  du* and the secant of Ts, the linear demand (ag S / q, or the floor's at height) and the
+  nonlinear one: the site's elastic spectrum in acceleration-displacement form
+  (Se(T) against SDe(T)) and its point at Ts;
+* :func:`draw_fragility` and :func:`draw_assessment` write them as PNG files.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from matplotlib.axes import Axes
+
+from rockyade.assess.assessment import Assessment
+from rockyade.assess.code import VERIFIED
+from rockyade.assess.fragility import FragilityResult
+from rockyade.constants import G
+from rockyade.figures.common import new_figure, save_figure
+
+CURVE = "#1f4e79"
+BAND = "#9ecae1"
+POINTS = "#08306b"
+DEMAND = "#b2182b"
+CODE = "#e08214"
+OK = "#1b7837"
+
+
+def plot_fragility(
+    result: FragilityResult, ax: Axes | None = None, marks: list[tuple[float, str, str, str]] | None = None
+) -> tuple[Any, Axes]:
+    """The stripes and the fit (module docstring) in the measure's shown unit.
+
+    Parameters
+    ----------
+    result
+        A fragility analysis.
+    ax
+        Axes to draw into (default: a new figure).
+    marks
+        Vertical lines: (value in SI, label, colour, line style).
+    """
+    if ax is None:
+        fig, ax = new_figure(None, figsize=(6.4, 4.2))
+    else:
+        fig = ax.figure
+    m, fit = result.measure, result.fit
+    s = result.stripes
+    x = s[m.si_column].to_numpy() / m.scale
+    top = 1.25 * max([float(x.max()), *(v / m.scale for v, *_ in marks or [])])
+    grid = np.linspace(top / 400, top, 400)
+    f = fit.fragility
+    if f.status == "fitted":
+        if not np.all(np.isnan(fit.band_lo)):
+            ax.fill_between(
+                fit.grid_si / m.scale,
+                fit.band_lo,
+                fit.band_hi,
+                color=BAND,
+                alpha=0.55,
+                lw=0,
+                label="90 % bootstrap band",
+            )
+        p = f.probability(grid * m.scale)
+        inside = grid <= x.max()
+        ax.plot(
+            grid[inside],
+            p[inside],
+            color=CURVE,
+            lw=1.8,
+            label=f"lognormal fit: median {m.shown(f.median):.3g} {m.unit}, beta {f.beta:.2f}",
+        )
+        ax.plot(grid[~inside], p[~inside], color=CURVE, lw=1.4, ls=":")
+        ax.plot([m.shown(f.median)], [0.5], "o", color=CURVE, mfc="white", ms=6, zorder=5)
+    elif f.status == "separated":
+        ax.axvline(m.shown(f.median), color=CURVE, lw=1.4, label=f"threshold near {m.shown(f.median):.3g} {m.unit}")
+    lo = np.clip(s["fraction"] - s["fraction_lo"], 0.0, None)  # >= 0 (the interval's rounding)
+    hi = np.clip(s["fraction_hi"] - s["fraction"], 0.0, None)
+    n = int(s["n_runs"].max()) if len(s) else 0
+    ax.errorbar(
+        x,
+        s["fraction"],
+        yerr=[lo, hi],
+        fmt="s",
+        color=POINTS,
+        ms=4.5,
+        capsize=2.5,
+        lw=0.9,
+        label=f"fraction of {n} records that collapse (95 % Wilson)",
+    )
+    for value, label, colour, style in marks or []:
+        ax.axvline(value / m.scale, color=colour, ls=style, lw=1.3, label=label)
+    ax.set_xlim(0, top)
+    ax.set_ylim(-0.03, 1.03)
+    ax.set_xlabel(m.label)
+    ax.set_ylabel("P(collapse)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower right")
+    return fig, ax
+
+
+def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
+    """The code's capacity curve and demand (module docstring)."""
+    if ax is None:
+        fig, ax = new_figure(None, figsize=(6.4, 4.2))
+    else:
+        fig = ax.figure
+    kin = a.limit.kinematic
+    if kin is None:
+        ax.text(0.5, 0.5, f"no mechanism ({a.limit.status})", ha="center", va="center", transform=ax.transAxes)
+        ax.set_axis_off()
+        return fig, ax
+    curve = kin.spectral()
+    ymax = kin.a0_star_m_s2
+    xmax = 0.0
+    if curve is not None:
+        d, acc = curve
+        keep = acc >= 0
+        ax.plot(d[keep] * 1e3, acc[keep], color="black", lw=1.8, label="capacity a*(d*) of the mechanism")
+        xmax = float(d[keep].max())
+    ax.plot([0.0], [kin.a0_star_m_s2], "o", color="black", ms=5, zorder=5)
+    ax.annotate(
+        f"a0* = {kin.a0_star_m_s2:.3g}", (0, kin.a0_star_m_s2), xytext=(6, 4), textcoords="offset points", fontsize=8
+    )
+    for c in a.checks:
+        if not c.applies:
+            continue
+        colour = OK if c.status == VERIFIED else DEMAND
+        if c.quantity == "a0*":
+            ax.axhline(
+                c.demand, color=colour, ls="--", lw=1.3, label=f"{c.name}: demand {c.demand:.3g} m/s$^2$ ({c.status})"
+            )
+            ymax = max(ymax, c.demand)
+        else:
+            ts = c.terms["Ts_s"]
+            se = c.terms["Se_Ts_m_s2"]
+            periods = np.linspace(0.02, 4.0, 400)
+            spectrum = a.site.spectrum.psa(periods)
+            sd = spectrum * (periods / (2 * math.pi)) ** 2
+            ax.plot(sd * 1e3, spectrum, color="0.55", lw=1.0, label="site's elastic spectrum (ADRS)")
+            ax.plot([0, c.demand * 1e3], [0, se], color="0.55", lw=0.8, ls=":")
+            ax.plot(
+                [c.demand * 1e3],
+                [se],
+                "D",
+                color=colour,
+                ms=6,
+                zorder=6,
+                label=f"{c.name}: demand SDe(Ts = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})",
+            )
+            ax.axvline(kin.du_star_m * 1e3, color=CURVE, ls="--", lw=1.2, label=f"du* = {kin.du_star_m * 1e3:.3g} mm")
+            if kin.ds_star_m is not None and kin.as_star_m_s2 is not None:
+                ax.plot([kin.ds_star_m * 1e3], [kin.as_star_m_s2], "s", color=CURVE, ms=4)
+            ymax = max(ymax, se)
+            xmax = max(xmax, c.demand)
+    ax.set_xlim(0, 1.15 * xmax * 1e3 if xmax > 0 else 1.0)
+    ax.set_ylim(0, 1.2 * ymax)
+    ax.set_xlabel("d* (mm)")
+    ax.set_ylabel("a* (m/s$^2$)")
+    ax.set_title(f"the code's check (e* = {kin.e_star:.3f}, FC = {kin.FC:g}; {a.verdict})", fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=6.5, loc="upper right")
+    return fig, ax
+
+
+def _marks(a: Assessment) -> list[tuple[float, str, str, str]]:
+    """The code's demand and capacity on the fragility's axis (ag, SI)."""
+    marks = [(a.site.ag_m_s2, f"the site's ag = {a.site.ag_m_s2 / G:.3g} g (the code's demand)", DEMAND, "-")]
+    styles = iter(("--", "-.", ":"))
+    for c in a.checks:
+        if c.applies:
+            marks.append(
+                (
+                    c.ag_capacity_m_s2,
+                    f"code capacity, {c.name}: ag = {c.ag_capacity_m_s2 / G:.3g} g",
+                    CODE,
+                    next(styles),
+                )
+            )
+    return marks
+
+
+def draw_fragility(result: FragilityResult, path: str | Path, title: str | None = None) -> Path:
+    """Write :func:`plot_fragility` as a PNG."""
+    fig, ax = new_figure(path, figsize=(6.8, 4.6), layout="constrained")
+    static = result.plan.static_acceleration_m_s2
+    marks = []
+    if result.measure.kind == "pga" and math.isfinite(static):
+        marks.append((static, f"static collapse, alpha0 g = {static / G:.3g} g (limit analysis)", "0.45", "--"))
+    plot_fragility(result, ax, marks=marks)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return save_figure(fig, path)
+
+
+def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -> Path:
+    """The capacity curve and demand (left) and, when the dynamics ran, the fragility in ag
+    with the code's demand and capacity marked (right); a PNG."""
+    panels = 2 if a.dynamic is not None else 1
+    fig, axes = new_figure(path, 1, panels, figsize=(6.4 * panels, 4.8), layout="constrained", squeeze=False)
+    plot_capacity(a, axes[0, 0])
+    if a.dynamic is not None:
+        plot_fragility(a.dynamic, axes[0, 1], marks=_marks(a))
+        ratio = a.median_over_code
+        axes[0, 1].set_title(
+            f"dynamics: {a.dynamic.plan.stripes.solver.name}, {a.dynamic.plan.stripes.motions.count} records"
+            + (f"; median / code capacity = {ratio:.2f}" if not math.isnan(ratio) else ""),
+            fontsize=9,
+        )
+    if title:
+        fig.suptitle(f"{title}: {a.site.describe()}", fontsize=10)
+    return save_figure(fig, path)
