@@ -4,6 +4,11 @@
   simulated second, its start-up cost (process, imports, scene building), and the
   reference DEM's kernel time on the same model: the ratio per simulated second.
 * Runs per minute with two parallel YADE workers (8 runs of 5 s simulated).
+* YADE kept warm against one process per run (:func:`warm_vs_cold`): 20 runs of specimen 1,
+  20 s each, under harmonic motions of different amplitudes, one after the other in this
+  process: runs per minute and the per-run start-up cost (everything but YADE's own loop)
+  each way, and the results compared bit for bit (``python benchmarks/bench_yade.py warm``
+  runs only this).
 * Assemblies: dry running-bond walls of about 10 and 100 blocks under a one-sine pulse,
   us per block-step and start-up time of YADE beside the reference DEM's
   (:func:`assembly_costs`, which ``bench_scale.py`` can call).
@@ -117,6 +122,60 @@ def assembly_costs(sizes=(10, 100), duration: float = 0.3) -> list[dict[str, obj
     return rows
 
 
+def harmonic_scene(amplitude_mm: float, duration: float = 20.0):
+    """Specimen 1 under a 3.3 Hz sine of ``amplitude_mm`` (20 cycles between 2-cycle ramps,
+    then free rocking until ``duration`` s; ``examples/specimen1_harmonic.toml``)."""
+    return scene_from_dict(
+        {
+            "duration_s": duration,
+            "sample_dt_s": 0.001,
+            "blocks": [BLOCK],
+            "contact": {"calibration": "matched"},
+            "motion": {
+                "type": "harmonic", "amplitude_mm": amplitude_mm, "frequency_hz": 3.3, "cycles": 20, "ramp_cycles": 2,
+            },
+        }
+    )
+
+
+def warm_vs_cold(runs: int = 20, duration: float = 20.0) -> dict[str, float]:
+    """``runs`` YADE runs in a row, in a process each (``warm=False``) then in one warm worker.
+
+    Returns
+    -------
+    dict
+        ``cold_runs_per_min``, ``warm_runs_per_min`` (1/min), ``cold_startup_s`` and
+        ``warm_startup_s`` (the median per-run cost outside YADE's own loop, s; the warm
+        worker's first run, which starts it, is left out) and ``identical`` (1.0 when every
+        warm result equals its cold one bit for bit).
+    """
+    scenes = [harmonic_scene(4.0 + 0.2 * k, duration) for k in range(runs)]
+    out: dict[str, float] = {}
+    results = {}
+    for name, solver in (("cold", YadeSolver(warm=False)), ("warm", YadeSolver())):
+        start = time.perf_counter()
+        results[name] = [solver.run(s) for s in scenes]
+        wall = time.perf_counter() - start
+        assert all(r.ok for r in results[name]), [r.meta.get("failure_reason") for r in results[name]]
+        startups = sorted(r.meta["startup_time_s"] for r in results[name][1 if name == "warm" else 0 :])
+        out[f"{name}_runs_per_min"] = 60 * runs / wall
+        out[f"{name}_startup_s"] = startups[len(startups) // 2]
+    out["identical"] = float(
+        all(w.frame.equals(c.frame) for w, c in zip(results["warm"], results["cold"], strict=True))
+    )
+    return out
+
+
+def print_warm_vs_cold(runs: int = 20, duration: float = 20.0) -> None:
+    r = warm_vs_cold(runs, duration)
+    print(
+        f"YADE, {runs} runs of specimen 1 ({duration:g} s, harmonic) in a row: one process per run "
+        f"{r['cold_runs_per_min']:.1f} runs/min ({r['cold_startup_s']:.2f} s start-up per run); kept warm "
+        f"{r['warm_runs_per_min']:.1f} runs/min ({r['warm_startup_s']:.2f} s); "
+        f"{r['warm_runs_per_min'] / r['cold_runs_per_min']:.2f}x; bit for bit the same: {bool(r['identical'])}"
+    )
+
+
 def main() -> None:
     if not yade_backend.yade_available():
         print("YADE is not installed: no YADE figures")
@@ -159,4 +218,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:] == ["warm"]:
+        print_warm_vs_cold()
+    else:
+        main()
+        print_warm_vs_cold()

@@ -50,3 +50,60 @@ def alive(pid: int) -> bool:
     except OSError:
         return False
     return state != "Z"
+
+
+def listening_tcp() -> dict[str, tuple[str, int]]:
+    """Every listening TCP socket of this machine (IPv4 and IPv6): inode -> (address, port),
+    the address as /proc/net/tcp* gives it, decoded ("0.0.0.0", "127.0.0.1", "::", ...)."""
+    import ipaddress
+
+    found = {}
+    for name in ("/proc/net/tcp", "/proc/net/tcp6"):
+        try:
+            lines = Path(name).read_text().splitlines()[1:]
+        except FileNotFoundError:
+            continue
+        for line in lines:
+            fields = line.split()
+            if fields[3] != "0A":  # LISTEN
+                continue
+            address, port = fields[1].split(":")
+            raw = bytes.fromhex(address)
+            # the kernel prints each 32-bit word in host (little-endian) order
+            raw = b"".join(raw[i : i + 4][::-1] for i in range(0, len(raw), 4))
+            found[fields[9]] = (str(ipaddress.ip_address(raw)), int(port, 16))
+    return found
+
+
+def socket_inodes(pids: set[int]) -> set[str]:
+    """Inodes of the sockets the processes ``pids`` hold."""
+    import re
+
+    found = set()
+    for pid in pids:
+        try:
+            fds = os.listdir(f"/proc/{pid}/fd")
+        except OSError:
+            continue
+        for fd in fds:
+            try:
+                m = re.match(r"socket:\[(\d+)\]", os.readlink(f"/proc/{pid}/fd/{fd}"))
+            except OSError:
+                continue
+            if m:
+                found.add(m.group(1))
+    return found
+
+
+def listening_of_tree(pid: int) -> dict[str, tuple[str, int]]:
+    """The listening TCP sockets of ``pid`` and every process below it."""
+    mine = socket_inodes({pid, *descendants(pid)})
+    return {inode: where for inode, where in listening_tcp().items() if inode in mine}
+
+
+def cmdline(pid: int) -> str:
+    """The command line of ``pid`` ("" when it is gone)."""
+    try:
+        return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+    except OSError:
+        return ""

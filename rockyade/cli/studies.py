@@ -76,7 +76,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
     from rockyade.studies.batch import failures, load_study, run_study_tasks
 
     how = Executor(args.executor, args.workers, args.scheduler, args.scheduler_timeout)  # checked before any work
-    study = load_study(args.study, args.out, *solver_options(args))
+    study = load_study(args.study, args.out, *solver_options(args), allow_large=args.allow_large)
     tasks = list(study.tasks)
     print(f"{study.name}: {len(tasks)} runs ({', '.join(study.solvers)}) -> {args.out}", flush=True)
     summary = run_study_tasks(

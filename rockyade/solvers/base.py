@@ -10,15 +10,21 @@ they travel to worker processes and Dask workers with the scene.
 Options are the dataclass's fields (e.g. ``ReferenceSolver(record_energy=False)``,
 ``YadeSolver(timeout_s=600)``); :meth:`SolverBase.from_options` checks options given by
 name (from a command line or a study file) and refuses one the solver does not take.
+
+Every solver derived from :class:`SolverBase` goes through one place on its way out: its
+``run`` is wrapped (:meth:`SolverBase.__init_subclass__`) so that every Result it returns,
+failed ones included, carries ``meta["motion_coverage"]``, how much of the scene's base
+motion the run leaves out (:func:`motion_coverage`).
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkable
 
-from rockyade.errors import InputError
+from rockyade.errors import InputError, RockyadeError
 
 if TYPE_CHECKING:
     from rockyade.result import Result
@@ -56,15 +62,48 @@ def check_flag(value: Any, field: str) -> bool:
     return value
 
 
+def motion_coverage(scene: Scene) -> dict[str, Any]:
+    """How much of ``scene``'s base motion its run covers
+    (:func:`rockyade.motion.coverage.record_coverage`: status, time, PGA and Arias intensity
+    left out, a sentence); when it cannot be worked out, ``status`` "unknown" and why."""
+    from rockyade.motion.coverage import record_coverage
+
+    try:
+        return record_coverage(scene.motion, scene.duration_s)
+    except (RockyadeError, OSError, ValueError) as exc:  # the run itself says what is wrong
+        return {"status": "unknown", "message": f"{type(exc).__name__}: {exc}"}
+
+
+def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene], Result]:
+    """``run`` whose Result carries ``meta["motion_coverage"]``."""
+
+    @functools.wraps(run)
+    def wrapper(self: Any, scene: Scene) -> Result:
+        result = run(self, scene)
+        if "motion_coverage" not in result.meta:
+            result.meta["motion_coverage"] = motion_coverage(scene)
+        return result
+
+    wrapper.records_coverage = True  # type: ignore[attr-defined]
+    return wrapper
+
+
 class SolverBase:
     """What the solvers share: options by name and no files kept (override both as needed).
 
     Subclasses are frozen dataclasses whose fields are their options, with ``name`` and
-    ``OPTIONS`` (option -> :data:`OptionCheck`) as class attributes.
+    ``OPTIONS`` (option -> :data:`OptionCheck`) as class attributes. The ``run`` a subclass
+    defines is wrapped so that its Results carry ``meta["motion_coverage"]``.
     """
 
     name: ClassVar[str] = ""
     OPTIONS: ClassVar[Mapping[str, OptionCheck]] = {}
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        run = cls.__dict__.get("run")
+        if run is not None and not getattr(run, "records_coverage", False):
+            cls.run = _with_coverage(run)  # type: ignore[attr-defined]
 
     @classmethod
     def from_options(cls, options: Mapping[str, Any], fields: Mapping[str, str] | None = None) -> Self:

@@ -45,7 +45,7 @@ from rockyade.kernel.single import single_body
 from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.base import SolverBase, check_flag, motion_coverage
 from rockyade.solvers.cost import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
@@ -177,6 +177,7 @@ class ReferenceSolver(SolverBase):
                 **_model_meta(model, wall),
                 "batched": {"runs": len(scenes), "setup_time_s": setup},
                 "setup_time_s": setup / max(1, len(scenes)),
+                "motion_coverage": motion_coverage(scenes[r]),
             }
             metrics = {
                 "max_abs_theta_rad": float(out.max_abs_theta[r]),

@@ -40,6 +40,7 @@ is written with what finished, the unfinished runs listed with status ``unfinish
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import itertools
 import json
@@ -56,7 +57,7 @@ import pandas as pd
 from rockyade.errors import BatchInterruptedError, InputError, os_error_message
 from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
-from rockyade.io.locking import output_lock
+from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.result import Result
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
@@ -70,6 +71,37 @@ TIMING_COLUMNS = ("wall_time_s", "elapsed_s")
 UNFINISHED = "unfinished"
 #: Study-file keys that set a solver's option: key -> option.
 SOLVER_OPTION_KEYS = {"yade_timeout_s": "timeout_s"}
+#: Runs a study may expand into (base scenes x grid points x solvers); ``allow_large``
+#: (``--allow-large``) lifts it up to MAX_RUNS_ALLOWED, a ceiling nothing lifts (every run is
+#: a validated scene held in memory, about 2 kB, and is validated in about 5 ms).
+MAX_RUNS = 100_000
+MAX_RUNS_ALLOWED = 1_000_000
+#: Largest study file, bytes: a grid is lists of values (1 MiB holds some 200,000 numbers;
+#: Python's TOML reader takes about 0.6 s for it); the count check above then refuses more.
+MAX_STUDY_BYTES = 1024 * 1024
+#: Keys of the scene format that a table takes only alone (its readers refuse both, saying
+#: "give exactly one of ..." or "give either ... or ..."): a grid key replaces its
+#: alternatives in the table it sets. The base scene is read into its canonical form, which
+#: may hold the other key (a pulse given in g holds amplitude_m_s2).
+ALTERNATIVES: dict[str, tuple[str, ...]] = {
+    # a pulse (motion)
+    "amplitude_g": ("amplitude_m_s2",),
+    "amplitude_m_s2": ("amplitude_g",),
+    # a harmonic motion (motion)
+    "cycles": ("duration_s",),
+    "duration_s": ("cycles",),
+    # a sampled motion (motion)
+    "dt_s": ("t_s",),
+    "t_s": ("dt_s",),
+    # a block (blocks.<i>)
+    "mass_kg": ("density_kg_m3",),
+    "density_kg_m3": ("mass_kg",),
+    "inertia_kgm2": ("p_rad_s",),
+    "p_rad_s": ("inertia_kgm2",),
+    "vertices_m": ("width_m", "height_m"),
+    "width_m": ("vertices_m",),
+    "height_m": ("vertices_m",),
+}
 
 
 @dataclass(frozen=True)
@@ -82,10 +114,14 @@ class BatchTask(Task):
         Where ``runs/`` is.
     save_history
         Write the time history as well as the metadata.
+    lock_token
+        The token of the batch's lock on ``out_dir`` (set when the batch runs): the run writes
+        there on the batch's behalf (:func:`rockyade.io.locking.writing_for`), wherever it runs.
     """
 
     out_dir: str = "."
     save_history: bool = True
+    lock_token: str = ""
 
 
 @dataclass(frozen=True)
@@ -106,12 +142,16 @@ def batch_task(
     save_history: bool = True,
 ) -> BatchTask:
     """A batch run; the solver keeps its own files (if any) in ``<out_dir>/runs/<solver>/``.
-    Without the history, the solver records only what the summary reads (:func:`lean_solver`)."""
+    Without the history, the solver records only what the summary reads (:func:`lean_solver`).
+
+    ``out_dir`` is made absolute here, on the client: a worker elsewhere (a Dask worker in
+    another folder) writes where the batch reads."""
     solver = as_solver(solver)
     if not save_history:
         solver = lean_solver(solver, scene)
-    kept = solver.keeping_files(Path(out_dir) / "runs" / solver.name)
-    return BatchTask(index, kept, scene, dict(labels), str(out_dir), save_history)
+    out = Path(out_dir).absolute()
+    kept = solver.keeping_files(out / "runs" / solver.name)
+    return BatchTask(index, kept, scene, dict(labels), str(out), save_history)
 
 
 def lean_solver(solver: Solver, scene: Scene) -> Solver:
@@ -139,7 +179,60 @@ def _set_path(d: dict[str, Any], dotted: str, value: Any, source: str | None) ->
         except (KeyError, IndexError, ValueError, TypeError):
             raise InputError(f"grid.{dotted}", f"no '{'.'.join(parts[: i + 1])}' in the base scene", source) from None
     last: Any = int(parts[-1]) if isinstance(target, list) else parts[-1]
+    if isinstance(target, dict):
+        for other in ALTERNATIVES.get(last, ()):
+            target.pop(other, None)
     target[last] = copy.deepcopy(value)
+
+
+def _check_alternatives(keys: Iterable[str], source: str | None) -> None:
+    """Refuse a grid that sets a key and its alternative in the same table."""
+    seen: dict[tuple[str, str], str] = {}
+    for key in keys:
+        table, _, leaf = key.rpartition(".")
+        for other in ALTERNATIVES.get(leaf, ()):
+            if (table, other) in seen:
+                raise InputError(
+                    f"grid.{key}",
+                    f"sets what grid.{seen[(table, other)]} sets (the scene takes one of {leaf} and {other}): "
+                    "keep one of the two",
+                    source,
+                )
+        seen[(table, leaf)] = key
+
+
+def grid_size(n_bases: int, grid: Mapping[str, list[Any]], n_solvers: int) -> int:
+    """Runs a study expands into: base scenes x the product of the grid's list lengths x solvers."""
+    count = n_bases * n_solvers
+    for values in grid.values():
+        count *= len(values)
+    return count
+
+
+def check_run_count(count: int, allow_large: bool = False, source: str | None = None) -> None:
+    """Refuse a study of more than :data:`MAX_RUNS` runs (``allow_large``: of more than
+    :data:`MAX_RUNS_ALLOWED`), from the grid's sizes, before anything is built.
+
+    Raises
+    ------
+    InputError
+        Field ``grid``, with the count and the limit.
+    """
+    if count > MAX_RUNS_ALLOWED:
+        raise InputError(
+            "grid",
+            f"the study expands into {count:,} runs, more than the limit of {MAX_RUNS:,} and than the "
+            f"{MAX_RUNS_ALLOWED:,} a batch can hold even with --allow-large: split it into several studies",
+            source,
+        )
+    if count > MAX_RUNS and not allow_large:
+        raise InputError(
+            "grid",
+            f"the study expands into {count:,} runs, more than the limit of {MAX_RUNS:,} (each run is a "
+            f"validated scene, a row and a file); use a smaller grid, or pass --allow-large (allow_large=True) "
+            f"to go up to {MAX_RUNS_ALLOWED:,}",
+            source,
+        )
 
 
 def _scene_dict(path: Path) -> dict[str, Any]:
@@ -153,8 +246,12 @@ def load_study(
     out_dir: str | Path,
     options: Mapping[str, Any] | None = None,
     fields: Mapping[str, str] | None = None,
+    allow_large: bool = False,
 ) -> Study:
     """Read a study file and expand it into tasks (scenes are validated now).
+
+    Record files the grid names (``"motion.file" = [...]``, or a file in a grid's motion
+    table) are found from the study file's folder, as a scene's from the scene's.
 
     Parameters
     ----------
@@ -163,11 +260,27 @@ def load_study(
         line); each goes to the solvers that take it, and one none of them takes is refused.
     fields
         How ``options`` are named in errors (e.g. ``{"timeout_s": "--yade-timeout"}``).
+    allow_large
+        Expand up to :data:`MAX_RUNS_ALLOWED` runs rather than :data:`MAX_RUNS`.
+
+    Raises
+    ------
+    InputError
+        A bad study file (naming the key), a file above :data:`MAX_STUDY_BYTES`, a grid of
+        more runs than the limit (from its sizes, before any scene is built), a bad scene.
     """
     path = Path(path)
     source = str(path)
     if not path.is_file():
         raise InputError("study", f"file not found: {path}")
+    size = path.stat().st_size
+    if size > MAX_STUDY_BYTES:
+        raise InputError(
+            "study",
+            f"the file has {size:,} bytes, more than the {MAX_STUDY_BYTES:,} (1 MiB) a study file may have: "
+            "a grid of that size expands into more runs than a batch takes; split the study",
+            source,
+        )
     from rockyade.io.fields import plain_data
     from rockyade.scene.loading import parse_text_file
 
@@ -196,12 +309,14 @@ def load_study(
         if not isinstance(values, list) or not values:
             raise InputError(f"grid.{key}", "must be a non-empty list of values", source)
     r.finish()
+    check_run_count(grid_size(len(file_list), grid_table, len(names)), allow_large, source)
     try:
         solvers = make_solvers(names, {**file_options, **(options or {})}, {**file_fields, **(fields or {})})
     except InputError as exc:  # a key of this file is named with the file
         raise InputError(exc.field, exc.message, source if exc.field in SOLVER_OPTION_KEYS else exc.source) from None
     bases = [(Path(f).stem, _scene_dict(path.parent / f)) for f in file_list]
-    return Study(name, tuple(expand(bases, grid_table, solvers, out_dir, save, source)), tuple(names))
+    tasks = expand(bases, grid_table, solvers, out_dir, save, source, allow_large=allow_large)
+    return Study(name, tuple(tasks), tuple(names))
 
 
 def expand(
@@ -211,20 +326,40 @@ def expand(
     out_dir: str | Path,
     save_history: bool = True,
     source: str | None = None,
+    *,
+    allow_large: bool = False,
 ) -> list[BatchTask]:
-    """Tasks for every base scene x grid point x solver (a Solver, or a name), scenes validated."""
+    """Tasks for every base scene x grid point x solver (a Solver, or a name), scenes validated.
+
+    A grid key replaces its alternatives (:data:`ALTERNATIVES`) in the table it sets. With a
+    ``source`` (the study file), record files named by the grid are found from its folder.
+
+    Raises
+    ------
+    InputError
+        More runs than the limits (:func:`check_run_count`, before anything is built), a
+        key and its alternative both in the grid, a grid point that is not a valid scene
+        (naming the base and the grid point).
+    """
     from rockyade.scene import scene_from_dict
 
     solver_list = [as_solver(s) for s in solvers]
+    check_run_count(grid_size(len(bases), grid, len(solver_list)), allow_large, source)
     keys = list(grid)
+    _check_alternatives(keys, source)
+    base_dir = Path(source).resolve().parent if source else None
     tasks = []
     for base_name, base in bases:
         for values in itertools.product(*(grid[k] for k in keys)):
             d = copy.deepcopy(base)
             for key, value in zip(keys, values, strict=True):
                 _set_path(d, key, value, source)
-            scene = _absolute_files(scene_from_dict(d, source=source))
             labels = {"base": base_name, **{k: _label(v) for k, v in zip(keys, values, strict=True)}}
+            try:
+                scene = _absolute_files(scene_from_dict(d, source=source, base_dir=base_dir))
+            except InputError as exc:
+                point = ", ".join(f"{k} = {v}" for k, v in labels.items())
+                raise InputError(exc.field, f"{exc.message} (grid point: {point})", exc.source) from None
             for solver in solver_list:
                 tasks.append(batch_task(len(tasks), solver, scene, labels, out_dir, save_history))
     return tasks
@@ -253,6 +388,11 @@ def run_name(scene_hash: str, solver: str) -> str:
 def run_task(task: BatchTask) -> dict[str, Any]:
     """Run one task: solve, metrics, write its files; return its summary row. Never raises:
     failures become rows."""
+    with writing_for(task.out_dir, task.lock_token) if task.lock_token else contextlib.nullcontext():
+        return _run_task(task)
+
+
+def _run_task(task: BatchTask) -> dict[str, Any]:
     start = time.perf_counter()
     runs = Path(task.out_dir) / "runs"
     runs.mkdir(parents=True, exist_ok=True)
@@ -272,6 +412,19 @@ def run_task(task: BatchTask) -> dict[str, Any]:
     return row
 
 
+def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The summary's columns of how much of the base motion a run leaves out
+    (``meta["motion_coverage"]``, :func:`rockyade.motion.coverage.record_coverage`): the time
+    after the scene's end, s, and the fraction of the motion's PGA the run never sees (0 when
+    the run covers the motion; no columns without a base motion)."""
+    if not coverage or "pga_left_out_fraction" not in coverage:
+        return {}
+    return {
+        "motion_time_left_out_s": coverage["time_left_out_s"],
+        "motion_pga_left_out_fraction": coverage["pga_left_out_fraction"],
+    }
+
+
 def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
     """The summary row's leading and status columns of a run from its Result's metadata."""
     return {
@@ -285,6 +438,7 @@ def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
         "overturn_time_s": meta.get("overturn_time_s"),
         "overturned_block": meta.get("overturned_block") or "",
         "wall_time_s": meta.get("wall_time_s"),
+        **coverage_columns(meta.get("motion_coverage")),
     }
 
 
@@ -306,6 +460,12 @@ def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
     should the group fail as a whole, its runs are run one by one."""
     if len(job) == 1:
         return [run_task(job[0])]
+    first = job[0]
+    with writing_for(first.out_dir, first.lock_token) if first.lock_token else contextlib.nullcontext():
+        return _run_group(job)
+
+
+def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
     from rockyade.analysis.metrics import peak_metrics, uplift_threshold_rad
 
     start = time.perf_counter()
@@ -315,7 +475,7 @@ def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
     try:
         runs = first.solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
     except Exception:  # a run of its own says what went wrong
-        return [run_task(task) for task in job]
+        return [_run_task(task) for task in job]
     elapsed = (time.perf_counter() - start) / len(job)
     folder = Path(first.out_dir) / "runs"
     folder.mkdir(parents=True, exist_ok=True)
@@ -370,7 +530,8 @@ def _metrics(scene: Scene, result: Result) -> dict[str, Any]:
 
 def _write_failure(task: BatchTask, row: dict[str, Any], exc: OSError) -> dict[str, Any]:
     """The row of a run whose result could not be written (no file of it is left half-written)."""
-    keep = (*LEADING_COLUMNS, *task.labels, "wall_time_s", "elapsed_s")
+    keep = (*LEADING_COLUMNS, *task.labels, "wall_time_s", "elapsed_s", "motion_time_left_out_s",
+            "motion_pga_left_out_fraction")
     return {
         **{k: v for k, v in row.items() if k in keep},
         "status": "failed",
@@ -467,8 +628,11 @@ def run_study_tasks(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     with output_lock(out, "out"):
+        token = lock_token(out)
         _settle(out)
-        return _run_locked(tasks, out, how, resume, progress, desc, allow_large, group_runs)
+        return _run_locked(
+            [replace(t, lock_token=token) for t in tasks], out, how, resume, progress, desc, allow_large, group_runs
+        )
 
 
 def _settle(out: Path) -> None:
@@ -490,9 +654,10 @@ def _run_locked(
     allow_large: bool,
     group_runs: bool = True,
 ) -> pd.DataFrame:
+    first, duplicates = _distinct(tasks)
     rows: list[dict[str, Any]] = []
     todo = []
-    for task in tasks:
+    for task in first:
         done = _completed_row(task) if resume else None
         if done is not None:
             rows.append(done)
@@ -516,13 +681,19 @@ def _run_locked(
     for i in outcome.unfinished:
         reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"
         rows.extend(_placeholder_row(task, UNFINISHED, reason) for task in jobs[i])
+    by_index = {row["index"]: row for row in rows}
+    for task, original in duplicates:
+        rows.append(_duplicate_row(task, by_index[original.index]))
+    for row in rows:
+        row.setdefault("duplicate_of", -1)
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
     os.sync()  # the runs' files reach the disk here, once, not at each run
     write_summary(summary, out)
     if outcome.stopped:
         if outcome.hard:
             _settle(out)
-        unfinished = sum(len(jobs[i]) for i in outcome.unfinished)
+        stopped = {task.index for i in outcome.unfinished for task in jobs[i]}
+        unfinished = len(stopped) + sum(1 for _task, original in duplicates if original.index in stopped)
         raise BatchInterruptedError(len(tasks) - unfinished, unfinished, str(out / "summary.csv"), hard=outcome.hard)
     return summary
 
@@ -530,8 +701,39 @@ def _run_locked(
 #: Most runs of one group in one job (groups are cut so that every worker gets jobs).
 MAX_RUNS_PER_JOB = 64
 
+
+def _distinct(tasks: list[BatchTask]) -> tuple[list[BatchTask], list[tuple[BatchTask, BatchTask]]]:
+    """The tasks run (the first of each run name: the same scene hash and solver) and the
+    duplicates, each with the task it repeats (run once: two tasks would write one file)."""
+    first: dict[str, BatchTask] = {}
+    duplicates = []
+    for task in tasks:
+        name = run_name(task.scene_hash, task.solver.name)
+        if name in first:
+            duplicates.append((task, first[name]))
+        else:
+            first[name] = task
+    return list(first.values()), duplicates
+
+
+def _duplicate_row(task: BatchTask, original: dict[str, Any]) -> dict[str, Any]:
+    """The row of a grid point that repeats an earlier one: its result, its own grid values,
+    and ``duplicate_of`` the index of the row it repeats."""
+    return {**original, "index": task.index, **task.labels, "duplicate_of": original["index"]}
+
+
 LEADING_COLUMNS = ("index", "run", "scene_hash", "solver")
-STATUS_COLUMNS = ("status", "failure_reason", "overturn_time_s", "overturned_block", "wall_time_s", "elapsed_s")
+STATUS_COLUMNS = (
+    "status",
+    "duplicate_of",
+    "failure_reason",
+    "overturn_time_s",
+    "overturned_block",
+    "wall_time_s",
+    "elapsed_s",
+    "motion_time_left_out_s",
+    "motion_pga_left_out_fraction",
+)
 
 
 def _ordered(summary: pd.DataFrame, tasks: list[BatchTask]) -> pd.DataFrame:

@@ -2,18 +2,24 @@
 
 The DEM model (:mod:`rockyade.dem.model`, the same the reference DEM runs) is written as
 JSON data (:mod:`rockyade.yade.payload`) and run by :mod:`rockyade.yade.driver`
-in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess:
+in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess kept
+warm between runs (:mod:`rockyade.yade.worker`: one per thread, reset between scenes):
 
 * no listening socket: the ``yade`` launcher (which opens a Python console on
-  0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used;
-* one OpenMP thread per run (``OMP_NUM_THREADS=1``), a timeout, stdout and stderr in a log
-  file next to the result;
-* a non-zero exit, a timeout, a Python exception inside YADE, a non-finite state, or a
-  missing or partial output file give a Result with status ``failed``, the reason and the
-  log path, never a Result that looks complete.
+  0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used, and the worker talks over
+  a socket pair;
+* one OpenMP thread per run (``OMP_NUM_THREADS=1``), a timeout per run, stdout and stderr
+  in a log file next to the result (never written through a link);
+* a crash, a timeout, a Python exception inside YADE, an output it cannot write (its
+  partial file removed, the path named), a non-finite state, or a missing or partial
+  output file give a Result with status ``failed``, the reason and the log path, never a
+  Result that looks complete;
+* nothing is left in the temporary folder: the folder YADE makes in /tmp at import is
+  removed at once, rockyade's own (a run without ``workdir``) honours ``TMPDIR`` and is
+  removed after a successful run.
 
-Runs are independent (own files, own process), so several can go in parallel (the
-runner, :mod:`rockyade.runner`). The solver, :class:`rockyade.solvers.yade.YadeSolver`,
+Runs are independent (own files; a worker runs one scene at a time), so several can go in
+parallel (the runner, :mod:`rockyade.runner`). The solver, :class:`rockyade.solvers.yade.YadeSolver`,
 turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
 :func:`write_script` gives YADE users the same scene as a script of their own.
 """
@@ -23,8 +29,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
-import subprocess
 import tempfile
 import time
 import zipfile
@@ -38,12 +42,12 @@ from rockyade.calibration.model import calibrated_model
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
-from rockyade.errors import InputError, SolverUnavailableError
+from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
-from rockyade.io.lifetime import child_dies_with_parent
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 from rockyade.yade.payload import scene_payload
+from rockyade.yade.worker import run_scene
 
 #: The script YADE's Python runs, shipped inside the package.
 DRIVER = Path(__file__).resolve().parent / "driver.py"
@@ -102,38 +106,6 @@ def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> flo
     return value
 
 
-def _run_process(cmd: list[str], log_file: Path, cwd: Path, timeout: float) -> str | None:
-    """Run YADE's Python; the reason it failed, or None. On timeout the process group is
-    killed (the driver and anything it started) and waited for: no orphan is left."""
-    with open(log_file, "w") as log:
-        proc = subprocess.Popen(
-            cmd,
-            stdout=log,
-            stderr=subprocess.STDOUT,
-            env=_env(),
-            cwd=cwd,
-            start_new_session=True,  # a group of its own: a timeout kills YADE and its children
-            preexec_fn=child_dies_with_parent(),  # ... and YADE dies with this process, even by SIGKILL
-        )
-        try:
-            code = proc.wait(timeout=timeout)
-        except subprocess.TimeoutExpired:
-            _kill_group(proc)
-            return f"timeout: YADE did not finish within {timeout:.6g} s and was stopped (raise it with --yade-timeout)"
-        except BaseException:  # Ctrl-C or any other interruption: never leave YADE running
-            _kill_group(proc)
-            raise
-    return None if code == 0 else f"YADE exited with code {code}"
-
-
-def _kill_group(proc: subprocess.Popen) -> None:
-    try:
-        os.killpg(proc.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        proc.kill()
-    proc.wait()
-
-
 def run_model(
     model: DemModel,
     *,
@@ -141,6 +113,7 @@ def run_model(
     name: str = "yade",
     timeout_s: float | None = None,
     accel_lowpass_hz: float | None = None,
+    warm: bool = True,
 ) -> Result:
     """Run a DEM model in YADE and return a Result (status ``failed`` on any failure).
 
@@ -154,7 +127,10 @@ def run_model(
         default a temporary directory, removed after a successful run and kept (its log
         path in the Result) after a failed one.
     timeout_s
-        Wall-clock limit of the YADE process, s (default :func:`default_timeout`).
+        Wall-clock limit of the run, s (default :func:`default_timeout`).
+    warm
+        Run in this thread's warm YADE worker (:mod:`rockyade.yade.worker`); False: in a
+        YADE process of its own (the same result, bit for bit, 0.7-1 s slower).
     """
     if not yade_available():
         raise SolverUnavailableError(
@@ -172,18 +148,30 @@ def run_model(
     scene_file = directory / f"{name}.yade.json"
     out_file = directory / f"{name}.yade.npz"
     log_file = directory / f"{name}.yade.log"
-    for stale in (out_file, log_file):
+    partial = directory / f"{name}.yade.npz.part"
+    for stale in (out_file, partial):  # a killed run's (the log is replaced, never written through)
         stale.unlink(missing_ok=True)
     payload = scene_payload(model)
-    write_json(scene_file, payload)
     start = time.perf_counter()
-    reason = _run_process([YADE_PYTHON, str(DRIVER), str(scene_file), str(out_file)], log_file, directory, timeout)
+    try:
+        write_json(scene_file, payload)
+        reason = run_scene(_command(), _env(), scene_file, out_file, log_file, timeout, warm)
+    except OSError as exc:  # a full disk: the run fails naming the file; its temporary files are gone
+        error = exc if exc.filename else OSError(exc.errno, exc.strerror, str(scene_file))
+        reason = f"cannot write {os_error_message(error)}"
     total = time.perf_counter() - start
+    if reason is not None:
+        partial.unlink(missing_ok=True)  # a worker killed while writing
     result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, payload.get("contact_plan"))
     result.meta["timeout_s"] = timeout
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
     return result
+
+
+def _command() -> list[str]:
+    """YADE's Python running the driver."""
+    return [YADE_PYTHON, str(DRIVER)]
 
 
 def _last_error_line(log_file: Path) -> str:

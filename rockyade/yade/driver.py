@@ -2,10 +2,24 @@
 
 Usage::
 
-    python3.11 driver.py SCENE.json RESULT.npz    # how rockyade runs it
+    python3.11 driver.py --serve FD                    # how rockyade runs it: many scenes
+    python3.11 driver.py SCENE.json RESULT.npz    # one scene
     yade -x run.py                                     # a `rockyade yade-script` folder:
     yade run.py                                        # scene.json beside run.py, writes
                                                        # result.npz and result.csv there
+
+``--serve FD``: a YADE worker (:mod:`rockyade.yade.worker` starts it). FD is its end of a
+socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
+then takes jobs ``{"scene": path, "out": path}``, each with the descriptor of the job's log
+file (SCM_RIGHTS) onto which its stdout and stderr go while the job runs, and answers each
+with ``{"ok": ...}``. Between jobs it resets YADE (:func:`reset`). After a job that raised
+it answers and exits (code 1): a fresh worker takes the next scene. It stops on
+``{"quit": true}`` or when its end of the socket closes.
+
+YADE makes a folder ``/tmp/yade-XXXXXX`` when it is imported (a fixed /tmp, whatever
+TMPDIR says) and removes it only at its own exit, which the driver never reaches (it leaves
+with ``os._exit``, below); nothing here uses that folder, so the driver removes it, empty,
+as soon as YADE is imported (not under the ``yade`` launcher, whose GUI may use it).
 
 Runs inside Debian's /usr/bin/python3.11 with YADE's modules on the path and imports only
 the standard library, numpy and YADE. rockyade never uses the ``yade`` launcher, which
@@ -54,9 +68,11 @@ The model, as the reference DEM's:
   finite (failed).
 """
 
+import contextlib
 import json
 import math
 import os
+import socket
 import sys
 import time
 import traceback
@@ -99,6 +115,40 @@ MAX_SPIN_RAD_S = 1000.0
 ROTATION_STEP_MAX_RAD = 0.9 * math.pi
 #: A contact slips when its elastic shear force is at least this fraction of tan(phi) Fn.
 SLIP_RATIO = 1.0 - 1e-6
+
+
+def _remove_yade_temp_folder():
+    """Remove the empty folder YADE made at import (module docstring); return its path."""
+    try:
+        folder = os.path.dirname(O.tmpFilename())
+    except Exception:  # nothing to remove
+        return None
+    with contextlib.suppress(OSError):
+        os.rmdir(folder)  # only an empty folder, never a link
+    return folder
+
+
+class OutputError(Exception):
+    """The output could not be written (its partial file is removed)."""
+
+    def __init__(self, path, exc):
+        super().__init__(f"cannot write {path}: {exc.strerror or exc}")
+        self.path = path
+        self.errno = exc.errno
+        self.strerror = exc.strerror or str(exc)
+
+
+def _write_replacing(path, write):
+    """``write(tmp)`` to ``path + ".part"``, then rename it onto ``path``; on failure the
+    partial file is removed and OutputError names ``path``."""
+    tmp = path + ".part"
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise OutputError(path, exc) from None
 
 
 def _material(values, density):
@@ -314,6 +364,9 @@ class Recorder:
         self.raw = [0.0] * nb
         self.turned = [0.0] * nb
         self.moving = [i for i, c in enumerate(clumps) if not c["fixed"]]
+        # each clump's State, fetched once (YADE updates it in place): a lookup is a
+        # boost.python call, and the recorder runs every sample
+        self.states = [O.bodies[c["id"]].state for c in clumps]
         self.sps = scene["steps_per_sample"]
         self.track_period = max(1, min(self.sps, int(ROTATION_STEP_MAX_RAD / (MAX_SPIN_RAD_S * scene["dt_s"]))))
         self.max_rotation_step = 0.0
@@ -356,12 +409,13 @@ class Recorder:
             return
         rec = self.rec
         for i, c in enumerate(self.clumps):
-            st = O.bodies[c["id"]].state
+            st = self.states[i]
             theta = c["angle0"] + self.turned[i]
-            x, y = st.pos[0], st.pos[1]
+            pos, vel = st.pos, st.vel  # one copy of each vector
+            x, y = pos[0], pos[1]
             w = st.angVel[2]
             finite = math.isfinite(x) and math.isfinite(y) and math.isfinite(theta)
-            if not finite or st.vel.norm() > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
+            if not finite or vel.norm() > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
                 self.status, self.stop_time, self.stop_body = "failed", O.time, i
                 self.stop()
                 return
@@ -369,7 +423,7 @@ class Recorder:
             rec["ang"][k, i] = theta
             rec["angvel"][k, i] = w
             px, py = _rotate(c["point"], theta)
-            rec["vpoint"][k, i] = (st.vel[0] - w * py, st.vel[1] + w * px)
+            rec["vpoint"][k, i] = (vel[0] - w * py, vel[1] + w * px)
             if not c["fixed"] and abs(theta - c["rest"]) >= c["stop_angle"] and i not in self.overturn_times:
                 self.overturn_times[i] = O.time
                 if self.stop_on_overturn and self.status == "completed":
@@ -387,7 +441,7 @@ class Recorder:
         MAX_SPIN_RAD_S or turned more than ROTATION_STEP_MAX_RAD: it cannot be unwrapped."""
         raw, turned = self.raw, self.turned
         for i in self.moving:
-            st = O.bodies[self.clumps[i]["id"]].state
+            st = self.states[i]
             now = _orientation_angle(st.ori * self.clumps[i]["ori0"])
             step = math.remainder(now - raw[i], 2.0 * math.pi)
             raw[i] = now
@@ -411,9 +465,7 @@ class Recorder:
         ncont_k, slip_k = self.rec["ncont"][k], self.rec["slip"][k]
         vertex_of, polyhedra, block_of_prism = self.vertex_of, self.polyhedra, self.block_of_prism
         points = {}  # (block, other block or -1 for the base) -> vertices touching
-        for inter in O.interactions:
-            if not inter.isReal:
-                continue
+        for inter in O.interactions.all(True):  # the real ones, in the container's order
             id1, id2 = inter.id1, inter.id2
             where = vertex_of.get(id1)
             other = id2
@@ -484,12 +536,14 @@ class Recorder:
             "rotation_track_period_steps": self.track_period,
             "complete": True,
         }
-        tmp = self.out_path + ".part"
-        with open(tmp, "wb") as fh:
-            np.savez(fh, **{k: v[:n] for k, v in self.rec.items()}, meta=np.array(json.dumps(meta)))
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, self.out_path)
+
+        def write(tmp):
+            with open(tmp, "wb") as fh:
+                np.savez(fh, **{k: v[:n] for k, v in self.rec.items()}, meta=np.array(json.dumps(meta)))
+                fh.flush()
+                os.fsync(fh.fileno())
+
+        _write_replacing(self.out_path, write)
         if self.csv_path:
             self.write_csv(n)
 
@@ -504,9 +558,12 @@ class Recorder:
         cols = [t]
         for i in range(len(names)):
             cols += [self.rec["pos"][:n, i, 0], self.rec["pos"][:n, i, 1], self.rec["ang"][:n, i] - rest[i]]
-        tmp = self.csv_path + ".part"
-        np.savetxt(tmp, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g")
-        os.replace(tmp, self.csv_path)
+        _write_replacing(
+            self.csv_path,
+            lambda tmp: np.savetxt(
+                tmp, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g"
+            ),
+        )
 
 
 def prepare(scene, out_path, csv_path=None):
@@ -550,6 +607,63 @@ def main(scene_path, out_path, csv_path=None, describe=False, wait=True):
             print(f"{recorder.status}: wrote {out_path} and {csv_path}")
 
 
+def reset():
+    """Leave nothing of a scene for the next: stop the run, a new empty scene (bodies,
+    interactions, engines, materials, time step, time and iteration count, periodic cell
+    are the scene's), not periodic, and no recorder."""
+    O.pause()
+    O.wait()
+    O.reset()
+    O.periodic = False
+    globals()["rockyade_record"] = None
+
+
+def _send(sock, message):
+    sock.send(json.dumps(message).encode())
+
+
+def serve(fd):
+    """Run scenes as they come on socket ``fd`` (module docstring); return the exit code."""
+    sock = socket.socket(fileno=fd)
+    keep_out, keep_err = os.dup(1), os.dup(2)
+    _send(sock, {"ready": True, "pid": os.getpid(), "yade_temp_folder": YADE_TEMP_FOLDER})
+    while True:
+        try:
+            data, fds, _flags, _addr = socket.recv_fds(sock, 1 << 16, 1)
+        except OSError:
+            return 0
+        if not data:  # the other end closed: rockyade is gone or done
+            for extra in fds:
+                os.close(extra)
+            return 0
+        job = json.loads(data)
+        if job.get("quit"):
+            return 0
+        sys.stdout.flush()
+        sys.stderr.flush()
+        for log in fds:
+            os.dup2(log, 1)
+            os.dup2(log, 2)
+            os.close(log)
+        reply = {"ok": True}
+        try:
+            main(job["scene"], job["out"])
+        except OutputError as exc:
+            reply = {"ok": False, "path": exc.path, "errno": exc.errno, "strerror": exc.strerror}
+        except Exception as exc:  # reported, then this worker ends
+            traceback.print_exc()
+            reply = {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os.dup2(keep_out, 1)
+        os.dup2(keep_err, 2)
+        if not reply["ok"] and "errno" not in reply:
+            _send(sock, reply)
+            return 1  # a scene that raised: a fresh worker takes the next
+        reset()
+        _send(sock, reply)
+
+
 def _interactive_launcher():
     """True under ``yade run.py`` (the launcher's console stays open: do not block it)."""
     runtime = sys.modules.get("yade.runtime")
@@ -565,11 +679,17 @@ def _exit(code):
     os._exit(code)
 
 
+YADE_TEMP_FOLDER = None
+
 if __name__ == "__main__":
     launcher = "yade.runtime" in sys.modules and hasattr(sys.modules["yade.runtime"], "opts")
+    if not launcher:
+        YADE_TEMP_FOLDER = _remove_yade_temp_folder()
     try:
         args = sys.argv[1:]
-        if args and args[0] == "--describe":
+        if args and args[0] == "--serve":
+            _exit(serve(int(args[1])))
+        elif args and args[0] == "--describe":
             main(args[1], None, describe=True)
         elif len(args) >= 2:
             main(args[0], args[1])

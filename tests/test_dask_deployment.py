@@ -1,0 +1,156 @@
+"""A real Dask deployment: a scheduler and workers started with Dask's own commands
+(``dask scheduler``, ``dask worker``) on the loopback interface, no dashboard; batches run
+against it from the command line. Nothing listens beyond 127.0.0.1; the summary equals a
+local run's; a worker killed mid-study costs no run and duplicates none."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from rockyade.result import Result
+from rockyade.studies.batch import comparable
+
+from .conftest import EXAMPLES
+from .processes import alive, listening_of_tree
+
+distributed = pytest.importorskip("distributed")
+
+DASK = str(Path(sys.executable).parent / "dask")
+#: ``--no-dashboard`` alone still serves HTTP (health, metrics) on 0.0.0.0 (:8787 for the
+#: scheduler): the address keeps that server on loopback, on a free port
+NO_DASHBOARD = ("--no-dashboard", "--dashboard-address", "127.0.0.1:0")
+
+
+def _wait_for(condition, timeout: float, what: str) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if condition():
+            return
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what}")
+
+
+class Cluster:
+    """``dask scheduler`` and ``workers`` ``dask worker`` processes (no nanny: one process
+    each, so killing one kills the worker), all bound to 127.0.0.1 with no dashboard (their
+    HTTP server on 127.0.0.1), run from a folder of their own (a relative path would land
+    there)."""
+
+    def __init__(self, folder: Path, workers: int) -> None:
+        folder.mkdir()
+        self.folder = folder
+        file = folder / "scheduler.json"
+        self.scheduler = self._start(
+            DASK, "scheduler", "--host", "127.0.0.1", "--port", "0", *NO_DASHBOARD, "--scheduler-file", str(file)
+        )
+        _wait_for(lambda: file.is_file() and file.stat().st_size > 0, 60, "the scheduler")
+        self.address = json.loads(file.read_text())["address"]
+        self.workers = [
+            self._start(
+                DASK, "worker", self.address, "--nthreads", "1", *NO_DASHBOARD, "--no-nanny",
+                "--host", "127.0.0.1", "--name", f"w{i}",
+            )
+            for i in range(workers)
+        ]
+        with distributed.Client(self.address, timeout=30) as client:
+            client.wait_for_workers(workers, timeout=120)
+
+    def _start(self, *command: str) -> subprocess.Popen[bytes]:
+        return subprocess.Popen(
+            command, cwd=self.folder, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+        )
+
+    def processes(self) -> list[subprocess.Popen[bytes]]:
+        return [self.scheduler, *self.workers]
+
+    def close(self) -> None:
+        for proc in self.processes():
+            with contextlib.suppress(ProcessLookupError):
+                proc.kill()
+            proc.wait()
+
+
+@pytest.fixture
+def cluster(tmp_path):
+    c = Cluster(tmp_path / "cluster", workers=2)
+    try:
+        yield c
+    finally:
+        c.close()
+
+
+def _study(folder: Path, duration_s: float, runs: int) -> None:
+    """A study of ``runs`` reference-DEM runs of specimen 3 rocking freely for ``duration_s``."""
+    folder.mkdir(exist_ok=True)
+    (folder / "scene.toml").write_text(
+        (EXAMPLES / "specimen3_free.toml")
+        .read_text()
+        .replace("duration_s = 4.0", f"duration_s = {duration_s}")
+        .replace("sample_dt_s = 0.001", "sample_dt_s = 0.01")
+    )
+    thetas = ", ".join(f"{0.02 + 0.005 * i:.3f}" for i in range(runs))
+    (folder / "study.toml").write_text(
+        f'name = "deploy"\nsolvers = ["reference"]\n[base]\nfile = "scene.toml"\n'
+        f'[grid]\n"motion.theta0_rad" = [{thetas}]\n'
+    )
+
+
+def _batch(folder: Path, out: str, *extra: str) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", out, "--quiet", *extra],
+        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )
+
+
+def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(
+    tmp_path, cluster
+):
+    _study(tmp_path, duration_s=8.0, runs=6)
+    local = _batch(tmp_path, "local", "--workers", "2")
+    _stdout, stderr = local.communicate(timeout=300)
+    assert local.returncode == 0, stderr
+    remote = _batch(tmp_path, "remote", "--executor", "dask", "--scheduler", cluster.address)  # relative --out
+    seen: dict = {}
+    while remote.poll() is None:
+        for proc in cluster.processes():
+            seen |= listening_of_tree(proc.pid)
+        time.sleep(0.05)
+    _stdout, stderr = remote.communicate()
+    assert remote.returncode == 0, stderr
+    assert cluster.address.startswith("tcp://127.0.0.1:")
+    assert seen and {host for host, _port in seen.values()} == {"127.0.0.1"}, seen  # no 0.0.0.0, no dashboard
+    summary = pd.read_csv(tmp_path / "remote" / "summary.csv")
+    pd.testing.assert_frame_equal(comparable(pd.read_csv(tmp_path / "local" / "summary.csv")), comparable(summary))
+    assert not (cluster.folder / "remote").exists()  # the run files are the client's, not in the workers' folder
+
+
+def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster):
+    runs = 8
+    _study(tmp_path, duration_s=400.0, runs=runs)  # runs of a few seconds each
+    batch = _batch(tmp_path, "out", "--executor", "dask", "--scheduler", cluster.address)
+    out = tmp_path / "out"
+    _wait_for(lambda: len(list((out / "runs").glob("*.json"))) >= 2, 300, "two finished runs")
+    victim = cluster.workers[0]
+    victim.send_signal(signal.SIGKILL)  # in the middle of its next run
+    victim.wait()
+    _stdout, stderr = batch.communicate(timeout=600)
+    assert batch.returncode == 0, stderr
+    assert alive(cluster.workers[1].pid)
+    summary = pd.read_csv(out / "summary.csv")
+    assert list(summary["index"]) == list(range(runs)) and summary.run.is_unique
+    assert (summary.status == "completed").all(), summary.failure_reason.tolist()
+    assert len(list((out / "runs").glob("*.json"))) == runs and len(list((out / "runs").glob("*.csv"))) == runs
+    for run in summary.run:
+        data = json.loads((out / "runs" / f"{run}.json").read_text())
+        assert data["summary"]["run"] == run and Result.read(out / "runs" / f"{run}.csv").ok
+    leftovers = [p for p in out.rglob(".*") if p.name.endswith((".tmp", ".pending", ".lock"))]
+    assert not leftovers, leftovers

@@ -1,0 +1,315 @@
+"""YADE kept warm (rockyade.yade.worker), with YADE really running: the same results as one
+process per run, a crash or a timeout costs one scene, no port, nothing left behind, no
+write through a link, a full disk named and cleaned up."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from rockyade.runner import Executor, solve_scenes
+from rockyade.scene import load_scene, scene_from_dict
+from rockyade.solvers.yade import YadeSolver
+from rockyade.yade import backend as yade_backend
+
+from .conftest import EXAMPLES
+from .processes import alive, cmdline, descendants, listening_of_tree, require_yade
+
+pytestmark = pytest.mark.yade
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _yade_present():
+    require_yade()
+
+
+def _scene(example: str, duration: float, **top):
+    d = load_scene(EXAMPLES / example).to_dict()
+    d.update(duration_s=duration, **top)
+    return scene_from_dict(d)
+
+
+def _serving() -> set[int]:
+    """This process's YADE workers."""
+    return {p for p in descendants(os.getpid()) if "--serve" in cmdline(p) and "driver.py" in cmdline(p)}
+
+
+def _same(a, b) -> None:
+    assert a.ok and b.ok, (a.meta.get("failure_reason"), b.meta.get("failure_reason"))
+    assert a.frame.equals(b.frame)  # bit for bit
+    for key in ("status", "overturn_time_s", "iterations", "dt_s", "overturn_times_s"):
+        assert a.meta.get(key) == b.meta.get(key), key
+
+
+def test_a_warm_worker_gives_the_results_of_one_process_per_run_bit_for_bit():
+    """Scenes that set different materials, engines (a base motion or none), time steps and
+    block counts, in a row in one worker, against a process of their own each."""
+    scenes = [
+        _scene("biblock_free.toml", 0.6),
+        _scene("specimen1_harmonic.toml", 1.5, sample_dt_s=0.002),
+        _scene("specimen3_free.toml", 1.0),
+        _scene("specimen1_pulse.toml", 1.0),
+    ]
+    cold = [YadeSolver(warm=False).run(s) for s in scenes]
+    order = [1, 0, 2, 3, 1, 2, 0]
+    warm = [YadeSolver().run(scenes[i]) for i in order]
+    for i, result in zip(order, warm, strict=True):
+        _same(result, cold[i])
+    assert len(_serving()) == 1  # one worker ran them all
+
+
+def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypatch):
+    good = _scene("specimen3_free.toml", 0.5)
+    reference = YadeSolver(warm=False).run(good)
+    assert YadeSolver().run(good).ok
+    real = yade_backend.scene_payload
+
+    def broken(model):
+        payload = real(model)
+        del payload["bodies"][0]["sphere_copies"]
+        return payload
+
+    monkeypatch.setattr(yade_backend, "scene_payload", broken)
+    bad = YadeSolver(workdir=tmp_path, stem="bad").run(good)
+    monkeypatch.undo()
+    assert bad.status == "failed" and "exited with code 1" in bad.meta["failure_reason"]
+    assert "KeyError" in bad.meta["failure_reason"] and "Traceback" in (tmp_path / "bad.yade.log").read_text()
+    _same(YadeSolver().run(good), reference)  # a fresh worker takes the next scene
+
+    # a crash: the worker killed by a signal in the middle of a scene
+    long = _scene("specimen1_free.toml", 120.0, sample_dt_s=0.01)
+    holder: dict = {}
+    thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="crash").run(long)))
+    before = _serving()
+    thread.start()
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not (_serving() - before):
+        time.sleep(0.05)
+    (victim,) = _serving() - before
+    time.sleep(1.0)
+    os.kill(victim, signal.SIGSEGV)
+    thread.join(60)
+    crashed = holder["r"]
+    assert crashed.status == "failed" and "exited with code -11" in crashed.meta["failure_reason"]
+    assert not alive(victim)
+    _same(YadeSolver().run(good), reference)
+
+
+def test_each_scene_has_its_own_timeout_in_a_warm_worker(tmp_path):
+    short = _scene("specimen3_free.toml", 0.5)
+    assert YadeSolver().run(short).ok
+    (pid,) = _serving()
+    start = time.monotonic()
+    slow = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(_scene("specimen1_free.toml", 60.0))
+    assert time.monotonic() - start < 20
+    assert slow.status == "failed" and slow.meta["failure_reason"].startswith("timeout: YADE did not finish within 2 s")
+    assert not alive(pid) and not (tmp_path / "slow.yade.npz").exists()
+    assert not list(tmp_path.glob("*.part"))
+    again = YadeSolver(timeout_s=30.0).run(short)  # a fresh worker, a fresh limit
+    assert again.ok and _serving() and pid not in _serving()
+
+
+def test_threads_each_keep_a_worker_and_close_it_when_they_end():
+    before = _serving()
+    scenes = [_scene("specimen3_free.toml", 0.4, motion={"type": "free", "theta0_rad": t}) for t in (0.02, 0.03, 0.04)]
+    results = solve_scenes(YadeSolver(), scenes, executor=Executor("threads", 2))
+    assert all(r.ok for r in results)
+    deadline = time.monotonic() + 10
+    while _serving() != before and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert _serving() == before  # the pool's threads ended: their workers were closed
+
+
+RUN_TWICE = """
+import sys, time
+from rockyade.scene import load_scene, scene_from_dict
+from rockyade.solvers.yade import YadeSolver
+d = load_scene(sys.argv[1]).to_dict()
+d["duration_s"] = float(sys.argv[2])
+for _ in range(2):
+    assert YadeSolver().run(scene_from_dict(d)).ok
+print("done", flush=True)
+time.sleep(float(sys.argv[3]))
+"""
+
+
+def test_a_warm_worker_listens_on_no_port_and_dies_with_its_parent():
+    import select
+
+    proc = subprocess.Popen(
+        [sys.executable, "-c", RUN_TWICE, str(EXAMPLES / "specimen1_free.toml"), "6.0", "60"],
+        stdout=subprocess.PIPE, text=True,
+    )
+    assert proc.stdout is not None
+    try:
+        seen: dict = {}
+        polls = 0
+        deadline = time.monotonic() + 240
+        while proc.poll() is None and time.monotonic() < deadline:
+            seen |= listening_of_tree(proc.pid)
+            polls += 1
+            if select.select([proc.stdout], [], [], 0.05)[0]:
+                break
+        assert proc.stdout.readline().strip() == "done"
+        assert polls > 10 and not seen
+        workers = {p for p in descendants(proc.pid) if "--serve" in cmdline(p)}
+        assert len(workers) == 1 and all(alive(p) for p in workers)  # one worker ran both, and waits, warm
+        proc.kill()
+        proc.wait()
+        deadline = time.monotonic() + 10
+        while any(alive(p) for p in workers) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(alive(p) for p in workers), "a YADE worker outlived the process that started it"
+    finally:
+        proc.kill()
+        proc.wait()
+
+
+def test_the_log_is_never_written_through_a_link(tmp_path, monkeypatch):
+    """A link planted where YADE's log goes, before the run and again whenever rockyade
+    removes the old log (an attacker winning the race between removing and opening): the
+    file it points to is never written. It was opened with a plain open(..., "w")."""
+    import pathlib
+
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    work = tmp_path / "work"
+    work.mkdir()
+    log = work / "x.yade.log"
+    log.symlink_to(victim)
+    real_unlink = pathlib.Path.unlink
+
+    def unlink_and_plant(self, missing_ok=False):
+        real_unlink(self, missing_ok=missing_ok)
+        if self.name == "x.yade.log":
+            self.symlink_to(victim)
+
+    monkeypatch.setattr(pathlib.Path, "unlink", unlink_and_plant)
+    result = YadeSolver(workdir=work, stem="x").run(_scene("specimen3_free.toml", 0.3))
+    monkeypatch.undo()
+    assert result.ok
+    assert victim.read_text() == "keep me"
+    assert not log.is_symlink() and log.is_file()
+
+
+# ---------------------------------------------------------------------- a private /tmp
+
+
+def _namespace_or_skip() -> None:
+    probe = subprocess.run(["unshare", "-Urm", "true"], capture_output=True)
+    if probe.returncode != 0:
+        pytest.skip("cannot mount a tmpfs here (no user namespaces)")
+
+
+def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
+    """/tmp a fresh tmpfs of its own: after YADE runs (one in its own process, two warm,
+    one that times out) it holds only the TMPDIR given, empty. Every run used to leave an
+    empty /tmp/yade-XXXXXX (YADE's, made at import whatever TMPDIR says)."""
+    _namespace_or_skip()
+    d = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
+    d["duration_s"] = 0.4
+    code = (
+        "import json, sys\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.yade import YadeSolver\n"
+        f"d = json.loads({json.dumps(d)!r})\ns = scene_from_dict(d)\n"
+        "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
+        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(scene_from_dict({**d, 'duration_s': 60.0}))\n"
+        "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
+    )
+    script = (
+        "mount -t tmpfs tmpfs /tmp && mkdir /tmp/ours && "
+        f"TMPDIR=/tmp/ours {sys.executable} -c \"$0\" && echo RAN && ls -A /tmp && echo -- && ls -A /tmp/ours"
+    )
+    proc = subprocess.run(["unshare", "-Urm", "sh", "-c", script, code], capture_output=True, text=True, timeout=300)
+    assert "RAN" in proc.stdout, proc.stdout + proc.stderr
+    listing = proc.stdout.split("RAN", 1)[1].split()
+    assert listing == ["kept", "ours", "--"], listing  # kept: the workdir asked for (the timed-out run's log)
+
+
+def test_a_full_disk_names_the_file_leaves_no_partial_output_and_resume_goes_on(tmp_path):
+    """YADE's output on a full disk (a small tmpfs): the run fails naming the file, no
+    ``.yade.npz.part`` is left, and once there is room ``--resume`` runs it. It used to leave
+    the partial file, and --resume failed until it was removed by hand."""
+    _namespace_or_skip()
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    d = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
+    d.update(duration_s=4.0, sample_dt_s=0.001)
+    (tmp_path / "s.json").write_text(json.dumps(d))
+    (tmp_path / "study.toml").write_text(f'solvers = ["yade"]\nsave_histories = false\n[base]\nfile = '
+                                         f'{json.dumps(str(tmp_path / "s.json"))}\n')
+    batch = f"{sys.executable} -m rockyade batch {tmp_path / 'study.toml'} --out {disk}/out --quiet --workers 1"
+    script = (
+        f"mount -t tmpfs -o size=96k tmpfs {disk} && {batch}; echo EXIT=$?; "
+        f"find {disk} -name '*.part' -o -name '.*.tmp'; echo FOUND; "
+        f"mount -o remount,size=64m {disk} && {batch} --resume; echo EXIT2=$?; cat {disk}/out/summary.csv"
+    )
+    proc = subprocess.run(["unshare", "-Urm", "sh", "-c", script], capture_output=True, text=True, timeout=600)
+    out = proc.stdout
+    assert "EXIT=1" in out, out + proc.stderr
+    first = out.split("EXIT=1", 1)[0]
+    assert "disk full" in first and ".yade.npz" in first, first
+    assert out.split("EXIT=1", 1)[1].split("FOUND", 1)[0].split() == []  # no partial file, no temporary
+    assert "EXIT2=0" in out, out + proc.stderr
+    assert "completed" in out.split("EXIT2=0", 1)[1]
+    assert "Traceback" not in proc.stderr
+
+
+def _yade_batch(folder, runs: int, duration_s: float, *extra: str) -> subprocess.Popen[str]:
+    """`rockyade batch` of ``runs`` YADE runs of specimen 1 (harmonic, then free rocking until
+    ``duration_s``) started from ``folder`` as a terminal would (its own session)."""
+    scene = (EXAMPLES / "specimen1_harmonic.toml").read_text()
+    scene = scene.replace("duration_s = 12.0", f"duration_s = {duration_s}")
+    (folder / "scene.toml").write_text(scene)
+    amplitudes = ", ".join(f"{4.0 + 0.1 * i:.1f}" for i in range(runs))
+    (folder / "study.toml").write_text(
+        'name = "warm"\nsolvers = ["yade"]\n[base]\nfile = "scene.toml"\n'
+        f'[grid]\n"motion.amplitude_mm" = [{amplitudes}]\n'
+    )
+    return subprocess.Popen(
+        [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", "out", "--quiet", *extra],
+        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+    )
+
+
+@pytest.mark.parametrize(
+    ("executor", "presses"), [("local", 2), ("dask", 2), ("local", 1)], ids=["local-twice", "dask-twice", "local-once"]
+)
+def test_ctrl_c_in_a_batch_leaves_no_warm_yade_behind(tmp_path, executor, presses):
+    """Ctrl-C (once: the running runs finish; twice: they stop at once) in a batch of YADE runs:
+    the batch exits with 130 and none of its warm YADE workers (a session of their own, which
+    the terminal's Ctrl-C does not reach) outlives it."""
+    if executor == "dask":
+        pytest.importorskip("dask")
+    proc = _yade_batch(tmp_path, 4, 40.0 if presses == 2 else 8.0, "--workers", "2", "--executor", executor)
+    try:
+        deadline = time.monotonic() + 180
+        yade: set[int] = set()
+        while len(yade) < 2 and proc.poll() is None and time.monotonic() < deadline:
+            yade = {p for p in descendants(proc.pid) if "--serve" in cmdline(p) and "driver.py" in cmdline(p)}
+            time.sleep(0.1)
+        assert len(yade) == 2, "two warm YADE workers"
+        time.sleep(1.0)  # the runs are under way
+        for press in range(presses):
+            if press:
+                time.sleep(0.3)
+            os.killpg(proc.pid, signal.SIGINT)
+        _stdout, stderr = proc.communicate(timeout=120)
+        assert proc.returncode == 130 and "Traceback" not in stderr, stderr
+        deadline = time.monotonic() + 10
+        while any(alive(p) for p in yade) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        assert not any(alive(p) for p in yade), "a warm YADE worker outlived its batch"
+        summary = (tmp_path / "out" / "summary.csv").read_text()
+        assert ("stopped by Ctrl-C" in summary) == (presses == 2)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
