@@ -194,3 +194,24 @@ def test_yade_refuses_a_couple_without_resultant():
     with pytest.raises(InputError, match="couple") as info:
         scene_payload(yade_model(block_scene(couple)))
     assert info.value.field == "loads"
+
+
+def test_loads_act_without_energy_terms_and_in_a_batch_group():
+    """Without energy terms a single block takes the fast single-body path, and grouped batch
+    runs share one model: neither may drop the loads. The loaded block's theta is the same
+    with and without energy terms, and a loaded scene is never grouped."""
+    from rockyade.solvers import make_solver
+
+    loaded = block_scene(top_load(0.1, 1500.0), {"type": "free", "theta0_rad": 0.06}, duration=1.0)
+    bare = block_scene([], {"type": "free", "theta0_rad": 0.06}, duration=1.0)
+    theta = {}
+    for energy in (True, False):
+        result = make_solver("reference", record_energy=energy).run(loaded)
+        theta[energy] = result.frame[result.frame.columns[result.frame.columns.str.contains("theta")][0]].to_numpy()
+    np.testing.assert_array_equal(theta[False], theta[True])
+    fast = make_solver("reference", record_energy=False)
+    free = fast.run(bare)
+    theta_bare = free.frame[free.frame.columns[free.frame.columns.str.contains("theta")][0]].to_numpy()
+    assert np.max(np.abs(theta_bare - theta[False])) > 1e-3
+    assert fast.group_key(loaded) is None
+    assert fast.group_key(bare) is not None

@@ -48,24 +48,52 @@ def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -
             continue
         alpha = spec.classical().alpha_rad
         theta = result.series("theta_rad", spec.name)
-        finite = theta[np.isfinite(theta)]
-        peaks = find_peaks(t, theta, min_peak_rad=max(1e-5, 1e-3 * alpha))
-        lifted = np.nonzero(np.abs(theta) > 1e-4 * alpha)[0]
-        out[spec.name] = {
-            "max_abs_theta_rad": float(np.max(np.abs(finite))) if finite.size else math.nan,
-            "max_theta_over_alpha": float(np.max(np.abs(finite)) / alpha) if finite.size else math.nan,
-            "n_peaks": len(peaks),
-            "first_peak_rad": float(peaks.theta_rad[0]) if len(peaks) else math.nan,
-            "first_peak_time_s": float(peaks.t_s[0]) if len(peaks) else math.nan,
-            "mu_eff": effective_restitution(peaks, alpha, n_impacts) if free else math.nan,
-            "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
-            "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
-            "overturned": fell[spec.name]
+        overturned = (
+            fell[spec.name]
             if spec.name in fell
             else result.meta.get("overturned_block") == spec.name
-            or spec.name in (result.meta.get("overturn_times_s") or {}),
-        }
-    return out
+            or spec.name in (result.meta.get("overturn_times_s") or {})
+        )
+        out[spec.name] = {**theta_metrics(t, theta, alpha), **peak_metrics(t, theta, alpha, free, n_impacts),
+                          "overturned": overturned}
+    # the keys in the order of earlier versions
+    order = ("max_abs_theta_rad", "max_theta_over_alpha", "n_peaks", "first_peak_rad", "first_peak_time_s", "mu_eff",
+             "residual_theta_rad", "uplift_time_s", "overturned")
+    return {name: {k: values[k] for k in order} for name, values in out.items()}
+
+
+def uplift_threshold_rad(alpha_rad: float) -> float:
+    """|theta| above which a block of slenderness ``alpha_rad`` counts as lifted off, rad."""
+    return 1e-4 * alpha_rad
+
+
+def theta_metrics(t: np.ndarray, theta: np.ndarray, alpha_rad: float) -> dict[str, float]:
+    """``max_abs_theta_rad``, ``max_theta_over_alpha``, ``residual_theta_rad`` and
+    ``uplift_time_s`` of one block's sampled rotation (``t`` in s, ``theta`` in rad; NaN
+    samples ignored). :func:`rockyade.kernel.runs.simulate_runs` computes the same in the kernel."""
+    finite = theta[np.isfinite(theta)]
+    lifted = np.nonzero(np.abs(theta) > uplift_threshold_rad(alpha_rad))[0]
+    peak = float(np.max(np.abs(finite))) if finite.size else math.nan
+    return {
+        "max_abs_theta_rad": peak,
+        "max_theta_over_alpha": peak / alpha_rad,
+        "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
+        "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
+    }
+
+
+def peak_metrics(
+    t: np.ndarray, theta: np.ndarray, alpha_rad: float, free: bool, n_impacts: int = MU_EFF_IMPACTS
+) -> dict[str, float]:
+    """``n_peaks``, ``first_peak_rad`` (rad), ``first_peak_time_s`` (s) and ``mu_eff`` (free
+    rocking only, else NaN) of one block's sampled rotation (``t`` in s, ``theta`` in rad)."""
+    peaks = find_peaks(t, theta, min_peak_rad=max(1e-5, 1e-3 * alpha_rad))
+    return {
+        "n_peaks": len(peaks),
+        "first_peak_rad": float(peaks.theta_rad[0]) if len(peaks) else math.nan,
+        "first_peak_time_s": float(peaks.t_s[0]) if len(peaks) else math.nan,
+        "mu_eff": effective_restitution(peaks, alpha_rad, n_impacts) if free else math.nan,
+    }
 
 
 #: Assemblies with more blocks than this get aggregate metrics only (batch rows, CLI summary).

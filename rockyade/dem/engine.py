@@ -18,6 +18,7 @@ from numpy.typing import NDArray
 from rockyade.dem.model import DemModel
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.broadphase import MARGIN_REL
+from rockyade.kernel.single import simulate_single, single_body
 from rockyade.kernel.state import pack
 
 #: A contact point keeps its shear spring when last step's point of the same pair lies within
@@ -175,7 +176,8 @@ def simulate_model(
         Keep each pair's separating-axis answer while the pair has not moved enough to
         change it (False: test every candidate pair every step; same results, slower).
 
-    The compiled kernel is loaded (or compiled) before the timer starts.
+    One moving body without energy terms takes the single-body path (:mod:`rockyade.kernel.single`,
+    the same results bit for bit). The compiled kernel is loaded (or compiled) before the timer starts.
     """
     records = pack(
         model_arrays(model, stop_angle_rad),
@@ -184,13 +186,14 @@ def simulate_model(
         record_corners=record_corners,
         coherent=coherent,
     )
-    _warm_up()
+    single = single_body(records[0], records[1], record_energy)
+    warm_up(single)
     start = time.perf_counter()
-    out = kernel.simulate(*records)
+    out = simulate_single(*records) if single else kernel.simulate(*records)
     return KernelOutput(*out), time.perf_counter() - start
 
 
-_WARM: list[bool] = []
+_WARM: set[str] = set()
 
 
 def _compiled_kernel_cached() -> bool:
@@ -200,11 +203,26 @@ def _compiled_kernel_cached() -> bool:
     return any(cache.glob("simulation.simulate-*.nbi"))
 
 
-def _warm_up() -> None:
-    """Run the kernel once on a tiny problem so that its loading is not timed."""
-    if _WARM:
+def warm_up(single: bool = False, runs: bool = False) -> None:
+    """Run the kernel (``single``: the single-body path, :mod:`rockyade.kernel.single`;
+    ``runs``: many runs at once, :mod:`rockyade.kernel.runs`) once on a tiny problem so that
+    its loading is not timed."""
+    key = "runs" if runs else "single" if single else "general"
+    if key in _WARM:
         return
-    _WARM.append(True)
+    _WARM.add(key)
+    if runs:
+        from rockyade.kernel.runs import simulate_runs
+
+        b, j, _, s, i = pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=False,
+                             coherent=True)
+        empty = np.zeros(0)
+        simulate_runs(b, j, s, i, empty, empty, empty, np.zeros(2, dtype=np.int64), 1e-3, 1e-4)
+        return
+    if single:
+        simulate_single(*pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=True,
+                              coherent=True))
+        return
     if not _compiled_kernel_cached():
         print(
             "rockyade: compiling the DEM kernel (numba, once per installation: 20-40 s) ...",

@@ -73,8 +73,11 @@ def file_mode() -> int:
 
 
 @contextlib.contextmanager
-def staged_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[tuple[IO[Any], Path]]:
-    """A complete, fsynced temporary file beside ``path`` that the caller renames itself.
+def staged_file(
+    path: str | os.PathLike[str], mode: str = "w", durable: bool = True
+) -> Iterator[tuple[IO[Any], Path]]:
+    """A complete, fsynced temporary file beside ``path`` that the caller renames itself
+    (``durable=False``: not fsynced).
 
     Yields ``(file, temporary_path)``; on success the file is closed with the umask's
     permissions and left in place for the caller to ``os.replace``; on failure it is removed.
@@ -90,7 +93,8 @@ def staged_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[tuple
             yield fh, tmp
             fh.flush()
             os.fchmod(fh.fileno(), file_mode())
-            os.fsync(fh.fileno())
+            if durable:
+                os.fsync(fh.fileno())
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
@@ -98,7 +102,7 @@ def staged_file(path: str | os.PathLike[str], mode: str = "w") -> Iterator[tuple
 
 
 @contextlib.contextmanager
-def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[Any]]:
+def atomic_open(path: str | os.PathLike[str], mode: str = "w", durable: bool = True) -> Iterator[IO[Any]]:
     """Open a temporary file next to ``path``; rename it onto ``path`` only on success.
 
     Parameters
@@ -107,9 +111,12 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
         Destination file.
     mode
         ``"w"`` (text, UTF-8) or ``"wb"`` (binary).
+    durable
+        Fsync the file and its folder (False: still atomic for readers and for a killed
+        process, but a power cut may leave the old file or an empty one).
     """
     dest = Path(path)
-    with staged_file(dest, mode) as (fh, tmp):
+    with staged_file(dest, mode, durable) as (fh, tmp):
         yield fh
     try:
         os.replace(tmp, dest)
@@ -117,7 +124,8 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w") -> Iterator[IO[An
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
         raise
-    fsync_dir(dest.parent)
+    if durable:
+        fsync_dir(dest.parent)
 
 
 def fsync_dir(directory: str | os.PathLike[str]) -> None:
@@ -144,15 +152,15 @@ def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
     return removed
 
 
-def write_text(path: str | os.PathLike[str], text: str) -> None:
-    """Write ``text`` to ``path`` atomically."""
-    with atomic_open(path, "w") as fh:
+def write_text(path: str | os.PathLike[str], text: str, durable: bool = True) -> None:
+    """Write ``text`` to ``path`` atomically (``durable``: see :func:`atomic_open`)."""
+    with atomic_open(path, "w", durable) as fh:
         fh.write(text)
 
 
-def write_json(path: str | os.PathLike[str], data: Any) -> None:
-    """Write ``data`` as indented JSON to ``path`` atomically."""
-    write_text(path, json_text(data) + "\n")
+def write_json(path: str | os.PathLike[str], data: Any, durable: bool = True) -> None:
+    """Write ``data`` as indented JSON to ``path`` atomically (``durable``: see :func:`atomic_open`)."""
+    write_text(path, json_text(data) + "\n", durable)
 
 
 def json_text(data: Any) -> str:

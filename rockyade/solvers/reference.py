@@ -23,8 +23,10 @@ fell, the first time it did.
 
 from __future__ import annotations
 
+import json
 import time
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 from typing import Any, ClassVar
 
 import numba
@@ -33,14 +35,17 @@ import pandas as pd
 
 from rockyade import __version__
 from rockyade.calibration.model import calibrated_model
-from rockyade.dem.engine import KernelOutput, simulate_model
+from rockyade.dem.engine import KernelOutput, model_arrays, simulate_model, warm_up
 from rockyade.dem.frames import dem_frame, energy_gain, load_work
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.kernel import simulation as kernel
+from rockyade.kernel.runs import simulate_runs
+from rockyade.kernel.single import single_body
+from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.base import SolverBase, check_flag, motion_coverage
 from rockyade.solvers.cost import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
@@ -93,6 +98,132 @@ class ReferenceSolver(SolverBase):
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
         return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
+
+    def group_key(self, scene: Scene) -> str | None:
+        """What runs sharing one structure have in common (None: this run goes alone).
+
+        Runs of one free-standing block without energy terms or loads whose scenes differ only
+        in their base motion (its samples: the record, the load factor) share the model and are
+        run together by :meth:`run_group` (whose kernel has no loads).
+        """
+        if self.record_energy or scene.positioned or len(scene.blocks) != 1 or scene.blocks[0].fixed or scene.loads:
+            return None
+        d = scene.to_dict()
+        motion = scene.motion
+        d["motion"] = [motion.type, motion.initial_theta_rad, motion.initial_omega_rad_s]
+        return json.dumps(d, sort_keys=True, default=str)
+
+    def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
+        """Run scenes of one :meth:`group_key` together: the model is built once, its motion
+        replaced per run, and the runs stepped in parallel (:func:`rockyade.kernel.runs.simulate_runs`;
+        the same per-run results, bit for bit, as :meth:`run`).
+
+        Parameters
+        ----------
+        scenes
+            Scenes with one group key.
+        uplift_rad
+            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
+        threads
+            Threads stepping the runs (numba's, in this thread; a batch's workers run one each).
+
+        Returns
+        -------
+        list of GroupRun
+            In the scenes' order: each run's metadata (as :meth:`run`'s Result, without the
+            history) and its sampled theta.
+        """
+        start = time.perf_counter()
+        base = calibrated_model(scenes[0])
+        models = [base] + [
+            replace(base, motion=s.motion.ground_motion(s.duration_s), scene_hash=s.scene_hash,
+                    base_at_rest=s.motion.type)
+            for s in scenes[1:]
+        ]
+        records = pack(model_arrays(base), stop_on_overturn=base.stop_on_overturn, record_energy=False,
+                       record_corners=False, coherent=True)
+        if not single_body(records[0], records[1], False):
+            raise ValueError("run_group: one moving block without energy terms only (see group_key)")
+        motions = [model_arrays_motion(m) for m in models]
+        starts = np.cumsum([0] + [m[0].size for m in motions])
+        mt, mah, mav = (np.concatenate([m[k] for m in motions]) if motions else np.zeros(0) for k in range(3))
+        setup = time.perf_counter() - start
+        warm_up(runs=True)
+        before = numba.get_num_threads()
+        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+        try:
+            start = time.perf_counter()
+            out = simulate_runs(records[0], records[1], records[3], records[4], mt, mah, mav, starts, uplift_rad,
+                                base.sample_dt_s)
+            wall = (time.perf_counter() - start) / max(1, len(scenes))
+        finally:
+            numba.set_num_threads(before)
+        runs = []
+        for r, model in enumerate(models):
+            n = int(out.n_filled[r])
+            one = KernelOutput(
+                out.pos[r, :, None, :], out.ang[r, :, None], out.angvel[r, :, None], None, None, None,
+                int(out.status[r]), n, float(out.t_stop[r]), 0 if out.status[r] != kernel.STATUS_COMPLETED else -1,
+                None, None, out.overturn_time[r : r + 1], 1, 0, 0,
+            )
+            meta = {
+                "solver": self.name,
+                "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
+                "scene_hash": model.scene_hash,
+                "wall_time_s": wall,
+                **_outcome(model, one, n, model.stop_on_overturn),
+                "overturn_criterion": CRITERION,
+                "broad_phase": {"rebuilds": 1, "max_candidate_pairs": 0, "separating_axis_tests": 0},
+                **_model_meta(model, wall),
+                "batched": {"runs": len(scenes), "setup_time_s": setup},
+                "setup_time_s": setup / max(1, len(scenes)),
+                "motion_coverage": motion_coverage(scenes[r]),
+            }
+            metrics = {
+                "max_abs_theta_rad": float(out.max_abs_theta[r]),
+                "residual_theta_rad": float(out.residual_theta[r]),
+                "uplift_time_s": float(out.uplift_time[r]),
+            }
+            theta = out.ang[r, :n] - model.bodies[0].rest_angle_rad
+            runs.append(GroupRun(meta, theta, model.sample_dt_s, metrics))
+        return runs
+
+
+@dataclass(frozen=True)
+class GroupRun:
+    """One run of :meth:`ReferenceSolver.run_group`.
+
+    Attributes
+    ----------
+    meta
+        The Result's metadata of the run.
+    theta_rad
+        (n,) sampled rotation from rest, rad.
+    sample_dt_s
+        Time between samples, s.
+    metrics
+        Computed in the kernel: ``max_abs_theta_rad`` (rad), ``residual_theta_rad`` (rad),
+        ``uplift_time_s`` (s, NaN: never).
+    """
+
+    meta: dict[str, Any]
+    theta_rad: np.ndarray
+    sample_dt_s: float
+    metrics: dict[str, float]
+
+    @property
+    def status(self) -> str:
+        """completed | overturned | failed."""
+        return str(self.meta["status"])
+
+
+def model_arrays_motion(model: DemModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The base motion of a model as the kernel reads it: t (s), a_h and a_v (m/s^2)."""
+    motion = model.motion
+    if motion is None:
+        return np.zeros(0), np.zeros(0), np.zeros(0)
+    return (np.ascontiguousarray(motion.t_s, dtype=float), np.ascontiguousarray(motion.ah_m_s2, dtype=float),
+            np.ascontiguousarray(motion.av_m_s2, dtype=float))
 
 
 def run_model(

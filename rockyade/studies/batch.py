@@ -21,6 +21,10 @@ summary (``summary.csv``, and ``summary.parquet`` when pyarrow is installed) has
 run: the grid values, status, failure reason, wall time and per-block metrics (see
 :func:`rockyade.analysis.run_metrics`, and the rocking pattern for stacks).
 
+A run's JSON is written atomically (a killed batch leaves whole files or none) but not synced
+to the disk by itself: the batch syncs once, at the summary checkpoint (after a power cut,
+a run whose file did not reach the disk is run again by ``resume``).
+
 A failed run never stops the batch: its row says why (a full disk too: the run fails with
 that reason and the batch goes on). ``resume`` skips runs whose JSON says they completed
 (or overturned) for the same scene hash and re-runs failed ones. The summary is sorted by
@@ -40,12 +44,14 @@ import contextlib
 import copy
 import itertools
 import json
+import os
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from rockyade.errors import BatchInterruptedError, InputError, os_error_message
@@ -53,8 +59,9 @@ from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
 from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.result import Result
-from rockyade.runner import Executor, Task, run_tasks, solve
+from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
+from rockyade.runner.groups import group_jobs
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
 from rockyade.solvers.base import Solver
@@ -135,13 +142,28 @@ def batch_task(
     save_history: bool = True,
 ) -> BatchTask:
     """A batch run; the solver keeps its own files (if any) in ``<out_dir>/runs/<solver>/``.
+    Without the history, the solver records only what the summary reads (:func:`lean_solver`).
 
     ``out_dir`` is made absolute here, on the client: a worker elsewhere (a Dask worker in
     another folder) writes where the batch reads."""
     solver = as_solver(solver)
+    if not save_history:
+        solver = lean_solver(solver, scene)
     out = Path(out_dir).absolute()
     kept = solver.keeping_files(out / "runs" / solver.name)
     return BatchTask(index, kept, scene, dict(labels), str(out), save_history)
+
+
+def lean_solver(solver: Solver, scene: Scene) -> Solver:
+    """The solver of a run whose history is not kept: without energy terms, and for a column
+    without contact states (the summary reads neither; an assembly's collapse metrics read
+    the contacts' slipping)."""
+    changes = {}
+    if getattr(solver, "record_energy", False):
+        changes["record_energy"] = False
+    if getattr(solver, "record_contacts", False) and not scene.positioned:
+        changes["record_contacts"] = False
+    return replace(solver, **changes) if changes else solver  # type: ignore[type-var]
 
 
 # ---------------------------------------------------------------------- the study file
@@ -376,19 +398,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
     runs.mkdir(parents=True, exist_ok=True)
     name = run_name(task.scene_hash, task.solver.name)
     result = solve(task)
-    row: dict[str, Any] = {
-        "index": task.index,
-        "run": name,
-        "scene_hash": result.meta.get("scene_hash"),
-        "solver": task.solver.name,
-        **task.labels,
-        "status": result.status,
-        "failure_reason": result.meta.get("failure_reason") or "",
-        "overturn_time_s": result.meta.get("overturn_time_s"),
-        "overturned_block": result.meta.get("overturned_block") or "",
-        "wall_time_s": result.meta.get("wall_time_s"),
-        **coverage_columns(result.meta.get("motion_coverage")),
-    }
+    row = _status_row(task, result.meta)
     if result.ok:
         row.update(_metrics(task.scene, result))
     row["elapsed_s"] = time.perf_counter() - start
@@ -396,7 +406,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
         if task.save_history and result.ok:
             result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
         else:
-            write_json(runs / f"{name}.json", {**result.meta, "summary": row})
+            write_json(runs / f"{name}.json", {**result.meta, "summary": row}, durable=False)
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = _write_failure(task, row, exc)
     return row
@@ -413,6 +423,87 @@ def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
         "motion_time_left_out_s": coverage["time_left_out_s"],
         "motion_pga_left_out_fraction": coverage["pga_left_out_fraction"],
     }
+
+
+def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
+    """The summary row's leading and status columns of a run from its Result's metadata."""
+    return {
+        "index": task.index,
+        "run": run_name(task.scene_hash, task.solver.name),
+        "scene_hash": meta.get("scene_hash"),
+        "solver": task.solver.name,
+        **task.labels,
+        "status": meta["status"],
+        "failure_reason": meta.get("failure_reason") or "",
+        "overturn_time_s": meta.get("overturn_time_s"),
+        "overturned_block": meta.get("overturned_block") or "",
+        "wall_time_s": meta.get("wall_time_s"),
+        **coverage_columns(meta.get("motion_coverage")),
+    }
+
+
+# ---------------------------------------------------------------------- runs in groups
+
+
+def job_key(task: BatchTask) -> Any:
+    """The group of a task (:func:`rockyade.runner.groups.group_jobs`): runs without history
+    whose solver runs scenes of one structure together (``group_key``); None: it runs alone."""
+    key = getattr(task.solver, "group_key", None)
+    if task.save_history or key is None:
+        return None
+    k = key(task.scene)
+    return None if k is None else (task.out_dir, repr(task.solver), k)
+
+
+def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
+    """Run a job of :func:`job_key`'s group (or one task); its summary rows. Never raises:
+    should the group fail as a whole, its runs are run one by one."""
+    if len(job) == 1:
+        return [run_task(job[0])]
+    first = job[0]
+    with writing_for(first.out_dir, first.lock_token) if first.lock_token else contextlib.nullcontext():
+        return _run_group(job)
+
+
+def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
+    from rockyade.analysis.metrics import peak_metrics, uplift_threshold_rad
+
+    start = time.perf_counter()
+    first = job[0]
+    spec = first.scene.blocks[0]
+    alpha = spec.classical().alpha_rad
+    try:
+        runs = first.solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+    except Exception:  # a run of its own says what went wrong
+        return [_run_task(task) for task in job]
+    elapsed = (time.perf_counter() - start) / len(job)
+    folder = Path(first.out_dir) / "runs"
+    folder.mkdir(parents=True, exist_ok=True)
+    free = first.scene.motion.type == "free"
+    rows = []
+    for task, one in zip(job, runs, strict=True):
+        row = _status_row(task, one.meta)
+        if one.status != "failed":
+            t = np.arange(one.theta_rad.size) * one.sample_dt_s
+            m = one.metrics
+            overturned = one.meta.get("overturned_block") == spec.name or spec.name in (
+                one.meta.get("overturn_times_s") or {}
+            )
+            row.update(
+                max_abs_theta_rad=m["max_abs_theta_rad"],
+                max_theta_over_alpha=m["max_abs_theta_rad"] / alpha,
+                **peak_metrics(t, one.theta_rad, alpha, free),
+                residual_theta_rad=m["residual_theta_rad"],
+                uplift_time_s=m["uplift_time_s"],
+                overturned=overturned,
+            )
+        row["elapsed_s"] = elapsed
+        try:
+            write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row}, durable=False)
+        except OSError as exc:
+            row = _write_failure(task, row, exc)
+        rows.append(row)
+    return rows
 
 
 def _metrics(scene: Scene, result: Result) -> dict[str, Any]:
@@ -507,6 +598,7 @@ def run_study_tasks(
     desc: str = "runs",
     allow_large: bool = False,
     scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
+    group_runs: bool = True,
 ) -> pd.DataFrame:
     """Run tasks and write the summary; return it (sorted by task order).
 
@@ -521,6 +613,9 @@ def run_study_tasks(
         Skip runs already completed for the same scene hash; re-run failed ones.
     allow_large
         Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost`.
+    group_runs
+        Run the runs that share a structure together (:func:`job_key`, :func:`run_job`; the
+        same rows); False: one run per job (benchmarks compare the two).
 
     Raises
     ------
@@ -535,7 +630,9 @@ def run_study_tasks(
     with output_lock(out, "out"):
         token = lock_token(out)
         _settle(out)
-        return _run_locked([replace(t, lock_token=token) for t in tasks], out, how, resume, progress, desc, allow_large)
+        return _run_locked(
+            [replace(t, lock_token=token) for t in tasks], out, how, resume, progress, desc, allow_large, group_runs
+        )
 
 
 def _settle(out: Path) -> None:
@@ -548,7 +645,14 @@ def _settle(out: Path) -> None:
 
 
 def _run_locked(
-    tasks: list[BatchTask], out: Path, how: Executor, resume: bool, progress: bool, desc: str, allow_large: bool
+    tasks: list[BatchTask],
+    out: Path,
+    how: Executor,
+    resume: bool,
+    progress: bool,
+    desc: str,
+    allow_large: bool,
+    group_runs: bool = True,
 ) -> pd.DataFrame:
     first, duplicates = _distinct(tasks)
     rows: list[dict[str, Any]] = []
@@ -559,35 +663,43 @@ def _run_locked(
             rows.append(done)
         else:
             todo.append(task)
-    outcome = run_tasks(
-        todo,
-        run_task,
+    check_costs(todo, allow_large)
+    key = job_key if group_runs else (lambda _task: None)
+    n_grouped = sum(key(t) is not None for t in todo)
+    jobs = group_jobs(todo, key, min(MAX_RUNS_PER_JOB, max(1, -(-n_grouped // (4 * how.workers)))))
+    outcome = run_jobs(
+        jobs,
+        run_job,
         executor=how,
-        allow_large=allow_large,
-        failed=_crashed_row,
-        on_done=lambda _i, row: rows.append(row),
-        describe_failure=_failure_line,
+        failed=lambda job, reason: [_crashed_row(task, reason) for task in job],
+        on_done=lambda _i, job_rows: rows.extend(job_rows),
+        describe_failure=lambda job_rows: "\n".join(filter(None, map(_failure_line, job_rows))) or None,
         progress=progress,
         desc=desc,
         skipped=len(rows),
     )
     for i in outcome.unfinished:
         reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"
-        rows.append(_placeholder_row(todo[i], UNFINISHED, reason))
+        rows.extend(_placeholder_row(task, UNFINISHED, reason) for task in jobs[i])
     by_index = {row["index"]: row for row in rows}
     for task, original in duplicates:
         rows.append(_duplicate_row(task, by_index[original.index]))
     for row in rows:
         row.setdefault("duplicate_of", -1)
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
+    os.sync()  # the runs' files reach the disk here, once, not at each run
     write_summary(summary, out)
     if outcome.stopped:
         if outcome.hard:
             _settle(out)
-        stopped = {todo[i].index for i in outcome.unfinished}
+        stopped = {task.index for i in outcome.unfinished for task in jobs[i]}
         unfinished = len(stopped) + sum(1 for _task, original in duplicates if original.index in stopped)
         raise BatchInterruptedError(len(tasks) - unfinished, unfinished, str(out / "summary.csv"), hard=outcome.hard)
     return summary
+
+
+#: Most runs of one group in one job (groups are cut so that every worker gets jobs).
+MAX_RUNS_PER_JOB = 64
 
 
 def _distinct(tasks: list[BatchTask]) -> tuple[list[BatchTask], list[tuple[BatchTask, BatchTask]]]:
@@ -661,7 +773,9 @@ __all__ = [
     "comparable",
     "expand",
     "failures",
+    "job_key",
     "load_study",
+    "run_job",
     "run_study_tasks",
     "run_task",
     "write_summary",
