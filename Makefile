@@ -23,6 +23,7 @@ $(STAMP): pyproject.toml
 lint: setup
 	$(BIN)/ruff check .
 	$(BIN)/lint-imports
+	$(BIN)/mypy rockyade
 
 test: setup lint
 	ROCKYADE_REQUIRE_YADE=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15

@@ -207,7 +207,7 @@ def structure_rotation(scene: Scene, result: Result) -> dict[str, float | str]:
         corner > 0), ``structure_max_theta_over_alpha``; NaN and ``structure_note`` saying why
         for an assembly that is not a stack (:data:`NO_WHOLE_ROTATION`). Angles in rad.
     """
-    nan = {
+    nan: dict[str, float | str] = {
         "structure": "none",
         "structure_alpha_rad": math.nan,
         "structure_max_theta_rad": math.nan,

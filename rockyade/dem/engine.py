@@ -37,15 +37,15 @@ class KernelOutput(NamedTuple):
     pos: NDArray[np.float64]
     ang: NDArray[np.float64]
     angvel: NDArray[np.float64]
-    vpoint: NDArray[np.float64]
-    corner_states: NDArray[np.int8]
-    energy: NDArray[np.float64]
+    vpoint: NDArray[np.float64] | None  # None: a batched run (rockyade.kernel.runs) keeps no history of it
+    corner_states: NDArray[np.int8] | None
+    energy: NDArray[np.float64] | None
     status: int
     n_filled: int
     t_stop: float
     stop_body: int
-    n_contacts: NDArray[np.int32]
-    slipping: NDArray[np.bool_]
+    n_contacts: NDArray[np.int32] | None
+    slipping: NDArray[np.bool_] | None
     overturn_time: NDArray[np.float64]
     n_builds: int
     max_pairs: int

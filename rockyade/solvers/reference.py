@@ -150,7 +150,8 @@ class ReferenceSolver(SolverBase):
         setup = time.perf_counter() - start
         warm_up(runs=True)
         before = numba.get_num_threads()
-        numba.set_num_threads(max(1, min(int(threads), numba.config.NUMBA_NUM_THREADS)))
+        most = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]  # numba.config sets it at import
+        numba.set_num_threads(max(1, min(int(threads), most)))
         try:
             start = time.perf_counter()
             out = simulate_runs(records[0], records[1], records[3], records[4], mt, mah, mav, starts, uplift_rad,
@@ -266,6 +267,9 @@ def run_model(
         model, record_energy, record_corners=corners, stop_on_overturn=stop_on_overturn, stop_angle_rad=stop_angle_rad
     )
     n = int(out.n_filled)
+    # simulate_model keeps every history (only a batched run's KernelOutput has None)
+    assert out.vpoint is not None and out.corner_states is not None and out.energy is not None
+    assert out.n_contacts is not None and out.slipping is not None
     frame = dem_frame(
         model,
         out.pos[:n],
@@ -349,7 +353,7 @@ def _outcome(model: DemModel, out: KernelOutput, n: int, stop_on_overturn: bool)
     overturn_times = {names[i]: float(t) for i, t in enumerate(out.overturn_time) if np.isfinite(t)}
     overturned_block = names[int(out.stop_body)] if status == "overturned" else None
     if not stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
-        t = np.arange(n) * model.sample_dt_s
+        t = np.arange(n, dtype=float) * model.sample_dt_s
         falls = body_falls(model.bodies, t, out.pos[:n], out.ang[:n], overturn_times)
         status, t_first, overturned_block = run_outcome(overturn_times, names, falls, t)
         t_stop = t_first if t_first is not None else t_stop

@@ -58,6 +58,7 @@ from rockyade.errors import BatchInterruptedError, InputError, os_error_message
 from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
 from rockyade.io.fields import TableReader
 from rockyade.io.locking import lock_token, output_lock, writing_for
+from rockyade.motion.types import RecordMotion
 from rockyade.result import Result
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
@@ -348,7 +349,7 @@ def expand(
     keys = list(grid)
     _check_alternatives(keys, source)
     base_dir = Path(source).resolve().parent if source else None
-    tasks = []
+    tasks: list[BatchTask] = []
     for base_name, base in bases:
         for values in itertools.product(*(grid[k] for k in keys)):
             d = copy.deepcopy(base)
@@ -367,10 +368,10 @@ def expand(
 
 def _absolute_files(scene: Scene) -> Scene:
     """The scene with its record file named by an absolute path (a worker elsewhere reads it)."""
-    file = getattr(scene.motion, "file", None)
-    if not file or Path(file).is_absolute():
+    motion = scene.motion
+    if not isinstance(motion, RecordMotion) or Path(motion.file).is_absolute():
         return scene
-    return replace(scene, motion=replace(scene.motion, file=str(Path(file).resolve())))
+    return replace(scene, motion=replace(motion, file=str(Path(motion.file).resolve())))
 
 
 def _label(value: Any) -> Any:
