@@ -37,6 +37,7 @@ class Opt:
 
     @property
     def dest(self) -> str:
+        """The argparse destination of the option (its name without dashes, '-' as '_')."""
         return self.flag[2:].replace("-", "_")
 
 

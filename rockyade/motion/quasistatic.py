@@ -90,13 +90,17 @@ class GravityRamp(MotionSpec):
     ramp_s: float = 1.0
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """Vertical base acceleration av = -g (1 - r(t)), r a half-cosine ramp over ``ramp_s`` (module
+        docstring), then held; m/s^2."""
         return _ramp_motion(self.ramp_s, duration_s, f"gravity ramp over {self.ramp_s:g} s")
 
     def sample_count(self, duration_s: float) -> int:
+        """Samples of the ramp (the held tail needs none: the last sample is held)."""
         return RAMP_SAMPLES + 1
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> GravityRamp:
+        """The motion from its ``[motion]`` table: ``ramp_s`` (s, 1e-3 to 1e3, default 1)."""
         return cls(r.number("ramp_s", 1.0, lo=1e-3, hi=1e3, unit="s"))
 
 
@@ -163,6 +167,8 @@ class Pushover(MotionSpec):
         return np.array(t), np.array(lam)
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The gravity ramp, then the horizontal base acceleration lambda(t) g in ``direction``
+        (:meth:`lambda_path`); m/s^2."""
         t_g, av_g = gravity_ramp_samples(self.ramp_s)
         t_p, lam = self.lambda_path(duration_s)
         sign = DIRECTIONS[self.direction]
@@ -176,10 +182,13 @@ class Pushover(MotionSpec):
         return GroundMotion(t[keep], ah[keep], av[keep], label)
 
     def sample_count(self, duration_s: float) -> int:
+        """Samples of the ramp and of the multiplier's path (two per held level)."""
         return RAMP_SAMPLES + 2 * max(1, self.levels().size) + 2
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> Pushover:
+        """The motion from its ``[motion]`` table: direction, ramp_s, settle_s, rate_g_per_s,
+        max_lambda, and held levels (start_lambda, step_lambda, hold_s); ranges in the module docstring."""
         direction = r.string("direction", "+x", choices=sorted(DIRECTIONS))
         ramp = r.number("ramp_s", 1.0, lo=1e-3, hi=1e3, unit="s")
         settle = r.number("settle_s", 0.5, lo=0.0, hi=1e3, unit="s")

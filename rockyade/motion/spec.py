@@ -98,22 +98,27 @@ class FreeRocking(MotionSpec):
     block: str | None = None
 
     def ground_motion(self, duration_s: float) -> GroundMotion | None:
+        """None: in free rocking the base does not move."""
         return None
 
     @property
     def initial_theta_rad(self) -> float:
+        """The release tilt ``theta0_rad``, rad."""
         return self.theta0_rad
 
     @property
     def initial_omega_rad_s(self) -> float:
+        """The release angular velocity ``omega0_rad_s``, rad/s."""
         return self.omega0_rad_s
 
     @property
     def released_block(self) -> str | None:
+        """The block given the release tilt (``block``; None: the top block)."""
         return self.block
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> FreeRocking:
+        """The motion from its ``[motion]`` table: ``theta0_rad``, ``omega0_rad_s``, ``block``."""
         theta0 = r.number("theta0_rad", lo=-math.pi / 2, hi=math.pi / 2, lo_open=True, hi_open=True, unit="rad")
         omega0 = r.number("omega0_rad_s", 0.0, lo=-MAX_OMEGA0_RAD_S, hi=MAX_OMEGA0_RAD_S, unit="rad/s")
         block = r.string("block", None)
@@ -135,10 +140,12 @@ class AtRest(MotionSpec):
     type: ClassVar[str] = "rest"
 
     def ground_motion(self, duration_s: float) -> GroundMotion | None:
+        """None: the base does not move (gravity acts from t = 0: a drop test)."""
         return None
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> AtRest:
+        """The motion from its ``[motion]`` table (no keys)."""
         return cls()
 
 
@@ -168,9 +175,11 @@ class SampledMotion(MotionSpec):
     load_factor: float = 1.0
 
     def sample_count(self, duration_s: float) -> int:
+        """The samples given in the table."""
         return len(self.accel_m_s2)
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The given samples times ``load_factor``, at ``t_s`` or every ``dt_s``; m/s^2."""
         ah = np.array(self.accel_m_s2) * self.load_factor
         av = None if self.accel_v_m_s2 is None else np.array(self.accel_v_m_s2) * self.load_factor
         if self.t_s is not None:
@@ -182,6 +191,8 @@ class SampledMotion(MotionSpec):
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> SampledMotion:
+        """The motion from its ``[motion]`` table: ``accel_m_s2`` with ``dt_s`` or ``t_s``, optional
+        ``accel_v_m_s2``."""
         accel = r.number_list("accel_m_s2", min_len=2, unit="m/s^2")
         dt = r.number("dt_s", None, lo=1.0e-6, hi=1.0, unit="s")
         t = r.number_list("t_s", None, min_len=2, unit="s")

@@ -88,14 +88,18 @@ class HarmonicMotion(MotionSpec):
         return Harmonic(self.amplitude_mm, self.frequency_hz, self.cycles, self.ramp_cycles, self.start_s)
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The harmonic base displacement's acceleration times ``load_factor`` (400 samples per cycle); m/s^2."""
         return self.harmonic.ground_motion(self.load_factor)
 
     def sample_count(self, duration_s: float) -> int:
         # as Harmonic.ground_motion samples it: 400 points per cycle to the end
+        """Samples at 400 points per cycle to the motion's end."""
         return math.ceil(self.harmonic.phases_s["end_s"] * self.frequency_hz * 400) + 1
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> HarmonicMotion:
+        """The motion from its ``[motion]`` table: ``amplitude_mm`` (mm), ``frequency_hz`` (Hz),
+        ``cycles`` or ``duration_s``, ``ramp_cycles``, ``start_s``."""
         amplitude = r.number("amplitude_mm", lo=0.0, hi=1000.0, lo_open=True, unit="mm")
         frequency = r.number("frequency_hz", lo=0.0, hi=100.0, lo_open=True, unit="Hz")
         cycles = r.integer("cycles", None, lo=1, hi=100_000)
@@ -127,15 +131,19 @@ class PulseMotion(MotionSpec):
         return Pulse(self.shape, self.amplitude_m_s2, self.period_s, self.cycles, self.start_s)
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The pulse times ``load_factor``, sampled at T/400 (at most 1 ms); m/s^2."""
         return self.pulse.ground_motion(self.load_factor)
 
     def sample_count(self, duration_s: float) -> int:
         # as Pulse.ground_motion samples it: T / 400, at most 1 ms, to the end
+        """Samples at T/400 (at most 1 ms) to the pulse's end."""
         pulse = self.pulse
         return math.ceil((pulse.start_s + pulse.duration_s) / min(pulse.period_s / 400.0, 1e-3)) + 2
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> PulseMotion:
+        """The motion from its ``[motion]`` table: ``shape``, ``amplitude_m_s2`` or ``amplitude_g``,
+        ``period_s``, ``cycles``, ``start_s``."""
         shape = r.string("shape", choices=PULSE_SHAPES)
         amp = r.number("amplitude_m_s2", None, lo=0.0, hi=1000.0, lo_open=True, unit="m/s^2")
         amp_g = r.number("amplitude_g", None, lo=0.0, hi=100.0, lo_open=True, unit="g")
@@ -178,20 +186,25 @@ class RecordMotion(MotionSpec):
         return rec
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The record's samples times ``load_factor``; m/s^2."""
         rec = self.record()
         label = f"record {Path(self.file).name}" + (f" x{self.load_factor:g}" if self.load_factor != 1 else "")
         return GroundMotion(rec.t_s, rec.accel_m_s2 * self.load_factor, None, label)
 
     def hash_material(self) -> dict[str, Any]:
+        """The table with the file named by the SHA-256 of its bytes (a moved file keeps its hash)."""
         d = self.to_dict()
         d["file"] = hashlib.sha256(Path(self.file).read_bytes()).hexdigest()
         return d
 
     def sample_count(self, duration_s: float) -> int:
+        """The record's samples, counted without reading them all."""
         return count_samples(self.file, self.format)
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> RecordMotion:
+        """The motion from its ``[motion]`` table: ``file`` (relative to ``base_dir``), ``format``,
+        ``units``, ``dt_s``, ``baseline``, ``bandpass_hz``."""
         name = r.string("file")
         path = Path(name)
         if not path.is_absolute() and base_dir is not None:
@@ -243,10 +256,12 @@ class SyntheticMotion(MotionSpec):
         return SuiteSpec(target, count=self.count or 30, seed=self.seed or 0, name=self.suite)
 
     def sample_count(self, duration_s: float) -> int:
+        """Samples of the suite's records (envelope duration over dt)."""
         spec = self.suite_spec()
         return round(spec.envelope.duration_s / spec.dt_s) + 1
 
     def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The suite's record number ``record`` (generated once, cached) times ``load_factor``; m/s^2."""
         rec = suite_record(self.suite_spec(), self.record)
         label = f"synthetic {self.suite} record {self.record}" + (
             f" x{self.load_factor:g}" if self.load_factor != 1 else ""
@@ -255,6 +270,8 @@ class SyntheticMotion(MotionSpec):
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> SyntheticMotion:
+        """The motion from its ``[motion]`` table: ``suite``, the EC8 spectrum and site (a custom
+        suite), ``seed``, ``count``, ``record``."""
         suite = r.string("suite", "paper")
         st = r.integer("spectrum_type", None, lo=1, hi=2)
         ground = r.string("ground", None, choices=["A", "B", "C", "D", "E"])

@@ -628,6 +628,11 @@ def prepare(scene, out_path, csv_path=None):
 
 
 def main(scene_path, out_path, csv_path=None, describe=False, wait=True):
+    """Run one scene in this YADE process: read the JSON payload at ``scene_path``, build the
+    clumps and contacts, run to the end or the stop rule, and write the samples to ``out_path``
+    (``.npz``; ``csv_path``: also as CSV). ``describe``: print the clumps' summary as JSON and
+    return without running; ``wait``: block until the run ends and write (False: leave the run
+    going, the recorder writes when it stops)."""
     with open(scene_path) as fh:
         scene = json.load(fh)
     recorder, clumps = prepare(scene, out_path, csv_path)
