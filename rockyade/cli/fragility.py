@@ -12,6 +12,7 @@ from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: these are imported when a command runs
     from rockyade.assess import SyntheticSuite
+    from rockyade.assess.fragility import FragilityPlan, FragilityResult
     from rockyade.assess.motions import MotionSet
     from rockyade.runner import Executor
     from rockyade.solvers.base import Solver
@@ -118,7 +119,7 @@ def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
     add_allow_large(p)
 
 
-def print_plan(plan: Any, workers: int, indent: str = "") -> None:
+def print_plan(plan: FragilityPlan, workers: int, indent: str = "") -> None:
     """The plan and its cost, before anything runs."""
     from rockyade.assess.report import plan_lines
 
@@ -126,7 +127,7 @@ def print_plan(plan: Any, workers: int, indent: str = "") -> None:
         print(indent + line, flush=True)
 
 
-def write_tables(out: Path, result: Any, prefix: str = "") -> list[str]:
+def write_tables(out: Path, result: FragilityResult, prefix: str = "") -> list[str]:
     """``runs.csv``, ``stripes.csv`` and ``records.csv`` of a fragility result; their names."""
     from rockyade.io.atomic import atomic_open
 

@@ -5,10 +5,15 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.build import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_file, json_out, total_time
+
+if TYPE_CHECKING:
+    from rockyade.result import Result
+    from rockyade.scene import Scene
+    from rockyade.solvers.base import Solver
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -48,7 +53,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     return 0 if result.ok else 1
 
 
-def _warn_if_the_motion_is_cut(scene: Any) -> None:
+def _warn_if_the_motion_is_cut(scene: Scene) -> None:
     """One warning line on stderr when the scene ends before its base motion does."""
     import sys
 
@@ -60,7 +65,7 @@ def _warn_if_the_motion_is_cut(scene: Any) -> None:
         print(f"rockyade: warning: {where}{coverage['message']}", file=sys.stderr)
 
 
-def _write_capacity(scene: Any, result: Any, path: Path) -> None:
+def _write_capacity(scene: Scene, result: Result, path: Path) -> None:
     """A pushover's capacity curve (rockyade.analysis.capacity) and its onset, one line."""
     from rockyade.analysis.capacity import capacity_curve, pushover_onset
     from rockyade.io.atomic import atomic_open
@@ -72,7 +77,7 @@ def _write_capacity(scene: Any, result: Any, path: Path) -> None:
     print(f"wrote {path} (capacity curve; onset lambda = {onset.multiplier:.4g}: {onset.rule})")
 
 
-def _write_collapse(scene: Any, result: Any, path: Path) -> None:
+def _write_collapse(scene: Scene, result: Result, path: Path) -> None:
     """Per block: whether and when it fell, rocking and sliding time, residual displacement."""
     from rockyade.analysis.collapse import collapse_report
     from rockyade.io.atomic import atomic_open
@@ -82,7 +87,7 @@ def _write_collapse(scene: Any, result: Any, path: Path) -> None:
     print(f"wrote {path} (collapse: the state of every block)")
 
 
-def _print_summary(scene: Any, result: Any, total_s: float = math.nan) -> None:
+def _print_summary(scene: Scene, result: Result, total_s: float = math.nan) -> None:
     from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
     from rockyade.blocks.restitution import MU_EFF_IMPACTS
 
@@ -199,7 +204,7 @@ def solver_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, 
     return options, flags
 
 
-def solvers_from_args(names: list[str], args: argparse.Namespace) -> list[Any]:
+def solvers_from_args(names: list[str], args: argparse.Namespace) -> list[Solver]:
     """The solvers ``names`` with the command line's solver options, each to the solvers that
     take it (an option none of them takes is refused: ``--yade-timeout`` without yade)."""
     from rockyade.solvers import make_solvers

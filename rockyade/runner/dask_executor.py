@@ -15,7 +15,7 @@ from typing import Any
 
 from rockyade.errors import InputError
 from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed, call
+from rockyade.runner.threads import Failed, Job, Value, call
 
 SCHEDULER_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc)://\S+$")
 
@@ -34,11 +34,11 @@ def check_scheduler(address: str) -> str:
 
 
 def run_dask_in_process(
-    jobs: Sequence[Any],
-    fn: Callable[[Any], Any],
+    jobs: Sequence[Job],
+    fn: Callable[[Job], Value],
     workers: int,
-    done: Callable[[int, Any], None],
-    failed: Failed | None,
+    done: Callable[[int, Value], None],
+    failed: Failed[Job, Value] | None,
     stop: StopRequest,
     started: set[int],
 ) -> None:
@@ -77,12 +77,12 @@ def run_dask_in_process(
 
 
 def run_dask_remote(
-    jobs: Sequence[Any],
-    fn: Callable[[Any], Any],
+    jobs: Sequence[Job],
+    fn: Callable[[Job], Value],
     scheduler: str,
     timeout_s: float,
-    done: Callable[[int, Any], None],
-    failed: Failed | None,
+    done: Callable[[int, Value], None],
+    failed: Failed[Job, Value] | None,
     stop: StopRequest,
     started: set[int],
 ) -> None:

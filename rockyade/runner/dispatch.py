@@ -17,13 +17,13 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import Any, Generic, TypeVar
 
 from rockyade.result import Result
 from rockyade.runner.executor import IN_THIS_THREAD, Executor
 from rockyade.runner.stopping import StopRequest
 from rockyade.runner.tasks import Task, check_costs, failed_task, solve
-from rockyade.runner.threads import Failed
+from rockyade.runner.threads import Failed, Job, Value
 from rockyade.scene import Scene
 from rockyade.solvers.base import Solver
 
@@ -32,7 +32,7 @@ TaskT = TypeVar("TaskT", bound=Task)
 
 
 @dataclass(frozen=True)
-class Outcome:
+class Outcome(Generic[Value]):
     """What a run of many jobs came to.
 
     Attributes
@@ -49,13 +49,13 @@ class Outcome:
         A second Ctrl-C stopped running jobs.
     """
 
-    values: dict[int, Any]
+    values: dict[int, Value]
     unfinished: list[int]
     started: frozenset[int]
     stopped: bool
     hard: bool
 
-    def in_order(self) -> list[Any]:
+    def in_order(self) -> list[Value]:
         """The values in the jobs' order (every job finished)."""
         return [self.values[i] for i in range(len(self.values))]
 
@@ -68,17 +68,17 @@ def progress_bar(total: int, enabled: bool, desc: str) -> Any:
 
 
 def run_jobs(
-    jobs: Iterable[Any],
-    fn: Callable[[Any], Any],
+    jobs: Iterable[Job],
+    fn: Callable[[Job], Value],
     *,
     executor: Executor = IN_THIS_THREAD,
-    failed: Failed | None = None,
-    on_done: Callable[[int, Any], None] | None = None,
-    describe_failure: Callable[[Any], str | None] | None = None,
+    failed: Failed[Job, Value] | None = None,
+    on_done: Callable[[int, Value], None] | None = None,
+    describe_failure: Callable[[Value], str | None] | None = None,
     progress: bool = False,
     desc: str = "runs",
     skipped: int = 0,
-) -> Outcome:
+) -> Outcome[Value]:
     """Run ``fn(job)`` for every job on ``executor`` (module docstring).
 
     Parameters
@@ -98,12 +98,12 @@ def run_jobs(
         Jobs done before (a resumed batch): counted on the bar as already finished.
     """
     jobs = list(jobs)
-    values: dict[int, Any] = {}
+    values: dict[int, Value] = {}
     started: set[int] = set()
     bar = progress_bar(len(jobs) + skipped, progress, desc)
     bar.update(skipped)
 
-    def done(i: int, value: Any) -> None:
+    def done(i: int, value: Value) -> None:
         values[i] = value
         bar.update(1)
         if on_done is not None:
@@ -139,7 +139,7 @@ def run_tasks(
     allow_large: bool = False,
     failed: Callable[[TaskT, str], Any] = failed_task,
     **options: Any,
-) -> Outcome:
+) -> Outcome[Any]:
     """Check the tasks' costs (before any run: :func:`~rockyade.runner.tasks.check_costs`),
     then run ``fn(task)`` for each (default :func:`~rockyade.runner.tasks.solve`: its
     Result); ``options`` as :func:`run_jobs` takes them.

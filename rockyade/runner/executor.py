@@ -14,11 +14,10 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 from rockyade.errors import InputError
 from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed
+from rockyade.runner.threads import Failed, Job, Value
 
 EXECUTORS = ("threads", "local", "dask")
 MAX_WORKERS = 1024
@@ -67,10 +66,10 @@ class Executor:
 
     def run(
         self,
-        jobs: Sequence[Any],
-        fn: Callable[[Any], Any],
-        done: Callable[[int, Any], None],
-        failed: Failed | None,
+        jobs: Sequence[Job],
+        fn: Callable[[Job], Value],
+        done: Callable[[int, Value], None],
+        failed: Failed[Job, Value] | None,
         stop: StopRequest,
         started: set[int],
     ) -> None:

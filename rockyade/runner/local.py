@@ -12,21 +12,20 @@ import collections
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, wait
 from concurrent.futures.process import BrokenProcessPool
-from typing import Any
 
 from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed
+from rockyade.runner.threads import Failed, Job, Value
 from rockyade.runner.workers import kill_workers, new_pool, replace_pool
 
 WORKER_DIED = "the worker process died (killed, or out of memory)"
 
 
 def run_local(
-    jobs: Sequence[Any],
-    fn: Callable[[Any], Any],
+    jobs: Sequence[Job],
+    fn: Callable[[Job], Value],
     workers: int,
-    done: Callable[[int, Any], None],
-    failed: Failed | None,
+    done: Callable[[int, Value], None],
+    failed: Failed[Job, Value] | None,
     stop: StopRequest,
     started: set[int],
 ) -> None:
@@ -36,7 +35,7 @@ def run_local(
     left the others unstarted (or, after a second Ctrl-C, stopped).
     """
     pending = collections.deque(range(len(jobs)))
-    running: dict[Future[Any], int] = {}
+    running: dict[Future[Value], int] = {}
     pool = new_pool(workers)
     killed = False
     try:

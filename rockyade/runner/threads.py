@@ -11,15 +11,18 @@ from __future__ import annotations
 import collections
 from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
-from typing import Any
+from typing import TypeVar
 
 from rockyade.runner.stopping import StopRequest
 
+#: A job, and the value its function gives (a Result, a row, ...): open to the caller.
+Job = TypeVar("Job")
+Value = TypeVar("Value")
 #: The value of a job that raised or whose worker died, from the job and the reason.
-Failed = Callable[[Any, str], Any]
+Failed = Callable[[Job, str], Value]
 
 
-def call(fn: Callable[[Any], Any], job: Any, failed: Failed | None) -> Any:
+def call(fn: Callable[[Job], Value], job: Job, failed: Failed[Job, Value] | None) -> Value:
     """``fn(job)``, or the failed value of the job if it raises (``failed`` None: it raises)."""
     try:
         return fn(job)
@@ -30,11 +33,11 @@ def call(fn: Callable[[Any], Any], job: Any, failed: Failed | None) -> Any:
 
 
 def run_threads(
-    jobs: Sequence[Any],
-    fn: Callable[[Any], Any],
+    jobs: Sequence[Job],
+    fn: Callable[[Job], Value],
     workers: int,
-    done: Callable[[int, Any], None],
-    failed: Failed | None,
+    done: Callable[[int, Value], None],
+    failed: Failed[Job, Value] | None,
     stop: StopRequest,
     started: set[int],
 ) -> None:
@@ -47,7 +50,7 @@ def run_threads(
             done(i, call(fn, job, failed))
         return
     pending = collections.deque(range(len(jobs)))
-    running: dict[Future[Any], int] = {}
+    running: dict[Future[Value], int] = {}
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-run")
     clean = False
     try:
