@@ -3,6 +3,7 @@ records, the fit and its band, and the collapse of real runs (Housner and the re
 
 from __future__ import annotations
 
+import json
 import math
 import shutil
 
@@ -23,6 +24,7 @@ from rockyade.assess import (
     parse_measure,
     records_in_folder,
 )
+from rockyade.assess.assessment import add_pushover
 from rockyade.assess.code import NOT_APPLICABLE, NOT_VERIFIED, VERIFIED, Check, check_code, verdict
 from rockyade.assess.fit import fit_stripes, refit, stripe_table
 from rockyade.assess.fragility import EXTEND_RATIO, _next_level, check_levels, fragility_plan, run_fragility
@@ -408,3 +410,44 @@ def test_finite_or_null_makes_json_strict():
 
     data = {"beta": math.nan, "band": (1.0, np.float64("inf")), "rows": [{"fraction": -math.inf, "n": 3}], "s": "x"}
     assert finite_or_null(data) == {"beta": None, "band": [1.0, None], "rows": [{"fraction": None, "n": 3}], "s": "x"}
+
+
+def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path, capsys):
+    """``rockyade assess --pushover`` on examples/free_standing_wall.toml (alpha0 = b / h = 0.1):
+    the reference DEM's onset (held levels every 1 % of alpha0) is within 2 % of alpha0, the
+    curve's first point sits on the code's a* axis (d* ~ 0, a* within 2 % of a0*), and the
+    figure carries the DEM line over the code's curve."""
+    from matplotlib import pyplot as plt
+
+    from rockyade.cli import main
+    from rockyade.figures.assess import plot_capacity
+    from rockyade.scene import load_scene
+
+    scene = load_scene(EXAMPLES / "free_standing_wall.toml")
+    a = assess(scene, Site(1, "B", 0.25 * G, 1.0), direction="+x")
+    add_pushover(a, scene)
+    kin, push = a.limit.kinematic, a.pushover
+    assert kin is not None and push is not None
+    assert kin.alpha0 == pytest.approx(0.1, rel=1e-9)
+    assert abs(push.onset.multiplier / kin.alpha0 - 1.0) <= 0.02
+    assert push.onset.below <= kin.alpha0 * (1 + 1e-6)
+    d0, a0 = float(push.d_star_m[0]), float(push.a_star_m_s2[0])
+    assert abs(d0) < 0.02 * kin.d0_star_m  # on the a* axis
+    assert abs(a0 / kin.a0_star_m_s2 - 1.0) <= 0.02
+    assert push.d_star_m[-1] > kin.d0_star_m  # the run went past the code's d0*: it overturned
+    data = a.to_dict()
+    assert data["pushover_onset_lambda"] == pytest.approx(push.onset.multiplier)
+    assert data["pushover_onset_minus_alpha0_pct"] == pytest.approx(100 * (push.onset.multiplier / 0.1 - 1))
+    fig, ax = plot_capacity(a)
+    labels = [line.get_label() for line in ax.get_lines()]
+    assert any(lab.startswith("reference DEM pushover") for lab in labels), labels
+    dem = next(line for line in ax.get_lines() if line.get_label().startswith("reference DEM pushover"))
+    assert np.asarray(dem.get_ydata())[0] == pytest.approx(a0)
+    plt.close(fig)
+    # the command: the option, the words, the JSON
+    assert main(["assess", str(EXAMPLES / "free_standing_wall.toml"), "--spectrum-type", "1", "--ground", "B",
+                 "--ag", "0.25g", "--static-only", "--pushover", "--out", str(tmp_path / "out")]) == 0
+    assert "pushover (reference DEM" in capsys.readouterr().out
+    written = json.loads((tmp_path / "out" / "assess.json").read_text())
+    assert abs(written["pushover_onset_minus_alpha0_pct"]) <= 2.0
+    assert (tmp_path / "out" / "assess.png").stat().st_size > 0

@@ -48,3 +48,21 @@ def test_cli_knows_every_check():
     from rockyade.studies.verify import CHECK_FUNCTIONS, CHECKS
 
     assert CLI_CHECKS == CHECKS == tuple(CHECK_FUNCTIONS)
+
+
+def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path):
+    """``--only loaded_block,loaded_pushover``: the limit analysis and Housner's uplift give
+    (W b + N d) / (W h_c) within 1e-6, the reference DEM's pushover onset lies within 2 % of it."""
+    proc = _rockyade("verify", "--only", "loaded_block,loaded_pushover", "--no-yade", "--out", "report", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    table = pd.read_csv(tmp_path / "report" / "verify.csv")
+    assert list(table["check"]) == ["loaded_block"] * 2 + ["loaded_pushover"] * 2
+    assert set(table["solver"]) == {"limit", "housner", "reference"}
+    assert table["passed"].all(), table.to_string()
+    expected = (1000 * 9.81 * 0.2 + 8000 * 0.15) / (1000 * 9.81 * 1.0)
+    assert table["expected"].to_numpy() == pytest.approx(expected, rel=1e-6)
+    block = table[table["check"] == "loaded_block"]
+    assert (block["difference"].abs() <= 1e-6 * expected).all()
+    onset = float(table.loc[2, "value"])
+    assert expected <= onset <= 1.02 * expected
+    assert (tmp_path / "report" / "verify_loaded_pushover.png").stat().st_size > 0

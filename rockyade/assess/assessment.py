@@ -45,6 +45,7 @@ from rockyade.assess.fragility import (
 )
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, RecordFiles, ec8_suite
+from rockyade.assess.pushover import PushoverCheck, run_pushover
 from rockyade.assess.site import Position, Site
 from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
@@ -133,6 +134,9 @@ class Assessment:
         The code's checks.
     dynamic
         The fragility in ag (None with ``static_only``).
+    pushover
+        The reference DEM's pushover at the mechanism's control point (None unless asked:
+        :func:`add_pushover`).
     """
 
     code: str
@@ -144,6 +148,7 @@ class Assessment:
     checks: list[Check]
     dynamic: FragilityResult | None = None
     notes: list[str] = field(default_factory=list)
+    pushover: PushoverCheck | None = None
 
     @property
     def verdict(self) -> str:
@@ -214,6 +219,12 @@ class Assessment:
                 "median_over_code_capacity_meaning": "the dynamic median ag over the largest ag at which a code "
                 "check is met: above 1 the code is conservative for this wall, below 1 it is not",
             }
+        out["pushover"] = None
+        if self.pushover is not None:
+            p = self.pushover.to_dict()
+            out["pushover_onset_lambda"] = p["pushover_onset_lambda"]
+            out["pushover_onset_minus_alpha0_pct"] = p["pushover_onset_minus_alpha0_pct"]
+            out["pushover"] = p
         out["notes"] = list(self.notes)
         return finite_or_null(out)
 
@@ -376,4 +387,15 @@ def add_dynamics(
     if on_plan is not None:
         on_plan(plan)
     assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress)
+    return assessment
+
+
+def add_pushover(assessment: Assessment, scene: Scene) -> Assessment:
+    """Run the reference DEM's pushover of the governing mechanism (:mod:`rockyade.assess.pushover`)
+    and attach it; the same assessment back (unchanged without a mechanism, with a note)."""
+    kin = assessment.limit.kinematic
+    if assessment.limit.status != "collapse" or kin is None:
+        assessment.notes.append("pushover: no mechanism to push (not run)")
+        return assessment
+    assessment.pushover = run_pushover(scene, kin, assessment.limit.direction)
     return assessment

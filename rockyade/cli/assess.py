@@ -126,6 +126,13 @@ def cmd_assess(args: argparse.Namespace) -> int:
             progress=not args.quiet,
             on_plan=on_plan,
         )
+    if args.pushover:
+        from rockyade.assess.assessment import add_pushover
+        from rockyade.assess.report import pushover_lines
+
+        add_pushover(result, scene)
+        if not args.json:
+            print("\n".join(pushover_lines(result)), flush=True)
     if not args.json:
         print("\n".join(dynamic_lines(result)))
     data = result.to_dict()
@@ -196,6 +203,13 @@ def register(sub: Any) -> None:
     height.add_argument("--storeys", type=int, metavar="N", help="storeys N of the building")
     height.add_argument(
         "--t1", type=float, metavar="S", help="period T1 of the building, s (default Ct H^(3/4), Ct = 0.05)"
+    )
+    p.add_argument(
+        "--pushover",
+        action="store_true",
+        help="also push the scene in the reference DEM (held levels around alpha0, the governing direction): "
+        "its onset against alpha0 and its capacity curve at the mechanism's control point, in the code's "
+        "a*-d* coordinates, over the code's curve (a few seconds of run; off by default)",
     )
     dyn = p.add_argument_group("the dynamics beside the code")
     dyn.add_argument("--static-only", action="store_true", help="the code's checks only, no runs")

@@ -10,7 +10,19 @@ from typing import Any
 from rockyade.cli.common import check_output_dir
 from rockyade.errors import InputError
 
-CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline", "kinematic", "code", "fragility_fit")
+CHECKS = (
+    "frame",
+    "drums",
+    "pad",
+    "wall",
+    "agreement",
+    "baseline",
+    "kinematic",
+    "code",
+    "fragility_fit",
+    "loaded_block",
+    "loaded_pushover",
+)
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -49,8 +61,9 @@ def register(sub: Any) -> None:
         description="Rocking frame (Makris & Vassiliou p_hat), 8-drum column uplift, pad case overlaps, a "
         "1,000-block wall at rest, reference DEM against YADE, this version's single-block and bi-block "
         "baseline, the limit analysis' kinematic quantities and the code's checks against closed forms and a hand "
-        "calculation, and the fragility fit recovering a known curve. Writes verify.csv, a figure per check and "
-        "index.md; exits 1 if any check fails.",
+        "calculation, the fragility fit recovering a known curve, and a block with a top load (its "
+        "multiplier from the limit analysis, Housner's uplift and the reference DEM's pushover against the closed "
+        "form). Writes verify.csv, a figure per check and index.md; exits 1 if any check fails.",
     )
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--only", help=f"comma-separated checks among {', '.join(CHECKS)} (default: all)")

@@ -8,6 +8,8 @@ curve with the demand beside the fragility in ag).
   du* and the secant of Ts, the linear demand (ag S / q, or the floor's at height) and the
   nonlinear one: the site's elastic spectrum in acceleration-displacement form
   (Se(T) against SDe(T)) and its point at Ts;
+* with ``--pushover``, the reference DEM's pushover curve at the mechanism's control point
+  in the same a*-d* coordinates over the code's curve;
 * :func:`draw_fragility` and :func:`draw_assessment` write them as PNG files.
 """
 
@@ -32,6 +34,7 @@ POINTS = "#08306b"
 DEMAND = "#b2182b"
 CODE = "#e08214"
 OK = "#1b7837"
+PUSH = "#762a83"
 
 
 def plot_fragility(
@@ -127,6 +130,20 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
         ax.plot(d[keep] * 1e3, acc[keep], color="black", lw=1.8, label="capacity a*(d*) of the mechanism")
         xmax = float(d[keep].max())
     ax.plot([0.0], [kin.a0_star_m_s2], "o", color="black", ms=5, zorder=5)
+    push = a.pushover
+    if push is not None and push.d_star_m.size:
+        # force-controlled: flat past the onset; cut where the code's curve ends (the run overturns)
+        reach = xmax if xmax > 0 else float(push.d_star_m.max())
+        inside = push.d_star_m <= 1.15 * reach
+        ax.plot(
+            push.d_star_m[inside] * 1e3,
+            push.a_star_m_s2[inside],
+            color=PUSH,
+            lw=1.6,
+            ls="-",
+            label=f"reference DEM pushover, force-controlled (held levels): onset lambda {push.onset.multiplier:.4g}, "
+            f"{100 * push.difference:+.1f} % on alpha0",
+        )
     ax.annotate(
         f"a0* = {kin.a0_star_m_s2:.3g}", (0, kin.a0_star_m_s2), xytext=(6, 4), textcoords="offset points", fontsize=8
     )

@@ -25,6 +25,10 @@ PANELS: dict[str, tuple[str, list[tuple[str | None, str]]]] = {
         "5-course wall (0.4 x 1 m) under a one-sine pulse (0.5 g, 0.4 s): top course, reference DEM and YADE",
         [],
     ),
+    "loaded_pushover": (
+        "Block 0.4 x 2 m with an 8 kN top load, pushed in held levels around (W b + N d) / (W h_c): rotation",
+        [("pier", "block")],
+    ),
 }
 STYLES = {"reference": ("C0", "-"), "yade": ("C3", "--")}
 

@@ -32,9 +32,17 @@ the tolerance, pass or fail):
 * ``code``: the NTC 2018 checks of a free-standing wall against the hand calculation of
   docs/limit.md (the wall of docs/howto/is-this-wall-safe.md);
 * ``fragility_fit``: the lognormal fit of stripes and its bootstrap band recover the curve
-  that synthetic outcomes were drawn from.
+  that synthetic outcomes were drawn from;
+* ``loaded_block``: a block 0.4 x 2 m (1000 kg) with a vertical top load N = 8 kN at
+  0.05 m from its axis, pushed towards +x (the load at d = 0.15 m from the pivot):
+  lambda = (W b + N d) / (W h_c) = 0.32232 from the limit analysis and from Housner's uplift
+  multiplier with the load's moment (modified Eq 1), within 1e-6;
+* ``loaded_pushover``: the reference DEM's pushover onset of that block (levels held 0.4 s
+  every 1 % of the closed form from 0.98 of it) within 2 % of the closed form, and the last
+  level at which it stood at most the closed form.
 
-The last three run no solver (the limit-analysis programme and the fit only).
+``kinematic``, ``code``, ``fragility_fit`` and ``loaded_block`` run no solver (the
+limit-analysis programme, Housner's model and the fit only).
 """
 
 from __future__ import annotations
@@ -64,7 +72,19 @@ if TYPE_CHECKING:
     from rockyade.limit.analysis import LimitResult
     from rockyade.limit.kinematic import KinematicQuantities
 
-CHECKS = ("frame", "drums", "pad", "wall", "agreement", "baseline", "kinematic", "code", "fragility_fit")
+CHECKS = (
+    "frame",
+    "drums",
+    "pad",
+    "wall",
+    "agreement",
+    "baseline",
+    "kinematic",
+    "code",
+    "fragility_fit",
+    "loaded_block",
+    "loaded_pushover",
+)
 
 
 @dataclass(frozen=True)
@@ -781,6 +801,118 @@ def check_fragility_fit(solvers: list[str]) -> tuple[list[Row], dict[str, Result
     return rows, {}
 
 
+#: The loaded block of ``loaded_block`` and ``loaded_pushover``: mass kg, width m, height m,
+#: the top load N and its offset from the axis towards +x, m.
+LOADED_MASS_KG, LOADED_WIDTH_M, LOADED_HEIGHT_M, LOADED_N, LOADED_X_M = 1000.0, 0.4, 2.0, 8000.0, 0.05
+
+
+def loaded_lambda() -> float:
+    """lambda = (W b + N d) / (W h_c) of the loaded block pushed towards +x: b = half the width,
+    d = b - x the load's lever about the +x pivot, h_c = half the height (moment equilibrium
+    about the pivot at uplift)."""
+    w = LOADED_MASS_KG * G
+    b, h_c = LOADED_WIDTH_M / 2, LOADED_HEIGHT_M / 2
+    return (w * b + LOADED_N * (b - LOADED_X_M)) / (w * h_c)
+
+
+def loaded_block_scene(motion: dict[str, Any] | None = None, duration_s: float = 1.0) -> Scene:
+    """The loaded block (:func:`loaded_lambda`) under ``motion`` (default at rest)."""
+    return scene_from_dict(
+        {
+            "duration_s": duration_s,
+            "sample_dt_s": 0.002,
+            "blocks": [
+                {
+                    "name": "pier",
+                    "width_m": LOADED_WIDTH_M,
+                    "height_m": LOADED_HEIGHT_M,
+                    "thickness_m": 1.0,
+                    "mass_kg": LOADED_MASS_KG,
+                }
+            ],
+            "motion": motion or rest_motion(),
+            "loads": [{"block": "pier", "point_m": [LOADED_X_M, LOADED_HEIGHT_M], "force_N": [0.0, -LOADED_N]}],
+        }
+    )
+
+
+def check_loaded_block(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The loaded block's multiplier (module docstring) from the limit analysis and from
+    Housner's uplift multiplier about the +x (right) pivot, against the closed form."""
+    from rockyade.limit import limit_analysis
+    from rockyade.solvers.housner import housner_model
+
+    scene = loaded_block_scene()
+    expected = loaded_lambda()
+    lam = _known(limit_analysis(scene, direction="+x").load_multiplier, "load multiplier")
+    housner = housner_model(scene).uplift_multiplier(-1)
+    src = "(W b + N d) / (W h_c)"
+    return [
+        Row("loaded_block", "limit", "lambda towards +x", lam, expected, src, "1e-6", _rel(lam, expected) <= 1e-6),
+        Row(
+            "loaded_block",
+            "housner",
+            "uplift multiplier about the +x pivot",
+            housner,
+            expected,
+            src,
+            "1e-6",
+            _rel(housner, expected) <= 1e-6,
+        ),
+    ], {}
+
+
+def check_loaded_pushover(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The reference DEM's pushover onset of the loaded block (module docstring); a short scene:
+    gravity ramp 0.5 s, settle 0.2 s, rise 0.2 g/s to the levels."""
+    from rockyade.analysis.capacity import capacity_curve, pushover_onset
+    from rockyade.motion.quasistatic import Pushover
+    from rockyade.motion.spec import parse_motion
+
+    expected = loaded_lambda()
+    step, start = round(0.01 * expected, 6), round(0.98 * expected, 6)
+    motion = {
+        "type": "pushover",
+        "direction": "+x",
+        "ramp_s": 0.5,
+        "settle_s": 0.2,
+        "rate_g_per_s": 0.2,
+        "max_lambda": round(start + 6 * step, 6),
+        "start_lambda": start,
+        "step_lambda": step,
+        "hold_s": 0.4,
+    }
+    spec = parse_motion(motion)
+    assert isinstance(spec, Pushover)
+    t_path, _ = spec.lambda_path(0.0)
+    scene = loaded_block_scene(motion, float(t_path[-1]) + 0.5)
+    result = run(scene, "reference")
+    onset = pushover_onset(capacity_curve(result, scene), scene)
+    src = "(W b + N d) / (W h_c)"
+    return [
+        Row(
+            "loaded_pushover",
+            "reference",
+            "pushover onset (first held level it did not stand)",
+            onset.multiplier,
+            expected,
+            src,
+            "2 %",
+            _rel(onset.multiplier, expected) <= 0.02,
+        ),
+        Row(
+            "loaded_pushover",
+            "reference",
+            "last held level it stood (at most the closed form, levels rounded to 1e-6)",
+            onset.below,
+            expected,
+            src,
+            "<= expected + 1e-6",
+            onset.below <= expected + 1e-6,
+        ),
+    ], {"reference": result}
+
+
 CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Result]]]] = {
     "frame": check_frame,
     "drums": check_drums,
@@ -791,6 +923,8 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "kinematic": check_kinematic,
     "code": check_code,
     "fragility_fit": check_fragility_fit,
+    "loaded_block": check_loaded_block,
+    "loaded_pushover": check_loaded_pushover,
 }
 
 
