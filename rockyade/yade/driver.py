@@ -16,7 +16,7 @@ with ``{"ok": ...}``. Between jobs it resets YADE (:func:`reset`). After a job t
 it answers and exits (code 1): a fresh worker takes the next scene. It stops on
 ``{"quit": true}`` or when its end of the socket closes.
 
-YADE makes a folder ``/tmp/yade-XXXXXX`` when it is imported (a fixed /tmp, whatever
+YADE makes a folder ``/tmp/yade-`` plus six random characters when it is imported (a fixed /tmp, whatever
 TMPDIR says) and removes it only at its own exit, which the driver never reaches (it leaves
 with ``os._exit``, below); nothing here uses that folder, so the driver removes it, empty,
 as soon as YADE is imported (not under the ``yade`` launcher, whose GUI may use it).
