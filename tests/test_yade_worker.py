@@ -12,9 +12,11 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
+import rockyade
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.yade import YadeSolver
@@ -223,14 +225,24 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
         "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(scene_from_dict({**d, 'duration_s': 60.0}))\n"
         "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
     )
+    # a checkout or a virtual environment under /tmp (a fresh clone in /tmp/fresh) stays
+    # visible: the old /tmp is bound to /var/tmp (in this mount namespace only) and those
+    # folders bound back into the new, empty /tmp
+    needed = sorted(
+        {Path(where).resolve().relative_to("/tmp").parts[0]
+         for where in (sys.prefix, Path(rockyade.__file__).parent) if Path(where).resolve().is_relative_to("/tmp")}
+    )
+    binds = "".join(f"mkdir /tmp/{name} && mount --bind /var/tmp/{name} /tmp/{name} && " for name in needed)
     script = (
-        "mount -t tmpfs tmpfs /tmp && mkdir /tmp/ours && "
+        f"mount --bind /tmp /var/tmp && mount -t tmpfs tmpfs /tmp && {binds}mkdir /tmp/ours && "
         f"TMPDIR=/tmp/ours {sys.executable} -c \"$0\" && echo RAN && ls -A /tmp && echo -- && ls -A /tmp/ours"
     )
     proc = subprocess.run(["unshare", "-Urm", "sh", "-c", script, code], capture_output=True, text=True, timeout=300)
     assert "RAN" in proc.stdout, proc.stdout + proc.stderr
-    listing = proc.stdout.split("RAN", 1)[1].split()
-    assert listing == ["kept", "ours", "--"], listing  # kept: the workdir asked for (the timed-out run's log)
+    in_tmp, in_ours = proc.stdout.split("RAN", 1)[1].split("--")
+    # kept: the workdir asked for (the timed-out run's log); nothing of YADE's
+    assert sorted(in_tmp.split()) == sorted(["kept", "ours", *needed]), in_tmp
+    assert in_ours.split() == [], in_ours
 
 
 def test_a_full_disk_names_the_file_leaves_no_partial_output_and_resume_goes_on(tmp_path):
