@@ -9,20 +9,7 @@ from typing import Any
 
 from rockyade.cli.common import check_output_dir
 from rockyade.errors import InputError
-
-CHECKS = (
-    "frame",
-    "drums",
-    "pad",
-    "wall",
-    "agreement",
-    "baseline",
-    "kinematic",
-    "code",
-    "fragility_fit",
-    "loaded_block",
-    "loaded_pushover",
-)
+from rockyade.studies.checks import CHECKS
 
 
 def cmd_verify(args: argparse.Namespace) -> int:

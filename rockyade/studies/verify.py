@@ -67,24 +67,12 @@ from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.scene.generators import arch, drum_column, pulse_motion, rest_motion, rocking_frame, stack, wall
 from rockyade.solvers import run
+from rockyade.studies.checks import CHECKS
 
 if TYPE_CHECKING:
     from rockyade.limit.analysis import LimitResult
     from rockyade.limit.kinematic import KinematicQuantities
 
-CHECKS = (
-    "frame",
-    "drums",
-    "pad",
-    "wall",
-    "agreement",
-    "baseline",
-    "kinematic",
-    "code",
-    "fragility_fit",
-    "loaded_block",
-    "loaded_pushover",
-)
 
 
 @dataclass(frozen=True)
