@@ -410,9 +410,14 @@ def run_uncertainty(
     progress: bool = True,
     figure: bool = True,
     accel_unit: str = "g",
+    group_runs: bool = True,
 ) -> UncertaintyResult:
     """Draw the samples, run every task through the batch engine and write the report
-    (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure)."""
+    (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure).
+
+    With ``group_runs`` the runs of one sample (one block: every record and load factor)
+    go to the solver as groups (:func:`rockyade.studies.batch.job_key`: one model, the same
+    rows); False: one run per job."""
     from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
 
     out = Path(out)
@@ -430,6 +435,7 @@ def run_uncertainty(
         resume=resume,
         progress=progress,
         desc=study.name,
+        group_runs=group_runs,
     )
     runs = with_measures(summary, record_measures(study))
     runs["overturned"] = runs["status"] == "overturned"
