@@ -236,3 +236,24 @@ def test_grouped_runs_give_the_same_verdicts_peaks_and_probabilities(tmp_path):
     pd.testing.assert_frame_equal(comparable(one.runs), comparable(grouped.runs))
     pd.testing.assert_frame_equal(one.probabilities, grouped.probabilities)
     pd.testing.assert_frame_equal(one.fragility, grouped.fragility)
+
+
+def test_a_samples_scenes_are_the_scenes_read_whole(tmp_path):
+    """build_tasks reads a sample's first scene whole and changes only the motion of the
+    others: the same scenes and hashes as reading each whole."""
+    import copy
+
+    from rockyade.scene import scene_from_dict
+    from rockyade.studies.uncertainty import build_tasks, draw_samples
+
+    study = uncertainty_study_from_dict(_study(samples=2))
+    samples = draw_samples(study)
+    tasks = build_tasks(study, samples, tmp_path)
+    assert len(tasks) == 3 * 2 * 2
+    for task in tasks:
+        lab = task.labels
+        block = dict(study.block, alpha_rad=lab["alpha_rad"], p_rad_s=lab["p_rad_s"], mu=lab["mu"])
+        whole = scene_from_dict({"duration_s": study.duration_s, "sample_dt_s": study.sample_dt_s, "blocks": [block],
+                                 "contact": copy.deepcopy(study.contact),
+                                 "motion": dict(dict(study.motions)[lab["record"]], load_factor=lab["load_factor"])})
+        assert task.scene == whole and task.scene_hash == whole.scene_hash
