@@ -99,3 +99,5 @@ def test_housner_runs_with_histories_or_of_stacks_go_alone(tmp_path):
     one = _pulses([1.0])[0]
     other = scene_from_dict({**one.to_dict(), "blocks": [{**one.to_dict()["blocks"][0], "mu": 0.9}]})
     assert HousnerSolver().group_key(one) != HousnerSolver().group_key(other)  # another model
+    released = scene_from_dict({**one.to_dict(), "motion": {"type": "free", "theta0_rad": 0.1}})
+    assert HousnerSolver().group_key(one) != HousnerSolver().group_key(released)  # free rocking's metrics differ

@@ -684,15 +684,16 @@ class HousnerSolver(SolverBase):
     def group_key(self, scene: Scene) -> str | None:
         """What runs sharing one model have in common (None: this run goes alone).
 
-        Runs of one block whose scenes differ only in their motion (the record, the load
-        factor, a pulse's amplitude, the release tilt) share Housner's model, and are run
-        together by :meth:`run_group`. A scene of several blocks (which :meth:`run` refuses)
-        goes alone.
+        Runs of one block whose scenes differ only in their motion of one type (the record,
+        the load factor, a pulse's amplitude, the release tilt) share Housner's model, and are
+        run together by :meth:`run_group` (the batch reads a group's metrics by its motion's
+        type: free rocking or not). A scene of several blocks (which :meth:`run` refuses) goes
+        alone.
         """
         if len(scene.blocks) != 1:
             return None
         d = scene.to_dict()
-        d.pop("motion")
+        d["motion"] = scene.motion.type
         return json.dumps(d, sort_keys=True, default=str)
 
     def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
