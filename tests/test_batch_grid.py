@@ -334,3 +334,30 @@ def test_every_result_carries_its_motion_coverage(solver):
     assert coverage["message"].startswith("the scene ends at 1 s")
     free = make_solver(solver).run(load_scene(EXAMPLES / "specimen3_free.toml"))
     assert free.meta["motion_coverage"]["status"] == "no base motion"
+
+
+def test_a_grid_over_the_motion_gives_the_scenes_read_whole(tmp_path):
+    """A grid that changes only the motion reads only the motion of each point: the same
+    scenes (and hashes) as reading each point whole, and the same error for a bad point."""
+    import copy
+    import itertools
+
+    from rockyade.scene import load_scene, scene_from_dict
+    from rockyade.studies.batch import expand
+
+    base = load_scene("examples/specimen2_record21.toml").to_dict()
+    grid = {"motion.record": [3, 21], "motion.load_factor": [0.4, 1.3]}
+    tasks = expand([("s2", base)], grid, ["housner"], tmp_path)
+    for task, (record, lf) in zip(tasks, itertools.product(*grid.values()), strict=True):
+        d = copy.deepcopy(base)
+        d["motion"].update(record=record, load_factor=lf)
+        whole = scene_from_dict(d)
+        assert task.scene == whole and task.scene_hash == whole.scene_hash
+    with pytest.raises(InputError) as bad:
+        expand([("s2", base)], {"motion.load_factor": [0.4, -1.0]}, ["housner"], tmp_path)
+    assert bad.value.field == "motion.load_factor" and "motion.load_factor = -1.0" in bad.value.message
+    free = load_scene("examples/specimen1_free.toml").to_dict()
+    tilts = expand([("s1", free)], {"motion.theta0_rad": [0.05, 0.1]}, ["housner"], tmp_path)
+    assert [t.scene.motion.initial_theta_rad for t in tilts] == [0.05, 0.1]
+    with pytest.raises(InputError, match="no block named 'nope'"):  # checked with the blocks, as read whole
+        expand([("s1", free)], {"motion.block": ["nope"]}, ["housner"], tmp_path)

@@ -215,3 +215,45 @@ def test_recorded_files_and_block_dimensions(tmp_path):
     assert peak["pulse1"] > peak["pulse0"]
     with pytest.raises(InputError, match=r"motion\.files"):
         uncertainty_study_from_dict(dict(data, motion={"files": ["none.csv"], "load_factors": [1.0]}), None, tmp_path)
+
+
+def test_grouped_runs_give_the_same_verdicts_peaks_and_probabilities(tmp_path):
+    """Each sample's runs (one block, every record and load factor) as groups, Housner and the
+    reference DEM: the same summary (verdicts, peaks, metrics) and tables as one run per job."""
+    from rockyade.studies.batch import comparable
+
+    study = uncertainty_study_from_dict(
+        _study(samples=2, duration_s=8.0, solvers=["housner", "reference"],
+               motion={"suite": "paper", "records": [1, 2], "load_factors": [1.0, 2.5], "pairing": "all"})
+    )
+    one = run_uncertainty(study, tmp_path / "one", workers=1, progress=False, figure=False, group_runs=False)
+    grouped = run_uncertainty(study, tmp_path / "grouped", workers=1, progress=False, figure=False)
+    runs = grouped.runs
+    assert set(runs["solver"]) == {"housner", "reference"} and (runs["status"] != "failed").all()
+    assert set(runs["status"]) == {"completed", "overturned"}
+    batched = [json.loads(p.read_text()).get("batched") for p in (tmp_path / "grouped" / "runs").glob("*.json")]
+    assert all(b is not None and b["runs"] == 4 for b in batched)  # every run in a group of its sample
+    pd.testing.assert_frame_equal(comparable(one.runs), comparable(grouped.runs))
+    pd.testing.assert_frame_equal(one.probabilities, grouped.probabilities)
+    pd.testing.assert_frame_equal(one.fragility, grouped.fragility)
+
+
+def test_a_samples_scenes_are_the_scenes_read_whole(tmp_path):
+    """build_tasks reads a sample's first scene whole and changes only the motion of the
+    others: the same scenes and hashes as reading each whole."""
+    import copy
+
+    from rockyade.scene import scene_from_dict
+    from rockyade.studies.uncertainty import build_tasks, draw_samples
+
+    study = uncertainty_study_from_dict(_study(samples=2))
+    samples = draw_samples(study)
+    tasks = build_tasks(study, samples, tmp_path)
+    assert len(tasks) == 3 * 2 * 2
+    for task in tasks:
+        lab = task.labels
+        block = dict(study.block, alpha_rad=lab["alpha_rad"], p_rad_s=lab["p_rad_s"], mu=lab["mu"])
+        whole = scene_from_dict({"duration_s": study.duration_s, "sample_dt_s": study.sample_dt_s, "blocks": [block],
+                                 "contact": copy.deepcopy(study.contact),
+                                 "motion": dict(dict(study.motions)[lab["record"]], load_factor=lab["load_factor"])})
+        assert task.scene == whole and task.scene_hash == whole.scene_hash

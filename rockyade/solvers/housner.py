@@ -61,10 +61,12 @@ potential at REST_FRACTION alpha.
 from __future__ import annotations
 
 import functools
+import json
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numba
 import numpy as np
@@ -77,8 +79,11 @@ from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion, ground_acceleration
 from rockyade.result import Result, column
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase
+from rockyade.solvers.base import SolverBase, motion_coverage
 from rockyade.solvers.cost import CostEstimate, sample_cost
+
+if TYPE_CHECKING:
+    from rockyade.solvers.reference import GroupRun
 
 #: A block is declared at rest when an impact leaves it an energy that would lift it by
 #: less than REST_FRACTION * alpha.
@@ -675,6 +680,96 @@ class HousnerSolver(SolverBase):
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
         return sample_cost(scene, self.name)
+
+    def group_key(self, scene: Scene) -> str | None:
+        """What runs sharing one model have in common (None: this run goes alone).
+
+        Runs of one block whose scenes differ only in their motion of one type (the record,
+        the load factor, a pulse's amplitude, the release tilt) share Housner's model, and are
+        run together by :meth:`run_group` (the batch reads a group's metrics by its motion's
+        type: free rocking or not). A scene of several blocks (which :meth:`run` refuses) goes
+        alone.
+        """
+        if len(scene.blocks) != 1:
+            return None
+        d = scene.to_dict()
+        d["motion"] = scene.motion.type
+        return json.dumps(d, sort_keys=True, default=str)
+
+    def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
+        """Run scenes of one :meth:`group_key` together: the model (classical parameters, loads)
+        is built once, each run's base motion once (the run and its coverage read the same
+        arrays), and no time-history frame is made; each run is integrated as :meth:`run`
+        integrates it (the same numbers, bit for bit).
+
+        Parameters
+        ----------
+        scenes
+            Scenes with one group key.
+        uplift_rad
+            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
+        threads
+            Unused: the runs are integrated one after the other in this thread (a batch's
+            workers run one job each); taken for the interface of
+            :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`.
+
+        Returns
+        -------
+        list of GroupRun
+            In the scenes' order: each run's metadata (as :meth:`run`'s Result, without the
+            history; ``wall_time_s`` the run's integration) and its sampled theta.
+        """
+        from rockyade.solvers.reference import GroupRun
+
+        start = time.perf_counter()
+        first = scenes[0]
+        if len(first.blocks) != 1:
+            raise InputError("blocks", "run_group: one block per scene only (see group_key)", first.source)
+        cp = first.blocks[0].classical()
+        model = housner_model(first)
+        _warm_up()
+        setup = time.perf_counter() - start
+        runs = []
+        for scene in scenes:
+            motion = scene.motion.ground_motion(scene.duration_s)
+            begin = time.perf_counter()
+            traj = solve(
+                model,
+                motion,
+                scene.duration_s,
+                scene.motion.initial_theta_rad,
+                scene.motion.initial_omega_rad_s,
+                scene.sample_dt_s,
+            )
+            wall = time.perf_counter() - begin
+            meta = _meta(scene, cp, motion, traj, wall)
+            meta["rockyade_version"] = __version__  # as a Result sets it
+            meta["motion_coverage"] = _coverage(scene, motion)
+            meta["batched"] = {"runs": len(scenes), "setup_time_s": setup}
+            runs.append(GroupRun(meta, traj.theta_rad, scene.sample_dt_s, _theta_metrics(traj, uplift_rad)))
+        return runs
+
+
+def _coverage(scene: Scene, motion: GroundMotion | None) -> dict:
+    """``meta["motion_coverage"]`` of a run from the base motion it ran
+    (:func:`rockyade.solvers.base.motion_coverage` builds that motion again)."""
+    from rockyade.motion.coverage import record_coverage
+
+    return record_coverage(motion, scene.duration_s) if motion is not None else motion_coverage(scene)
+
+
+def _theta_metrics(traj: Trajectory, uplift_rad: float) -> dict[str, float]:
+    """``max_abs_theta_rad``, ``residual_theta_rad`` (rad) and ``uplift_time_s`` (s, NaN: never)
+    of a trajectory, as :func:`rockyade.analysis.metrics.theta_metrics` computes them from a
+    Result (NaN samples ignored)."""
+    theta = traj.theta_rad
+    finite = theta[np.isfinite(theta)]
+    lifted = np.nonzero(np.abs(theta) > uplift_rad)[0]
+    return {
+        "max_abs_theta_rad": float(np.max(np.abs(finite))) if finite.size else math.nan,
+        "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
+        "uplift_time_s": float(traj.t_s[lifted[0]]) if lifted.size else math.nan,
+    }
 
 
 def housner_model(scene: Scene, g: float = G) -> HousnerModel:

@@ -342,28 +342,57 @@ def expand(
         key and its alternative both in the grid, a grid point that is not a valid scene
         (naming the base and the grid point).
     """
-    from rockyade.scene import scene_from_dict
-
     solver_list = [as_solver(s) for s in solvers]
     check_run_count(grid_size(len(bases), grid, len(solver_list)), allow_large, source)
     keys = list(grid)
     _check_alternatives(keys, source)
     base_dir = Path(source).resolve().parent if source else None
+    motion_only = bool(keys) and all(k == "motion" or k.startswith("motion.") for k in keys)
     tasks: list[BatchTask] = []
     for base_name, base in bases:
+        base_scene = _valid_scene(base, source, base_dir) if motion_only else None
         for values in itertools.product(*(grid[k] for k in keys)):
-            d = copy.deepcopy(base)
+            # a grid over the motion changes only the motion's table: the rest is shared, read-only
+            d = {**base, "motion": copy.deepcopy(base["motion"])} if base_scene is not None else copy.deepcopy(base)
             for key, value in zip(keys, values, strict=True):
                 _set_path(d, key, value, source)
             labels = {"base": base_name, **{k: _label(v) for k, v in zip(keys, values, strict=True)}}
             try:
-                scene = _absolute_files(scene_from_dict(d, source=source, base_dir=base_dir))
+                scene = _absolute_files(_grid_scene(d, base_scene, source, base_dir))
             except InputError as exc:
                 point = ", ".join(f"{k} = {v}" for k, v in labels.items())
                 raise InputError(exc.field, f"{exc.message} (grid point: {point})", exc.source) from None
             for solver in solver_list:
                 tasks.append(batch_task(len(tasks), solver, scene, labels, out_dir, save_history))
     return tasks
+
+
+def _valid_scene(d: dict[str, Any], source: str | None, base_dir: Path | None) -> Scene | None:
+    """The scene of ``d``, or None if it is not valid as it is (a grid point may complete it)."""
+    from rockyade.scene import scene_from_dict
+
+    try:
+        return scene_from_dict(d, source=source, base_dir=base_dir)
+    except InputError:
+        return None
+
+
+def _grid_scene(d: dict[str, Any], base_scene: Scene | None, source: str | None, base_dir: Path | None) -> Scene:
+    """The scene of a grid point ``d``: ``scene_from_dict(d)``. With ``base_scene`` (the valid
+    base scene of a grid over the motion only) the same Scene, read at a third of the cost:
+    only the motion is read, and checked with the rest (:meth:`rockyade.scene.Scene.with_changes`);
+    a motion that does not read is read again with the whole scene, which says what is wrong."""
+    from rockyade.io.fields import plain_data
+    from rockyade.motion.spec import parse_motion
+    from rockyade.scene import scene_from_dict
+
+    if base_scene is not None:
+        try:
+            motion = parse_motion(plain_data(d["motion"], "motion", source), source, base_dir)
+            return base_scene.with_changes(motion=motion)
+        except InputError:
+            pass
+    return scene_from_dict(d, source=source, base_dir=base_dir)
 
 
 def _absolute_files(scene: Scene) -> Scene:

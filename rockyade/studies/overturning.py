@@ -11,17 +11,19 @@ reference DEM (matched calibration); Housner also gives the full overturn map of
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from rockyade.analysis.metrics import uplift_threshold_rad
 from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
 from rockyade.figures import new_figure, save_figure
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.runner import Executor, run_jobs
-from rockyade.scene import scene_from_dict
+from rockyade.scene import Scene, scene_from_dict
 from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
@@ -32,6 +34,9 @@ FREQUENCY_RATIOS = tuple(np.round(np.arange(1.0, 10.01, 0.5), 2))
 STEP = 0.05
 MAX_RATIO = 15.0
 FREE_TIME_S = 4.0
+#: Amplitudes run as one group in a scan that stops at the first overturn (the runs after it
+#: in the group are not kept: at most CHUNK - 1 runs more than one at a time).
+CHUNK = 8
 
 
 def _scene(ratio_a: float, ratio_w: float, alpha: float, p: float):
@@ -40,31 +45,98 @@ def _scene(ratio_a: float, ratio_w: float, alpha: float, p: float):
     return scene_from_dict(scene_dict([block_table("1")], motion, period + FREE_TIME_S, 0.002, "matched"))
 
 
-def _scan(args: tuple[Solver, float, float, float, bool]) -> list[dict]:
-    """Scan amplitudes upward at one frequency; stop at the first overturn unless ``full``."""
-    solver, ratio_w, alpha, p, full = args
-    rows = []
+@dataclass(frozen=True)
+class Scan:
+    """The amplitude scan at one pulse frequency.
+
+    Attributes
+    ----------
+    solver
+        The solver.
+    ratio_w
+        omega_p / p (-).
+    alpha, p
+        The block's alpha (rad) and p (rad/s).
+    full
+        Scan every amplitude up to ``max_ratio`` (else stop at the first overturn).
+    grouped
+        Run the amplitudes in groups where the solver can (:func:`run_scenes`; the same
+        verdicts), else one run at a time.
+    max_ratio
+        Largest a_p / (g tan alpha) scanned (-); None: :data:`MAX_RATIO`.
+    """
+
+    solver: Solver
+    ratio_w: float
+    alpha: float
+    p: float
+    full: bool
+    grouped: bool = True
+    max_ratio: float | None = None
+
+
+def amplitude_ratios(max_ratio: float | None = None) -> list[float]:
+    """The amplitudes a_p / (g tan alpha) scanned, from uplift upward in steps of :data:`STEP`
+    (the same accumulated sums as one step at a time), up to ``max_ratio`` (default :data:`MAX_RATIO`)."""
+    top = MAX_RATIO if max_ratio is None else max_ratio
+    ratios = []
     ratio_a = 1.0 + STEP
-    while ratio_a <= MAX_RATIO + 1e-9:
-        result = solver.run(_scene(ratio_a, ratio_w, alpha, p))
-        rows.append(
-            {
-                "solver": solver.name,
-                "omega_ratio": ratio_w,
-                "amplitude_ratio": round(ratio_a, 4),
-                "overturned": result.status == "overturned",
-                "status": result.status,
-                "failure_reason": result.meta.get("failure_reason") or "",
-            }
-        )
-        if result.status == "overturned" and not full:
-            break
+    while ratio_a <= top + 1e-9:
+        ratios.append(ratio_a)
         ratio_a += STEP
+    return ratios
+
+
+def run_scenes(solver: Solver, scenes: list[Scene], alpha: float) -> list[tuple[str, str]]:
+    """(status, failure reason) of each scene's run: together when the solver runs them as one
+    group (``group_key``, ``run_group``: each run's own result), else one at a time."""
+    key = getattr(solver, "group_key", None)
+    if key is not None and len(scenes) > 1:
+        keys = {key(s) for s in scenes}
+        if len(keys) == 1 and None not in keys:
+            try:
+                runs = solver.run_group(scenes, uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                return [(one.status, one.meta.get("failure_reason") or "") for one in runs]
+            except Exception:  # a run of its own says what went wrong
+                pass
+    out = []
+    for scene in scenes:
+        result = solver.run(scene)
+        out.append((result.status, result.meta.get("failure_reason") or ""))
+    return out
+
+
+def _scan(scan: Scan) -> list[dict]:
+    """Scan amplitudes upward at one frequency; stop at the first overturn unless ``full``.
+
+    Grouped, a full scan runs every amplitude at once and a scan that stops runs
+    :data:`CHUNK` amplitudes at a time, keeping the rows up to the first overturn."""
+    solver = scan.solver
+    ratios = amplitude_ratios(scan.max_ratio)
+    size = 1 if not scan.grouped else len(ratios) if scan.full else CHUNK
+    rows = []
+    for start in range(0, len(ratios), max(1, size)):
+        part = ratios[start : start + size]
+        scenes = [_scene(ratio_a, scan.ratio_w, scan.alpha, scan.p) for ratio_a in part]
+        for ratio_a, (status, reason) in zip(part, run_scenes(solver, scenes, scan.alpha), strict=True):
+            rows.append(
+                {
+                    "solver": solver.name,
+                    "omega_ratio": scan.ratio_w,
+                    "amplitude_ratio": round(ratio_a, 4),
+                    "overturned": status == "overturned",
+                    "status": status,
+                    "failure_reason": reason,
+                }
+            )
+            if status == "overturned" and not scan.full:
+                return rows
     return rows
 
 
-def run(report: Report, workers: int = 2) -> pd.DataFrame:
-    """Compute the spectrum; write ``overturning_spectrum.csv``, the scan and the figure."""
+def run(report: Report, workers: int = 2, grouped: bool = True) -> pd.DataFrame:
+    """Compute the spectrum; write ``overturning_spectrum.csv``, the scan and the figure
+    (``grouped``: amplitudes run in groups where the solver can, :class:`Scan`)."""
     report.section(
         "Overturning spectrum under one-sine pulses",
         "Specimen 1, experimental alpha = 0.235 rad and p = 3.84 1/s; minimum a_p / (g tan alpha) that overturns the "
@@ -74,8 +146,8 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     alpha, p = block["alpha_rad"], block["p_rad_s"]
     calibrated_model(_scene(2.0, 2.0, alpha, p))  # matched beta once, before the workers fork
     dem = ReferenceSolver(record_energy=False, record_contacts=False)
-    jobs = [(HousnerSolver(), w, alpha, p, True) for w in FREQUENCY_RATIOS] + [
-        (dem, w, alpha, p, False) for w in FREQUENCY_RATIOS
+    jobs = [Scan(HousnerSolver(), w, alpha, p, True, grouped) for w in FREQUENCY_RATIOS] + [
+        Scan(dem, w, alpha, p, False, grouped) for w in FREQUENCY_RATIOS
     ]
     scans = run_jobs(
         jobs, _scan, executor=Executor("local", workers), progress=True, desc="overturning: frequency scans"

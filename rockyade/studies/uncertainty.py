@@ -306,30 +306,40 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
 
 
 def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | Path) -> list[BatchTask]:
-    """One batch task per (sample, record, load factor, solver)."""
+    """One batch task per (sample, record, load factor, solver).
+
+    A sample's scenes share everything but the motion: the first is read whole, the others
+    are it with their motion (read, and checked with the block: :meth:`rockyade.scene.Scene.with_changes`)."""
+    from rockyade.motion.spec import parse_motion
     from rockyade.scene import scene_from_dict
     from rockyade.solvers import make_solver
 
     solvers = [make_solver(name) for name in study.solvers]
     motions = dict(study.motions)
+    source = study.source or None
     tasks = []
     index = 0
     for row in samples.itertuples(index=False):
         block = dict(study.block, alpha_rad=float(row.alpha_rad), p_rad_s=float(row.p_rad_s), mu=float(row.mu))
         records = [row.record] if study.pairing == "sampled" and not row.nominal else list(motions)
+        first = None
         for record in records:
             for lf in study.load_factors:
                 motion = dict(motions[record], load_factor=lf)
-                scene = scene_from_dict(
-                    {
-                        "duration_s": study.duration_s,
-                        "sample_dt_s": study.sample_dt_s,
-                        "blocks": [block],
-                        "contact": copy.deepcopy(study.contact),
-                        "motion": motion,
-                    },
-                    source=study.source or None,
-                )
+                if first is None:
+                    first = scene_from_dict(
+                        {
+                            "duration_s": study.duration_s,
+                            "sample_dt_s": study.sample_dt_s,
+                            "blocks": [block],
+                            "contact": copy.deepcopy(study.contact),
+                            "motion": motion,
+                        },
+                        source=source,
+                    )
+                    scene = first
+                else:
+                    scene = first.with_changes(motion=parse_motion(motion, source))
                 labels = {
                     "base": study.name,
                     "sample": int(row.sample),
@@ -410,9 +420,14 @@ def run_uncertainty(
     progress: bool = True,
     figure: bool = True,
     accel_unit: str = "g",
+    group_runs: bool = True,
 ) -> UncertaintyResult:
     """Draw the samples, run every task through the batch engine and write the report
-    (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure)."""
+    (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure).
+
+    With ``group_runs`` the runs of one sample (one block: every record and load factor)
+    go to the solver as groups (:func:`rockyade.studies.batch.job_key`: one model, the same
+    rows); False: one run per job."""
     from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
 
     out = Path(out)
@@ -430,6 +445,7 @@ def run_uncertainty(
         resume=resume,
         progress=progress,
         desc=study.name,
+        group_runs=group_runs,
     )
     runs = with_measures(summary, record_measures(study))
     runs["overturned"] = runs["status"] == "overturned"
