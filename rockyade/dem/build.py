@@ -200,11 +200,11 @@ def _check_settlement(
 ) -> float:
     """Largest static penetration under gravity and the scene's point loads, m; refused above
     MAX_SETTLEMENT_FRACTION of the blocks' height."""
-    names = [b.name for b in bodies]
+    body_names = [b.name for b in bodies]
     centroids = np.array([b.rest_centroid_m for b in bodies], dtype=float)
     loads = None
     if scene.loads:
-        located = [(names.index(q.block), q.point_m, q.force_N) for q in scene.loads]
+        located = [(body_names.index(q.block), q.point_m, q.force_N) for q in scene.loads]
         loads = rest_load_wrenches(len(bodies), centroids, located)
     pen = static_penetration(springs, [b.mass_kg for b in bodies], [b.fixed for b in bodies], g, loads)
     if pen is None or pen.size == 0:
