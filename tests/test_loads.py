@@ -215,3 +215,54 @@ def test_loads_act_without_energy_terms_and_in_a_batch_group():
     assert np.max(np.abs(theta_bare - theta[False])) > 1e-3
     assert fast.group_key(loaded) is None
     assert fast.group_key(bare) is not None
+
+
+def test_housner_energy_counts_the_loads_potential_and_is_conserved_between_impacts():
+    """A loaded block (1.5 kN, 0.1 m right of the axis, and 300 N horizontally, both on the top face)
+    released at 0.06 rad rocks freely: HousnerModel.energy(), which adds the dead load's potential
+    -F . u, is conserved between impacts to 1e-6 relative; without the loads' terms (the number it
+    gave before) it is not (a change of several per cent within one half-cycle)."""
+    import dataclasses
+    import itertools
+
+    from rockyade.solvers.housner import solve
+
+    loads = [{"block": "pier", "point_m": [0.1, HEIGHT], "force_N": [300.0, -1500.0]}]
+    model = housner_model(block_scene(loads, {"type": "free", "theta0_rad": 0.06}, duration=3.0))
+    assert model.loaded and model.load_b_left != 0.0 and model.load_a_left != model.load_a_right
+    bare = dataclasses.replace(model, load_a_left=0.0, load_b_left=0.0, load_a_right=0.0, load_b_right=0.0)
+    traj = solve(model, None, 3.0, 0.06, sample_dt_s=0.0005)
+    bounds = np.concatenate([[0.0], traj.impacts[:, 0], [3.0]])
+    checked, worst_old = 0, 0.0
+    for t0, t1 in itertools.pairwise(bounds):
+        inside = (traj.t_s > t0 + 1e-6) & (traj.t_s < t1 - 1e-6) & (traj.theta_rad != 0.0)
+        if inside.sum() < 10:
+            continue
+        theta, omega = traj.theta_rad[inside], traj.omega_rad_s[inside]
+        side = 1 if theta[0] > 0 else -1
+        e = np.array([model.energy(side, th, om) for th, om in zip(theta, omega, strict=True)])
+        old = np.array([bare.energy(side, th, om) for th, om in zip(theta, omega, strict=True)])
+        assert np.ptp(e) / abs(e[0]) < 1e-6
+        worst_old = max(worst_old, float(np.ptp(old) / abs(old[0])))
+        checked += 1
+    assert checked >= 2, traj.impacts
+    assert worst_old > 0.05, worst_old
+
+
+def test_the_dem_settlement_check_counts_the_loads():
+    """The static settlement check of the DEM's model counts the loads with the weights: one
+    block on two springs K settles by (W + N) / (2 K). K is chosen so that the block alone
+    settles half the limit (1e-4 of its height): a load N = 0.5 W gives 1.5 x that, and a load
+    N = 5 W takes it three times past the limit and is refused (gravity alone, as before, passed it)."""
+    from rockyade.calibration.model import calibrated_model
+    from rockyade.constants import MAX_SETTLEMENT_FRACTION
+
+    k = W / (2 * 0.5 * MAX_SETTLEMENT_FRACTION * HEIGHT)
+    contact = {"calibration": "paper", "K_N_per_m": k}
+    bare = calibrated_model(block_scene([], contact=contact))
+    assert bare.static_settlement_m == pytest.approx(W / (2 * k), rel=1e-9)
+    light = calibrated_model(block_scene(top_load(0.0, 0.5 * W), contact=contact))
+    assert light.static_settlement_m == pytest.approx(1.5 * W / (2 * k), rel=1e-9)
+    with pytest.raises(InputError) as info:
+        calibrated_model(block_scene(top_load(0.0, 5.0 * W), contact=contact))
+    assert info.value.field == "contact.K_N_per_m" and "sink" in str(info.value)

@@ -66,3 +66,21 @@ def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path):
     onset = float(table.loc[2, "value"])
     assert expected <= onset <= 1.02 * expected
     assert (tmp_path / "report" / "verify_loaded_pushover.png").stat().st_size > 0
+
+
+def test_limit_pushover_check_passes_against_the_closed_forms(tmp_path):
+    """``limit_pushover``: the limit analysis gives b/h = 0.2 for the block, 17/35 for the restrained
+    wall's three hinges, tan(30 deg) for the sliding panel and 0.1494 for the arch, and the
+    reference DEM's onset is within 2 % of each (at or above it, the levels being 1 % apart)."""
+    import math
+
+    table = verify(tmp_path, ["limit_pushover"], ["reference"])
+    assert list(table["solver"]) == ["reference"] * 4
+    assert table["passed"].all(), table.to_string()
+    expected = dict(zip([q.split(":")[0] for q in table["quantity"]], table["expected"], strict=True))
+    assert expected["block"] == pytest.approx(0.2, rel=1e-9)
+    assert expected["restrained wall"] == pytest.approx(17 / 35, rel=1e-9)
+    assert expected["panel"] == pytest.approx(math.tan(math.radians(30.0)), rel=1e-6)
+    assert expected["arch"] == pytest.approx(0.1494, abs=1e-4)
+    ratio = table["value"] / table["expected"]
+    assert ((ratio >= 1.0 - 1e-5) & (ratio <= 1.02)).all(), table.to_string()

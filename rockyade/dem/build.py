@@ -28,7 +28,7 @@ from rockyade.constants import MAX_SETTLEMENT_FRACTION, G
 from rockyade.dem.joints import ContactParameters, JointTable, resolve_joints
 from rockyade.dem.model import STABILITY_MARGIN, DemBody, DemModel, check_user_dt, time_step_eq7
 from rockyade.dem.overturn import stop_angles
-from rockyade.dem.statics import mass_vector, rest_springs, stability_limit, static_penetration
+from rockyade.dem.statics import mass_vector, rest_load_wrenches, rest_springs, stability_limit, static_penetration
 from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import BlockSpec, Scene
 from rockyade.scene.placement import PlacedBlock, RestContact, placed_blocks, rest_contacts, rotation_matrix
@@ -198,8 +198,15 @@ def _calibration_label(scene: Scene) -> str:
 def _check_settlement(
     springs, bodies: tuple[DemBody, ...], contacts: list[RestContact], joints: JointTable, scene: Scene, g: float
 ) -> float:
-    """Largest static penetration, m; refused above MAX_SETTLEMENT_FRACTION of the blocks' height."""
-    pen = static_penetration(springs, [b.mass_kg for b in bodies], [b.fixed for b in bodies], g)
+    """Largest static penetration under gravity and the scene's point loads, m; refused above
+    MAX_SETTLEMENT_FRACTION of the blocks' height."""
+    body_names = [b.name for b in bodies]
+    centroids = np.array([b.rest_centroid_m for b in bodies], dtype=float)
+    loads = None
+    if scene.loads:
+        located = [(body_names.index(q.block), q.point_m, q.force_N) for q in scene.loads]
+        loads = rest_load_wrenches(len(bodies), centroids, located)
+    pen = static_penetration(springs, [b.mass_kg for b in bodies], [b.fixed for b in bodies], g, loads)
     if pen is None or pen.size == 0:
         return math.nan
     owner = springs.contact[springs.normal]

@@ -9,9 +9,9 @@ moving bodies (fixed bodies and the base do not move) this gives a sparse stiffn
   dt <= (2 / w_max) (sqrt(1 + xi^2) - xi), w_max the highest natural frequency of K, M and
   xi its damping ratio with the stiffness-proportional dashpots (beta w / 2) and the
   mass-proportional one (a / 2w): the default time step stays below it.
-* Settlement: K u = f (gravity) gives the static penetration of every contact point; it must
-  stay small against the blocks (the paper's stiffness read as N/m sinks a block into its
-  base, see the stiffness scale).
+* Settlement: K u = f (gravity and the point loads, forces without mass) gives the static
+  penetration of every contact point; it must stay small against the blocks (the paper's
+  stiffness read as N/m sinks a block into its base, see the stiffness scale).
 
 And the rigid column's own statics: :func:`column_uplift`, the smallest horizontal base
 acceleration that lifts one of its blocks.
@@ -175,11 +175,48 @@ def stability_limit(springs: RestSprings, mass: NDArray[np.float64], mass_dampin
     return (2.0 / w_max) * (math.sqrt(1.0 + xi * xi) - xi), w_max
 
 
+def rest_load_wrenches(
+    nb: int, centroids: NDArray[np.float64], loads: Sequence[tuple[int, Sequence[float], Sequence[float]]]
+) -> NDArray[np.float64]:
+    """(nb, 3) resultant of the point loads on each body at rest: Fx, Fy (N) and the moment
+    about the body's centroid, (p - c) x F (N m, counter-clockwise).
+
+    Parameters
+    ----------
+    nb
+        Number of bodies.
+    centroids
+        (nb, 2) centroids at rest, base frame, m.
+    loads
+        (body index, point of application at rest (x, y) in m, force (Fx, Fy) in N) per load.
+    """
+    out = np.zeros((nb, 3))
+    for i, point, force in loads:
+        rx, ry = point[0] - centroids[i][0], point[1] - centroids[i][1]
+        out[i] += (force[0], force[1], rx * force[1] - ry * force[0])
+    return out
+
+
 def static_displacement(
-    springs: RestSprings, masses: Sequence[float], fixed: Sequence[bool], g: float
+    springs: RestSprings,
+    masses: Sequence[float],
+    fixed: Sequence[bool],
+    g: float,
+    loads: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64] | None:
-    """(nb, 3) static displacement (x, y, rotation) of every body under gravity, m and rad
-    (zeros for fixed bodies); None when K is singular (a body with no support, a mechanism).
+    """(nb, 3) static displacement (x, y, rotation) of every body under gravity and the point
+    loads, m and rad (zeros for fixed bodies); None when K is singular (a body with no support,
+    a mechanism).
+
+    Parameters
+    ----------
+    springs, masses, fixed
+        The rest springs, body masses (kg) and fixed flags.
+    g
+        Gravity, m/s^2.
+    loads
+        (nb, 3) point loads on each body (:func:`rest_load_wrenches`: Fx, Fy in N, moment in
+        N m); a load is a force without mass, added to the weights. None: gravity alone.
     """
     K = springs.stiffness.tocsc()
     if K.shape[0] == 0 or springs.k.size == 0:
@@ -187,7 +224,10 @@ def static_displacement(
     f = np.zeros(K.shape[0])
     for i, (m, fx) in enumerate(zip(masses, fixed, strict=True)):
         if not fx:
-            f[springs.dof_of[i] + 1] = -m * g
+            d = springs.dof_of[i]
+            f[d + 1] = -m * g
+            if loads is not None:
+                f[d : d + 3] += loads[i]
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
             warnings.simplefilter("ignore", MatrixRankWarning)  # a mechanism: answered below
@@ -207,10 +247,15 @@ def static_displacement(
 
 
 def static_penetration(
-    springs: RestSprings, masses: Sequence[float], fixed: Sequence[bool], g: float
+    springs: RestSprings,
+    masses: Sequence[float],
+    fixed: Sequence[bool],
+    g: float,
+    loads: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64] | None:
-    """Static compression of every normal spring under gravity, m (None for a mechanism)."""
-    disp = static_displacement(springs, masses, fixed, g)
+    """Static compression of every normal spring under gravity and the point loads (``loads``
+    as in :func:`static_displacement`), m (None for a mechanism)."""
+    disp = static_displacement(springs, masses, fixed, g, loads)
     if disp is None:
         return None
     u = np.concatenate([disp[i] for i, d in enumerate(springs.dof_of) if d >= 0])

@@ -25,8 +25,10 @@ from rockyade.limit.model import PointLoad, RigidBlockModel, rigid_block_model
 #: The note every answer with finite friction carries (docs/limit.md, "Friction").
 FRICTION_NOTE = (
     "with finite friction the rigid-block programme assumes associated (dilatant) sliding; real "
-    "Coulomb friction does not dilate, so where joints slide the multiplier can overestimate the "
-    "collapse load (Gilbert, Casapulla & Ahmed 2006; Ferris & Tin-Loi 2001)"
+    "Coulomb friction does not dilate, so the multiplier can overestimate the collapse load where "
+    "joints slide, and also where a lower mechanism needs a joint to slide without opening (a "
+    "running-bond wall's heel units: docs/assemblies.md) (Gilbert, Casapulla & Ahmed 2006; "
+    "Ferris & Tin-Loi 2001)"
 )
 
 

@@ -19,8 +19,12 @@ finite friction the programme's dual is the upper-bound mechanism with an associ
 rule (a sliding joint dilates at tan(phi)): real Coulomb friction does not dilate, and the
 multiplier of a mechanism in which joints slide can be above the true one (Gilbert,
 Casapulla & Ahmed 2006, Comput. Struct. 84, 873-887; Ferris & Tin-Loi 2001, Int. J. Mech.
-Sci. 43, 209-224). The multiplier is exact (to the solver's tolerance) when no joint
-slides, and always with ``sliding=False``.
+Sci. 43, 209-224). With ``sliding=False`` (no joint end moves along its joint) the
+multiplier is exact (to the solver's tolerance). With finite friction it is exact for
+associated friction; for Coulomb friction it is an upper bound even when the mechanism found
+has no sliding joint, because a lower mechanism may need a joint end to slide without
+opening, which the associated rule forbids: a slender running-bond panel's whole-panel
+rocking (L / H = 0.5) against its heel mechanism (0.434; docs/assemblies.md).
 
 The dual variables of the equilibrium equations are the mechanism: a virtual velocity
 (vx, vy, omega) of every moving block for which the load lambda m g d does unit work and

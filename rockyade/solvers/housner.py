@@ -151,13 +151,32 @@ class HousnerModel:
         return _theta_dd(side, theta, ah, av, self._params())
 
     def energy(self, side: int, theta: float, omega: float) -> float:
-        """Energy in units of M g R: omega^2 / (2 p^2) + cos(alpha - |theta|) - cos(alpha).
+        """Energy in units of M g R of the active side (R its pivot-to-centroid distance):
 
-        Conserved between impacts when the base does not move.
+            omega^2 / (2 p^2) + cos(alpha - |theta|) - cos(alpha) - (a / g) sin(theta) + (b / g) (1 - cos(theta)),
+
+        the kinetic energy, the weight's potential and the point loads' (module docstring). A
+        dead load is a constant force F without mass: its potential is -F . u, u the
+        displacement of its point, and with the load's moment M_F = A cos(theta) - B sin(theta)
+        about the pivot, -integral M_F dtheta = -A sin(theta) + B (1 - cos(theta)); over M g R
+        that is the last two terms (a = A / (M R), b = B / (M R)). Conserved between impacts
+        when the base does not move.
+
+        Parameters
+        ----------
+        side
+            +1 rocking on the left pivot (theta > 0), -1 on the right one.
+        theta
+            Rotation, rad (counter-clockwise).
+        omega
+            Angular velocity, rad/s.
         """
         p = self.p_left if side > 0 else self.p_right
         alpha = self.alpha_left if side > 0 else self.alpha_right
-        return 0.5 * omega * omega / (p * p) + math.cos(alpha - abs(theta)) - math.cos(alpha)
+        a = self.load_a_left if side > 0 else self.load_a_right
+        b = self.load_b_left if side > 0 else self.load_b_right
+        loads = -(a / self.g) * math.sin(theta) + (b / self.g) * (1.0 - math.cos(theta))
+        return 0.5 * omega * omega / (p * p) + math.cos(alpha - abs(theta)) - math.cos(alpha) + loads
 
     def _params(self) -> np.ndarray:
         return np.array(

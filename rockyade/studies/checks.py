@@ -13,4 +13,5 @@ CHECKS = (
     "fragility_fit",
     "loaded_block",
     "loaded_pushover",
+    "limit_pushover",
 )
