@@ -89,9 +89,10 @@ def _duration(seconds: float) -> str:
 def dem_time_step(scene: Scene) -> tuple[float, int]:
     """The DEM's time step (s) and its moving bodies, from the model the solvers build.
 
-    The model is built on the scene with the base at rest (the step depends on the joints
-    and masses, not on the motion, so no motion is built); a matched calibration is
-    estimated with the paper's damping (Eq 13), which the matching changes little.
+    The step depends on the joints and masses, not on the motion. The model is the one the
+    run builds (:func:`rockyade.calibration.model.calibrated_model` keeps it for the run),
+    except for a matched calibration, estimated with the paper's damping (Eq 13), which the
+    matching changes little, on the scene with the base at rest (no motion is built).
     """
     from rockyade.calibration.model import calibrated_model
     from rockyade.motion.spec import AtRest
@@ -99,8 +100,9 @@ def dem_time_step(scene: Scene) -> tuple[float, int]:
     contact = scene.contact
     if contact.calibration == "matched" and contact.beta_s is None:
         contact = dataclasses.replace(contact, calibration="paper")
-    at_rest = dataclasses.replace(scene, motion=AtRest(), contact=contact)
-    model = calibrated_model(at_rest)
+        model = calibrated_model(dataclasses.replace(scene, motion=AtRest(), contact=contact))
+    else:
+        model = calibrated_model(scene)
     moving = sum(1 for b in model.bodies if not b.fixed)
     return float(model.dt_s), moving
 
