@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,9 +54,9 @@ class PlacedBlock:
     rotation_rad: float
     fixed: bool
 
-    @property
+    @cached_property
     def size_m(self) -> float:
-        """Largest extent of the polygon, m."""
+        """Largest extent of the polygon, m (computed once: the block is frozen)."""
         return float(np.max(np.ptp(self.vertices_m, axis=0)))
 
 
