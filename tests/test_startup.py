@@ -49,3 +49,15 @@ def test_scene_and_motion_import_no_scipy_or_pandas(module: str) -> None:
         code += "rockyade.scene.load_scene\n"  # the loader (lazy in rockyade.scene) too
     heavy = [m for m in _imported_after(code) if m != COMPILER]
     assert heavy == [], f"import {module} imports {heavy[:8]}"
+
+
+def test_the_dem_model_imports_scipy_spatial_only_for_an_alpha_override() -> None:
+    # scipy.spatial (0.2-1 s) serves only a block whose base is replaced by its alpha (ConvexHull)
+    heavy = _imported_after("import rockyade.calibration.model\nimport rockyade.solvers.reference\n")
+    assert not [m for m in heavy if m.startswith("scipy.spatial")], heavy[:8]
+    code = (
+        "from rockyade.blocks.geometry import Block\n"
+        "from rockyade.dem.build import contact_polygon\n"
+        "contact_polygon(Block.rectangle(0.25, 1.0, 0.754, mass_kg=503), 0.2)\n"
+    )
+    assert any(m.startswith("scipy.spatial") for m in _imported_after(code))
