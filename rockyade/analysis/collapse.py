@@ -164,13 +164,16 @@ def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[B
         The scene that produced ``result`` (its blocks, bottom to top).
     result
         The run's Result (any solver)."""
-    return _block_states(scene, result, _Columns(result))
+    states, geometry, _ = _block_states(scene, result, _Columns(result))
+    return states, geometry
 
 
 def _block_states(
     scene: Scene, result: Result, columns: _Columns
-) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
+) -> tuple[NDArray[np.int8], list[BlockGeometry], list[Fall]]:
+    """:func:`block_states`, and each block's :func:`block_fall_of`."""
     geometry = block_geometry(scene, result)
+    falls = []
     t = result.t
     n = t.size
     states = np.zeros((n, len(geometry)), dtype=np.int8)
@@ -181,6 +184,7 @@ def _block_states(
         x = columns("x_m", g.name)
         y = columns("y_m", g.name)
         fall = block_fall_of(g, result, columns)
+        falls.append(fall)
         rocking = np.abs(theta) > max(ROCK_MIN_RAD, ROCK_FRACTION * g.alpha_rad)
         sliding = _sliding(columns, g, supports.get(g.name, []), centroids, dt)
         slipping = _slipping(result, g.name)
@@ -199,7 +203,7 @@ def _block_states(
         if fall.fell:
             code[fall.fall :] = FALLEN
         states[:, j] = code
-    return states, geometry
+    return states, geometry, falls
 
 
 @dataclass(frozen=True)
@@ -344,7 +348,7 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
         The run's Result (any solver).
     """
     columns = _Columns(result)
-    states, geometry = _block_states(scene, result, columns)
+    states, geometry, falls = _block_states(scene, result, columns)
     t = result.t
     dt = float(t[1] - t[0]) if t.size > 1 else 0.0
     rows = []
@@ -352,7 +356,7 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
         theta = columns("theta_rad", g.name)
         finite = np.isfinite(theta)
         last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
-        fall = block_fall_of(g, result, columns)
+        fall = falls[j]
         rows.append(
             {
                 "block": g.name,

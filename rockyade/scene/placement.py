@@ -183,16 +183,21 @@ def _edge_normals(poly: NDArray[np.float64]) -> NDArray[np.float64]:
     return normals / np.hypot(normals[:, 0], normals[:, 1])[:, None]
 
 
-def penetration_depth(p: NDArray[np.float64], q: NDArray[np.float64]) -> float:
+def penetration_depth(
+    p: NDArray[np.float64],
+    q: NDArray[np.float64],
+    normals: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> float:
     """Separating-axis penetration of two convex polygons, m (<= 0: apart or touching).
 
     The smallest overlap of the two polygons' projections over all their edge normals;
-    negative values are separations.
+    negative values are separations. ``normals`` are the two polygons' edge normals, when
+    the caller has them.
     """
     depth = math.inf
-    for normals in (_edge_normals(p), _edge_normals(q)):
-        pp = p @ normals.T
-        qq = q @ normals.T
+    for axes in normals if normals is not None else (_edge_normals(p), _edge_normals(q)):
+        pp = p @ axes.T
+        qq = q @ axes.T
         overlap = np.minimum(pp.max(axis=0), qq.max(axis=0)) - np.maximum(pp.min(axis=0), qq.min(axis=0))
         depth = min(depth, float(overlap.min()))
     return depth
@@ -204,9 +209,10 @@ def overlapping_pairs(blocks: list[PlacedBlock], tol: float = OVERLAP_TOL) -> li
     Returns (i, j, depth_m) triples.
     """
     polys = [b.vertices_m for b in blocks]
+    normals = [_edge_normals(p) for p in polys]
     out = []
     for i, j in candidate_pairs(polys):
-        depth = penetration_depth(polys[i], polys[j])
+        depth = penetration_depth(polys[i], polys[j], (normals[i], normals[j]))
         if depth > tol * min(blocks[i].size_m, blocks[j].size_m):
             out.append((i, j, depth))
     return out
