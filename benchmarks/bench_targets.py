@@ -218,8 +218,23 @@ def wall_target() -> None:
         run_model(model, record_energy=True)
         wall = min(run_model(model, record_energy=True).meta["wall_time_s"] for _ in range(2))
         per[n] = 1e9 * wall / (model.n_steps * len(model.bodies))
-    row("assembly: ~1,000-block wall at rest per block-step / single block (energy on)",
-        f"{per[1000]:.0f} / {per[1]:.0f} ns", "<= 3x", f"{per[1000] / per[1]:.1f}x (not worked on)")
+    row("assembly: ~1,000-block wall at rest per block-step / single block (energy on, kernel, 0.05 s)",
+        f"{per[1000]:.0f} / {per[1]:.0f} ns", "<= 3x", f"{per[1000] / per[1]:.1f}x")
+    # as a user counts it (issue 17 item 1): `rockyade run --solver reference`'s result,
+    # wall_time_s (the kernel, loaded before its timer) / (n_steps x moving blocks); the
+    # single block over 2 s so that its fixed costs do not count (the wall's 0.05 s are
+    # 10,000 steps of its 5e-6 s time step)
+    from rockyade.solvers import make_solver
+
+    solver = make_solver("reference")
+    user = {}
+    for n, duration_s, repeat in ((1, 2.0, 5), (1000, 0.05, 2)):
+        scene = scene_for(n, "rest", duration_s)
+        moving = sum(1 for spec in scene.blocks if not spec.fixed)
+        metas = [solver.run(scene).meta for _ in range(repeat)]
+        user[n] = min(1e9 * m["wall_time_s"] / (m["n_steps"] * moving) for m in metas)
+    row("assembly: the same as `rockyade run` reports it (wall_time_s per block-step; 1 block over 2 s)",
+        f"{user[1000]:.0f} / {user[1]:.0f} ns", "<= 3x", f"{user[1000] / user[1]:.1f}x")
 
 
 def main() -> None:

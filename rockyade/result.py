@@ -23,6 +23,7 @@ import glob
 import hashlib
 import json
 import os
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -128,7 +129,7 @@ class Result:
         """
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
-        text = self.frame.to_csv(index=False, float_format=CSV_FLOAT_FORMAT, lineterminator="\n")
+        text = csv_text(self.frame, CSV_FLOAT_FORMAT)
         meta = dict(self.meta)
         meta.update(extra_meta or {})
         meta["csv_file"] = csv_path.name
@@ -188,6 +189,45 @@ class Result:
         for key in ("csv_file", "csv_sha256", "columns"):
             meta.pop(key, None)
         return cls(frame, meta)
+
+
+#: Column names written as they are by pandas' CSV writer (no quoting needed).
+_PLAIN_NAME = re.compile(r'^[^",\r\n]+$')
+
+
+def csv_text(frame: pd.DataFrame, float_format: str) -> str:
+    """``frame.to_csv(index=False, float_format=float_format, lineterminator="\\n")``, the same
+    text, formatted row by row when every column is a float without NaN, an integer or a bool
+    (pandas formats each value through Python calls: 3 s for a 1,000-block wall's result).
+
+    Parameters
+    ----------
+    frame
+        The table (its index is not written).
+    float_format
+        printf-style format of the floats, e.g. ``"%.12g"``.
+    """
+    formats: list[str] | None = []
+    has_nan = frame.isna().to_numpy().any(axis=0)
+    for (name, dtype), nan in zip(frame.dtypes.items(), has_nan, strict=True):
+        if formats is None or not (isinstance(name, str) and _PLAIN_NAME.match(name)):
+            formats = None
+            break
+        if dtype.kind == "f" and dtype.itemsize == 8 and not nan:
+            formats.append(float_format)
+        elif dtype.kind in "iu":
+            formats.append("%d")
+        elif dtype.kind == "b":
+            formats.append("%s")
+        else:
+            formats = None
+            break
+    if not formats:
+        return frame.to_csv(index=False, float_format=float_format, lineterminator="\n")
+    row = ",".join(formats) + "\n"
+    columns = [values.to_numpy().tolist() for _, values in frame.items()]
+    body = "".join(row % values for values in zip(*columns, strict=True))
+    return ",".join(frame.columns) + "\n" + body
 
 
 def pending_json_path(json_path: Path) -> Path:

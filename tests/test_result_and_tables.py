@@ -99,3 +99,32 @@ def test_report_flags_known_inconsistencies():
     assert report.loc[(5, "specimen 1", "K", "T")]["consistent"]
     assert report.loc[(5, "specimen 2", "f_min", "E")]["consistent"]
     assert report.loc[(3, "specimen 2", "mu", "T")]["consistent"]
+
+
+@pytest.mark.parametrize("odd", [None, "nan", "text", "quoted name"])
+def test_result_csv_text_is_pandas_to_csv_byte_for_byte(odd: str | None) -> None:
+    from rockyade.result import CSV_FLOAT_FORMAT, csv_text
+
+    rng = np.random.default_rng(3)
+    frame = pd.DataFrame(
+        {
+            "t_s": np.arange(50) * 0.002,
+            "b_theta_rad": rng.normal(scale=1e-3, size=50),
+            "b_x_m": rng.normal(scale=1e8, size=50) * rng.integers(0, 2, 50),  # zeros, large values
+            "extremes": [0.0, -0.0, np.inf, -np.inf, 5e-324, 1e308, 1 / 3, -2.5] + [1e-17] * 42,
+            "b_n_contacts": rng.integers(0, 4, 50),
+            "b_slipping": rng.integers(0, 2, 50).astype(bool),
+            "small_int": np.arange(50, dtype=np.int8),
+        }
+    )
+    if odd == "nan":
+        frame.loc[7, "b_x_m"] = np.nan
+    elif odd == "text":
+        frame["state"] = "rest"
+    elif odd == "quoted name":
+        frame['a "b", c'] = 1.5
+    assert csv_text(frame, CSV_FLOAT_FORMAT) == frame.to_csv(
+        index=False, float_format=CSV_FLOAT_FORMAT, lineterminator="\n"
+    )
+    empty = frame.iloc[:0]
+    assert csv_text(empty, "%.8g") == empty.to_csv(index=False, float_format="%.8g", lineterminator="\n")

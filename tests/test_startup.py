@@ -49,3 +49,40 @@ def test_scene_and_motion_import_no_scipy_or_pandas(module: str) -> None:
         code += "rockyade.scene.load_scene\n"  # the loader (lazy in rockyade.scene) too
     heavy = [m for m in _imported_after(code) if m != COMPILER]
     assert heavy == [], f"import {module} imports {heavy[:8]}"
+
+
+def test_the_dem_model_imports_scipy_spatial_only_for_an_alpha_override() -> None:
+    # scipy.spatial (0.2-1 s) serves only a block whose base is replaced by its alpha (ConvexHull)
+    heavy = _imported_after("import rockyade.calibration.model\nimport rockyade.solvers.reference\n")
+    assert not [m for m in heavy if m.startswith("scipy.spatial")], heavy[:8]
+    code = (
+        "from rockyade.blocks.geometry import Block\n"
+        "from rockyade.dem.build import contact_polygon\n"
+        "contact_polygon(Block.rectangle(0.25, 1.0, 0.754, mass_kg=503), 0.2)\n"
+    )
+    assert any(m.startswith("scipy.spatial") for m in _imported_after(code))
+
+
+def test_the_cost_estimate_and_the_run_build_one_model(monkeypatch: pytest.MonkeyPatch) -> None:
+    # rockyade run estimates the cost (the model's time step), then runs: one model build
+    import rockyade.calibration.model as model_module
+    from rockyade.scene import scene_from_dict
+    from rockyade.solvers import make_solver
+
+    builds = []
+    build = model_module._calibrated_model
+    monkeypatch.setattr(model_module, "_calibrated_model", lambda *a: builds.append(a) or build(*a))
+    scene = scene_from_dict(
+        {
+            "duration_s": 0.05,
+            "sample_dt_s": 0.001,
+            "blocks": [{"name": "b", "width_m": 0.25, "height_m": 1.0, "thickness_m": 0.754, "mass_kg": 503}],
+            "contact": {"calibration": "paper"},
+            "motion": {"type": "free", "theta0_rad": 0.05},
+        }
+    )
+    solver = make_solver("reference")
+    estimate = solver.estimate_cost(scene)
+    result = solver.run(scene)
+    assert len(builds) == 1
+    assert result.ok and estimate.time_step_s == pytest.approx(result.meta["dt_s"], rel=1e-12)

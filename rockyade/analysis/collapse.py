@@ -52,7 +52,7 @@ from rockyade.dem.overturn import (
 )
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.scene.placement import placed_blocks, rest_contacts
+from rockyade.scene.placement import placed_blocks, scene_rest_contacts
 
 STATES = ("rest", "rocking", "sliding", "fallen", "carried", "falling")
 REST, ROCKING, SLIDING, FALLEN, CARRIED, FALLING = range(6)
@@ -139,8 +139,20 @@ def block_geometry(scene: Scene, result: Result) -> list[BlockGeometry]:
     return out
 
 
-def _series(result: Result, quantity: str, name: str) -> NDArray[np.float64]:
-    return np.asarray(result.series(quantity, name), dtype=float)
+class _Columns:
+    """A result's per-block columns as float arrays, each looked up once (a DataFrame
+    lookup costs ~0.1 ms; a 1,000-block wall asks for each column several times)."""
+
+    def __init__(self, result: Result) -> None:
+        self.result = result
+        self._arrays: dict[tuple[str, str], NDArray[np.float64]] = {}
+
+    def __call__(self, quantity: str, name: str) -> NDArray[np.float64]:
+        key = (quantity, name)
+        array = self._arrays.get(key)
+        if array is None:
+            array = self._arrays[key] = np.asarray(self.result.series(quantity, name), dtype=float)
+        return array
 
 
 def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
@@ -152,19 +164,29 @@ def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[B
         The scene that produced ``result`` (its blocks, bottom to top).
     result
         The run's Result (any solver)."""
+    states, geometry, _ = _block_states(scene, result, _Columns(result))
+    return states, geometry
+
+
+def _block_states(
+    scene: Scene, result: Result, columns: _Columns
+) -> tuple[NDArray[np.int8], list[BlockGeometry], list[Fall]]:
+    """:func:`block_states`, and each block's :func:`block_fall_of`."""
     geometry = block_geometry(scene, result)
+    falls = []
     t = result.t
     n = t.size
     states = np.zeros((n, len(geometry)), dtype=np.int8)
     dt = float(t[1] - t[0]) if n > 1 else 1.0
     supports, centroids = _supports(scene)
     for j, g in enumerate(geometry):
-        theta = _series(result, "theta_rad", g.name)
-        x = _series(result, "x_m", g.name)
-        y = _series(result, "y_m", g.name)
-        fall = block_fall_of(g, result)
+        theta = columns("theta_rad", g.name)
+        x = columns("x_m", g.name)
+        y = columns("y_m", g.name)
+        fall = block_fall_of(g, result, columns)
+        falls.append(fall)
         rocking = np.abs(theta) > max(ROCK_MIN_RAD, ROCK_FRACTION * g.alpha_rad)
-        sliding = _sliding(result, g, supports.get(g.name, []), centroids, dt)
+        sliding = _sliding(columns, g, supports.get(g.name, []), centroids, dt)
         slipping = _slipping(result, g.name)
         if slipping is not None:  # the DEM says whether a contact slips
             sliding &= slipping
@@ -181,7 +203,7 @@ def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[B
         if fall.fell:
             code[fall.fall :] = FALLEN
         states[:, j] = code
-    return states, geometry
+    return states, geometry, falls
 
 
 @dataclass(frozen=True)
@@ -199,7 +221,7 @@ def _supports(scene: Scene) -> tuple[dict[str, list[_Support]], dict[str, tuple[
     under it; a block without one (a voussoir between radial joints) takes all its joints.
     And every block's centroid at rest (base frame, m)."""
     placed = placed_blocks(scene)
-    contacts = rest_contacts(placed)
+    contacts = scene_rest_contacts(scene)
     out: dict[str, list[_Support]] = {}
     touching: dict[str, list[_Support]] = {}
     for c in contacts:
@@ -221,30 +243,29 @@ def _supports(scene: Scene) -> tuple[dict[str, list[_Support]], dict[str, tuple[
 
 
 def _material_point(
-    result: Result, name: str | None, point_m: NDArray[np.float64], centroid_m: tuple[float, float]
+    columns: _Columns, n: int, name: str | None, point_m: NDArray[np.float64], centroid_m: tuple[float, float]
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """Path (x, y) of the material point of block ``name`` that was at ``point_m`` at rest,
-    and the block's rotation; the base (None) does not move in the base frame."""
-    n = result.t.size
+    and the block's rotation, over ``n`` samples; the base (None) does not move in the base frame."""
     if name is None:
         return np.full(n, point_m[0]), np.full(n, point_m[1]), np.zeros(n)
-    theta = _series(result, "theta_rad", name)
+    theta = columns("theta_rad", name)
     rx, ry = point_m[0] - centroid_m[0], point_m[1] - centroid_m[1]
     c, s = np.cos(theta), np.sin(theta)
-    x = centroid_m[0] + _series(result, "x_m", name) + c * rx - s * ry
-    y = centroid_m[1] + _series(result, "y_m", name) + s * rx + c * ry
+    x = centroid_m[0] + columns("x_m", name) + c * rx - s * ry
+    y = centroid_m[1] + columns("y_m", name) + s * rx + c * ry
     return x, y, theta
 
 
 def _sliding(
-    result: Result,
+    columns: _Columns,
     g: BlockGeometry,
     supports: list[_Support],
     centroids: dict[str, tuple[float, float]],
     dt: float,
 ) -> NDArray[np.bool_]:
     """Samples at which the block slides on every joint it rests on (see module docstring)."""
-    n = result.t.size
+    n = columns("theta_rad", g.name).size
     if n < 2:
         return np.zeros(n, dtype=bool)
     if not supports:  # in the air at rest: against the base
@@ -252,8 +273,10 @@ def _sliding(
     sliding = np.ones(n, dtype=bool)
     for sup in supports:
         point = np.asarray(sup.point_m, dtype=float)
-        xj, yj, thj = _material_point(result, g.name, point, centroids[g.name])
-        xs, ys, ths = _material_point(result, sup.below, point, centroids[sup.below] if sup.below else (0.0, 0.0))
+        xj, yj, thj = _material_point(columns, n, g.name, point, centroids[g.name])
+        xs, ys, ths = _material_point(
+            columns, n, sup.below, point, centroids[sup.below] if sup.below else (0.0, 0.0)
+        )
         # the joint's direction turns with the block under it
         tx = np.cos(ths) * sup.tangent[0] - np.sin(ths) * sup.tangent[1]
         ty = np.sin(ths) * sup.tangent[0] + np.cos(ths) * sup.tangent[1]
@@ -273,7 +296,7 @@ def _slipping(result: Result, name: str) -> NDArray[np.bool_] | None:
         return None
 
 
-def block_fall_of(g: BlockGeometry, result: Result) -> Fall:
+def block_fall_of(g: BlockGeometry, result: Result, columns: _Columns | None = None) -> Fall:
     """:func:`rockyade.dem.overturn.block_fall` of one block of a result (sample indices).
 
     Parameters
@@ -281,11 +304,14 @@ def block_fall_of(g: BlockGeometry, result: Result) -> Fall:
     g
         The block (:func:`block_geometry`).
     result
-        The run's Result (any solver)."""
+        The run's Result (any solver).
+    columns
+        The result's columns, each looked up once (internal)."""
+    columns = columns or _Columns(result)
     return block_fall(
         result.t,
-        _series(result, "theta_rad", g.name),
-        _series(result, "y_m", g.name),
+        columns("theta_rad", g.name),
+        columns("y_m", g.name),
         g.alpha_rad,
         g.landing_rad,
         g.height_m,
@@ -321,15 +347,16 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
     result
         The run's Result (any solver).
     """
-    states, geometry = block_states(scene, result)
+    columns = _Columns(result)
+    states, geometry, falls = _block_states(scene, result, columns)
     t = result.t
     dt = float(t[1] - t[0]) if t.size > 1 else 0.0
     rows = []
     for j, g in enumerate(geometry):
-        theta = _series(result, "theta_rad", g.name)
+        theta = columns("theta_rad", g.name)
         finite = np.isfinite(theta)
         last = int(np.flatnonzero(finite)[-1]) if finite.any() else -1
-        fall = block_fall_of(g, result)
+        fall = falls[j]
         rows.append(
             {
                 "block": g.name,
@@ -340,8 +367,8 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
                 "max_abs_theta_rad": float(np.nanmax(np.abs(theta))) if finite.any() else math.nan,
                 "max_theta_over_alpha": float(np.nanmax(np.abs(theta)) / g.alpha_rad) if finite.any() else math.nan,
                 "residual_theta_rad": float(theta[last]) if last >= 0 else math.nan,
-                "residual_x_m": float(_series(result, "x_m", g.name)[last]) if last >= 0 else math.nan,
-                "residual_y_m": float(_series(result, "y_m", g.name)[last]) if last >= 0 else math.nan,
+                "residual_x_m": float(columns("x_m", g.name)[last]) if last >= 0 else math.nan,
+                "residual_y_m": float(columns("y_m", g.name)[last]) if last >= 0 else math.nan,
                 "rocking_time_s": float(np.sum(states[:, j] == ROCKING) * dt),
                 "sliding_time_s": float(np.sum(states[:, j] == SLIDING) * dt),
                 "final_state": STATES[int(states[last, j])] if last >= 0 else "rest",

@@ -4,6 +4,7 @@ assembly (collapse), and of a stack as one body (:func:`structure_rotation`)."""
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
@@ -12,8 +13,13 @@ from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, f
 from rockyade.result import Result
 from rockyade.scene import Scene
 
+if TYPE_CHECKING:
+    import pandas as pd
 
-def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -> dict[str, dict[str, float]]:
+
+def run_metrics(
+    scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS, report: pd.DataFrame | None = None
+) -> dict[str, dict[str, float]]:
     """Per-block summary of a run: peaks, max |theta|, effective mu, overturn.
 
     Parameters
@@ -24,6 +30,8 @@ def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -
         The Result.
     n_impacts
         Impacts used for the effective restitution (free rocking).
+    report
+        The run's :func:`rockyade.analysis.collapse.collapse_report`, when the caller has it.
 
     Returns
     -------
@@ -39,9 +47,10 @@ def run_metrics(scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS) -
     free = scene.motion.type == "free"
     fell: dict[str, bool] = {}
     if scene.positioned and result.ok:
-        from rockyade.analysis.collapse import collapse_report
+        if report is None:
+            from rockyade.analysis.collapse import collapse_report
 
-        report = collapse_report(scene, result)
+            report = collapse_report(scene, result)
         fell = dict(zip(report["block"], report["fell"], strict=True))
     for spec in scene.blocks:
         if spec.fixed:
@@ -100,7 +109,9 @@ def peak_metrics(
 PER_BLOCK_LIMIT = 10
 
 
-def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | str]:
+def assembly_metrics(
+    scene: Scene, result: Result, report: pd.DataFrame | None = None
+) -> dict[str, float | int | str]:
     """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
     ``n_blocks``, ``n_fallen`` (blocks that came down within the run), ``fallen_fraction``,
     ``first_fall_time_s``, ``first_fallen_block``, ``n_falling_at_end`` (blocks still falling
@@ -118,10 +129,13 @@ def assembly_metrics(scene: Scene, result: Result) -> dict[str, float | int | st
     scene
         The scene that produced ``result`` (its blocks, bottom to top).
     result
-        The run's Result (any solver)."""
-    from rockyade.analysis.collapse import collapse_report
+        The run's Result (any solver).
+    report
+        The run's :func:`rockyade.analysis.collapse.collapse_report`, when the caller has it."""
+    if report is None:
+        from rockyade.analysis.collapse import collapse_report
 
-    report = collapse_report(scene, result)
+        report = collapse_report(scene, result)
     fallen = report[report["fell"]]
     residual = np.hypot(report["residual_x_m"], report["residual_y_m"])
     first = fallen.sort_values("fall_time_s", kind="stable").iloc[0] if len(fallen) else None
@@ -158,7 +172,7 @@ def stack_order(scene: Scene) -> list[str] | None:
     ----------
     scene
         Any scene (a column scene is a stack by construction)."""
-    from rockyade.scene.placement import placed_blocks, rest_contacts
+    from rockyade.scene.placement import placed_blocks, scene_rest_contacts
 
     if any(spec.fixed for spec in scene.blocks):
         return None
@@ -166,7 +180,7 @@ def stack_order(scene: Scene) -> list[str] | None:
         return [spec.name for spec in scene.blocks]
     placed = placed_blocks(scene)
     below: dict[int, list[int]] = {}
-    for c in rest_contacts(placed):
+    for c in scene_rest_contacts(scene):
         if c.kind != "bed":
             return None
         lower = -1 if c.b < 0 else (c.b if c.upper == c.a else c.a)

@@ -8,6 +8,7 @@ counter-clockwise. Rotational inertia is about the z axis.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -45,6 +46,16 @@ class PolygonSection:
     polar_second_moment_m4: float
 
 
+def _next(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``np.roll(a, -1, axis=0)`` (each row's successor, cyclically) without its overhead."""
+    return np.concatenate((a[1:], a[:1]))
+
+
+def _previous(a: NDArray[np.float64]) -> NDArray[np.float64]:
+    """``np.roll(a, 1, axis=0)`` (each row's predecessor, cyclically) without its overhead."""
+    return np.concatenate((a[-1:], a[:-1]))
+
+
 def polygon_section(vertices: NDArray[np.float64]) -> PolygonSection:
     """Area, centroid and polar second moment of a simple polygon (Green's theorem).
 
@@ -59,8 +70,8 @@ def polygon_section(vertices: NDArray[np.float64]) -> PolygonSection:
     """
     x = vertices[:, 0]
     y = vertices[:, 1]
-    xn = np.roll(x, -1)
-    yn = np.roll(y, -1)
+    xn = _next(x)
+    yn = _next(y)
     cross = x * yn - xn * y
     area = 0.5 * cross.sum()
     cx = ((x + xn) * cross).sum() / (6.0 * area)
@@ -105,12 +116,12 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
     if area < 0:
         arr = arr[::-1].copy()
     unit = arr / scale
-    edges = np.roll(unit, -1, axis=0) - unit
+    edges = _next(unit) - unit
     lengths = np.hypot(edges[:, 0], edges[:, 1])
     if np.any(lengths <= LEVEL_TOL):
         raise InputError(field_name, "has repeated (coincident) vertices")
     offset = _offsets(unit)
-    prev = np.roll(edges, 1, axis=0)
+    prev = _previous(edges)
     turn = prev[:, 0] * edges[:, 1] - prev[:, 1] * edges[:, 0]  # at each vertex
     if np.any((turn < 0) & (offset > SIMPLIFY_TOL)):
         raise InputError(field_name, "polygon must be convex (vertices in order around it)")
@@ -127,8 +138,8 @@ def _as_vertices(vertices: ArrayLike, field_name: str) -> NDArray[np.float64]:
 
 def _offsets(unit: NDArray[np.float64]) -> NDArray[np.float64]:
     """Distance of each vertex from the chord joining its two neighbours (same units)."""
-    before = np.roll(unit, 1, axis=0)
-    after = np.roll(unit, -1, axis=0)
+    before = _previous(unit)
+    after = _next(unit)
     return _distance_to_line(unit, before, after)
 
 
@@ -193,7 +204,7 @@ def polygon_section_area(vertices: NDArray[np.float64]) -> float:
     """Signed area of a polygon (> 0 counter-clockwise), m^2 (shoelace formula)."""
     x = vertices[:, 0]
     y = vertices[:, 1]
-    return 0.5 * float((x * np.roll(y, -1) - np.roll(x, -1) * y).sum())
+    return 0.5 * float((x * _next(y) - _next(x) * y).sum())
 
 
 def rectangle_vertices(width: float, height: float) -> NDArray[np.float64]:
@@ -269,8 +280,10 @@ class Block:
         """A rectangular block of base ``width_m`` (2b) and height ``height_m`` (2h)."""
         _positive(width_m, f"{field_prefix}width_m")
         _positive(height_m, f"{field_prefix}height_m")
-        return cls.polygon(
-            rectangle_vertices(width_m, height_m),
+        verts, section = _rectangle_outline(float(width_m), float(height_m), f"{field_prefix}vertices_m")
+        return cls._from_outline(
+            verts,
+            section,
             thickness_m,
             mass_kg=mass_kg,
             density_kg_m3=density_kg_m3,
@@ -306,10 +319,33 @@ class Block:
             Optional rotational inertia about the centroid, kg m^2; by default that of a
             uniform density.
         """
-        verts = _as_vertices(vertices_m, f"{field_prefix}vertices_m")
-        verts = verts - np.array([0.0, verts[:, 1].min()])
+        verts, section = _outline(vertices_m, f"{field_prefix}vertices_m")
+        return cls._from_outline(
+            verts,
+            section,
+            thickness_m,
+            mass_kg=mass_kg,
+            density_kg_m3=density_kg_m3,
+            inertia_kgm2=inertia_kgm2,
+            name=name,
+            field_prefix=field_prefix,
+        )
+
+    @classmethod
+    def _from_outline(
+        cls,
+        verts: NDArray[np.float64],
+        section: PolygonSection,
+        thickness_m: float,
+        *,
+        mass_kg: float | None,
+        density_kg_m3: float | None,
+        inertia_kgm2: float | None,
+        name: str,
+        field_prefix: str,
+    ) -> Block:
+        """:meth:`polygon` of validated vertices (:func:`_outline`) and their section."""
         _positive(thickness_m, f"{field_prefix}thickness_m")
-        section = polygon_section(verts)
         if (mass_kg is None) == (density_kg_m3 is None):
             raise InputError(f"{field_prefix}mass_kg", "give exactly one of mass_kg and density_kg_m3")
         if mass_kg is not None:
@@ -324,13 +360,18 @@ class Block:
         else:
             inertia = mass / section.area_m2 * section.polar_second_moment_m4
         block = cls(name, verts, float(thickness_m), mass, inertia, inertia_kgm2 is not None)
+        block.__dict__["section"] = section  # the cached property's value: computed above
         block._check_base(f"{field_prefix}vertices_m")
         return block
 
+    def __post_init__(self) -> None:
+        # a frozen block: its vertices may be shared (the cached outline) and its section is cached
+        self.vertices_m.setflags(write=False)
+
     # ------------------------------------------------------------------- properties
-    @property
+    @cached_property
     def section(self) -> PolygonSection:
-        """Area properties of the cross-section."""
+        """Area properties of the cross-section (computed once: a block is frozen)."""
         return polygon_section(self.vertices_m)
 
     @property
@@ -388,6 +429,23 @@ class Block:
                 field_name,
                 f"centroid x = {cx:g} m lies outside the base [{x_left:g}, {x_right:g}] m: the block cannot stand",
             )
+
+
+def _outline(vertices_m: ArrayLike, field_name: str) -> tuple[NDArray[np.float64], PolygonSection]:
+    """Validated vertices (counter-clockwise, lowest on y = 0, read-only) and their section."""
+    verts = _as_vertices(vertices_m, field_name)
+    verts = verts - np.array([0.0, verts[:, 1].min()])
+    verts.setflags(write=False)
+    return verts, polygon_section(verts)
+
+
+@lru_cache(maxsize=256)
+def _rectangle_outline(
+    width_m: float, height_m: float, field_name: str
+) -> tuple[NDArray[np.float64], PolygonSection]:
+    """:func:`_outline` of a rectangle (m), remembered per size (a wall has a few): its
+    vertices are read-only."""
+    return _outline(rectangle_vertices(width_m, height_m), field_name)
 
 
 def _positive(value: object, field_name: str) -> float:

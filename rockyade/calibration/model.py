@@ -33,6 +33,10 @@ def supported_masses(scene: Scene) -> list[float]:
 def calibrated_model(scene: Scene, g: float = G) -> DemModel:
     """The scene's DEM model, every moving block's joint calibrated first (module docstring).
 
+    The last scene's model is kept: the model is frozen and only read by the solvers, so the
+    cost estimate of ``rockyade run`` and the run itself share it (a 1,000-block wall spends
+    seconds here). Only one is kept, so that a study's many scenes do not hold their models.
+
     Parameters
     ----------
     scene
@@ -40,6 +44,19 @@ def calibrated_model(scene: Scene, g: float = G) -> DemModel:
     g
         Gravity, m/s^2.
     """
+    global _LAST
+    if _LAST is not None and _LAST[0] is scene and _LAST[1] == g:
+        return _LAST[2]
+    model = _calibrated_model(scene, g)
+    _LAST = (scene, g, model)  # the scene itself, so that its id is not reused while kept
+    return model
+
+
+#: The last (scene, g, model) of :func:`calibrated_model`.
+_LAST: tuple[Scene, float, DemModel] | None = None
+
+
+def _calibrated_model(scene: Scene, g: float) -> DemModel:
     supported = supported_masses(scene)
     joints = [
         None

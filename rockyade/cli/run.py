@@ -11,6 +11,8 @@ from rockyade.cli.build import add_snapshot_options, check_run_drawings, write_r
 from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_file, json_out, total_time
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from rockyade.result import Result
     from rockyade.scene import Scene
     from rockyade.solvers.base import Solver
@@ -36,11 +38,12 @@ def cmd_run(args: argparse.Namespace) -> int:
         solver = solver.keeping_files(args.out.parent, args.out.stem)
     with output_lock(args.out) if args.out else contextlib.nullcontext():
         result = solver.run(scene)
+        report = _collapse_report(scene, result)
         if args.out:
             json_path = result.write(args.out)
             print(f"wrote {args.out} and {json_path}")
-            if scene.positioned and result.ok:
-                _write_collapse(scene, result, args.out.with_name(f"{args.out.stem}_collapse.csv"))
+            if report is not None:
+                _write_collapse(report, args.out.with_name(f"{args.out.stem}_collapse.csv"))
             if scene.motion.type == "pushover" and len(result.frame):
                 _write_capacity(scene, result, args.out.with_name(f"{args.out.stem}_capacity.csv"))
     if args.plot:
@@ -49,8 +52,17 @@ def cmd_run(args: argparse.Namespace) -> int:
         plot_results({args.solver: result}, args.plot, title=f"{Path(args.scene).name} ({args.solver})")
         print(f"wrote {args.plot}")
     write_run_drawings(args, scene, result, args.out or Path(Path(args.scene).stem + ".csv"))
-    _print_summary(scene, result, total_time(args))
+    _print_summary(scene, result, total_time(args), report)
     return 0 if result.ok else 1
+
+
+def _collapse_report(scene: Scene, result: Result) -> pd.DataFrame | None:
+    """The state of every block of an assembly's run (written and summarised), else None."""
+    if not (scene.positioned and result.ok):
+        return None
+    from rockyade.analysis.collapse import collapse_report
+
+    return collapse_report(scene, result)
 
 
 def _warn_if_the_motion_is_cut(scene: Scene) -> None:
@@ -77,17 +89,19 @@ def _write_capacity(scene: Scene, result: Result, path: Path) -> None:
     print(f"wrote {path} (capacity curve; onset lambda = {onset.multiplier:.4g}: {onset.rule})")
 
 
-def _write_collapse(scene: Scene, result: Result, path: Path) -> None:
-    """Per block: whether and when it fell, rocking and sliding time, residual displacement."""
-    from rockyade.analysis.collapse import collapse_report
+def _write_collapse(report: pd.DataFrame, path: Path) -> None:
+    """Per block: whether and when it fell, rocking and sliding time, residual displacement
+    (:func:`rockyade.analysis.collapse.collapse_report`)."""
     from rockyade.io.atomic import atomic_open
 
     with atomic_open(path) as fh:
-        collapse_report(scene, result).to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
+        report.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
     print(f"wrote {path} (collapse: the state of every block)")
 
 
-def _print_summary(scene: Scene, result: Result, total_s: float = math.nan) -> None:
+def _print_summary(
+    scene: Scene, result: Result, total_s: float = math.nan, report: pd.DataFrame | None = None
+) -> None:
     from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
     from rockyade.blocks.restitution import MU_EFF_IMPACTS
 
@@ -100,7 +114,7 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan) -> N
             print(f"  log: {meta['log_path']}")
         return
     if scene.positioned:
-        a = assembly_metrics(scene, result)
+        a = assembly_metrics(scene, result, report)
         line = f"  {a['n_blocks']} moving blocks: {a['n_fallen']} fell"
         if a["n_fallen"]:
             line += f" (first {a['first_fallen_block']} at t = {a['first_fall_time_s']:.4g} s)"
@@ -121,7 +135,7 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan) -> N
         from rockyade.analysis.metrics import structure_rotation
 
         _print_structure(structure_rotation(scene, result), result, scene)
-    for name, m in run_metrics(scene, result).items():
+    for name, m in run_metrics(scene, result, report=report).items():
         theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
         line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
         if not math.isnan(m["mu_eff"]):

@@ -20,7 +20,6 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from rockyade.blocks.classical import frequency_parameter, inertia_for_frequency
 from rockyade.blocks.geometry import LEVEL_TOL, Block
@@ -64,6 +63,8 @@ def contact_polygon(block: Block, alpha_rad: float | None) -> np.ndarray:
     others = verts[~on_base]
     new_base = np.array([[cx - b_eq, 0.0], [cx + b_eq, 0.0]])
     points = np.vstack([new_base, others])
+    from scipy.spatial import ConvexHull  # here: scipy.spatial costs 0.2-1 s to import, most scenes need none
+
     hull = ConvexHull(points)
     return _from_bottom_left(points[hull.vertices])  # hull vertices: counter-clockwise in 2-D
 

@@ -76,6 +76,11 @@ CALIBRATIONS = ("paper", "matched")
 MAX_SAMPLES = 50_000_000
 
 
+def _without_caches(obj: object) -> dict[str, Any]:
+    """A frozen object's fields for pickling, without what it computed and kept (keys with "_")."""
+    return {k: v for k, v in obj.__dict__.items() if not k.startswith("_")}
+
+
 @dataclass(frozen=True)
 class BlockSpec:
     """One ``[[blocks]]`` entry, validated. See the module docstring for the keys."""
@@ -96,8 +101,17 @@ class BlockSpec:
     rotation_rad: float = 0.0
     fixed: bool = False
 
+    def __getstate__(self) -> dict[str, Any]:
+        return _without_caches(self)
+
     def block(self) -> Block:
-        """The rigid block (geometry, mass, inertia)."""
+        """The rigid block (geometry, mass, inertia); built once (both are frozen)."""
+        cached = self.__dict__.get("_block")
+        if cached is None:
+            cached = self.__dict__["_block"] = self._new_block()
+        return cached
+
+    def _new_block(self) -> Block:
         if self.vertices_m is not None:
             return Block.polygon(
                 self.vertices_m,
@@ -224,6 +238,9 @@ class Scene:
     source: str | None = field(default=None, compare=False)
     joints: tuple[JointOverride, ...] = ()
     loads: tuple[LoadSpec, ...] = ()
+
+    def __getstate__(self) -> dict[str, Any]:
+        return _without_caches(self)
 
     # ------------------------------------------------------------------ queries
     @property

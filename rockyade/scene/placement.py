@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from numpy.typing import NDArray
@@ -53,9 +54,9 @@ class PlacedBlock:
     rotation_rad: float
     fixed: bool
 
-    @property
+    @cached_property
     def size_m(self) -> float:
-        """Largest extent of the polygon, m."""
+        """Largest extent of the polygon, m (computed once: the block is frozen)."""
         return float(np.max(np.ptp(self.vertices_m, axis=0)))
 
 
@@ -102,11 +103,35 @@ def place_polygon(vertices_m: NDArray[np.float64], position_m, rotation_rad: flo
 def placed_blocks(scene) -> list[PlacedBlock]:
     """The scene's blocks at rest in the base frame (see module docstring).
 
+    Computed once per scene (a scene is frozen; the vertices are read-only): loading,
+    the model build and the analyses all ask.
+
     Parameters
     ----------
     scene
         A :class:`~rockyade.scene.Scene` (positioned or column).
     """
+    cached = scene.__dict__.get("_placed_blocks")
+    if cached is None:
+        cached = scene.__dict__["_placed_blocks"] = tuple(_placed_blocks(scene))
+    return list(cached)
+
+
+def scene_rest_contacts(scene) -> list[RestContact]:
+    """:func:`rest_contacts` of the scene's own polygons (:func:`placed_blocks`), once per scene.
+
+    Parameters
+    ----------
+    scene
+        A :class:`~rockyade.scene.Scene` (positioned or column).
+    """
+    cached = scene.__dict__.get("_rest_contacts")
+    if cached is None:
+        cached = scene.__dict__["_rest_contacts"] = tuple(rest_contacts(placed_blocks(scene)))
+    return list(cached)
+
+
+def _placed_blocks(scene) -> list[PlacedBlock]:
     out: list[PlacedBlock] = []
     base_y = 0.0
     for i, spec in enumerate(scene.blocks):
@@ -121,6 +146,7 @@ def placed_blocks(scene) -> list[PlacedBlock]:
             position, rotation = (spec.x_offset_m, base_y), 0.0
             base_y += block.height_m
         verts = place_polygon(block.vertices_m, position, rotation)
+        verts.setflags(write=False)
         centroid = place_polygon(np.array([block.centroid_m]), position, rotation)[0]
         out.append(
             PlacedBlock(i, spec.name, verts, (float(centroid[0]), float(centroid[1])), float(rotation), spec.fixed)
@@ -152,21 +178,26 @@ def candidate_pairs(polygons: list[NDArray[np.float64]], margin: float = 0.0) ->
 
 def _edge_normals(poly: NDArray[np.float64]) -> NDArray[np.float64]:
     """Outward unit normals of a counter-clockwise polygon's edges."""
-    edges = np.roll(poly, -1, axis=0) - poly
+    edges = np.concatenate((poly[1:], poly[:1])) - poly  # np.roll(poly, -1, axis=0) - poly
     normals = np.column_stack([edges[:, 1], -edges[:, 0]])
     return normals / np.hypot(normals[:, 0], normals[:, 1])[:, None]
 
 
-def penetration_depth(p: NDArray[np.float64], q: NDArray[np.float64]) -> float:
+def penetration_depth(
+    p: NDArray[np.float64],
+    q: NDArray[np.float64],
+    normals: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+) -> float:
     """Separating-axis penetration of two convex polygons, m (<= 0: apart or touching).
 
     The smallest overlap of the two polygons' projections over all their edge normals;
-    negative values are separations.
+    negative values are separations. ``normals`` are the two polygons' edge normals, when
+    the caller has them.
     """
     depth = math.inf
-    for normals in (_edge_normals(p), _edge_normals(q)):
-        pp = p @ normals.T
-        qq = q @ normals.T
+    for axes in normals if normals is not None else (_edge_normals(p), _edge_normals(q)):
+        pp = p @ axes.T
+        qq = q @ axes.T
         overlap = np.minimum(pp.max(axis=0), qq.max(axis=0)) - np.maximum(pp.min(axis=0), qq.min(axis=0))
         depth = min(depth, float(overlap.min()))
     return depth
@@ -178,9 +209,10 @@ def overlapping_pairs(blocks: list[PlacedBlock], tol: float = OVERLAP_TOL) -> li
     Returns (i, j, depth_m) triples.
     """
     polys = [b.vertices_m for b in blocks]
+    normals = [_edge_normals(p) for p in polys]
     out = []
     for i, j in candidate_pairs(polys):
-        depth = penetration_depth(polys[i], polys[j])
+        depth = penetration_depth(polys[i], polys[j], (normals[i], normals[j]))
         if depth > tol * min(blocks[i].size_m, blocks[j].size_m):
             out.append((i, j, depth))
     return out
@@ -190,27 +222,34 @@ def overlapping_pairs(blocks: list[PlacedBlock], tol: float = OVERLAP_TOL) -> li
 
 
 def _shared_segment(
-    p: NDArray[np.float64], q: NDArray[np.float64], tol: float
+    p: NDArray[np.float64],
+    q: NDArray[np.float64],
+    tol: float,
+    normals: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
 ) -> tuple[float, NDArray[np.float64], tuple[tuple[float, float], tuple[float, float]]]:
-    """The boundary segment two touching convex polygons share: length, normal (q -> p), ends."""
-    np_, nq = _edge_normals(p), _edge_normals(q)
+    """The boundary segment two touching convex polygons share: length, normal (q -> p), ends.
+
+    ``normals`` are the two polygons' :func:`_edge_normals`, when the caller has them."""
+    np_, nq = normals if normals is not None else (_edge_normals(p), _edge_normals(q))
     best, normal, ends = 0.0, np.zeros(2), ((0.0, 0.0), (0.0, 0.0))
-    for e in range(len(p)):
+    # the edge pairs that can be anti-parallel, all at once (a looser test than the exact one
+    # below, which decides), in the order of a loop over e, then f
+    edges, faces = np.nonzero(np_ @ nq.T <= -1.0 + 1e-6)
+    for e, f in zip(edges.tolist(), faces.tolist(), strict=True):
         a0, a1 = p[e], p[(e + 1) % len(p)]
-        for f in range(len(q)):
-            if np_[e] @ nq[f] > -1.0 + 1e-9:
-                continue
-            b0, b1 = q[f], q[(f + 1) % len(q)]
-            if abs((b0 - a0) @ np_[e]) > tol or abs((b1 - a0) @ np_[e]) > tol:
-                continue
-            d = (a1 - a0) / np.hypot(*(a1 - a0))
-            s = sorted((0.0, float((a1 - a0) @ d)))
-            t = sorted((float((b0 - a0) @ d), float((b1 - a0) @ d)))
-            lo, hi = max(s[0], t[0]), min(s[1], t[1])
-            if hi - lo > best:
-                best, normal = hi - lo, -np_[e]
-                e0, e1 = a0 + lo * d, a0 + hi * d
-                ends = ((float(e0[0]), float(e0[1])), (float(e1[0]), float(e1[1])))
+        if np_[e] @ nq[f] > -1.0 + 1e-9:
+            continue
+        b0, b1 = q[f], q[(f + 1) % len(q)]
+        if abs((b0 - a0) @ np_[e]) > tol or abs((b1 - a0) @ np_[e]) > tol:
+            continue
+        d = (a1 - a0) / np.hypot(*(a1 - a0))
+        s = sorted((0.0, float((a1 - a0) @ d)))
+        t = sorted((float((b0 - a0) @ d), float((b1 - a0) @ d)))
+        lo, hi = max(s[0], t[0]), min(s[1], t[1])
+        if hi - lo > best:
+            best, normal = hi - lo, -np_[e]
+            e0, e1 = a0 + lo * d, a0 + hi * d
+            ends = ((float(e0[0]), float(e0[1])), (float(e1[0]), float(e1[1])))
     return best, normal, ends
 
 
@@ -226,6 +265,7 @@ def rest_contacts(blocks: list[PlacedBlock], polygons: list[NDArray[np.float64]]
         pass theirs, whose base corners may sit at the equivalent base b_eq (Eq 11).
     """
     polys = polygons if polygons is not None else [b.vertices_m for b in blocks]
+    normals = [_edge_normals(p) for p in polys]
     out: list[RestContact] = []
     for i, p in enumerate(polys):
         if blocks[i].fixed:
@@ -240,7 +280,7 @@ def rest_contacts(blocks: list[PlacedBlock], polygons: list[NDArray[np.float64]]
         if blocks[i].fixed and blocks[j].fixed:
             continue
         tol = TOUCH_TOL * min(blocks[i].size_m, blocks[j].size_m)
-        length, normal, ends = _shared_segment(polys[i], polys[j], tol)
+        length, normal, ends = _shared_segment(polys[i], polys[j], tol, (normals[i], normals[j]))
         if length <= tol:
             continue
         bed = abs(normal[1]) >= BED_NORMAL_MIN_Y

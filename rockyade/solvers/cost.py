@@ -21,6 +21,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+from collections.abc import Hashable
 from dataclasses import dataclass
 from typing import Any
 
@@ -89,9 +90,10 @@ def _duration(seconds: float) -> str:
 def dem_time_step(scene: Scene) -> tuple[float, int]:
     """The DEM's time step (s) and its moving bodies, from the model the solvers build.
 
-    The model is built on the scene with the base at rest (the step depends on the joints
-    and masses, not on the motion, so no motion is built); a matched calibration is
-    estimated with the paper's damping (Eq 13), which the matching changes little.
+    The step depends on the joints and masses, not on the motion. The model is the one the
+    run builds (:func:`rockyade.calibration.model.calibrated_model` keeps it for the run),
+    except for a matched calibration, estimated with the paper's damping (Eq 13), which the
+    matching changes little, on the scene with the base at rest (no motion is built).
     """
     from rockyade.calibration.model import calibrated_model
     from rockyade.motion.spec import AtRest
@@ -99,21 +101,26 @@ def dem_time_step(scene: Scene) -> tuple[float, int]:
     contact = scene.contact
     if contact.calibration == "matched" and contact.beta_s is None:
         contact = dataclasses.replace(contact, calibration="paper")
-    at_rest = dataclasses.replace(scene, motion=AtRest(), contact=contact)
-    model = calibrated_model(at_rest)
+        model = calibrated_model(dataclasses.replace(scene, motion=AtRest(), contact=contact))
+    else:
+        model = calibrated_model(scene)
     moving = sum(1 for b in model.bodies if not b.fixed)
     return float(model.dt_s), moving
 
 
-_DT_CACHE: dict[str, tuple[float, int]] = {}
+_DT_CACHE: dict[Hashable, tuple[float, int]] = {}
 
 
 def _cached_dem_time_step(scene: Scene) -> tuple[float, int]:
     """:func:`dem_time_step`, remembered per scene without its motion (grids vary the motion)."""
-    d = scene.to_dict()
-    d.pop("motion", None)
-    d["duration_s"] = 0.0
-    key = json.dumps(d, sort_keys=True, default=str)
+    key: Hashable = (scene.sample_dt_s, scene.blocks, scene.contact, scene.output, scene.joints, scene.loads)
+    try:
+        hash(key)  # the frozen specs hash their fields (a 1,000-block wall: ~1 ms, its JSON ~1 s)
+    except TypeError:
+        d = scene.to_dict()
+        d.pop("motion", None)
+        d["duration_s"] = 0.0
+        key = json.dumps(d, sort_keys=True, default=str)
     if key not in _DT_CACHE:
         if len(_DT_CACHE) > 4096:
             _DT_CACHE.clear()
