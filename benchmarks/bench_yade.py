@@ -5,10 +5,11 @@
   reference DEM's kernel time on the same model: the ratio per simulated second.
 * Runs per minute with two parallel YADE workers (8 runs of 5 s simulated).
 * YADE kept warm against one process per run (:func:`warm_vs_cold`): 20 runs of specimen 1,
-  20 s each, under harmonic motions of different amplitudes, one after the other in this
-  process: runs per minute and the per-run start-up cost (everything but YADE's own loop)
-  each way, and the results compared bit for bit (``python benchmarks/bench_yade.py warm``
-  runs only this).
+  20 s each, under harmonic motions of different amplitudes, a cold and a warm run of each
+  in turn in this process: runs per minute (wall), CPU time per run (this process and
+  YADE's), the per-run start-up cost (everything but YADE's own loop) each way, the load
+  average, and the results compared bit for bit (``python benchmarks/bench_yade.py warm
+  [RUNS]`` runs only this).
 * Assemblies: dry running-bond walls of about 10 and 100 blocks under a one-sine pulse,
   us per block-step and start-up time of YADE beside the reference DEM's
   (:func:`assembly_costs`, which ``bench_scale.py`` can call).
@@ -17,6 +18,8 @@
 from __future__ import annotations
 
 import math
+import os
+import resource
 import sys
 import time
 from pathlib import Path
@@ -29,6 +32,7 @@ from rockyade.solvers.reference import run_model
 from rockyade.solvers.yade import YadeSolver
 from rockyade.studies.specimens import block_table
 from rockyade.yade import backend as yade_backend
+from rockyade.yade import worker as yade_worker
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 
@@ -138,28 +142,60 @@ def harmonic_scene(amplitude_mm: float, duration: float = 20.0):
     )
 
 
+def _worker_cpu_s() -> float:
+    """CPU time (user + system) of this thread's warm YADE worker so far, s (0 without one)."""
+    box = yade_worker._slot().box
+    if not box or not box[-1].alive():
+        return 0.0
+    fields = Path(f"/proc/{box[-1].proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def warm_vs_cold(runs: int = 20, duration: float = 20.0) -> dict[str, float]:
-    """``runs`` YADE runs in a row, in a process each (``warm=False``) then in one warm worker.
+    """``runs`` YADE runs, each in a process of its own (``warm=False``) and in this thread's
+    warm worker, taken in pairs (cold, warm) so that both see the same load.
 
     Returns
     -------
     dict
-        ``cold_runs_per_min``, ``warm_runs_per_min`` (1/min), ``cold_startup_s`` and
-        ``warm_startup_s`` (the median per-run cost outside YADE's own loop, s; the warm
-        worker's first run, which starts it, is left out) and ``identical`` (1.0 when every
-        warm result equals its cold one bit for bit).
+        ``cold_runs_per_min``, ``warm_runs_per_min`` (1/min of wall time), ``cold_cpu_s`` and
+        ``warm_cpu_s`` (CPU time per run, s: this process plus YADE's), ``cold_startup_s`` and
+        ``warm_startup_s`` (the median per-run wall time outside YADE's own loop, s; the warm
+        worker's first run, which starts it, is left out), ``yade_loop_s`` (the median of YADE's
+        own loop, wall, s), ``load_average`` (1 min, before and after, the larger) and
+        ``identical`` (1.0 when every warm result equals its cold one bit for bit).
     """
     scenes = [harmonic_scene(4.0 + 0.2 * k, duration) for k in range(runs)]
-    out: dict[str, float] = {}
-    results = {}
-    for name, solver in (("cold", YadeSolver(warm=False)), ("warm", YadeSolver())):
-        start = time.perf_counter()
-        results[name] = [solver.run(s) for s in scenes]
-        wall = time.perf_counter() - start
-        assert all(r.ok for r in results[name]), [r.meta.get("failure_reason") for r in results[name]]
+    solvers = {"cold": YadeSolver(warm=False), "warm": YadeSolver()}
+    wall = {"cold": 0.0, "warm": 0.0}
+    cpu = {"cold": 0.0, "warm": 0.0}
+    results: dict[str, list] = {"cold": [], "warm": []}
+    load = os.getloadavg()[0]
+    for s in scenes:
+        for name, solver in solvers.items():
+            children = resource.getrusage(resource.RUSAGE_CHILDREN)
+            worker = _worker_cpu_s()
+            own, start = time.process_time(), time.perf_counter()
+            result = solver.run(s)
+            wall[name] += time.perf_counter() - start
+            used = time.process_time() - own
+            if name == "cold":  # its process has ended and been reaped
+                after = resource.getrusage(resource.RUSAGE_CHILDREN)
+                used += after.ru_utime + after.ru_stime - children.ru_utime - children.ru_stime
+            else:
+                used += _worker_cpu_s() - worker
+            cpu[name] += used
+            assert result.ok, result.meta.get("failure_reason")
+            results[name].append(result)
+    yade_worker.close_workers()
+    out: dict[str, float] = {"load_average": max(load, os.getloadavg()[0])}
+    for name in solvers:
         startups = sorted(r.meta["startup_time_s"] for r in results[name][1 if name == "warm" else 0 :])
-        out[f"{name}_runs_per_min"] = 60 * runs / wall
+        out[f"{name}_runs_per_min"] = 60 * runs / wall[name]
+        out[f"{name}_cpu_s"] = cpu[name] / runs
         out[f"{name}_startup_s"] = startups[len(startups) // 2]
+    loops = sorted(r.meta["wall_time_s"] for r in results["warm"])
+    out["yade_loop_s"] = loops[len(loops) // 2]
     out["identical"] = float(
         all(w.frame.equals(c.frame) for w, c in zip(results["warm"], results["cold"], strict=True))
     )
@@ -169,10 +205,14 @@ def warm_vs_cold(runs: int = 20, duration: float = 20.0) -> dict[str, float]:
 def print_warm_vs_cold(runs: int = 20, duration: float = 20.0) -> None:
     r = warm_vs_cold(runs, duration)
     print(
-        f"YADE, {runs} runs of specimen 1 ({duration:g} s, harmonic) in a row: one process per run "
-        f"{r['cold_runs_per_min']:.1f} runs/min ({r['cold_startup_s']:.2f} s start-up per run); kept warm "
-        f"{r['warm_runs_per_min']:.1f} runs/min ({r['warm_startup_s']:.2f} s); "
-        f"{r['warm_runs_per_min'] / r['cold_runs_per_min']:.2f}x; bit for bit the same: {bool(r['identical'])}"
+        f"YADE, {runs} runs of specimen 1 ({duration:g} s, harmonic), cold and warm in pairs: "
+        f"one process per run {r['cold_runs_per_min']:.1f} runs/min ({r['cold_startup_s']:.2f} s start-up per run), "
+        f"kept warm {r['warm_runs_per_min']:.1f} runs/min ({r['warm_startup_s']:.2f} s): "
+        f"{r['warm_runs_per_min'] / r['cold_runs_per_min']:.2f}x (wall); "
+        f"CPU per run {r['cold_cpu_s']:.2f} s cold, {r['warm_cpu_s']:.2f} s warm: "
+        f"{r['cold_cpu_s'] / r['warm_cpu_s']:.2f}x; YADE's loop {r['yade_loop_s']:.2f} s (wall); "
+        f"load average {r['load_average']:.2f} on {os.cpu_count()} cores; "
+        f"bit for bit the same: {bool(r['identical'])}"
     )
 
 
@@ -218,8 +258,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:] == ["warm"]:
-        print_warm_vs_cold()
+    if sys.argv[1:2] == ["warm"]:
+        print_warm_vs_cold(*(int(a) for a in sys.argv[2:3]))
     else:
         main()
         print_warm_vs_cold()

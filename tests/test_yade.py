@@ -354,13 +354,23 @@ def test_instability_inside_yade_gives_failed_result(tmp_path):
     assert "numerical instability" in result.meta["failure_reason"]
 
 
+def _warm_yade() -> None:
+    """This thread's warm YADE started (a loaded machine can take the whole of a short timeout
+    to start YADE, and a run stopped before its first sample has none to keep)."""
+    assert YadeSolver().run(scene_from_dict({**load_scene(EXAMPLES / "specimen3_free.toml").to_dict(),
+                                             "duration_s": 0.2})).ok
+
+
 def test_timeout_gives_failed_result(tmp_path):
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 60.0})
+    _warm_yade()
     start = time.time()
     result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=3.0).run(scene)
     assert time.time() - start < 30
     assert result.status == "failed" and result.meta["failure_reason"].startswith("timeout")
-    assert not (tmp_path / "slow.yade.npz").exists()
+    # stopped by the driver at the deadline: what it recorded is kept, marked partial
+    assert result.meta["partial"] is True and result.meta["partial_samples"] == len(result.frame) > 0
+    assert not list(tmp_path.glob("*.part"))
 
 
 def test_partial_output_is_not_a_result(tmp_path):
@@ -501,7 +511,8 @@ def test_default_timeout_grows_with_the_work_and_is_capped():
 
 
 def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
-    """--yade-timeout: a failed result saying so, exit 1, and no YADE process left behind."""
+    """--yade-timeout: a failed result saying so with the samples recorded up to the stop
+    (partial), exit 1, and no YADE process left running the scene."""
     from rockyade.cli import main
 
     d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
@@ -509,13 +520,21 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     (tmp_path / "long.json").write_text(json.dumps(d))
     monkeypatch.chdir(tmp_path)
     before = descendants(os.getpid())
+    _warm_yade()
     start = time.time()
     code = main(["run", "long.json", "--solver", "yade", "--out", "t/long.csv", "--yade-timeout", "2"])
     assert code == 1 and time.time() - start < 30
     out = capsys.readouterr().out
     assert "timeout: YADE did not finish within 2 s" in out
-    assert Result.read(Path("t/long.csv")).status == "failed"
-    assert not [p for p in descendants(os.getpid()) - before if alive(p)]  # the timed-out YADE was killed
+    kept = Result.read(Path("t/long.csv"))
+    assert kept.status == "failed" and kept.meta["partial"] is True and len(kept.frame) > 0
+    # the scene was stopped: its warm YADE waits idle for the next one, and quits when asked
+    from rockyade.yade.worker import QUIT_WAIT_S, close_workers
+
+    start = time.monotonic()
+    close_workers()
+    assert time.monotonic() - start < QUIT_WAIT_S
+    assert not [p for p in descendants(os.getpid()) - before if alive(p)]
 
 
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])

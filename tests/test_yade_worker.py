@@ -14,13 +14,17 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import rockyade
+from rockyade.calibration.model import calibrated_model
+from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.yade import YadeSolver
 from rockyade.yade import backend as yade_backend
+from rockyade.yade import worker as yade_worker
 
 from .conftest import EXAMPLES
 from .processes import alive, cmdline, descendants, listening_of_tree, require_yade
@@ -105,18 +109,63 @@ def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypa
     _same(YadeSolver().run(good), reference)
 
 
-def test_each_scene_has_its_own_timeout_in_a_warm_worker(tmp_path):
+def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tmp_path):
+    """A run stopped at its timeout (the driver stops it at the deadline): status failed, never
+    complete, with the samples it recorded marked partial (the same, bit for bit, as the start
+    of a complete run), read back from its files as such; the warm worker takes the next scene
+    with a fresh limit."""
     short = _scene("specimen3_free.toml", 0.5)
     assert YadeSolver().run(short).ok
     (pid,) = _serving()
     start = time.monotonic()
-    slow = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(_scene("specimen1_free.toml", 60.0))
+    long = _scene("specimen1_free.toml", 60.0)
+    slow = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(long)
     assert time.monotonic() - start < 20
-    assert slow.status == "failed" and slow.meta["failure_reason"].startswith("timeout: YADE did not finish within 2 s")
-    assert not alive(pid) and not (tmp_path / "slow.yade.npz").exists()
+    assert slow.status == "failed" and not slow.ok
+    assert slow.meta["failure_reason"].startswith("timeout: YADE did not finish within 2 s")
+    n = slow.meta["partial_samples"]
+    assert slow.meta["partial"] is True and 0 < n == len(slow.frame) < calibrated_model(long).n_samples
+    assert slow.meta["overturn_time_s"] is None
     assert not list(tmp_path.glob("*.part"))
-    again = YadeSolver(timeout_s=30.0).run(short)  # a fresh worker, a fresh limit
-    assert again.ok and _serving() and pid not in _serving()
+    complete = YadeSolver(warm=False).run(_scene("specimen1_free.toml", 1.0))
+    m = min(n, len(complete.frame))
+    for column in ("theta_rad", "omega_rad_s", "x_m", "y_m"):
+        assert np.array_equal(slow.frame[column].to_numpy()[:m], complete.frame[column].to_numpy()[:m]), column
+    slow.write(tmp_path / "slow.csv")
+    back = Result.read(tmp_path / "slow.csv")
+    assert back.status == "failed" and back.meta["partial"] is True and len(back.frame) == n
+    again = YadeSolver(timeout_s=30.0).run(short)  # the same worker, a fresh limit
+    assert again.ok and _serving() == {pid}
+
+
+def test_a_killed_yade_run_keeps_the_samples_it_flushed(tmp_path, monkeypatch):
+    """A worker killed from outside in the middle of a scene (a hard kill: nothing of the
+    driver runs) after it flushed its samples: the run fails naming the signal, keeps the
+    samples of the last flush marked partial, and that flushed file is whole (written to a
+    ``.part`` file and renamed: a kill never leaves a truncated output)."""
+    monkeypatch.setattr(yade_worker, "FLUSH_PERIOD_S", 0.3)
+    long = _scene("specimen1_free.toml", 120.0, sample_dt_s=0.01)
+    holder: dict = {}
+    thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="k").run(long)))
+    before = _serving()
+    thread.start()
+    npz = tmp_path / "k.yade.npz"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not ((_serving() - before) and npz.is_file()):
+        time.sleep(0.05)
+    (victim,) = _serving() - before
+    time.sleep(0.5)
+    os.kill(victim, signal.SIGKILL)
+    thread.join(60)
+    killed = holder["r"]
+    assert killed.status == "failed" and "exited with code -9" in killed.meta["failure_reason"]
+    n = killed.meta["partial_samples"]
+    assert killed.meta["partial"] is True and 0 < n == len(killed.frame) < calibrated_model(long).n_samples
+    with np.load(npz, allow_pickle=False) as data:
+        meta = json.loads(str(data["meta"]))
+        assert meta["complete"] is False and meta["status"] == "running" and meta["n_filled"] == n
+        assert data["ang"].shape[0] == n
+    assert not list(tmp_path.glob("*.part"))
 
 
 def test_threads_each_keep_a_worker_and_close_it_when_they_end():

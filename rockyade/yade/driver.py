@@ -10,9 +10,12 @@ Usage::
 
 ``--serve FD``: a YADE worker (:mod:`rockyade.yade.worker` starts it). FD is its end of a
 socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
-then takes jobs ``{"scene": path, "out": path}``, each with the descriptor of the job's log
-file (SCM_RIGHTS) onto which its stdout and stderr go while the job runs, and answers each
-with ``{"ok": ...}``. Between jobs it resets YADE (:func:`reset`). After a job that raised
+then takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
+descriptor of the job's log file (SCM_RIGHTS) onto which its stdout and stderr go while the
+job runs, and answers each with ``{"ok": ...}`` (``"timeout": true`` when the scene was
+stopped at its deadline, a ``time.monotonic()`` value, with its samples written; every
+``flush_s`` seconds of a run the samples so far are written, ``complete: false``, so that a
+worker killed from outside leaves them). Between jobs it resets YADE (:func:`reset`). After a job that raised
 it answers and exits (code 1): a fresh worker takes the next scene. It stops on
 ``{"quit": true}`` or when its end of the socket closes.
 
@@ -47,8 +50,11 @@ The model, as the reference DEM's:
   on each moving clump (InterpolatingDirectedForceEngine, linear between samples, zero
   after; one engine per distinct mass and direction);
 * NewtonIntegrator with damping 0 (its default is 0.2), gravity -g, O.dt as given;
-* a PyRunner *before* the other engines records every ``steps_per_sample`` steps, so the
-  sample at step n sees x_n and t_n = n dt;
+* the recorder is called *before* the other engines every ``steps_per_sample`` steps, so
+  the sample at step n sees x_n and t_n = n dt: rockyade steps the scene itself in the
+  driver's thread (:func:`run_stepping`, ``O.step()``: the same steps as YADE's thread runs,
+  without a Python command per call), the ``yade`` launcher's console runs it in YADE's
+  thread with a PyRunner placed first;
 * rotation is continuous from rest, as the reference DEM's: the driver accumulates the
   change of each block's orientation (2 atan2(q_z, q_w) of ori * ori0.conjugate(), taken
   as the smallest angle) at
@@ -323,14 +329,17 @@ def _describe(clumps):
     """What was built: for tests of the YADE pitfalls (no simulation is run)."""
     newton = next(e for e in O.engines if type(e).__name__ == "NewtonIntegrator")
     runner = O.engines[0]
+    recorder = globals()["rockyade_record"]
+    stepping = recorder.runner is None  # called by run_stepping before each step's engines
     out = {
         "engines": [type(e).__name__ for e in O.engines],
         "newton_damping": newton.damping,
         "gravity": list(newton.gravity),
         "dt": O.dt,
-        "recorder_first": type(runner).__name__ == "PyRunner",
-        "recorder_period": runner.iterPeriod,
-        "rotation_track_period": globals()["rockyade_record"].track_period,
+        "recorder_first": stepping or type(runner).__name__ == "PyRunner",
+        "recorder_period": recorder.sps if stepping else runner.iterPeriod,
+        "recorder": "run_stepping" if stepping else "PyRunner",
+        "rotation_track_period": recorder.track_period,
         "clumps": [],
     }
     for c in clumps:
@@ -373,24 +382,33 @@ def _describe(clumps):
 
 
 class Recorder:
-    """Samples the state every ``steps_per_sample`` steps; writes the output when done."""
+    """Samples the state every ``steps_per_sample`` steps; writes the output when done.
+
+    Called before the engines of a step (by :func:`run_stepping`, or by a PyRunner placed
+    first when YADE's own thread runs the scene); after each call ``period`` is the number
+    of steps to the next call. Samples are kept in Python lists (a float taken from YADE is
+    stored as it is: the arrays written are those a per-element write into numpy arrays
+    gives) and turned into arrays when the output is written: a numpy scalar update costs
+    more than the YADE calls that feed it.
+
+    ``deadline``: a ``time.monotonic()`` value (CLOCK_MONOTONIC, the same clock in every
+    process of the machine) at which the run stops with status ``timeout`` and writes what it
+    has; ``flush_s``: every so many seconds of wall time the samples so far are written
+    (``complete: false``), so that a run killed from outside keeps them.
+    """
 
     def __init__(self, scene, clumps, out_path, csv_path=None):
         nb = len(clumps)
-        ns = scene["n_samples"]
-        maxv = max(len(b["vertices_m"]) for b in scene["bodies"])
-        self.scene, self.clumps, self.ns = scene, clumps, ns
+        self.scene, self.clumps, self.ns, self.nb = scene, clumps, scene["n_samples"], nb
+        self.maxv = max(len(b["vertices_m"]) for b in scene["bodies"])
         self.out_path, self.csv_path = out_path, csv_path
-        self.rec = {
-            "pos": np.full((ns, nb, 2), np.nan),
-            "ang": np.full((ns, nb), np.nan),
-            "angvel": np.full((ns, nb), np.nan),
-            "vpoint": np.full((ns, nb, 2), np.nan),
-            "fn": np.zeros((ns, nb, maxv)),
-            "state": np.zeros((ns, nb, maxv), dtype=np.int8),
-            "ncont": np.zeros((ns, nb), dtype=np.int32),
-            "slip": np.zeros((ns, nb), dtype=bool),
-        }
+        # per sample and block: x, y, theta, omega, and the velocity of the acceleration point
+        self.kin = []
+        # contacts, sparse: flat index (sample, block, vertex) -> normal force and state;
+        # (sample, block) -> number of contact points; (sample, block) that slip
+        self.fn_at, self.fn_val, self.state_val = [], [], []
+        self.ncont_at, self.ncont_val = [], []
+        self.slip_at = []
         # continuous rotation: last orientation angle seen and the rotation accumulated since
         self.raw = [0.0] * nb
         self.turned = [0.0] * nb
@@ -398,12 +416,19 @@ class Recorder:
         # each clump's State, fetched once (YADE updates it in place): a lookup is a
         # boost.python call, and the recorder runs every sample
         self.states = [O.bodies[c["id"]].state for c in clumps]
+        self.per_clump = [
+            (i, self.states[i], c["angle0"], c["point"], c["fixed"], c["rest"], c["stop_angle"])
+            for i, c in enumerate(clumps)
+        ]
+        self.tracked = [(i, self.states[i], clumps[i]["ori0"]) for i in self.moving]
         self.sps = scene["steps_per_sample"]
         self.track_period = max(1, min(self.sps, int(ROTATION_STEP_MAX_RAD / (MAX_SPIN_RAD_S * scene["dt_s"]))))
+        self.period = self.sps
         self.max_rotation_step = 0.0
         self.runner = None
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
+        self.stopped = False
         self.overturn_times = {}
         self.stop_on_overturn = scene.get("stop_on_overturn", True)
         self.max_depth_ratio = 0.0
@@ -420,6 +445,17 @@ class Recorder:
         self.written = False
         self.wait = True
         self.own_time = 0.0  # spent in the recorder, s
+        self.deadline = math.inf
+        self.flush_s = math.inf
+        self.next_flush = math.inf
+        self.flushes = 0
+
+    def limit(self, deadline=None, flush_s=None):
+        """Stop at ``deadline`` (``time.monotonic()``) and write every ``flush_s`` seconds (None: never)."""
+        now = time.monotonic()
+        self.deadline = math.inf if deadline is None else float(deadline)
+        self.flush_s = math.inf if flush_s is None else float(flush_s)
+        self.next_flush = now + self.flush_s
 
     def __call__(self):
         start = time.perf_counter()
@@ -431,18 +467,18 @@ class Recorder:
         k = self.k
         if k >= self.ns or self.written:
             return
-        step = O.iter
-        to_sample = k * self.sps - step
+        to_sample = k * self.sps - O.iter
         if not self.track():
             return
         if to_sample > 0:  # a rotation record between samples
+            self.period = min(to_sample, self.track_period)
             if self.runner is not None:
-                self.runner.iterPeriod = min(to_sample, self.track_period)
+                self.runner.iterPeriod = self.period
             return
-        rec = self.rec
-        for i, c in enumerate(self.clumps):
-            st = self.states[i]
-            theta = c["angle0"] + self.turned[i]
+        turned = self.turned
+        row = []
+        for i, st, angle0, point, fixed, rest, stop_angle in self.per_clump:
+            theta = angle0 + turned[i]
             pos, vel = st.pos, st.vel  # one copy of each vector
             x, y = pos[0], pos[1]
             w = st.angVel[2]
@@ -451,32 +487,39 @@ class Recorder:
                 self.status, self.stop_time, self.stop_body = "failed", O.time, i
                 self.stop()
                 return
-            rec["pos"][k, i] = (x, y)
-            rec["ang"][k, i] = theta
-            rec["angvel"][k, i] = w
-            px, py = _rotate(c["point"], theta)
-            rec["vpoint"][k, i] = (vel[0] - w * py, vel[1] + w * px)
-            if not c["fixed"] and abs(theta - c["rest"]) >= c["stop_angle"] and i not in self.overturn_times:
+            px, py = _rotate(point, theta)
+            row += (x, y, theta, w, vel[0] - w * py, vel[1] + w * px)
+            if not fixed and abs(theta - rest) >= stop_angle and i not in self.overturn_times:
                 self.overturn_times[i] = O.time
                 if self.stop_on_overturn and self.status == "completed":
                     self.status, self.stop_time, self.stop_body = "overturned", O.time, i
+        self.kin += row
         self.contact_forces(k)
         if self.deep_overlap_time is None and self.max_depth_ratio >= 1.0:
             self.deep_overlap_time = O.time
         self.k = k + 1
+        self.period = min(self.sps, self.track_period)
         if self.runner is not None:
-            self.runner.iterPeriod = min(self.sps, self.track_period)
+            self.runner.iterPeriod = self.period
         if self.status != "completed" or self.k >= self.ns:
             self.stop()
+            return
+        now = time.monotonic()
+        if now >= self.deadline:
+            self.status, self.stop_time = "timeout", O.time
+            self.stop()
+        elif now >= self.next_flush:
+            self.write_samples(complete=False)
+            self.flushes += 1
+            self.next_flush = time.monotonic() + self.flush_s
 
     def track(self):
         """Accumulate each moving block's rotation since the last call (the smallest angle
         between the two orientations); False (the run failed) when a block spins beyond
         MAX_SPIN_RAD_S or turned more than ROTATION_STEP_MAX_RAD: it cannot be unwrapped."""
         raw, turned = self.raw, self.turned
-        for i in self.moving:
-            st = self.states[i]
-            now = _orientation_angle(st.ori * self.clumps[i]["ori0"])
+        for i, st, ori0 in self.tracked:
+            now = _orientation_angle(st.ori * ori0)
             step = math.remainder(now - raw[i], 2.0 * math.pi)
             raw[i] = now
             turned[i] += step
@@ -495,10 +538,10 @@ class Recorder:
 
         Also the deepest penetration seen against a Polyhedra prism, in sphere radii: at one
         radius the sphere's centre is inside the prism and YADE's contact loses its normal."""
-        fn_k, state_k = self.rec["fn"][k], self.rec["state"][k]
-        ncont_k, slip_k = self.rec["ncont"][k], self.rec["slip"][k]
         vertex_of, polyhedra, block_of_prism = self.vertex_of, self.polyhedra, self.block_of_prism
+        fn_of, state_of = {}, {}  # (block, vertex) -> summed normal force, state
         points = {}  # (block, other block or -1 for the base) -> vertices touching
+        slipping = set()
         for inter in O.interactions.all(True):  # the real ones, in the container's order
             id1, id2 = inter.id1, inter.id2
             where = vertex_of.get(id1)
@@ -512,37 +555,81 @@ class Recorder:
             fn = phys.normalForce.norm()
             if fn <= 0.0:
                 continue
-            fn_k[i, v] += fn
+            key = (i, v)
+            fn_of[key] = fn_of.get(key, 0.0) + fn
             slips = phys.shearForce.norm() >= SLIP_RATIO * fn * phys.tangensOfFrictionAngle
             if slips:
-                state_k[i, v] = 2
-            elif state_k[i, v] == 0:
-                state_k[i, v] = 1
+                state_of[key] = 2
+            elif key not in state_of:
+                state_of[key] = 1
             j = block_of_prism.get(other, -1)
-            key = (i, j) if j < 0 or i < j else (j, i)
-            touching = points.get(key)
+            pair = (i, j) if j < 0 or i < j else (j, i)
+            touching = points.get(pair)
             if touching is None:
-                points[key] = {(i, v)}
+                points[pair] = {key}
             else:
-                touching.add((i, v))
+                touching.add(key)
             if slips:
-                slip_k[i] = True
+                slipping.add(i)
                 if j >= 0:
-                    slip_k[j] = True
+                    slipping.add(j)
             if other in polyhedra:
                 depth = inter.geom.penetrationDepth / radius
                 if depth > self.max_depth_ratio:
                     self.max_depth_ratio = depth
+        if not fn_of:
+            return
+        nb, maxv = self.nb, self.maxv
+        base = k * nb
+        for (i, v), fn in fn_of.items():
+            self.fn_at.append((base + i) * maxv + v)
+            self.fn_val.append(fn)
+            self.state_val.append(state_of[i, v])
+        counts = {}
         for (a, b), touching in points.items():
             if b < 0:  # the base: every vertex on it, as the reference DEM
-                ncont_k[a] += len(touching)
+                counts[a] = counts.get(a, 0) + len(touching)
             else:  # two blocks: at most the two ends of their contact segment
                 n = min(2, len(touching))
-                ncont_k[a] += n
-                ncont_k[b] += n
+                counts[a] = counts.get(a, 0) + n
+                counts[b] = counts.get(b, 0) + n
+        for a, n in counts.items():
+            self.ncont_at.append(base + a)
+            self.ncont_val.append(n)
+        for i in slipping:
+            self.slip_at.append(base + i)
+
+    def arrays(self, n):
+        """The first ``n`` samples as the output's arrays."""
+        nb, maxv = self.nb, self.maxv
+        kin = np.array(self.kin[: n * nb * 6], dtype=float).reshape(n, nb, 6)
+        size = n * nb * maxv
+        fn, state = np.zeros(size), np.zeros(size, dtype=np.int8)
+        at = np.array(self.fn_at, dtype=np.int64)
+        keep = at < size
+        fn[at[keep]] = np.array(self.fn_val, dtype=float)[keep]
+        state[at[keep]] = np.array(self.state_val, dtype=np.int8)[keep]
+        ncont = np.zeros(n * nb, dtype=np.int32)
+        at = np.array(self.ncont_at, dtype=np.int64)
+        keep = at < n * nb
+        ncont[at[keep]] = np.array(self.ncont_val, dtype=np.int32)[keep]
+        slip = np.zeros(n * nb, dtype=bool)
+        at = np.array(self.slip_at, dtype=np.int64)
+        slip[at[at < n * nb]] = True
+        return {
+            "pos": np.ascontiguousarray(kin[:, :, 0:2]),
+            "ang": np.ascontiguousarray(kin[:, :, 2]),
+            "angvel": np.ascontiguousarray(kin[:, :, 3]),
+            "vpoint": np.ascontiguousarray(kin[:, :, 4:6]),
+            "fn": fn.reshape(n, nb, maxv),
+            "state": state.reshape(n, nb, maxv),
+            "ncont": ncont.reshape(n, nb),
+            "slip": slip.reshape(n, nb),
+        }
 
     def stop(self):
         """End of the run seen from inside it: pause, and write now unless the caller waits."""
+        self.stopped = True
         O.pause()
         if not self.wait:
             self.write()
@@ -552,9 +639,17 @@ class Recorder:
         if self.written:
             return
         self.written = True
+        self.write_samples(complete=self.status != "timeout")
+        if self.csv_path:
+            self.write_csv(self.k)
+
+    def write_samples(self, complete):
+        """The samples so far to ``out_path`` (replacing it as one step: a kill leaves the
+        previous file); ``complete`` False: a flush while running, or a run stopped at its
+        deadline."""
         n = self.k
         meta = {
-            "status": self.status,
+            "status": self.status if complete or self.status == "timeout" else "running",
             "stop_time_s": self.stop_time,
             "overturn_times_s": {str(i): t for i, t in self.overturn_times.items()},
             "stop_body": self.stop_body,
@@ -569,30 +664,32 @@ class Recorder:
             "deep_overlap_time_s": self.deep_overlap_time,
             "max_rotation_step_rad": self.max_rotation_step,
             "rotation_track_period_steps": self.track_period,
-            "complete": True,
+            "complete": complete,
+            "flushes": self.flushes,
+            "process_cpu_s": time.process_time(),
         }
+        arrays = self.arrays(n)
 
         def write(tmp):
             with open(tmp, "wb") as fh:
-                np.savez(fh, **{k: v[:n] for k, v in self.rec.items()}, meta=np.array(json.dumps(meta)))
+                np.savez(fh, **arrays, meta=np.array(json.dumps(meta)))
                 fh.flush()
                 os.fsync(fh.fileno())
 
         _write_replacing(self.out_path, write)
-        if self.csv_path:
-            self.write_csv(n)
 
     def write_csv(self, n):
         """A plain table for hand work: t, and per block x, y (centroid) and theta (from rest)."""
         names = [b["name"] for b in self.scene["bodies"]]
         rest = [b["rest_angle_rad"] for b in self.scene["bodies"]]
+        arrays = self.arrays(n)
         header = ["t_s"]
         for name in names:
             header += [f"{name}_x_m", f"{name}_y_m", f"{name}_rotation_rad"]
         t = np.arange(n) * self.scene["dt_s"] * self.scene["steps_per_sample"]
         cols = [t]
         for i in range(len(names)):
-            cols += [self.rec["pos"][:n, i, 0], self.rec["pos"][:n, i, 1], self.rec["ang"][:n, i] - rest[i]]
+            cols += [arrays["pos"][:, i, 0], arrays["pos"][:, i, 1], arrays["ang"][:, i] - rest[i]]
         _write_replacing(
             self.csv_path,
             lambda tmp: np.savetxt(
@@ -601,15 +698,17 @@ class Recorder:
         )
 
 
-def prepare(scene, out_path, csv_path=None):
-    """Build the scene and its engines; return the recorder."""
+def prepare(scene, out_path, csv_path=None, stepping=False):
+    """Build the scene and its engines; return the recorder. ``stepping``: the recorder is
+    called by :func:`run_stepping` (no PyRunner: YADE's own thread is not used)."""
     start = time.perf_counter()
     clumps = build(scene)
     recorder = Recorder(scene, clumps, out_path, csv_path)
     globals()["rockyade_record"] = recorder
-    recorder.runner = PyRunner(command="rockyade_record()", iterPeriod=scene["steps_per_sample"], initRun=True)
+    if not stepping:
+        recorder.runner = PyRunner(command="rockyade_record()", iterPeriod=scene["steps_per_sample"], initRun=True)
     O.engines = [
-        recorder.runner,
+        *([] if stepping else [recorder.runner]),
         ForceResetter(),
         InsertionSortCollider(
             [Bo1_Sphere_Aabb(), Bo1_Box_Aabb(), Bo1_Polyhedra_Aabb()], verletDist=0.2 * scene["min_sphere_radius_m"]
@@ -627,25 +726,47 @@ def prepare(scene, out_path, csv_path=None):
     return recorder, clumps
 
 
-def main(scene_path, out_path, csv_path=None, describe=False, wait=True):
+def run_stepping(recorder, n_steps):
+    """Run the scene in this thread, one ``O.step()`` at a time, calling the recorder before
+    the engines of the steps it asks for, as a PyRunner placed first would (the same steps,
+    the same states, bit for bit) without YADE's thread and a Python command per call. The
+    step in which the recorder stops the run is completed, as ``O.pause()`` lets it be; at
+    most ``n_steps + 1`` steps, as ``O.run(n_steps + 1)``."""
+    step = O.step
+    last = n_steps + 1
+    while O.iter < last:
+        recorder()
+        if recorder.stopped:
+            step()
+            return
+        for _ in range(min(recorder.period, last - O.iter)):
+            step()
+
+
+def main(scene_path, out_path, csv_path=None, describe=False, wait=True, deadline=None, flush_s=None):
     """Run one scene in this YADE process: read the JSON payload at ``scene_path``, build the
     clumps and contacts, run to the end or the stop rule, and write the samples to ``out_path``
     (``.npz``; ``csv_path``: also as CSV). ``describe``: print the clumps' summary as JSON and
-    return without running; ``wait``: block until the run ends and write (False: leave the run
-    going, the recorder writes when it stops)."""
+    return without running; ``wait``: run in this thread (:func:`run_stepping`) and write
+    (False: leave the run going in YADE's thread, the recorder writes when it stops);
+    ``deadline`` and ``flush_s``: :meth:`Recorder.limit`. Returns the run's status."""
     with open(scene_path) as fh:
         scene = json.load(fh)
-    recorder, clumps = prepare(scene, out_path, csv_path)
+    recorder, clumps = prepare(scene, out_path, csv_path, stepping=wait)
     if describe:
         print(json.dumps(_describe(clumps)))
-        return
+        return None
     recorder.wait = wait
+    recorder.limit(deadline, flush_s)
     recorder.start = time.perf_counter()
-    O.run(scene["n_steps"] + 1, wait)
-    if wait:
-        recorder.write()
-        if csv_path:
-            print(f"{recorder.status}: wrote {out_path} and {csv_path}")
+    if not wait:
+        O.run(scene["n_steps"] + 1, False)
+        return None
+    run_stepping(recorder, scene["n_steps"])
+    recorder.write()
+    if csv_path:
+        print(f"{recorder.status}: wrote {out_path} and {csv_path}")
+    return recorder.status
 
 
 def reset():
@@ -688,7 +809,9 @@ def serve(fd):
             os.close(log)
         reply = {"ok": True}
         try:
-            main(job["scene"], job["out"])
+            status = main(job["scene"], job["out"], deadline=job.get("deadline"), flush_s=job.get("flush_s"))
+            if status == "timeout":  # stopped at its deadline, its samples written
+                reply["timeout"] = True
         except OutputError as exc:
             reply = {"ok": False, "path": exc.path, "errno": exc.errno, "strerror": exc.strerror}
         except Exception as exc:  # reported, then this worker ends

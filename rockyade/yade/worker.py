@@ -17,8 +17,11 @@ per scene (``tests/test_yade_worker.py``).
   worker (:func:`run_scene`); a thread that ends closes it; a forked child forgets its
   parent's.
 * **Timeout per scene.** Each scene has its own wall-clock limit (counting a worker's
-  start when one is needed); at the limit the worker is killed, the scene fails, the next
-  scene starts a fresh worker.
+  start when one is needed). The driver stops the scene at that deadline itself and writes
+  the samples it has (the worker goes on to the next scene); a worker that has not answered
+  STOP_GRACE_S later is killed and the next scene starts a fresh one. While a scene runs its
+  samples so far are written every FLUSH_PERIOD_S seconds, so a killed scene keeps them too:
+  the Result is ``failed`` with ``partial: true`` (:mod:`rockyade.yade.backend`).
 * **A crash costs one scene.** A worker that dies (a YADE crash, a signal) or whose scene
   raised fails that scene only; the next starts a fresh worker.
 * **Nothing left behind.** The worker's start-up output goes to an anonymous file; the
@@ -48,6 +51,12 @@ from rockyade.io.lifetime import child_dies_with_parent
 QUIT_WAIT_S = 5.0
 #: Largest message either side sends, bytes.
 MESSAGE_BYTES = 1 << 16
+#: A scene's samples so far are written every so many seconds while it runs (kept when the
+#: worker is killed), s.
+FLUSH_PERIOD_S = 30.0
+#: Seconds after a scene's deadline before its worker is killed: the driver stops the scene at
+#: the deadline itself (at its next sample) and writes what it recorded in this time.
+STOP_GRACE_S = 10.0
 
 
 class WorkerLostError(Exception):
@@ -182,7 +191,9 @@ class YadeWorker:
         WorkerLostError
             The worker ended (the reason is the scene's failure); it is not used again.
         """
-        message = json.dumps({"scene": str(scene_file), "out": str(out_file)}).encode()
+        # the deadline as time.monotonic() gives it: CLOCK_MONOTONIC, one clock for every process
+        job = {"scene": str(scene_file), "out": str(out_file), "deadline": deadline, "flush_s": FLUSH_PERIOD_S}
+        message = json.dumps(job).encode()
         try:
             socket.send_fds(self.sock, [message], [log_fd])
         except OSError:  # it died since the last job: the caller starts a fresh one
@@ -190,15 +201,15 @@ class YadeWorker:
             self.forget()
             raise
         try:
-            reply = self._receive(deadline, timeout)
+            reply = self._receive(deadline + STOP_GRACE_S, timeout)
         except WorkerLostError:
             raise
         except BaseException:  # Ctrl-C or any other interruption: never leave YADE running
             self.kill()
             self.forget()
             raise
-        if reply.get("ok"):
-            return None
+        if reply.get("ok"):  # done, or stopped at its deadline with its samples written
+            return _timeout_reason(timeout) if reply.get("timeout") else None
         if "errno" in reply:  # YADE could not write its output (its partial file removed)
             error = OSError(reply["errno"], reply.get("strerror") or "", reply.get("path"))
             return f"YADE could not write its output: {os_error_message(error)}"
