@@ -249,6 +249,26 @@ def _load_meta(path: Path) -> dict[str, Any] | None:
     return data if isinstance(data, dict) else None
 
 
+def stored_status(csv_path: str | os.PathLike[str]) -> str | None:
+    """The status of the complete result pair at ``csv_path`` (its JSON's SHA-256 matches the
+    CSV), or None: no pair, a damaged or mismatched one, or a link (not followed).
+
+    Parameters
+    ----------
+    csv_path
+        The CSV; its JSON lies beside it.
+    """
+    csv_path = Path(csv_path)
+    if csv_path.is_symlink() or csv_path.with_suffix(".json").is_symlink() or not csv_path.is_file():
+        return None
+    try:
+        meta = _matching_meta(csv_path, csv_path.read_text())
+    except (OSError, UnicodeDecodeError):
+        return None
+    status = meta.get("status") if meta is not None else None
+    return str(status) if status is not None else None
+
+
 def _matching_meta(csv_path: Path, text: str) -> dict[str, Any] | None:
     """The metadata whose SHA-256 matches the CSV: the JSON, or a pending JSON."""
     digest = hashlib.sha256(text.encode()).hexdigest()

@@ -537,6 +537,30 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     assert not [p for p in descendants(os.getpid()) - before if alive(p)]
 
 
+def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, capsys):
+    """A complete result at --out stays byte for byte when a later run to the same path fails
+    (a YADE timeout): the failed one goes beside it as <stem>_failed.csv, marked partial; a
+    failed result at --out (not complete) is replaced as any other."""
+    from rockyade.cli import main
+
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    d["duration_s"] = 60.0
+    (tmp_path / "long.json").write_text(json.dumps(d))
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "long.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
+    before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
+    _warm_yade()
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long.csv", "--yade-timeout", "2"]) == 1
+    assert "keeps the complete result of an earlier run" in capsys.readouterr().out
+    assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
+    assert Result.read(Path("r/long.csv")).status == "completed"
+    failed = Result.read(Path("r/long_failed.csv"))
+    assert failed.status == "failed" and failed.meta["partial"] is True
+    # a failed result is not worth keeping over another failed one
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "2"]) == 1
+    assert not Path("r/long_failed_failed.csv").exists()
+
+
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])
 def test_cli_bad_yade_timeout_is_refused(value, tmp_path, capsys):
     from rockyade.cli import main

@@ -40,8 +40,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         result = solver.run(scene)
         report = _collapse_report(scene, result)
         if args.out:
-            json_path = result.write(args.out)
-            print(f"wrote {args.out} and {json_path}")
+            out = _result_path(args.out, result)
+            json_path = result.write(out)
+            print(f"wrote {out} and {json_path}")
+            if out != args.out:
+                print(f"  (the run failed: {args.out} keeps the complete result of an earlier run)")
             if report is not None:
                 _write_collapse(report, args.out.with_name(f"{args.out.stem}_collapse.csv"))
             if scene.motion.type == "pushover" and len(result.frame):
@@ -54,6 +57,23 @@ def cmd_run(args: argparse.Namespace) -> int:
     write_run_drawings(args, scene, result, args.out or Path(Path(args.scene).stem + ".csv"))
     _print_summary(scene, result, total_time(args), report)
     return 0 if result.ok else 1
+
+
+def _result_path(out: Path, result: Result) -> Path:
+    """Where a run's result goes: ``out``, unless the run failed and ``out`` holds a complete
+    result of an earlier run, which a failed run never replaces: then ``<stem>_failed.csv``
+    beside it (its JSON says ``failed``, and ``partial`` where samples were kept)."""
+    if result.ok or not _holds_a_complete_result(out):
+        return out
+    return out.with_name(f"{out.stem}_failed{out.suffix}")
+
+
+def _holds_a_complete_result(out: Path) -> bool:
+    """Whether ``out`` and its JSON are a complete result of a run that did not fail."""
+    from rockyade.result import stored_status
+
+    status = stored_status(out)
+    return status is not None and status != "failed"
 
 
 def _collapse_report(scene: Scene, result: Result) -> pd.DataFrame | None:
