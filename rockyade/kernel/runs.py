@@ -128,6 +128,17 @@ def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, 
 
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _segment(seg, i: int, h: int, mt, mah, mav) -> None:
+    """Slot ``i`` of ``seg`` takes the motion's interval from sample ``h`` to ``h`` + 1."""
+    seg[0, i] = mt[h]
+    seg[1, i] = mt[h + 1]
+    seg[2, i] = mah[h]
+    seg[3, i] = mah[h + 1]
+    seg[4, i] = mav[h]
+    seg[5, i] = mav[h + 1]
+
+
 @numba.njit(cache=True, nogil=True)
 def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn: float, ks: float, cn: float,
               cs: float, tanphi: float, rest_ang: float, stop_angle: float, g: float, dt: float, n_steps: int,
@@ -166,14 +177,21 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
     shear = np.zeros((n, nv))
     hint = np.zeros(n, dtype=np.int64)
     first = np.empty(n, dtype=np.int64)
-    n_motion = np.empty(n, dtype=np.int64)
     t_last = np.empty(n)
     ot = np.full(n, math.nan)
+    # each run's motion: its first and last sample, and the interval the time is in
+    t_first = np.zeros(n)
+    a_last = np.zeros((2, n))
+    seg = np.zeros((6, n))  # t, t', a_h, a_h', a_v, a_v' at the interval's ends
     for i in range(n):
         a, b = starts[lo + i], starts[lo + i + 1]
         first[i] = a
-        n_motion[i] = b - a
         t_last[i] = mt[b - 1] if b - a >= 2 else -math.inf
+        if b - a >= 2:
+            t_first[i] = mt[a]
+            a_last[0, i] = mah[b - 1]
+            a_last[1, i] = mav[b - 1]
+            _segment(seg, i, a, mt, mah, mav)
     done = np.zeros(n, dtype=np.bool_)
     n_act = n
     for step in range(n_steps + 1):
@@ -185,20 +203,22 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
         n_done = 0
         for i in range(n_act):
             # the base acceleration (run_body's lookup, this run's motion)
-            a = first[i]
             ah = 0.0
             av = 0.0
-            if t < t_last[i] and t >= mt[a]:
-                h = hint[i]
-                while t >= mt[a + h + 1]:
-                    h += 1
-                hint[i] = h
-                u = (t - mt[a + h]) / (mt[a + h + 1] - mt[a + h])
-                ah = mah[a + h] + u * (mah[a + h + 1] - mah[a + h])
-                av = mav[a + h] + u * (mav[a + h + 1] - mav[a + h])
+            if t < t_last[i] and t >= t_first[i]:
+                if t >= seg[1, i]:  # the next interval (rare: a record's samples are many steps apart)
+                    a = first[i]
+                    h = hint[i]
+                    while t >= mt[a + h + 1]:
+                        h += 1
+                    hint[i] = h
+                    _segment(seg, i, a + h, mt, mah, mav)
+                u = (t - seg[0, i]) / (seg[1, i] - seg[0, i])
+                ah = seg[2, i] + u * (seg[3, i] - seg[2, i])
+                av = seg[4, i] + u * (seg[5, i] - seg[4, i])
             elif t == t_last[i]:
-                ah = mah[a + n_motion[i] - 1]
-                av = mav[a + n_motion[i] - 1]
+                ah = a_last[0, i]
+                av = a_last[1, i]
             xi, yi, angi, vxi, vyi, wi = x[i], y[i], ang[i], vx[i], vy[i], w[i]
             c = math.cos(angi)
             s = math.sin(angi)
@@ -273,7 +293,10 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
                 if keep != i:
                     run_of[keep], x[keep], y[keep], ang[keep] = run_of[i], x[i], y[i], ang[i]
                     vx[keep], vy[keep], w[keep], hint[keep] = vx[i], vy[i], w[i], hint[i]
-                    first[keep], n_motion[keep], t_last[keep], ot[keep] = first[i], n_motion[i], t_last[i], ot[i]
+                    first[keep], t_first[keep], t_last[keep], ot[keep] = first[i], t_first[i], t_last[i], ot[i]
+                    a_last[0, keep], a_last[1, keep] = a_last[0, i], a_last[1, i]
+                    for f in range(6):
+                        seg[f, keep] = seg[f, i]
                     for v in range(nv):
                         shear[keep, v] = shear[i, v]
                 done[keep] = False
