@@ -161,6 +161,9 @@ def overhead_target(repeat: int) -> None:
         cpu_one = min(cpu_one, best_cpu(lambda tasks=tasks: [run_task(t) for t in tasks], 1) / len(tasks))
         tasks = fresh()
         cpu_group = min(cpu_group, best_cpu(lambda tasks=tasks: run_job(tuple(tasks)), 1) / len(tasks))
+    row("kernel: 10 runs stepped together (simulate_runs) / one at a time (single-body path), per run",
+        f"{1e3 * kern_group:.1f} / {1e3 * kern_one:.1f} ms CPU", "about 2x faster (issue: 13-18 ns per run-step)",
+        f"{kern_one / kern_group:.2f}x")
     for label, cpu, kern in (("one run per job", cpu_one, kern_one), ("a group of 10 runs", cpu_group, kern_group)):
         row(f"overhead of a 25 s batch run, {label}", f"{1e3 * cpu:.1f} ms CPU, kernel {1e3 * kern:.1f} ms",
             "<= 20 % of the kernel", f"{100 * (cpu - kern) / kern:.0f} % (before: "

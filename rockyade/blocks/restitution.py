@@ -56,26 +56,26 @@ def find_peaks(t: NDArray[np.float64], theta: NDArray[np.float64], min_peak_rad:
     theta = np.asarray(theta, dtype=float)
     t = np.asarray(t, dtype=float)
     valid = np.isfinite(theta)
-    sign = np.where(np.abs(theta) < 0.1 * min_peak_rad, 0, np.sign(theta))
+    amp = np.abs(theta)
+    sign = np.where(amp < 0.1 * min_peak_rad, 0, np.sign(theta))
     sign[~valid] = 0
     times, values = [], []
     n = theta.size
-    i = 0
-    while i < n:
-        if sign[i] == 0:
-            i += 1
-            continue
-        j = i
-        while j + 1 < n and sign[j + 1] == sign[i]:
-            j += 1
-        seg = np.abs(theta[i : j + 1])
-        k = i + int(np.argmax(seg))
-        closed = i > 0 and j < n - 1
-        if closed and abs(theta[k]) >= min_peak_rad:
-            tk, vk = _parabolic_vertex(t, theta, k)
+    if n:
+        # the excursions: runs of one sign; in each, the first sample of the largest |theta|
+        cut = np.flatnonzero(sign[1:] != sign[:-1]) + 1
+        first = np.concatenate(([0], cut))
+        last = np.concatenate((cut, [n])) - 1
+        largest = np.maximum.reduceat(amp, first)
+        at_largest = np.flatnonzero(amp == np.repeat(largest, last - first + 1))
+        rocking = sign[first] != 0
+        first, last = first[rocking], last[rocking]
+        k = at_largest[np.searchsorted(at_largest, first)]
+        closed = (first > 0) & (last < n - 1)
+        for kk in k[closed & (amp[k] >= min_peak_rad)]:
+            tk, vk = _parabolic_vertex(t, theta, int(kk))
             times.append(tk)
             values.append(vk)
-        i = j + 1
     return Peaks(np.array(times), np.array(values))
 
 

@@ -1,8 +1,14 @@
 """Many runs of one body in one call: the runs of a study that share a structure (the same
-block, joint, time step and length) and differ in their base motion, advanced in parallel
-over runs (numba ``prange``), each by the single-body loop (:func:`rockyade.kernel.single.run_body`,
-the same results bit for bit as one run at a time), with the summary's metrics computed as
-each run ends:
+block, joint, time step and length) and differ in their base motion.
+
+:func:`simulate_runs` steps them together: chunks of up to :data:`CHUNK_RUNS` runs, in
+parallel over numba's threads (``prange``), each chunk advanced step by step with the inner
+loop over its runs (:func:`step_runs`: the runs' state held by field), and a run that ends
+drops out of its chunk. Each run's arithmetic is that of
+the single-body loop (:func:`rockyade.kernel.single.run_body`), operation for operation, so
+the results are the same bits as one run at a time (:func:`simulate_runs_each`, which runs
+each by ``run_body``; ``tests/test_runs_batched.py``). The summary's metrics are computed
+in the kernel from each run's samples:
 
 * peak |theta| over the samples and the time of its first sample, rad and s;
 * the residual theta, the last sample's, rad;
@@ -10,18 +16,26 @@ each run ends:
 * how the run ended, when, and the first time |theta| reached the stop angle.
 
 Only the sampled position, angle and angular velocity are kept (what the outcome and the
-summary need); a run that ends early stops there (its remaining samples stay NaN) and its
-thread takes the next run.
+summary need); a run that ends early stops there (its remaining samples stay NaN).
 """
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.kernel.contact_law import contact_law
+from rockyade.kernel.integration import (
+    MAX_SPEED_M_S,
+    MAX_SPIN_RAD_S,
+    STATUS_COMPLETED,
+    STATUS_FAILED,
+    STATUS_OVERTURNED,
+)
 from rockyade.kernel.single import run_body
 
 
@@ -42,8 +56,9 @@ class RunsOutput(NamedTuple):
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
-def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
-    """Run R motions on one body (module docstring).
+def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
+    """Run R motions on one body, each by :func:`rockyade.kernel.single.run_body` (the per-run
+    path that :func:`simulate_runs` is checked against; the same arguments and results).
 
     Parameters
     ----------
@@ -98,6 +113,259 @@ def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplif
         )
         status[r], t_stop[r], n_filled[r], overturn_t[r] = st, ts, nf, ot
         # the summary's metrics from this run's samples (theta = angle - rest angle)
+        best = -1.0
+        for k in range(nf):
+            th = ang[r, k] - rest
+            if abs(th) > best:
+                best = abs(th)
+                peak_t[r] = k * sample_dt
+            if abs(th) > uplift_rad and np.isnan(uplift[r]):
+                uplift[r] = k * sample_dt
+        if nf > 0:
+            peak[r] = best
+            residual[r] = ang[r, nf - 1] - rest
+    return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)
+
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _segment(seg, i: int, h: int, mt, mah, mav) -> None:
+    """Slot ``i`` of ``seg`` takes the motion's interval from sample ``h`` to ``h`` + 1."""
+    seg[0, i] = mt[h]
+    seg[1, i] = mt[h + 1]
+    seg[2, i] = mah[h]
+    seg[3, i] = mah[h + 1]
+    seg[4, i] = mav[h]
+    seg[5, i] = mav[h + 1]
+
+
+@numba.njit(cache=True, nogil=True)
+def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn: float, ks: float, cn: float,
+              cs: float, tanphi: float, rest_ang: float, stop_angle: float, g: float, dt: float, n_steps: int,
+              sps: int, damping: float, stop_on_overturn: bool, mt, mah, mav, starts, x0: float, y0: float,
+              ang0: float, vx0: float, vy0: float, w0: float, status, t_stop, n_filled, overturn_t, pos, ang_s,
+              angvel_s) -> None:
+    """Step runs ``lo`` to ``hi`` - 1 together (module docstring): each step, the inner loop goes
+    over the runs still going (their state held by field, one array each, by slot), each run's
+    arithmetic that of :func:`rockyade.kernel.single.run_body` (operation for operation, so the
+    same doubles; the samples' extras that the runs do not keep left out); a run that ends drops
+    out of the active set, which is compacted at once.
+
+    Parameters
+    ----------
+    lo, hi
+        The runs stepped by this call.
+    verts, nv, mass, inertia, kn, ks, cn, cs, tanphi, rest_ang, stop_angle, g, dt, n_steps, sps, damping,
+    stop_on_overturn
+        As :func:`rockyade.kernel.single.run_body` (SI units).
+    mt, mah, mav, starts
+        The runs' base motions one after the other (s, m/s^2, m/s^2) and where each starts.
+    x0, y0, ang0, vx0, vy0, w0
+        The shared initial state (m, rad, m/s, rad/s).
+    status, t_stop, n_filled, overturn_t, pos, ang_s, angvel_s
+        :class:`RunsOutput`'s arrays, rows ``lo`` to ``hi`` - 1 written.
+    """
+    n = hi - lo
+    # the state of the runs still going, by slot (slot i holds run run_of[i])
+    run_of = np.arange(lo, hi)
+    x = np.full(n, x0)
+    y = np.full(n, y0)
+    ang = np.full(n, ang0)
+    vx = np.full(n, vx0)
+    vy = np.full(n, vy0)
+    w = np.full(n, w0)
+    shear = np.zeros((n, nv))
+    hint = np.zeros(n, dtype=np.int64)
+    first = np.empty(n, dtype=np.int64)
+    t_last = np.empty(n)
+    ot = np.full(n, math.nan)
+    # each run's motion: its first and last sample, and the interval the time is in
+    t_first = np.zeros(n)
+    a_last = np.zeros((2, n))
+    seg = np.zeros((6, n))  # t, t', a_h, a_h', a_v, a_v' at the interval's ends
+    for i in range(n):
+        a, b = starts[lo + i], starts[lo + i + 1]
+        first[i] = a
+        t_last[i] = mt[b - 1] if b - a >= 2 else -math.inf
+        if b - a >= 2:
+            t_first[i] = mt[a]
+            a_last[0, i] = mah[b - 1]
+            a_last[1, i] = mav[b - 1]
+            _segment(seg, i, a, mt, mah, mav)
+    done = np.zeros(n, dtype=np.bool_)
+    n_act = n
+    for step in range(n_steps + 1):
+        if n_act == 0:
+            break
+        t = step * dt
+        sampling = step % sps == 0
+        k = step // sps
+        n_done = 0
+        for i in range(n_act):
+            # the base acceleration (run_body's lookup, this run's motion)
+            ah = 0.0
+            av = 0.0
+            if t < t_last[i] and t >= t_first[i]:
+                if t >= seg[1, i]:  # the next interval (rare: a record's samples are many steps apart)
+                    a = first[i]
+                    h = hint[i]
+                    while t >= mt[a + h + 1]:
+                        h += 1
+                    hint[i] = h
+                    _segment(seg, i, a + h, mt, mah, mav)
+                u = (t - seg[0, i]) / (seg[1, i] - seg[0, i])
+                ah = seg[2, i] + u * (seg[3, i] - seg[2, i])
+                av = seg[4, i] + u * (seg[5, i] - seg[4, i])
+            elif t == t_last[i]:
+                ah = a_last[0, i]
+                av = a_last[1, i]
+            xi, yi, angi, vxi, vyi, wi = x[i], y[i], ang[i], vx[i], vy[i], w[i]
+            c = math.cos(angi)
+            s = math.sin(angi)
+            fx = -mass * ah
+            fy = -mass * (g + av)
+            tz = 0.0
+            for v in range(nv):
+                py = yi + s * verts[v, 0] + c * verts[v, 1]
+                delta = -py
+                if delta < 0.0:
+                    if shear[i, v] != 0.0:
+                        shear[i, v] = 0.0
+                    continue
+                px = xi + c * verts[v, 0] - s * verts[v, 1]
+                rax = px - xi
+                ray = py - yi
+                vrx = vxi - wi * ray
+                vry = vyi + wi * rax
+                fn, _spring, s_new, visc, _state, _slip = contact_law(
+                    delta, -vry, -vrx, shear[i, v], kn, ks, cn, cs, tanphi, dt
+                )
+                shear[i, v] = s_new
+                cfx = s_new + visc
+                fx += cfx
+                fy += fn
+                tz += rax * fn - ray * cfx
+            # kick
+            w_prev = wi
+            if damping > 0.0:
+                fx += -damping * mass * vxi
+                fy += -damping * mass * vyi
+                tz += -damping * inertia * wi
+            vxi += dt * fx / mass
+            vyi += dt * fy / mass
+            wi += dt * tz / inertia
+            if sampling:
+                r = run_of[i]
+                pos[r, k, 0] = xi
+                pos[r, k, 1] = yi
+                ang_s[r, k] = angi
+                angvel_s[r, k] = 0.5 * (wi + w_prev)
+                n_filled[r] = k + 1
+            if step == n_steps:
+                done[i] = True
+                n_done += 1
+                continue
+            # drift, then the blow-up and overturn checks
+            xi += dt * vxi
+            yi += dt * vyi
+            angi += dt * wi
+            x[i], y[i], ang[i], vx[i], vy[i], w[i] = xi, yi, angi, vxi, vyi, wi
+            st = STATUS_COMPLETED
+            if not (vxi * vxi + vyi * vyi <= MAX_SPEED_M_S * MAX_SPEED_M_S and abs(wi) <= MAX_SPIN_RAD_S):
+                st = STATUS_FAILED
+            elif abs(angi - rest_ang) >= stop_angle and math.isnan(ot[i]):
+                ot[i] = (step + 1) * dt
+                if stop_on_overturn:
+                    st = STATUS_OVERTURNED
+            if st != STATUS_COMPLETED:
+                r = run_of[i]
+                status[r] = st
+                t_stop[r] = (step + 1) * dt
+                done[i] = True
+                n_done += 1
+        if n_done:
+            # the runs that ended drop out: their last values out, the others moved down
+            keep = 0
+            for i in range(n_act):
+                if done[i]:
+                    overturn_t[run_of[i]] = ot[i]
+                    continue
+                if keep != i:
+                    run_of[keep], x[keep], y[keep], ang[keep] = run_of[i], x[i], y[i], ang[i]
+                    vx[keep], vy[keep], w[keep], hint[keep] = vx[i], vy[i], w[i], hint[i]
+                    first[keep], t_first[keep], t_last[keep], ot[keep] = first[i], t_first[i], t_last[i], ot[i]
+                    a_last[0, keep], a_last[1, keep] = a_last[0, i], a_last[1, i]
+                    for f in range(6):
+                        seg[f, keep] = seg[f, i]
+                    for v in range(nv):
+                        shear[keep, v] = shear[i, v]
+                done[keep] = False
+                keep += 1
+            n_act = keep
+
+
+#: Runs stepped together by one call of :func:`step_runs` at most (a chunk: their state stays
+#: in the core's caches, and the chunks are shared out among numba's threads).
+CHUNK_RUNS = 16
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
+    """Run R motions on one body, stepped together (module docstring): the runs are cut into
+    chunks of at most :data:`CHUNK_RUNS` runs, in parallel over numba's threads, and each chunk is stepped by
+    :func:`step_runs`; the same results, bit for bit, as :func:`simulate_runs_each`.
+
+    Parameters
+    ----------
+    bodies, joints, settings, initial
+        The records of :func:`rockyade.kernel.state.pack` for the shared structure (one
+        moving body, ``record_energy`` and ``record_corners`` off).
+    mt, mah, mav
+        The runs' base motions one after the other: s, m/s^2, m/s^2.
+    starts
+        (R + 1,) where each run's motion starts in them (the last: their length).
+    uplift_rad
+        |theta| above which the block has lifted off, rad.
+    sample_dt
+        Time between samples, s.
+
+    Returns
+    -------
+    RunsOutput
+    """
+    n_runs = starts.size - 1
+    nv = bodies.nverts[0]
+    n_samples = settings.n_steps // settings.steps_per_sample + 1
+    j = joints.base_joint[0]
+    rest = bodies.rest_ang[0]
+    status = np.full(n_runs, STATUS_COMPLETED, dtype=np.int64)
+    t_stop = np.full(n_runs, -1.0)
+    n_filled = np.zeros(n_runs, dtype=np.int64)
+    overturn_t = np.full(n_runs, np.nan)
+    pos = np.full((n_runs, n_samples, 2), np.nan)
+    ang = np.full((n_runs, n_samples), np.nan)
+    angvel = np.full((n_runs, n_samples), np.nan)
+    peak = np.full(n_runs, np.nan)
+    peak_t = np.full(n_runs, np.nan)
+    residual = np.full(n_runs, np.nan)
+    uplift = np.full(n_runs, np.nan)
+    n_chunks = (n_runs + CHUNK_RUNS - 1) // CHUNK_RUNS
+    verts = np.ascontiguousarray(bodies.verts[0, :nv])
+    for c in numba.prange(n_chunks):
+        lo = c * n_runs // n_chunks
+        hi = (c + 1) * n_runs // n_chunks
+        if hi > lo:
+            step_runs(
+                lo, hi, verts, nv, bodies.mass[0], bodies.inertia[0],
+                joints.kn[j], joints.ks[j], joints.cn[j], joints.cs[j], joints.tanphi[j],
+                rest, bodies.stop_angle[0], settings.g, settings.dt, settings.n_steps, settings.steps_per_sample,
+                settings.mass_damping, settings.stop_on_overturn, mt, mah, mav, starts,
+                initial.pos[0, 0], initial.pos[0, 1], initial.ang[0], initial.vel[0, 0], initial.vel[0, 1],
+                initial.angvel[0], status, t_stop, n_filled, overturn_t, pos, ang, angvel,
+            )
+    for r in numba.prange(n_runs):
+        # the summary's metrics from this run's samples (theta = angle - rest angle)
+        nf = n_filled[r]
         best = -1.0
         for k in range(nf):
             th = ang[r, k] - rest
