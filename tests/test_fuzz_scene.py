@@ -234,4 +234,4 @@ def _run(d: dict) -> None:
 @fuzz_settings(40)
 @given(perturbed_scenes())
 def test_fuzz_runs_of_perturbed_scenes(d):
-    outcome("scene runs", lambda: _run(d))
+    outcome("scene runs", lambda: _run(d), compiles=True)
