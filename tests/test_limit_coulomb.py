@@ -177,3 +177,25 @@ def test_the_cli_says_which_rule_and_offers_the_coulomb_one(tmp_path, capsys):
         assert main(["limit", str(path), *argv]) == 2
         err = capsys.readouterr().err
         assert message in err and len(err.strip().splitlines()) == 1
+
+
+def test_assess_passes_the_rule_through_and_always_says_the_friction_note(tmp_path, capsys):
+    """``rockyade assess --friction-rule coulomb``: the code's check on the non-dilatant mechanism;
+    the default rule's friction note shows for a rocking mechanism too (the slender panel rocks)."""
+    path = tmp_path / "panel.toml"
+    write_scene(path, _panel_data())
+    site = ["--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--static-only", "--direction", "+x"]
+    assert main(["assess", str(path), *site, "--json"]) == 0
+    associated = json.loads(capsys.readouterr().out)
+    assert associated["load_multiplier"] == pytest.approx(0.5, rel=1e-9)
+    assert associated["mechanism"]["friction_rule"] == "associated" and associated["mechanism"]["sliding"] == []
+    assert any("--friction-rule coulomb" in note for note in associated["limit_notes"])
+    assert main(["assess", str(path), *site, "--friction-rule", "coulomb", "--json"]) == 0
+    coulomb = json.loads(capsys.readouterr().out)
+    assert coulomb["mechanism"]["friction_rule"] == "coulomb" and coulomb["mechanism"]["iterations"] > 1
+    assert abs(coulomb["load_multiplier"] / HEEL - 1.0) <= 0.02
+    assert main(["assess", str(path), *site]) == 0
+    out = capsys.readouterr().out
+    assert "note: with finite friction the rigid-block programme assumes associated" in out
+    assert main(["assess", str(path), *site, "--friction-rule", "tresca"]) == 2
+    assert "--friction-rule: must be one of associated, coulomb" in capsys.readouterr().err

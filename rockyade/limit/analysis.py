@@ -29,7 +29,7 @@ FRICTION_NOTE = (
     "Coulomb friction does not dilate, so the multiplier can overestimate the collapse load where "
     "joints slide, and also where a lower mechanism needs a joint to slide without opening (a "
     "running-bond wall's heel units: docs/assemblies.md) (Gilbert, Casapulla & Ahmed 2006; "
-    "Ferris & Tin-Loi 2001)"
+    "Ferris & Tin-Loi 2001); the coulomb friction rule (--friction-rule coulomb) gives the non-dilatant answer"
 )
 #: The friction rules of :func:`limit_analysis` (docs/limit.md, "Friction").
 FRICTION_RULES = ("associated", "coulomb")
