@@ -42,6 +42,7 @@ import time
 from dataclasses import dataclass, replace
 
 import numpy as np
+import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.optimize import linprog
 
@@ -199,8 +200,9 @@ def certified(model: RigidBlockModel, solution: LPSolution) -> LPSolution | None
     n_cols = lam_col
     lower = np.where(free, -np.inf, 0.0)
     upper = np.full(n_cols, np.inf)
-    eq_rows: list[NDArray[np.float64]] = []
-    ub_rows: list[NDArray[np.float64]] = []
+    # extra rows as (row, column, value) triplets: slip rows (equalities), cone rows (<= 0)
+    eq: list[tuple[int, int, float]] = []
+    ub: list[tuple[int, int, float]] = []
     mu = friction_coefficients(model)
     for k, itf in enumerate(model.interfaces):
         for e in range(2):
@@ -211,26 +213,26 @@ def certified(model: RigidBlockModel, solution: LPSolution) -> LPSolution | None
                 continue
             if itf.friction_angle_deg is None:
                 continue  # locked or sliding freely along a joint without friction: n >= 0, t free
-            row = np.zeros(n_cols)
-            if abs(dt) > tol:  # slides without opening: t = -tan(phi) n sign(slip)
-                row[ct], row[cn] = 1.0, mu[k] * np.sign(dt)
-                eq_rows.append(row)
-            else:  # locked: |t| <= tan(phi) n
-                row[ct], row[cn] = 1.0, -mu[k]
-                ub_rows.append(row)
-                row2 = np.zeros(n_cols)
-                row2[ct], row2[cn] = -1.0, -mu[k]
-                ub_rows.append(row2)
-    A_force = A[:, :lam_col].toarray()
-    b_eq = b - A[:, lam_col].toarray().ravel() * solution.load_multiplier
-    A_eq = np.vstack([A_force, *eq_rows]) if eq_rows else A_force
-    b_full = np.concatenate([b_eq, np.zeros(len(eq_rows))])
+            if abs(dt) > tol:  # slides without opening: t + tan(phi) n sign(slip) = 0
+                r = len(eq) // 2
+                eq += [(r, ct, 1.0), (r, cn, float(mu[k] * np.sign(dt)))]
+            else:  # locked: t - tan(phi) n <= 0 and -t - tan(phi) n <= 0
+                r = len(ub) // 2
+                ub += [(r, ct, 1.0), (r, cn, -float(mu[k])), (r + 1, ct, -1.0), (r + 1, cn, -float(mu[k]))]
+
+    def rows(triplets: list[tuple[int, int, float]], n_rows: int) -> sp.csr_matrix:
+        r, c, v = zip(*triplets, strict=True) if triplets else ((), (), ())
+        return sp.csr_matrix((v, (r, c)), shape=(n_rows, n_cols))
+
+    n_eq, n_ub = len(eq) // 2, len(ub) // 2
+    A_eq = sp.vstack([A[:, :lam_col], rows(eq, n_eq)], format="csr")
+    b_eq = np.concatenate([b - A[:, lam_col].toarray().ravel() * solution.load_multiplier, np.zeros(n_eq)])
     res = linprog(
         np.zeros(n_cols),
-        A_ub=np.array(ub_rows) if ub_rows else None,
-        b_ub=np.zeros(len(ub_rows)) if ub_rows else None,
+        A_ub=rows(ub, n_ub) if n_ub else None,
+        b_ub=np.zeros(n_ub) if n_ub else None,
         A_eq=A_eq,
-        b_eq=b_full,
+        b_eq=b_eq,
         bounds=np.column_stack([lower, upper]),
         method="highs",
     )

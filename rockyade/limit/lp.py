@@ -24,7 +24,9 @@ multiplier is exact (to the solver's tolerance). With finite friction it is exac
 associated friction; for Coulomb friction it is an upper bound even when the mechanism found
 has no sliding joint, because a lower mechanism may need a joint end to slide without
 opening, which the associated rule forbids: a slender running-bond panel's whole-panel
-rocking (L / H = 0.5) against its heel mechanism (0.434; docs/assemblies.md).
+rocking (L / H = 0.5) against its heel mechanism (0.434; docs/assemblies.md). With fixed
+friction capacities (``friction_capacity_N``) the programme is one step of the non-associated
+iteration of :mod:`rockyade.limit.coulomb`.
 
 The dual variables of the equilibrium equations are the mechanism: a virtual velocity
 (vx, vy, omega) of every moving block for which the load lambda m g d does unit work and
