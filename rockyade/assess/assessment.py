@@ -56,7 +56,7 @@ from rockyade.assess.stripes import (
     record_measures,
 )
 from rockyade.constants import G
-from rockyade.errors import InputError
+from rockyade.errors import InputError, SolverFailedError
 from rockyade.limit import DEFAULT_FC, LimitResult, limit_analysis
 from rockyade.runner import Executor
 from rockyade.scene import Scene
@@ -193,7 +193,8 @@ class Assessment:
         }
         out.update({k: lim.get(k) for k in QUANTITY_KEYS})
         out["kinematic"] = lim.get("kinematic")
-        out["mechanism"] = {k: lim[k] for k in ("mechanism", "hinges", "sliding", "friction_angle_deg")}
+        keys = ("mechanism", "hinges", "sliding", "friction_angle_deg", "friction_rule", "iterations")
+        out["mechanism"] = {k: lim[k] for k in keys}
         out["limit_notes"] = lim["notes"]
         if self.other_direction is not None:
             o = self.other_direction
@@ -230,15 +231,27 @@ class Assessment:
 
 
 def _limit(
-    scene: Scene, direction: str | None, friction_angle_deg: float | None, sliding: bool, fc: float
+    scene: Scene,
+    direction: str | None,
+    friction_angle_deg: float | None,
+    sliding: bool,
+    fc: float,
+    rule: str = "associated",
 ) -> tuple[LimitResult, LimitResult | None]:
     """(governing, other): the direction given, or both keeping the smaller a0*."""
     directions = [direction] if direction else ["+x", "-x"]
     results = [
-        limit_analysis(scene, d, friction_angle_deg=friction_angle_deg, sliding=sliding, fc=fc) for d in directions
+        limit_analysis(scene, d, friction_angle_deg=friction_angle_deg, sliding=sliding, fc=fc, friction_rule=rule)
+        for d in directions
     ]
     if any(r.status == "unstable" for r in results):
         raise SceneCannotStandError(scene.source)
+    for r in results:
+        if r.status == "not_converged":
+            raise SolverFailedError(
+                f"the limit analysis with the coulomb friction rule did not converge towards {r.direction} "
+                f"({r.reason}): no code check; the associated rule (the default) bounds it from above"
+            )
     collapsing = [r for r in results if r.status == "collapse"]
     if not collapsing:
         return results[0], (results[1] if len(results) > 1 else None)
@@ -298,6 +311,7 @@ def assess(
     direction: str | None = None,
     friction_angle_deg: float | None = None,
     sliding: bool = True,
+    friction_rule: str = "associated",
     dynamic: DynamicSettings | None = None,
     executor: Executor | None = None,
     allow_large: bool = False,
@@ -320,8 +334,9 @@ def assess(
         The confidence factor FC (default 1.35).
     direction
         ``+x``, ``-x``, or None for both (the smaller a0* governs).
-    friction_angle_deg, sliding
-        The joints of the limit analysis (:func:`rockyade.limit.limit_analysis`).
+    friction_angle_deg, sliding, friction_rule
+        The joints of the limit analysis (:func:`rockyade.limit.limit_analysis`); a coulomb rule
+        that does not converge raises SolverFailedError.
     dynamic
         The dynamic part's settings; None: the code's checks only.
     executor
@@ -346,7 +361,7 @@ def assess(
             "the dynamic part shakes the scene's base with ground motions; a mechanism at height is shaken by its "
             "floor (not modelled): pass --static-only for the code's check at height",
         )
-    best, other = _limit(scene, direction, friction_angle_deg, sliding, fc)
+    best, other = _limit(scene, direction, friction_angle_deg, sliding, fc, friction_rule)
     checks = code_checks(best.kinematic, site, position) if best.kinematic is not None else []
     out = Assessment(code, fc, site, position, best, other, checks)
     if best.status == "no_mechanism":

@@ -10,7 +10,6 @@ from rockyade.assess.code import NOT_APPLICABLE, VERIFIED, Check
 from rockyade.assess.fragility import FragilityPlan, FragilityResult
 from rockyade.assess.stripes import collapse_rule
 from rockyade.constants import G
-from rockyade.limit.analysis import FRICTION_NOTE
 from rockyade.limit.report import hinge_words, plural, sliding_words
 
 
@@ -146,8 +145,8 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         f"code verdict: {a.verdict.upper() if a.verdict != VERIFIED else 'verified'}"
         + (f" (the code's capacity is ag = {cap / G:.4g} g; the site's ag is {site_ag:.4g} g)" if cap == cap else "")
     )
-    # the friction caveat matters where joints slide (the limit analysis says so again then)
-    lines += [f"note: {note}" for note in lim.notes if mech.slides or note != FRICTION_NOTE]
+    # the friction caveat holds for any finite friction (a rocking mechanism can be too high as well)
+    lines += [f"note: {note}" for note in lim.notes]
     lines += [f"note: {note}" for note in a.notes]
     return lines
 
@@ -197,4 +196,3 @@ def pushover_lines(a: Assessment) -> list[str]:
         f"  onset lambda = {p.onset.multiplier:.4g} (stood at {p.onset.below:.4g}) against alpha0 = {p.alpha0:.4f}: "
         f"{100 * p.difference:+.2f} %; a* = {onset_star:.4g} m/s^2 against a0* = {kin.a0_star_m_s2:.4g} m/s^2",
     ]
-

@@ -92,6 +92,9 @@ def cmd_assess(args: argparse.Namespace) -> int:
     friction = None
     if args.friction_angle_deg is not None:
         friction = check_friction_angle(args.friction_angle_deg, "--friction-angle-deg")
+    from rockyade.limit.analysis import check_friction_rule
+
+    rule = check_friction_rule(args.friction_rule, "--friction-rule")
     site, position = _site(args), _position(args)
     dynamic = _dynamic(args)
     executor = executor_from(args)
@@ -107,6 +110,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
         direction=direction,
         friction_angle_deg=friction,
         sliding=not args.no_sliding,
+        friction_rule=rule,
     )
     if not args.json:
         print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
@@ -197,6 +201,13 @@ def register(sub: Any) -> None:
         "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 90)"
     )
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
+    p.add_argument(
+        "--friction-rule",
+        default="associated",
+        metavar="RULE",
+        help="the limit analysis's friction: associated (default; sliding joints dilate) or coulomb (non-dilatant, "
+        "iterated: see rockyade limit)",
+    )
     height = p.add_argument_group("a mechanism at height (default: at ground level)")
     height.add_argument("--z", type=float, metavar="M", help="height of the mechanism above the foundation, m")
     height.add_argument("--building-height", type=float, metavar="M", help="height H of the building, m")

@@ -10,13 +10,14 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
+from rockyade.limit.coulomb import MAX_ITERATIONS, solve_coulomb
 from rockyade.limit.kinematic import DEFAULT_FC, KinematicQuantities, check_fc, kinematic_quantities
 from rockyade.limit.lp import DIRECTIONS, solve_equilibrium
 from rockyade.limit.mechanism import Mechanism, mechanism_of
@@ -28,8 +29,22 @@ FRICTION_NOTE = (
     "Coulomb friction does not dilate, so the multiplier can overestimate the collapse load where "
     "joints slide, and also where a lower mechanism needs a joint to slide without opening (a "
     "running-bond wall's heel units: docs/assemblies.md) (Gilbert, Casapulla & Ahmed 2006; "
-    "Ferris & Tin-Loi 2001)"
+    "Ferris & Tin-Loi 2001); the coulomb friction rule (--friction-rule coulomb) gives the non-dilatant answer"
 )
+#: The friction rules of :func:`limit_analysis` (docs/limit.md, "Friction").
+FRICTION_RULES = ("associated", "coulomb")
+#: What the coulomb rule's answer says of itself.
+COULOMB_NOTE = (
+    "Coulomb friction without dilatancy, by iterated linear programmes (Gilbert, Casapulla & Ahmed 2006): "
+    "a heuristic, not guaranteed to find the lowest collapse load"
+)
+
+
+def check_friction_rule(value: str, field: str = "friction_rule") -> str:
+    """One of :data:`FRICTION_RULES`, else InputError naming ``field``."""
+    if value not in FRICTION_RULES:
+        raise InputError(field, f"must be one of {', '.join(FRICTION_RULES)}, got {value!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -40,8 +55,9 @@ class LimitResult:
     ----------
     status
         "collapse" (a multiplier and a mechanism), "unstable" (the assembly cannot stand
-        under gravity and the loads: no multiplier) or "no_mechanism" (no horizontal
-        acceleration makes it collapse).
+        under gravity and the loads: no multiplier), "no_mechanism" (no horizontal
+        acceleration makes it collapse) or "not_converged" (the coulomb rule's iteration did
+        not settle: no multiplier, ``reason`` says why).
     load_multiplier
         lambda: the horizontal acceleration, in g, that the assembly carries at collapse.
     direction
@@ -58,7 +74,14 @@ class LimitResult:
         The friction angle applied to every joint, degrees; None when sliding is excluded;
         "scene" when each joint takes its own from the scene.
     solve_time_s
-        Time of the programme, s.
+        Time of the programme(s), s.
+    friction_rule
+        "associated" or "coulomb" (:func:`limit_analysis`).
+    iterations
+        Programmes solved by the coulomb rule's iteration after the associated one (0 under the
+        associated rule, or when no joint has friction).
+    reason
+        Why the coulomb rule's iteration stopped without converging (status "not_converged"), else "".
     """
 
     status: str
@@ -71,6 +94,9 @@ class LimitResult:
     kinematic: KinematicQuantities | None
     friction_angle_deg: float | str | None
     solve_time_s: float
+    friction_rule: str = "associated"
+    iterations: int = 0
+    reason: str = ""
 
     @property
     def sliding_allowed(self) -> bool:
@@ -81,6 +107,9 @@ class LimitResult:
     def notes(self) -> list[str]:
         """Caveats that apply to this answer."""
         out = list(self.model.notes)
+        if self.sliding_allowed and self.friction_rule == "coulomb":
+            out.append(COULOMB_NOTE)
+            return out
         if self.sliding_allowed:
             out.append(FRICTION_NOTE)
         if self.mechanism is not None and self.mechanism.slides:
@@ -99,6 +128,9 @@ class LimitResult:
             "direction": self.direction,
             "friction_angle_deg": self.friction_angle_deg,
             "sliding_allowed": self.sliding_allowed,
+            "friction_rule": self.friction_rule,
+            "iterations": self.iterations,
+            "reason": self.reason,
             "n_blocks": model.n_blocks,
             "n_interfaces": len(model.interfaces),
             "solve_time_s": self.solve_time_s,
@@ -147,6 +179,8 @@ def limit_analysis(
     sliding: bool = True,
     fc: float = DEFAULT_FC,
     nonlinear: bool = True,
+    friction_rule: str = "associated",
+    max_iterations: int = MAX_ITERATIONS,
 ) -> LimitResult:
     """The collapse multiplier, mechanism and kinematic quantities of a scene.
 
@@ -167,9 +201,19 @@ def limit_analysis(
         The code's confidence factor FC in [1, 10] (default 1.35).
     nonlinear
         Also the nonlinear kinematic analysis (the capacity curve to alpha = 0).
+    friction_rule
+        "associated" (default): Coulomb's cone with its associated flow, sliding joints dilate
+        (:mod:`rockyade.limit.lp`); "coulomb": sliding without dilatancy, by the iteration of
+        :mod:`rockyade.limit.coulomb` from the associated solution. Its status is
+        "not_converged" (no multiplier) when the iteration does not settle.
+    max_iterations
+        The coulomb rule's programmes at most, an integer in [1, 10000] (default 100).
     """
     if direction not in DIRECTIONS:
         raise InputError("direction", f"must be +x or -x, got {direction!r}")
+    check_friction_rule(friction_rule)
+    if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or not 1 <= max_iterations <= 10000:
+        raise InputError("max_iterations", f"must be an integer in [1, 10000], got {max_iterations!r}")
     fc = check_fc(fc)
     if isinstance(scene, RigidBlockModel):
         if loads or friction_angle_deg is not None or not sliding:
@@ -185,10 +229,21 @@ def limit_analysis(
     else:
         phi = "scene"
     sol = solve_equilibrium(model, direction)
+    rule = friction_rule
     if sol.status != "collapse":
-        return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s)
+        return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s, rule)
+    iterations = 0
+    if friction_rule == "coulomb" and phi is not None:
+        iterated = solve_coulomb(model, sol, max_iterations=max_iterations)
+        iterations, sol = iterated.iterations, iterated.solution
+        if not iterated.converged:
+            time_s, why = iterated.solve_time_s, iterated.reason
+            return LimitResult(
+                "not_converged", None, direction, model, None, None, None, None, phi, time_s, rule, iterations, why
+            )
+        sol = replace(sol, solve_time_s=iterated.solve_time_s)
     assert sol.load_multiplier is not None  # a "collapse" always carries its multiplier (lp.py)
-    mech = mechanism_of(model, sol)
+    mech = mechanism_of(model, sol, "coulomb" if sol.friction_capacity_N is not None else "associated")
     kin = kinematic_quantities(model, mech, sol.load_multiplier, direction, fc=fc, nonlinear=nonlinear)
     return LimitResult(
         "collapse",
@@ -201,4 +256,6 @@ def limit_analysis(
         kin,
         phi,
         sol.solve_time_s,
+        friction_rule,
+        iterations,
     )

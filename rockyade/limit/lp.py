@@ -24,7 +24,9 @@ multiplier is exact (to the solver's tolerance). With finite friction it is exac
 associated friction; for Coulomb friction it is an upper bound even when the mechanism found
 has no sliding joint, because a lower mechanism may need a joint end to slide without
 opening, which the associated rule forbids: a slender running-bond panel's whole-panel
-rocking (L / H = 0.5) against its heel mechanism (0.434; docs/assemblies.md).
+rocking (L / H = 0.5) against its heel mechanism (0.434; docs/assemblies.md). With fixed
+friction capacities (``friction_capacity_N``) the programme is one step of the non-associated
+iteration of :mod:`rockyade.limit.coulomb`.
 
 The dual variables of the equilibrium equations are the mechanism: a virtual velocity
 (vx, vy, omega) of every moving block for which the load lambda m g d does unit work and
@@ -75,6 +77,9 @@ class LPSolution:
         Wall time of the HiGHS calls, s.
     message
         HiGHS's message for the last call.
+    friction_capacity_N
+        (n_interfaces, 2) the fixed friction capacities |t| <= c of the non-dilatant programme
+        (:func:`rockyade.limit.coulomb.solve_coulomb`), N; None for the associated rule.
     """
 
     status: str
@@ -85,17 +90,19 @@ class LPSolution:
     velocities: NDArray[np.float64] | None
     solve_time_s: float
     message: str
+    friction_capacity_N: NDArray[np.float64] | None = None
 
 
 def _cross(r: NDArray[np.float64], f: NDArray[np.float64]) -> float:
     return float(r[0] * f[1] - r[1] * f[0])
 
 
-def equilibrium_system(model: RigidBlockModel, direction: str):
+def equilibrium_system(model: RigidBlockModel, direction: str, non_dilatant: bool = False):
     """The scaled programme: (A, b, lambda column, column kinds, row of each moving block, scales).
 
     Rows: 3 per moving block (x force / W, y force / W, moment / (W L)); columns: 2 per
-    interface end (f1, f2 with friction; N, T without), then lambda. W is the largest block
+    interface end (f1, f2 with friction; N, T without, and with friction when ``non_dilatant``:
+    then the caller bounds T by a fixed capacity), then lambda. W is the largest block
     weight, L the assembly's size.
     """
     if direction not in DIRECTIONS:
@@ -115,7 +122,7 @@ def equilibrium_system(model: RigidBlockModel, direction: str):
     col = 0
     for itf in model.interfaces:
         n, t = itf.normal, itf.tangent
-        if itf.friction_angle_deg is None:
+        if itf.friction_angle_deg is None or non_dilatant:
             directions = ((n, False), (t, True))
         else:
             mu = math.tan(math.radians(itf.friction_angle_deg))
@@ -156,7 +163,12 @@ def equilibrium_system(model: RigidBlockModel, direction: str):
 METHODS = ("highs", "highs-ds", "highs-ipm")
 
 
-def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str = "highs") -> LPSolution:
+def solve_equilibrium(
+    model: RigidBlockModel,
+    direction: str = "+x",
+    method: str = "highs",
+    friction_capacity_N: NDArray[np.float64] | None = None,
+) -> LPSolution:
     """Maximise lambda subject to every moving block's equilibrium (module docstring).
 
     Parameters
@@ -168,18 +180,35 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
     method
         HiGHS's method, one of :data:`METHODS` (the interior point method runs a crossover, so
         its answer is a vertex as the simplex's: same multiplier, same kind of mechanism).
+    friction_capacity_N
+        (n_interfaces, 2) fixed friction capacities c >= 0 at the interface ends, N: with them every
+        joint with friction carries |t| <= c whatever its normal force (a non-dilatant, Tresca-like
+        joint: one step of :func:`rockyade.limit.coulomb.solve_coulomb`); None: Coulomb's cone
+        |t| <= tan(phi) n with its associated flow.
     """
     if method not in METHODS:
         raise InputError("method", f"must be one of {', '.join(METHODS)}, got {method!r}")
-    A, b, lam_col, free, row_of, (w_ref, l_ref) = equilibrium_system(model, direction)
+    non_dilatant = friction_capacity_N is not None
+    A, b, lam_col, free, row_of, (w_ref, l_ref) = equilibrium_system(model, direction, non_dilatant)
     n_cols = lam_col + 1
     c = np.zeros(n_cols)
     c[lam_col] = -1.0
     lower = np.where(np.append(free, False), -np.inf, 0.0)
+    upper_t = np.full(n_cols, np.inf)
+    if friction_capacity_N is not None:
+        cap_n = np.asarray(friction_capacity_N, dtype=float)
+        if cap_n.shape != (len(model.interfaces), 2) or not np.all(np.isfinite(cap_n)) or cap_n.min(initial=0.0) < 0:
+            raise InputError("friction_capacity_N", "must be (n_interfaces, 2) finite capacities >= 0 N")
+        for k, itf in enumerate(model.interfaces):
+            if itf.friction_angle_deg is not None:
+                for e in range(2):
+                    col_t = 4 * k + 2 * e + 1  # columns: (N, T) at end 0, then at end 1
+                    lower[col_t] = -cap_n[k, e] / w_ref
+                    upper_t[col_t] = cap_n[k, e] / w_ref
     t0 = time.perf_counter()
     res = None
     for cap in (LAMBDA_CAP, None):
-        upper = np.full(n_cols, np.inf)
+        upper = upper_t.copy()
         upper[lam_col] = np.inf if cap is None else cap
         res = linprog(c, A_eq=A, b_eq=b, bounds=np.column_stack([lower, upper]), method=method)
         if res.status != 0 or cap is None or res.x[lam_col] < 0.999 * cap:
@@ -187,9 +216,9 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
     elapsed = time.perf_counter() - t0
     assert res is not None  # the loop above runs at least once
     if res.status == 2:
-        return LPSolution("unstable", None, direction, None, None, None, elapsed, res.message)
+        return LPSolution("unstable", None, direction, None, None, None, elapsed, res.message, friction_capacity_N)
     if res.status == 3:
-        return LPSolution("no_mechanism", None, direction, None, None, None, elapsed, res.message)
+        return LPSolution("no_mechanism", None, direction, None, None, None, elapsed, res.message, friction_capacity_N)
     if res.status != 0:
         raise SolverFailedError(f"HiGHS could not solve the equilibrium programme: {res.message}")
     x = res.x
@@ -197,7 +226,7 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
     normal = np.empty((len(model.interfaces), 2))
     tangential = np.empty_like(normal)
     for k, itf in enumerate(model.interfaces):
-        if itf.friction_angle_deg is None:
+        if itf.friction_angle_deg is None or non_dilatant:
             normal[k], tangential[k] = forces[k, :, 0], forces[k, :, 1]
         else:
             mu = math.tan(math.radians(itf.friction_angle_deg))
@@ -208,4 +237,14 @@ def solve_equilibrium(model: RigidBlockModel, direction: str = "+x", method: str
     for i in model.moving:
         r = row_of[i]
         velocities[i] = (y[r], y[r + 1], y[r + 2] / l_ref)
-    return LPSolution("collapse", float(x[lam_col]), direction, normal, tangential, velocities, elapsed, res.message)
+    return LPSolution(
+        "collapse",
+        float(x[lam_col]),
+        direction,
+        normal,
+        tangential,
+        velocities,
+        elapsed,
+        res.message,
+        None if friction_capacity_N is None else np.asarray(friction_capacity_N, dtype=float),
+    )

@@ -21,6 +21,12 @@ Checks (:class:`MechanismChecks`): the mechanism is kinematically admissible to 
 order (no end closes: dv_n >= tan(phi) |dv_t| with friction, dv_n >= 0 and dv_t = 0
 without), and the virtual work of gravity, the loads and lambda m g d vanishes at the
 multiplier. Both are computed from the geometry, independently of the solver.
+
+Under the non-associated (Coulomb) rule (:mod:`rockyade.limit.coulomb`) a joint with friction
+slides without opening: an end *slides* when dv_t != 0 and dv_n = 0, admissibility asks only
+dv_n >= 0 there, and the virtual work of gravity, the loads and lambda m g d equals the work
+dissipated by friction, sum c |dv_t| over the ends with c the friction capacity of the last
+programme (tan(phi) times the normal force the iteration settled on).
 """
 
 from __future__ import annotations
@@ -124,7 +130,8 @@ class MechanismChecks:
         units (0 when admissible): max(0, tan(phi) |dv_t| - dv_n), or without sliding
         max(0, -dv_n, |dv_t|).
     virtual_work_residual
-        |lambda W_load + W_gravity + W_loads| / (sum of the absolute works), dimensionless.
+        |lambda W_load + W_gravity + W_loads - D| / (sum of the absolute works), dimensionless; D the
+        work dissipated by friction (0 under the associated rule).
     """
 
     max_closing: float
@@ -196,8 +203,15 @@ def virtual_work(model: RigidBlockModel, velocities: NDArray[np.float64], lam: f
     return total, scale
 
 
-def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
-    """The normalised, classified and checked mechanism of a collapse solution."""
+def mechanism_of(model: RigidBlockModel, solution: LPSolution, friction_rule: str = "associated") -> Mechanism:
+    """The normalised, classified and checked mechanism of a collapse solution.
+
+    ``friction_rule``: "associated" (the programme's cone, dilatant sliding) or "coulomb" (a solution
+    of :func:`rockyade.limit.coulomb.solve_coulomb`: sliding without opening, module docstring).
+    """
+    coulomb = friction_rule == "coulomb"
+    if coulomb and solution.friction_capacity_N is None:
+        raise ValueError("the coulomb rule's mechanism needs the capacities of its programme")
     if solution.velocities is None or solution.load_multiplier is None:
         raise ValueError("only a collapse solution has a mechanism")
     vel = solution.velocities.copy()
@@ -214,15 +228,21 @@ def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
     vel[~moving] = 0.0
     hinges, sliding, separating, active = [], [], [], []
     worst = 0.0
+    dissipated = 0.0
     for k, itf in enumerate(model.interfaces):
         rel = [relative_velocity(model, vel, itf, p) for p in itf.ends_m]
         mu = None if itf.friction_angle_deg is None else math.tan(math.radians(itf.friction_angle_deg))
-        for dn, dt in rel:
-            worst = max(worst, -dn, abs(dt)) if mu is None else max(worst, mu * abs(dt) - dn)
+        # the dilatancy of sliding: tan(phi) under the associated rule, none under Coulomb's
+        dilatancy = 0.0 if coulomb else (mu or 0.0)
+        for e, (dn, dt) in enumerate(rel):
+            worst = max(worst, -dn, abs(dt)) if mu is None else max(worst, dilatancy * abs(dt) - dn)
+            if coulomb and mu is not None:
+                assert solution.friction_capacity_N is not None  # checked above
+                dissipated += float(solution.friction_capacity_N[k, e]) * abs(dt)
         closed = [abs(dn) <= tol and abs(dt) <= tol for dn, dt in rel]
-        # an end slides when it slips on the friction cone (dv_n = tan(phi) |dv_t|); an end that
+        # an end slides when it slips on the friction cone (dv_n = dilatancy |dv_t|); an end that
         # opens by more than that has left the joint, whatever its tangential motion
-        slipping = [mu is not None and abs(dt) > tol and dn <= mu * abs(dt) + tol for dn, dt in rel]
+        slipping = [mu is not None and abs(dt) > tol and dn <= dilatancy * abs(dt) + tol for dn, dt in rel]
         for e in range(2):
             if closed[e] and (moving[itf.a] or (itf.b >= 0 and moving[itf.b])):
                 active.append((k, e))
@@ -243,5 +263,6 @@ def mechanism_of(model: RigidBlockModel, solution: LPSolution) -> Mechanism:
         else:
             separating.append(k)
     total, scale_w = virtual_work(model, vel, solution.load_multiplier, solution.direction)
+    total, scale_w = total - dissipated, scale_w + dissipated
     checks = MechanismChecks(max(worst, 0.0), abs(total) / scale_w if scale_w > 0 else 0.0)
     return Mechanism(vel, moving, tuple(hinges), tuple(sliding), tuple(separating), checks, tuple(active))

@@ -87,6 +87,12 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         joints = "each joint's friction angle from the scene"
     else:
         joints = f"friction angle {result.friction_angle_deg:g} deg"
+    if result.sliding_allowed:
+        joints += (
+            f"; friction rule coulomb (sliding without dilatancy, {plural(result.iterations, 'iteration')})"
+            if result.friction_rule == "coulomb"
+            else "; friction rule associated (sliding dilates: --friction-rule coulomb gives the non-dilatant answer)"
+        )
     lines = [
         f"limit analysis of {source}: {plural(model.n_blocks - n_fixed, 'moving block')}{fixed}, "
         f"{plural(len(model.interfaces), 'joint')}; load lambda m g towards {result.direction}; joints: {joints}",
@@ -103,6 +109,9 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
                 "  without sliding a joint cannot open with a motion along it either (a block cannot lift off a "
                 "restraint it moves along): a finite friction angle lifts that restriction"
             )
+    elif result.status == "not_converged":
+        lines.append(f"status: not_converged: the coulomb rule's iteration did not settle ({result.reason}): no")
+        lines.append("  load multiplier; the associated rule's answer (the default) bounds it from above")
     if result.status != "collapse":
         lines.extend(f"note: {note}" for note in result.model.notes)
         return lines
@@ -127,8 +136,9 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         lines.append("  " + sliding_words(model, slide, mech.velocities))
     if len(mech.sliding) > MAX_LISTED:
         lines.append(f"  ... and {len(mech.sliding) - MAX_LISTED} more sliding joints (--json lists all)")
+    work = "virtual work equal to friction's dissipation" if result.friction_rule == "coulomb" else "virtual work zero"
     lines.append(
-        f"checks: kinematic constraints met to {mech.checks.max_closing:.1e}, virtual work zero to "
+        f"checks: kinematic constraints met to {mech.checks.max_closing:.1e}, {work} to "
         f"{mech.checks.virtual_work_residual:.1e} (relative)"
     )
     lines.append(f"kinematic quantities (NTC 2018, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
