@@ -113,18 +113,32 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
     n_motion = mt.size
     t_last = mt[n_motion - 1] if n_motion >= 2 else -math.inf
     next_sample = 0
+    # the interval [m_lo, m_hi) of the motion samples that holds t, and its spans, kept in
+    # scalars while t stays in it (the same operands as indexing the samples every step)
+    m_lo = mt[0] if n_motion >= 1 else math.inf
+    m_hi = m_lo
+    m_span = 1.0
+    ah_lo = ah_span = av_lo = av_span = 0.0
     for step in range(n_steps + 1):
         t = step * dt
         # the base acceleration: ground_acceleration's arithmetic, its interval found by
         # walking forward (the times only increase)
         ah = 0.0
         av = 0.0
-        if t < t_last and t >= mt[0]:
-            while t >= mt[hint + 1]:
-                hint += 1
-            u = (t - mt[hint]) / (mt[hint + 1] - mt[hint])
-            ah = mah[hint] + u * (mah[hint + 1] - mah[hint])
-            av = mav[hint] + u * (mav[hint + 1] - mav[hint])
+        if t < t_last and t >= m_lo:
+            if t >= m_hi:
+                while t >= mt[hint + 1]:
+                    hint += 1
+                m_lo = mt[hint]
+                m_hi = mt[hint + 1]
+                m_span = m_hi - m_lo
+                ah_lo = mah[hint]
+                ah_span = mah[hint + 1] - ah_lo
+                av_lo = mav[hint]
+                av_span = mav[hint + 1] - av_lo
+            u = (t - m_lo) / m_span
+            ah = ah_lo + u * ah_span
+            av = av_lo + u * av_span
         elif t == t_last:
             ah = mah[n_motion - 1]
             av = mav[n_motion - 1]
