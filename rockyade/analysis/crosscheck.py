@@ -139,7 +139,8 @@ class CollapseSearch:
         The bracket: the highest level that stood below the first collapse, and that
         collapse (NaN where there is none: 0 and inf are not levels run).
     survived_above_fraction
-        Of the scan's levels above the first collapse, the fraction that stood (NaN with none).
+        Of the scan's levels above the scan's first collapse, the fraction that stood (NaN
+        with none).
     status
         :data:`BRACKETED`, :data:`ABOVE`, :data:`BELOW` or :data:`NO_RUNS`.
     runs, failed
@@ -173,7 +174,9 @@ def collapse_summary(outcomes: Mapping[float, bool | None], scan: Sequence[float
     if not collapses:
         return CollapseSearch(math.nan, known[-1][0], math.nan, math.nan, ABOVE, len(outcomes), failed)
     first = collapses[0]
-    above = [bool(outcomes[float(v)]) for v in scan if float(v) > first and outcomes.get(float(v)) is not None]
+    scanned = [(float(v), outcomes.get(float(v))) for v in sorted(scan)]
+    first_scanned = next((v for v, c in scanned if c), math.inf)
+    above = [bool(c) for v, c in scanned if v > first_scanned and c is not None]
     survived = float(np.mean([not c for c in above])) if above else math.nan
     below = [level for level, c in known if level < first and not c]
     if not below:

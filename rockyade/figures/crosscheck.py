@@ -108,7 +108,7 @@ class PairedRatios:
         is given); return self with ``figure_`` and ``ax_`` set."""
         if ax is None:
             n = max(1, len(self.labels))
-            fig, ax = new_figure(path, figsize=(7.5, 1.2 + 0.38 * n), layout="constrained")
+            fig, ax = new_figure(path, figsize=(7.5, 2.4 + 0.38 * n), layout="constrained")
         else:
             fig = figure_of(ax)
         y = np.arange(len(self.labels))[::-1]
