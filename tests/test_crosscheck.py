@@ -186,14 +186,23 @@ def complete(plan, tmp_path_factory):
 
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
+    assert summary.partial is False and summary.verdicts
     from rockyade.studies.crosscheck import RESULT_FILES, partial_dir
 
     for name in RESULT_FILES:
         assert (out / name).is_file(), name
     assert not partial_dir(out).exists()
     ci = pd.read_csv(out / "collapse_intensities.csv")
-    for column in ("record", "solver", "dt_factor", "collapse_intensity", "intensity_unit", "bracket_low",
-                   "bracket_high", "survived_above_fraction"):
+    for column in (
+        "record",
+        "solver",
+        "dt_factor",
+        "collapse_intensity",
+        "intensity_unit",
+        "bracket_low",
+        "bracket_high",
+        "survived_above_fraction",
+    ):
         assert column in ci.columns
     assert len(ci) == 2 * 2 * 2  # records x solvers x dt factors
     done = ci[ci.status == BRACKETED]
@@ -391,8 +400,16 @@ def cli(*argv: str) -> int:
     ],
 )
 def test_bad_input_is_one_line_and_exit_2(argv, option, records, tmp_path, capsys):
-    code = cli("crosscheck", str(EXAMPLES / "specimen1_record.toml"), "--records", str(records), "--out",
-               str(tmp_path / "o"), "--quiet", *argv)
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+        *argv,
+    )
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and option in err[0], err
     assert not (tmp_path / "o").exists()
@@ -400,9 +417,27 @@ def test_bad_input_is_one_line_and_exit_2(argv, option, records, tmp_path, capsy
 
 def test_command_writes_the_set(records, tmp_path, capsys):
     out = tmp_path / "cc"
-    code = cli("crosscheck", str(EXAMPLES / "specimen1_record.toml"), "--records", str(records), "--solvers",
-               "housner,reference", "--levels", "0.3,0.6,1.2", "--resolution", "0.2", "--dt-factors", "1",
-               "--tail", "1", "--out", str(out), "--quiet", "--workers", "1")
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--solvers",
+        "housner,reference",
+        "--levels",
+        "0.3,0.6,1.2",
+        "--resolution",
+        "0.2",
+        "--dt-factors",
+        "1",
+        "--tail",
+        "1",
+        "--out",
+        str(out),
+        "--quiet",
+        "--workers",
+        "1",
+    )
     text = capsys.readouterr().out
     assert code == 0, text
     assert "cost: about" in text and "housner / reference" in text
@@ -418,7 +453,44 @@ def test_figure_is_a_display_object(complete):
     pairs = pd.read_csv(complete[0] / "pairs.csv")
     fig, ax = file_figure()
     display = PairedRatios.from_pairs(pairs, "pga").plot(ax=ax)
-    assert display.ax_ is ax and isinstance(display.figure_, Figure)
+    assert display.ax_ is ax and display.figure_ is fig and isinstance(fig, Figure)
     assert len(display.labels) == len(pairs) and ax.get_xscale() == "log"
     with pytest.raises(InputError, match="pairs"):
         PairedRatios.from_pairs(pairs.drop(columns=["median_ratio"]))
+
+
+# ---------------------------------------------------------------------- compare
+
+
+def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_path, capsys):
+    from rockyade.analysis.compare import compare, verdict
+    from rockyade.scene import load_scene
+    from rockyade.solvers import make_solver
+
+    scene = load_scene(EXAMPLES / "specimen1_record.toml")
+    results = {n: make_solver(n).run(scene) for n in ("housner", "reference")}
+    table = compare(scene, results, "reference")
+    assert set(table.solver) == {"housner"}  # no row of the reference against itself
+    finer = {n: make_solver(n, dt_factor=0.5).run(scene) for n in results}
+    line = verdict(scene, results, "reference", finer)
+    row = table[table.metric == "max_abs_theta_rad"].iloc[0]
+    gap = abs(row.value - row.reference_value) / max(row.value, row.reference_value)
+    assert line.startswith("same outcome (completed); peak |theta| within ")
+    assert f"{100 * gap:.1f} %" in line and "halving the step changed" in line
+    # a constructed case: the finer step moves a solver more than the solvers differ
+    assert "says nothing" in verdict(scene, results, "reference", {"housner": results["reference"]})
+    assert verdict(scene, results, "reference").endswith("the time step not checked")
+    code = cli(
+        "compare",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--solvers",
+        "housner,reference",
+        "--dt-factor",
+        "0.5",
+        "--out",
+        str(tmp_path / "c"),
+    )
+    out = capsys.readouterr().out
+    assert code == 0 and "verdict: same outcome" in out
+    assert (tmp_path / "c" / "specimen1_record_housner_halfdt.json").is_file()
+    assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
