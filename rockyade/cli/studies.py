@@ -199,7 +199,8 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, default=Path("reports/paper"), help="output directory (default reports/paper)")
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument(
-        "--only", help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning"
+        "--only",
+        help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning,crosscheck",
     )
     p.add_argument("--no-yade", action="store_true", help="skip the YADE runs")
     p.add_argument(

@@ -75,7 +75,8 @@ class PairedRatios:
 
     @classmethod
     def from_pairs(cls, pairs: pd.DataFrame, measure: str = "pga", tolerance: float = 0.05) -> PairedRatios:
-        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck.summarise`).
+        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck.summarise`); with a
+        ``scene`` column (several cross-checks in one table), each label starts with it.
 
         Raises
         ------
@@ -87,12 +88,14 @@ class PairedRatios:
             raise InputError("pairs", f"needs the columns {', '.join(COLUMNS)}; missing {', '.join(missing)}")
         labels = []
         for _, r in pairs.iterrows():
+            scene = f"{r['scene']}: " if "scene" in pairs.columns else ""
+            n = f"(n = {r['records']})"
             if r["kind"] == "dt":
-                labels.append(
-                    f"{r['solver_a']}: dt x {r['dt_factor_a']:g} / dt x {r['dt_factor_b']:g} ({r['records']})"
-                )
+                labels.append(f"{scene}{r['solver_a']}: dt x {r['dt_factor_a']:g} / dt x {r['dt_factor_b']:g} {n}")
             else:
-                labels.append(f"{r['solver_a']} / {r['solver_b']}, dt x {r['dt_factor_a']:g} ({r['records']})")
+                labels.append(
+                    f"{scene}{r['solver_a']} / {r['solver_b']}, dt x {r['dt_factor_a']:g} (n = {r['records']})"
+                )
         return cls(
             labels,
             pairs["median_ratio"].to_numpy(dtype=float),
