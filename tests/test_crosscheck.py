@@ -26,6 +26,8 @@ from rockyade.analysis.crosscheck import (
 )
 from rockyade.errors import BatchInterruptedError, InputError
 
+from .conftest import external_records_dir, needs_records
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -494,3 +496,38 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     assert code == 0 and "verdict: same outcome" in out
     assert (tmp_path / "c" / "specimen1_record_housner_halfdt.json").is_file()
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
+
+
+# ---------------------------------------------------------------------- real records
+
+
+@needs_records("RSN6_IMPVALL.I_I-ELC180-hor1.AT2", "RSN77_SFERN_PUL164-hor1.AT2")
+def test_real_records_housner_and_the_reference_dem_agree_on_a_slender_block(tmp_path):
+    """Two PEER records (El Centro 1940, Pacoima Dam 1971) copied into a folder of their own:
+    the collapse intensities of Housner and the reference DEM, paired by record, within 10 %."""
+    import shutil
+
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck import crosscheck_plan
+
+    folder = tmp_path / "peer"
+    folder.mkdir()
+    for name in ("RSN6_IMPVALL.I_I-ELC180-hor1.AT2", "RSN77_SFERN_PUL164-hor1.AT2"):
+        shutil.copy(external_records_dir() / name, folder / name)
+    plan = crosscheck_plan(
+        load_scene(EXAMPLES / "specimen1_record.toml"),
+        records_in_folder(folder),
+        parse_measure("pga"),
+        ["housner", "reference"],
+        dt_factors=(1.0,),
+        resolution=0.05,
+        executor=Executor("threads", 1),
+        tail_s=2.0,
+        progress=False,
+    )
+    summary = run(plan, tmp_path / "out")
+    pair = summary.pairs[summary.pairs.kind == "solvers"].iloc[0]
+    assert pair.records == 2
+    assert 0.9 <= pair.median_ratio <= 1.1, pair.sentence
