@@ -19,16 +19,19 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Self
+from typing import Self
 
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
 from rockyade.errors import InputError
 from rockyade.figures.common import figure_of, new_figure, save_figure
 
+#: Ratios marked on the axis (those inside its limits).
+TICKS = (0.25, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 2.0, 4.0)
 #: The columns the display reads.
 COLUMNS = (
     "kind",
@@ -75,7 +78,7 @@ class PairedRatios:
 
     @classmethod
     def from_pairs(cls, pairs: pd.DataFrame, measure: str = "pga", tolerance: float = 0.05) -> PairedRatios:
-        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck.summarise`); with a
+        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck_report.summarise`); with a
         ``scene`` column (several cross-checks in one table), each label starts with it.
 
         Raises
@@ -111,7 +114,7 @@ class PairedRatios:
         is given); return self with ``figure_`` and ``ax_`` set."""
         if ax is None:
             n = max(1, len(self.labels))
-            fig, ax = new_figure(path, figsize=(7.5, 2.4 + 0.38 * n), layout="constrained")
+            fig, ax = new_figure(path, figsize=(7.5, 1.6 + 0.38 * n), layout="constrained")
         else:
             fig = figure_of(ax)
         y = np.arange(len(self.labels))[::-1]
@@ -145,19 +148,16 @@ class PairedRatios:
         finite = np.concatenate([v[np.isfinite(v)] for v in (self.median, self.low, self.high)] + [np.array([1.0])])
         span = max(float(np.max(np.abs(np.log(finite)))), math.log(1 + 2.5 * self.tolerance))
         ax.set_xscale("log")
-        ax.set_xlim(math.exp(-1.15 * span), math.exp(1.15 * span))
+        low, high = math.exp(-1.15 * span), math.exp(1.15 * span)
+        ax.set_xlim(low, high)
+        ticks = [t for t in TICKS if low <= t <= high]
+        ax.xaxis.set_major_locator(FixedLocator(ticks))
+        ax.xaxis.set_minor_locator(NullLocator())
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:.3g}"))
         ax.set_yticks(y, self.labels)
-        ax.set_ylim(-0.8, len(self.labels) - 0.2 + 0.9)
+        ax.set_ylim(-0.7, len(self.labels) - 0.3)
         ax.set_xlabel(f"ratio of collapse intensities ({self.measure}), paired by record")
-        ax.xaxis.set_minor_formatter(_plain_formatter())
-        ax.xaxis.set_major_formatter(_plain_formatter())
-        ax.legend(
-            loc="upper center",
-            bbox_to_anchor=(0.5, -0.18 - 0.9 / max(1, len(self.labels))),
-            ncols=1,
-            fontsize=8,
-            frameon=False,
-        )
+        ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.01), ncols=2, fontsize=8, frameon=False)
         ax.grid(axis="x", which="both", lw=0.3, color="0.8")
         self.figure_, self.ax_ = fig, ax
         return self
@@ -168,12 +168,6 @@ class PairedRatios:
             self.plot(path=path)
         assert self.figure_ is not None
         return save_figure(self.figure_, path)
-
-
-def _plain_formatter() -> Any:
-    from matplotlib.ticker import FuncFormatter
-
-    return FuncFormatter(lambda v, _pos: f"{v:.3g}")
 
 
 __all__ = ["PairedRatios"]
