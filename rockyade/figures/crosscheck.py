@@ -32,6 +32,7 @@ from rockyade.figures.common import figure_of, new_figure, save_figure
 
 #: Ratios marked on the axis (those inside its limits).
 TICKS = (0.25, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 2.0, 4.0)
+COARSE_TICKS = (0.25, 0.5, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.5, 2.0, 4.0)
 #: The columns the display reads.
 COLUMNS = (
     "kind",
@@ -114,7 +115,8 @@ class PairedRatios:
         is given); return self with ``figure_`` and ``ax_`` set."""
         if ax is None:
             n = max(1, len(self.labels))
-            fig, ax = new_figure(path, figsize=(7.5, 1.6 + 0.38 * n), layout="constrained")
+            width = 4.5 + 0.07 * max((len(label) for label in self.labels), default=20)
+            fig, ax = new_figure(path, figsize=(width, 1.6 + 0.38 * n), layout="constrained")
         else:
             fig = figure_of(ax)
         y = np.arange(len(self.labels))[::-1]
@@ -151,6 +153,8 @@ class PairedRatios:
         low, high = math.exp(-1.15 * span), math.exp(1.15 * span)
         ax.set_xlim(low, high)
         ticks = [t for t in TICKS if low <= t <= high]
+        if len(ticks) > 8:  # a wide range: fewer marks, so that they do not run into each other
+            ticks = [t for t in COARSE_TICKS if low <= t <= high]
         ax.xaxis.set_major_locator(FixedLocator(ticks))
         ax.xaxis.set_minor_locator(NullLocator())
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _pos: f"{v:.3g}"))
