@@ -531,3 +531,39 @@ def test_real_records_housner_and_the_reference_dem_agree_on_a_slender_block(tmp
     pair = summary.pairs[summary.pairs.kind == "solvers"].iloc[0]
     assert pair.records == 2
     assert 0.9 <= pair.median_ratio <= 1.1, pair.sentence
+
+
+def test_figure_text_does_not_overlap(tmp_path):
+    """Many rows with long labels and a wide range (as the paper's figure): no two texts of the
+    figure (tick labels, axis label, legend) overlap."""
+    from matplotlib.text import Text
+
+    from rockyade.figures.crosscheck import PairedRatios
+
+    rows = []
+    for k in range(1, 5):
+        for kind, a, b in (("dt", "reference", "reference"), ("solvers", "housner", "reference")):
+            rows.append(
+                {
+                    "scene": f"specimen {k}",
+                    "kind": kind,
+                    "solver_a": a,
+                    "solver_b": b,
+                    "dt_factor_a": 0.5,
+                    "dt_factor_b": 1.0,
+                    "records": 30,
+                    "median_ratio": 1.0 + 0.02 * k,
+                    "ratio_low": 0.8,
+                    "ratio_high": 1.4,
+                }
+            )
+    display = PairedRatios.from_pairs(pd.DataFrame(rows), "PGA")
+    display.save(tmp_path / "f.png")
+    fig = display.figure_
+    fig.canvas.draw()  # the layout at the figure's own dpi (savefig draws at another)
+    renderer = fig.canvas.get_renderer()
+    texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            assert not boxes[i].overlaps(boxes[j]), (texts[i].get_text(), texts[j].get_text())
