@@ -25,6 +25,7 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -157,6 +158,43 @@ class RigidBlockModel:
             if not self.fixed[i] and load.mass_kg:
                 out.append((i, np.asarray(load.point_m, dtype=float), float(load.mass_kg)))
         return out
+
+    def loads_table(self) -> list[dict[str, Any]]:
+        """Each given load as plain data: its block, point, force, mass and whether the mass
+        takes part in the horizontal acceleration (and so in the code's P_i)."""
+        out = []
+        for q in self.given_loads:
+            i = int(q.block)
+            mass = float(q.mass_kg or 0.0)
+            if self.fixed[i]:
+                why = "on a fixed block: it goes straight to the base"
+            elif mass > 0.0:
+                why = "its mass shakes with its block (a P_i of the kinematic method, Circolare 2019 C8.7.1)"
+            else:
+                why = "given without mass (mass_kg = 0): its horizontal force is taken elsewhere"
+            out.append(
+                {
+                    "block": self.names[i],
+                    "point_m": list(q.point_m),
+                    "force_N": list(q.force_N),
+                    "mass_kg": mass,
+                    "mass_takes_part": bool(mass > 0.0 and not self.fixed[i]),
+                    "why": why,
+                }
+            )
+        return out
+
+    def load_lines(self) -> list[str]:
+        """One line per load for the text reports: force, point and whether its mass takes part."""
+        lines = []
+        for k, q in enumerate(self.loads_table()):
+            fx, fy = q["force_N"]
+            mass = f"with its mass {q['mass_kg']:.4g} kg" if q["mass_takes_part"] else "without mass"
+            lines.append(
+                f"load {k}: ({fx:.4g}, {fy:.4g}) N on {q['block']} at ({q['point_m'][0]:.4g}, {q['point_m'][1]:.4g}) m, "
+                f"{mass}: {q['why']}"
+            )
+        return lines
 
     @property
     def n_blocks(self) -> int:
