@@ -21,7 +21,7 @@ def test_site_one_by_hand():
     Se(1.0) = 8.193312 x 0.419846 / 1.0 = 3.439928; Se(3.0) = 8.193312 x 0.419846 x 2.6 / 9 = 0.993757.
     """
     sp = ntc_spectrum(0.25, 2.4, 0.3, "B", "T2")
-    assert sp.S == pytest.approx(1.392, rel=1e-12)
+    assert pytest.approx(1.392, rel=1e-12) == sp.S
     assert sp.TC_s == pytest.approx(0.419846, rel=1e-6)
     assert sp.TB_s == pytest.approx(0.139949, rel=1e-5)
     assert sp.TD_s == pytest.approx(2.6, rel=1e-12)
@@ -39,7 +39,7 @@ def test_site_two_by_hand():
     Se(1.5) = 6.62175 x 0.883883 / 1.5 = 3.901903; Se(4.0) = 6.62175 x 0.883883 x 2.2 / 16 = 0.804768.
     """
     sp = ntc_spectrum(0.15, 2.5, 0.5, "D", "T1")
-    assert sp.S == pytest.approx(1.80, rel=1e-12)
+    assert pytest.approx(1.80, rel=1e-12) == sp.S
     assert sp.TC_s == pytest.approx(0.883883, rel=1e-6)
     assert sp.TD_s == pytest.approx(2.2, rel=1e-12)
     se = sp.psa([0.0, 0.5, 1.5, 4.0])
@@ -88,7 +88,7 @@ def test_the_ntc_site_gives_the_checks_ag_and_s():
     site = NtcSite(0.25, 2.4, 0.3, "b", "t2")
     assert site.soil == "B" and site.topography == "T2"
     assert site.ag_m_s2 == pytest.approx(0.25 * 9.81)
-    assert site.S == pytest.approx(1.392)
+    assert pytest.approx(1.392) == site.S
     data = site.to_dict()
     assert data["spectrum_code"] == "ntc2018" and data["SS"] == pytest.approx(1.16)
     assert data["spectrum"]["F0"] == 2.4

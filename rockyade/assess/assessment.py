@@ -188,6 +188,9 @@ class Assessment:
             "verdict_rule": "verified when one of the checks that apply is met (the linear check with q and the "
             "nonlinear check are two ways of checking the mechanism)",
             "site": self.site.to_dict(),
+            "g_m_s2": G,
+            "g_meaning": "the one g of the check: ag in g and a0* = alpha0 g / (e* FC) (the verdict does not depend "
+            "on it); records in g are read with standard gravity 9.80665 m/s^2",
             "position": self.position.to_dict(),
             "direction": self.limit.direction,
             "load_multiplier": self.limit.load_multiplier,

@@ -177,7 +177,8 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
                 "m/s^2",
                 terms={"ag_m_s2": ag, "S": S, "q": q},
                 ag_capacity_m_s2=ag * a0 / demand,
-                source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g}; S from {site.spectrum_clause.split(';')[0]}",
+                source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g}; "
+                f"S from {site.spectrum_clause.split(';')[0]}",
             )
         )
         name, inequality = "nonlinear, ground level", "du* >= SDe(Ts)"

@@ -62,6 +62,7 @@ def fit_lines(result: FragilityResult, what: str = "") -> list[str]:
         )
     else:
         lines.append(f"no fit: {f.status}")
+    lines += [f"  note: {note}" for note in fit.notes]
     if result.levels_added:
         added = ", ".join(f"{m.shown(v):.3g}" for v in result.levels_added)
         lines.append(f"levels added to bracket the median: {added} {m.unit}")
@@ -108,6 +109,8 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     lines = [
         f"assessment of {source}: NTC 2018 kinematic method (NTC 2018 8.7.1, Circolare 2019 C8.7.1), FC = {a.fc:g}",
         f"site: {a.site.describe()}; mechanism {a.position.describe()}",
+        f"g = {G:g} m/s^2 throughout the check (ag in g and a0* = alpha0 g / (e* FC): the verdict does not depend "
+        "on it); records given in g are read with standard gravity 9.80665 m/s^2",
     ]
     if lim.status == "no_mechanism":
         lines.append("limit analysis: no horizontal acceleration makes it collapse (no mechanism): no code check")

@@ -38,12 +38,22 @@ def _site(args: argparse.Namespace) -> AnySite:
     from rockyade.constants import G
 
     ec8_given = [o for o in ("spectrum_type", "ground", "importance") if getattr(args, o) is not None]
-    ntc_given = [o for o in ("f0", "tc_star", "soil", "topography", "topography_height_ratio") if getattr(args, o) is not None]
+    ntc_given = [
+        o for o in ("f0", "tc_star", "soil", "topography", "topography_height_ratio") if getattr(args, o) is not None
+    ]
+    if args.spectrum is None and ec8_given and ntc_given:
+        raise InputError(
+            "--" + ntc_given[0].replace("_", "-"),
+            f"mixes the NTC 2018 site (--{ntc_given[0].replace('_', '-')}) with an EC8 option "
+            f"(--{ec8_given[0].replace('_', '-')}): give one site, or --spectrum to say which",
+        )
     spectrum = args.spectrum or ("ec8" if ec8_given else "ntc2018")
     ag = parse_acceleration(args.ag, "--ag")
     if spectrum == "ec8":
         if ntc_given:
-            raise InputError("--" + ntc_given[0].replace("_", "-"), "is an NTC 2018 site parameter, not with the EC8 spectrum")
+            raise InputError(
+                "--" + ntc_given[0].replace("_", "-"), "is an NTC 2018 site parameter, not with the EC8 spectrum"
+            )
         for option in ("spectrum_type", "ground"):
             if getattr(args, option) is None:
                 raise InputError("--" + option.replace("_", "-"), "is required with the EC8 spectrum")
@@ -211,7 +221,8 @@ def register(sub: Any) -> None:
         "assess",
         help="the code's kinematic checks of a wall (NTC 2018) and the rocking dynamics beside them",
         description="The collapse mechanism and the kinematic quantities by limit analysis (alpha0, M*, e*, a0*, "
-        "d0*, du*, Ts), the checks of NTC 2018 (Circolare 2019 C8.7.1) against the site's NTC 2018 spectrum (or EC8's), "
+        "d0*, du*, Ts), the checks of NTC 2018 (Circolare 2019 C8.7.1) against the site's NTC 2018 spectrum "
+        "(or EC8's), "
         "each with its clause and formula, the checks not made listed, and, "
         "unless --static-only, the same scene under a spectrum-compatible suite scaled to the site (or your "
         "records), at stripes of load factors on that scaling: the fraction of records that collapse it at the "
@@ -238,7 +249,9 @@ def register(sub: Any) -> None:
     ntc.add_argument("--f0", type=float, help="F0, the spectrum's maximum amplification")
     ntc.add_argument("--tc-star", type=float, metavar="S", help="TC*, s")
     ntc.add_argument("--soil", help="subsoil category A, B, C, D or E (Tab. 3.2.II; SS and CC of Tab. 3.2.IV)")
-    ntc.add_argument("--topography", help="topographic category T1, T2, T3 or T4 (Tab. 3.2.III; ST of Tab. 3.2.V; default T1)")
+    ntc.add_argument(
+        "--topography", help="topographic category T1, T2, T3 or T4 (Tab. 3.2.III; ST of Tab. 3.2.V; default T1)"
+    )
     ntc.add_argument(
         "--topography-height-ratio",
         type=float,

@@ -182,9 +182,7 @@ def kinematic_quantities(
     d = DIRECTIONS[direction]
     points = [(i, p, mass) for i, p, mass in model.weight_points() if mechanism.moving[i]]
     m = np.array([mass for _, _, mass in points])
-    dx = np.array(
-        [d * point_velocity(mechanism.velocities[i], model.centroids_m[i], p)[0] for i, p, _ in points]
-    )
+    dx = np.array([d * point_velocity(mechanism.velocities[i], model.centroids_m[i], p)[0] for i, p, _ in points])
     sum_m = float(m.sum())
     s1, s2 = float(np.sum(m * dx)), float(np.sum(m * dx * dx))
     M_star = s1 * s1 / s2

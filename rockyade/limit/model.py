@@ -191,7 +191,8 @@ class RigidBlockModel:
             fx, fy = q["force_N"]
             mass = f"with its mass {q['mass_kg']:.4g} kg" if q["mass_takes_part"] else "without mass"
             lines.append(
-                f"load {k}: ({fx:.4g}, {fy:.4g}) N on {q['block']} at ({q['point_m'][0]:.4g}, {q['point_m'][1]:.4g}) m, "
+                f"load {k}: ({fx:.4g}, {fy:.4g}) N on {q['block']} at "
+                f"({q['point_m'][0]:.4g}, {q['point_m'][1]:.4g}) m, "
                 f"{mass}: {q['why']}"
             )
         return lines

@@ -153,7 +153,9 @@ def ntc_spectrum(
         if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value)):
             raise InputError(name, f"must be a number, got {value!r}")
         if not (lo < value <= hi if name == "--ag" else lo <= value <= hi):
-            raise InputError(name, f"must be in [{lo:g}, {hi:g}] (NTC 2018 Allegato A's range is narrower), got {value!r}")
+            raise InputError(
+                name, f"must be in [{lo:g}, {hi:g}] (NTC 2018 Allegato A's range is narrower), got {value!r}"
+            )
     ss, cc = soil_factors(soil, ag_g, F0, tc_star_s)
     st = topography_factor(topography, height_ratio)
     tc = cc * tc_star_s
