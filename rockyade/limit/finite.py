@@ -26,8 +26,11 @@ onto the joints by Gauss-Newton, and at every configuration
 (the virtual work of gravity, the loads F at their points p and alpha m g d, zero), down to
 alpha = 0. This is the nonlinear kinematic analysis of NTC 2018 / Circolare 2019 C8.7.1
 (the multiplier of the mechanism at finite displacement). The joints are kept as they
-are at rest: no new contact is sought and a joint that slides is not followed (the code's
-nonlinear analysis is for rocking mechanisms).
+are at rest and a joint that slides is not followed (the code's nonlinear analysis is for
+rocking mechanisms). A new contact is not followed either: where a moving block meets a fixed
+block it did not touch at rest (a restrained wall's top closing its gap), the curve stops there
+and says so (the mechanism changes: the wall bears on its restraint, and its capacity beyond
+is another mechanism's, which a limit analysis of the scene with the gap closed gives).
 """
 
 from __future__ import annotations
@@ -41,6 +44,7 @@ from numpy.typing import NDArray
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism
 from rockyade.limit.model import RigidBlockModel
+from rockyade.scene.placement import candidate_pairs, penetration_depth
 
 #: Largest rotation of any block in one step, rad.
 MAX_STEP_ROTATION_RAD = 2.0e-3
@@ -293,6 +297,37 @@ class _Kinematics:
         return float(max(0.0, -gaps.min()))
 
 
+def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int]]:
+    """(moving block, fixed block) pairs that do not touch at rest and lie within a quarter of the
+    assembly's size of each other: where a gap can close (module docstring)."""
+    touching = {frozenset((itf.a, itf.b)) for itf in model.interfaces}
+    touching |= {frozenset((c.a, c.b)) for c in model.corners}
+    fixed = [j for j in range(model.n_blocks) if model.fixed[j]]
+    if not fixed:
+        return []
+    moving = sorted(kin.group_of)
+    bodies = moving + fixed
+    polys = [model.polygons_m[b] for b in bodies]
+    out = []
+    for i, j in candidate_pairs(polys, margin=0.25 * model.size_m):
+        a, b = bodies[i], bodies[j]
+        if model.fixed[a] == model.fixed[b] or frozenset((a, b)) in touching:
+            continue
+        out.append((a, b) if not model.fixed[a] else (b, a))
+    return out
+
+
+def _closed(model: RigidBlockModel, kin: _Kinematics, s, pairs) -> tuple[int, int] | None:
+    """The first watched pair whose blocks overlap in configuration ``s``, else None."""
+    tol = 1e-9 * model.size_m
+    for a, b in pairs:
+        rest = model.polygons_m[a]
+        moved = np.array([kin.place(s, kin.group_of[a], p)[0] for p in rest])
+        if penetration_depth(moved, model.polygons_m[b]) > tol:
+            return a, b
+    return None
+
+
 def _alpha(model: RigidBlockModel, kin: _Kinematics, s, q, direction: str) -> float:
     """alpha by virtual work in configuration ``s`` with velocity ``q`` (module docstring).
 
@@ -352,6 +387,7 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     h = MAX_STEP_ROTATION_RAD / omega_max
     gap = overlap = 0.0
     stopped = None
+    watched = _watched_pairs(model, kin)
     while len(dks) < MAX_STEPS:
         q1 = field(s, q)
         if q1 is None:
@@ -373,6 +409,19 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
         if abs(a_new - alphas[-1]) > MAX_STEP_ALPHA * abs(alpha0) and h > 1e-9 * model.size_m:
             h *= 0.5
             continue
+        met = _closed(model, kin, trial, watched)
+        if met is not None and h > 1e-6 * model.size_m:
+            h *= 0.5  # find where the gap closes
+            continue
+        if met is not None:
+            a, b = (model.names[x] for x in met)
+            dk_met = d * float(kin.place(trial, group_k, c_k)[0][0] - c_k[0])
+            stopped = (
+                f"{a} meets {b} between dk = {dks[-1]:.4g} and {dk_met:.4g} m (alpha = {alphas[-1]:.4g}): a gap "
+                "closes and a new contact forms, which this mechanism does not follow (the capacity beyond is "
+                "another mechanism's: a limit analysis with the gap closed)"
+            )
+            break
         s, q, gap = trial, q_new, max(gap, trial_gap)
         overlap = max(overlap, kin.released_overlap(s))
         dks.append(d * float(kin.place(s, group_k, c_k)[0][0] - c_k[0]))

@@ -18,10 +18,11 @@ for "floor"). The wall's length along its plane is the blocks' ``thickness_m``
 (``wall_length_m``).
 
 ``restraint_friction_deg`` sets the friction of the joints between the wall and the
-restraint (a ``[[joints]]`` entry; default: the scene's). A restraint that holds the wall by
-friction locks the two-block wall: its upper block must slide up the restraint for the
-three-hinge mechanism of Fig. 2 to form; give 0 (a frictionless, or rolling, restraint; see
-docs/assemblies.md for the mechanism's multiplier).
+restraint (a ``[[joints]]`` entry; default 0, as :func:`~rockyade.scene.generators.wall_section`'s;
+None: the scene's). A restraint that holds the wall by friction locks the two-block wall: its
+upper block must slide up the restraint for the three-hinge mechanism of Fig. 2 to form, which a
+frictionless (or rolling) restraint allows (see docs/assemblies.md for the mechanism's
+multiplier). :func:`~rockyade.scene.generators.wall_section` builds the same section in courses.
 
 Block names: ``wall`` (or ``wall_lower``, ``wall_upper``) and ``restraint`` or ``floor``.
 """
@@ -60,7 +61,7 @@ def restrained_wall(
     restraint_width_m: float = 0.3,
     restraint_height_m: float = 0.3,
     gap_m: float = 0.0,
-    restraint_friction_deg: float | None = None,
+    restraint_friction_deg: float | None = 0.0,
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
@@ -86,7 +87,7 @@ def restrained_wall(
     gap_m
         Gap between the wall and the restraint, m.
     restraint_friction_deg
-        Friction angle of the wall-restraint joints, degrees in [0, 90) (None: the scene's).
+        Friction angle of the wall-restraint joints, degrees in [0, 90) (default 0; None: the scene's).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is the paper's calibration
         (slender wall blocks).
