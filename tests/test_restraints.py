@@ -194,3 +194,21 @@ def test_the_capacity_curve_stops_where_the_gap_closes_and_says_so():
     dk = T / 2 * (1 - math.cos(theta)) + 2.25 * math.sin(theta)
     assert kin.curve.dk_m[-1] == pytest.approx(dk, abs=5e-6)
     assert kin.curve.dk_m[-1] <= dk
+
+
+def test_a_fixed_block_that_touches_nothing_is_named():
+    data = wall_section(height_m=H, thickness_m=T, courses=2, motion={"type": "rest"})
+    data["blocks"].append(
+        {
+            "name": "stray",
+            "width_m": 0.2,
+            "height_m": 0.2,
+            "thickness_m": 1.0,
+            "density_kg_m3": 2000.0,
+            "position_m": [2.0, 0.5],
+            "fixed": True,
+        }
+    )
+    notes = rigid_block_model(scene_from_dict(data)).notes
+    assert any("stray" in n and "touch no moving block" in n for n in notes)
+    assert not any("touch no" in n for n in rigid_block_model(restrained_8_courses()).notes)

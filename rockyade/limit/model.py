@@ -361,9 +361,18 @@ def rigid_block_model(
             interfaces.extend(ways[0])
         elif ways and (fixed[pc.a] or pc.b < 0 or fixed[pc.b]):
             corners.append(Corner(pc.a, pc.b, pc.point_m, ways))
+    touching = {b for itf in interfaces for b in (itf.a, itf.b)} | {b for c in corners for b in (c.a, c.b)}
+    idle = [names[i] for i in np.flatnonzero(fixed) if i not in touching]
+    notes = _left_out(scene)
+    if idle:
+        shown = ", ".join(idle[:5]) + (" ..." if len(idle) > 5 else "")
+        notes += (
+            f"fixed block(s) {shown} touch no moving block at rest: they take no part in the limit analysis "
+            "(a gap left on purpose, or a block not placed as meant)",
+        )
     return RigidBlockModel(
         corners=tuple(corners),
-        notes=_left_out(scene),
+        notes=notes,
         names=names,
         masses_kg=masses,
         centroids_m=centroids,
