@@ -212,3 +212,79 @@ def test_a_fixed_block_that_touches_nothing_is_named():
     notes = rigid_block_model(scene_from_dict(data)).notes
     assert any("stray" in n and "touch no moving block" in n for n in notes)
     assert not any("touch no" in n for n in rigid_block_model(restrained_8_courses()).notes)
+
+
+def test_the_three_hinge_mechanism_sliding_on_a_frictionless_restraint_is_followed_to_alpha_0():
+    """restrained-wall's two blocks (t 0.3, H 3, split 1.5, restraint 0.3 deep, frictionless): the lower
+    block turns by theta about (t/2, 0); the upper block hinges on it at the moved (-t/2, 1.5) and its
+    face passes through the restraint's corner D = (t/2, 2.7) (the rotation phi of the upper block
+    solves that). alpha(theta) = dV/dtheta / d(sum W x)/dtheta by finite differences of the positions,
+    computed here without the package; it falls to 0 where V is highest."""
+    from scipy.optimize import brentq
+
+    from rockyade.scene.generators import restrained_wall
+
+    t, h, h1, hr = 0.3, 3.0, 1.5, 0.3
+    toe, corner, hinge0 = np.array([t / 2, 0.0]), np.array([t / 2, h - hr]), np.array([-t / 2, h1])
+
+    def rot(a):
+        return np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+
+    def centroids(theta):
+        hinge = toe + rot(-theta) @ (hinge0 - toe)
+
+        def off_face(phi):  # D's distance from the upper block's far face
+            d = corner - (hinge + rot(phi) @ np.array([t, 0.0]))
+            u = rot(phi) @ np.array([0.0, 1.0])
+            return u[0] * d[1] - u[1] * d[0]
+
+        phi = brentq(off_face, -1e-9, 1.0) if theta > 0 else 0.0
+        lower = toe + rot(-theta) @ (np.array([0.0, h1 / 2]) - toe)
+        upper = hinge + rot(phi) @ (np.array([0.0, (h + h1) / 2]) - hinge0)
+        return lower, upper
+
+    def alpha(theta, eps=1e-7):
+        (l1, u1), (l0, u0) = centroids(theta + eps), centroids(theta - eps)
+        return (h1 * (l1[1] - l0[1]) + (h - h1) * (u1[1] - u0[1])) / (h1 * (l1[0] - l0[0]) + (h - h1) * (u1[0] - u0[0]))
+
+    theta0 = brentq(alpha, 1e-4, 0.5)
+    d0 = centroids(theta0)[0][0]  # the control point: the lower block's centroid
+    data = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion={"type": "rest"})
+    res = limit_analysis(scene_from_dict(data), direction="+x")
+    assert res.mechanism.slides and res.load_multiplier == pytest.approx(17 / 35, rel=1e-9)
+    kin = res.kinematic
+    assert kin.control_block == "wall_lower"
+    assert kin.curve.d0_m == pytest.approx(d0, rel=1e-4)
+    for theta in (0.01, 0.05, 0.1):
+        dk = centroids(theta)[0][0]
+        assert np.interp(dk, kin.curve.dk_m, kin.curve.alpha) == pytest.approx(alpha(theta), abs=2e-4)
+
+
+def test_sliding_with_friction_says_why_it_is_not_followed():
+    res = limit_analysis(restrained_8_courses(), direction="+x")
+    assert res.mechanism.slides and res.kinematic.d0_star_m is None
+    assert "slides with friction" in res.kinematic.nonlinear_note
+
+
+def test_the_pushover_of_a_wall_with_a_gap_sees_the_onset_before_the_restraint_holds_it():
+    """The wall turns at alpha0 = 0.1979 but only until its top meets the restraint 1 mm away (its control
+    point, w08's centroid, then moved 0.94 mm): the pushover's growth threshold of 1 mm would never be
+    reached (the onset was NaN, 'stood at' every level); the onset is sought within the gap's travel."""
+    from rockyade.assess.pushover import run_pushover
+
+    data = wall_section(
+        height_m=H,
+        thickness_m=T,
+        courses=8,
+        top="restrained",
+        gap_m=0.001,
+        overburden_n_per_m=N,
+        overburden_eccentricity_m=E,
+        density_kg_m3=RHO,
+        motion={"type": "rest"},
+    )
+    scene = scene_from_dict(data)
+    res = limit_analysis(scene, direction="+x")
+    check = run_pushover(scene, res.kinematic, "+x")
+    assert math.isfinite(check.onset.multiplier)
+    assert abs(check.difference) <= 0.011  # the first held level at or above alpha0 (levels 1 % apart)
