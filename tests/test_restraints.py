@@ -288,3 +288,45 @@ def test_the_pushover_of_a_wall_with_a_gap_sees_the_onset_before_the_restraint_h
     check = run_pushover(scene, res.kinematic, "+x")
     assert math.isfinite(check.onset.multiplier)
     assert abs(check.difference) <= 0.011  # the first held level at or above alpha0 (levels 1 % apart)
+
+
+def test_one_generator_its_names_defaults_and_gaps(tmp_path):
+    from rockyade.cli import main
+    from rockyade.errors import InputError
+    from rockyade.scene import load_scene
+    from rockyade.scene.generators import restrained_wall
+
+    # one face, no gap: allowed; the restraint's friction (0 by default) on every course that can touch it
+    scene = restrained_8_courses(gap_m=0.0)
+    assert [b.name for b in scene.blocks if b.fixed] == ["restraint_far"]
+    assert {j.blocks for j in scene.joints} == {("w07", "restraint_far"), ("w08", "restraint_far")}
+    assert {j.get("friction_angle_deg") for j in scene.joints} == {0.0}
+    # both faces need a gap; a gap the wall cannot close before it overturns is refused, with the numbers
+    with pytest.raises(InputError, match="clamp"):
+        wall_section(top="restrained")
+    with pytest.raises(InputError, match=r"< thickness_m \(0.3 m\).*0.3 m closes") as info:
+        wall_section(top="restrained-near", gap_m=0.3)
+    assert info.value.field == "gap_m"
+    with pytest.raises(InputError, match=r"must be < 0.01496 m with restraint = 'floor'"):
+        restrained_wall(blocks=1, restraint="floor", gap_m=0.02)
+    # the same names and defaults: restrained-wall takes wall-section's names, its restraint frictionless
+    assert (
+        main(
+            [
+                "build",
+                "restrained-wall",
+                "--height-m",
+                "2.4",
+                "--thickness-m",
+                "0.36",
+                "--motion",
+                "rest",
+                "--out",
+                str(tmp_path / "rw.toml"),
+            ]
+        )
+        == 0
+    )
+    rw = load_scene(tmp_path / "rw.toml")
+    assert rw.blocks[0].width_m == pytest.approx(0.36) and rw.blocks[-1].position_m[1] == pytest.approx(2.1)
+    assert [j.get("friction_angle_deg") for j in rw.joints] == [0.0]

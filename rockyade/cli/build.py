@@ -34,6 +34,7 @@ class Opt:
     choices: tuple[str, ...] | None = None
     metavar: str | None = None
     append: bool = False
+    aliases: tuple[str, ...] = ()
 
     @property
     def dest(self) -> str:
@@ -197,9 +198,11 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
     "restrained-wall": (
         "a wall restrained at its top by a fixed block (out-of-plane section, the paper's Fig. 2)",
         [
-            Opt("--wall-height-m", 3.0, "wall height, m"),
-            Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m"),
-            Opt("--wall-length-m", 1.0, "wall length along its plane (the blocks' out-of-plane thickness), m"),
+            Opt("--wall-height-m", 3.0, "wall height, m (or --height-m, as wall-section)", aliases=("--height-m",)),
+            Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m (or --thickness-m)",
+                aliases=("--thickness-m",)),
+            Opt("--wall-length-m", 1.0, "wall length along its plane (the blocks' out-of-plane thickness), m "
+                "(or --length-m)", aliases=("--length-m",)),
             Opt("--blocks", 2, "1 or 2 wall blocks", int),
             Opt("--split", 0.5, "two blocks: lower block height / wall height"),
             Opt(
@@ -325,7 +328,7 @@ def _add(parser: argparse.ArgumentParser | Any, opt: Opt) -> None:
         kwargs.update(action="append", type=opt.type)
     else:
         kwargs.update(type=opt.type, choices=opt.choices)
-    parser.add_argument(opt.flag, **kwargs)
+    parser.add_argument(opt.flag, *opt.aliases, **kwargs)
 
 
 # ---------------------------------------------------------------------- build

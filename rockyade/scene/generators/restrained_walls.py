@@ -14,7 +14,8 @@ fixed block (it moves with the base) that restrains the top:
   left.
 
 ``gap_m`` leaves a gap between the wall and the restraint (horizontal for "side", vertical
-for "floor"). The wall's length along its plane is the blocks' ``thickness_m``
+for "floor"); a gap the wall cannot close before it overturns (the wall's thickness for "side",
+sqrt(t^2 + H^2) - H for "floor") is refused. The wall's length along its plane is the blocks' ``thickness_m``
 (``wall_length_m``).
 
 ``restraint_friction_deg`` sets the friction of the joints between the wall and the
@@ -29,6 +30,7 @@ Block names: ``wall`` (or ``wall_lower``, ``wall_upper``) and ``restraint`` or `
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any
@@ -113,6 +115,16 @@ def restrained_wall(
             rect_block("wall_lower", T, lower, zero, zero, length, density),
             rect_block("wall_upper", T, H - lower, zero, lower, length, density),
         ]
+    # a gap the wall cannot close before it overturns (turning about its toe, its centroid over the toe
+    # when its top has moved by its thickness and its top corner has risen by sqrt(t^2 + H^2) - H)
+    reach = float(T) if kind == "side" else math.hypot(float(T), float(H)) - float(H)
+    if float(gap) >= reach:
+        raise InputError(
+            "gap_m",
+            f"must be < {reach:.4g} m with restraint = {kind!r}: the wall overturns (its top moved "
+            f"{'by its thickness' if kind == 'side' else 'up by sqrt(t^2 + H^2) - H'}) before a gap of "
+            f"{float(gap):g} m closes",
+        )
     if kind == "side":
         if rh > H:
             raise InputError(
