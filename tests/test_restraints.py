@@ -45,8 +45,8 @@ H, T, RHO, N, E, PHI = 2.4, 0.36, 1600.0, 6000.0, 0.05, 35.0
 BEFORE = 1.1885  # the multiplier of the inadmissible mechanism, before corners were contacts
 
 
-def restrained_8_courses(gap_m: float = 1e-9, **kwargs):
-    contact = {"calibration": "paper", "friction_angle_deg": PHI}
+def restrained_8_courses(gap_m: float = 1e-9, phi: float = PHI, **kwargs):
+    contact = {"calibration": "paper", "friction_angle_deg": phi}
     data = wall_section(
         height_m=H,
         thickness_m=T,
@@ -330,3 +330,20 @@ def test_one_generator_its_names_defaults_and_gaps(tmp_path):
     rw = load_scene(tmp_path / "rw.toml")
     assert rw.blocks[0].width_m == pytest.approx(0.36) and rw.blocks[-1].position_m[1] == pytest.approx(2.1)
     assert [j.get("friction_angle_deg") for j in rw.joints] == [0.0]
+
+
+def test_with_joints_that_do_not_slide_at_45_degrees_it_is_the_hand_three_hinge_mechanism():
+    """Joints at 45 degrees: the top course can no longer be squeezed out (tan 45 x 2.1 of rise), and the
+    mechanism is the three hinges by hand, exactly, followed to alpha = 0 (the top slides on the
+    frictionless restraint)."""
+    res = limit_analysis(restrained_8_courses(phi=45.0), direction="+x")
+    assert res.load_multiplier == pytest.approx(three_hinge(), rel=1e-9)
+    assert [h.point_m for h in res.mechanism.hinges] == [(T / 2, 0.0), (-T / 2, 1.5)]
+    assert entering(res) <= 1e-6
+    assert res.kinematic.d0_star_m is not None and res.kinematic.d0_star_m > 0.1
+
+
+def test_wall_section_in_two_courses_is_restrained_wall():
+    """Two equal courses restrained on the far face with no gap: restrained-wall's 17/35."""
+    res = limit_analysis(scene_from_dict(wall_section(courses=2, top="restrained-far", motion={"type": "rest"})))
+    assert res.load_multiplier == pytest.approx(17 / 35, rel=1e-9)
