@@ -259,7 +259,13 @@ def test_study_displays_draw_into_given_axes_and_keep_what_they_drew(tmp_path, h
     assert bars.figure_ is fig2 and len(bars.ax_[0].patches) == 12
 
     cells = pd.DataFrame(
-        {"frequency_hz": [1.0], "amplitude_mm": [0.5], "pattern_dem": ["rest"], "pattern_paper": [None], "agree": [None]}
+        {
+            "frequency_hz": [1.0],
+            "amplitude_mm": [0.5],
+            "pattern_dem": ["rest"],
+            "pattern_paper": [None],
+            "agree": [None],
+        }
     )
     fig3 = Figure()
     ax3 = fig3.subplots()

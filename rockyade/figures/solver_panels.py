@@ -14,6 +14,7 @@ import textwrap
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -23,7 +24,7 @@ from rockyade.figures.common import axes_list, figure_of, new_figure, save_figur
 from rockyade.figures.styles import plot_solver
 
 #: How a failed run shows: a legend entry with a red cross and no curve.
-FAILED_STYLE = {"color": "red", "ls": "none", "marker": "x"}
+FAILED_STYLE: dict[str, Any] = {"color": "red", "ls": "none", "marker": "x"}
 
 
 @dataclass(frozen=True)
@@ -97,7 +98,7 @@ class Panel:
     spans: Sequence[Span] = ()
     note: str = ""
     note_width: int = 110
-    legend_loc: str = "best"
+    legend_loc: Any = "best"
     legend_ncol: int = 1
 
 
