@@ -359,7 +359,8 @@ def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_withou
     that the floor clamps the wall."""
     from rockyade.cli import main
 
-    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", motion={"type": "rest"}))
+    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", restraint_friction_deg=None,
+                                             motion={"type": "rest"}))
     assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
     assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
     assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0

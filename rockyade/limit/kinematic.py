@@ -196,10 +196,11 @@ def kinematic_quantities(
     values: dict[str, float | None] = dict.fromkeys(("d0", "du", "ds", "as", "Ts"))
     if not nonlinear:
         note = "not asked for"
-    elif mechanism.slides:
+    elif any(model.interfaces[s.interface].friction_angle_deg for s in mechanism.sliding):
         note = (
-            "a joint slides: the code's nonlinear analysis follows rocking mechanisms (hinges); "
-            "a sliding block keeps alpha = tan(phi) and never reaches alpha = 0"
+            "a joint slides with friction: the code's nonlinear analysis follows rocking mechanisms (hinges, "
+            "and frictionless sliding on a restraint); a block sliding with friction keeps alpha = tan(phi) and "
+            "never reaches alpha = 0"
         )
     else:
         curve = capacity_curve(model, mechanism, direction, k)

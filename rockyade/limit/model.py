@@ -33,8 +33,9 @@ from numpy.typing import NDArray
 from rockyade.blocks.geometry import polygon_section
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.limit.contacts import PointContact, point_contacts
 from rockyade.scene.carried import carried_on, load_mass_kg, loaded_mass_properties, residual_force
-from rockyade.scene.placement import placed_blocks, rest_contacts
+from rockyade.scene.placement import TOUCH_TOL, placed_blocks, rest_contacts
 
 #: The base's name in interfaces, hinges and output.
 BASE = "base"
@@ -105,6 +106,26 @@ class Interface:
 
 
 @dataclass(frozen=True)
+class Corner:
+    """A point contact with several ways to hold (:mod:`rockyade.limit.contacts`).
+
+    Attributes
+    ----------
+    a, b
+        Body indices (``b = -1``: the base); ``a`` moves.
+    point_m
+        The point at rest, base frame, m.
+    ways
+        Each way as the interfaces (zero length, at the point) that make it.
+    """
+
+    a: int
+    b: int
+    point_m: tuple[float, float]
+    ways: tuple[tuple[Interface, ...], ...]
+
+
+@dataclass(frozen=True)
 class RigidBlockModel:
     """A scene as rigid blocks, interfaces and loads (module docstring).
 
@@ -132,6 +153,11 @@ class RigidBlockModel:
         The loads as given, ``block`` an index and ``mass_kg`` resolved to kg (module docstring).
     block_masses_kg, block_centroids_m
         The blocks' own masses, kg, and centroids, m (None: as ``masses_kg``, ``centroids_m``).
+    corners
+        Point contacts that can hold in more than one way (two corners meeting, one of them on a
+        fixed block or the base: :mod:`rockyade.limit.contacts`), each with its ways as
+        interfaces of zero length; :func:`rockyade.limit.admissible.solve_admissible` chooses.
+        Point contacts with one way are among ``interfaces`` (kind "corner").
     """
 
     names: tuple[str, ...]
@@ -143,6 +169,7 @@ class RigidBlockModel:
     loads: tuple[PointLoad, ...] = ()
     g: float = G
     notes: tuple[str, ...] = ()
+    corners: tuple[Corner, ...] = ()
     given_loads: tuple[PointLoad, ...] = ()
     block_masses_kg: NDArray[np.float64] | None = None
     block_centroids_m: NDArray[np.float64] | None = None
@@ -339,6 +366,25 @@ def _outside(poly: NDArray[np.float64], point: NDArray[np.float64]) -> float:
     return float(np.max(np.einsum("ij,ij->i", point - poly, normals)))
 
 
+def _point_contacts(placed, polygons, fixed, rest) -> list[PointContact]:
+    """The point contacts of the placed blocks where no joint of ``rest`` passes
+    (:func:`rockyade.limit.contacts.point_contacts`)."""
+    tol = TOUCH_TOL * max((b.size_m for b in placed), default=1.0)
+    segments: dict[tuple[int, int], list[NDArray[np.float64]]] = {}
+    for c in rest:
+        segments.setdefault((min(c.a, c.b), max(c.a, c.b)), []).append(np.asarray(c.ends_m, dtype=float))
+
+    def covered(i: int, j: int, p: NDArray[np.float64]) -> bool:
+        for e0, e1 in segments.get((min(i, j), max(i, j)), ()):
+            d = e1 - e0
+            s = float(np.clip((p - e0) @ d / max(float(d @ d), 1e-300), 0.0, 1.0))
+            if np.hypot(*(e0 + s * d - p)) <= tol:
+                return True
+        return False
+
+    return point_contacts(polygons, fixed, covered, tol)
+
+
 def scene_loads(scene) -> tuple[PointLoad, ...]:
     """The scene's ``[[loads]]`` as :class:`PointLoad` (block by name, point and force as given)."""
     return tuple(
@@ -385,7 +431,8 @@ def rigid_block_model(
     fixed = np.array([b.fixed for b in placed], dtype=bool)
     default = float(scene.contact.friction_angle_deg) if friction_angle_deg is None else friction_angle_deg
     interfaces = []
-    for c in rest_contacts(placed):
+    rest = rest_contacts(placed)
+    for c in rest:
         a, b = c.a, c.b
         normal = np.asarray(c.normal, dtype=float)
         # the moving body first, else the upper body of a bed joint (the normal points into a)
@@ -396,17 +443,42 @@ def rigid_block_model(
         else:
             phi = _friction_of(scene, a, b, default)
         interfaces.append(Interface(a, b, np.asarray(c.ends_m, dtype=float), normal, phi if sliding else None, c.kind))
+    corners = []
+    for pc in _point_contacts(placed, polygons, fixed, rest):
+        if friction_angle_deg is not None or not sliding:
+            phi = friction_angle_deg
+        else:
+            phi = _friction_of(scene, pc.a, pc.b, default)
+        ends = np.array([pc.point_m, pc.point_m])
+        ways = tuple(
+            tuple(Interface(pc.a, pc.b, ends, np.asarray(n), phi if sliding else None, "corner") for n in way)
+            for way in pc.ways
+        )
+        if len(ways) == 1:
+            interfaces.extend(ways[0])
+        elif ways and (fixed[pc.a] or pc.b < 0 or fixed[pc.b]):
+            corners.append(Corner(pc.a, pc.b, pc.point_m, ways))
+    touching = {b for itf in interfaces for b in (itf.a, itf.b)} | {b for c in corners for b in (c.a, c.b)}
+    idle = [names[i] for i in np.flatnonzero(fixed) if i not in touching]
+    notes = _left_out(scene)
+    if idle:
+        shown = ", ".join(idle[:5]) + (" ..." if len(idle) > 5 else "")
+        notes += (
+            f"fixed block(s) {shown} touch no moving block at rest: they take no part in the limit analysis "
+            "(a gap left on purpose, or a block not placed as meant)",
+        )
     resolved = _resolve_loads(scene_loads(scene) + tuple(loads), names, polygons)
-    loaded_m, loaded_c, given, rest = _carry(masses, centroids, fixed, resolved, float(g))
+    loaded_m, loaded_c, given, residual = _carry(masses, centroids, fixed, resolved, float(g))
     return RigidBlockModel(
-        notes=_left_out(scene),
+        corners=tuple(corners),
+        notes=notes,
         names=names,
         masses_kg=loaded_m,
         centroids_m=loaded_c,
         polygons_m=polygons,
         fixed=fixed,
         interfaces=tuple(interfaces),
-        loads=rest,
+        loads=residual,
         g=float(g),
         given_loads=given,
         block_masses_kg=masses,

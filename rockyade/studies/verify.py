@@ -663,6 +663,7 @@ def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
                 _rel(kin.e_star, expected) <= 1e-9,
             )
         )
+    rows += _restrained_wall_rows()
     t60 = _arch_minimum_thickness(60)
     rows.append(
         Row(
@@ -677,6 +678,56 @@ def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
         )
     )
     return rows, {}
+
+
+def _restrained_wall_rows() -> list[Row]:
+    """The wall restrained at its top against closed forms (docs/assemblies.md, tests/test_restraints.py):
+    the two-block wall's three-hinge mechanism, 17/35 (t 0.3, H 3, split 0.5, restraint 0.3 deep,
+    frictionless); the 8-course tuff wall (H 2.4, t 0.36, 1600 kg/m^3, joints 35 degrees, a roof of
+    6 kN/m at 0.05 m without mass, a frictionless restraint on its far face): the seven lower
+    courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
+    tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
+    from rockyade.limit import limit_analysis
+    from rockyade.scene.generators import restrained_wall, wall_section
+
+    two = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0)
+    lam2 = _known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
+    eight = wall_section(
+        height_m=2.4,
+        thickness_m=0.36,
+        courses=8,
+        top="restrained-far",
+        gap_m=0.0,
+        overburden_n_per_m=6000.0,
+        overburden_eccentricity_m=0.05,
+        density_kg_m3=1600.0,
+        contact={"calibration": "paper", "friction_angle_deg": 35.0},
+    )
+    lam8 = _known(limit_analysis(scene_from_dict(eight), direction="+x").load_multiplier, "load multiplier")
+    wc = 1600.0 * G * 0.36 * 0.3
+    expected8 = (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
+    return [
+        Row(
+            "kinematic",
+            "limit",
+            "wall restrained at its top, 2 blocks: lambda",
+            lam2,
+            17 / 35,
+            "three hinges: 17/35",
+            "1e-9",
+            _rel(lam2, 17 / 35) <= 1e-9,
+        ),
+        Row(
+            "kinematic",
+            "limit",
+            "8-course wall restrained on its far face: lambda",
+            lam8,
+            expected8,
+            "top course squeezed up (<= three hinges 1.3619)",
+            "1e-9",
+            _rel(lam8, expected8) <= 1e-9 and lam8 <= 1.3619,
+        ),
+    ]
 
 
 def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
