@@ -145,7 +145,8 @@ def _check(name: str, quantity: str, inequality: str, demand: float, capacity: f
 
 
 def _not_applicable(name: str, quantity: str, inequality: str, unit: str, reason: str) -> Check:
-    return Check(name, quantity, inequality, math.nan, math.nan, unit, NOT_APPLICABLE, reason=reason)
+    source = CHECK_SOURCES.get(name, CLAUSE)
+    return Check(name, quantity, inequality, math.nan, math.nan, unit, NOT_APPLICABLE, reason=reason, source=source)
 
 
 def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: float = Q_FACTOR) -> list[Check]:
