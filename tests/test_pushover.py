@@ -179,7 +179,7 @@ def test_pushover_onset_of_a_loaded_block_is_the_closed_form(solver):
     n, x = 8000.0, 0.05
     expected = (MASS * G * WIDTH / 2 + n * (WIDTH / 2 - x)) / (MASS * G * HEIGHT / 2)
     motion = pushover(expected)
-    scene = block_scene(motion, [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n]}])
+    scene = block_scene(motion, [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n], "mass_kg": 0.0}])
     assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(expected, rel=1e-6)
     result = run(scene, solver)
     curve = capacity_curve(result, scene)

@@ -515,6 +515,13 @@ def _with_overburden(args: argparse.Namespace, kind: str, data: dict[str, Any]) 
     )
 
 
+def _overburden_mass(args: argparse.Namespace, data: dict[str, Any]) -> dict[str, Any]:
+    """``--overburden-mass none``: the overburden's [[loads]] without mass (mass_kg = 0)."""
+    if getattr(args, "overburden_mass", "carried") != "none" or not data.get("loads"):
+        return data
+    return {**data, "loads": [{**q, "mass_kg": 0.0} for q in data["loads"]]}
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -534,6 +541,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     try:
         data = GENERATORS[kind](**kwargs)
         data = _with_overburden(args, kind, data)
+        data = _overburden_mass(args, data)
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
@@ -723,10 +731,18 @@ def register(sub: Any) -> None:
         )
         for opt in options:
             _add(k, opt)
-        if kind in OVERBURDEN:
-            loads = k.add_argument_group("overburden (forces without mass, written as [[loads]])")
-            for opt in OVERBURDEN[kind][1]:
+        if kind in OVERBURDEN or kind == "wall-section":
+            loads = k.add_argument_group("overburden (written as [[loads]], with the mass of its weight by default)")
+            for opt in OVERBURDEN.get(kind, ("", []))[1]:
                 _add(loads, opt)
+            loads.add_argument(
+                "--overburden-mass",
+                choices=("carried", "none"),
+                default="carried",
+                help="carried: the load's mass (its weight / g) shakes with the wall, as the code counts the loads "
+                "a wall carries (Circolare 2019 C8.7.1); none: a force without mass (its horizontal force goes "
+                "elsewhere) (default: carried)",
+            )
         group = k.add_argument_group("material, time, motion and joints")
         for opt in COMMON:
             _add(group, opt)

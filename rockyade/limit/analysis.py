@@ -136,6 +136,7 @@ class LimitResult:
             "n_interfaces": len(model.interfaces),
             "solve_time_s": self.solve_time_s,
             "notes": self.notes,
+            "loads": model.loads_table(),
             "mechanism": None,
             "hinges": [],
             "sliding": [],

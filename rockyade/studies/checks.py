@@ -12,6 +12,7 @@ CHECKS = (
     "code",
     "fragility_fit",
     "loaded_block",
+    "loaded_mass",
     "loaded_pushover",
     "limit_pushover",
 )

@@ -703,6 +703,7 @@ def _restrained_wall_rows() -> list[Row]:
         density_kg_m3=1600.0,
         contact={"calibration": "paper", "friction_angle_deg": 35.0},
     )
+    eight["loads"] = [{**q, "mass_kg": 0.0} for q in eight["loads"]]  # the case's roof: without mass
     lam8 = _known(limit_analysis(scene_from_dict(eight), direction="+x").load_multiplier, "load multiplier")
     wc = 1600.0 * G * 0.36 * 0.3
     expected8 = (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
@@ -866,8 +867,11 @@ def loaded_lambda() -> float:
     return (w * b + LOADED_N * (b - LOADED_X_M)) / (w * h_c)
 
 
-def loaded_block_scene(motion: dict[str, Any] | None = None, duration_s: float = 1.0) -> Scene:
-    """The loaded block (:func:`loaded_lambda`) under ``motion`` (default at rest)."""
+def loaded_block_scene(
+    motion: dict[str, Any] | None = None, duration_s: float = 1.0, load_mass_kg: float = 0.0
+) -> Scene:
+    """The loaded block (:func:`loaded_lambda`) under ``motion`` (default at rest); its load
+    without mass unless ``load_mass_kg`` is given."""
     return scene_from_dict(
         {
             "duration_s": duration_s,
@@ -882,9 +886,59 @@ def loaded_block_scene(motion: dict[str, Any] | None = None, duration_s: float =
                 }
             ],
             "motion": motion or rest_motion(),
-            "loads": [{"block": "pier", "point_m": [LOADED_X_M, LOADED_HEIGHT_M], "force_N": [0.0, -LOADED_N]}],
+            "loads": [
+                {
+                    "block": "pier",
+                    "point_m": [LOADED_X_M, LOADED_HEIGHT_M],
+                    "force_N": [0.0, -LOADED_N],
+                    "mass_kg": load_mass_kg,
+                }
+            ],
         }
     )
+
+
+def check_loaded_mass(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The loaded block with the load's mass (its weight / g) shaking with it: the limit
+    analysis and Housner's uplift multiplier against (W b + N d) / (W h_c + N h_N), h_N the
+    load's height (its horizontal force lambda N at its point), and the code's e* with the
+    load as a P_i at h_N: (W h_c + N h_N)^2 / ((W + N) (W h_c^2 + N h_N^2))."""
+    from rockyade.limit import limit_analysis
+    from rockyade.solvers.housner import housner_model
+
+    scene = loaded_block_scene(load_mass_kg=LOADED_N / G)
+    w, n = LOADED_MASS_KG * G, LOADED_N
+    b, h_c, h_n = LOADED_WIDTH_M / 2, LOADED_HEIGHT_M / 2, LOADED_HEIGHT_M
+    expected = (w * b + n * (b - LOADED_X_M)) / (w * h_c + n * h_n)
+    result = limit_analysis(scene, direction="+x")
+    lam = _known(result.load_multiplier, "load multiplier")
+    housner = housner_model(scene).uplift_multiplier(-1)
+    e_star = _kinematic(result).e_star
+    e_expected = (w * h_c + n * h_n) ** 2 / ((w + n) * (w * h_c**2 + n * h_n**2))
+    src = "(W b + N d) / (W h_c + N h_N)"
+    return [
+        Row("loaded_mass", "limit", "lambda towards +x", lam, expected, src, "1e-6", _rel(lam, expected) <= 1e-6),
+        Row(
+            "loaded_mass",
+            "housner",
+            "uplift multiplier about the +x pivot",
+            housner,
+            expected,
+            src,
+            "1e-6",
+            _rel(housner, expected) <= 1e-6,
+        ),
+        Row(
+            "loaded_mass",
+            "limit",
+            "e* with the load a P_i",
+            e_star,
+            e_expected,
+            "(W h_c + N h_N)^2 / ((W + N)(W h_c^2 + N h_N^2))",
+            "1e-6",
+            _rel(e_star, e_expected) <= 1e-6,
+        ),
+    ], {}
 
 
 def check_loaded_block(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
@@ -1077,6 +1131,7 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "code": check_code,
     "fragility_fit": check_fragility_fit,
     "loaded_block": check_loaded_block,
+    "loaded_mass": check_loaded_mass,
     "loaded_pushover": check_loaded_pushover,
     "limit_pushover": check_limit_pushover,
 }
