@@ -166,6 +166,9 @@ def run_model(
         "solver_max_iter": numerics.solver_max_iter,
         "newton_max_iter": numerics.newton_max_iter,
         "friction_laws": payload["laws"],
+        "friction_solver": numerics.friction_solver,
+        "vertex_disk_radius_m": payload["disk_radius_m"],
+        "dt_s": numerics.dt_s,
         **(extra_meta or {}),
     }
     result = _parse(model, numerics, out_file, reason, log_file, total, accel_lowpass_hz, extra)
@@ -233,18 +236,23 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
     if status == "completed" and n != model.n_samples:
         return f"Siconos stopped early: {n} of {model.n_samples} samples"
     if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
-        return f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s (non-finite state or runaway speed)"
+        return (
+            f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s (non-finite state or runaway speed)"
+        )
     calls = int(meta.get("solver_calls", 0))
     bad = int(meta.get("unconverged_steps", 0))
     if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (calls and bad > FAIL_UNCONVERGED_FRACTION * calls):
         return (
             f"Siconos did not converge: {bad} of {calls} friction-contact solves ended above the tolerance "
-            f"(largest residual {float(meta.get('max_residual', 0.0)):.3g}, first at t = {meta.get('first_unconverged_s')} s); "
+            f"(largest residual {float(meta.get('max_residual', 0.0)):.3g}, "
+            f"first at t = {meta.get('first_unconverged_s')} s); "
             "try a smaller dt_factor or more solver iterations"
         )
     gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
     if t_blowup is not None:
-        return f"numerical instability in Siconos at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+        return (
+            f"numerical instability in Siconos at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+        )
     return None
 
 
@@ -315,7 +323,6 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
         "blocks": names,
         "sample_dt_s": model.sample_dt_s,
         "duration_s": model.duration_s,
-        "dt_s": numerics.dt_s,
         "n_steps": int(meta.get("steps", 0)),
         "iterations": int(meta.get("steps", 0)),
         "solver_calls": calls,
@@ -324,6 +331,7 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
         "unconverged_steps": int(meta.get("unconverged_steps", 0)),
         "max_solver_residual": float(meta.get("max_residual", 0.0)),
         "max_penetration_m": float(meta.get("max_penetration_m", 0.0)),
+        "max_bullet_overlap_m": float(meta.get("max_bullet_overlap_m", 0.0)),
         "calibration": "siconos (nonsmooth: Newton restitution e, Coulomb friction; geometry and inertia as the DEMs)",
         "mu_model": {b.name: model_restitution(b) for b in model.bodies if not b.fixed},
         "bodies": model.body_summary(),
@@ -331,4 +339,3 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
         "process_cpu_s": meta.get("process_cpu_s"),
         **extra,
     }
-

@@ -23,13 +23,16 @@ samples, the loads and the time step.
 
 The model (nonsmooth contact dynamics, Moreau-Jean time stepping):
 
-* each moving block is a ``RigidBody2dDS`` (x, y, theta) with one ``SiconosConvexHull2d``
-  contactor (margins 0); a fixed block and the ground are static contactor sets (they move
-  with the base: not at all in the base frame);
-* contacts are found by Bullet (``SiconosBulletCollisionManager``, 2-D) and obey a Newton
-  impact law with Coulomb friction (``NewtonImpactFrictionNSL(e, 0, mu, 2)``), one law per
-  friction coefficient between contactor groups; the one-step problem is
-  ``FrictionContact(2)`` solved by NSGS to the tolerance given;
+* each moving block is a ``RigidBody2dDS`` (x, y, theta) with a ``SiconosConvexHull2d``
+  contactor (its contact polygon, margins 0) and a small ``SiconosDisk`` inside each vertex,
+  tangent to its two edges; a fixed block and the ground are static contactor sets (they
+  move with the base: not at all in the base frame);
+* contacts are found by Bullet (``SiconosBulletCollisionManager``, 2-D) between a block's
+  vertex disks and the other blocks' hulls or the ground only (the DEMs' vertex-to-edge
+  contacts: a hull-on-hull contact of two flat faces gets a single point in the middle, on
+  which a stack cannot stand), and obey a Newton impact law with Coulomb friction
+  (``NewtonImpactFrictionNSL(e, 0, mu, 2)``) per pair of contactor groups; the one-step
+  problem is ``FrictionContact(2)`` solved by NSGS to the tolerance given;
 * ``MoreauJeanOSI(theta)``; the ground motion enters in the base frame as an inertial
   force -m a_g(t) on every moving block (exact for a rigid base: the base frame translates
   without rotating), with the vertical -m (g + a_v(t)), both evaluated at the middle of each
@@ -54,6 +57,8 @@ import traceback
 import numpy as np
 
 SCENE_FORMAT = "rockyade-siconos-scene-1"
+#: The friction-contact solvers by name: NSGS (iterative), Lemke (pivoting, exact in 2-D).
+SOLVERS = {"nsgs": "SICONOS_FRICTION_2D_NSGS", "lemke": "SICONOS_FRICTION_2D_LEMKE", "enum": "SICONOS_FRICTION_2D_ENUM"}
 #: Beyond these the state is a numerical blow-up, not rocking (as in the DEMs).
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
@@ -100,6 +105,7 @@ def _siconos():
         SiconosContactor,
         SiconosContactorSet,
         SiconosConvexHull2d,
+        SiconosDisk,
     )
     from siconos.mechanics.collision.bullet import SiconosBulletCollisionManager, SiconosBulletOptions
 
@@ -112,6 +118,7 @@ def _siconos():
         "SiconosContactor": SiconosContactor,
         "SiconosContactorSet": SiconosContactorSet,
         "SiconosConvexHull2d": SiconosConvexHull2d,
+        "SiconosDisk": SiconosDisk,
         "Manager": SiconosBulletCollisionManager,
         "Options": SiconosBulletOptions,
     }
@@ -137,6 +144,17 @@ def _hull(S, vertices):
     return shape
 
 
+def _disk(S, radius):
+    shape = S["SiconosDisk"](float(radius))
+    shape.setInsideMargin(0.0)
+    shape.setOutsideMargin(0.0)
+    return shape
+
+
+def _offset(x, y):
+    return [float(x), float(y), 0.0, 1.0, 0.0, 0.0, 0.0]
+
+
 def _world(vertices, centroid, angle):
     c, s = math.cos(angle), math.sin(angle)
     return [[centroid[0] + c * x - s * y, centroid[1] + s * x + c * y] for x, y in vertices]
@@ -149,10 +167,12 @@ def build(scene, S):
     options.dimension = 1  # SICONOS_BULLET_2D
     sizes = [max(np.ptp(np.asarray(b["vertices_m"]), axis=0)) for b in scene["bodies"]]
     options.contactBreakingThreshold = scene["contact_breaking_fraction"] * min(sizes)
+    # contacts found afresh at every step: Bullet's persistent manifolds keep near-duplicate
+    # points of a disk (measured: up to four per vertex), on which the friction solver stalls
+    options.clearOverlappingPairCache = True
     options.perturbationIterations = 0
     options.minimumPointsPerturbationThreshold = 0
     manager = S["Manager"](options)
-    groups = scene["groups"]  # contactor group of each body; the ground is group 0
     for law in scene["laws"]:
         nsl = sk.NewtonImpactFrictionNSL(float(scene["restitution"]), 0.0, float(law["mu"]), 2)
         manager.insertNonSmoothLaw(nsl, int(law["g1"]), int(law["g2"]))
@@ -162,15 +182,20 @@ def build(scene, S):
     xs = [b["centroid0_m"][0] for b in scene["bodies"]]
     left, right = min(xs) - GROUND_MARGIN_SIZES * big, max(xs) + GROUND_MARGIN_SIZES * big
     ground = S["SiconosContactorSet"]()
-    ground.append(S["SiconosContactor"](_hull(S, [[left, -big], [right, -big], [right, 0.0], [left, 0.0]]), IDENTITY, 0))
+    ground.append(
+        S["SiconosContactor"](_hull(S, [[left, -big], [right, -big], [right, 0.0], [left, 0.0]]), IDENTITY, 0)
+    )
     manager.insertStaticContactorSet(ground, IDENTITY)
     bodies = []
+    radius = float(scene["disk_radius_m"])
     for i, b in enumerate(scene["bodies"]):
         verts = b["vertices_m"]
         if b["fixed"]:
+            at = b["centroid0_m"], b["angle0_rad"]
             cs = S["SiconosContactorSet"]()
-            world = _world(verts, b["centroid0_m"], b["angle0_rad"])
-            cs.append(S["SiconosContactor"](_hull(S, world), IDENTITY, int(groups[i])))
+            cs.append(S["SiconosContactor"](_hull(S, _world(verts, *at)), IDENTITY, int(b["hull_group"])))
+            for x, y in _world(b["disk_centres_m"], *at):
+                cs.append(S["SiconosContactor"](_disk(S, radius), _offset(x, y), int(b["disk_group"])))
             manager.insertStaticContactorSet(cs, IDENTITY)
             bodies.append(None)
             continue
@@ -185,14 +210,17 @@ def build(scene, S):
         ds.setUseContactorInertia(False)
         ds.setNumber(i + 1)
         cs = S["SiconosContactorSet"]()
-        cs.append(S["SiconosContactor"](_hull(S, verts), IDENTITY, int(groups[i])))
+        cs.append(S["SiconosContactor"](_hull(S, verts), IDENTITY, int(b["hull_group"])))
+        for x, y in b["disk_centres_m"]:
+            cs.append(S["SiconosContactor"](_disk(S, radius), _offset(x, y), int(b["disk_group"])))
         ds.setContactors(cs)
+        ds.setAllowSelfCollide(False)
         ds.setFExtPtr([0.0, -float(b["mass_kg"]) * scene["g"], 0.0])
         nsds.insertDynamicalSystem(ds)
         bodies.append(ds)
     osi = sk.MoreauJeanOSI(float(scene["theta"]))
     timedisc = sk.TimeDiscretisation(0.0, float(scene["dt_s"]))
-    so = sk.solver_options_create(sn.SICONOS_FRICTION_2D_NSGS)
+    so = sk.solver_options_create(getattr(sn, SOLVERS[scene["friction_solver"]]))
     so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(scene["solver_max_iter"])
     so.dparam[sn.SICONOS_DPARAM_TOL] = float(scene["solver_tol"])
     problem = sk.FrictionContact(2, so)
@@ -227,7 +255,8 @@ class Recorder:
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
         self.overturn_times = {}
-        self.max_penetration = 0.0
+        self.max_penetration = 0.0  # of a vertex below the ground, m (geometric)
+        self.max_overlap = 0.0  # Bullet's -gap, m (a disk's includes about 0.44 of its radius)
         self.iterations = 0
         self.solver_calls = 0
         self.unconverged = 0
@@ -262,6 +291,9 @@ class Recorder:
             c, s = math.cos(phi), math.sin(phi)
             rx, ry = c * px - s * py, s * px + c * py
             self.vpoint[k, i] = (vx - w * ry, vy + w * rx)
+            low = min(y + s * vxb + c * vyb for vxb, vyb in self.verts[i])
+            if -low > self.max_penetration:
+                self.max_penetration = -low
             stop = b["stop_angle_rad"]
             if stop is not None and abs(phi - b["rest_angle_rad"]) >= stop and i not in self.overturn_times:
                 self.overturn_times[i] = t
@@ -292,9 +324,9 @@ class Recorder:
         cp = self._points()
         if cp is None:
             return
-        depth = float(-np.min(cp[:, 9]))
-        if depth > self.max_penetration:
-            self.max_penetration = depth
+        overlap = float(-np.min(cp[:, 9]))
+        if overlap > self.max_overlap:
+            self.max_overlap = overlap
         dt = self.scene["dt_s"]
         points = {}
         for row in cp:
@@ -372,6 +404,7 @@ class Recorder:
             "first_unconverged_s": self.first_unconverged_s,
             "max_residual": self.max_residual,
             "max_penetration_m": self.max_penetration,
+            "max_bullet_overlap_m": self.max_overlap,
             "complete": complete,
             "flushes": self.flushes,
             "process_cpu_s": time.process_time(),
@@ -422,8 +455,11 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     built = build(scene, S)
     rec = Recorder(scene, built, S, out_path)
     sim = built["sim"]
-    moving = [(i, ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
-              for i, ds in enumerate(built["bodies"]) if ds is not None]
+    moving = [
+        (i, ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
+        for i, ds in enumerate(built["bodies"])
+        if ds is not None
+    ]
     forces = base_forces(scene)
     dt, sps, n_steps = scene["dt_s"], scene["steps_per_sample"], scene["n_steps"]
     deadline = math.inf if deadline is None else float(deadline)

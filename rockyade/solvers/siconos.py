@@ -101,7 +101,7 @@ class SiconosSolver(SolverBase):
         Run in a Siconos process kept warm between runs (one per thread; the default), or
         in a process of its own (False): the same result; warm saves the start-up.
     dt_s
-        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 2e-3 / p of
+        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 1e-3 / p of
         the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
         interval.
     dt_factor
@@ -145,7 +145,15 @@ class SiconosSolver(SolverBase):
     workdir: str | None = None
 
     def __post_init__(self) -> None:
-        for key in ("timeout_s", "dt_s", "dt_factor", "restitution", "solver_tol", "solver_max_iter", "newton_max_iter"):
+        for key in (
+            "timeout_s",
+            "dt_s",
+            "dt_factor",
+            "restitution",
+            "solver_tol",
+            "solver_max_iter",
+            "newton_max_iter",
+        ):
             object.__setattr__(self, key, self.OPTIONS[key](getattr(self, key), key))
         object.__setattr__(self, "warm", check_flag(self.warm, "warm"))
         object.__setattr__(self, "workdir", _check_folder(self.workdir, "workdir"))
@@ -169,9 +177,11 @@ class SiconosSolver(SolverBase):
             solver_max_iter=self.solver_max_iter,
             newton_max_iter=self.newton_max_iter,
         )
-        how = {
+        how: dict[str, object] = {
             "dt_factor": self.dt_factor,
-            "dt_source": "user" if self.dt_s is not None else "default (2e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
+            "dt_source": "user"
+            if self.dt_s is not None
+            else "default (1e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
             "dt_base_s": base,
         }
         return numerics, how
