@@ -48,7 +48,9 @@ def _block(width: float, height: float, motion: dict, duration: float, sample_dt
         {
             "duration_s": duration,
             "sample_dt_s": sample_dt,
-            "blocks": [{"name": "b", "width_m": width, "height_m": height, "thickness_m": 0.5, "density_kg_m3": 2000.0}],
+            "blocks": [
+                {"name": "b", "width_m": width, "height_m": height, "thickness_m": 0.5, "density_kg_m3": 2000.0}
+            ],
             "contact": {"calibration": "paper"},
             "motion": motion,
         }

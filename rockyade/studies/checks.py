@@ -14,4 +14,5 @@ CHECKS = (
     "loaded_block",
     "loaded_pushover",
     "limit_pushover",
+    "siconos",
 )
