@@ -58,7 +58,11 @@ import numpy as np
 
 SCENE_FORMAT = "rockyade-siconos-scene-1"
 #: The friction-contact solvers by name: NSGS (iterative), Lemke (pivoting, exact in 2-D).
-SOLVERS = {"nsgs": "SICONOS_FRICTION_2D_NSGS", "lemke": "SICONOS_FRICTION_2D_LEMKE", "enum": "SICONOS_FRICTION_2D_ENUM"}
+SOLVERS = {
+    "nsgs": "SICONOS_FRICTION_2D_NSGS",
+    "lemke": "SICONOS_FRICTION_2D_LEMKE",
+    "enum": "SICONOS_FRICTION_2D_ENUM",
+}
 #: Beyond these the state is a numerical blow-up, not rocking (as in the DEMs).
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
