@@ -56,8 +56,10 @@ MAX_TIMEOUT_S = 30 * 86400.0
 #: A run fails when a step's friction-contact residual exceeds this (the solver stopped far
 #: from a solution) ...
 FAIL_RESIDUAL = 1e-4
-#: ... or when more than this fraction of the solver's calls end above its tolerance.
+#: ... or when more than this fraction of the solver's calls (and at least FAIL_UNCONVERGED_MIN
+#: of them) end above its tolerance.
 FAIL_UNCONVERGED_FRACTION = 0.01
+FAIL_UNCONVERGED_MIN = 10
 
 
 def siconos_available() -> bool:
@@ -241,7 +243,9 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
         )
     calls = int(meta.get("solver_calls", 0))
     bad = int(meta.get("unconverged_steps", 0))
-    if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (calls and bad > FAIL_UNCONVERGED_FRACTION * calls):
+    if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (
+        bad >= FAIL_UNCONVERGED_MIN and bad > FAIL_UNCONVERGED_FRACTION * calls
+    ):
         return (
             f"Siconos did not converge: {bad} of {calls} friction-contact solves ended above the tolerance "
             f"(largest residual {float(meta.get('max_residual', 0.0)):.3g}, "
