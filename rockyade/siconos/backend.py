@@ -49,7 +49,7 @@ FLUSH_PERIOD_S = 30.0
 
 #: Default timeout: start-up allowance plus this many seconds per body-step, capped.
 TIMEOUT_STARTUP_S = 60.0
-TIMEOUT_PER_BODY_STEP_S = 500e-6
+TIMEOUT_PER_BODY_STEP_S = 10e-3
 TIMEOUT_CAP_S = 3600.0
 MAX_TIMEOUT_S = 30 * 86400.0
 
@@ -78,7 +78,8 @@ def _env() -> dict[str, str]:
 
 def default_timeout(n_steps: int, n_bodies: int) -> float:
     """Wall-clock limit of a run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
-    body-step (5-20x what Siconos needs), capped at TIMEOUT_CAP_S."""
+    body-step (measured on a loaded 2-core machine: 0.9 ms per body-step for a single block,
+    37 ms for a 33-block wall), capped at TIMEOUT_CAP_S."""
     return min(TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * n_steps * n_bodies, TIMEOUT_CAP_S)
 
 

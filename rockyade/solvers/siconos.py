@@ -95,7 +95,7 @@ class SiconosSolver(SolverBase):
     Attributes
     ----------
     timeout_s
-        Wall-clock limit of each run, s (default 60 s plus 0.5 ms per body-step, at most
+        Wall-clock limit of each run, s (default 60 s plus 10 ms per body-step, at most
         an hour).
     warm
         Run in a Siconos process kept warm between runs (one per thread; the default), or
@@ -132,7 +132,7 @@ class SiconosSolver(SolverBase):
         "workdir": _check_folder,
     }
     #: Siconos's time per body-step, s (cost estimate; benchmarks/bench_siconos.py).
-    SECONDS_PER_BODY_STEP: ClassVar[float] = 30e-6
+    SECONDS_PER_BODY_STEP: ClassVar[float] = 1e-3
 
     timeout_s: float | None = None
     warm: bool = True
