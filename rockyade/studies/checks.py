@@ -15,4 +15,5 @@ CHECKS = (
     "loaded_mass",
     "loaded_pushover",
     "limit_pushover",
+    "siconos",
 )
