@@ -288,8 +288,8 @@ def pair_verdict(
     """The verdict on the median ratio of collapse intensities ``a`` / ``b``.
 
     * ``agree``: the median within ``tolerance`` of 1 and its interval within twice it;
-    * ``unresolved``: the difference |median - 1| is not larger than a solver's own change
-      with dt halved (``dt_change``: solver -> |median of its dt ratio - 1|): it says nothing;
+    * ``unresolved``: the difference |median - 1| is smaller than a solver's own change with
+      dt halved (``dt_change``: solver -> |median of its dt ratio - 1|): it says nothing;
     * ``differ``: the interval excludes 1 +/- ``tolerance``;
     * ``inconclusive`` otherwise.
 
@@ -321,10 +321,10 @@ def pair_verdict(
         if loudest is not None and moved[loudest] > tolerance:
             caveat = f", but {loudest} is not converged in dt (it moves by more than the tolerance)"
         return PairVerdict("agree", f"{text}: agree within {100 * tolerance:g} %{dt_note}{caveat}")
-    if loudest is not None and diff <= moved[loudest]:
+    if loudest is not None and diff < moved[loudest]:
         return PairVerdict(
             "unresolved",
-            f"{text}: the difference ({100 * diff:.1f} %) is not larger than {loudest}'s own change with dt halved "
+            f"{text}: the difference ({100 * diff:.1f} %) is smaller than {loudest}'s own change with dt halved "
             f"({100 * moved[loudest]:.1f} %): it says nothing until the step is converged",
         )
     if math.isfinite(lo) and (lo > 1 + tolerance or hi < 1 - tolerance):
