@@ -3,7 +3,11 @@
 For every block and every solver, against a reference solver (by default the reference
 DEM): the first peak amplitudes and times, the effective restitution (free rocking), max
 |theta|, the overturn verdict and time, and the RMS difference of theta(t) over the common
-time window. One long table (CSV) with the value, the reference value and the difference.
+time window. One long table (CSV) with the value, the reference value and the difference;
+the reference solver is not compared with itself (its values are the ``reference_value``
+column). :func:`verdict` sums it up in one line: the outcome agreement, the largest peak
+difference between solvers and, given runs at half the time step, whether halving the step
+changed the peaks more than the solvers differ (then the difference says nothing).
 """
 
 from __future__ import annotations
@@ -74,6 +78,8 @@ def compare(scene: Scene, results: dict[str, Result], reference: str | None = No
         alpha = spec.classical().alpha_rad
         ref_metrics = _metrics(scene, results[reference], spec.name, alpha)
         for solver, result in results.items():
+            if solver == reference and len(results) > 1:
+                continue  # a solver is never compared with itself
             metrics = _metrics(scene, result, spec.name, alpha)
             if not metrics:
                 rows.append([spec.name, solver, reference, "status", math.nan, math.nan, math.nan, math.nan])
@@ -85,3 +91,80 @@ def compare(scene: Scene, results: dict[str, Result], reference: str | None = No
                 rel = diff / ref_value if ref_value not in (0.0,) and math.isfinite(ref_value) else math.nan
                 rows.append([spec.name, solver, reference, name, value, ref_value, diff, rel])
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def _peaks(scene: Scene, result: Result) -> dict[str, float]:
+    """Block -> max |theta| of a result (rad); empty for a failed one."""
+    if not result.ok:
+        return {}
+    return {
+        spec.name: float(np.nanmax(np.abs(result.series("theta_rad", spec.name))))
+        for spec in scene.blocks
+        if not spec.fixed and spec.name in result.blocks
+    }
+
+
+def _largest_difference(a: dict[str, float], b: dict[str, float]) -> tuple[float, str]:
+    """The largest relative difference |a - b| / max(a, b) over the blocks both have (symmetric:
+    a solver's change with dt and two solvers' gap are measured alike), and its block."""
+    worst, where = 0.0, ""
+    for block, vb in b.items():
+        va = a.get(block, math.nan)
+        if math.isfinite(va) and math.isfinite(vb) and max(va, vb) > 0:
+            d = abs(va - vb) / max(va, vb)
+            if d > worst or not where:
+                worst, where = d, block
+    return (worst, where) if where else (math.nan, "")
+
+
+def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dict[str, Result] | None = None) -> str:
+    """One line: do the solvers give the same outcome (overturned or not), how far apart are
+    their peaks |theta| (the largest relative difference from ``reference``, over blocks, of the
+    larger of the two), and,
+    with ``finer`` (solver -> its run at half the time step), did halving the step change a
+    solver's peaks more than the solvers differ (then the difference says nothing).
+
+    Parameters
+    ----------
+    scene
+        The scene all results come from.
+    results
+        Solver name -> Result at the step compared.
+    reference
+        The solver the others are compared with.
+    finer
+        Solver name -> Result of the same solver at half that step (absent: not run).
+    """
+    outcomes = {s: (r.status if r.ok else "failed") for s, r in results.items()}
+    kinds = set(outcomes.values())
+    if len(kinds) == 1:
+        outcome = f"same outcome ({kinds.pop()})"
+    else:
+        outcome = "outcomes differ (" + ", ".join(f"{s} {o}" for s, o in outcomes.items()) + ")"
+    ref = _peaks(scene, results[reference])
+    diffs = {s: _largest_difference(_peaks(scene, r), ref) for s, r in results.items() if s != reference}
+    diffs = {s: d for s, d in diffs.items() if math.isfinite(d[0])}
+    if diffs:
+        solver = max(diffs, key=lambda s: diffs[s][0])
+        gap, block = diffs[solver]
+        peak = f"peak |theta| within {100 * gap:.1f} % of {reference} (largest: {solver}, {block})"
+    else:
+        gap, peak = math.nan, "no peaks to compare"
+    if not finer:
+        return f"{outcome}; {peak}; the time step not checked"
+    changes = {
+        s: _largest_difference(_peaks(scene, finer[s]), _peaks(scene, results[s]))[0] for s in finer if s in results
+    }
+    changes = {s: c for s, c in changes.items() if math.isfinite(c)}
+    flips = [s for s in finer if s in results and finer[s].status != results[s].status]
+    if not changes:
+        return f"{outcome}; {peak}; halving the step gave no peaks to compare"
+    moved = max(changes, key=lambda s: changes[s])
+    step = f"halving the step changed {moved}'s peaks by {100 * changes[moved]:.1f} %"
+    if flips:
+        step += f" and the outcome of {', '.join(flips)}"
+    if math.isfinite(gap) and (changes[moved] >= gap or flips):
+        step += ", not less than the difference between solvers: that difference says nothing"
+    elif math.isfinite(gap):
+        step += ", less than the difference between solvers"
+    return f"{outcome}; {peak}; {step}"

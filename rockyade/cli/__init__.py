@@ -51,6 +51,7 @@ COMMAND_MODULES: list[str] = [
     "rockyade.cli.verify",
     "rockyade.cli.limit",
     "rockyade.cli.fragility",
+    "rockyade.cli.crosscheck",
     "rockyade.cli.assess",
     "rockyade.cli.examples",
 ]

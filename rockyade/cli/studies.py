@@ -26,8 +26,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
     out: Path = args.out
     check_output_dir(out, "out")
     runners = solvers_from_args(solvers, args)
+    runners, finer = _with_dt_factor(runners, args.dt_factor, not args.no_dt_check)
 
-    from rockyade.analysis.compare import compare
+    from rockyade.analysis.compare import compare, verdict
     from rockyade.figures import plot_results
     from rockyade.io.atomic import atomic_open
     from rockyade.io.locking import output_lock
@@ -47,6 +48,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
             results[solver.name] = result
             status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
             print(f"{solver.name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
+        halved = {}
+        for solver in finer:
+            result = solver.keeping_files(out, f"{stem}_halfdt").run(scene)
+            result.write(out / f"{stem}_{solver.name}_halfdt.csv")
+            halved[solver.name] = result
         table = compare(scene, results, args.reference)
         with atomic_open(out / f"{stem}_compare.csv") as fh:
             table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
@@ -64,9 +70,36 @@ def cmd_compare(args: argparse.Namespace) -> int:
         )
     ]
     print(view.to_string(index=False, float_format=lambda v: f"{v:.5g}"))
+    reference = args.reference or ("reference" if "reference" in results else next(iter(results)))
+    print(f"verdict: {verdict(scene, results, reference, halved if finer else None)}")
     print(f"wrote {out / f'{stem}_compare.csv'} and {out / f'{stem}_compare.png'}")
     print(f"total wall time {total_time(args):.3g} s")
     return 0 if all(r.ok for r in results.values()) else 1
+
+
+def _with_dt_factor(solvers: list[Any], factor: float, check: bool) -> tuple[list[Any], list[Any]]:
+    """The solvers at ``--dt-factor`` and, with ``check``, each one that takes ``dt_factor`` at
+    half of it (the convergence check of the verdict).
+
+    Raises
+    ------
+    InputError
+        ``--dt-factor`` out of (0, 1], or given to a solver without the option.
+    """
+    from dataclasses import replace
+
+    from rockyade.solvers.base import DT_FACTOR_MIN, check_dt_factor
+
+    factor = check_dt_factor(factor, "--dt-factor")
+    takes = [s for s in solvers if "dt_factor" in type(s).OPTIONS]
+    if factor != 1.0:
+        lacking = [s.name for s in solvers if s not in takes]
+        if lacking:
+            raise InputError("--dt-factor", f"the {', '.join(lacking)} solver has no time-step factor")
+        solvers = [replace(s, dt_factor=factor) for s in solvers]
+        takes = solvers
+    finer = [replace(s, dt_factor=factor / 2) for s in takes] if check and factor / 2 >= DT_FACTOR_MIN else []
+    return solvers, finer
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
@@ -166,7 +199,8 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, default=Path("reports/paper"), help="output directory (default reports/paper)")
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument(
-        "--only", help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning"
+        "--only",
+        help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning,crosscheck",
     )
     p.add_argument("--no-yade", action="store_true", help="skip the YADE runs")
     p.add_argument(
@@ -183,11 +217,21 @@ def register(sub: Any) -> None:
         help="one scene through several solvers, with agreement metrics",
         description="Run a scene through several solvers; write each result, a CSV of agreement "
         "metrics (peaks, peak times, effective mu, max |theta|, overturn, RMS of theta differences) "
-        "and a figure of theta(t).",
+        "against the reference solver (never a solver against itself) and a figure of theta(t); print a "
+        "one-line verdict: the outcome agreement, the peak difference, and whether halving the time step "
+        "changed the peaks more than the solvers differ.",
     )
     p.add_argument("scene", type=Path, help="scene file")
     p.add_argument("--solvers", default="housner,reference,yade", help="comma-separated solvers")
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
+    p.add_argument(
+        "--dt-factor",
+        type=float,
+        default=1.0,
+        help="factor in (0, 1] on every solver's own time step (default 1); each solver is also run at half of "
+        "it for the verdict's convergence check",
+    )
+    p.add_argument("--no-dt-check", action="store_true", help="skip the runs at half the time step")
     p.add_argument("--out", type=Path, default=Path("compare"), help="output directory")
     add_yade_timeout(p)
     add_allow_large(p)

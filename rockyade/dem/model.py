@@ -204,6 +204,28 @@ class DemModel:
         return replace(self, dt_s=self.sample_dt_s / steps, steps_per_sample=steps, dt_source="user")
 
 
+    def with_dt_factor(self, factor: float) -> DemModel:
+        """The model with its time step times ``factor`` in (0, 1] (a solver's ``dt_factor``):
+        the steps per sample divided by ``factor`` and rounded up, so that the step still
+        divides the sample interval and is at most ``factor`` times the one chosen (0.5 halves
+        it exactly); itself for 1.
+
+        Parameters
+        ----------
+        factor
+            The factor on the time step, in (0, 1].
+        """
+        if factor == 1.0:
+            return self
+        steps = math.ceil(self.steps_per_sample / factor - 1e-9)
+        return replace(
+            self,
+            dt_s=self.sample_dt_s / steps,
+            steps_per_sample=steps,
+            dt_source=f"{self.dt_source}, times dt_factor {factor:g}",
+        )
+
+
 def check_user_dt(dt_s: float, dt_stable_s: float) -> None:
     """Refuse a time step above the stability limit.
 

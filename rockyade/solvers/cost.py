@@ -146,11 +146,15 @@ def _estimate(
     )
 
 
-def dem_cost(scene: Scene, solver: str, seconds_per_body_step: float) -> CostEstimate:
-    """The cost of a DEM run: time steps x moving bodies at the model's time step, the
-    time history of every block and corner, ``seconds_per_body_step`` of the DEM (s)."""
+def dem_cost(scene: Scene, solver: str, seconds_per_body_step: float, dt_factor: float = 1.0) -> CostEstimate:
+    """The cost of a DEM run: time steps x moving bodies at the model's time step (times the
+    solver's ``dt_factor``), the time history of every block and corner,
+    ``seconds_per_body_step`` of the DEM (s)."""
     dt, moving = _cached_dem_time_step(scene)
     steps_per_sample = max(1, math.ceil(scene.sample_dt_s / dt - 1e-9))
+    if dt_factor != 1.0:  # as DemModel.with_dt_factor rounds it
+        steps_per_sample = math.ceil(steps_per_sample / dt_factor - 1e-9)
+        dt = scene.sample_dt_s / steps_per_sample
     steps = float(scene.n_samples - 1) * steps_per_sample * max(1, moving)
     corners = sum(len(b.vertices_m or ()) or 4 for b in scene.blocks)
     columns = 2 + 6 * len(scene.blocks) + corners + 7

@@ -80,7 +80,7 @@ from rockyade.motion.ground import GroundMotion, ground_acceleration
 from rockyade.result import Result, column
 from rockyade.scene import Scene
 from rockyade.scene.carried import carried_on, loaded_rocking_parameters, residual_force
-from rockyade.solvers.base import SolverBase, motion_coverage
+from rockyade.solvers.base import SolverBase, check_dt_factor, motion_coverage
 from rockyade.solvers.cost import CostEstimate, sample_cost
 
 if TYPE_CHECKING:
@@ -659,9 +659,27 @@ def _warm_up() -> None:
 
 @dataclass(frozen=True)
 class HousnerSolver(SolverBase):
-    """Housner's exact solution as a solver (single blocks on a rigid base; no options)."""
+    """Housner's exact solution as a solver (single blocks on a rigid base).
+
+    Attributes
+    ----------
+    dt_factor
+        Factor in (0, 1] on the largest Runge-Kutta step 1 / (``STEPS_PER_RADIAN`` p), the
+        only step of the solution (impacts, uplift and overturning are found by root finding
+        to machine precision); recorded in the Result's ``dt_factor`` and ``dt_s``.
+    """
 
     name: ClassVar[str] = "housner"
+    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
+
+    dt_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
+
+    def _step_s(self, model: HousnerModel) -> float:
+        """The largest Runge-Kutta step, s: ``dt_factor`` / (``STEPS_PER_RADIAN`` p)."""
+        return self.dt_factor / (STEPS_PER_RADIAN * max(model.p_left, model.p_right))
 
     def run(self, scene: Scene) -> Result:
         """Solve a single-block scene with Housner's equation and return a Result.
@@ -692,10 +710,11 @@ class HousnerSolver(SolverBase):
             scene.motion.initial_theta_rad,
             scene.motion.initial_omega_rad_s,
             scene.sample_dt_s,
+            self._step_s(model),
         )
         wall = time.perf_counter() - start
         frame = _frame(scene, spec.block(), model, motion, traj)
-        return Result(frame, _meta(scene, cp, motion, traj, wall))
+        return Result(frame, {**_meta(scene, cp, motion, traj, wall), "dt_factor": self.dt_factor, "dt_s": traj.step_s})
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
@@ -760,9 +779,10 @@ class HousnerSolver(SolverBase):
                 scene.motion.initial_theta_rad,
                 scene.motion.initial_omega_rad_s,
                 scene.sample_dt_s,
+                self._step_s(model),
             )
             wall = time.perf_counter() - begin
-            meta = _meta(scene, cp, motion, traj, wall)
+            meta = {**_meta(scene, cp, motion, traj, wall), "dt_factor": self.dt_factor, "dt_s": traj.step_s}
             meta["rockyade_version"] = __version__  # as a Result sets it
             meta["motion_coverage"] = _coverage(scene, motion)
             meta["batched"] = {"runs": len(scenes), "setup_time_s": setup}

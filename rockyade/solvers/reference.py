@@ -45,7 +45,7 @@ from rockyade.kernel.single import single_body
 from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_flag, motion_coverage
+from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag, motion_coverage
 from rockyade.solvers.cost import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
@@ -66,15 +66,23 @@ class ReferenceSolver(SolverBase):
     record_contacts
         ``n_contacts`` and ``slipping`` per block and, for columns, the state of every
         corner.
+    dt_factor
+        Factor in (0, 1] on the model's time step (Eq 7 or the stability limit; 0.5 halves
+        it: the convergence check of ``rockyade crosscheck``), recorded in the Result's
+        ``dt_factor`` beside the ``dt_s`` used.
     """
 
     name: ClassVar[str] = "reference"
-    OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag}
+    OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag, "dt_factor": check_dt_factor}
     #: Kernel time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 150e-9
 
     record_energy: bool = True
     record_contacts: bool = True
+    dt_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
 
     def run(self, scene: Scene) -> Result:
         """Run a scene with the reference DEM.
@@ -83,7 +91,7 @@ class ReferenceSolver(SolverBase):
         (including a matched calibration when asked for).
         """
         start = time.perf_counter()
-        model = calibrated_model(scene)
+        model = calibrated_model(scene).with_dt_factor(self.dt_factor)
         setup = time.perf_counter() - start
         result = run_model(
             model,
@@ -93,11 +101,12 @@ class ReferenceSolver(SolverBase):
             per_corner=not scene.positioned,
         )
         result.meta["setup_time_s"] = setup
+        result.meta["dt_factor"] = self.dt_factor
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
-        return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
+        return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP, self.dt_factor)
 
     def group_key(self, scene: Scene) -> str | None:
         """What runs sharing one structure have in common (None: this run goes alone).
@@ -134,7 +143,7 @@ class ReferenceSolver(SolverBase):
             history) and its sampled theta.
         """
         start = time.perf_counter()
-        base = calibrated_model(scenes[0])
+        base = calibrated_model(scenes[0]).with_dt_factor(self.dt_factor)
         models = [base] + [
             replace(base, motion=s.motion.ground_motion(s.duration_s), scene_hash=s.scene_hash,
                     base_at_rest=s.motion.type)
@@ -178,6 +187,7 @@ class ReferenceSolver(SolverBase):
                 **_model_meta(model, wall),
                 "batched": {"runs": len(scenes), "setup_time_s": setup},
                 "setup_time_s": setup / max(1, len(scenes)),
+                "dt_factor": self.dt_factor,
                 "motion_coverage": motion_coverage(scenes[r]),
             }
             metrics = {

@@ -17,7 +17,7 @@ from typing import Any, ClassVar
 from rockyade.errors import InputError
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost import CostEstimate, dem_cost
 from rockyade.yade.backend import check_timeout, run_model, yade_model
 
@@ -54,6 +54,9 @@ class YadeSolver(SolverBase):
         Run in a YADE process kept warm between runs (one per thread; the default), or in
         a process of its own (False): the same result, bit for bit; a warm run saves YADE's
         start-up, 0.7-1.0 s.
+    dt_factor
+        Factor in (0, 1] on the model's time step (as the reference DEM's), recorded in the
+        Result's ``dt_factor`` beside the ``dt_s`` used.
     """
 
     name: ClassVar[str] = "yade"
@@ -62,6 +65,7 @@ class YadeSolver(SolverBase):
         "workdir": _check_folder,
         "stem": _check_stem,
         "warm": check_flag,
+        "dt_factor": check_dt_factor,
     }
     #: YADE's time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 5e-6
@@ -70,8 +74,10 @@ class YadeSolver(SolverBase):
     workdir: str | None = None
     stem: str | None = None
     warm: bool = True
+    dt_factor: float = 1.0
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
         object.__setattr__(self, "timeout_s", check_timeout(self.timeout_s, "timeout_s"))
         object.__setattr__(self, "stem", _check_stem(self.stem, "stem"))
         if self.workdir is not None:
@@ -79,8 +85,8 @@ class YadeSolver(SolverBase):
 
     def run(self, scene: Scene) -> Result:
         """Run a scene in YADE (:func:`rockyade.yade.backend.run_model`)."""
-        model = yade_model(scene)
-        return run_model(
+        model = yade_model(scene).with_dt_factor(self.dt_factor)
+        result = run_model(
             model,
             workdir=self.workdir,
             name=self.stem or f"{scene.scene_hash}_{self.name}",
@@ -88,10 +94,12 @@ class YadeSolver(SolverBase):
             accel_lowpass_hz=scene.output.accel_lowpass_hz,
             warm=self.warm,
         )
+        result.meta["dt_factor"] = self.dt_factor
+        return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
-        return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP)
+        return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP, self.dt_factor)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> YadeSolver:
         """This solver keeping YADE's files in ``folder``, named ``stem`` (default: by scene hash)."""

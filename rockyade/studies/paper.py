@@ -2,8 +2,10 @@
 
 Parts, in order: the tables (1-6), free rocking (Figs 9, 13), harmonic tests (Figs 14,
 18, 19), random motion (Fig. 15), the bi-block pattern map (Section 7.2), sensitivity to
-the classical parameters, collapse fragility over the synthetic suite, and the overturning
-spectrum under pulses. Everything lands in one directory with an ``index.md``.
+the classical parameters, collapse fragility over the synthetic suite, the overturning
+spectrum under pulses, and the cross-check of the solvers under earthquakes (collapse
+intensities paired by record, :mod:`rockyade.studies.paper_crosscheck`). Everything lands
+in one directory with an ``index.md``.
 
 Every run is logged in the report: a failed run (or a part that stops with an error) is
 counted and listed in its part of ``index.md``, in ``failed_runs.csv`` and in the summary
@@ -21,7 +23,7 @@ from rockyade import __version__
 from rockyade.io.atomic import write_text
 from rockyade.studies.report import Report
 
-PARTS = ("tables", "free", "harmonic", "random", "patterns", "sensitivity", "fragility", "overturning")
+PARTS = ("tables", "free", "harmonic", "random", "patterns", "sensitivity", "fragility", "overturning", "crosscheck")
 
 
 def run_tables(report: Report) -> None:
@@ -58,6 +60,7 @@ def run_paper_study(
         free_rocking,
         harmonic,
         overturning,
+        paper_crosscheck,
         pattern_map,
         random_motion,
         sensitivity,
@@ -75,6 +78,7 @@ def run_paper_study(
         "sensitivity": lambda: sensitivity.run(report),
         "fragility": lambda: fragility_study.run(report, workers, use_yade, accel_unit),
         "overturning": lambda: overturning.run(report, workers),
+        "crosscheck": lambda: paper_crosscheck.run(report, workers, use_yade),
     }
     for part in PARTS:
         if part not in parts:

@@ -1,0 +1,177 @@
+"""``rockyade crosscheck``: several solvers on one scene over a record set, compared by their
+collapse intensities paired by record, with the convergence in the time step beside
+(docs/verification.md, docs/howto/which-solver.md)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from rockyade.cli.common import add_allow_large, check_output_dir
+from rockyade.errors import InputError
+
+
+def _fraction(text: str, option: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(option, f"must be a number, got {text!r}") from None
+
+
+def cmd_crosscheck(args: argparse.Namespace) -> int:
+    """Plan (cost line), run the rounds, write the set and swap it in; exit 1 when a run failed."""
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.assess.motions import MotionSet
+    from rockyade.cli.fragility import float_list, refuse_suite_options_with_records, suite_from
+    from rockyade.cli.run import solver_options
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck import (
+        check_dt_factors,
+        check_out,
+        crosscheck_plan,
+        parse_solvers,
+        run_crosscheck,
+    )
+
+    check_output_dir(args.out, "--out")
+    check_out(args.out)
+    names = parse_solvers(args.solvers)
+    measure = parse_measure(args.intensity)
+    levels = float_list(args.levels, "--levels") if args.levels else None
+    dt_factors = check_dt_factors(float_list(args.dt_factors, "--dt-factors"))
+    resolution = _fraction(args.resolution, "--resolution")
+    tolerance = _fraction(args.tolerance, "--tolerance")
+    try:
+        how = Executor(args.executor, args.workers, args.scheduler, args.scheduler_timeout)
+    except InputError as exc:
+        raise InputError("--" + exc.field.replace("_", "-"), exc.message) from None
+    options, _flags = solver_options(args)
+    if "timeout_s" in options and "yade" not in names:
+        raise InputError("--yade-timeout", "applies to the yade solver; this cross-check does not run it")
+    if args.records is not None:
+        for option in ("spectrum_type", "ground", "ag"):
+            if getattr(args, option) is not None:
+                raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8, not to --records")
+        refuse_suite_options_with_records(args)
+        motions: MotionSet = records_in_folder(args.records, args.units)
+    else:
+        if args.units is not None:
+            raise InputError("--units", "applies to --records")
+        motions = suite_from(args)
+    scene = load_scene(args.scene)
+    record_executor = how if how.kind == "local" else Executor("local", args.workers)
+    plan = crosscheck_plan(
+        scene,
+        motions,
+        measure,
+        names,
+        levels=levels,
+        dt_factors=dt_factors,
+        resolution=resolution,
+        tolerance=tolerance,
+        solver_options=options,
+        executor=record_executor,
+        fallen_blocks=args.fallen_blocks,
+        sample_dt_s=args.sample_dt,
+        tail_s=args.tail,
+        progress=not args.quiet,
+        allow_large=args.allow_large,
+    )
+    print(f"crosscheck of {args.scene}: {', '.join(names)} over {motions.describe()}", flush=True)
+    print(
+        f"levels ({measure.unit}): {', '.join(f'{measure.shown(v):.4g}' for v in plan.scan_si)} "
+        f"({plan.stripes.levels_source})",
+        flush=True,
+    )
+    print(plan.cost_line(args.workers), flush=True)
+    summary = run_crosscheck(
+        plan, args.out, how, resume=args.resume, progress=not args.quiet, allow_large=args.allow_large
+    )
+    for line in summary.verdicts:
+        print(line)
+    print(f"wrote {args.out}/index.md, collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, crosscheck.png")
+    failed = int(summary.runs["collapsed"].isna().sum()) if len(summary.runs) else 0
+    if failed:
+        print(f"{failed} run(s) failed (status and reason in {args.out}/runs.csv)")
+    return 1 if failed else 0
+
+
+def register(sub: Any) -> None:
+    """Add ``rockyade crosscheck``."""
+    from rockyade.cli.run import add_yade_timeout
+
+    p = sub.add_parser(
+        "crosscheck",
+        help="several solvers on one scene over a record set: collapse intensities paired by record, with intervals",
+        description="For each solver, each time-step factor and each record, find the collapse intensity (the "
+        "smallest scale of the record, in the intensity measure, at which the scene collapses) by a scan then "
+        "bisection; compare the solvers by the median of their paired ratios with a bootstrap 95 %% interval, "
+        "the share of runs with the same verdict and the fragility per solver; rerun each solver with dt halved "
+        "and report its own change beside. Writes collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, "
+        "crosscheck.png and index.md, replacing --out as a whole when done; works in <out>.partial meanwhile. "
+        "Exit 0, 1 when a run failed, 2 on bad input, 130 after Ctrl-C (--resume finishes it). See "
+        "docs/verification.md.",
+    )
+    p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--records", type=Path, metavar="DIR", help="a folder of record files (.at2, .csv, .txt, .dat)")
+    source.add_argument(
+        "--suite",
+        choices=("ec8", "paper"),
+        help="a synthetic suite: ec8 (with --spectrum-type, --ground, --ag) or the paper's",
+    )
+    p.add_argument("--spectrum-type", type=int, help="EC8 spectrum type of --suite ec8: 1 or 2")
+    p.add_argument("--ground", help="EC8 ground type of --suite ec8: A, B, C, D or E")
+    p.add_argument("--ag", help="design ground acceleration of --suite ec8, with its unit: 0.25g or 2.45m/s2")
+    p.add_argument("--count", type=int, help="records of a synthetic suite (default 20; the paper's: 30)")
+    p.add_argument("--seed", type=int, help="seed of the synthetic suite (default 1)")
+    p.add_argument("--units", help="units of record files that do not name theirs: g, m/s2, cm/s2 (default m/s2)")
+    p.add_argument(
+        "--solvers",
+        default="housner,reference",
+        help="comma-separated solvers, at least two (default housner,reference)",
+    )
+    p.add_argument(
+        "--intensity",
+        default="pga",
+        help="the intensity measure: pga (g), pgv (m/s) or 'sa(T)' (g; T in s); default pga",
+    )
+    p.add_argument(
+        "--levels",
+        help="the scan's levels in the measure's unit, comma-separated (default: the scene's static collapse "
+        "acceleration times 1 to 8, as rockyade fragility)",
+    )
+    p.add_argument("--resolution", default="0.01", help="bisection to a bracket of ratio 1 + this (default 0.01)")
+    p.add_argument(
+        "--tolerance",
+        default="0.05",
+        help="agreement: median ratio within 1 +/- this, interval within twice (default 0.05)",
+    )
+    p.add_argument(
+        "--dt-factors", default="1,0.5", help="time-step factors, the first 1 (default 1,0.5: the convergence check)"
+    )
+    p.add_argument("--out", type=Path, required=True, help="output directory (replaced as a whole when done)")
+    p.add_argument("--resume", action="store_true", help="finish an interrupted cross-check without repeating a run")
+    p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
+    p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or Dask")
+    p.add_argument(
+        "--scheduler", help="Dask scheduler address (default: Dask's threaded scheduler in this process; no port opens)"
+    )
+    p.add_argument(
+        "--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)"
+    )
+    p.add_argument(
+        "--fallen-blocks",
+        type=int,
+        default=1,
+        metavar="N",
+        help="several blocks: a run collapses when N fell (default 1)",
+    )
+    p.add_argument("--sample-dt", type=float, default=0.01, metavar="S", help="output sampling, s (default 0.01)")
+    p.add_argument("--tail", type=float, default=5.0, metavar="S", help="free motion after each record, s (default 5)")
+    p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_yade_timeout(p)
+    add_allow_large(p)
+    p.set_defaults(func=cmd_crosscheck)

@@ -1,0 +1,629 @@
+"""``rockyade crosscheck``: several solvers on one scene over a record set, compared by their
+collapse intensities (the statistics: :mod:`rockyade.analysis.crosscheck`; the method and
+what was measured: docs/verification.md).
+
+For each solver, each time-step factor (1, and 0.5 for the convergence check) and each
+record, a collapse search: the scan's levels (from the scene's static collapse acceleration,
+as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility.fragility_plan`),
+then bisection to the resolution. The searches advance together, one round at a time; each
+round's runs go through the batch machinery (:func:`rockyade.studies.batch.run_study_tasks`:
+the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
+
+Files. The study works in ``<out>.partial/`` beside ``--out``: ``plan.json`` (what the study
+is), ``dt<f>/runs/`` (one JSON per finished run, by scene hash and solver, one folder per
+time-step factor) and, after Ctrl-C, a summary marked PARTIAL. When every search is done,
+the summary is written there (``collapse_intensities.csv``, ``pairs.csv``, ``runs.csv``,
+``crosscheck.json``, ``crosscheck.png``, ``index.md``) and the folder replaces ``--out`` as a
+whole (the old set renamed aside, the new one renamed in, the old one removed): a crash
+leaves the previous complete set or the new one, never a mix (:func:`settle` finishes a swap
+that a kill cut short).
+
+Resume. Every search is a function of its outcomes, so ``--resume`` replays the searches
+from the runs on disk and runs only what is missing (a run that failed is run again); after
+Ctrl-C or kill -9 no finished run is repeated. Without ``--resume`` an unfinished study in
+``<out>.partial/`` is discarded and the study starts afresh; with it, a study whose plan
+differs is refused.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+import os
+import secrets
+import shutil
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rockyade.analysis.crosscheck import (
+    RESOLUTION,
+    TOLERANCE,
+    next_levels,
+)
+from rockyade.assess.fragility import FragilityPlan, fragility_plan
+from rockyade.assess.measures import Measure
+from rockyade.assess.motions import MotionSet
+from rockyade.assess.stripes import MAX_LOAD_FACTOR
+from rockyade.errors import BatchInterruptedError, InputError
+from rockyade.io.atomic import fsync_dir, write_json
+from rockyade.io.locking import DIR_LOCK_NAME, output_lock
+from rockyade.runner import Executor
+from rockyade.scene import Scene
+from rockyade.solvers import make_solver, solver_class, solver_names
+from rockyade.solvers.base import Solver
+from rockyade.studies.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
+from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
+
+#: Time-step factors by default: the solver's own step, and half of it (convergence).
+DT_FACTORS = (1.0, 0.5)
+#: The files of a complete set.
+RESULT_FILES = ("collapse_intensities.csv", "pairs.csv", "runs.csv", "crosscheck.json", "crosscheck.png", "index.md")
+#: Suffix of the working folder beside --out.
+PARTIAL_SUFFIX = ".partial"
+
+
+@dataclass(frozen=True)
+class CrosscheckPlan:
+    """What a cross-check runs (see :func:`crosscheck_plan`).
+
+    Attributes
+    ----------
+    stripes
+        The fragility plan whose scene, records, measure, levels and load factors it shares.
+    solvers
+        Solver names, in order.
+    dt_factors
+        Time-step factors, the first the reference (1).
+    resolution
+        Bisection to a bracket of ratio 1 + resolution.
+    tolerance
+        Median ratio within 1 +/- tolerance (interval within twice it) counts as agreement.
+    records_per_solver
+        Solver -> how many of the records it runs (the first ones; absent: all).
+    solver_options
+        Options every solver taking them gets (e.g. YADE's ``timeout_s``).
+    """
+
+    stripes: FragilityPlan
+    solvers: tuple[str, ...]
+    dt_factors: tuple[float, ...] = DT_FACTORS
+    resolution: float = RESOLUTION
+    tolerance: float = TOLERANCE
+    records_per_solver: Mapping[str, int] = field(default_factory=dict)
+    solver_options: Mapping[str, Any] = field(default_factory=dict)
+
+    @property
+    def measure(self) -> Measure:
+        """The intensity measure."""
+        return self.stripes.measure
+
+    @property
+    def scene(self) -> Scene:
+        """The scene (its motion replaced in every run)."""
+        return self.stripes.stripes.scene
+
+    @property
+    def motions(self) -> MotionSet:
+        """The records."""
+        return self.stripes.stripes.motions
+
+    @property
+    def scan_si(self) -> tuple[float, ...]:
+        """The scan's levels, SI."""
+        return tuple(self.stripes.levels_si)
+
+    def records_of(self, solver: str) -> range:
+        """The record indices ``solver`` runs."""
+        return range(min(self.motions.count, self.records_per_solver.get(solver, self.motions.count)))
+
+    def solver(self, name: str, dt_factor: float) -> Solver:
+        """The solver ``name`` at ``dt_factor`` with the options it takes."""
+        return _solver(name, dt_factor, self.solver_options)
+
+    def searches(self) -> list[tuple[str, float, int]]:
+        """Every (solver, dt factor, record index) searched."""
+        return [(s, f, i) for f in self.dt_factors for s in self.solvers for i in self.records_of(s)]
+
+    def identity(self) -> dict[str, Any]:
+        """What makes two studies the same (a resume must match it): everything that
+        decides which runs are made."""
+        plan = self.stripes.stripes
+        return {
+            "scene_hash": self.scene.scene_hash,
+            "motions": self.motions.to_dict(),
+            "measure": self.measure.to_dict(),
+            "scan_si": list(self.scan_si),
+            "solvers": list(self.solvers),
+            "dt_factors": list(self.dt_factors),
+            "resolution": self.resolution,
+            "records_per_solver": dict(self.records_per_solver),
+            "solver_options": {k: str(v) for k, v in self.solver_options.items()},
+            "fallen_blocks": plan.fallen_blocks,
+            "sample_dt_s": plan.sample_dt_s,
+            "tail_s": plan.tail_s,
+        }
+
+    def expected_runs(self) -> int:
+        """Runs the study is expected to make: per search the scan and the bisection from
+        the scan's step to the resolution (extensions beyond the levels not counted)."""
+        scan = sorted(self.scan_si)
+        step = max(b / a for a, b in itertools.pairwise(scan)) if len(scan) > 1 else 2.0
+        bisections = max(0, math.ceil(math.log2(math.log(step) / math.log1p(self.resolution))))
+        return len(self.searches()) * (len(scan) + bisections)
+
+    def cost_line(self, workers: int) -> str:
+        """The study's expected runs and time, before anything runs."""
+        plan = self.stripes.stripes
+        longest = int(np.argmax(plan.durations_s))
+        top = max(self.scan_si)
+        scene = plan.scene_for(longest, plan.load_factor(longest, top))
+        per_search = self.expected_runs() / max(1, len(self.searches()))
+        seconds = 0.0
+        for s, f, _i in self.searches():
+            seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
+        return (
+            f"cost: about {self.expected_runs()} runs ({len(self.searches())} searches of {per_search:.0f} runs: "
+            f"{len(self.scan_si)} scan levels, then bisection to {100 * self.resolution:g} %), "
+            f"about {_duration(seconds / max(1, workers))} on {workers} worker(s) by the solvers' estimates"
+        )
+
+
+def _solver(name: str, dt_factor: float, solver_options: Mapping[str, Any]) -> Solver:
+    """Solver ``name`` at ``dt_factor`` (an option only when not 1) with the options it takes."""
+    options = {k: v for k, v in solver_options.items() if k in solver_class(name).OPTIONS}
+    if dt_factor != 1.0:
+        options["dt_factor"] = dt_factor
+    return make_solver(name, **options)
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.2g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.2g} min"
+    return f"{seconds / 3600:.3g} h"
+
+
+def parse_solvers(text: str, field_name: str = "--solvers") -> tuple[str, ...]:
+    """``housner,reference`` as solver names: known, distinct, at least two."""
+    names = tuple(s.strip() for s in str(text).split(",") if s.strip())
+    known = solver_names()
+    bad = [n for n in names if n not in known]
+    if bad or len(set(names)) != len(names) or len(names) < 2:
+        raise InputError(
+            field_name, f"must be at least two distinct solvers among {', '.join(known)}, comma-separated, got {text!r}"
+        )
+    return names
+
+
+def check_dt_factors(values: Sequence[float], field_name: str = "--dt-factors") -> tuple[float, ...]:
+    """Distinct factors in (0, 1], the first 1 (the solvers' own steps)."""
+    out = tuple(float(v) for v in values)
+    if not out or out[0] != 1.0 or len(set(out)) != len(out) or any(not (0.0 < v <= 1.0) for v in out):
+        raise InputError(
+            field_name, f"must be distinct factors in (0, 1] on the solvers' time steps, the first 1, got {values!r}"
+        )
+    return out
+
+
+def crosscheck_plan(
+    scene: Scene,
+    motions: MotionSet,
+    measure: Measure,
+    solvers: Sequence[str],
+    *,
+    levels: Sequence[float] | None = None,
+    dt_factors: Sequence[float] = DT_FACTORS,
+    resolution: float = RESOLUTION,
+    tolerance: float = TOLERANCE,
+    records_per_solver: Mapping[str, int] | None = None,
+    solver_options: Mapping[str, Any] | None = None,
+    executor: Executor | None = None,
+    fallen_blocks: int = 1,
+    sample_dt_s: float = 0.01,
+    tail_s: float = 5.0,
+    progress: bool = True,
+    allow_large: bool = False,
+) -> CrosscheckPlan:
+    """Check the inputs, measure the records and choose the scan; nothing runs yet.
+
+    Parameters
+    ----------
+    scene, motions, measure
+        As :func:`rockyade.assess.fragility.fragility_plan` takes them.
+    solvers
+        Solver names (at least two).
+    levels
+        The scan's levels in the measure's shown unit (default: the fragility's stripes).
+    dt_factors
+        Time-step factors (default 1 and 0.5).
+    resolution
+        Bisection resolution, in (0.001, 0.5].
+    tolerance
+        Tolerance on a median ratio, in (0, 0.5].
+    records_per_solver
+        Solver -> records it runs (the first ones).
+    solver_options
+        Options for the solvers that take them.
+    allow_large
+        Go beyond :data:`rockyade.studies.batch.MAX_RUNS` expected runs.
+
+    Raises
+    ------
+    InputError
+        A bad option (named), a solver that cannot change its time step, a record that
+        cannot be scaled to the levels, a study above the run limit.
+    """
+    names = tuple(solvers)
+    factors = check_dt_factors(dt_factors)
+    if not (math.isfinite(resolution) and 0.001 <= resolution <= 0.5):
+        raise InputError("--resolution", f"must be in [0.001, 0.5] (a fraction of the level), got {resolution!r}")
+    if not (math.isfinite(tolerance) and 0.0 < tolerance <= 0.5):
+        raise InputError("--tolerance", f"must be in (0, 0.5] (a fraction), got {tolerance!r}")
+    if len(factors) > 1:
+        lacking = [n for n in names if "dt_factor" not in solver_class(n).OPTIONS]
+        if lacking:
+            raise InputError(
+                "--dt-factors", f"the {', '.join(lacking)} solver has no dt_factor option: pass --dt-factors 1"
+            )
+    for name, count in (records_per_solver or {}).items():
+        if name not in names or isinstance(count, bool) or not isinstance(count, int) or count < 1:
+            raise InputError("records_per_solver", f"{name}: must be a solver run and a count >= 1, got {count!r}")
+    options = dict(solver_options or {})
+    for name in names:  # every solver's options checked now
+        for f in factors:
+            _solver(name, f, options)
+    stripes = fragility_plan(
+        scene,
+        motions,
+        measure,
+        names[0],
+        levels=levels,
+        extend=False,
+        executor=executor,
+        fallen_blocks=fallen_blocks,
+        sample_dt_s=sample_dt_s,
+        tail_s=tail_s,
+        progress=progress,
+    )
+    plan = CrosscheckPlan(stripes, names, factors, resolution, tolerance, dict(records_per_solver or {}), options)
+    expected = plan.expected_runs()
+    if expected > MAX_RUNS and not allow_large:
+        raise InputError(
+            "--allow-large",
+            f"the cross-check is expected to make {expected:,} runs, more than the limit of {MAX_RUNS:,}: fewer "
+            "records, solvers or levels, or pass --allow-large",
+        )
+    return plan
+
+
+# ---------------------------------------------------------------------- the folders
+
+
+def partial_dir(out: Path) -> Path:
+    """The working folder of a cross-check writing ``out``."""
+    return out.parent / f"{out.name}{PARTIAL_SUFFIX}"
+
+
+def _complete(folder: Path) -> bool:
+    """The folder holds a complete cross-check set (its JSON says so)."""
+    try:
+        data = json.loads((folder / "crosscheck.json").read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("partial") is False
+
+
+def settle(out: Path) -> None:
+    """Finish a swap that a kill cut short (module docstring): a complete new set waiting in
+    ``<out>.partial`` goes in; else an old set renamed aside comes back; old sets are removed."""
+    stage = partial_dir(out)
+    olds = sorted(p for p in out.parent.glob(f".{out.name}.old-*") if p.is_dir() and not p.is_symlink())
+    if not out.exists():
+        if stage.is_dir() and not stage.is_symlink() and _complete(stage):
+            os.rename(stage, out)
+        elif olds:
+            os.rename(olds.pop(), out)
+        fsync_dir(out.parent)
+    for old in olds:
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def check_out(out: Path) -> None:
+    """Refuse an ``--out`` that a swap would destroy: a link, a file, or a folder of other
+    files than a cross-check's set (InputError naming ``--out``)."""
+    for path in (out, partial_dir(out)):
+        if path.is_symlink():
+            raise InputError("--out", f"{path} is a symbolic link; give a real folder")
+        if path.exists() and not path.is_dir():
+            raise InputError("--out", f"{path} is a file; give a folder")
+    if out.is_dir() and any(True for _ in out.iterdir()) and not (out / "crosscheck.json").is_file():
+        raise InputError(
+            "--out",
+            f"{out} holds files that are not a cross-check's result (no crosscheck.json): it would be "
+            "replaced as a whole; give a new or empty folder",
+        )
+
+
+def _swap(stage: Path, out: Path) -> None:
+    """Put the complete set of ``stage`` in place of ``out`` (module docstring)."""
+    old = out.parent / f".{out.name}.old-{secrets.token_hex(4)}"
+    if out.exists():
+        os.rename(out, old)
+    os.rename(stage, out)
+    fsync_dir(out.parent)
+    if old.exists():
+        shutil.rmtree(old, ignore_errors=True)
+
+
+# ---------------------------------------------------------------------- running
+
+
+@dataclass
+class Outcomes:
+    """Every run's verdict so far: (solver, dt factor, record index) -> level (SI) -> collapsed
+    (True), stood (False) or failed (None); and the rows of the runs."""
+
+    verdicts: dict[tuple[str, float, int], dict[float, bool | None]] = field(default_factory=dict)
+    rows: dict[tuple[str, float, int, float], dict[str, Any]] = field(default_factory=dict)
+
+    def add(self, key: tuple[str, float, int], level: float, row: Mapping[str, Any], collapsed: bool | None) -> None:
+        """Record one run."""
+        self.verdicts.setdefault(key, {})[level] = collapsed
+        self.rows[(*key, level)] = dict(row)
+
+
+def _collapsed(row: Mapping[str, Any], fallen_blocks: int, single: bool) -> bool | None:
+    """A batch row's verdict (as :func:`rockyade.assess.stripes.collapse_of` decides it): None
+    for a run that failed or did not finish."""
+    status = row.get("status")
+    if status not in ("completed", "overturned"):
+        return None
+    if single or fallen_blocks == 1:
+        return status == "overturned"
+    return int(row.get("n_fallen") or 0) >= fallen_blocks
+
+
+def _stored_row(task: BatchTask) -> dict[str, Any] | None:
+    """The summary row a finished run of ``task`` left on disk (completed or overturned, the
+    same scene), or None."""
+    path = Path(task.out_dir) / "runs" / f"{run_name(task.scene_hash, task.solver.name)}.json"
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if data.get("scene_hash") != task.scene_hash or data.get("status") not in ("completed", "overturned"):
+        return None
+    summary = data.get("summary")
+    return dict(summary) if isinstance(summary, dict) else None
+
+
+class Study:
+    """A cross-check being run in its working folder (module docstring)."""
+
+    def __init__(
+        self,
+        plan: CrosscheckPlan,
+        stage: Path,
+        executor: Executor,
+        *,
+        progress: bool,
+        allow_large: bool,
+        say: Callable[[str], None],
+    ) -> None:
+        self.plan = plan
+        self.stage = stage
+        self.executor = executor
+        self.progress = progress
+        self.allow_large = allow_large
+        self.say = say
+        self.outcomes = Outcomes()
+        self.ran = 0
+        self.reused = 0
+        self.solvers = {(s, f): plan.solver(s, f) for s in plan.solvers for f in plan.dt_factors}
+        self.single = len(plan.scene.blocks) == 1
+
+    def folder(self, dt_factor: float) -> Path:
+        """Where the runs at ``dt_factor`` go."""
+        return self.stage / f"dt{dt_factor:g}"
+
+    def task(self, key: tuple[str, float, int], level: float) -> BatchTask:
+        """The batch task of one run."""
+        solver, f, i = key
+        sp = self.plan.stripes.stripes
+        lf = sp.load_factor(i, level)
+        m = self.plan.measure
+        labels = {
+            "record": sp.motions.label(i),
+            "record_index": i,
+            "dt_factor": f,
+            "level_si": level,
+            m.column: m.shown(level),
+            "load_factor": lf,
+        }
+        return batch_task(0, self.solvers[(solver, f)], sp.scene_for(i, lf), labels, self.folder(f), save_history=False)
+
+    def pending(self) -> list[tuple[tuple[str, float, int], float, BatchTask]]:
+        """The runs of the next round: each search advanced over the runs on disk first."""
+        plan, sp = self.plan, self.plan.stripes.stripes
+        todo = []
+        for key in plan.searches():
+            i = key[2]
+            verdicts = self.outcomes.verdicts.setdefault(key, {})
+            while True:
+                levels = next_levels(
+                    verdicts,
+                    plan.scan_si,
+                    plan.resolution,
+                    lowest=sp.im_si[i] * 1e-3,
+                    highest=sp.im_si[i] * MAX_LOAD_FACTOR,
+                )
+                levels = [level for level in levels if level not in verdicts]  # a run that failed: the search ends
+                missing = []
+                for level in levels:
+                    task = self.task(key, level)
+                    row = _stored_row(task)
+                    if row is None:
+                        missing.append((key, level, task))
+                    else:
+                        self.reused += 1
+                        self.outcomes.add(key, level, row, _collapsed(row, sp.fallen_blocks, self.single))
+                if missing or not levels:
+                    todo += missing
+                    break
+        return todo
+
+    def warm_up(self) -> None:
+        """Load, in this process, the compiled code of the solvers that run groups of runs in
+        process (``run_group``), on a run of 0.05 s: worker processes forked for each round
+        then inherit it rather than load it again (seconds a round on a busy machine)."""
+        from rockyade.analysis.metrics import uplift_threshold_rad
+
+        if self.executor.in_process or not self.plan.scene.blocks:
+            return
+        sp = self.plan.stripes.stripes
+        scene = sp.scene_for(0, sp.load_factor(0, self.plan.scan_si[0]))
+        scene = replace(scene, duration_s=min(scene.duration_s, 0.05))
+        alpha = scene.blocks[0].classical().alpha_rad
+        for solver in self.solvers.values():
+            key = getattr(solver, "group_key", None)
+            if key is None or key(scene) is None:
+                continue
+            try:
+                solver.run_group([scene], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+            except Exception:  # a warm-up that fails costs only time; the runs say what is wrong
+                continue
+
+    def run(self) -> None:
+        """Run rounds until every search is done.
+
+        Raises
+        ------
+        BatchInterruptedError
+            Ctrl-C (what finished is on disk).
+        """
+        rounds = 0
+        self.warm_up()
+        while True:
+            todo = self.pending()
+            if not todo:
+                return
+            rounds += 1
+            self.say(f"round {rounds}: {len(todo)} run(s)")
+            for f in self.plan.dt_factors:
+                part = [(key, level, task) for key, level, task in todo if key[1] == f]
+                if not part:
+                    continue
+                tasks = [_indexed(task, n) for n, (_k, _l, task) in enumerate(part)]
+                summary = run_study_tasks(
+                    tasks,
+                    self.folder(f),
+                    executor=self.executor,
+                    resume=True,
+                    progress=self.progress,
+                    desc=f"crosscheck dt x {f:g}, round {rounds}",
+                    allow_large=self.allow_large,
+                )
+                rows = summary.to_dict(orient="records")
+                for (key, level, _task), row in zip(part, sorted(rows, key=lambda r: r["index"]), strict=True):
+                    self.ran += 1
+                    self.outcomes.add(
+                        key, level, row, _collapsed(row, self.plan.stripes.stripes.fallen_blocks, self.single)
+                    )
+
+
+def _indexed(task: BatchTask, index: int) -> BatchTask:
+    return replace(task, index=index)
+
+
+def run_crosscheck(
+    plan: CrosscheckPlan,
+    out: str | Path,
+    executor: Executor,
+    *,
+    resume: bool = False,
+    progress: bool = True,
+    allow_large: bool = False,
+    say: Callable[[str], None] = print,
+) -> Summary:
+    """Run the study and replace ``out`` with its complete set (module docstring).
+
+    Raises
+    ------
+    InputError
+        ``out`` a swap would destroy, a resume of another study, a run above the cost limits.
+    BatchInterruptedError
+        Ctrl-C: the partial summary is in ``<out>.partial``; ``--resume`` finishes it.
+    """
+    out = Path(out)
+    check_out(out)
+    stage = partial_dir(out)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    settle(out)
+    stage.mkdir(exist_ok=True)
+    start = time.perf_counter()
+    with output_lock(stage, "--out"):
+        identity = plan.identity()
+        plan_file = stage / "plan.json"
+        stored = _read_json(plan_file)
+        if stored is not None and stored != json.loads(json.dumps(identity)) and resume:
+            raise InputError(
+                "--resume",
+                f"the unfinished study in {stage} is another study (its plan.json differs): run without "
+                "--resume to start afresh",
+            )
+        if stored is not None and not resume:
+            say(f"discarding the unfinished cross-check in {stage} (--resume would have finished it)")
+        if not resume or stored is None:
+            for child in stage.iterdir():
+                if child.name == DIR_LOCK_NAME:
+                    continue
+                if child.is_dir() and not child.is_symlink():
+                    shutil.rmtree(child)
+                else:
+                    child.unlink()
+            write_json(plan_file, identity)
+        study = Study(plan, stage, executor, progress=progress, allow_large=allow_large, say=say)
+        try:
+            study.run()
+        except BatchInterruptedError as exc:
+            study.pending()  # what the interrupted round finished, read back from disk
+            summary = summarise(plan, study.outcomes, partial=True)
+            write_summary(plan, summary, stage, time.perf_counter() - start, {"runs_made": study.ran})
+            say(f"partial summary in {stage / 'index.md'}")
+            raise BatchInterruptedError(len(summary.runs), exc.unfinished, str(stage / "runs.csv"), exc.hard) from None
+        summary = summarise(plan, study.outcomes, partial=False)
+        seconds = time.perf_counter() - start
+        write_summary(plan, summary, stage, seconds, {"runs_made": study.ran, "runs_reused": study.reused})
+        say(f"{study.ran} run(s) made, {study.reused} found done")
+        (stage / DIR_LOCK_NAME).unlink(missing_ok=True)  # the lock's file must not go into the set
+        _swap(stage, out)
+    return summary
+
+
+def _read_json(path: Path) -> Any:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+
+
+__all__ = [
+    "DT_FACTORS",
+    "RESULT_FILES",
+    "CrosscheckPlan",
+    "Summary",
+    "check_dt_factors",
+    "crosscheck_plan",
+    "parse_solvers",
+    "partial_dir",
+    "run_crosscheck",
+    "settle",
+    "summarise",
+]

@@ -1,0 +1,345 @@
+"""The summary of a cross-check (:mod:`rockyade.studies.crosscheck`): collapse intensities,
+paired ratios with their bootstrap intervals, the convergence in the time step, the verdict
+agreement and the fragility per solver, from the runs' outcomes
+(:mod:`rockyade.analysis.crosscheck`); ``index.md`` in words and numbers; the set's files.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import pandas as pd
+
+from rockyade.analysis.crosscheck import (
+    BRACKETED,
+    CollapseSearch,
+    MedianInterval,
+    collapse_summary,
+    median_interval,
+    pair_verdict,
+    paired_ratios,
+    verdict_agreement,
+)
+from rockyade.assess.stripes import collapse_rule
+from rockyade.io.atomic import atomic_open, write_json, write_text
+
+if TYPE_CHECKING:
+    from rockyade.studies.crosscheck import CrosscheckPlan, Outcomes
+
+
+@dataclass(frozen=True)
+class Summary:
+    """The numbers of a cross-check (complete or partial)."""
+
+    collapse: pd.DataFrame
+    pairs: pd.DataFrame
+    runs: pd.DataFrame
+    fragility: list[dict[str, Any]]
+    verdicts: list[str]
+    partial: bool
+
+
+def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summary:
+    """Collapse intensities, paired ratios, convergence, verdict agreement and fragility from
+    the outcomes (module docstring of :mod:`rockyade.analysis.crosscheck`)."""
+    m = plan.measure
+    sp = plan.stripes.stripes
+    scan = list(plan.scan_si)
+    rows = []
+    searches: dict[tuple[str, float, int], CollapseSearch] = {}
+    for key in plan.searches():
+        solver, f, i = key
+        found = collapse_summary(outcomes.verdicts.get(key, {}), scan)
+        searches[key] = found
+        rows.append(
+            {
+                "record": sp.motions.label(i),
+                "record_index": i,
+                "solver": solver,
+                "dt_factor": f,
+                "collapse_intensity": m.shown(found.collapse_intensity),
+                "intensity_unit": m.unit,
+                "intensity_measure": m.name,
+                "bracket_low": m.shown(found.bracket_low),
+                "bracket_high": m.shown(found.bracket_high),
+                "survived_above_fraction": found.survived_above_fraction,
+                "status": found.status,
+                "runs": found.runs,
+                "failed_runs": found.failed,
+            }
+        )
+    collapse = pd.DataFrame(rows)
+    run_rows = []
+    for (solver, f, i, level), row in sorted(outcomes.rows.items()):
+        run_rows.append(
+            {
+                "record": sp.motions.label(i),
+                "record_index": i,
+                "solver": solver,
+                "dt_factor": f,
+                m.column: m.shown(level),
+                "level_si": level,
+                "load_factor": level / sp.im_si[i],
+                "scan": any(math.isclose(level, s, rel_tol=1e-12) for s in scan),
+                "status": row.get("status"),
+                "collapsed": outcomes.verdicts[(solver, f, i)].get(level),
+                "failure_reason": row.get("failure_reason") or "",
+                "run": row.get("run"),
+            }
+        )
+    runs = pd.DataFrame(run_rows)
+
+    def intensities(solver: str, f: float) -> dict[str, float]:
+        return {sp.motions.label(i): searches[(solver, f, i)].collapse_intensity for i in plan.records_of(solver)}
+
+    def scan_verdicts(solver: str, f: float) -> dict[tuple[str, float], bool | None]:
+        out: dict[tuple[str, float], bool | None] = {}
+        for i in plan.records_of(solver):
+            v = outcomes.verdicts.get((solver, f, i), {})
+            for level in scan:
+                if level in v:
+                    out[(sp.motions.label(i), level)] = v[level]
+        return out
+
+    pair_rows = []
+    dt_change: dict[str, float] = {}
+    finest = plan.dt_factors[-1]
+    for solver in plan.solvers:
+        for f in plan.dt_factors[1:]:
+            ratio = median_interval(
+                paired_ratios(intensities(solver, f), intensities(solver, plan.dt_factors[0])).values()
+            )
+            same, n = verdict_agreement(scan_verdicts(solver, f), scan_verdicts(solver, plan.dt_factors[0]))
+            if f == finest:
+                dt_change[solver] = abs(ratio.median - 1.0) if math.isfinite(ratio.median) else math.nan
+            pair_rows.append(_pair_row("dt", solver, solver, f, plan.dt_factors[0], ratio, same, n, "", ""))
+    verdicts = []
+    for f in plan.dt_factors:
+        for ia, a in enumerate(plan.solvers):
+            for b in plan.solvers[ia + 1 :]:
+                ratio = median_interval(paired_ratios(intensities(a, f), intensities(b, f)).values())
+                same, n = verdict_agreement(scan_verdicts(a, f), scan_verdicts(b, f))
+                v = pair_verdict(a, b, ratio, plan.tolerance, dt_change if len(plan.dt_factors) > 1 else None)
+                pair_rows.append(_pair_row("solvers", a, b, f, f, ratio, same, n, v.verdict, v.sentence))
+                if f == finest or len(plan.dt_factors) == 1:
+                    verdicts.append(f"at dt x {f:g}: {v.sentence}")
+    pairs = pd.DataFrame(pair_rows, columns=list(PAIR_COLUMNS))
+    fragility = _fragility(plan, runs)
+    return Summary(collapse, pairs, runs, fragility, verdicts, partial)
+
+
+PAIR_COLUMNS = (
+    "kind",
+    "solver_a",
+    "solver_b",
+    "dt_factor_a",
+    "dt_factor_b",
+    "records",
+    "median_ratio",
+    "ratio_low",
+    "ratio_high",
+    "same_verdict_runs",
+    "compared_runs",
+    "same_verdict_share",
+    "verdict",
+    "sentence",
+)
+
+
+def _pair_row(
+    kind: str,
+    a: str,
+    b: str,
+    fa: float,
+    fb: float,
+    ratio: MedianInterval,
+    same: int,
+    n: int,
+    verdict: str,
+    sentence: str,
+) -> dict[str, Any]:
+    return {
+        "kind": kind,
+        "solver_a": a,
+        "solver_b": b,
+        "dt_factor_a": fa,
+        "dt_factor_b": fb,
+        "records": ratio.n,
+        "median_ratio": ratio.median,
+        "ratio_low": ratio.low,
+        "ratio_high": ratio.high,
+        "same_verdict_runs": same,
+        "compared_runs": n,
+        "same_verdict_share": same / n if n else math.nan,
+        "verdict": verdict,
+        "sentence": sentence,
+    }
+
+
+def _fragility(plan: CrosscheckPlan, runs: pd.DataFrame) -> list[dict[str, Any]]:
+    """Per solver and dt factor, the lognormal fragility of its runs (scan and bisection)
+    with its bootstrap intervals (:func:`rockyade.assess.fit.fit_stripes`)."""
+    from rockyade.assess.fit import fit_stripes
+
+    m = plan.measure
+    out: list[dict[str, Any]] = []
+    if runs.empty:
+        return out
+    for (solver, f), group in runs.groupby(["solver", "dt_factor"], sort=False):
+        frame = pd.DataFrame(
+            {
+                "record_index": group["record_index"],
+                m.si_column: group["level_si"],
+                "status": np.where(group["collapsed"].isna(), "failed", "completed"),
+                "collapsed": group["collapsed"].fillna(False).astype(bool),
+            }
+        )
+        try:
+            fit = fit_stripes(frame, m.si_column)
+        except (ValueError, np.linalg.LinAlgError) as exc:
+            out.append({"solver": solver, "dt_factor": f, "status": f"not fitted: {exc}"})
+            continue
+        d = fit.to_dict(m.scale, m.unit)
+        out.append({"solver": solver, "dt_factor": float(f), **d})
+    return out
+
+
+def _fmt(v: float, digits: int = 4) -> str:
+    return f"{v:.{digits}g}" if isinstance(v, (int, float)) and math.isfinite(v) else "-"
+
+
+def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
+    """``index.md``: the verdicts in words and numbers, then how the study was made."""
+    m = plan.measure
+    sp = plan.stripes.stripes
+    lines = [f"# Cross-check of {', '.join(plan.solvers)} on {plan.scene.source or 'the scene'}", ""]
+    if summary.partial:
+        lines += [
+            "**PARTIAL: the study was stopped before every search finished. These numbers are of the runs "
+            "that finished; run the same command with --resume to finish it.**",
+            "",
+        ]
+    lines += [
+        f"Collapse intensity: the smallest {m.name} ({m.unit}) of each record's scaling at which the scene collapses "
+        f"({collapse_rule(plan.scene, sp.fallen_blocks)}), by a scan over {len(plan.scan_si)} levels "
+        f"({', '.join(_fmt(m.shown(v), 3) for v in plan.scan_si)} {m.unit}) then bisection to "
+        f"{100 * plan.resolution:g} %. Records: {plan.motions.describe()}. Agreement: the median ratio of two "
+        f"solvers' collapse intensities, paired by record, within {100 * plan.tolerance:g} % of 1 and its bootstrap "
+        f"95 % interval within {200 * plan.tolerance:g} %. Time-step factors: "
+        f"{', '.join(f'{f:g}' for f in plan.dt_factors)}.",
+        "",
+        "## Verdicts",
+        "",
+    ]
+    lines += [f"- {v}" for v in summary.verdicts] or ["- no pair of solvers has collapse intensities to compare"]
+    pairs = summary.pairs
+    dt_rows = pairs[pairs["kind"] == "dt"] if not pairs.empty else pairs
+    if len(dt_rows):
+        lines += ["", "## Convergence in the time step", ""]
+        for _, r in dt_rows.iterrows():
+            lines.append(
+                f"- {r.solver_a}: collapse intensity at dt x {r.dt_factor_a:g} / at dt x {r.dt_factor_b:g} = "
+                f"{_fmt(r.median_ratio)} (95 % interval {_fmt(r.ratio_low)}-{_fmt(r.ratio_high)}, "
+                f"{r.records} records); "
+                f"the same verdict in {r.same_verdict_runs} of {r.compared_runs} scan runs"
+            )
+    lines += [
+        "",
+        "## Paired ratios",
+        "",
+        "| a | b | dt factor | records | median a/b | 95 % interval | same verdict | verdict |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
+    ]
+    for _, r in pairs[pairs["kind"] == "solvers"].iterrows() if not pairs.empty else []:
+        lines.append(
+            f"| {r.solver_a} | {r.solver_b} | {r.dt_factor_a:g} | {r.records} | {_fmt(r.median_ratio)} | "
+            f"{_fmt(r.ratio_low)}-{_fmt(r.ratio_high)} | {r.same_verdict_runs}/{r.compared_runs} | {r.verdict} |"
+        )
+    lines += [
+        "",
+        "## Fragility per solver",
+        "",
+        f"| solver | dt factor | median ({m.unit}) | 90 % interval | beta | 90 % interval |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    key = f"median_{m.unit.replace('/', '_')}"
+    for fr in summary.fragility:
+        mi = fr.get(f"median_interval_{m.unit.replace('/', '_')}", [math.nan, math.nan])
+        bi = fr.get("beta_interval", [math.nan, math.nan])
+        lines.append(
+            f"| {fr['solver']} | {fr['dt_factor']:g} | {_fmt(fr.get(key, math.nan))} | {_fmt(mi[0])}-{_fmt(mi[1])} | "
+            f"{_fmt(fr.get('beta', math.nan), 3)} | {_fmt(bi[0], 3)}-{_fmt(bi[1], 3)} |"
+        )
+    c = summary.collapse
+    if not c.empty:
+        open_ = c[c["status"] != BRACKETED]
+        above = c["survived_above_fraction"]
+        survived = float(np.nanmedian(above)) if above.notna().any() else math.nan
+        lines += [
+            "",
+            "## Searches",
+            "",
+            f"{len(c) - len(open_)} of {len(c)} searches bracketed a collapse intensity. "
+            + (
+                f"Not bracketed: {len(open_)} ({', '.join(sorted(set(open_['status'])))}); they are left out of "
+                "the ratios."
+                if len(open_)
+                else ""
+            )
+            + f" Median fraction of scanned levels above the first collapse that stood: {_fmt(survived, 3)} (above 0: "
+            "a stronger scaling of a record stood, the overturning region is not simply connected).",
+        ]
+    lines += [
+        "",
+        "## Files",
+        "",
+        "- `collapse_intensities.csv`: per record, solver and dt factor, the collapse intensity and its bracket;",
+        "- `pairs.csv`: per pair of solvers (kind `solvers`) and per solver against itself at a finer step "
+        "(kind `dt`), the median ratio, its interval and the share of the same verdict;",
+        "- `runs.csv`: every run; `crosscheck.json`: all of it with the plan; `crosscheck.png`: the paired ratios.",
+        "",
+        f"Runs: {len(summary.runs)}; wall time {seconds:.0f} s.",
+    ]
+    if not summary.partial:
+        lines += ["", "![paired ratios of collapse intensities](crosscheck.png)"]
+    return "\n".join(lines) + "\n"
+
+
+def write_summary(
+    plan: CrosscheckPlan, summary: Summary, folder: Path, seconds: float, extra: Mapping[str, Any]
+) -> None:
+    """The set's files in ``folder`` (the JSON last: it says whether the set is complete)."""
+    from rockyade.assess.strict import finite_or_null
+
+    for name, frame in (
+        ("collapse_intensities.csv", summary.collapse),
+        ("pairs.csv", summary.pairs),
+        ("runs.csv", summary.runs),
+    ):
+        with atomic_open(folder / name) as fh:
+            frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
+    if not summary.partial:
+        from rockyade.figures.crosscheck import PairedRatios
+
+        PairedRatios.from_pairs(summary.pairs, plan.measure.name, plan.tolerance).save(folder / "crosscheck.png")
+    write_text(folder / "index.md", index_text(plan, summary, seconds))
+    data = {
+        "partial": summary.partial,
+        "plan": plan.identity(),
+        "scene": plan.scene.source,
+        "tolerance": plan.tolerance,
+        "collapse_rule": collapse_rule(plan.scene, plan.stripes.stripes.fallen_blocks),
+        "levels_source": plan.stripes.levels_source,
+        "verdicts": summary.verdicts,
+        "pairs": summary.pairs.to_dict(orient="records"),
+        "fragility": summary.fragility,
+        "collapse_intensities": summary.collapse.to_dict(orient="records"),
+        "wall_time_s": seconds,
+        **extra,
+    }
+    write_json(folder / "crosscheck.json", finite_or_null(data))

@@ -1,0 +1,110 @@
+"""The paper study's cross-check under earthquakes (``rockyade paper``, part ``crosscheck``).
+
+The four specimens (experimental alpha, p, mu; matched calibration) over the paper's suite
+(30 records) with Housner and the reference DEM, each at its own time step and at half of
+it: per specimen a ``rockyade crosscheck`` (:mod:`rockyade.studies.crosscheck`) into
+``crosscheck/specimen<k>/``. YADE against the reference DEM on a subset
+(:data:`YADE_SPECIMEN`, the first :data:`YADE_RECORDS` records, the solvers' own steps), as the
+fragility part does. Collapse intensities in PGA (g), bisection to :data:`RESOLUTION`.
+The paired ratios of every specimen are gathered in ``crosscheck_pairs.csv`` and
+``crosscheck.png``; the verdicts go into the index.
+"""
+
+from __future__ import annotations
+
+import time
+
+import pandas as pd
+
+from rockyade.assess import paper_suite_set, parse_measure
+from rockyade.runner import Executor
+from rockyade.scene import Scene, scene_from_dict
+from rockyade.studies.crosscheck import crosscheck_plan, run_crosscheck
+from rockyade.studies.report import Report
+from rockyade.studies.specimens import block_table, scene_dict
+
+SPECIMENS = ("1", "2", "3", "4")
+RECORDS = 30
+#: Bisection resolution of the paper's cross-check (2 %: the verdict's tolerance is 5 %).
+RESOLUTION = 0.02
+#: YADE on a subset: one specimen, the first records, the solvers' own time steps.
+YADE_SPECIMEN = "1"
+YADE_RECORDS = 3
+
+
+def specimen_scene(key: str) -> Scene:
+    """Specimen ``key`` as a scene (its motion replaced by each run)."""
+    motion = {"type": "synthetic", "suite": "paper", "record": 1}
+    return scene_from_dict(scene_dict([block_table(key)], motion, 25.0, 0.01, "matched"), source=f"specimen {key}")
+
+
+def run(report: Report, workers: int, use_yade: bool = True) -> None:
+    """Run the cross-checks and add their section to ``report``."""
+    executor = Executor("local", workers)
+    measure = parse_measure("pga")
+    report.section(
+        "Cross-check of the solvers under earthquakes",
+        "Per record of the paper's suite, the collapse intensity (the smallest PGA of the record's scaling at which "
+        "the specimen overturns, by a scan then bisection to "
+        f"{100 * RESOLUTION:g} %) with Housner and the reference DEM, each at its own time step and at half of it; "
+        "the solvers compared by the median of their ratios paired by record with a bootstrap 95 % interval "
+        "(`rockyade crosscheck`, docs/verification.md). A difference between solvers smaller than a solver's own "
+        "change with dt halved says nothing.",
+    )
+    frames, lines, timings = [], [], []
+    jobs: list[tuple[str, Scene, list[str], tuple[float, ...], int]] = [
+        (f"specimen {k}", specimen_scene(k), ["housner", "reference"], (1.0, 0.5), RECORDS) for k in SPECIMENS
+    ]
+    if use_yade:
+        jobs.append(
+            (
+                f"specimen {YADE_SPECIMEN}, YADE subset",
+                specimen_scene(YADE_SPECIMEN),
+                ["reference", "yade"],
+                (1.0,),
+                YADE_RECORDS,
+            )
+        )
+    for label, scene, solvers, factors, count in jobs:
+        start = time.perf_counter()
+        plan = crosscheck_plan(
+            scene,
+            paper_suite_set(count),
+            measure,
+            solvers,
+            dt_factors=factors,
+            resolution=RESOLUTION,
+            executor=executor,
+            progress=False,
+        )
+        folder = "crosscheck/" + label.replace(", YADE subset", "_yade").replace(" ", "")
+        summary = run_crosscheck(plan, report.out / folder, executor, resume=True, progress=False, say=lambda _s: None)
+        timings.append(f"{label} {time.perf_counter() - start:.0f} s")
+        for _, row in summary.runs.iterrows():
+            reason = row["failure_reason"] if isinstance(row["failure_reason"], str) else ""
+            status = "failed" if row["collapsed"] is None or pd.isna(row["collapsed"]) else str(row["status"])
+            report.record(
+                f"{label} {row['record']} {row['pga_g']:.4g} g dt x {row['dt_factor']:g}", row["solver"], status, reason
+            )
+        pairs = summary.pairs.copy()
+        pairs.insert(0, "scene", label)
+        frames.append(pairs)
+        lines += [f"- **{label}** ({folder}/index.md): {v}" for v in summary.verdicts]
+    table = pd.concat(frames, ignore_index=True)
+    report.table(
+        "crosscheck_pairs.csv",
+        table,
+        "per specimen, the median ratio of collapse intensities of two solvers paired by record (kind `solvers`) and "
+        "of a solver at half its step against its own step (kind `dt`), the bootstrap 95 % interval, the share of "
+        "scan runs with the same verdict.",
+    )
+    from rockyade.figures.crosscheck import PairedRatios
+
+    PairedRatios.from_pairs(table, "PGA").save(report.out / "crosscheck.png")
+    report.figure(
+        "crosscheck.png",
+        "paired ratios of collapse intensities (median and bootstrap 95 % interval), per specimen and pair of "
+        "solvers, and each solver at half its time step against its own step; shaded: agreement within 5 %.",
+    )
+    report.note("**Verdicts** (at the finest step):\n\n" + "\n".join(lines))
+    report.note("Wall time: " + ", ".join(timings) + ".")

@@ -1,0 +1,570 @@
+"""rockyade crosscheck: the statistics on constructed data with known answers, a small real
+cross-check (Housner and the reference DEM on short records), resume without repeating a run,
+and result sets that are replaced whole, never mixed."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from rockyade.analysis.crosscheck import (
+    ABOVE,
+    BRACKETED,
+    MAX_EXTENSIONS,
+    collapse_summary,
+    median_interval,
+    next_levels,
+    pair_verdict,
+    paired_ratios,
+    scan_levels,
+    verdict_agreement,
+)
+from rockyade.errors import BatchInterruptedError, InputError
+
+from .conftest import external_records_dir, needs_records
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def search(collapses, scan, resolution=0.01, **limits):
+    """Run a collapse search against an oracle ``collapses(level) -> bool``; its outcomes."""
+    outcomes: dict[float, bool | None] = {}
+    for _ in range(200):
+        levels = next_levels(outcomes, scan, resolution, **limits)
+        if not levels:
+            return outcomes
+        for level in levels:
+            outcomes[level] = collapses(level)
+    raise AssertionError("the search did not end")
+
+
+# ---------------------------------------------------------------------- the statistics
+
+
+@pytest.mark.parametrize("threshold", [0.27, 0.5, 0.93, 1.61])
+def test_bisection_finds_a_known_threshold(threshold):
+    scan = scan_levels(0.25, 2.0, 7)
+    outcomes = search(lambda x: x >= threshold, scan, 0.01)
+    found = collapse_summary(outcomes, scan)
+    assert found.status == BRACKETED
+    assert found.bracket_low < threshold <= found.bracket_high
+    assert found.bracket_high / found.bracket_low <= 1.01 + 1e-9
+    assert found.collapse_intensity == found.bracket_high
+    if threshold < 1.5:  # a simply connected region: every scanned level above the first collapse collapses
+        assert found.survived_above_fraction == 0.0
+    else:  # the first scanned collapse is the top level: none above it
+        assert math.isnan(found.survived_above_fraction)
+    assert found.runs == len(outcomes) <= 7 + 6  # the scan, then bisection from a step of 2**0.5 to 1 %
+
+
+def test_overturning_region_not_simply_connected():
+    scan = scan_levels(0.25, 2.0, 7)  # 0.25, 0.354, 0.5, 0.707, 1, 1.41, 2
+    # collapses from 0.4 to 0.8 and from 1.9 up: stands at 1 and 1.41
+    outcomes = search(lambda x: 0.4 <= x < 0.8 or x >= 1.9, scan, 0.01)
+    found = collapse_summary(outcomes, scan)
+    assert found.bracket_low < 0.4 <= found.bracket_high
+    assert found.survived_above_fraction == pytest.approx(2 / 4)  # above 0.5: of 0.707, 1, 1.41, 2, 1 and 1.41 stood
+
+
+def test_search_extends_then_gives_up():
+    scan = scan_levels(0.25, 2.0, 7)
+    outcomes = search(lambda x: False, scan, highest=100.0)
+    assert sum(1 for v in outcomes if v > 2.0) == MAX_EXTENSIONS
+    found = collapse_summary(outcomes, scan)
+    assert found.status == ABOVE and math.isnan(found.collapse_intensity)
+    assert found.bracket_low == pytest.approx(2.0 * 2**MAX_EXTENSIONS)
+    # a threshold just above the scan is found by one extension
+    found = collapse_summary(search(lambda x: x >= 2.5, scan), scan)
+    assert found.bracket_low < 2.5 <= found.bracket_high and found.status == BRACKETED
+    # below the scan, and a limit on the load factor that stops the extension
+    found = collapse_summary(search(lambda x: x >= 0.2, scan), scan)
+    assert found.bracket_low < 0.2 <= found.bracket_high
+    assert search(lambda x: x >= 0.2, scan, lowest=0.2) == {v: True for v in scan}
+
+
+def test_failed_runs_have_no_verdict():
+    scan = [1.0, 2.0]
+    found = collapse_summary({1.0: None, 2.0: True}, scan)
+    assert found.failed == 1 and found.status != BRACKETED
+
+
+def test_bootstrap_interval_contains_the_known_median_ratio():
+    rng = np.random.default_rng(7)
+    ratios = 1.1 * np.exp(rng.normal(0.0, 0.08, 61))
+    true_median = 1.1
+    m = median_interval(ratios)
+    assert m.low < true_median < m.high
+    assert m.low <= m.median <= m.high and m.n == 61
+    assert m.high - m.low < 0.1
+    assert median_interval(ratios) == m  # seeded: the same values give the same interval
+    same = median_interval([1.2, 1.2, 1.2])
+    assert (same.median, same.low, same.high) == (1.2, 1.2, 1.2)
+    assert math.isnan(median_interval([1.0]).low) and median_interval([]).n == 0
+
+
+def test_paired_ratios_and_verdict_agreement():
+    a = {"r1": 0.5, "r2": 0.8, "r3": math.nan}
+    b = {"r1": 0.25, "r2": 0.8, "r3": 0.3, "r4": 1.0}
+    assert paired_ratios(a, b) == {"r1": 2.0, "r2": 1.0}
+    va = {("r1", 0.5): True, ("r1", 1.0): True, ("r2", 0.5): None, ("r2", 1.0): False}
+    vb = {("r1", 0.5): False, ("r1", 1.0): True, ("r2", 0.5): True, ("r2", 1.0): False}
+    assert verdict_agreement(va, vb) == (2, 3)
+
+
+def test_pair_verdict_says_nothing_below_the_dt_change():
+    tight = median_interval(1.03 * np.exp(np.random.default_rng(1).normal(0, 0.01, 40)))
+    assert pair_verdict("a", "b", tight, 0.05).verdict == "agree"
+    wide_gap = median_interval(1.2 * np.exp(np.random.default_rng(2).normal(0, 0.01, 40)))
+    assert pair_verdict("a", "b", wide_gap, 0.05).verdict == "differ"
+    moved = pair_verdict("a", "b", wide_gap, 0.05, {"a": 0.3, "b": 0.0})
+    assert moved.verdict == "unresolved" and "says nothing" in moved.sentence
+    assert pair_verdict("a", "b", median_interval([0.7, 1.0, 1.0]), 0.05, {"a": 0.0}).verdict == "inconclusive"
+    caveat = pair_verdict("a", "b", tight, 0.05, {"b": 0.08})
+    assert caveat.verdict == "agree" and "not converged" in caveat.sentence
+
+
+# ---------------------------------------------------------------------- a real cross-check
+
+
+def write_records(folder: Path, count: int = 2) -> Path:
+    """Short records (3 s at 0.01 s, m/s^2): a sine pulse of a period each, with noise."""
+    folder.mkdir(parents=True, exist_ok=True)
+    t = np.arange(0.0, 3.0 + 1e-9, 0.01)
+    for k, period in enumerate((0.45, 0.8, 1.1)[:count]):
+        rng = np.random.default_rng(k + 1)
+        a = 3.0 * np.sin(2 * np.pi * t / period) * np.exp(-(((t - 1.2) / 0.6) ** 2))
+        a += 0.3 * rng.standard_normal(t.size) * np.exp(-(((t - 1.2) / 0.8) ** 2))
+        lines = [f"# test record {k + 1}", "t_s,accel_m_s2"] + [f"{x:.4f},{y:.6g}" for x, y in zip(t, a, strict=True)]
+        (folder / f"rec{k + 1}.csv").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def small_plan(records: Path, dt_factors=(1.0, 0.5)):
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck import crosscheck_plan
+
+    return crosscheck_plan(
+        load_scene(EXAMPLES / "specimen1_record.toml"),
+        records_in_folder(records),
+        parse_measure("pga"),
+        ["housner", "reference"],
+        levels=[0.3, 0.6, 1.2],
+        dt_factors=dt_factors,
+        resolution=0.1,
+        executor=Executor("threads", 1),
+        tail_s=1.0,
+        progress=False,
+    )
+
+
+def run(plan, out: Path, resume: bool = False):
+    from rockyade.runner import Executor
+    from rockyade.studies.crosscheck import run_crosscheck
+
+    return run_crosscheck(plan, out, Executor("threads", 1), resume=resume, progress=False, say=lambda _s: None)
+
+
+@pytest.fixture(scope="module")
+def records(tmp_path_factory):
+    return write_records(tmp_path_factory.mktemp("records") / "records")
+
+
+@pytest.fixture(scope="module")
+def plan(records):
+    return small_plan(records)
+
+
+@pytest.fixture(scope="module")
+def complete(plan, tmp_path_factory):
+    out = tmp_path_factory.mktemp("cc") / "out"
+    return out, run(plan, out)
+
+
+def test_small_real_crosscheck(complete, plan):
+    out, summary = complete
+    assert summary.partial is False and summary.verdicts
+    from rockyade.studies.crosscheck import RESULT_FILES, partial_dir
+
+    for name in RESULT_FILES:
+        assert (out / name).is_file(), name
+    assert not partial_dir(out).exists()
+    ci = pd.read_csv(out / "collapse_intensities.csv")
+    for column in (
+        "record",
+        "solver",
+        "dt_factor",
+        "collapse_intensity",
+        "intensity_unit",
+        "bracket_low",
+        "bracket_high",
+        "survived_above_fraction",
+    ):
+        assert column in ci.columns
+    assert len(ci) == 2 * 2 * 2  # records x solvers x dt factors
+    done = ci[ci.status == BRACKETED]
+    assert len(done) >= 6
+    assert (done.bracket_high / done.bracket_low <= 1.1 + 1e-9).all()
+    assert (done.collapse_intensity == done.bracket_high).all() and set(ci.intensity_unit) == {"g"}
+    # each bracket is what the runs say: the top collapsed, the bottom stood
+    runs = pd.read_csv(out / "runs.csv")
+    for _, r in done.iterrows():
+        mine = runs[(runs.record == r.record) & (runs.solver == r.solver) & (runs.dt_factor == r.dt_factor)]
+        assert bool(mine.loc[np.isclose(mine.pga_g, r.bracket_high), "collapsed"].iloc[0])
+        assert not bool(mine.loc[np.isclose(mine.pga_g, r.bracket_low), "collapsed"].iloc[0])
+    pairs = pd.read_csv(out / "pairs.csv")
+    assert set(pairs.kind) == {"solvers", "dt"}
+    solvers = pairs[pairs.kind == "solvers"]
+    assert len(solvers) == 2 and (solvers.solver_a != solvers.solver_b).all()
+    for _, r in solvers.iterrows():  # the ratio is the median of the per-record ratios
+        a = ci[(ci.solver == r.solver_a) & (ci.dt_factor == r.dt_factor_a)].set_index("record").collapse_intensity
+        b = ci[(ci.solver == r.solver_b) & (ci.dt_factor == r.dt_factor_b)].set_index("record").collapse_intensity
+        assert r.median_ratio == pytest.approx(float(np.nanmedian(a / b)))
+        assert 0 < r.same_verdict_share <= 1 and r.compared_runs == 2 * 3
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["partial"] is False and data["runs_reused"] == 0
+    assert data["runs_made"] == len(runs)
+    assert {(f["solver"], f["dt_factor"]) for f in data["fragility"]} == {
+        (s, f) for s in ("housner", "reference") for f in (1.0, 0.5)
+    }
+    index = (out / "index.md").read_text()
+    assert "## Verdicts" in index and "PARTIAL" not in index and "housner / reference" in index
+
+
+def test_dt_factor_is_recorded_in_every_run(complete):
+    out, _summary = complete
+    for folder, factor in (("dt1", 1.0), ("dt0.5", 0.5)):
+        files = list((out / folder / "runs").glob("*.json"))
+        assert files
+        for path in files[:6]:
+            meta = json.loads(path.read_text())
+            assert meta["dt_factor"] == factor and meta["dt_s"] > 0
+
+
+def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
+    import rockyade.studies.crosscheck as cc
+
+    reference_out, _ = complete
+    total = len(pd.read_csv(reference_out / "runs.csv"))
+    real = cc.run_study_tasks
+    calls = {"n": 0}
+
+    def stop_at_the_third_round(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise BatchInterruptedError(0, len(args[0]), None)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cc, "run_study_tasks", stop_at_the_third_round)
+    out = tmp_path / "out"
+    with pytest.raises(BatchInterruptedError):
+        run(plan, out)
+    stage = cc.partial_dir(out)
+    partial = json.loads((stage / "crosscheck.json").read_text())
+    assert partial["partial"] is True and not out.exists()
+    assert "PARTIAL" in (stage / "index.md").read_text()
+    first = {p: p.stat().st_mtime_ns for p in stage.rglob("runs/*.json")}
+    assert 0 < len(first) < total
+    monkeypatch.setattr(cc, "run_study_tasks", real)
+    run(plan, out, resume=True)
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["runs_reused"] == len(first)
+    assert data["runs_made"] == total - len(first)  # no run made twice
+    for path, mtime in first.items():  # the first pass's runs were read, not written again
+        moved = out / path.relative_to(stage)
+        assert moved.stat().st_mtime_ns == mtime
+    same = pd.read_csv(out / "collapse_intensities.csv")
+    pd.testing.assert_frame_equal(same, pd.read_csv(reference_out / "collapse_intensities.csv"))
+
+
+def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypatch):
+    """A process killed mid-study (no summary written): the runs on disk are all it left."""
+    import rockyade.studies.crosscheck as cc
+
+    real = cc.run_study_tasks
+    calls = {"n": 0}
+
+    def killed(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise SystemExit(137)  # stands for SIGKILL: nothing after this line runs
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cc, "run_study_tasks", killed)
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit):
+        run(plan, out)
+    assert not (cc.partial_dir(out) / "crosscheck.json").exists()
+    done = len(list(cc.partial_dir(out).rglob("runs/*.json")))
+    monkeypatch.setattr(cc, "run_study_tasks", real)
+    run(plan, out, resume=True)
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["runs_reused"] == done > 0
+
+
+def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp_path, monkeypatch):
+    import shutil
+
+    import rockyade.studies.crosscheck as cc
+
+    out = tmp_path / "out"
+    shutil.copytree(complete[0], out)
+    before = (out / "crosscheck.json").read_bytes()
+    other_records = write_records(tmp_path / "one", count=1)
+    other = small_plan(other_records, dt_factors=(1.0,))
+    # a study that crashes part-way leaves the complete earlier set as it was
+    real = cc.run_study_tasks
+    calls = {"n": 0}
+
+    def crash(*args, **kwargs):
+        calls["n"] += 1
+        if calls["n"] == 2:
+            raise OSError(28, "No space left on device")
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(cc, "run_study_tasks", crash)
+    with pytest.raises(OSError):
+        run(other, out)
+    assert (out / "crosscheck.json").read_bytes() == before
+    monkeypatch.setattr(cc, "run_study_tasks", real)
+    with pytest.raises(InputError, match="--resume"):  # a resume of another study is refused
+        run(small_plan(other_records, dt_factors=(1.0, 0.5)), out, resume=True)
+    run(other, out)  # without --resume: the unfinished study is discarded, the new set replaces the old
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["plan"]["dt_factors"] == [1.0] and data["runs_reused"] == 0
+    ci = pd.read_csv(out / "collapse_intensities.csv")
+    assert set(ci.record) == {"rec1.csv"} and set(ci.dt_factor) == {1.0}
+    files = list(out.rglob("runs/*.json"))
+    assert len(files) == data["runs_made"] == len(pd.read_csv(out / "runs.csv"))  # no run of the old set left
+    assert not (out / "dt0.5").exists() and not cc.partial_dir(out).exists()
+    assert not list(out.parent.glob(".out.old-*"))
+
+
+def test_settle_finishes_a_cut_swap(tmp_path):
+    from rockyade.studies.crosscheck import partial_dir, settle
+
+    out = tmp_path / "out"
+    old = tmp_path / ".out.old-abcd"
+    old.mkdir()
+    (old / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "old"}))
+    settle(out)  # killed between the two renames, the new set not complete: the old one comes back
+    assert json.loads((out / "crosscheck.json").read_text())["who"] == "old" and not old.exists()
+    old = tmp_path / ".out.old-efgh"
+    out.rename(old)
+    stage = partial_dir(out)
+    stage.mkdir()
+    (stage / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "new"}))
+    settle(out)  # the new set was complete: it goes in, the old one is removed
+    assert json.loads((out / "crosscheck.json").read_text())["who"] == "new"
+    assert not old.exists() and not stage.exists()
+
+
+def test_out_that_is_not_a_crosscheck_is_refused(tmp_path):
+    from rockyade.studies.crosscheck import check_out
+
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "notes.txt").write_text("keep me")
+    with pytest.raises(InputError, match="--out"):
+        check_out(mine)
+    (tmp_path / "link").symlink_to(mine)
+    with pytest.raises(InputError, match="symbolic link"):
+        check_out(tmp_path / "link")
+
+
+# ---------------------------------------------------------------------- the command
+
+
+def cli(*argv: str) -> int:
+    from rockyade.cli import main
+
+    return main(list(argv))
+
+
+@pytest.mark.parametrize(
+    ("argv", "option"),
+    [
+        (["--solvers", "housner"], "--solvers"),
+        (["--solvers", "housner,housner"], "--solvers"),
+        (["--solvers", "housner,nosuch"], "--solvers"),
+        (["--dt-factors", "0.5,1"], "--dt-factors"),
+        (["--dt-factors", "1,1.5"], "--dt-factors"),
+        (["--resolution", "0"], "--resolution"),
+        (["--tolerance", "nan"], "--tolerance"),
+        (["--yade-timeout", "5"], "--yade-timeout"),
+        (["--workers", "0"], "--workers"),
+        (["--count", "3"], "--count"),
+    ],
+)
+def test_bad_input_is_one_line_and_exit_2(argv, option, records, tmp_path, capsys):
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+        *argv,
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and option in err[0], err
+    assert not (tmp_path / "o").exists()
+
+
+def test_command_writes_the_set(records, tmp_path, capsys):
+    out = tmp_path / "cc"
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--solvers",
+        "housner,reference",
+        "--levels",
+        "0.3,0.6,1.2",
+        "--resolution",
+        "0.2",
+        "--dt-factors",
+        "1",
+        "--tail",
+        "1",
+        "--out",
+        str(out),
+        "--quiet",
+        "--workers",
+        "1",
+    )
+    text = capsys.readouterr().out
+    assert code == 0, text
+    assert "cost: about" in text and "housner / reference" in text
+    assert (out / "index.md").is_file() and (out / "crosscheck.png").stat().st_size > 10_000
+
+
+def test_figure_is_a_display_object(complete):
+    from matplotlib.figure import Figure
+
+    from rockyade.figures.common import file_figure
+    from rockyade.figures.crosscheck import PairedRatios
+
+    pairs = pd.read_csv(complete[0] / "pairs.csv")
+    fig, ax = file_figure()
+    display = PairedRatios.from_pairs(pairs, "pga").plot(ax=ax)
+    assert display.ax_ is ax and display.figure_ is fig and isinstance(fig, Figure)
+    assert len(display.labels) == len(pairs) and ax.get_xscale() == "log"
+    with pytest.raises(InputError, match="pairs"):
+        PairedRatios.from_pairs(pairs.drop(columns=["median_ratio"]))
+
+
+# ---------------------------------------------------------------------- compare
+
+
+def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_path, capsys):
+    from rockyade.analysis.compare import compare, verdict
+    from rockyade.scene import load_scene
+    from rockyade.solvers import make_solver
+
+    scene = load_scene(EXAMPLES / "specimen1_record.toml")
+    results = {n: make_solver(n).run(scene) for n in ("housner", "reference")}
+    table = compare(scene, results, "reference")
+    assert set(table.solver) == {"housner"}  # no row of the reference against itself
+    finer = {n: make_solver(n, dt_factor=0.5).run(scene) for n in results}
+    line = verdict(scene, results, "reference", finer)
+    row = table[table.metric == "max_abs_theta_rad"].iloc[0]
+    gap = abs(row.value - row.reference_value) / max(row.value, row.reference_value)
+    assert line.startswith("same outcome (completed); peak |theta| within ")
+    assert f"{100 * gap:.1f} %" in line and "halving the step changed" in line
+    # a constructed case: the finer step moves a solver more than the solvers differ
+    assert "says nothing" in verdict(scene, results, "reference", {"housner": results["reference"]})
+    assert verdict(scene, results, "reference").endswith("the time step not checked")
+    code = cli(
+        "compare",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--solvers",
+        "housner,reference",
+        "--dt-factor",
+        "0.5",
+        "--out",
+        str(tmp_path / "c"),
+    )
+    out = capsys.readouterr().out
+    assert code == 0 and "verdict: same outcome" in out
+    assert (tmp_path / "c" / "specimen1_record_housner_halfdt.json").is_file()
+    assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
+
+
+# ---------------------------------------------------------------------- real records
+
+
+@needs_records("RSN6_IMPVALL.I_I-ELC180-hor1.AT2", "RSN77_SFERN_PUL164-hor1.AT2")
+def test_real_records_housner_and_the_reference_dem_agree_on_a_slender_block(tmp_path):
+    """Two PEER records (El Centro 1940, Pacoima Dam 1971) copied into a folder of their own:
+    the collapse intensities of Housner and the reference DEM, paired by record, within 10 %."""
+    import shutil
+
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck import crosscheck_plan
+
+    folder = tmp_path / "peer"
+    folder.mkdir()
+    for name in ("RSN6_IMPVALL.I_I-ELC180-hor1.AT2", "RSN77_SFERN_PUL164-hor1.AT2"):
+        shutil.copy(external_records_dir() / name, folder / name)
+    plan = crosscheck_plan(
+        load_scene(EXAMPLES / "specimen1_record.toml"),
+        records_in_folder(folder),
+        parse_measure("pga"),
+        ["housner", "reference"],
+        dt_factors=(1.0,),
+        resolution=0.05,
+        executor=Executor("threads", 1),
+        tail_s=2.0,
+        progress=False,
+    )
+    summary = run(plan, tmp_path / "out")
+    pair = summary.pairs[summary.pairs.kind == "solvers"].iloc[0]
+    assert pair.records == 2
+    assert 0.9 <= pair.median_ratio <= 1.1, pair.sentence
+
+
+def test_figure_text_does_not_overlap(tmp_path):
+    """Many rows with long labels and a wide range (as the paper's figure): no two texts of the
+    figure (tick labels, axis label, legend) overlap."""
+    from matplotlib.text import Text
+
+    from rockyade.figures.crosscheck import PairedRatios
+
+    rows = []
+    for k in range(1, 5):
+        for kind, a, b in (("dt", "reference", "reference"), ("solvers", "housner", "reference")):
+            rows.append(
+                {
+                    "scene": f"specimen {k}",
+                    "kind": kind,
+                    "solver_a": a,
+                    "solver_b": b,
+                    "dt_factor_a": 0.5,
+                    "dt_factor_b": 1.0,
+                    "records": 30,
+                    "median_ratio": 1.0 + 0.02 * k,
+                    "ratio_low": 0.8,
+                    "ratio_high": 1.4,
+                }
+            )
+    display = PairedRatios.from_pairs(pd.DataFrame(rows), "PGA")
+    display.save(tmp_path / "f.png")
+    fig = display.figure_
+    fig.canvas.draw()  # the layout at the figure's own dpi (savefig draws at another)
+    renderer = fig.canvas.get_renderer()
+    texts = [t for t in fig.findobj(Text) if t.get_visible() and t.get_text().strip()]
+    boxes = [t.get_window_extent(renderer) for t in texts]
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            assert not boxes[i].overlaps(boxes[j]), (texts[i].get_text(), texts[j].get_text())
