@@ -97,8 +97,10 @@ def _contents(folder: Path) -> dict[str, bytes]:
 
 def test_a_set_that_fails_while_written_leaves_the_old_set_whole(tmp_path):
     before = _old_set(tmp_path / "out")
-    with pytest.raises(OSError, match="fig.png"), replacing_set(tmp_path / "out", ("runs.csv", "fig.png", "set.json"),
-                                                              "set.json") as stage:
+    with (
+        pytest.raises(OSError, match=r"fig\.png"),
+        replacing_set(tmp_path / "out", ("runs.csv", "fig.png", "set.json"), "set.json") as stage,
+    ):
         (stage / "runs.csv").write_text("new runs")
         raise OSError(28, "No space left on device", str(tmp_path / "out" / "fig.png"))
     assert _contents(tmp_path / "out") == before  # nothing staged is left either
@@ -136,9 +138,28 @@ def test_a_swap_killed_half_way_is_finished_by_the_next_writer(tmp_path, moved):
 
 def _fragility(folder: Path, *extra: str) -> list[str]:
     levels = ",".join(f"{0.3 + 0.05 * i:.2f}" for i in range(20))
-    return [sys.executable, "-m", "rockyade", "fragility", "wall.toml", "--records", "records", "--levels", levels,
-            "--no-extend", "--solver", "reference", "--tail", "20", "--workers", "1", "--out", "frag", "--quiet",
-            *extra]
+    return [
+        sys.executable,
+        "-m",
+        "rockyade",
+        "fragility",
+        "wall.toml",
+        "--records",
+        "records",
+        "--levels",
+        levels,
+        "--no-extend",
+        "--solver",
+        "reference",
+        "--tail",
+        "20",
+        "--workers",
+        "1",
+        "--out",
+        "frag",
+        "--quiet",
+        *extra,
+    ]
 
 
 def _records_in(partial: Path) -> set[str]:
@@ -147,8 +168,9 @@ def _records_in(partial: Path) -> set[str]:
 
 def _start(folder: Path, argv: list[str]) -> subprocess.Popen[str]:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
-    return subprocess.Popen(argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True, env=env)
+    return subprocess.Popen(
+        argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True, env=env
+    )
 
 
 def _wait_for_records(proc: subprocess.Popen[str], partial: Path, n: int) -> None:
@@ -181,8 +203,14 @@ def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, 
     assert not (tmp_path / "frag" / "fragility.json").exists()  # nothing that looks complete
     kept = _records_in(partial)
     assert 2 <= len(kept) < 40
-    done = subprocess.run(_fragility(tmp_path, "--resume"), cwd=tmp_path, capture_output=True, text=True,
-                          timeout=900, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    done = subprocess.run(
+        _fragility(tmp_path, "--resume"),
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert done.returncode == 0, done.stderr
     assert f"resumed: {len(kept)} run(s) read back" in done.stdout  # runs repeated: 0
     runs = pd.read_csv(tmp_path / "frag" / "runs.csv")
@@ -193,8 +221,20 @@ def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, 
 def test_resume_of_another_studys_folder_is_refused(tmp_path, wall, records, capsys):
     out = tmp_path / "frag"
     Journal(out / "partial", {"command": "assess", "scene_hash": "x", "options": {}}, resume=False)
-    code = main(["fragility", str(wall), "--records", str(records), "--levels", "0.2,0.5", "--out", str(out),
-                 "--quiet", "--resume"])
+    code = main(
+        [
+            "fragility",
+            str(wall),
+            "--records",
+            str(records),
+            "--levels",
+            "0.2,0.5",
+            "--out",
+            str(out),
+            "--quiet",
+            "--resume",
+        ]
+    )
     err = capsys.readouterr().err
     assert code == 2 and "--resume" in err and "written by 'assess', not 'fragility'" in err
     assert len(err.strip().splitlines()) == 1
@@ -203,8 +243,9 @@ def test_resume_of_another_studys_folder_is_refused(tmp_path, wall, records, cap
 def test_an_error_after_the_checks_leaves_no_empty_out_folder(tmp_path, wall, records, capsys):
     """A level no record reaches within the largest load factor: refused before --out is made."""
     out = tmp_path / "frag"
-    code = main(["fragility", str(wall), "--records", str(records), "--levels", "0.2,500", "--out", str(out),
-                 "--quiet"])
+    code = main(
+        ["fragility", str(wall), "--records", str(records), "--levels", "0.2,500", "--out", str(out), "--quiet"]
+    )
     assert code == 2 and "--levels" in capsys.readouterr().err
     assert not out.exists()
 
@@ -226,12 +267,40 @@ def test_an_interrupt_before_any_run_leaves_no_empty_out_folder(tmp_path):
 def test_fragility_takes_the_executor_options_of_batch(tmp_path, wall, records, capsys):
     pytest.importorskip("dask")
     out = tmp_path / "frag"
-    code = main(["fragility", str(wall), "--records", str(records), "--levels", "0.2,1", "--out", str(out),
-                 "--quiet", "--executor", "dask", "--workers", "2"])
+    code = main(
+        [
+            "fragility",
+            str(wall),
+            "--records",
+            str(records),
+            "--levels",
+            "0.2,1",
+            "--out",
+            str(out),
+            "--quiet",
+            "--executor",
+            "dask",
+            "--workers",
+            "2",
+        ]
+    )
     assert code == 0, capsys.readouterr()
     assert len(pd.read_csv(out / "runs.csv")) == 4
-    code = main(["fragility", str(wall), "--records", str(records), "--levels", "0.2,1", "--out", str(out),
-                 "--quiet", "--scheduler", "tcp://127.0.0.1:9"])
+    code = main(
+        [
+            "fragility",
+            str(wall),
+            "--records",
+            str(records),
+            "--levels",
+            "0.2,1",
+            "--out",
+            str(out),
+            "--quiet",
+            "--scheduler",
+            "tcp://127.0.0.1:9",
+        ]
+    )
     assert code == 2 and "--scheduler: needs --executor dask" in capsys.readouterr().err
 
 
@@ -270,3 +339,41 @@ def test_a_full_disk_leaves_the_previous_set_whole_and_names_the_file(tmp_path, 
     listing = after.split("EXIT 1")[1].split("FILES")[0]
     assert ".set." not in listing  # nothing staged is left
     assert "partial" in listing  # the finished runs are kept: --resume writes the set once there is room
+
+
+# ---------------------------------------------------------------------- record folders
+
+
+def test_linked_records_are_followed_and_counted(tmp_path, records):
+    """One real record and two links to record files elsewhere: three records (it used to
+    run one, silently); a folder of links only reads as well."""
+    from rockyade.assess import records_in_folder
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    shutil.copy(EXAMPLES / "records" / "ec8_type2_D_record21.AT2", elsewhere / "b.AT2")
+    half = pd.read_csv(EXAMPLES / "records" / "ec8_type2_D_record21.csv", comment="#")
+    half["accel_m_s2"] *= 0.5  # another accelerogram
+    half.to_csv(elsewhere / "c.csv", index=False)
+    mixed = tmp_path / "mixed"
+    mixed.mkdir()
+    shutil.copy(EXAMPLES / "records" / "ricker_pulse_T0.5s.AT2", mixed / "a.AT2")
+    (mixed / "b.AT2").symlink_to(elsewhere / "b.AT2")
+    (mixed / "c.csv").symlink_to(elsewhere / "c.csv")
+    assert records_in_folder(mixed).count == 3
+    links = tmp_path / "links"
+    links.mkdir()
+    (links / "b.AT2").symlink_to(elsewhere / "b.AT2")
+    assert records_in_folder(links).count == 1
+
+
+def test_a_link_to_no_record_file_is_refused_naming_it(tmp_path):
+    from rockyade.assess import records_in_folder
+
+    folder = tmp_path / "recs"
+    folder.mkdir()
+    shutil.copy(EXAMPLES / "records" / "ricker_pulse_T0.5s.AT2", folder / "a.AT2")
+    (folder / "gone.AT2").symlink_to(tmp_path / "nowhere.AT2")
+    with pytest.raises(InputError) as info:
+        records_in_folder(folder)
+    assert info.value.field == "--records" and "gone.AT2" in info.value.message

@@ -9,7 +9,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, json_out, print_wrote
-from rockyade.cli.resumable import write_partial
 from rockyade.cli.fragility import (
     DEFAULT_COUNT,
     add_run_options,
@@ -21,6 +20,7 @@ from rockyade.cli.fragility import (
     solver_from,
     write_tables,
 )
+from rockyade.cli.resumable import write_partial
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs

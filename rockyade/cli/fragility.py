@@ -231,11 +231,13 @@ def register(sub: Any) -> None:
         "fragility",
         help="collapse fragility of a scene: records scaled to stripes of PGA, PGV or Sa(T), lognormal fit",
         description="Replace the scene's motion by each record scaled (a load factor on its accelerations as read) "
-        "to stripes of an intensity measure, run every run through the runner (local processes, or Dask: --executor), count the runs "
-        "that collapse (a single block: overturned; several blocks: --fallen-blocks fell) and fit a lognormal "
-        "curve by maximum likelihood with a bootstrap band over the records. Writes runs.csv, stripes.csv, "
-        "records.csv, fragility.json and fragility.png in --out. Exit 0, 1 when a run failed or the scene cannot "
-        "stand, 2 on bad input. See docs/howto/is-this-wall-safe.md.",
+        "to stripes of an intensity measure, run every run through the runner (local processes, or Dask: "
+        "--executor), count the runs that collapse (a single block: overturned; several blocks: --fallen-blocks "
+        "fell) and fit a lognormal curve by maximum likelihood with a bootstrap band over the records. Writes "
+        "runs.csv, stripes.csv, records.csv, fragility.json and fragility.png in --out, a set replaced as a whole; "
+        "each run is written to --out/partial/ as it ends, Ctrl-C leaves a partial summary there and --resume goes "
+        "on from it. Exit 0, 1 when a run failed or the scene cannot stand, 2 on bad input. See "
+        "docs/howto/is-this-wall-safe.md.",
     )
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
     source = p.add_mutually_exclusive_group(required=True)

@@ -70,8 +70,20 @@ def executor_from(args: argparse.Namespace) -> Executor:
 def identity(command: str, args: argparse.Namespace, scene_hash: str, ignore: Sequence[str] = ()) -> dict[str, Any]:
     """What decides a command's runs: its name, the scene's hash and every option but those
     that only say where or how it runs (``--out``, ``--resume``, the executor, progress)."""
-    skip = {"out", "resume", "quiet", "json", "workers", "executor", "scheduler", "scheduler_timeout", "func",
-            "started_at", "command", *ignore}
+    skip = {
+        "out",
+        "resume",
+        "quiet",
+        "json",
+        "workers",
+        "executor",
+        "scheduler",
+        "scheduler_timeout",
+        "func",
+        "started_at",
+        "command",
+        *ignore,
+    }
     options = {k: _plain(v) for k, v in sorted(vars(args).items()) if k not in skip}
     return {"command": command, "scene_hash": scene_hash, "options": options}
 
@@ -104,7 +116,9 @@ class StudyOutput:
 
 
 @contextlib.contextmanager
-def study_output(out: Path, ident: Mapping[str, Any], resume: bool, names: Sequence[str], last: str) -> Iterator[StudyOutput]:
+def study_output(
+    out: Path, ident: Mapping[str, Any], resume: bool, names: Sequence[str], last: str
+) -> Iterator[StudyOutput]:
     """Make ``out`` (after every check: the caller validated its input), lock it, settle what
     a killed run left, open its journal. On an error or Ctrl-C that leaves no finished run, a
     folder made here is removed again (no empty ``--out``).

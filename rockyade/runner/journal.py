@@ -78,6 +78,46 @@ def read_run(folder: str | Path, name: str, scene_hash: str) -> dict[str, Any] |
     return None
 
 
+def claim(folder: str | Path, identity: Mapping[str, Any], resume: bool, field: str = "--resume") -> dict[str, Any]:
+    """Write the study's identity (``<folder>/study.json``); with ``resume``, first refuse a
+    folder whose identity is another's. The identity as it reads back from the file.
+
+    Parameters
+    ----------
+    folder
+        The runs' folder (made if missing).
+    identity
+        What decides the study's runs (JSON-ready).
+    resume
+        The caller keeps the runs there.
+    field
+        The option named when the resume is refused.
+
+    Raises
+    ------
+    InputError
+        ``resume`` over a folder written by another study or with other options.
+    """
+    folder = Path(folder)
+    ident = json.loads(json_text(dict(identity)))
+    path = folder / IDENTITY_FILE
+    if resume and path.is_file():
+        try:
+            earlier = json.loads(path.read_text())
+        except (OSError, ValueError):
+            earlier = None
+        if earlier != ident:
+            why = _differences(earlier, ident)
+            raise InputError(
+                field,
+                f"{folder} holds the runs of another study or other options ({why}); "
+                "run the command as it was run, or without --resume to start again",
+            )
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json(path, ident)
+    return ident
+
+
 class Journal:
     """The finished runs of one study in ``folder`` (module docstring).
 
@@ -102,25 +142,11 @@ class Journal:
 
     def __init__(self, folder: str | Path, identity: Mapping[str, Any], resume: bool, field: str = "--resume") -> None:
         self.folder = Path(folder)
-        self.identity = json.loads(json_text(dict(identity)))  # as it reads back from the file
         self.resumed = 0
-        path = self.folder / IDENTITY_FILE
-        if resume and path.is_file():
-            try:
-                earlier = json.loads(path.read_text())
-            except (OSError, ValueError):
-                earlier = None
-            if earlier != self.identity:
-                raise InputError(
-                    field,
-                    f"{self.folder} holds the runs of another study or other options ({_differences(earlier, self.identity)}); "
-                    "run the command as it was run, or without --resume to start again",
-                )
-        elif not resume:
+        if not resume:
             self.clear()
-        self.folder.mkdir(parents=True, exist_ok=True)
+        self.identity = claim(self.folder, identity, resume, field)
         remove_stale_temporaries(self.folder)
-        write_json(path, self.identity)
 
     def done(self, name: str, scene_hash: str) -> dict[str, Any] | None:
         """The row of a run finished earlier (:func:`read_run`), counted in ``resumed``."""
@@ -159,4 +185,4 @@ def _differences(earlier: Any, now: Mapping[str, Any]) -> str:
     return shown or "unknown"
 
 
-__all__ = ["IDENTITY_FILE", "KEPT_STATUSES", "Journal", "read_run", "write_run"]
+__all__ = ["IDENTITY_FILE", "KEPT_STATUSES", "Journal", "claim", "read_run", "write_run"]
