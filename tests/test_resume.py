@@ -377,3 +377,27 @@ def test_a_link_to_no_record_file_is_refused_naming_it(tmp_path):
     with pytest.raises(InputError) as info:
         records_in_folder(folder)
     assert info.value.field == "--records" and "gone.AT2" in info.value.message
+
+
+def test_a_batch_whose_scheduler_does_not_answer_leaves_no_empty_out_folder(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    study = tmp_path / "study.toml"
+    study.write_text(f'name = "s"\nsolvers = ["housner"]\n[base]\nfile = "{EXAMPLES / "specimen1_free.toml"}"\n')
+    out = tmp_path / "out"
+    code = main(
+        [
+            "batch",
+            str(study),
+            "--out",
+            str(out),
+            "--executor",
+            "dask",
+            "--scheduler",
+            "tcp://127.0.0.1:9",
+            "--scheduler-timeout",
+            "1",
+            "--quiet",
+        ]
+    )
+    assert code == 2 and "no Dask scheduler answered" in capsys.readouterr().err
+    assert not out.exists()

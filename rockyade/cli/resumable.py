@@ -128,31 +128,21 @@ def study_output(
     InputError
         Another process writes ``out``; ``resume`` over another study's journal.
     """
-    from rockyade.io.locking import DIR_LOCK_NAME, output_lock
+    from rockyade.io.folders import output_folder
+    from rockyade.io.locking import output_lock
     from rockyade.io.resultset import settle
     from rockyade.runner.journal import Journal
 
-    created = not out.exists()
-    out.mkdir(parents=True, exist_ok=True)
-    ok = False
-    try:
-        with output_lock(out, "--out"):
-            settle(out, names, last)
-            journal = Journal(out / PARTIAL_DIR, ident, resume)
-            try:
-                yield StudyOutput(out, journal, created)
-                ok = True
-            finally:
-                if not ok:
-                    journal.remove_if_empty()
-    finally:
-        if not ok and created:
-            with contextlib.suppress(OSError):
-                leftover = [p for p in out.iterdir() if p.name != DIR_LOCK_NAME]
-                if not leftover:
-                    with contextlib.suppress(FileNotFoundError):
-                        (out / DIR_LOCK_NAME).unlink()
-                    out.rmdir()
+    with output_folder(out) as created, output_lock(out, "--out"):
+        settle(out, names, last)
+        journal = Journal(out / PARTIAL_DIR, ident, resume)
+        ok = False
+        try:
+            yield StudyOutput(out, journal, created)
+            ok = True
+        finally:
+            if not ok:
+                journal.remove_if_empty()
 
 
 def write_partial(output: StudyOutput, frame: Any, summary: Mapping[str, Any]) -> Path:

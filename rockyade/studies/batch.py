@@ -57,6 +57,7 @@ import pandas as pd
 from rockyade.errors import BatchInterruptedError, InputError, os_error_message
 from rockyade.io.atomic import atomic_open, remove_stale_temporaries
 from rockyade.io.fields import TableReader
+from rockyade.io.folders import output_folder
 from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.motion.types import RecordMotion
 from rockyade.result import Result
@@ -655,8 +656,7 @@ def run_study_tasks(
     """
     how = executor if isinstance(executor, Executor) else Executor(executor, workers, scheduler, scheduler_timeout_s)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    with output_lock(out, "out"):
+    with output_folder(out), output_lock(out, "out"):  # an error before any run leaves no empty folder
         token = lock_token(out)
         _settle(out)
         if identity is not None:
