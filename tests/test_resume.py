@@ -163,7 +163,9 @@ def _fragility(folder: Path, *extra: str) -> list[str]:
 
 
 def _records_in(partial: Path) -> set[str]:
-    return {p.name for p in partial.glob("*.json") if p.name != "study.json"} if partial.is_dir() else set()
+    """The runs' records in a journal (not its identity, nor the partial summary)."""
+    skip = {"study.json", "partial.json", "assess.json"}
+    return {p.name for p in partial.glob("*.json") if p.name not in skip} if partial.is_dir() else set()
 
 
 def _start(folder: Path, argv: list[str]) -> subprocess.Popen[str]:
@@ -401,3 +403,52 @@ def test_a_batch_whose_scheduler_does_not_answer_leaves_no_empty_out_folder(tmp_
     )
     assert code == 2 and "no Dask scheduler answered" in capsys.readouterr().err
     assert not out.exists()
+
+
+# ---------------------------------------------------------------------- Ctrl-C
+
+
+def test_the_ctrl_c_handler_never_raises(capsys):
+    """The handler counts and returns (an exception raised from a signal handler surfaces at an
+    arbitrary point of the main thread: the stray 'SystemError: <built-in function isinstance>
+    returned a result with an exception set' from random.seed); after the second Ctrl-C of
+    in-process runs the next Ctrl-C is Python's own."""
+    import threading
+
+    from rockyade.runner.stopping import StopRequest
+
+    assert threading.current_thread() is threading.main_thread()
+    before = signal.getsignal(signal.SIGINT)
+    with StopRequest(raise_on_second=True) as stop:
+        assert signal.getsignal(signal.SIGINT) == stop._handler
+        stop._handler(signal.SIGINT, None)
+        stop._handler(signal.SIGINT, None)  # used to raise KeyboardInterrupt here
+        assert stop.requested and stop.now
+        assert signal.getsignal(signal.SIGINT) == before
+    assert signal.getsignal(signal.SIGINT) == before
+    assert "finishes first" in capsys.readouterr().err
+
+
+def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
+    """Runs on threads of this process: after a second Ctrl-C the loop raises KeyboardInterrupt
+    at its next wait (not the handler), abandoning the running threads."""
+    import threading
+
+    from rockyade.runner.stopping import StopRequest
+    from rockyade.runner.threads import run_threads
+
+    release = threading.Event()
+    stop = StopRequest(raise_on_second=True)
+    started: set[int] = set()
+
+    def job(i: int) -> int:
+        if i == 0:
+            stop._handler(signal.SIGINT, None)
+            stop._handler(signal.SIGINT, None)
+        release.wait(60)
+        return i
+
+    with pytest.raises(KeyboardInterrupt):  # while job 0 still runs
+        run_threads([0, 1], job, 2, lambda i, v: None, None, stop, started)
+    assert not release.is_set()
+    release.set()

@@ -568,6 +568,31 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     assert not Path("r/long_failed_failed.csv").exists()
 
 
+def test_a_failed_yade_run_never_touches_a_complete_runs_files(tmp_path, monkeypatch, capsys):
+    """A complete YADE run at --out, then a run to the same --out that times out: the complete
+    run's CSV, JSON, scene data, output and log stay byte for byte, and its JSON's log_path
+    names its own log; the failed run's files go beside as <stem>_failed.*. The timeout used to
+    delete the old .yade.npz and overwrite .yade.log."""
+    from rockyade.cli import main
+
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    (tmp_path / "short.json").write_text(json.dumps({**d, "duration_s": 0.5}))
+    (tmp_path / "long.json").write_text(json.dumps({**d, **NEVER_FINISHES}))
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "short.json", "--solver", "yade", "--out", "r/x.csv"]) == 0
+    before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
+    assert {"x.csv", "x.json", "x.yade.json", "x.yade.npz", "x.yade.log"} <= set(before)
+    _warm_yade()
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/x.csv", "--yade-timeout", "2"]) == 1
+    capsys.readouterr()
+    assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
+    complete = Result.read(Path("r/x.csv"))
+    assert complete.status == "completed" and Path(complete.meta["log_path"]).name == "x.yade.log"
+    failed = Result.read(Path("r/x_failed.csv"))
+    assert failed.status == "failed" and Path(failed.meta["log_path"]).name == "x_failed.yade.log"
+    assert Path("r/x_failed.yade.log").is_file() and not list(Path("r").glob("*.running.*"))
+
+
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])
 def test_cli_bad_yade_timeout_is_refused(value, tmp_path, capsys):
     from rockyade.cli import main

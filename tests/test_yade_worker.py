@@ -149,9 +149,10 @@ def test_a_killed_yade_run_keeps_the_samples_it_flushed(tmp_path, monkeypatch):
     thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="k").run(long)))
     before = _serving()
     thread.start()
+    running = tmp_path / "k.running.yade.npz"  # the run's own name until it ends
     npz = tmp_path / "k.yade.npz"
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and not ((_serving() - before) and npz.is_file()):
+    while time.monotonic() < deadline and not ((_serving() - before) and running.is_file()):
         time.sleep(0.05)
     (victim,) = _serving() - before
     time.sleep(0.5)
@@ -271,7 +272,8 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
         "import json, sys\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.yade import YadeSolver\n"
         f"d = json.loads({json.dumps(d)!r})\ns = scene_from_dict(d)\n"
         "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
-        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(scene_from_dict({**d, 'duration_s': 3600.0, 'sample_dt_s': 0.01}))\n"
+        "long = scene_from_dict({**d, 'duration_s': 3600.0, 'sample_dt_s': 0.01})\n"
+        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(long)\n"
         "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
     )
     # a checkout or a virtual environment under /tmp (a fresh clone in /tmp/fresh) stays
