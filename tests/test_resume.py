@@ -452,3 +452,27 @@ def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
         run_threads([0, 1], job, 2, lambda i, v: None, None, stop, started)
     assert not release.is_set()
     release.set()
+
+
+def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, records):
+    """Ctrl-C in the dynamics of ``assess --out``: the static answer is written (marked
+    partial) with the runs that finished, and ``--resume`` runs only the others."""
+    factors = ",".join(f"{0.5 + 0.1 * i:.1f}" for i in range(15))
+    argv = [sys.executable, "-m", "rockyade", "assess", "wall.toml", "--spectrum-type", "1", "--ground", "B", "--ag",
+            "0.25g", "--records", "records", "--load-factors", factors, "--no-extend", "--solver", "reference",
+            "--tail", "20", "--workers", "1", "--out", "a", "--quiet"]  # fmt: skip
+    proc = _start(tmp_path, argv)
+    partial = tmp_path / "a" / "partial"
+    _wait_for_records(proc, partial, 2)
+    os.killpg(proc.pid, signal.SIGINT)
+    _out, err = proc.communicate(timeout=600)
+    assert proc.returncode == 130, err
+    static = json.loads((partial / "assess.json").read_text())
+    assert static["partial"] is True and static["alpha0"] > 0 and static["verdict"]
+    assert "a/partial/assess.json" in err and not (tmp_path / "a" / "assess.json").exists()
+    kept = _records_in(partial)
+    done = subprocess.run([*argv, "--resume"], cwd=tmp_path, capture_output=True, text=True, timeout=900,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert f"resumed: {len(kept)} run(s) read back" in done.stdout
+    assert len(pd.read_csv(tmp_path / "a" / "runs.csv")) == 30 and not partial.exists()

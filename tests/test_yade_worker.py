@@ -271,8 +271,10 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
     code = (
         "import json, sys\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.yade import YadeSolver\n"
         f"d = json.loads({json.dumps(d)!r})\ns = scene_from_dict(d)\n"
-        "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
         "long = scene_from_dict({**d, 'duration_s': 3600.0, 'sample_dt_s': 0.01})\n"
+        "r = YadeSolver(timeout_s=0.01, workdir='/tmp/kept0').run(long)\n"  # shorter than YADE's start-up
+        "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
+        "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
         "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(long)\n"
         "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
     )
@@ -292,7 +294,7 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
     assert "RAN" in proc.stdout, proc.stdout + proc.stderr
     in_tmp, in_ours = proc.stdout.split("RAN", 1)[1].split("--")
     # kept: the workdir asked for (the timed-out run's log); nothing of YADE's
-    assert sorted(in_tmp.split()) == sorted(["kept", "ours", *needed]), in_tmp
+    assert sorted(in_tmp.split()) == sorted(["kept", "kept0", "ours", *needed]), in_tmp
     assert in_ours.split() == [], in_ours
 
 
