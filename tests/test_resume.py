@@ -476,3 +476,38 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
     assert done.returncode == 0, done.stderr
     assert f"resumed: {len(kept)} run(s) read back" in done.stdout
     assert len(pd.read_csv(tmp_path / "a" / "runs.csv")) == 30 and not partial.exists()
+
+
+@pytest.mark.parametrize("executor", ["local", "dask"])
+def test_a_fragility_opens_no_listening_socket(tmp_path, wall, records, executor):
+    """The study commands on local processes or Dask's threaded scheduler open no port (polled
+    over the process tree while it runs, to the end)."""
+    if executor == "dask":
+        pytest.importorskip("dask")
+    from .test_reliability_batch import _listening_sockets_of_tree
+
+    proc = _start(tmp_path, _fragility(tmp_path, "--executor", executor, "--workers", "2"))  # the last --workers
+    seen: set[str] = set()
+    polls = 0
+    while proc.poll() is None:
+        seen |= _listening_sockets_of_tree(proc.pid)
+        polls += 1
+        time.sleep(0.02)
+    _out, err = proc.communicate()
+    assert proc.returncode == 0, err
+    assert polls > 10 and not seen
+
+
+def test_the_interrupt_message_names_an_option_the_command_has():
+    """`fragility` and `assess` said 'run the same command with --resume' and had no --resume;
+    a study run by `paper` has none either."""
+    from rockyade.cli import build_parser
+    from rockyade.errors import BatchInterruptedError
+
+    parser = build_parser()
+    commands = parser._subparsers._group_actions[0].choices  # type: ignore[union-attr]
+    for name in ("batch", "fragility", "assess", "uncertainty"):
+        assert "--resume" in commands[name]._option_string_actions, name
+    assert "--resume" not in commands["paper"]._option_string_actions
+    assert "--resume" in str(BatchInterruptedError(1, 2, None))
+    assert "--resume" not in str(BatchInterruptedError(1, 2, None, resume_option=None))

@@ -136,10 +136,10 @@ def cmd_assess(args: argparse.Namespace) -> int:
     if dynamic is not None:
         try:
             _dynamics(args, result, scene, dynamic, executor, None)
-        except BatchInterruptedError:
+        except BatchInterruptedError as exc:
             if args.json:  # the static answer, kept
                 json_out({**_static_data(args, result), "partial": True})
-            raise
+            raise type(exc)(exc.finished, exc.unfinished, None, exc.hard, "--out DIR (then --resume)") from None
     data = _finish(args, result, scene)
     if args.out is not None:
         with study_output(args.out, identity("assess", args, file_digest(args.scene)), False, ASSESS_SET,

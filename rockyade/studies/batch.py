@@ -625,6 +625,7 @@ def run_study_tasks(
     scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
     group_runs: bool = True,
     identity: Mapping[str, Any] | None = None,
+    resume_option: str | None = "--resume",
 ) -> pd.DataFrame:
     """Run tasks and write the summary; return it (sorted by task order).
 
@@ -639,6 +640,8 @@ def run_study_tasks(
         Skip runs already completed for the same scene hash; re-run failed ones.
     allow_large
         Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost`.
+    resume_option
+        The caller's option that resumes, named after Ctrl-C (None: it cannot resume).
     identity
         What study this is (:func:`rockyade.runner.journal.claim`: ``runs/study.json``);
         ``resume`` over the runs of another is refused. None: not checked.
@@ -662,7 +665,15 @@ def run_study_tasks(
         if identity is not None:
             claim(out / "runs", identity, resume)
         return _run_locked(
-            [replace(t, lock_token=token) for t in tasks], out, how, resume, progress, desc, allow_large, group_runs
+            [replace(t, lock_token=token) for t in tasks],
+            out,
+            how,
+            resume,
+            progress,
+            desc,
+            allow_large,
+            group_runs,
+            resume_option,
         )
 
 
@@ -684,6 +695,7 @@ def _run_locked(
     desc: str,
     allow_large: bool,
     group_runs: bool = True,
+    resume_option: str | None = "--resume",
 ) -> pd.DataFrame:
     first, duplicates = _distinct(tasks)
     rows: list[dict[str, Any]] = []
@@ -724,7 +736,9 @@ def _run_locked(
             _settle(out)
         stopped = {task.index for i in outcome.unfinished for task in jobs[i]}
         unfinished = len(stopped) + sum(1 for _task, original in duplicates if original.index in stopped)
-        raise BatchInterruptedError(len(tasks) - unfinished, unfinished, str(out / "summary.csv"), hard=outcome.hard)
+        raise BatchInterruptedError(
+            len(tasks) - unfinished, unfinished, str(out / "summary.csv"), outcome.hard, resume_option
+        )
     return summary
 
 
