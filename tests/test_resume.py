@@ -469,7 +469,7 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
     assert proc.returncode == 130, err
     static = json.loads((partial / "assess.json").read_text())
     assert static["partial"] is True and static["alpha0"] > 0 and static["verdict"]
-    assert "a/partial/assess.json" in err and not (tmp_path / "a" / "assess.json").exists()
+    assert "a/partial/runs.csv" in err and not (tmp_path / "a" / "assess.json").exists()
     kept = _records_in(partial)
     done = subprocess.run([*argv, "--resume"], cwd=tmp_path, capture_output=True, text=True, timeout=900,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip

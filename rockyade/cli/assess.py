@@ -191,9 +191,9 @@ def _interrupted(args: argparse.Namespace, result: Any, exc: Any, output: Any) -
     write_json(output.partial / "assess.json", data)
     rows = getattr(exc, "rows", [])
     plan = getattr(exc, "plan", None)
-    if rows and plan is not None:
-        write_partial(output, runs_frame(rows, plan.measure), data["dynamic_interrupted"])
     exc.summary_path = str(output.partial / "assess.json")
+    if rows and plan is not None:  # the message names the runs' list (the static answer is beside it)
+        exc.summary_path = str(write_partial(output, runs_frame(rows, plan.measure), data["dynamic_interrupted"]))
     if args.json:
         json_out(data)
 
