@@ -50,8 +50,8 @@ class StopRequest:
         elif self.count == 2:
             if self.raise_on_second:
                 say(
-                    "Ctrl-C again: stopping; a run of this process in progress cannot be stopped safely and "
-                    "finishes first (Ctrl-C a third time interrupts it at once)"
+                    "Ctrl-C again: stopping the running runs now (a run in this thread cannot be stopped safely "
+                    "and finishes first; Ctrl-C a third time interrupts it at once)"
                 )
                 if self._installed:  # the next Ctrl-C is Python's own KeyboardInterrupt
                     signal.signal(signal.SIGINT, self._previous)

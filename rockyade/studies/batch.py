@@ -643,7 +643,7 @@ def run_study_tasks(
     resume_option
         The caller's option that resumes, named after Ctrl-C (None: it cannot resume).
     identity
-        What study this is (:func:`rockyade.runner.journal.claim`: ``runs/study.json``);
+        What study this is (:func:`rockyade.runner.journal.claim`: ``study.json`` in ``out_dir``);
         ``resume`` over the runs of another is refused. None: not checked.
     group_runs
         Run the runs that share a structure together (:func:`job_key`, :func:`run_job`; the
@@ -663,7 +663,7 @@ def run_study_tasks(
         token = lock_token(out)
         _settle(out)
         if identity is not None:
-            claim(out / "runs", identity, resume)
+            claim(out, identity, resume)
         return _run_locked(
             [replace(t, lock_token=token) for t in tasks],
             out,
