@@ -85,7 +85,9 @@ def run_dask_in_process(
         # Dask's scheduler waits in a thread of its own; this thread takes each finished job
         # (``done`` runs here) and, after a second Ctrl-C, stops at its next wait (a safe point:
         # the signal handler never raises)
-        threading.Thread(target=drive, name="rockyade-dask-get", daemon=True).start()
+        # not a daemon: neither are the pool's threads it starts, which the command line then
+        # sees as busy after a second Ctrl-C and ends the process without waiting for them
+        threading.Thread(target=drive, name="rockyade-dask-get", daemon=False).start()
         while True:
             try:
                 item = finished.get(timeout=0.1)
