@@ -61,18 +61,30 @@ class BatchInterruptedError(RockyadeError):
         The summary written, or None when it could not be.
     hard
         A second Ctrl-C stopped the running runs (the process should end at once).
+    resume_option
+        The command's option that resumes (named in the message), None: it has none.
     """
 
-    def __init__(self, finished: int, unfinished: int, summary_path: str | None, hard: bool = False) -> None:
+    def __init__(
+        self,
+        finished: int,
+        unfinished: int,
+        summary_path: str | None,
+        hard: bool = False,
+        resume_option: str | None = "--resume",
+    ) -> None:
         self.finished = finished
         self.unfinished = unfinished
         self.summary_path = summary_path
         self.hard = hard
+        self.resume_option = resume_option
         where = f"; {summary_path} lists them" if summary_path else ""
-        super().__init__(
-            f"interrupted: {finished} run(s) finished, {unfinished} unfinished{where} "
-            "(run the same command with --resume to finish them)"
+        then = (
+            f" (run the same command with {resume_option} to finish them)"
+            if resume_option
+            else " (this command does not resume: run it again)"
         )
+        super().__init__(f"interrupted: {finished} run(s) finished, {unfinished} unfinished{where}{then}")
 
 
 def os_error_message(exc: OSError) -> str:

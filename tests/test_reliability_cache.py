@@ -152,6 +152,26 @@ def test_a_cache_folder_that_is_a_file_gives_the_record_and_one_warning(cache, g
     assert "Traceback" not in err and blocked.read_text() == "a file where a folder should be"
 
 
+def test_a_folder_in_place_of_a_cache_file_is_named_and_the_record_generated(cache, generated, monkeypatch, capsys):
+    """A folder where a record's cache file should be: the record is generated, one note
+    names the file (it used to end with 'rockyade: error: 14: Is a directory', naming a file
+    descriptor), one warning says the cache cannot be written there, whatever the reads."""
+    from rockyade.motion import synthetic
+
+    monkeypatch.setattr(synthetic, "_WARNED", set())
+    monkeypatch.setattr(synthetic, "_NOTED", set())
+    monkeypatch.setattr(synthetic, "_HELD", type(synthetic._HELD)())
+    cache.unlink()
+    cache.mkdir()
+    for _ in range(3):
+        rec = suite_record(SPEC, 1)
+    np.testing.assert_array_equal(rec.accel_m_s2, generated.accel_m_s2)
+    err = capsys.readouterr().err
+    assert err.count(f"rockyade: note: {cache}: a folder, not a cache file: regenerated") == 1, err
+    assert err.count("rockyade: warning: cannot write the synthetic-record cache") == 1, err
+    assert cache.is_dir() and "Traceback" not in err
+
+
 def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated):
     """A read-only cache folder (a read-only file system: root writes through permissions)."""
     folder = tmp_path / "ro"

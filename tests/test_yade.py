@@ -361,8 +361,15 @@ def _warm_yade() -> None:
                                              "duration_s": 0.2})).ok
 
 
+#: A run no machine finishes within the tests' timeouts (2 to 3 s): an hour of specimen 1
+#: rocking (7.2e7 body-steps, minutes of YADE on the fastest machine seen, where 60 s of
+#: it, the earlier choice, finished within 3 s), sampled every 0.01 s to stay within the
+#: cost limits.
+NEVER_FINISHES = {"duration_s": 3600.0, "sample_dt_s": 0.01}
+
+
 def test_timeout_gives_failed_result(tmp_path):
-    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 60.0})
+    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), **NEVER_FINISHES})
     _warm_yade()
     start = time.time()
     result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=3.0).run(scene)
@@ -516,7 +523,7 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     from rockyade.cli import main
 
     d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
-    d["duration_s"] = 60.0
+    d.update(NEVER_FINISHES)
     (tmp_path / "long.json").write_text(json.dumps(d))
     monkeypatch.chdir(tmp_path)
     before = descendants(os.getpid())
@@ -544,7 +551,7 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     from rockyade.cli import main
 
     d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
-    d["duration_s"] = 60.0
+    d.update(NEVER_FINISHES)
     (tmp_path / "long.json").write_text(json.dumps(d))
     monkeypatch.chdir(tmp_path)
     assert main(["run", "long.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
@@ -559,6 +566,31 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     # a failed result is not worth keeping over another failed one
     assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "2"]) == 1
     assert not Path("r/long_failed_failed.csv").exists()
+
+
+def test_a_failed_yade_run_never_touches_a_complete_runs_files(tmp_path, monkeypatch, capsys):
+    """A complete YADE run at --out, then a run to the same --out that times out: the complete
+    run's CSV, JSON, scene data, output and log stay byte for byte, and its JSON's log_path
+    names its own log; the failed run's files go beside as <stem>_failed.*. The timeout used to
+    delete the old .yade.npz and overwrite .yade.log."""
+    from rockyade.cli import main
+
+    d = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    (tmp_path / "short.json").write_text(json.dumps({**d, "duration_s": 0.5}))
+    (tmp_path / "long.json").write_text(json.dumps({**d, **NEVER_FINISHES}))
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "short.json", "--solver", "yade", "--out", "r/x.csv"]) == 0
+    before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
+    assert {"x.csv", "x.json", "x.yade.json", "x.yade.npz", "x.yade.log"} <= set(before)
+    _warm_yade()
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/x.csv", "--yade-timeout", "2"]) == 1
+    capsys.readouterr()
+    assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
+    complete = Result.read(Path("r/x.csv"))
+    assert complete.status == "completed" and Path(complete.meta["log_path"]).name == "x.yade.log"
+    failed = Result.read(Path("r/x_failed.csv"))
+    assert failed.status == "failed" and Path(failed.meta["log_path"]).name == "x_failed.yade.log"
+    assert Path("r/x_failed.yade.log").is_file() and not list(Path("r").glob("*.running.*"))
 
 
 @pytest.mark.parametrize("value", ["0", "-5", "nan", "1e12"])

@@ -91,7 +91,7 @@ def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypa
     _same(YadeSolver().run(good), reference)  # a fresh worker takes the next scene
 
     # a crash: the worker killed by a signal in the middle of a scene
-    long = _scene("specimen1_free.toml", 120.0, sample_dt_s=0.01)
+    long = _scene("specimen1_free.toml", 3600.0, sample_dt_s=0.01)
     holder: dict = {}
     thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="crash").run(long)))
     before = _serving()
@@ -118,7 +118,7 @@ def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tm
     assert YadeSolver().run(short).ok
     (pid,) = _serving()
     start = time.monotonic()
-    long = _scene("specimen1_free.toml", 60.0)
+    long = _scene("specimen1_free.toml", 3600.0, sample_dt_s=0.01)  # an hour: no machine finishes it in 2 s
     slow = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(long)
     assert time.monotonic() - start < 20
     assert slow.status == "failed" and not slow.ok
@@ -127,7 +127,7 @@ def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tm
     assert slow.meta["partial"] is True and 0 < n == len(slow.frame) < calibrated_model(long).n_samples
     assert slow.meta["overturn_time_s"] is None
     assert not list(tmp_path.glob("*.part"))
-    complete = YadeSolver(warm=False).run(_scene("specimen1_free.toml", 1.0))
+    complete = YadeSolver(warm=False).run(_scene("specimen1_free.toml", 1.0, sample_dt_s=0.01))
     m = min(n, len(complete.frame))
     for column in ("theta_rad", "omega_rad_s", "x_m", "y_m"):
         assert np.array_equal(slow.frame[column].to_numpy()[:m], complete.frame[column].to_numpy()[:m]), column
@@ -144,14 +144,15 @@ def test_a_killed_yade_run_keeps_the_samples_it_flushed(tmp_path, monkeypatch):
     samples of the last flush marked partial, and that flushed file is whole (written to a
     ``.part`` file and renamed: a kill never leaves a truncated output)."""
     monkeypatch.setattr(yade_worker, "FLUSH_PERIOD_S", 0.3)
-    long = _scene("specimen1_free.toml", 120.0, sample_dt_s=0.01)
+    long = _scene("specimen1_free.toml", 3600.0, sample_dt_s=0.01)
     holder: dict = {}
     thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="k").run(long)))
     before = _serving()
     thread.start()
+    running = tmp_path / "k.running.yade.npz"  # the run's own name until it ends
     npz = tmp_path / "k.yade.npz"
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and not ((_serving() - before) and npz.is_file()):
+    while time.monotonic() < deadline and not ((_serving() - before) and running.is_file()):
         time.sleep(0.05)
     (victim,) = _serving() - before
     time.sleep(0.5)
@@ -270,8 +271,11 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
     code = (
         "import json, sys\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.yade import YadeSolver\n"
         f"d = json.loads({json.dumps(d)!r})\ns = scene_from_dict(d)\n"
+        "long = scene_from_dict({**d, 'duration_s': 3600.0, 'sample_dt_s': 0.01})\n"
+        "r = YadeSolver(timeout_s=0.01, workdir='/tmp/kept0').run(long)\n"  # shorter than YADE's start-up
+        "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
         "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
-        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(scene_from_dict({**d, 'duration_s': 60.0}))\n"
+        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(long)\n"
         "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
     )
     # a checkout or a virtual environment under /tmp (a fresh clone in /tmp/fresh) stays
@@ -290,7 +294,7 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
     assert "RAN" in proc.stdout, proc.stdout + proc.stderr
     in_tmp, in_ours = proc.stdout.split("RAN", 1)[1].split("--")
     # kept: the workdir asked for (the timed-out run's log); nothing of YADE's
-    assert sorted(in_tmp.split()) == sorted(["kept", "ours", *needed]), in_tmp
+    assert sorted(in_tmp.split()) == sorted(["kept", "kept0", "ours", *needed]), in_tmp
     assert in_ours.split() == [], in_ours
 
 

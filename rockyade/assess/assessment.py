@@ -471,9 +471,11 @@ def add_dynamics(
     allow_large: bool = False,
     progress: bool = True,
     on_plan: Any = None,
+    journal: Any = None,
 ) -> Assessment:
     """Run the dynamic part of an assessment (module docstring) and attach it; the same
-    assessment back.
+    assessment back. ``journal``: where each run is written as it ends, and read back on a
+    resume (:func:`rockyade.assess.fragility.run_fragility`).
 
     Raises
     ------
@@ -490,7 +492,7 @@ def add_dynamics(
     plan = dynamic_plan(scene, assessment.site, settings, executor, progress)
     if on_plan is not None:
         on_plan(plan)
-    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress)
+    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress, journal=journal)
     return assessment
 
 

@@ -45,8 +45,9 @@ from rockyade.assess.stripes import (
     runs_frame,
 )
 from rockyade.constants import G
-from rockyade.errors import InputError, RockyadeError
+from rockyade.errors import BatchInterruptedError, InputError, RockyadeError
 from rockyade.runner import Executor
+from rockyade.runner.journal import Journal
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import Solver
@@ -355,20 +356,39 @@ def run_fragility(
     allow_large: bool = False,
     progress: bool = True,
     on_round: Callable[[str], None] | None = None,
+    journal: Journal | None = None,
 ) -> FragilityResult:
     """Run the stripes (extending them as the plan says), fit and return the result.
+
+    With a ``journal`` each run is written there as it ends, and a run it holds from an
+    earlier, interrupted analysis of the same plan is read back rather than run
+    (:func:`rockyade.assess.stripes.run_stripes`).
 
     Raises
     ------
     InputError
         A run above the runner's cost limits (``allow_large`` lifts them).
     BatchInterruptedError
-        Ctrl-C; its ``rows`` are the runs that finished.
+        Ctrl-C; its ``rows`` are the runs that finished, its ``plan`` this plan.
     """
-    executor = executor or Executor("local", 2)
+    try:
+        return _run_fragility(plan, executor or Executor("local", 2), allow_large, progress, on_round, journal)
+    except BatchInterruptedError as exc:
+        exc.plan = plan  # type: ignore[attr-defined]  # its rows read with the plan's measure
+        raise
+
+
+def _run_fragility(
+    plan: FragilityPlan,
+    executor: Executor,
+    allow_large: bool,
+    progress: bool,
+    on_round: Callable[[str], None] | None,
+    journal: Journal | None,
+) -> FragilityResult:
     m = plan.measure
     levels = list(plan.levels_si)
-    rows = run_stripes(plan.stripes, levels, executor, allow_large=allow_large, progress=progress)
+    rows = run_stripes(plan.stripes, levels, executor, allow_large=allow_large, progress=progress, journal=journal)
     added: list[float] = []
     for _ in range(MAX_EXTRA_LEVELS if plan.extend else 0):
         table = stripe_table(runs_frame(rows, m), m.si_column)
@@ -391,6 +411,7 @@ def run_fragility(
             allow_large=allow_large,
             progress=progress,
             done_rows=rows,
+            journal=journal,
         )
     runs = runs_frame(rows, m)
     stripes = stripe_table(runs, m.si_column)

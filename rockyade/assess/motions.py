@@ -8,7 +8,9 @@ cache where the run happens). **A load factor multiplies the record's accelerati
 read** (after the conversion of the file's units to m/s^2; nothing else is done to them).
 
 * :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt`` and ``.dat`` file of a folder,
-  sorted by name (the same accelerogram twice, e.g. an ``.AT2`` and its ``.csv``, is refused);
+  sorted by name (the same accelerogram twice, e.g. an ``.AT2`` and its ``.csv``, is refused;
+  a link to a record file is followed and counted, a link to anything else refused:
+  :func:`record_files`);
 * :func:`ec8_suite`: a suite compatible with the EC8 spectrum of a spectrum type, ground type
   and ag; :func:`paper_suite_set`: the paper's suite (Type 2, ground D, ag S = 2.8 m/s^2).
 """
@@ -16,6 +18,7 @@ read** (after the conversion of the file's units to m/s^2; nothing else is done 
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -147,9 +150,7 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
     path = Path(folder)
     if not path.is_dir():
         raise InputError(field, f"{path} is not a folder of record files")
-    files = sorted(
-        p for p in path.iterdir() if p.suffix.lower() in RECORD_SUFFIXES and p.is_file() and not p.is_symlink()
-    )
+    files = record_files(path, field)
     if not files:
         raise InputError(field, f"no record file ({', '.join(RECORD_SUFFIXES)}) in {path}")
     if len(files) > MAX_RECORDS:
@@ -160,6 +161,28 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
     read = [records.record(i) for i in range(records.count)]
     _refuse_duplicates(read, [f.name for f in files], field)
     return records
+
+
+def record_files(folder: Path, field: str = "--records") -> list[Path]:
+    """The record files of a folder, sorted by name: its files whose names end in one of
+    :data:`RECORD_SUFFIXES`. A symbolic link to a regular file is followed and counted as
+    the file it names (a folder of links to a shared set of records reads as that set); a link
+    to anything else (a folder, nothing) is refused, naming it.
+
+    Raises
+    ------
+    InputError
+        A record link that does not lead to a regular file.
+    """
+    files = []
+    for p in sorted(folder.iterdir()):
+        if p.suffix.lower() not in RECORD_SUFFIXES:
+            continue
+        if p.is_symlink() and not p.is_file():
+            raise InputError(field, f"{p} is a link to {os.readlink(p)}, not to a record file: remove it or fix it")
+        if p.is_file():
+            files.append(p)
+    return files
 
 
 def _refuse_duplicates(records: Sequence[Record], names: Sequence[str], field: str) -> None:

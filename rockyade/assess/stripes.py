@@ -44,6 +44,7 @@ from rockyade.assess.motions import MotionSet, record_summary
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.result import Result
 from rockyade.runner import Executor, Task, run_jobs, run_tasks
+from rockyade.runner.journal import Journal
 from rockyade.runner.tasks import solve
 from rockyade.scene import Scene
 from rockyade.solvers.base import Solver
@@ -309,6 +310,11 @@ def record_measures(
     return pd.DataFrame(outcome.in_order())
 
 
+def run_name(task: StripeTask) -> str:
+    """A run's name in a journal: its scene's hash and its solver."""
+    return f"{task.scene_hash}_{task.solver.name}"
+
+
 def run_stripes(
     plan: StripePlan,
     levels_si: Sequence[float],
@@ -318,8 +324,12 @@ def run_stripes(
     allow_large: bool = False,
     progress: bool = True,
     done_rows: Sequence[dict[str, Any]] = (),
+    journal: Journal | None = None,
 ) -> list[dict[str, Any]]:
     """Run every record at every level; the rows in task order.
+
+    With a ``journal`` (:class:`rockyade.runner.journal.Journal`) a run finished earlier is
+    not run again (its row is read back) and each run's row is written there as it ends.
 
     Raises
     ------
@@ -330,16 +340,32 @@ def run_stripes(
         Ctrl-C (``done_rows`` and what finished are in its ``rows``).
     """
     tasks = plan.tasks(levels_si, first_index)
+    earlier: dict[int, dict[str, Any]] = {}
+    if journal is not None:
+        for task in tasks:
+            row = journal.done(run_name(task), task.scene_hash)
+            if row is not None:
+                earlier[task.index] = {**row, "run": task.index}
+    todo = [t for t in tasks if t.index not in earlier]
+
+    def on_done(i: int, row: dict[str, Any]) -> None:
+        if journal is not None:
+            task = todo[i]
+            journal.record(run_name(task), {"status": row["status"], "scene_hash": task.scene_hash, "summary": row})
+
     outcome = run_tasks(
-        tasks,
+        todo,
         run_stripe_task,
         executor=executor,
         allow_large=allow_large,
         failed=failed_row,
+        on_done=on_done,
         progress=progress,
         desc="runs",
+        skipped=len(earlier),
     )
-    rows = [outcome.values[i] for i in sorted(outcome.values)]
+    by_index = {**earlier, **{todo[i].index: row for i, row in outcome.values.items()}}
+    rows = [by_index[k] for k in sorted(by_index)]
     if outcome.unfinished:
         error = BatchInterruptedError(len(done_rows) + len(rows), len(outcome.unfinished), None, outcome.hard)
         error.rows = [*done_rows, *rows]  # type: ignore[attr-defined]

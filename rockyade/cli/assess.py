@@ -20,6 +20,7 @@ from rockyade.cli.fragility import (
     solver_from,
     write_tables,
 )
+from rockyade.cli.resumable import write_partial
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
@@ -120,9 +121,10 @@ def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
 def cmd_assess(args: argparse.Namespace) -> int:
     """The checks, the dynamics, the text (or JSON), and with --out the files."""
     from rockyade.assess import assess
-    from rockyade.assess.assessment import add_dynamics
     from rockyade.assess.code import check_code
-    from rockyade.assess.report import assessment_lines, dynamic_lines
+    from rockyade.assess.report import assessment_lines
+    from rockyade.cli.resumable import file_digest, finish, identity, study_output
+    from rockyade.errors import BatchInterruptedError
     from rockyade.limit.kinematic import check_fc
     from rockyade.limit.model import check_friction_angle
     from rockyade.scene import load_scene
@@ -130,6 +132,8 @@ def cmd_assess(args: argparse.Namespace) -> int:
     check_code(args.code)
     if args.out is not None:
         check_output_dir(args.out, "--out")
+    elif args.resume:
+        raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
     try:
         fc = check_fc(args.fc)
     except InputError as exc:
@@ -163,22 +167,90 @@ def cmd_assess(args: argparse.Namespace) -> int:
     )
     if not args.json:
         print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
+    data: dict[str, Any]
+    if dynamic is not None and args.out is not None:
+        with study_output(args.out, identity("assess", args, file_digest(args.scene)), args.resume, ASSESS_SET,
+                          ASSESS_LAST) as output:
+            try:
+                _dynamics(args, result, scene, dynamic, executor, output.journal)
+            except BatchInterruptedError as exc:
+                _interrupted(args, result, exc, output)
+                raise type(exc)(exc.finished, exc.unfinished, exc.summary_path, exc.hard) from None
+            if output.journal.resumed and not args.json:
+                print(f"resumed: {output.journal.resumed} run(s) read back from {output.partial}, not run again")
+            data = _finish(args, result, scene)
+            _write(args, result, data)
+            finish(output)
+        return 0
     if dynamic is not None:
+        try:
+            _dynamics(args, result, scene, dynamic, executor, None)
+        except BatchInterruptedError as exc:
+            if args.json:  # the static answer, kept
+                json_out({**_static_data(args, result), "partial": True})
+            raise type(exc)(exc.finished, exc.unfinished, None, exc.hard, "--out DIR (then --resume)") from None
+    data = _finish(args, result, scene)
+    if args.out is not None:
+        with study_output(args.out, identity("assess", args, file_digest(args.scene)), False, ASSESS_SET,
+                          ASSESS_LAST) as output:
+            _write(args, result, data)
+            finish(output)
+    return 0
 
-        def on_plan(plan: Any) -> None:
-            if not args.json:
-                print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
-                print_plan(plan, args.workers, indent="  ")
 
-        add_dynamics(
-            result,
-            scene,
-            dynamic,
-            executor,
-            allow_large=args.allow_large,
-            progress=not args.quiet,
-            on_plan=on_plan,
-        )
+#: The files of an assessment's result set, and the one that marks it complete (last in).
+ASSESS_SET = ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json")
+ASSESS_LAST = "assess.json"
+
+
+def _dynamics(args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, journal: Any) -> None:
+    from rockyade.assess.assessment import add_dynamics
+
+    def on_plan(plan: Any) -> None:
+        if not args.json:
+            print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
+            print_plan(plan, args.workers, indent="  ")
+
+    add_dynamics(
+        result,
+        scene,
+        dynamic,
+        executor,
+        allow_large=args.allow_large,
+        progress=not args.quiet,
+        on_plan=on_plan,
+        journal=journal,
+    )
+
+
+def _static_data(args: argparse.Namespace, result: Any) -> dict[str, Any]:
+    data: dict[str, Any] = result.to_dict()
+    data["scene"] = str(args.scene)
+    return data
+
+
+def _interrupted(args: argparse.Namespace, result: Any, exc: Any, output: Any) -> None:
+    """After Ctrl-C: the static answer (``partial/assess.json``, marked partial) and the runs
+    that finished (``partial/runs.csv``), for ``--resume`` to go on from."""
+    from rockyade.assess.stripes import runs_frame
+    from rockyade.io.atomic import write_json
+
+    data = {**_static_data(args, result), "partial": True,
+            "dynamic_interrupted": {"finished": exc.finished, "unfinished": exc.unfinished}}
+    write_json(output.partial / "assess.json", data)
+    rows = getattr(exc, "rows", [])
+    plan = getattr(exc, "plan", None)
+    exc.summary_path = str(output.partial / "assess.json")
+    if rows and plan is not None:  # the message names the runs' list (the static answer is beside it)
+        exc.summary_path = str(write_partial(output, runs_frame(rows, plan.measure), data["dynamic_interrupted"]))
+    if args.json:
+        json_out(data)
+
+
+def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, Any]:
+    """The pushover, the dynamics' text, the JSON."""
+    from rockyade.assess.report import dynamic_lines
+
     if args.pushover:
         from rockyade.assess.assessment import add_pushover
         from rockyade.assess.report import pushover_lines
@@ -188,30 +260,27 @@ def cmd_assess(args: argparse.Namespace) -> int:
             print("\n".join(pushover_lines(result)), flush=True)
     if not args.json:
         print("\n".join(dynamic_lines(result)))
-    data = result.to_dict()
-    data["scene"] = str(args.scene)
+    data = _static_data(args, result)
     if args.json:
         json_out(data)
-    if args.out is not None:
-        _write(args, result, data)
-    return 0
+    return data
 
 
 def _write(args: argparse.Namespace, result: Any, data: dict[str, Any]) -> None:
+    """The result set, replaced as a whole (:mod:`rockyade.io.resultset`)."""
     from rockyade.figures.assess import draw_assessment
     from rockyade.io.atomic import write_json
-    from rockyade.io.locking import output_lock
+    from rockyade.io.resultset import replacing_set
 
     out: Path = args.out
-    out.mkdir(parents=True, exist_ok=True)
-    with output_lock(out, "--out"):
+    with replacing_set(out, ASSESS_SET, ASSESS_LAST) as stage:
         written = []
         if result.dynamic is not None:
-            written += write_tables(out, result.dynamic)
-        write_json(out / "assess.json", data)
-        written.append("assess.json")
-        draw_assessment(result, out / "assess.png", title=args.scene.name)
+            written += write_tables(stage, result.dynamic)
+        draw_assessment(result, stage / "assess.png", title=args.scene.name)
         written.append("assess.png")
+        write_json(stage / "assess.json", data)
+        written.append("assess.json")
     print_wrote(Path(f"{', '.join(written)} in {out}"), args.json)
 
 

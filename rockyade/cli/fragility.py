@@ -34,13 +34,10 @@ def float_list(text: str, option: str) -> tuple[float, ...]:
 
 
 def executor_from(args: argparse.Namespace) -> Executor:
-    """Local worker processes (``--workers``)."""
-    from rockyade.runner import Executor
+    """The executor of ``--executor``, ``--workers`` and ``--scheduler`` (as ``batch``)."""
+    from rockyade.cli.resumable import executor_from as from_args
 
-    try:
-        return Executor("local", args.workers)
-    except InputError as exc:
-        raise InputError("--workers", exc.message) from None
+    return from_args(args)
 
 
 def solver_from(args: argparse.Namespace) -> Solver | None:
@@ -91,6 +88,7 @@ def refuse_suite_options_with_records(args: argparse.Namespace) -> None:
 
 def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
     """Options shared by ``fragility`` and ``assess``: solver, workers, records, collapse, sampling."""
+    from rockyade.cli.resumable import add_executor_options
     from rockyade.cli.run import add_yade_timeout
 
     p.add_argument(
@@ -99,7 +97,7 @@ def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
         help="housner, reference or yade (default: housner for a single block, the reference DEM otherwise)",
     )
     add_yade_timeout(p)
-    p.add_argument("--workers", type=int, default=2, help="local worker processes (default 2)")
+    add_executor_options(p)
     p.add_argument("--count", type=int, help=count_help)
     p.add_argument("--seed", type=int, help=f"seed of the synthetic suite (default {DEFAULT_SEED})")
     p.add_argument("--units", help="units of record files that do not name theirs: g, m/s2, cm/s2 (default m/s2)")
@@ -140,12 +138,21 @@ def write_tables(out: Path, result: FragilityResult, prefix: str = "") -> list[s
     return names
 
 
+#: The files of a fragility result set, and the one that marks it complete (last in).
+FRAGILITY_SET = ("runs.csv", "stripes.csv", "records.csv", "fragility.png", "fragility.json")
+FRAGILITY_LAST = "fragility.json"
+
+
 def cmd_fragility(args: argparse.Namespace) -> int:
-    """Run the stripes, fit the curve, write the CSVs, JSON and figure."""
+    """Run the stripes, fit the curve, write the CSVs, JSON and figure (a set replaced as a
+    whole); Ctrl-C writes a partial summary that ``--resume`` goes on from."""
     from rockyade.assess import fragility_plan, parse_measure, records_in_folder, run_fragility
     from rockyade.assess.report import fit_lines
+    from rockyade.assess.stripes import runs_frame
+    from rockyade.cli.resumable import file_digest, finish, identity, study_output, write_partial
+    from rockyade.errors import BatchInterruptedError
     from rockyade.io.atomic import write_json
-    from rockyade.io.locking import output_lock
+    from rockyade.io.resultset import replacing_set
     from rockyade.scene import load_scene
 
     check_output_dir(args.out, "--out")
@@ -164,35 +171,56 @@ def cmd_fragility(args: argparse.Namespace) -> int:
             raise InputError("--units", "applies to --records")
         motions = suite_from(args)
     scene = load_scene(args.scene)
-    args.out.mkdir(parents=True, exist_ok=True)
-    with output_lock(args.out, "--out"):
-        plan = fragility_plan(
-            scene,
-            motions,
-            measure,
-            solver,
-            levels=levels,
-            extend=False if args.no_extend else None,
-            executor=executor,
-            fallen_blocks=args.fallen_blocks,
-            sample_dt_s=args.sample_dt,
-            tail_s=args.tail,
-            progress=not args.quiet,
-        )
+    # every check (the levels' load factors included) before --out is made
+    plan = fragility_plan(
+        scene,
+        motions,
+        measure,
+        solver,
+        levels=levels,
+        extend=False if args.no_extend else None,
+        executor=executor,
+        fallen_blocks=args.fallen_blocks,
+        sample_dt_s=args.sample_dt,
+        tail_s=args.tail,
+        progress=not args.quiet,
+    )
+    ident = identity("fragility", args, file_digest(args.scene))
+    with study_output(args.out, ident, args.resume, FRAGILITY_SET, FRAGILITY_LAST) as output:
         print(f"fragility of {args.scene}")
         print_plan(plan, args.workers)
-        result = run_fragility(plan, executor, allow_large=args.allow_large, progress=not args.quiet, on_round=print)
+        try:
+            result = run_fragility(
+                plan,
+                executor,
+                allow_large=args.allow_large,
+                progress=not args.quiet,
+                on_round=print,
+                journal=output.journal,
+            )
+        except BatchInterruptedError as exc:
+            rows = getattr(exc, "rows", [])
+            if rows:
+                exc.summary_path = str(
+                    write_partial(output, runs_frame(rows, plan.measure), {"finished": exc.finished,
+                                                                          "unfinished": exc.unfinished})
+                )
+            raise type(exc)(exc.finished, exc.unfinished, exc.summary_path, exc.hard) from None
+        if output.journal.resumed:
+            print(f"resumed: {output.journal.resumed} run(s) read back from {output.partial}, not run again")
         for line in fit_lines(result):
             print(line)
-        written = write_tables(args.out, result)
-        data = result.to_dict()
-        data["scene"] = str(args.scene)
-        write_json(args.out / "fragility.json", data)
-        written.append("fragility.json")
         from rockyade.figures.assess import draw_fragility
 
-        draw_fragility(result, args.out / "fragility.png", title=f"{args.scene.name}: collapse fragility")
-        written.append("fragility.png")
+        with replacing_set(args.out, FRAGILITY_SET, FRAGILITY_LAST) as stage:
+            written = write_tables(stage, result)
+            data = result.to_dict()
+            data["scene"] = str(args.scene)
+            draw_fragility(result, stage / "fragility.png", title=f"{args.scene.name}: collapse fragility")
+            written.append("fragility.png")
+            write_json(stage / "fragility.json", data)
+            written.append("fragility.json")
+        finish(output)
     print(f"wrote {', '.join(written)} in {args.out}")
     return 1 if result.failed else 0
 
@@ -203,11 +231,13 @@ def register(sub: Any) -> None:
         "fragility",
         help="collapse fragility of a scene: records scaled to stripes of PGA, PGV or Sa(T), lognormal fit",
         description="Replace the scene's motion by each record scaled (a load factor on its accelerations as read) "
-        "to stripes of an intensity measure, run every run through the runner (local processes), count the runs "
-        "that collapse (a single block: overturned; several blocks: --fallen-blocks fell) and fit a lognormal "
-        "curve by maximum likelihood with a bootstrap band over the records. Writes runs.csv, stripes.csv, "
-        "records.csv, fragility.json and fragility.png in --out. Exit 0, 1 when a run failed or the scene cannot "
-        "stand, 2 on bad input. See docs/howto/is-this-wall-safe.md.",
+        "to stripes of an intensity measure, run every run through the runner (local processes, or Dask: "
+        "--executor), count the runs that collapse (a single block: overturned; several blocks: --fallen-blocks "
+        "fell) and fit a lognormal curve by maximum likelihood with a bootstrap band over the records. Writes "
+        "runs.csv, stripes.csv, records.csv, fragility.json and fragility.png in --out, a set replaced as a whole; "
+        "each run is written to --out/partial/ as it ends, Ctrl-C leaves a partial summary there and --resume goes "
+        "on from it. Exit 0, 1 when a run failed or the scene cannot stand, 2 on bad input. See "
+        "docs/howto/is-this-wall-safe.md.",
     )
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
     source = p.add_mutually_exclusive_group(required=True)

@@ -120,6 +120,7 @@ def cmd_batch(args: argparse.Namespace) -> int:
         progress=not args.quiet,
         desc=study.name,
         allow_large=args.allow_large,
+        identity={"command": "batch", "study": study.name},  # runs are found by scene hash and solver
     )
     failed = failures(summary)
     counts = summary["status"].value_counts().to_dict()

@@ -35,6 +35,7 @@ def cmd_uncertainty(args: argparse.Namespace) -> int:
         executor=args.executor,
         workers=args.workers,
         scheduler=args.scheduler,
+        scheduler_timeout_s=args.scheduler_timeout,
         resume=args.resume,
         progress=not args.quiet,
         accel_unit=args.accel_units,
@@ -97,8 +98,17 @@ def register(sub: Any) -> None:
     p.add_argument("--seed", type=int, help="override the seed of the Latin hypercube")
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or a Dask cluster")
-    p.add_argument("--scheduler", help="Dask scheduler address (default: an in-process cluster)")
-    p.add_argument("--resume", action="store_true", help="skip runs already completed")
+    p.add_argument(
+        "--scheduler",
+        help="Dask scheduler address, e.g. tls://host:8786 (default: Dask's threaded scheduler in this "
+        "process; no port opens). See docs/batches.md",
+    )
+    p.add_argument(
+        "--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)"
+    )
+    p.add_argument(
+        "--resume", action="store_true", help="skip runs already completed by an interrupted run of the same study"
+    )
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
         "--accel-units",

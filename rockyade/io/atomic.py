@@ -95,6 +95,12 @@ def staged_file(
             os.fchmod(fh.fileno(), file_mode())
             if durable:
                 os.fsync(fh.fileno())
+    except OSError as exc:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        if exc.filename is None:  # a write on a full disk names no file: the message names it
+            exc.filename = str(dest)
+        raise
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()

@@ -318,7 +318,7 @@ def suite_record(spec: SuiteSpec, index: int) -> Record:
     except FileNotFoundError:
         pass
     except CacheDamagedError as exc:
-        _note(f"{path}: {exc}: regenerated")
+        _note_once(path, f"{path}: {exc}: regenerated")
     record = generate_record(spec, index)
     trouble = record_problem(record.t_s, record.accel_m_s2)
     if trouble:
@@ -399,10 +399,11 @@ def _read_plain_file(path: Path) -> bytes:
         if exc.errno == errno.ENOTDIR:
             raise CacheDamagedError("a folder on its path is a file") from None
         raise CacheDamagedError(f"cannot be read ({exc.strerror or exc})") from None
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):  # checked on the descriptor: a folder does not even open as a file
+        os.close(fd)
+        raise CacheDamagedError("a folder, not a cache file" if stat.S_ISDIR(info.st_mode) else "not a plain file")
     with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fh.fileno())
-        if not stat.S_ISREG(info.st_mode):
-            raise CacheDamagedError("not a plain file")
         if info.st_size > MAX_CACHE_BYTES:
             raise CacheDamagedError(f"{info.st_size} bytes, more than the {MAX_CACHE_BYTES} a cache file may have")
         return fh.read(MAX_CACHE_BYTES + 1)
@@ -473,6 +474,17 @@ def _warn_once(where: Path, message: str) -> None:
 
 def _note(message: str) -> None:
     print(f"rockyade: note: {message}", file=sys.stderr)
+
+
+_NOTED: set[str] = set()
+
+
+def _note_once(where: Path, message: str) -> None:
+    """One note per cache file and process (a cache that cannot be rewritten finds the same
+    damaged file at every read)."""
+    if str(where) not in _NOTED:
+        _NOTED.add(str(where))
+        _note(message)
 
 
 def generate_suite(spec: SuiteSpec) -> list[Record]:

@@ -8,7 +8,9 @@ cancels what has not finished. Dask is optional: ``pip install 'rockyade[dask]'`
 
 from __future__ import annotations
 
+import queue
 import re
+import threading
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -58,17 +60,46 @@ def run_dask_in_process(
         started.add(i)
         return i, call(fn, jobs[i], failed)
 
+    finished: queue.Queue[Any] = queue.Queue()
+    end = object()
+    errors: list[BaseException] = []
+
     def posttask(key: Any, value: Any, dsk: Any, state: Any, worker_id: Any) -> None:
         if value is not unfinished:
-            done(*value)
+            finished.put(value)
+
+    def drive() -> None:
+        try:
+            with Callback(posttask=posttask):
+                dask.threaded.get(graph, list(graph), pool=pool)
+        except BaseException as exc:  # handed to the calling thread
+            errors.append(exc)
+        finally:
+            finished.put(end)
 
     # the graph's arguments are positions: Dask never looks inside a job
     graph = {f"run-{i}": (guarded, i) for i in range(len(jobs))}
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-dask")
     clean = False
     try:
-        with Callback(posttask=posttask):
-            dask.threaded.get(graph, list(graph), pool=pool)
+        # Dask's scheduler waits in a thread of its own; this thread takes each finished job
+        # (``done`` runs here) and, after a second Ctrl-C, stops at its next wait (a safe point:
+        # the signal handler never raises)
+        # not a daemon: neither are the pool's threads it starts, which the command line then
+        # sees as busy after a second Ctrl-C and ends the process without waiting for them
+        threading.Thread(target=drive, name="rockyade-dask-get", daemon=False).start()
+        while True:
+            try:
+                item = finished.get(timeout=0.1)
+            except queue.Empty:
+                if stop.now:
+                    raise KeyboardInterrupt from None
+                continue
+            if item is end:
+                break
+            done(*item)
+        if errors:
+            raise errors[0]
         clean = True
     finally:
         # after a second Ctrl-C the running jobs are threads that cannot be killed: the

@@ -16,8 +16,10 @@ class StopRequest:
     Parameters
     ----------
     raise_on_second
-        Raise KeyboardInterrupt on the second Ctrl-C (executors whose runs are threads of
-        this process cannot be killed: the caller then ends the process).
+        The runs are threads of this process (they cannot be killed): after the second
+        Ctrl-C the run loops raise KeyboardInterrupt at their next safe point (between two
+        waits; a run in the calling thread first finishes) for the caller to end the
+        process, and a third Ctrl-C is Python's own. The handler itself never raises.
     """
 
     def __init__(self, raise_on_second: bool = False) -> None:
@@ -38,14 +40,24 @@ class StopRequest:
         return self.count >= 2
 
     def _handler(self, signum: int, frame: Any) -> None:
+        # never raises: an exception raised here would surface at an arbitrary point of the
+        # main thread (inside a C call it reads as "SystemError: ... returned a result with
+        # an exception set"); the run loops read the count at their own safe points
         self.count += 1
         self.event.set()
         if self.count == 1:
             say("Ctrl-C: no new run starts; waiting for the running runs to finish (Ctrl-C again stops them now)")
         elif self.count == 2:
-            say("Ctrl-C again: stopping the running runs now")
             if self.raise_on_second:
-                raise KeyboardInterrupt
+                say(
+                    "Ctrl-C again: stopping the running runs now (a run in this thread cannot be stopped safely "
+                    "and finishes first; Ctrl-C a third time interrupts it at once)"
+                )
+                if self._installed:  # the next Ctrl-C is Python's own KeyboardInterrupt
+                    signal.signal(signal.SIGINT, self._previous)
+                    self._installed = False
+            else:
+                say("Ctrl-C again: stopping the running runs now")
 
     def __enter__(self) -> StopRequest:
         if threading.current_thread() is threading.main_thread():

@@ -2,8 +2,9 @@
 
 The numba kernels release the GIL and a YADE run is a process of its own, so threads run
 solvers in parallel without the cost of worker processes (and ``fn`` need not pickle).
-Threads cannot be killed: after a second Ctrl-C the caller ends the process
-(:class:`~rockyade.runner.stopping.StopRequest` raises KeyboardInterrupt for it).
+Threads cannot be killed: after a second Ctrl-C the loop raises KeyboardInterrupt at its
+next wait and the caller ends the process (:class:`~rockyade.runner.stopping.StopRequest`
+only counts; it never raises from the signal handler).
 """
 
 from __future__ import annotations
@@ -64,6 +65,8 @@ def run_threads(
             finished, _ = wait(running, timeout=0.2, return_when=FIRST_COMPLETED)
             for future in finished:
                 done(running.pop(future), future.result())
+            if stop.now and running:  # a safe point: the running threads are abandoned
+                raise KeyboardInterrupt
         clean = True
     finally:
         pool.shutdown(wait=clean, cancel_futures=True)

@@ -21,13 +21,14 @@ summary (``summary.csv``, and ``summary.parquet`` when pyarrow is installed) has
 run: the grid values, status, failure reason, wall time and per-block metrics (see
 :func:`rockyade.analysis.run_metrics`, and the rocking pattern for stacks).
 
-A run's JSON is written atomically (a killed batch leaves whole files or none) but not synced
-to the disk by itself: the batch syncs once, at the summary checkpoint (after a power cut,
-a run whose file did not reach the disk is run again by ``resume``).
+A run's JSON is its record in the journal of finished runs that every study command shares
+(:mod:`rockyade.runner.journal`): written atomically and fsynced, file and folder, as the run
+ends (a killed batch, or a power cut, leaves whole records or none).
 
 A failed run never stops the batch: its row says why (a full disk too: the run fails with
 that reason and the batch goes on). ``resume`` skips runs whose JSON says they completed
-(or overturned) for the same scene hash and re-runs failed ones. The summary is sorted by
+(or overturned) for the same scene hash and re-runs failed ones
+(:func:`rockyade.runner.journal.read_run`). The summary is sorted by
 run order, so the same inputs give the same summary on any executor (wall times aside).
 
 The runs go through :mod:`rockyade.runner`: costs checked before any run (``allow_large``
@@ -44,7 +45,6 @@ import contextlib
 import copy
 import itertools
 import json
-import os
 import time
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, replace
@@ -55,14 +55,16 @@ import numpy as np
 import pandas as pd
 
 from rockyade.errors import BatchInterruptedError, InputError, os_error_message
-from rockyade.io.atomic import atomic_open, remove_stale_temporaries, write_json
+from rockyade.io.atomic import atomic_open, remove_stale_temporaries
 from rockyade.io.fields import TableReader
+from rockyade.io.folders import output_folder
 from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.motion.types import RecordMotion
 from rockyade.result import Result
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.runner.groups import group_jobs
+from rockyade.runner.journal import claim, read_run, write_run
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
 from rockyade.solvers.base import Solver
@@ -436,7 +438,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
         if task.save_history and result.ok:
             result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
         else:
-            write_json(runs / f"{name}.json", {**result.meta, "summary": row}, durable=False)
+            write_run(runs, name, {**result.meta, "summary": row})
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = _write_failure(task, row, exc)
     return row
@@ -529,7 +531,7 @@ def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
             )
         row["elapsed_s"] = elapsed
         try:
-            write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row}, durable=False)
+            write_run(folder, row["run"], {**one.meta, "summary": row})
         except OSError as exc:
             row = _write_failure(task, row, exc)
         rows.append(row)
@@ -572,21 +574,14 @@ def _write_failure(task: BatchTask, row: dict[str, Any], exc: OSError) -> dict[s
 
 
 def _completed_row(task: BatchTask) -> dict[str, Any] | None:
-    """The summary row of a run already completed (or overturned) for the same scene."""
-    path = Path(task.out_dir) / "runs" / f"{run_name(task.scene_hash, task.solver.name)}.json"
-    if not path.is_file():
+    """The summary row of a run already completed (or overturned) for the same scene
+    (:func:`rockyade.runner.journal.read_run`)."""
+    row = read_run(Path(task.out_dir) / "runs", run_name(task.scene_hash, task.solver.name), task.scene_hash)
+    if row is None:
         return None
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, json.JSONDecodeError):
-        return None
-    same = data.get("scene_hash") == task.scene_hash and "summary" in data
-    if data.get("status") in ("completed", "overturned") and same:
-        row = dict(data["summary"])
-        row["index"] = task.index
-        row.update(task.labels)
-        return row
-    return None
+    row["index"] = task.index
+    row.update(task.labels)
+    return row
 
 
 def _placeholder_row(task: BatchTask, status: str, reason: str) -> dict[str, Any]:
@@ -629,6 +624,8 @@ def run_study_tasks(
     allow_large: bool = False,
     scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
     group_runs: bool = True,
+    identity: Mapping[str, Any] | None = None,
+    resume_option: str | None = "--resume",
 ) -> pd.DataFrame:
     """Run tasks and write the summary; return it (sorted by task order).
 
@@ -643,6 +640,11 @@ def run_study_tasks(
         Skip runs already completed for the same scene hash; re-run failed ones.
     allow_large
         Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost`.
+    resume_option
+        The caller's option that resumes, named after Ctrl-C (None: it cannot resume).
+    identity
+        What study this is (:func:`rockyade.runner.journal.claim`: ``study.json`` in ``out_dir``);
+        ``resume`` over the runs of another is refused. None: not checked.
     group_runs
         Run the runs that share a structure together (:func:`job_key`, :func:`run_job`; the
         same rows); False: one run per job (benchmarks compare the two).
@@ -650,18 +652,28 @@ def run_study_tasks(
     Raises
     ------
     InputError
-        Bad settings, a run above the cost limits, an output another batch is writing.
+        Bad settings, a run above the cost limits, an output another batch is writing,
+        ``resume`` over the runs of another study (``identity``).
     BatchInterruptedError
         After Ctrl-C, once the summary of what finished is written.
     """
     how = executor if isinstance(executor, Executor) else Executor(executor, workers, scheduler, scheduler_timeout_s)
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    with output_lock(out, "out"):
+    with output_folder(out), output_lock(out, "out"):  # an error before any run leaves no empty folder
         token = lock_token(out)
         _settle(out)
+        if identity is not None:
+            claim(out, identity, resume)
         return _run_locked(
-            [replace(t, lock_token=token) for t in tasks], out, how, resume, progress, desc, allow_large, group_runs
+            [replace(t, lock_token=token) for t in tasks],
+            out,
+            how,
+            resume,
+            progress,
+            desc,
+            allow_large,
+            group_runs,
+            resume_option,
         )
 
 
@@ -683,6 +695,7 @@ def _run_locked(
     desc: str,
     allow_large: bool,
     group_runs: bool = True,
+    resume_option: str | None = "--resume",
 ) -> pd.DataFrame:
     first, duplicates = _distinct(tasks)
     rows: list[dict[str, Any]] = []
@@ -717,14 +730,15 @@ def _run_locked(
     for row in rows:
         row.setdefault("duplicate_of", -1)
     summary = _ordered(pd.DataFrame(rows).sort_values("index").reset_index(drop=True), tasks)
-    os.sync()  # the runs' files reach the disk here, once, not at each run
     write_summary(summary, out)
     if outcome.stopped:
         if outcome.hard:
             _settle(out)
         stopped = {task.index for i in outcome.unfinished for task in jobs[i]}
         unfinished = len(stopped) + sum(1 for _task, original in duplicates if original.index in stopped)
-        raise BatchInterruptedError(len(tasks) - unfinished, unfinished, str(out / "summary.csv"), hard=outcome.hard)
+        raise BatchInterruptedError(
+            len(tasks) - unfinished, unfinished, str(out / "summary.csv"), outcome.hard, resume_option
+        )
     return summary
 
 

@@ -149,7 +149,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str
     )
     prepare()
     runs = report.out / "fragility_runs"
-    summary = run_study_tasks(tasks(runs), runs, workers=workers, desc="fragility")
+    summary = run_study_tasks(tasks(runs), runs, workers=workers, desc="fragility", resume_option=None)
     if use_yade:
         subset = tasks(
             report.out / "fragility_yade_runs",
@@ -159,7 +159,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str
             ("yade",),
         )
         yade_summary = run_study_tasks(
-            subset, report.out / "fragility_yade_runs", workers=workers, desc="fragility (YADE)"
+            subset, report.out / "fragility_yade_runs", workers=workers, desc="fragility (YADE)", resume_option=None
         )
         summary = pd.concat([summary, yade_summary], ignore_index=True)
     report.record_summary(

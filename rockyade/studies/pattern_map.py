@@ -76,7 +76,9 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
         replace(t, index=i, labels={**t.labels, "frequency_hz": _frequency_hz(t.scene.motion)}, save_history=False)
         for i, t in enumerate(tasks)
     ]
-    summary = run_study_tasks(tasks, report.out / "pattern_map_runs", workers=workers, desc="pattern map")
+    summary = run_study_tasks(
+        tasks, report.out / "pattern_map_runs", workers=workers, desc="pattern map", resume_option=None
+    )
     report.record_summary(summary, lambda row: f"{row['frequency_hz']:g} Hz, {row['motion.amplitude_mm']:g} mm")
     report.note(f"Ran: reference DEM, {run_state(report, 'reference', len(summary))}.")
     cells = summary[["frequency_hz", "motion.amplitude_mm", "status", "pattern"]].rename(

@@ -64,7 +64,10 @@ import pandas as pd
 from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open, write_json
 from rockyade.io.fields import TableReader
+from rockyade.io.locking import output_lock
+from rockyade.io.resultset import replacing_set
 from rockyade.motion.intensity import INTENSITY_MEASURES, check_measure, intensity_measures, scaled
+from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.solvers import solver_names
 from rockyade.studies.batch import BatchTask, batch_task, run_study_tasks
 from rockyade.studies.sampling import (
@@ -416,6 +419,7 @@ def run_uncertainty(
     executor: str = "local",
     workers: int = 2,
     scheduler: str | None = None,
+    scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
     resume: bool = False,
     progress: bool = True,
     figure: bool = True,
@@ -427,13 +431,14 @@ def run_uncertainty(
 
     With ``group_runs`` the runs of one sample (one block: every record and load factor)
     go to the solver as groups (:func:`rockyade.studies.batch.job_key`: one model, the same
-    rows); False: one run per job."""
-    from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
+    rows); False: one run per job.
 
+    Each run is written as it ends (the batch engine's journal: ``runs/``); ``resume`` keeps
+    the runs an interrupted study of the same name, samples and seed left
+    (:func:`rockyade.runner.journal.claim` refuses another's); the report files are a set
+    replaced as a whole (:mod:`rockyade.io.resultset`)."""
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     samples = draw_samples(study)
-    _write_csv(out / "samples.csv", samples)
     prepare(study)
     tasks = build_tasks(study, samples, out)
     summary = run_study_tasks(
@@ -442,30 +447,63 @@ def run_uncertainty(
         executor=executor,
         workers=workers,
         scheduler=scheduler,
+        scheduler_timeout_s=scheduler_timeout_s,
         resume=resume,
         progress=progress,
         desc=study.name,
         group_runs=group_runs,
+        identity={"command": "uncertainty", "study": study.name, "samples": study.samples, "seed": study.seed},
     )
+    with output_lock(out, "out"), replacing_set(out, REPORT_SET, REPORT_LAST) as stage:
+        _write_csv(stage / "samples.csv", samples)
+        return _report(study, out, stage, samples, summary, figure, accel_unit)
+
+
+#: The report's files, a set replaced as a whole, and the one that marks it complete.
+REPORT_SET = (
+    "samples.csv",
+    "runs.csv",
+    "probabilities.csv",
+    "fragility.csv",
+    "spread.csv",
+    "uncertainty.png",
+    "uncertainty.json",
+)
+REPORT_LAST = "uncertainty.json"
+
+
+def _report(
+    study: UncertaintyStudy,
+    out: Path,
+    stage: Path,
+    samples: pd.DataFrame,
+    summary: pd.DataFrame,
+    figure: bool,
+    accel_unit: str,
+) -> UncertaintyResult:
+    """Write the report's files in ``stage`` (swapped in for the set in ``out`` after)."""
+    from rockyade.probability.exceedance import exceedance_table, fragility_table, spread_table
+
     runs = with_measures(summary, record_measures(study))
     runs["overturned"] = runs["status"] == "overturned"
-    _write_csv(out / "runs.csv", runs)
+    _write_csv(stage / "runs.csv", runs)
     sampled = runs[~runs["nominal"].astype(bool)]
     probabilities = exceedance_table(sampled, study.levels)
-    _write_csv(out / "probabilities.csv", probabilities)
+    _write_csv(stage / "probabilities.csv", probabilities)
     fragility = fragility_table(sampled, study.measures)
-    _write_csv(out / "fragility.csv", fragility)
+    _write_csv(stage / "fragility.csv", fragility)
     spread = spread_table(runs) if study.pairing == "all" else None
     if spread is not None:
-        _write_csv(out / "spread.csv", spread)
+        _write_csv(stage / "spread.csv", spread)
     fig_path = None
     if figure:
         from rockyade.figures.uncertainty import plot_uncertainty
 
         fig_path = out / "uncertainty.png"
-        plot_uncertainty(study, probabilities, sampled, fragility, spread, fig_path, accel_unit=accel_unit)
+        stage_png = stage / "uncertainty.png"
+        plot_uncertainty(study, probabilities, sampled, fragility, spread, stage_png, accel_unit=accel_unit)
     write_json(
-        out / "uncertainty.json",
+        stage / "uncertainty.json",
         {
             "name": study.name,
             "source": study.source,

@@ -147,11 +147,14 @@ def run_model(
     # taken relative to it a second time
     directory = (Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="rockyade-yade-"))).resolve()
     directory.mkdir(parents=True, exist_ok=True)
-    scene_file = directory / f"{name}.yade.json"
-    out_file = directory / f"{name}.yade.npz"
-    log_file = directory / f"{name}.yade.log"
-    partial = directory / f"{name}.yade.npz.part"
-    for stale in (out_file, partial):  # a killed run's (the log is replaced, never written through)
+    # the run writes under a name of its own; its files take the run's name once it ended
+    # (:func:`_keep_files`): an earlier run's files are never touched by a run that fails
+    work = f"{name}.running"
+    scene_file = directory / f"{work}.yade.json"
+    out_file = directory / f"{work}.yade.npz"
+    log_file = directory / f"{work}.yade.log"
+    partial = directory / f"{work}.yade.npz.part"
+    for stale in (out_file, partial, log_file):  # a killed run's
         stale.unlink(missing_ok=True)
     payload = scene_payload(model)
     start = time.perf_counter()
@@ -172,7 +175,27 @@ def run_model(
     result.meta["timeout_s"] = timeout
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
+    else:
+        _keep_files(directory, work, name, result)
     return result
+
+
+def _keep_files(directory: Path, work: str, name: str, result: Result) -> None:
+    """Give a run's files (``<work>.yade.*``) their names: ``<name>.yade.*``, unless the run
+    failed and ``<name>.yade.npz`` is an earlier run's output: then ``<name>_failed.yade.*``
+    beside it, so that a failed run never replaces or deletes the files of an earlier one
+    (whose result's ``log_path`` names its own log). ``log_path`` says where the log went."""
+    final = name
+    if not result.ok and (directory / f"{name}.yade.npz").exists():
+        final = f"{name}_failed"
+    for suffix in (".yade.json", ".yade.npz", ".yade.log"):
+        src = directory / f"{work}{suffix}"
+        if src.exists():
+            os.replace(src, directory / f"{final}{suffix}")
+        elif suffix != ".yade.log":  # no output of this run: none of an earlier run's stays beside its log
+            (directory / f"{final}{suffix}").unlink(missing_ok=True)
+    if "log_path" in result.meta:
+        result.meta["log_path"] = str(directory / f"{final}.yade.log")
 
 
 def _command() -> list[str]:

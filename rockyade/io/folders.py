@@ -1,0 +1,57 @@
+"""An output folder made for a command that is removed again when the command fails before
+it wrote anything (no empty ``--out`` after an error or Ctrl-C)."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Iterator
+from pathlib import Path
+
+#: What a command leaves in a folder it has not written a result to yet: its lock, and the
+#: study's identity in an otherwise empty runs folder.
+BOOKKEEPING = (".rockyade.lock", "study.json")
+
+
+@contextlib.contextmanager
+def output_folder(path: str | os.PathLike[str]) -> Iterator[bool]:
+    """Make ``path`` (and its parents) if missing; yield whether it was made here. On any
+    exception a folder made here that holds nothing but bookkeeping (:data:`BOOKKEEPING`,
+    in it or in empty sub-folders) is removed, and the exception goes on.
+
+    Parameters
+    ----------
+    path
+        The output folder.
+    """
+    out = Path(path)
+    created = not out.exists()
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        yield created
+    except BaseException:
+        if created:
+            with contextlib.suppress(OSError):
+                remove_if_unused(out)
+        raise
+
+
+def remove_if_unused(folder: Path) -> bool:
+    """Remove ``folder`` if it holds only bookkeeping files and empty folders (never following
+    a link); whether it was removed."""
+    entries = list(folder.iterdir())
+    for entry in entries:
+        if entry.is_symlink():
+            return False
+        if entry.is_dir():
+            if not remove_if_unused(entry):
+                return False
+        elif entry.name not in BOOKKEEPING:
+            return False
+    for entry in folder.iterdir():
+        entry.unlink()
+    folder.rmdir()
+    return True
+
+
+__all__ = ["BOOKKEEPING", "output_folder", "remove_if_unused"]
