@@ -141,8 +141,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
             color=PUSH,
             lw=1.6,
             ls="-",
-            label=f"reference DEM pushover, force-controlled (held levels): onset lambda {push.onset.multiplier:.4g}, "
-            f"{100 * push.difference:+.1f} % on alpha0",
+            label=f"reference DEM pushover, force-controlled (held levels): {_onset_label(push)}",
         )
     ax.annotate(
         f"a0* = {kin.a0_star_m_s2:.3g}", (0, kin.a0_star_m_s2), xytext=(6, 4), textcoords="offset points", fontsize=8
@@ -238,3 +237,14 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
     if title:
         fig.suptitle(f"{title}: {a.site.describe()}", fontsize=10)
     return save_figure(fig, path)
+
+
+def _onset_label(push: Any) -> str:
+    """The pushover's onset for a legend: a percentage only where two held levels bracket it."""
+    if push.bound == "measured":
+        return f"onset λ {push.onset.multiplier:.4g}, {100 * push.difference:+.1f} % on alpha0"
+    if push.bound == "below":
+        return f"onset below λ {push.onset.multiplier:.4g} (the first level)"
+    if push.bound == "above":
+        return f"held at every level up to λ {push.onset.below:.4g}"
+    return "no onset measured"
