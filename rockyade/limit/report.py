@@ -122,6 +122,11 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     lines.append(
         f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} m/s^2)"
     )
+    if lam == 0.0:
+        lines.append(
+            "  lambda = 0: any horizontal acceleration, however small, moves it (a joint without friction, "
+            "friction angle 0, slides): it has no lateral capacity to assess"
+        )
     n_moving = int(mech.moving.sum())
     opened = f", {plural(len(mech.separating), 'joint')} opening fully" if mech.separating else ""
     lines.append(
