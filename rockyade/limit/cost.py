@@ -95,8 +95,8 @@ class LimitCost:
         else:
             programmes = "1 programme"
         return (
-            f"{self.blocks} blocks ({self.moving_blocks} moving), {self.joints} joints; {self.rows} equations, "
-            f"{self.variables} variables, {self.nonzeros} nonzeros; {programmes}; expected "
+            f"{_n(self.blocks, 'block')} ({self.moving_blocks} moving), {_n(self.joints, 'joint')}; "
+            f"{self.rows} equations, {self.variables} variables, {self.nonzeros} nonzeros; {programmes}; expected "
             f"{_duration(self.expected_time_s)} and about {self.memory_bytes / 1e6:.0f} MB"
         )
 
@@ -116,6 +116,10 @@ class LimitCost:
             "expected_time_s": self.expected_time_s,
             "memory_bytes": self.memory_bytes,
         }
+
+
+def _n(count: int, noun: str) -> str:
+    return f"{count} {noun}{'' if count == 1 else 's'}"
 
 
 def _duration(seconds: float) -> str:

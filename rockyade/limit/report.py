@@ -102,6 +102,12 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     if result.status == "unstable":
         lines.append("status: unstable: the assembly cannot stand under gravity (and its loads) alone: no")
         lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")
+        if model.loads:
+            from rockyade.limit.standing import unbalanced_loads_of_model
+
+            found = unbalanced_loads_of_model(model)
+            if found is not None:
+                lines.append(f"  {found.message}")
     elif result.status == "no_mechanism":
         lines.append("status: no_mechanism: no horizontal acceleration makes it collapse (lambda is unbounded)")
         if not result.sliding_allowed:
