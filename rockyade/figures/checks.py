@@ -64,7 +64,7 @@ def covered_markers(fig: Figure) -> list[str]:
                 (points[:, 0] > box.x0) & (points[:, 0] < box.x1) & (points[:, 1] > box.y0) & (points[:, 1] < box.y1)
             )
             if inside.any():
-                label = line.get_label()
+                label = str(line.get_label())
                 found.append("unlabelled" if label.startswith("_") else label)
     return found
 
