@@ -11,7 +11,7 @@ from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.limit import limit_analysis
 from rockyade.limit.report import text_report
-from rockyade.limit.standing import unbalanced_loads
+from rockyade.limit.standing import check_loads_stand, unbalanced_loads
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import make_solver, run, solver_names
 
@@ -63,16 +63,18 @@ def test_every_solver_refuses_a_block_its_load_lifts_off(solver):
 def test_a_top_course_pulled_off_names_the_top_block_only():
     found = unbalanced_loads(two_courses(6000.0))  # the upper block weighs 4903 N
     assert found is not None
-    assert found.moving == ("upper",) and found.lifted == ("upper",) and found.loads == (0,)
+    assert found.moving == ("upper",) and found.lifted == ("upper",) and found.loads == (0,) and found.flies_apart
     assert found.carried_fraction == pytest.approx(500.0 * G / 6000.0, rel=1e-6)
     assert unbalanced_loads(two_courses(4000.0)) is None  # less than its weight: carried
 
 
-def test_a_horizontal_load_past_the_overturning_one_is_refused():
+def test_a_horizontal_load_past_the_overturning_one_is_a_collapse_not_a_flight():
     # overturns at F = W b / h_c = 11 kN x 0.2 / 0.7 = 3.14 kN (friction 30 deg would carry 6.35 kN)
     push = [{"block": "b", "point_m": [0.0, 0.7], "force_N": [4000.0, 0.0]}]
     found = unbalanced_loads(scene(push))
-    assert found is not None and found.moving == ("b",) and found.lifted == ()
+    assert found is not None and found.moving == ("b",) and found.lifted == () and not found.flies_apart
+    assert "overturns or slides b at rest" in found.message
+    check_loads_stand(scene(push))  # it runs: the dynamics show the collapse
     assert found.carried_fraction == pytest.approx(MASS * G * 0.2 / 0.7 / 4000.0, rel=1e-6)
     assert unbalanced_loads(scene([{"block": "b", "point_m": [0.0, 0.7], "force_N": [3000.0, 0.0]}])) is None
 

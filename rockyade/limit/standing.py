@@ -1,8 +1,8 @@
 """Whether a scene's loads can be carried at rest: the rule every solver applies before a run.
 
-A scene whose ``[[loads]]`` no equilibrium at rest can carry (a load that lifts its block off
-its supports, pulls a course off the one below, or pushes a block past its friction) does not
-rock: its blocks leave their supports for good. Such a run has no meaning whatever the solver
+A scene whose ``[[loads]]`` lift blocks off their supports (a load larger than the weight it
+pulls up, a course pulled off the one below: tension no joint carries) does not rock: its blocks
+leave their supports for good. Such a run has no meaning whatever the solver
 makes of it (Housner's Eq 1 with a load larger than the weight, a DEM's block flying off, a
 "numerical instability"), so every solver refuses it before it starts
 (:meth:`rockyade.solvers.base.SolverBase` calls :func:`check_loads_stand` on every scene with
@@ -13,9 +13,11 @@ The test is the lower-bound programme of :mod:`rockyade.limit.lp` at rest (no ho
 acceleration) with the loads scaled by s: maximise s in [0, 1] such that every moving block is in
 equilibrium under its weight, s times the loads and contact forces with no tension and
 Coulomb's friction (Livesley 1978). If s < 1 the loads cannot be carried; the programme's dual
-is the mechanism by which they move the blocks (the blocks that move, and whether the loaded
-block is lifted). A scene that cannot stand under its weight alone (s = 0 infeasible: an
-overhang that topples) is not this rule's: it collapses, and the dynamics show it.
+is the mechanism by which they move the blocks; when the weight and loads of the blocks that
+move pull them up together, they fly apart and the run is refused. Loads that overturn or slide
+blocks at rest (the moving blocks still pressed down) are a collapse the dynamics show: those
+scenes run (Housner overturns a block tipped by a horizontal load). A scene that cannot stand
+under its weight alone (s = 0 infeasible: an overhang that topples) is not this rule's either.
 """
 
 from __future__ import annotations
@@ -50,6 +52,11 @@ class UnbalancedLoads:
         Indices of the scene's ``[[loads]]`` that do work in the mechanism (they move it).
     lifted
         Names of moving blocks the mechanism lifts (their centroid moves up more than sideways).
+    flies_apart
+        True when the weight and the loads of the moving blocks together pull them up: they leave
+        their supports for good (a load larger than what it lifts, a course pulled off): no solver's
+        run of it means anything. False: the loads overturn or slide the blocks at rest, a collapse
+        that the dynamics show (they run).
     message
         The whole in words: the loads, their blocks, what happens, the largest fraction carried.
     """
@@ -58,6 +65,7 @@ class UnbalancedLoads:
     moving: tuple[str, ...]
     loads: tuple[int, ...]
     lifted: tuple[str, ...]
+    flies_apart: bool
     message: str
 
 
@@ -116,8 +124,13 @@ def unbalanced_loads_of_model(model: RigidBlockModel) -> UnbalancedLoads | None:
         if moves[i] and float(np.dot(point_velocity, load.force_N)) > 0.0:
             working.append(k)
     working = working or [k for k, load in enumerate(model.loads) if moves[int(load.block)]]
-    message = _words(model, s, moving, tuple(working), lifted)
-    return UnbalancedLoads(s, moving, tuple(working), lifted, message)
+    # the moving blocks' weight and loads together: pulled up, they leave their supports for good
+    net_up = -float(model.masses_kg[moves].sum() * model.g) + sum(
+        float(load.force_N[1]) for load in model.loads if moves[int(load.block)]
+    )
+    flies = net_up > 0.0
+    message = _words(model, s, moving, tuple(working), lifted if flies else ())
+    return UnbalancedLoads(s, moving, tuple(working), lifted if flies else (), flies, message)
 
 
 def _words(model: RigidBlockModel, s: float, moving, working, lifted) -> str:
@@ -136,16 +149,16 @@ def _words(model: RigidBlockModel, s: float, moving, working, lifted) -> str:
         what = (
             f"{verb} {lift} off {'its' if len(lifted) == 1 else 'their'} supports for good (a joint carries no tension)"
         )
-    else:
-        shown = ", ".join(moving[:8]) + (" ..." if len(moving) > 8 else "")
-        what = (
-            f"{'moves' if len(working) == 1 else 'move'} {shown} off {'its' if len(moving) == 1 else 'their'} "
-            "supports for good (no equilibrium with joints that carry no tension and have Coulomb's friction)"
+        return (
+            f"{loads} {what}; at rest at most {100 * s:.3g} % of it can be carried, so the scene cannot stand "
+            "(rockyade limit: unstable) and a run of it would mean nothing: reduce the load, or add the mass or "
+            "restraint that carries it"
         )
+    shown = ", ".join(moving[:8]) + (" ..." if len(moving) > 8 else "")
     return (
-        f"{loads} {what}; at rest at most {100 * s:.3g} % of it can be carried, so the scene cannot stand "
-        "(rockyade limit: unstable) and a run of it would mean nothing: reduce the load, or add the mass or "
-        "restraint that carries it"
+        f"{loads} {'overturns or slides' if len(working) == 1 else 'overturn or slide'} {shown} at rest (at most "
+        f"{100 * s:.3g} % of it can be carried): the scene cannot stand (rockyade limit: unstable), and a run "
+        "shows it collapse"
     )
 
 
@@ -153,6 +166,6 @@ def check_loads_stand(scene, model: RigidBlockModel | None = None) -> None:
     """Refuse (InputError naming the load) a scene whose loads cannot be carried at rest: the rule
     every solver applies before a run (module docstring)."""
     found = unbalanced_loads(scene, model)
-    if found is not None:
+    if found is not None and found.flies_apart:
         field = f"loads[{found.loads[0]}]" if found.loads else "loads"
         raise InputError(field, found.message, getattr(scene, "source", None))
