@@ -67,9 +67,10 @@ def test_a_bad_time_limit_is_refused(value, capsys):
         limit_analysis(load_scene(WALL), time_limit_s=float(value))
 
 
-def test_the_method_is_the_dual_simplex_for_small_programmes_and_ipm_for_large():
+def test_the_method_is_the_interior_point_one_where_it_was_measured_faster():
     assert highs_method("highs", 100) == "highs-ds"
-    assert highs_method("highs", 10**6) == "highs-ipm"
+    assert highs_method("highs", 11485) == "highs-ipm"  # the 999-block wall
+    assert highs_method("highs", 35329) == "highs-ds"  # the 3,015-block wall: ipm's crossover imprecise
     assert highs_method("highs-ds", 10**6) == "highs-ds"
 
 

@@ -3,9 +3,10 @@
 The rigid-block model is built first (linear in the blocks: about 1 ms of CPU per block, the
 contacts at rest included); its size then sets the programme's: 3 rows per moving block, 4
 columns per joint and one for lambda (:mod:`rockyade.limit.lp`). The estimate of one programme
-is a fit to the running-bond walls that ``rockyade build wall`` makes (999, 3,015 and 10,005
-blocks; CPU time of HiGHS's interior point method, which :func:`rockyade.limit.lp.highs_method`
-chooses above :data:`rockyade.limit.lp.IPM_COLUMNS` columns):
+is set by the running-bond walls that ``rockyade build wall`` makes: 2.5 s of CPU for the 999-block
+wall's programme (69,687 nonzeros, interior point method), more than 60 s for the 3,015-block wall's
+(212,000 nonzeros, dual simplex, unfinished on a loaded machine); quadratic in the nonzeros, an
+upper-side guess beyond:
 
     seconds ~ SECONDS_PER_NONZERO x nonzeros ** NONZERO_EXPONENT,
     bytes   ~ BASE_MEMORY_BYTES + BYTES_PER_NONZERO x nonzeros,
@@ -28,8 +29,8 @@ from rockyade.errors import InputError, at_least, at_most
 from rockyade.limit.model import RigidBlockModel
 
 #: The fit of one programme's CPU time, s (module docstring).
-SECONDS_PER_NONZERO = 2.0e-6
-NONZERO_EXPONENT = 1.15
+SECONDS_PER_NONZERO = 5.0e-10
+NONZERO_EXPONENT = 2.0
 #: Memory: the interpreter with numpy and scipy, and per nonzero of the programme, bytes.
 BASE_MEMORY_BYTES = 150.0e6
 BYTES_PER_NONZERO = 1500.0

@@ -205,11 +205,15 @@ def equilibrium_system(model: RigidBlockModel, direction: str, non_dilatant: boo
 
 #: HiGHS's methods as scipy names them; "highs" is rockyade's choice (:func:`highs_method`).
 METHODS = ("highs", "highs-ds", "highs-ipm")
-#: Columns above which "highs" takes the interior point method rather than the dual simplex: on a
+#: Columns between which "highs" takes the interior point method rather than the dual simplex: on a
 #: running-bond wall of 999 blocks (11,485 columns) the interior point method (with its crossover to a
-#: vertex) takes 2.4 s of CPU against the dual simplex's 11 s, the same multiplier to 5e-7 and a vertex
-#: mechanism as well; below it the two are both fast and the dual simplex keeps its bit-for-bit answers.
+#: vertex) takes 2.4 to 2.9 s of CPU against the dual simplex's 11 to 12.5 s, the same multiplier to 5e-7
+#: and a vertex mechanism as well; below IPM_COLUMNS both are fast and the dual simplex keeps its
+#: bit-for-bit answers; on the 3,015-block wall (35,329 columns) the crossover ends "imprecise" and
+#: HiGHS's simplex clean-up from its basis took longer than the dual simplex alone (160 s of CPU
+#: against 60 s, both unfinished on a loaded machine), so above IPM_MAX_COLUMNS the dual simplex stays.
 IPM_COLUMNS = 4000
+IPM_MAX_COLUMNS = 20000
 
 
 class TimeLimitError(SolverFailedError):
@@ -218,10 +222,11 @@ class TimeLimitError(SolverFailedError):
 
 def highs_method(method: str, n_columns: int) -> str:
     """The HiGHS method scipy runs for ``method`` on a programme of ``n_columns`` columns: "highs"
-    is the dual simplex up to :data:`IPM_COLUMNS` columns and the interior point method above."""
+    is the interior point method from :data:`IPM_COLUMNS` to :data:`IPM_MAX_COLUMNS` columns, where
+    it was measured faster, and the dual simplex elsewhere."""
     if method != "highs":
         return method
-    return "highs-ipm" if n_columns > IPM_COLUMNS else "highs-ds"
+    return "highs-ipm" if IPM_COLUMNS < n_columns <= IPM_MAX_COLUMNS else "highs-ds"
 
 
 def time_options(time_limit_s: float | None) -> dict[str, float]:
