@@ -26,7 +26,7 @@ lint: setup
 	$(BIN)/mypy rockyade
 
 test: setup lint
-	ROCKYADE_REQUIRE_YADE=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
+	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
 
 run: setup
 	$(BIN)/rockyade paper --out $(OUT) --workers $(WORKERS)

@@ -224,3 +224,50 @@ def test_no_module_selects_a_backend_or_shows_a_figure():
                 owner = ast.unparse(node.func.value)
                 assert called not in ("show", "switch_backend"), f"{path}: {owner}.{called}()"
                 assert not (called == "use" and owner.endswith("matplotlib")), f"{path}: {owner}.use()"
+
+
+def test_study_displays_draw_into_given_axes_and_keep_what_they_drew(tmp_path, housner_result):
+    """The paper study's figures are display objects in figures/: computed data in, ``plot(ax=)``,
+    ``figure_`` and ``ax_`` kept; a failed run is a legend entry, never a curve."""
+    import pandas as pd
+
+    from rockyade.figures.parameter_sensitivity import SensitivityDisplay
+    from rockyade.figures.rocking_patterns import PatternMapDisplay
+    from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
+
+    r = housner_result
+    panel = Panel(curves=[Curve("housner", "Housner", r.t, r.series("theta_rad")), Curve("yade", "YADE: FAILED")])
+    fig = Figure()
+    axes = fig.subplots(1, 2)
+    shown = SolverPanelsDisplay([[panel, Panel(note="not reachable")]]).plot(list(axes))
+    assert shown.figure_ is fig and shown.ax_ == [list(axes)]
+    assert len(axes[0].lines) == 3  # the curve, the failed entry (no points) and the zero line
+    assert [len(line.get_xdata()) for line in axes[0].lines][1] == 0
+    assert "not reachable" in axes[1].texts[0].get_text()
+    written = SolverPanelsDisplay([[panel]], title="t").plot(path=tmp_path / "panels.png")
+    assert (tmp_path / "panels.png").stat().st_size > 5_000 and written.figure_ is not fig
+
+    rows = [
+        {"response": resp, "solver": s, "parameter": p, "change_pct": c, "relative_change_pct": 2.0 * c}
+        for resp in ("peak", "mu_eff")
+        for s in ("housner", "reference")
+        for p in ("alpha_rad", "p_rad_s", "mu")
+        for c in (-5, 5)
+    ]
+    fig2 = Figure()
+    bars = SensitivityDisplay(pd.DataFrame(rows)).plot(list(fig2.subplots(1, 2)))
+    assert bars.figure_ is fig2 and len(bars.ax_[0].patches) == 12
+
+    cells = pd.DataFrame(
+        {
+            "frequency_hz": [1.0],
+            "amplitude_mm": [0.5],
+            "pattern_dem": ["rest"],
+            "pattern_paper": [None],
+            "agree": [None],
+        }
+    )
+    fig3 = Figure()
+    ax3 = fig3.subplots()
+    grid = PatternMapDisplay(cells, (1.0, 2.0), (0.5, 1.0)).plot(ax3)
+    assert grid.ax_ is ax3 and ax3.texts[0].get_text() == "rest"

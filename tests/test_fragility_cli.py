@@ -78,7 +78,8 @@ def test_fragility_of_a_block_under_records_writes_every_output(capsys, tmp_path
     assert len(runs) == 8 and set(runs["solver"]) == {"housner"}
     assert not runs.loc[runs.pga_g == 0.2, "collapsed"].any()  # below g tan(alpha) = 0.25 g nothing moves
     data = strict_json((out / "fragility.json").read_text())
-    assert data["measure"]["name"] == "pga" and data["fit"]["status"] in ("fitted", "separated", "no trend")
+    # two records: too few for a fit (fewer than 5: refused, saying so)
+    assert data["measure"]["name"] == "pga" and data["fit"]["status"].startswith("not fitted: 2 records")
     assert data["collapse_rule"].startswith("the block overturns")
     assert data["levels_source"] == "given" and len(data["stripes"]) == 4
 

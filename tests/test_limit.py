@@ -94,7 +94,7 @@ def test_an_off_centre_vertical_load_changes_the_multiplier_as_statics_says(x_lo
     N = 0.7 * W
     b, h_c = width / 2, height / 2
     s = 1.0 if direction == "+x" else -1.0
-    load = PointLoad("b01", (x_load, height), (0.0, -N))
+    load = PointLoad("b01", (x_load, height), (0.0, -N), mass_kg=0.0)
     result = limit_analysis(scene, direction=direction, loads=[load], sliding=False)
     expected = (W * b + N * (b - s * x_load)) / (W * h_c)
     assert result.load_multiplier == pytest.approx(expected, rel=EXACT)

@@ -78,7 +78,7 @@ def test_an_overburden_follows_the_block_in_the_nonlinear_curve():
     scene = block_scene(width, height)
     W = float(rigid_block_model(scene).masses_kg[0] * G)
     N, x_n = 0.5 * W, -0.1
-    result = limit_analysis(scene, loads=[PointLoad("b01", (x_n, height), (0.0, -N))], sliding=False)
+    result = limit_analysis(scene, loads=[PointLoad("b01", (x_n, height), (0.0, -N), mass_kg=0.0)], sliding=False)
     kin = result.kinematic
     theta = _theta_of(kin.curve.dk_m, b, h_c)
     c, s = np.cos(theta), np.sin(theta)

@@ -1,6 +1,6 @@
-"""Point loads ([[loads]]): validation, the closed form lambda = (W b + N d) / (W h_c) in
-Housner's modified Eq 1 and the limit analysis, and free rocking of a loaded block in Housner
-against the reference DEM."""
+"""Point loads ([[loads]]): validation, the closed forms lambda = (W b + N d) / (W h_c) without
+the load's mass and (W b + N d) / (W h_c + N h_N) with it in Housner's modified Eq 1 and the
+limit analysis, and free rocking of a loaded block in Housner against the reference DEM."""
 
 from __future__ import annotations
 
@@ -36,15 +36,21 @@ def block_scene(loads, motion=None, duration=1.0, **extra):
     )
 
 
-def top_load(x, n):
+def top_load(x, n, mass=0.0):
     """A vertical load n (N, downwards) on the top face at x (block frame: the base runs
-    from -0.2 to 0.2 m)."""
-    return [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n]}]
+    from -0.2 to 0.2 m); ``mass``: its mass_kg (0: without mass; None: not given, the default
+    mass of its weight n / g)."""
+    load = {"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n]}
+    if mass is not None:
+        load["mass_kg"] = mass
+    return [load]
 
 
-def closed_form(n, d):
-    """lambda = (W b + N d) / (W h_c): the block's statics about the pivot."""
-    return (W * B + n * d) / (W * H_C)
+def closed_form(n, d, with_mass=False):
+    """lambda = (W b + N d) / (W h_c) for a load without mass: the block's statics about the
+    pivot; with the load's mass its horizontal force lambda N acts at the load's height h_N:
+    lambda = (W b + N d) / (W h_c + N h_N)."""
+    return (W * B + n * d) / (W * H_C + (n * HEIGHT if with_mass else 0.0))
 
 
 @pytest.mark.parametrize(
@@ -87,22 +93,76 @@ def test_a_load_on_a_fixed_block_is_refused():
 def test_loads_are_in_the_canonical_scene_and_its_hash():
     plain = block_scene([])
     loaded = block_scene(top_load(0.1, 2000.0))
-    assert loaded.to_dict()["loads"] == [{"block": "pier", "point_m": [0.1, 2.0], "force_N": [0.0, -2000.0]}]
+    assert loaded.to_dict()["loads"] == [
+        {"block": "pier", "point_m": [0.1, 2.0], "force_N": [0.0, -2000.0], "mass_kg": 0.0}
+    ]
     assert "loads" not in plain.to_dict()
     assert plain.scene_hash != loaded.scene_hash
     assert scene_from_dict(loaded.to_dict()) == loaded
+    default = block_scene(top_load(0.1, 2000.0, mass=None))
+    assert "mass_kg" not in default.to_dict()["loads"][0]
+    assert len({default.scene_hash, loaded.scene_hash, block_scene(top_load(0.1, 2000.0, 2000.0 / G)).scene_hash}) == 3
 
 
+def test_a_negative_load_mass_is_refused():
+    with pytest.raises(InputError) as info:
+        block_scene(top_load(0.0, 100.0, mass=-1.0))
+    assert info.value.field == "loads[0].mass_kg"
+
+
+def test_the_default_mass_is_the_weight_over_g():
+    """mass_kg omitted: the load's mass is -fy / g (the code's carried vertical load); the
+    same scene with mass_kg = N / g written out gives the same multiplier."""
+    n, x = 6000.0, 0.05
+    implied = limit_analysis(block_scene(top_load(x, n, mass=None)), direction="+x").load_multiplier
+    written = limit_analysis(block_scene(top_load(x, n, mass=n / G)), direction="+x").load_multiplier
+    assert implied == pytest.approx(closed_form(n, B - x, with_mass=True), rel=1e-6)
+    assert written == pytest.approx(implied, rel=1e-12)
+
+
+@pytest.mark.parametrize("with_mass", [False, True])
 @pytest.mark.parametrize(("x", "n"), [(0.1, 5000.0), (-0.15, 20000.0), (0.0, 3000.0)])
-def test_housner_and_limit_analysis_give_the_closed_form(x, n):
+def test_housner_and_limit_analysis_give_the_closed_form(x, n, with_mass):
     """Housner's uplift threshold (modified Eq 1) and the LP limit analysis: about the left
-    pivot (a_h > 0, limit direction -x) the arm is d = x + b, about the right one b - x."""
-    scene = block_scene(top_load(x, n))
+    pivot (a_h > 0, limit direction -x) the arm is d = x + b, about the right one b - x; with
+    the load's mass its horizontal force adds N h_N to the overturning moment."""
+    scene = block_scene(top_load(x, n, mass=n / G if with_mass else 0.0))
     model = housner_model(scene)
-    assert model.uplift_multiplier(+1) == pytest.approx(closed_form(n, x + B), rel=1e-12)
-    assert model.uplift_multiplier(-1) == pytest.approx(closed_form(n, B - x), rel=1e-12)
-    assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx(closed_form(n, x + B), rel=1e-6)
-    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(closed_form(n, B - x), rel=1e-6)
+    left, right = closed_form(n, x + B, with_mass), closed_form(n, B - x, with_mass)
+    assert model.uplift_multiplier(+1) == pytest.approx(left, rel=1e-12)
+    assert model.uplift_multiplier(-1) == pytest.approx(right, rel=1e-12)
+    assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx(left, rel=1e-6)
+    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(right, rel=1e-6)
+
+
+def test_the_engineers_roof_by_hand():
+    """A 2.4 m tuff wall 0.36 m thick (1600 kg/m^3), per metre: W = 1600 x 9.81 x 0.36 x 2.4
+    = 13561.34 N, b = 0.18 m, h_c = 1.2 m; a timber roof N = 6 kN/m at 0.05 m from the axis
+    towards +x, so its lever about the +x pivot is d = 0.18 - 0.05 = 0.13 m and h_N = 2.4 m:
+    without its mass alpha0 = (13561.34 x 0.18 + 6000 x 0.13) / (13561.34 x 1.2)
+    = 3221.04 / 16273.61 = 0.19793; with it (13561.34 x 1.2 + 6000 x 2.4 = 30673.61)
+    alpha0 = 3221.04 / 30673.61 = 0.10501 (the engineer's "about 0.105").
+    e* with the roof as a P_i: s1 = 1382.4 x 1.2 + 611.62 x 2.4 = 3126.78,
+    s2 = 1382.4 x 1.44 + 611.62 x 5.76 = 5513.31, M* = s1^2 / s2 = 1773.3 kg, e* = 1773.3 / 1994.02 = 0.8893."""
+    from rockyade.scene.generators.wall_sections import wall_section
+
+    lam = {}
+    kin = {}
+    for with_mass in (False, True):
+        data = wall_section(height_m=2.4, thickness_m=0.36, density_kg_m3=1600.0, overburden_n_per_m=6000.0,
+                            overburden_eccentricity_m=0.05, motion={"type": "rest"})
+        if not with_mass:
+            data["loads"] = [{**q, "mass_kg": 0.0} for q in data["loads"]]
+        result = limit_analysis(scene_from_dict(data), direction="+x")
+        lam[with_mass], kin[with_mass] = result.load_multiplier, result.kinematic
+    assert lam[False] == pytest.approx(3221.04 / 16273.61, rel=1e-5)
+    assert round(lam[False], 3) == 0.198
+    assert lam[True] == pytest.approx(3221.04 / 30673.61, rel=1e-5)
+    assert round(lam[True], 3) == 0.105
+    assert kin[False].e_star == pytest.approx(1.0, rel=1e-9)
+    assert kin[True].M_star_kg == pytest.approx(3126.78**2 / 5513.31, rel=1e-4)
+    assert kin[True].e_star == pytest.approx(0.8893, abs=1e-4)
+    assert kin[True].participating_mass_kg == pytest.approx(1382.4 + 6000.0 / G, rel=1e-9)
 
 
 def test_housner_onset_under_a_slow_ramp_is_the_closed_form():
@@ -134,12 +194,15 @@ def first_crossings(theta, dt, count=3):
     return np.nonzero(np.diff(np.sign(theta)))[0][:count] * dt
 
 
-def test_free_rocking_of_a_loaded_block_housner_against_the_reference_dem():
-    """An eccentric top load (1.5 kN, 0.1 m right of the axis) released at 0.06 rad: both
-    solvers cross theta = 0 at the same times within 0.5 %, and the load changes them
-    (it is really applied)."""
+@pytest.mark.parametrize("mass", [0.0, 1500.0 / G, 750.0 / G])
+def test_free_rocking_of_a_loaded_block_housner_against_the_reference_dem(mass):
+    """An eccentric top load (1.5 kN, 0.1 m right of the axis) released at 0.06 rad, without
+    mass, with the mass of its weight and with half of it (the rest of its force without
+    mass): both solvers cross theta = 0 at the same times within 0.5 % (Housner's p, alpha and
+    mu of the loaded block against the DEM's merged body), and the load changes them (it is
+    really applied)."""
     motion = {"type": "free", "theta0_rad": 0.06}
-    loaded = block_scene(top_load(0.1, 1500.0), motion, duration=1.6)
+    loaded = block_scene(top_load(0.1, 1500.0, mass), motion, duration=1.6 if mass == 0.0 else 2.2)
     times = {}
     for name in ("housner", "reference"):
         result = run(loaded, name)
@@ -148,7 +211,7 @@ def test_free_rocking_of_a_loaded_block_housner_against_the_reference_dem():
         times[name] = first_crossings(theta, 0.001)
     assert len(times["housner"]) == 3
     np.testing.assert_allclose(times["reference"], times["housner"], rtol=5e-3)
-    bare = run(block_scene([], motion, duration=1.6), "housner")
+    bare = run(block_scene([], motion, duration=2.2), "housner")
     theta = bare.frame[bare.frame.columns[bare.frame.columns.str.contains("theta")][0]].to_numpy()
     assert abs(first_crossings(theta, 0.001)[1] - times["housner"][1]) > 0.05
 
@@ -168,11 +231,13 @@ def test_the_reference_dem_energy_balance_counts_the_loads_work():
     assert math.isfinite(result.meta["initial_potential_energy_J"])
 
 
-def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem():
+@pytest.mark.parametrize("mass", [0.0, 1500.0 / G])
+def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem(mass):
     """The same release in YADE (the load a non-colliding clump member, its force summed with
-    its current arm): theta = 0 crossings within 0.5 % of the reference DEM's."""
+    its current arm; its mass in the body's from the DEM model): theta = 0 crossings within
+    0.5 % of the reference DEM's."""
     require_yade()
-    scene = block_scene(top_load(0.1, 1500.0), {"type": "free", "theta0_rad": 0.06}, duration=1.6)
+    scene = block_scene(top_load(0.1, 1500.0, mass), {"type": "free", "theta0_rad": 0.06}, duration=2.2)
     times = {}
     for name in ("reference", "yade"):
         result = run(scene, name)

@@ -1,5 +1,6 @@
 """Generators' overburden: floor and roof loads at the top of walls, wall sections and columns,
-written as [[loads]] and checked against lambda = (W b + N d) / (W h_c)."""
+written as [[loads]] with their mass (by default) and checked against lambda = (W b + N d) / (W h_c + N h_N),
+or (W b + N d) / (W h_c) without it."""
 
 from __future__ import annotations
 
@@ -14,20 +15,26 @@ from rockyade.scene.generators import rest_motion, restrained_wall, stack, wall
 from rockyade.scene.generators.overburden import add_overburden
 
 
-def test_a_column_top_load_gives_the_closed_form_in_the_limit_analysis():
+@pytest.mark.parametrize("with_mass", [False, True])
+def test_a_column_top_load_gives_the_closed_form_in_the_limit_analysis(with_mass):
     data = add_overburden(stack(widths_m=[0.4], heights_m=2.0, motion=rest_motion()), "point", force_N=5000.0,
-                          eccentricity_m=-0.1)
+                          eccentricity_m=-0.1, with_mass=with_mass)
+    assert data["loads"][0]["mass_kg"] == (pytest.approx(5000.0 / G) if with_mass else 0.0)
     scene = scene_from_dict(data)
     w = scene.blocks[0].block().mass_kg * G
-    # pushed towards +x the block turns about its right corner: the load is 0.3 m from it
-    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx((w * 0.2 + 5000 * 0.3) / w, 1e-6)
-    assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx((w * 0.2 + 5000 * 0.1) / w, 1e-6)
+    # pushed towards +x the block turns about its right corner: the load is 0.3 m from it; with
+    # its mass, lambda N acts at the top, h_N = 2 m
+    over = w * 1.0 + (5000 * 2.0 if with_mass else 0.0)
+    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx((w * 0.2 + 5000 * 0.3) / over, 1e-6)
+    assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx((w * 0.2 + 5000 * 0.1) / over, 1e-6)
 
 
 def test_a_wall_section_carries_its_load_per_metre_times_its_length():
     data = restrained_wall(blocks=1, wall_length_m=2.0, gap_m=0.05)
     loaded = add_overburden(data, "section", force_N_per_m=10000.0, eccentricity_m=0.1)
-    assert loaded["loads"] == [{"block": "wall", "point_m": [0.1, 3.0], "force_N": [0.0, -20000.0]}]
+    assert loaded["loads"] == [
+        {"block": "wall", "point_m": [0.1, 3.0], "force_N": [0.0, -20000.0], "mass_kg": pytest.approx(20000.0 / G)}
+    ]
     assert "loads" not in data  # the input is not changed
 
 
@@ -66,6 +73,13 @@ def test_rockyade_build_writes_the_overburden(tmp_path, capsys):
     scene = load_scene(out)
     assert scene.motion.type == "gravity-ramp"
     assert [(q.block, q.point_m, q.force_N) for q in scene.loads] == [("wall", (0.1, 3.0), (0.0, -20000.0))]
+    assert scene.loads[0].mass_kg == pytest.approx(20000.0 / G)
+    assert main(["build", "restrained-wall", "--blocks", "1", "--gap-m", "0.05", "--overburden-n-per-m", "20000",
+                 "--overburden-mass", "none", "--out", str(out)]) == 0
+    assert load_scene(out).loads[0].mass_kg == 0.0
+    assert main(["build", "wall-section", "--overburden-n-per-m", "6000", "--overburden-mass", "none",
+                 "--out", str(out)]) == 0
+    assert load_scene(out).loads[0].mass_kg == 0.0
     assert main(["build", "column", "--top-load-n", "100", "--top-load-eccentricity-m", "5",
                  "--out", str(tmp_path / "c.toml")]) == 2
     assert "--top-load-eccentricity-m" in capsys.readouterr().err

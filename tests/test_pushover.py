@@ -179,7 +179,7 @@ def test_pushover_onset_of_a_loaded_block_is_the_closed_form(solver):
     n, x = 8000.0, 0.05
     expected = (MASS * G * WIDTH / 2 + n * (WIDTH / 2 - x)) / (MASS * G * HEIGHT / 2)
     motion = pushover(expected)
-    scene = block_scene(motion, [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n]}])
+    scene = block_scene(motion, [{"block": "pier", "point_m": [x, HEIGHT], "force_N": [0.0, -n], "mass_kg": 0.0}])
     assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(expected, rel=1e-6)
     result = run(scene, solver)
     curve = capacity_curve(result, scene)
@@ -359,7 +359,8 @@ def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_withou
     that the floor clamps the wall."""
     from rockyade.cli import main
 
-    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", motion={"type": "rest"}))
+    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", restraint_friction_deg=None,
+                                             motion={"type": "rest"}))
     assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
     assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
     assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0

@@ -68,6 +68,17 @@ def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path):
     assert (tmp_path / "report" / "verify_loaded_pushover.png").stat().st_size > 0
 
 
+def test_loaded_mass_check_gives_the_closed_form_with_the_loads_mass(tmp_path):
+    """``--only loaded_mass``: the block 0.4 x 2 m (1000 kg) with N = 8 kN at d = 0.15 m and its
+    mass N / g at h_N = 2 m: lambda = (9810 x 0.2 + 8000 x 0.15) / (9810 x 1 + 8000 x 2)
+    = 3162 / 25810 = 0.122511 from the limit analysis and Housner; e* = (9810 + 16000)^2 /
+    ((9810 + 8000)(9810 + 32000)) = 0.894606."""
+    table = verify(tmp_path / "report", ["loaded_mass"], ["reference"])
+    assert list(table["check"]) == ["loaded_mass"] * 3 and table["passed"].all(), table.to_string()
+    assert table["value"].to_numpy()[:2] == pytest.approx(3162.0 / 25810.0, rel=1e-6)
+    assert table["value"].to_numpy()[2] == pytest.approx(25810.0**2 / (17810.0 * 41810.0), rel=1e-6)
+
+
 def test_limit_pushover_check_passes_against_the_closed_forms(tmp_path):
     """``limit_pushover``: the limit analysis gives b/h = 0.2 for the block, 17/35 for the restrained
     wall's three hinges, tan(30 deg) for the sliding panel and 0.1494 for the arch, and the

@@ -36,11 +36,12 @@ def test_an_overburden_gives_w_b_plus_n_d_over_w_h():
     w = RHO * T * H * L * G
     n = q * L
     assert [(x.block, x.point_m, x.force_N) for x in scene.loads] == [("w03", (e, H), (0.0, -n))]
-    # towards +x the wall turns about (t/2, 0): the load is t/2 - e from it
+    assert scene.loads[0].mass_kg == pytest.approx(n / G)  # the overburden carries its mass by default
+    # towards +x the wall turns about (t/2, 0): the load is t/2 - e from it, at height H
     assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(
-        (w * T / 2 + n * (T / 2 - e)) / (w * H / 2), rel=1e-9)
+        (w * T / 2 + n * (T / 2 - e)) / (w * H / 2 + n * H), rel=1e-9)
     assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx(
-        (w * T / 2 + n * (T / 2 + e)) / (w * H / 2), rel=1e-9)
+        (w * T / 2 + n * (T / 2 + e)) / (w * H / 2 + n * H), rel=1e-9)
 
 
 def test_a_restrained_top_needs_a_gap_and_is_frictionless():

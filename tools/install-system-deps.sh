@@ -2,12 +2,14 @@
 # Install the Debian packages rockyade needs, only those missing (idempotent, no prompts).
 #   python3 + venv : the project's virtual environment
 #   yade           : the YADE DEM engine (Debian package, imported from Debian's python3.11)
+#   python3-siconos: Siconos, nonsmooth contact dynamics (imported from Debian's python3)
 set -euo pipefail
 
 need=()
 command -v python3 >/dev/null 2>&1 || need+=(python3)
 if ! python3 -c 'import venv, ensurepip' >/dev/null 2>&1; then need+=(python3-venv); fi
 if ! [ -f /usr/lib/x86_64-linux-gnu/yade-double/py/yade/__init__.py ]; then need+=(yade); fi
+if ! [ -f /usr/lib/python3/dist-packages/siconos/mechanics/collision/bullet.py ]; then need+=(python3-siconos); fi
 
 if [ ${#need[@]} -eq 0 ]; then
   echo "system packages: all present"

@@ -32,6 +32,7 @@ from rockyade.assess.code import (
     NOT_APPLICABLE,
     Check,
     check_code,
+    checks_not_made,
     code_capacity_ag,
     code_checks,
     verdict,
@@ -46,7 +47,7 @@ from rockyade.assess.fragility import (
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, RecordFiles, ec8_suite
 from rockyade.assess.pushover import PushoverCheck, run_pushover
-from rockyade.assess.site import Position, Site
+from rockyade.assess.site import AnySite, Position, Site
 from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
@@ -141,7 +142,7 @@ class Assessment:
 
     code: str
     fc: float
-    site: Site
+    site: AnySite
     position: Position
     limit: LimitResult
     other_direction: LimitResult | None
@@ -187,6 +188,9 @@ class Assessment:
             "verdict_rule": "verified when one of the checks that apply is met (the linear check with q and the "
             "nonlinear check are two ways of checking the mechanism)",
             "site": self.site.to_dict(),
+            "g_m_s2": G,
+            "g_meaning": "the one g of the check: ag in g and a0* = alpha0 g / (e* FC) (the verdict does not depend "
+            "on it); records in g are read with standard gravity 9.80665 m/s^2",
             "position": self.position.to_dict(),
             "direction": self.limit.direction,
             "load_multiplier": self.limit.load_multiplier,
@@ -196,6 +200,8 @@ class Assessment:
         keys = ("mechanism", "hinges", "sliding", "friction_angle_deg", "friction_rule", "iterations")
         out["mechanism"] = {k: lim[k] for k in keys}
         out["limit_notes"] = lim["notes"]
+        out["loads"] = lim["loads"]
+        out["rigid_body_mechanism"] = rigid_body_mechanism(self.limit)
         if self.other_direction is not None:
             o = self.other_direction
             out["other_direction"] = {
@@ -230,6 +236,83 @@ class Assessment:
         return finite_or_null(out)
 
 
+#: Why an NTC 2018 site's dynamics need the user's records.
+NTC_SUITE_MESSAGE = (
+    "the synthetic suite is generated to match an EC8 spectrum (type and ground); for an NTC 2018 site give "
+    "--records (a folder of the site's records, e.g. spectrum-compatible ones), or --static-only, or the EC8 "
+    "spectrum (--spectrum ec8 --spectrum-type --ground)"
+)
+
+
+def rigid_body_mechanism(limit: LimitResult) -> dict[str, Any] | None:
+    """When the mechanism turns several blocks as one rigid body (a wall's courses rotating
+    together), the code's e* of the blocks as separate P_i beside that of the same body as one
+    block, and what it means (a note); None otherwise.
+
+    The kinematic method counts each block as a P_i at its centroid, so n courses that turn as
+    one give e* = (1/4) / (1/3 - 1/(12 n^2)) -> 0.75, while the same wall as one block has
+    e* = 1; a0* = alpha0 g / (e* FC) is then 1 / e* times the monolith's for the same motion. Such
+    courses are not expected to act as separate blocks dynamically: the DEMs find a wall in
+    courses rocking as its monolith when its mechanism turns all courses as one
+    (docs/howto/is-this-wall-safe.md).
+    """
+    kin, mech = limit.kinematic, limit.mechanism
+    if kin is None or mech is None:
+        return None
+    model = limit.model
+    moving = np.flatnonzero(mech.moving)
+    if moving.size < 2:
+        return None
+    v = mech.velocities
+    omega = v[moving, 2]
+    scale = max(float(np.max(np.abs(v[moving, :2]))), 1e-300)
+    if np.ptp(omega) > 1e-9 * max(float(np.max(np.abs(omega))), 1e-300):
+        return None
+    ref = int(moving[0])
+    c = model.centroids_m
+    for i in moving[1:]:  # v_i = v_ref + omega x (c_i - c_ref): one rigid-body motion
+        r = c[i] - c[ref]
+        expected = v[ref, :2] + omega[0] * np.array([-r[1], r[0]])
+        if np.max(np.abs(v[i, :2] - expected)) > 1e-7 * scale:
+            return None
+    d = 1.0 if limit.direction == "+x" else -1.0
+    own_m = model.masses_kg if model.block_masses_kg is None else model.block_masses_kg
+    own_c = model.centroids_m if model.block_centroids_m is None else model.block_centroids_m
+    mass = float(own_m[moving].sum())
+    centre = np.average(own_c[moving], axis=0, weights=own_m[moving])
+    points = [(mass, centre)] + [
+        (float(q.mass_kg), np.asarray(q.point_m, dtype=float))
+        for q in model.given_loads
+        if q.mass_kg and int(q.block) in set(moving.tolist())
+    ]
+
+    def dx(p: np.ndarray) -> float:
+        r = p - c[ref]
+        return d * float(v[ref, 0] - omega[0] * r[1])
+
+    s1 = sum(m * dx(p) for m, p in points)
+    s2 = sum(m * dx(p) ** 2 for m, p in points)
+    total = sum(m for m, _ in points)
+    e_one = s1 * s1 / s2 / total
+    a0_one = kin.alpha0 * model.g / (e_one * kin.FC)
+    names = [model.names[i] for i in moving]
+    note = (
+        f"the mechanism turns {len(names)} blocks ({names[0]} ... {names[-1]}) as one rigid body: they are not "
+        "expected to act as separate blocks dynamically (the DEMs find a wall in courses rocking as its monolith "
+        f"when its mechanism turns all courses as one). The code's e* = {kin.e_star:.4g} counts each block as a P_i; "
+        f"the same body as one block has e* = {e_one:.4g}, so a0* = {kin.a0_star_m_s2:.4g} m/s^2 is "
+        f"{e_one / kin.e_star:.3g} times the monolith's {a0_one:.4g} m/s^2 for the same motion: the capacity the "
+        "courses add is the code's lumping, not the dynamics'"
+    )
+    return {
+        "blocks": names,
+        "e_star_blocks": kin.e_star,
+        "e_star_one_body": e_one,
+        "a0_star_one_body_m_s2": a0_one,
+        "note": note,
+    }
+
+
 def _limit(
     scene: Scene,
     direction: str | None,
@@ -261,13 +344,15 @@ def _limit(
 
 
 def dynamic_plan(
-    scene: Scene, site: Site, settings: DynamicSettings, executor: Executor, progress: bool = True
+    scene: Scene, site: AnySite, settings: DynamicSettings, executor: Executor, progress: bool = True
 ) -> FragilityPlan:
     """The stripes in ag (module docstring); records generated or read now, nothing run."""
     solver = as_solver(settings.solver or default_solver(scene))
     fallen = check_fallen_blocks(scene, settings.fallen_blocks)
     motions: MotionSet
     if settings.records is None:
+        if not isinstance(site, Site):
+            raise InputError("--records", NTC_SUITE_MESSAGE)
         motions = ec8_suite(site.spectrum_type, site.ground, site.ag_m_s2, settings.count, settings.seed)
     else:
         motions = settings.records
@@ -303,7 +388,7 @@ def dynamic_plan(
 
 def assess(
     scene: Scene,
-    site: Site,
+    site: AnySite,
     *,
     code: str = "ntc2018",
     position: Position | None = None,
@@ -368,6 +453,10 @@ def assess(
         out.notes.append("no horizontal acceleration makes the scene collapse statically: no code check")
     if any(c.status == NOT_APPLICABLE for c in checks):
         out.notes.extend(f"{c.name}: not applicable ({c.reason})" for c in checks if c.status == NOT_APPLICABLE)
+    rigid = rigid_body_mechanism(best)
+    if rigid is not None:
+        out.notes.append(rigid["note"])
+    out.notes.extend(checks_not_made(best.kinematic, position))
     if dynamic is not None:
         add_dynamics(out, scene, dynamic, executor, allow_large=allow_large, progress=progress, on_plan=on_plan)
     return out

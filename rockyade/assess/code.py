@@ -1,23 +1,29 @@
 """The code's checks of a mechanism: the kinematic method of NTC 2018 (Circolare 2019 C8.7.1).
 
 The capacity side is :mod:`rockyade.limit.kinematic` (alpha0, M*, e*, a0*, d0*, du*, Ts);
-here the demand of the site (:class:`~rockyade.assess.site.Site`, EN 1998-1's elastic
-spectrum Se(T), :mod:`rockyade.motion.ec8`) and the comparison:
+here the demand of the site (:mod:`rockyade.assess.site`: NTC 2018's elastic spectrum
+3.2.3.2.1, or EN 1998-1's 3.2.2.2 when asked for) and the comparison, each check with its
+clause and formula (:data:`CHECK_SOURCES`):
 
-* linear kinematic analysis, a mechanism at ground level: a0* >= ag S / q;
+* linear kinematic analysis, a mechanism at ground level: a0* >= ag S / q (Circolare 2019
+  C8.7.1, the same form as Circolare 2009 C8A.4.2.3);
 * nonlinear kinematic analysis, a mechanism at ground level: du* >= SDe(Ts), with the
-  elastic displacement spectrum SDe(T) = Se(T) (T / 2 pi)^2 (EN 1998-1 3.2.2.2, Eq 3.7, for
-  T up to 4 s);
+  elastic displacement spectrum SDe(T) = Se(T) (T / 2 pi)^2 (NTC 2018 3.2.3.2.3 Eq 3.2.12;
+  EN 1998-1 3.2.2.2 Eq 3.7), for Ts up to 4 s;
 * linear kinematic analysis, a mechanism at height Z of a building of height H, N storeys
-  and period T1: a0* >= Se(T1) psi(Z) gamma / q, psi(Z) = Z / H, gamma = 3 N / (2 N + 1);
+  and period T1: a0* >= Se(T1) psi(Z) gamma / q, psi(Z) = Z / H, gamma = 3 N / (2 N + 1). This
+  is the form of Circolare 2009 C8A.4.2.3, kept: Circolare 2019 C8.7.1 takes the demand at
+  height from the floor spectra of NTC 2018 7.2.3 / Circolare 2019 C7.2.3, which is not
+  implemented here; the output says so in the check's own source.
 
-with the behaviour factor q = 2 (Circolare 2019 C8.7.1; the same checks as Circolare 2009
-C8A.4). The linear and the nonlinear analyses are two ways of checking the same mechanism
-(the linear one, with q, the simpler and more conservative): the mechanism is verified when
-one of the checks that apply is met. Every demand is proportional to ag, so each check also
-gives the ag at which it is met exactly, ag_capacity = ag x capacity / demand: the code's
-capacity in the units of the site's shaking. The nonlinear check at height (with the floor
-spectrum) is not implemented.
+with the behaviour factor q = 2. The linear and the nonlinear analyses are two ways of checking
+the same mechanism (the linear one, with q, the simpler and more conservative): the mechanism
+is verified when one of the checks that apply is met. Every demand is proportional to ag, so
+each check also gives the ag at which it is met exactly, ag_capacity = ag x capacity / demand:
+the code's capacity in the units of the site's shaking.
+
+Checks the tool does not make are listed, with the reason, by :func:`checks_not_made` (they
+go into the output's notes).
 """
 
 from __future__ import annotations
@@ -26,7 +32,7 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from rockyade.assess.site import Position, Site
+from rockyade.assess.site import AnySite, Position
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.limit.kinematic import KinematicQuantities
@@ -36,7 +42,17 @@ CODES = ("ntc2018",)
 #: Behaviour factor of the linear kinematic check (Circolare 2019 C8.7.1).
 Q_FACTOR = 2.0
 #: The clause every check comes from.
-CLAUSE = "NTC 2018, Circolare 2019 C8.7.1 (kinematic analysis of local mechanisms; as Circolare 2009 C8A.4)"
+CLAUSE = "NTC 2018 8.7.1, Circolare 2019 C8.7.1 (kinematic analysis of local mechanisms)"
+#: Each check's clause and formula (the check's ``source``).
+CHECK_SOURCES = {
+    "linear, ground level": "Circolare 2019 C8.7.1, linear kinematic analysis at ground level (the same form as "
+    "Circolare 2009 C8A.4.2.3): a0* = alpha0 g / (e* FC) >= ag S / q",
+    "nonlinear, ground level": "Circolare 2019 C8.7.1, nonlinear kinematic analysis at ground level (the same form "
+    "as Circolare 2009 C8A.4.2.3): du* = 0.4 d0* >= SDe(Ts), Ts = 2 pi sqrt(ds* / as*), ds* = 0.4 du*",
+    "linear, at height": "Circolare 2009 C8A.4.2.3 form, kept (NOT the 2019 form): a0* >= Se(T1) psi(Z) gamma / q; "
+    "Circolare 2019 C8.7.1 takes the demand at height from the floor spectra of NTC 2018 7.2.3 / Circolare 2019 "
+    "C7.2.3, not implemented here",
+}
 
 VERIFIED, NOT_VERIFIED, NOT_APPLICABLE = "verified", "not verified", "not applicable"
 
@@ -48,8 +64,8 @@ def check_code(code: str) -> str:
     return code
 
 
-def displacement_spectrum(site: Site, period_s: float) -> float:
-    """SDe(T) = Se(T) (T / 2 pi)^2, m (EN 1998-1 Eq 3.7)."""
+def displacement_spectrum(site: AnySite, period_s: float) -> float:
+    """SDe(T) = Se(T) (T / 2 pi)^2, m (NTC 2018 Eq 3.2.12; EN 1998-1 Eq 3.7)."""
     se = float(site.spectrum.psa([period_s])[0])
     return se * (period_s / (2.0 * math.pi)) ** 2
 
@@ -129,10 +145,11 @@ def _check(name: str, quantity: str, inequality: str, demand: float, capacity: f
 
 
 def _not_applicable(name: str, quantity: str, inequality: str, unit: str, reason: str) -> Check:
-    return Check(name, quantity, inequality, math.nan, math.nan, unit, NOT_APPLICABLE, reason=reason)
+    source = CHECK_SOURCES.get(name, CLAUSE)
+    return Check(name, quantity, inequality, math.nan, math.nan, unit, NOT_APPLICABLE, reason=reason, source=source)
 
 
-def code_checks(kin: KinematicQuantities, site: Site, position: Position, q: float = Q_FACTOR) -> list[Check]:
+def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: float = Q_FACTOR) -> list[Check]:
     """The checks of a mechanism's kinematic quantities against the site's demand (module docstring).
 
     Parameters
@@ -161,7 +178,8 @@ def code_checks(kin: KinematicQuantities, site: Site, position: Position, q: flo
                 "m/s^2",
                 terms={"ag_m_s2": ag, "S": S, "q": q},
                 ag_capacity_m_s2=ag * a0 / demand,
-                source=f"{CLAUSE}; q = {q:g}",
+                source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g}; "
+                f"S from {site.spectrum_clause.split(';')[0]}",
             )
         )
         name, inequality = "nonlinear, ground level", "du* >= SDe(Ts)"
@@ -190,7 +208,7 @@ def code_checks(kin: KinematicQuantities, site: Site, position: Position, q: flo
                         "S": S,
                     },
                     ag_capacity_m_s2=ag * kin.du_star_m / sde,
-                    source=f"{CLAUSE}; SDe(T) = Se(T) (T / 2 pi)^2, EN 1998-1 3.2.2.2 Eq 3.7",
+                    source=f"{CHECK_SOURCES[name]}; {site.spectrum_clause}",
                 )
             )
         return checks
@@ -208,10 +226,43 @@ def code_checks(kin: KinematicQuantities, site: Site, position: Position, q: flo
             "m/s^2",
             terms={"Se_T1_m_s2": se_t1, "T1_s": T1, "psi": psi, "gamma": gamma, "q": q, "ag_m_s2": ag, "S": S},
             ag_capacity_m_s2=ag * a0 / demand,
-            source=f"{CLAUSE}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g}; T1: {position.period_source}",
+            source=f"{CHECK_SOURCES['linear, at height']}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g}; "
+            f"T1: {position.period_source}; Se from {site.spectrum_clause}",
         )
     )
     return checks
+
+
+def checks_not_made(kin: KinematicQuantities | None, position: Position) -> list[str]:
+    """The checks of the kinematic method this tool does not make, each with the reason (for
+    the output's notes)."""
+    out = []
+    if position.at_height:
+        out.append(
+            "not made: the nonlinear check at height (Circolare 2009 C8A.4.2.3 with the floor's displacement "
+            "spectrum; Circolare 2019 C8.7.1 with the floor spectra of C7.2.3): the floor's response is not "
+            "modelled; only the linear check at height (2009 form) is made"
+        )
+    if kin is not None and kin.nonlinear_note and "slides" in kin.nonlinear_note:
+        out.append(
+            "not made: the nonlinear check of this mechanism, in which a joint slides: the code's nonlinear "
+            "kinematic analysis follows rocking (hinged) mechanisms; the linear check stands alone"
+        )
+    out.append(
+        "not made: a check of sliding mechanisms as such (the code's kinematic method is written for rocking "
+        "mechanisms): the limit analysis lets joints slide with associated friction, which bounds a sliding "
+        "multiplier from above (--friction-rule coulomb for the non-dilatant one)"
+    )
+    out.append(
+        "not made: the damage limit state (SLD) and operational checks; only the life-safety checks (SLV) with the "
+        "site's spectrum as given"
+    )
+    out.append(
+        "not made: the finite compressive strength of the masonry at the hinges (rigid blocks: each hinge at the "
+        "edge of its joint), which lowers alpha0; and mechanisms outside the scene's section (in-plane, corners, "
+        "roof thrust): only the section's mechanisms towards +x and -x are examined"
+    )
+    return out
 
 
 def verdict(checks: list[Check]) -> str:

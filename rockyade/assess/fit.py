@@ -11,6 +11,11 @@
   the pointwise 5 %-95 % range of the fitted curves, and the medians' and betas' 5 %-95 %
   ranges are their intervals. Draws whose fit has no slope (separated stripes, no trend)
   give no curve and are counted.
+* How few records is too few: below :data:`MIN_RECORDS` (5) records the fit is refused (a
+  lognormal median from so few records cannot be bounded: the bootstrap over records has
+  only a handful of distinct resamples); below :data:`FEW_RECORDS` (10) it is fitted with a
+  warning. A bootstrap band whose end is the median itself says why (a share of the draws
+  that give back exactly the median: the band does not measure the uncertainty on that side).
 """
 
 from __future__ import annotations
@@ -32,6 +37,9 @@ BOOTSTRAP_SEED = 20240611
 BAND_LEVEL = 0.90
 #: Two-sided level of the stripes' Wilson intervals.
 STRIPE_LEVEL = 0.95
+#: Fewest records a fit is made on, and the number below which it carries a warning.
+MIN_RECORDS = 5
+FEW_RECORDS = 10
 
 
 def stripe_table(runs: pd.DataFrame, level_column: str) -> pd.DataFrame:
@@ -80,6 +88,8 @@ class StripeFit:
         The band of the curve: intensities (SI) and the 5 % and 95 % probabilities there.
     draws, fitted_draws
         Bootstrap draws, and those that gave a curve.
+    notes
+        Warnings on the fit (few records, a band ending at the median), in words.
     """
 
     fragility: Fragility
@@ -91,6 +101,7 @@ class StripeFit:
     band_hi: NDArray[np.float64]
     draws: int
     fitted_draws: int
+    notes: tuple[str, ...] = ()
 
     @property
     def fitted(self) -> bool:
@@ -121,6 +132,7 @@ class StripeFit:
             "fraction": f.fraction,
             "stripes": f.n_points,
             "method": "maximum likelihood on the stripes (Baker 2015)",
+            "notes": list(self.notes),
         }
 
 
@@ -248,13 +260,28 @@ def fit_stripes(
         The bootstrap.
     """
     levels, matrix = _outcomes(runs, level_column)
-    best = _fit(levels, matrix)
+    n_records = matrix.shape[0]
+    notes: list[str] = []
+    if n_records < MIN_RECORDS:
+        best: Fragility | None = Fragility(
+            math.nan,
+            math.nan,
+            int(levels.size),
+            f"not fitted: {n_records} records, fewer than {MIN_RECORDS}: a lognormal median from so few records "
+            "cannot be bounded (run more records)",
+        )
+    else:
+        best = _fit(levels, matrix)
+        if n_records < FEW_RECORDS:
+            notes.append(
+                f"fitted on {n_records} records, fewer than {FEW_RECORDS}: the median and beta are rough and the "
+                "bootstrap band is wide or uninformative (run more records)"
+            )
     if best is None:
         best = Fragility(math.nan, math.nan, int(levels.size), "not fitted: fewer than two stripes with runs")
     grid = np.linspace(0.0, 2.0 * float(levels.max()), 201)[1:] if grid_si is None else np.asarray(grid_si)
     rng = np.random.default_rng(seed)
     medians, betas, curves = [], [], []
-    n_records = matrix.shape[0]
     for _ in range(draws if best.status == "fitted" else 0):
         counts = _counts(levels, matrix[rng.integers(0, n_records, n_records)])
         fit = None if counts is None else refit(*counts, (best.median, best.beta))
@@ -268,6 +295,14 @@ def fit_stripes(
         band = np.percentile(np.array(curves), [tail, 100.0 - tail], axis=0)
         m_int = tuple(float(v) for v in np.percentile(medians, [tail, 100.0 - tail]))
         b_int = tuple(float(v) for v in np.percentile(betas, [tail, 100.0 - tail]))
+        same = float(np.mean(np.abs(np.array(medians) / best.median - 1.0) <= 1e-6))
+        for end, side in ((m_int[0], "lower"), (m_int[1], "upper")):
+            if abs(end / best.median - 1.0) <= 1e-6:
+                notes.append(
+                    f"the band's {side} end is the median itself: {100 * same:.0f} % of the bootstrap draws give back "
+                    "exactly the fitted median (resampled records that change no stripe around it), so the band "
+                    f"does not measure the uncertainty on its {side} side"
+                )
     else:  # too few draws with a curve: no band rather than a band of a few
         band = np.full((2, grid.size), np.nan)
         m_int, b_int = (math.nan, math.nan), (math.nan, math.nan)
@@ -281,4 +316,5 @@ def fit_stripes(
         band[1],
         draws if best.status == "fitted" else 0,
         len(curves),
+        tuple(notes),
     )

@@ -25,7 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.analysis.capacity import Onset, capacity_curve, pushover_onset
+from rockyade.analysis.capacity import ONSET_THRESHOLD_M, Onset, capacity_curve, pushover_onset
 from rockyade.errors import InputError
 from rockyade.limit.kinematic import KinematicQuantities
 from rockyade.motion.quasistatic import Pushover
@@ -174,7 +174,11 @@ def run_pushover(scene: Scene, kin: KinematicQuantities, direction: str) -> Push
     centroid = placed_blocks(pushed)[names.index(kin.control_block)].centroid_m
     result = run(pushed, "reference")
     curve = capacity_curve(result, pushed, block=kin.control_block, point_m=(float(centroid[0]), float(centroid[1])))
-    onset = pushover_onset(curve, pushed)
+    # a wall that closes a gap onto a restraint moves only that far (then bears on it): mark the onset
+    # well within that (the DEM's elastic creep below the onset is a thousand times smaller)
+    closed = kin.curve.closed_dk_m if kin.curve is not None else None
+    threshold = ONSET_THRESHOLD_M if closed is None else min(ONSET_THRESHOLD_M, 0.25 * closed)
+    onset = pushover_onset(curve, pushed, threshold_m=threshold)
     t = curve["t_s"].to_numpy()
     lam = curve["lambda"].to_numpy()
     dk = curve["displacement_m"].to_numpy()

@@ -62,6 +62,7 @@ def fit_lines(result: FragilityResult, what: str = "") -> list[str]:
         )
     else:
         lines.append(f"no fit: {f.status}")
+    lines += [f"  note: {note}" for note in fit.notes]
     if result.levels_added:
         added = ", ".join(f"{m.shown(v):.3g}" for v in result.levels_added)
         lines.append(f"levels added to bracket the median: {added} {m.unit}")
@@ -82,7 +83,7 @@ def fragility_lines(result: FragilityResult, source: str) -> list[str]:
 def _check_line(check: Check) -> str:
     unit = check.unit
     if check.status == NOT_APPLICABLE:
-        return f"  {check.name}: {check.inequality}: not applicable ({check.reason})"
+        return f"  {check.name}: {check.inequality}: not applicable ({check.reason})\n    clause: {check.source}"
     t = check.terms
     if check.quantity == "a0*" and "T1_s" not in t:
         demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}"
@@ -97,6 +98,7 @@ def _check_line(check: Check) -> str:
     return (
         f"  {check.name}: {check.quantity} = {check.capacity:.4g} {unit} against {demand}: {word} "
         f"(capacity / demand {check.ratio:.3g}; met up to ag = {check.ag_capacity_m_s2 / G:.4g} g)"
+        f"\n    clause: {check.source}"
     )
 
 
@@ -105,8 +107,10 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     (:func:`dynamic_lines` gives the dynamic part)."""
     lim, kin = a.limit, a.limit.kinematic
     lines = [
-        f"assessment of {source}: NTC 2018 kinematic method (Circolare 2019 C8.7.1), FC = {a.fc:g}",
+        f"assessment of {source}: NTC 2018 kinematic method (NTC 2018 8.7.1, Circolare 2019 C8.7.1), FC = {a.fc:g}",
         f"site: {a.site.describe()}; mechanism {a.position.describe()}",
+        f"g = {G:g} m/s^2 throughout the check (ag in g and a0* = alpha0 g / (e* FC): the verdict does not depend "
+        "on it); records given in g are read with standard gravity 9.80665 m/s^2",
     ]
     if lim.status == "no_mechanism":
         lines.append("limit analysis: no horizontal acceleration makes it collapse (no mechanism): no code check")
@@ -124,6 +128,7 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         f"mechanism (limit analysis, load towards {lim.direction}{other}): {plural(n, 'block')} "
         f"move{'s' if n == 1 else ''}, {joints}"
     )
+    lines += model.load_lines()
     lines += ["  " + hinge_words(model, h) for h in mech.hinges[:5]]
     lines += ["  " + sliding_words(model, s, mech.velocities) for s in mech.sliding[:5]]
     lines.append(
@@ -137,7 +142,7 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         )
     else:
         lines.append(f"  nonlinear: none ({kin.nonlinear_note})")
-    lines.append("checks:")
+    lines.append("checks made:")
     lines += [_check_line(c) for c in a.checks]
     cap = a.code_capacity_ag_m_s2
     site_ag = a.site.ag_m_s2 / G
@@ -147,7 +152,11 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     )
     # the friction caveat holds for any finite friction (a rocking mechanism can be too high as well)
     lines += [f"note: {note}" for note in lim.notes]
-    lines += [f"note: {note}" for note in a.notes]
+    lines += [f"note: {note}" for note in a.notes if not note.startswith("not made: ")]
+    not_made = [note.removeprefix("not made: ") for note in a.notes if note.startswith("not made: ")]
+    if not_made:
+        lines.append("checks not made:")
+        lines += [f"  {note}" for note in not_made]
     return lines
 
 

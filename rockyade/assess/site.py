@@ -1,9 +1,20 @@
 """The site and the place of a mechanism in its building: what the code's demand depends on.
 
-The site's elastic spectrum is EN 1998-1's (Section 3.2.2.2, :mod:`rockyade.motion.ec8`): a
-spectrum type (1 or 2), a ground type (A-E) and the design ground acceleration on type A
-ground ag = gamma_I agR (EN 1998-1 3.2.1(3): agR the reference peak ground acceleration,
-gamma_I the importance factor).
+The site's elastic spectrum is either
+
+* NTC 2018's (:class:`NtcSite`, Section 3.2.3.2.1, :mod:`rockyade.motion.ntc2018`): the
+  site's ag, F0 and TC* for the limit state's return period (NTC 2018 Allegato A), the
+  subsoil category A-E (SS, CC of Tab. 3.2.IV) and the topographic category T1-T4 (ST of
+  Tab. 3.2.V); what an Italian verdict uses; or
+* EN 1998-1's (:class:`Site`, Section 3.2.2.2, :mod:`rockyade.motion.ec8`): a spectrum type
+  (1 or 2), a ground type (A-E) and the design ground acceleration on type A ground
+  ag = gamma_I agR (EN 1998-1 3.2.1(3): agR the reference peak ground acceleration, gamma_I
+  the importance factor).
+
+One g everywhere in the check: an acceleration given in g (``0.25g``, the site's ag/g) is
+turned into m/s^2 with the project's g = 9.81 m/s^2 (:data:`rockyade.constants.G`), the same g
+that turns the multiplier alpha0 into a0* = alpha0 g / (e* FC): the check a0* >= ag S / q is
+then alpha0 / (e* FC) >= (ag/g) S / q whatever the value of g.
 
 A mechanism sits at ground level (the default) or at a height Z of a building of height H,
 N storeys and fundamental period T1 (the demand is then the floor's: Circolare 2019
@@ -22,6 +33,7 @@ from typing import Any
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.motion.ec8 import EC8_GROUND, ElasticSpectrum
+from rockyade.motion.ntc2018 import NtcSpectrum, ntc_spectrum, soil_factors, topography_factor
 
 #: Largest design ground acceleration accepted, in g: above it the number is a typing error.
 MAX_AG_G = 1.0
@@ -70,7 +82,7 @@ def parse_acceleration(text: str | float, field: str = "--ag", max_g: float = MA
 
 @dataclass(frozen=True)
 class Site:
-    """The site's elastic spectrum (EN 1998-1 3.2.2.2).
+    """The site's elastic spectrum of EN 1998-1 (3.2.2.2).
 
     Attributes
     ----------
@@ -140,7 +152,122 @@ class Site:
             "ag_g": self.ag_m_s2 / G,
             "spectrum": self.spectrum.as_dict(),
             "source": "EN 1998-1 3.2.2.2 (Eqs 3.2-3.5, Tables 3.2 and 3.3); ag = gamma_I agR (3.2.1(3))",
+            "spectrum_code": self.spectrum_code,
         }
+
+    @property
+    def spectrum_code(self) -> str:
+        """Whose spectrum: ``ec8``."""
+        return "ec8"
+
+    @property
+    def spectrum_clause(self) -> str:
+        """The clause of the spectrum and of SDe (for the checks' sources)."""
+        return "EN 1998-1 3.2.2.2 (Eqs 3.2-3.5); SDe(T) = Se(T) (T / 2 pi)^2, Eq 3.7"
+
+
+@dataclass(frozen=True)
+class NtcSite:
+    """The site's elastic spectrum of NTC 2018 (3.2.3.2.1; module docstring).
+
+    Attributes
+    ----------
+    ag_g
+        ag on type A ground for the limit state's return period, in g (Allegato A).
+    F0
+        Maximum spectral amplification (Allegato A).
+    tc_star_s
+        TC*, s (Allegato A).
+    soil
+        Subsoil category A-E (Tab. 3.2.II).
+    topography
+        Topographic category T1-T4 (Tab. 3.2.III).
+    height_ratio
+        Height of the site above the base of the relief over the relief's height (1: at the
+        top, where ST is Tab. 3.2.V's value).
+    """
+
+    ag_g: float
+    F0: float
+    tc_star_s: float
+    soil: str = "A"
+    topography: str = "T1"
+    height_ratio: float = 1.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "soil", str(self.soil).upper())
+        object.__setattr__(self, "topography", str(self.topography).upper())
+        self.spectrum  # noqa: B018 -- validates every parameter now, naming the option
+
+    @property
+    def ag_m_s2(self) -> float:
+        """ag, m/s^2 (ag/g x 9.81)."""
+        return self.ag_g * G
+
+    @property
+    def spectrum(self) -> NtcSpectrum:
+        """The 5 % damped elastic spectrum (NTC 2018 Eqs 3.2.2)."""
+        return ntc_spectrum(self.ag_g, self.F0, self.tc_star_s, self.soil, self.topography, self.height_ratio, g=G)
+
+    @property
+    def SS(self) -> float:
+        """Stratigraphic amplification SS (Tab. 3.2.IV)."""
+        return soil_factors(self.soil, self.ag_g, self.F0, self.tc_star_s)[0]
+
+    @property
+    def ST(self) -> float:
+        """Topographic amplification ST (Tab. 3.2.V, at ``height_ratio``)."""
+        return topography_factor(self.topography, self.height_ratio)
+
+    @property
+    def S(self) -> float:
+        """S = SS ST (NTC 2018 3.2.3.2.1)."""
+        return self.SS * self.ST
+
+    @property
+    def spectrum_code(self) -> str:
+        """Whose spectrum: ``ntc2018``."""
+        return "ntc2018"
+
+    @property
+    def spectrum_clause(self) -> str:
+        """The clause of the spectrum and of SDe (for the checks' sources)."""
+        return "NTC 2018 3.2.3.2.1 (Eqs 3.2.2); SDe(T) = Se(T) (T / 2 pi)^2, NTC 2018 3.2.3.2.3 Eq 3.2.12"
+
+    def describe(self) -> str:
+        """One line: the site's parameters and the spectrum's."""
+        sp = self.spectrum
+        ratio = f" at {self.height_ratio:g} of the relief's height" if self.topography != "T1" else ""
+        return (
+            f"NTC 2018 spectrum (3.2.3.2.1): ag = {self.ag_g:.4g} g ({self.ag_m_s2:.4g} m/s^2), F0 = {self.F0:g}, "
+            f"TC* = {self.tc_star_s:g} s; soil {self.soil} (SS = {self.SS:.4g}), topography {self.topography}"
+            f"{ratio} (ST = {self.ST:.4g}): S = {self.S:.4g}, TB = {sp.TB_s:.4g} s, TC = {sp.TC_s:.4g} s, "
+            f"TD = {sp.TD_s:.4g} s"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        """JSON-ready: the inputs and the spectrum's parameters."""
+        return {
+            "spectrum_code": self.spectrum_code,
+            "ag_g": self.ag_g,
+            "ag_m_s2": self.ag_m_s2,
+            "F0": self.F0,
+            "TC_star_s": self.tc_star_s,
+            "soil": self.soil,
+            "SS": self.SS,
+            "CC": soil_factors(self.soil, self.ag_g, self.F0, self.tc_star_s)[1],
+            "topography": self.topography,
+            "topography_height_ratio": self.height_ratio,
+            "ST": self.ST,
+            "S": self.S,
+            "spectrum": self.spectrum.as_dict(),
+            "source": "NTC 2018 3.2.3.2.1 (Eqs 3.2.2-3.2.7, Tabs 3.2.IV and 3.2.V); ag, F0, TC* of the site from "
+            "Allegato A for the limit state's return period",
+        }
+
+
+#: Either site (the checks read ``ag_m_s2``, ``S``, ``spectrum`` and ``spectrum_clause``).
+AnySite = Site | NtcSite
 
 
 @dataclass(frozen=True)

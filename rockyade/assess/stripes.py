@@ -17,11 +17,19 @@ not the time history. A run **collapses** when
   collapse table of :func:`rockyade.analysis.collapse.collapse_report` says (a block lying
   on another face, carried down by more than half its height, or left leaning beyond its
   tipping angle).
+
+A run's row gives its peak rotation as ``max_theta_over_alpha``, the largest |theta| of its
+blocks over the whole scene's critical angle (:func:`whole_alpha`: atan of the limit-analysis
+multiplier of its mechanism, the whole's alpha for a stack turning about its base), so that a
+wall in courses and its monolith, rotating the same, read the same; ``max_theta_over_own_alpha``
+keeps the largest of each block's |theta| over its own alpha (a 0.3 m course of a 2.4 m wall
+has alpha = 0.876 rad against the wall's 0.124: 7 times smaller a number for the same motion).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from collections.abc import Sequence
@@ -58,6 +66,7 @@ RUN_COLUMNS = (
     "collapsed",
     "n_fallen",
     "max_theta_over_alpha",
+    "max_theta_over_own_alpha",
     "failure_reason",
     "wall_time_s",
     "scene_hash",
@@ -116,23 +125,45 @@ class StripeTask(Task):
     level_si: float = math.nan
     load_factor: float = math.nan
     fallen_blocks: int = 1
+    whole_alpha_rad: float = math.nan
 
 
-def collapse_of(scene: Scene, result: Result, fallen_blocks: int = 1) -> tuple[bool, int, float]:
-    """(collapsed, blocks fallen, largest peak |theta| / alpha) of a run (module docstring)."""
+def whole_alpha(scene: Scene) -> float:
+    """The whole scene's critical angle, rad: atan of the smaller of its limit-analysis
+    multipliers towards +x and -x (for one block its alpha; for a stack turning about its base
+    the whole's alpha, b / h_c = tan alpha); NaN without a mechanism."""
+    if single_block(scene):
+        return float(scene.blocks[0].classical().alpha_rad)
+    from rockyade.limit import limit_analysis
+
+    lams = []
+    for direction in ("+x", "-x"):
+        try:
+            lam = limit_analysis(scene, direction, nonlinear=False).load_multiplier
+        except InputError:
+            lam = None
+        if lam is not None and math.isfinite(lam):
+            lams.append(lam)
+    return math.atan(min(lams)) if lams else math.nan
+
+
+def collapse_of(scene: Scene, result: Result, fallen_blocks: int = 1) -> tuple[bool, int, float, float]:
+    """(collapsed, blocks fallen, largest peak |theta| / the block's own alpha, largest peak
+    |theta| in rad) of a run (module docstring)."""
     if single_block(scene):
         spec = scene.blocks[0]
         theta = np.asarray(result.series("theta_rad", spec.name), dtype=float)
         finite = theta[np.isfinite(theta)]
-        ratio = float(np.max(np.abs(finite)) / spec.classical().alpha_rad) if finite.size else math.nan
+        peak = float(np.max(np.abs(finite))) if finite.size else math.nan
         over = result.status == "overturned"
-        return over, int(over), ratio
+        return over, int(over), peak / spec.classical().alpha_rad, peak
     from rockyade.analysis.collapse import collapse_report
 
     report = collapse_report(scene, result)
     fallen = int(report["fell"].sum())
     ratio = float(np.nanmax(report["max_theta_over_alpha"])) if len(report) else math.nan
-    return fallen >= fallen_blocks, fallen, ratio
+    peak = float(np.nanmax(report["max_abs_theta_rad"])) if len(report) else math.nan
+    return fallen >= fallen_blocks, fallen, ratio, peak
 
 
 def _row(task: StripeTask, status: str, reason: str) -> dict[str, Any]:
@@ -147,6 +178,7 @@ def _row(task: StripeTask, status: str, reason: str) -> dict[str, Any]:
         "collapsed": False,
         "n_fallen": 0,
         "max_theta_over_alpha": math.nan,
+        "max_theta_over_own_alpha": math.nan,
         "failure_reason": reason,
         "wall_time_s": math.nan,
         "scene_hash": task.scene_hash,
@@ -162,11 +194,17 @@ def run_stripe_task(task: StripeTask) -> dict[str, Any]:
     row["wall_time_s"] = time.perf_counter() - start
     if result.ok:
         try:
-            collapsed, fallen, ratio = collapse_of(task.scene, result, task.fallen_blocks)
+            collapsed, fallen, ratio, peak = collapse_of(task.scene, result, task.fallen_blocks)
         except Exception as exc:  # an analysis that fails is this run's failure, not the batch's
             row.update(status="failed", failure_reason=f"collapse analysis: {type(exc).__name__}: {exc}")
         else:
-            row.update(collapsed=bool(collapsed), n_fallen=fallen, max_theta_over_alpha=ratio)
+            whole = peak / task.whole_alpha_rad if math.isfinite(task.whole_alpha_rad) else ratio
+            row.update(
+                collapsed=bool(collapsed),
+                n_fallen=fallen,
+                max_theta_over_alpha=whole,
+                max_theta_over_own_alpha=ratio,
+            )
     return row
 
 
@@ -209,6 +247,13 @@ class StripePlan:
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S
     tail_s: float = DEFAULT_TAIL_S
 
+    @functools.cached_property
+    def whole_alpha_rad(self) -> float:
+        """The whole scene's critical angle (:func:`whole_alpha`), rad: a run's
+        ``max_theta_over_alpha`` is its peak rotation over it (``max_theta_over_own_alpha``
+        keeps each block's own)."""
+        return whole_alpha(self.scene)
+
     def scene_for(self, i: int, load_factor: float) -> Scene:
         """The scene of record i at ``load_factor`` (module docstring)."""
         motion = self.motions.motion(i, load_factor)
@@ -246,6 +291,7 @@ class StripePlan:
                         level_si=float(level),
                         load_factor=lf,
                         fallen_blocks=self.fallen_blocks,
+                        whole_alpha_rad=self.whole_alpha_rad,
                     )
                 )
         return out

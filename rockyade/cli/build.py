@@ -34,6 +34,7 @@ class Opt:
     choices: tuple[str, ...] | None = None
     metavar: str | None = None
     append: bool = False
+    aliases: tuple[str, ...] = ()
 
     @property
     def dest(self) -> str:
@@ -183,9 +184,10 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
             Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
             Opt("--courses", 1, "equal courses (1: one block)", int),
-            Opt("--top", "free", "free, or restrained by a fixed block on each side with a gap", str,
-                ("free", "restrained")),
-            Opt("--gap-m", 0.0, "restrained: gap between each face and its restraint (> 0), m"),
+            Opt("--top", "free", "free; restrained (a fixed block beside each face, with a gap > 0); restrained-far or "
+                "restrained-near (one face, x > 0 or x < 0; a zero gap gives the three-hinge mechanism)", str,
+                ("free", "restrained", "restrained-far", "restrained-near")),
+            Opt("--gap-m", 0.0, "restrained: gap between the face and its restraint (< the thickness), m"),
             Opt("--restraint-height-m", 0.3, "restrained: depth of the restraints, m"),
             Opt("--restraint-width-m", 0.3, "restrained: width of the restraints, m"),
             Opt("--restraint-friction-deg", 0.0, "restrained: friction of the wall-restraint joints, deg (0: none)"),
@@ -196,9 +198,11 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
     "restrained-wall": (
         "a wall restrained at its top by a fixed block (out-of-plane section, the paper's Fig. 2)",
         [
-            Opt("--wall-height-m", 3.0, "wall height, m"),
-            Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m"),
-            Opt("--wall-length-m", 1.0, "wall length along its plane (the blocks' out-of-plane thickness), m"),
+            Opt("--wall-height-m", 3.0, "wall height, m (or --height-m, as wall-section)", aliases=("--height-m",)),
+            Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m (or --thickness-m)",
+                aliases=("--thickness-m",)),
+            Opt("--wall-length-m", 1.0, "wall length along its plane (the blocks' out-of-plane thickness), m "
+                "(or --length-m)", aliases=("--length-m",)),
             Opt("--blocks", 2, "1 or 2 wall blocks", int),
             Opt("--split", 0.5, "two blocks: lower block height / wall height"),
             Opt(
@@ -213,9 +217,9 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--gap-m", 0.0, "gap between the wall and the restraint, m"),
             Opt(
                 "--restraint-friction-deg",
-                None,
-                "friction angle of the wall-restraint joint, deg (default: --friction-angle-deg); 0: a "
-                "frictionless restraint, which the three-hinge mechanism of Fig. 2 needs",
+                0.0,
+                "friction angle of the wall-restraint joint, deg (default 0: a frictionless restraint, which the "
+                "three-hinge mechanism of Fig. 2 needs, as wall-section's)",
             ),
         ],
     ),
@@ -324,7 +328,7 @@ def _add(parser: argparse.ArgumentParser | Any, opt: Opt) -> None:
         kwargs.update(action="append", type=opt.type)
     else:
         kwargs.update(type=opt.type, choices=opt.choices)
-    parser.add_argument(opt.flag, **kwargs)
+    parser.add_argument(opt.flag, *opt.aliases, **kwargs)
 
 
 # ---------------------------------------------------------------------- build
@@ -530,6 +534,13 @@ def _with_overburden(args: argparse.Namespace, kind: str, data: dict[str, Any]) 
     )
 
 
+def _overburden_mass(args: argparse.Namespace, data: dict[str, Any]) -> dict[str, Any]:
+    """``--overburden-mass none``: the overburden's [[loads]] without mass (mass_kg = 0)."""
+    if getattr(args, "overburden_mass", "carried") != "none" or not data.get("loads"):
+        return data
+    return {**data, "loads": [{**q, "mass_kg": 0.0} for q in data["loads"]]}
+
+
 def cmd_build(args: argparse.Namespace) -> int:
     """Generate an assembly scene and write it."""
     from rockyade import __version__
@@ -550,6 +561,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     try:
         data = GENERATORS[kind](**kwargs)
         data = _with_overburden(args, kind, data)
+        data = _overburden_mass(args, data)
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
@@ -739,10 +751,18 @@ def register(sub: Any) -> None:
         )
         for opt in options:
             _add(k, opt)
-        if kind in OVERBURDEN:
-            loads = k.add_argument_group("overburden (forces without mass, written as [[loads]])")
-            for opt in OVERBURDEN[kind][1]:
+        if kind in OVERBURDEN or kind == "wall-section":
+            loads = k.add_argument_group("overburden (written as [[loads]], with the mass of its weight by default)")
+            for opt in OVERBURDEN.get(kind, ("", []))[1]:
                 _add(loads, opt)
+            loads.add_argument(
+                "--overburden-mass",
+                choices=("carried", "none"),
+                default="carried",
+                help="carried: the load's mass (its weight / g) shakes with the wall, as the code counts the loads "
+                "a wall carries (Circolare 2019 C8.7.1); none: a force without mass (its horizontal force goes "
+                "elsewhere) (default: carried)",
+            )
         group = k.add_argument_group("material, time, motion and joints")
         for opt in COMMON:
             _add(group, opt)

@@ -11,7 +11,7 @@ from rockyade.errors import InputError
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
-SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade")
+SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade", "siconos")
 
 
 def json_out(data: object) -> None:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -30,6 +31,7 @@ from rockyade.dem.overturn import stop_angles
 from rockyade.dem.statics import mass_vector, rest_load_wrenches, rest_springs, stability_limit, static_penetration
 from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import BlockSpec, Scene
+from rockyade.scene.carried import carried_on, loaded_mass_properties, residual_force
 from rockyade.scene.placement import PlacedBlock, RestContact, placed_blocks, rest_contacts, rotation_matrix
 
 # ---------------------------------------------------------------------- bodies
@@ -83,7 +85,11 @@ def _dem_body(
     placed: PlacedBlock,
     accel_point: object,
     g: float,
+    carried: Sequence[tuple[tuple[float, float], float]] = (),
 ) -> DemBody:
+    """The DEM body of one block, with the masses of the loads it carries merged in
+    (:func:`rockyade.scene.carried.loaded_mass_properties`): the body's centroid is the
+    loaded block's, its contact polygon and output point are given from there."""
     block = spec.block()
     cx, cy = block.centroid_m
     polygon = contact_polygon(block, spec.alpha_rad)
@@ -96,7 +102,7 @@ def _dem_body(
         point = (0.0, block.height_m - cy)
     else:
         point = (float(accel_point[0]) - cx, float(accel_point[1]) - cy)  # type: ignore[index]
-    common = dict(
+    common: dict[str, Any] = dict(
         name=spec.name,
         mass_kg=block.mass_kg,
         contact_vertices_m=polygon - np.array([cx, cy]),
@@ -126,7 +132,22 @@ def _dem_body(
         notes.append(
             f"centroidal inertia set to {inertia:.6g} kg m^2 so that p = sqrt(M g R / I_O) = {spec.p_rad_s:g} 1/s"
         )
-    p = frequency_parameter(block.mass_kg, R, inertia + block.mass_kg * R * R, g)
+    mass = block.mass_kg
+    if carried:
+        props = loaded_mass_properties(mass, placed.centroid_m, inertia, carried)
+        shift = rotation_matrix(-placed.rotation_rad) @ (np.asarray(props.centroid_m) - np.asarray(placed.centroid_m))
+        cx, cy = cx + float(shift[0]), cy + float(shift[1])  # the loaded block's centroid, block frame
+        mass, inertia = props.mass_kg, props.inertia_c_kgm2
+        common.update(
+            mass_kg=mass,
+            contact_vertices_m=polygon - np.array([cx, cy]),
+            rest_centroid_m=props.centroid_m,
+            accel_point_m=(point[0] - float(shift[0]), point[1] - float(shift[1])),
+        )
+        notes.append(f"carries {props.carried_kg:.6g} kg of load mass: centroid and inertia of the loaded block")
+        R = float(np.hypot(cx - pivot_left[0], cy))
+        alpha = math.atan2(abs(cx - pivot_left[0]), cy)
+    p = frequency_parameter(mass, R, inertia + mass * R * R, g)
     return DemBody(inertia_kgm2=inertia, alpha_rad=alpha, p_rad_s=p, R_m=R, notes=tuple(notes), **common)
 
 
@@ -205,7 +226,7 @@ def _check_settlement(
     centroids = np.array([b.rest_centroid_m for b in bodies], dtype=float)
     loads = None
     if scene.loads:
-        located = [(body_names.index(q.block), q.point_m, q.force_N) for q in scene.loads]
+        located = [(body_names.index(q.block), q.point_m, residual_force(q, g)) for q in scene.loads]
         loads = rest_load_wrenches(len(bodies), centroids, located)
     pen = static_penetration(springs, [b.mass_kg for b in bodies], [b.fixed for b in bodies], g, loads)
     if pen is None or pen.size == 0:
@@ -250,12 +271,15 @@ def _joint_height(c: RestContact, bodies: tuple[DemBody, ...]) -> float:
 # ---------------------------------------------------------------------- loads
 
 
-def load_arrays(scene: Scene, bodies: Sequence[DemBody]) -> tuple[np.ndarray, np.ndarray] | tuple[None, None]:
+def load_arrays(
+    scene: Scene, bodies: Sequence[DemBody], g: float = G
+) -> tuple[np.ndarray, np.ndarray] | tuple[None, None]:
     """Each body's point loads reduced for the kernel (:mod:`rockyade.kernel.point_loads`).
 
     A load F at the base-frame point p acts on its body at r_b = R(-theta_rest) (p - c), its
     arm from the centroid c in the body frame at angle 0 (the frame the kernel turns by the
-    body's angle).
+    body's angle). The weight of the load's mass acts through its body's (the mass is merged
+    into the body, :func:`_dem_body`): F here is the rest, :func:`rockyade.scene.carried.residual_force`.
 
     Returns
     -------
@@ -272,7 +296,7 @@ def load_arrays(scene: Scene, bodies: Sequence[DemBody]) -> tuple[np.ndarray, np
         i = names.index(load.block)
         body = bodies[i]
         r = rotation_matrix(-body.rest_angle_rad) @ (np.asarray(load.point_m) - np.asarray(body.rest_centroid_m))
-        fx, fy = load.force_N
+        fx, fy = residual_force(load, g)
         force[i] += (fx, fy)
         arm[i, 0] += r[0] * fy - r[1] * fx
         arm[i, 1] += r[0] * fx + r[1] * fy
@@ -317,7 +341,16 @@ def build_dem_model(
         )
     placed = placed_blocks(scene)
     bodies = tuple(
-        _dem_body(spec, i, own[i], placed[i], scene.output.accel_point, g) for i, spec in enumerate(scene.blocks)
+        _dem_body(
+            spec,
+            i,
+            own[i],
+            placed[i],
+            scene.output.accel_point,
+            g,
+            () if spec.fixed else carried_on(scene.loads, spec.name, g),
+        )
+        for i, spec in enumerate(scene.blocks)
     )
     contacts = rest_contacts(placed, [world_polygon(b) for b in bodies])
     table = resolve_joints(
@@ -351,7 +384,7 @@ def build_dem_model(
             f"{STABILITY_MARGIN:g} x stability limit (Eq 7 above it)",
         )
     steps = max(1, math.ceil(scene.sample_dt_s / dt_target - 1e-9))
-    load_force, load_arm = load_arrays(scene, bodies)
+    load_force, load_arm = load_arrays(scene, bodies, g)
     return DemModel(
         bodies=bodies,
         joints=table,

@@ -18,16 +18,3 @@ SOLVER_LABELS = {"housner": "Housner (exact)", "reference": "reference DEM", "ya
 def plot_solver(ax: Any, solver: str, t: Any, y: Any, label: str | None = None) -> None:
     """Draw one solver's curve in its study style."""
     ax.plot(t, y, label=label or SOLVER_LABELS.get(solver, solver), **SOLVER_STYLES[solver])
-
-
-def shade_harmonic_states(ax, phases: dict[str, float], t_end: float, settle_cycles: float, frequency: float) -> None:
-    """Shade the transient, stationary and free-rocking states of a harmonic test."""
-    transient_end = phases["ramp_up_end_s"] + settle_cycles / frequency
-    spans = (
-        (0.0, transient_end, "transient", "#f2d7b6"),
-        (transient_end, phases["end_s"], "stationary", "#d4e6f1"),
-        (phases["end_s"], t_end, "free rocking", "#d5f5e3"),
-    )
-    for start, end, label, colour in spans:
-        if end > start:
-            ax.axvspan(start, end, color=colour, alpha=0.5, lw=0, label=label)

@@ -19,9 +19,10 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
+from rockyade.limit.admissible import solve_admissible
 from rockyade.limit.coulomb import MAX_ITERATIONS, solve_coulomb
 from rockyade.limit.kinematic import DEFAULT_FC, KinematicQuantities, check_fc, kinematic_quantities
-from rockyade.limit.lp import DIRECTIONS, solve_equilibrium
+from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism, mechanism_of
 from rockyade.limit.model import PointLoad, RigidBlockModel, rigid_block_model
 
@@ -140,6 +141,7 @@ class LimitResult:
             "n_interfaces": len(model.interfaces),
             "solve_time_s": self.solve_time_s,
             "notes": self.notes,
+            "loads": model.loads_table(),
             "mechanism": None,
             "hinges": [],
             "sliding": [],
@@ -246,7 +248,7 @@ def limit_analysis(
     else:
         phi = "scene"
     t0 = time.perf_counter()
-    sol = solve_equilibrium(model, direction, time_limit_s=time_limit_s)
+    sol, model = solve_admissible(model, direction, time_limit_s=time_limit_s)
     rule = friction_rule
     if sol.status != "collapse":
         return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s, rule)

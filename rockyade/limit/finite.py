@@ -26,8 +26,15 @@ onto the joints by Gauss-Newton, and at every configuration
 (the virtual work of gravity, the loads F at their points p and alpha m g d, zero), down to
 alpha = 0. This is the nonlinear kinematic analysis of NTC 2018 / Circolare 2019 C8.7.1
 (the multiplier of the mechanism at finite displacement). The joints are kept as they
-are at rest: no new contact is sought and a joint that slides is not followed (the code's
-nonlinear analysis is for rocking mechanisms).
+are at rest. A frictionless joint that slides (a wall's top on a frictionless restraint: the
+three-hinge mechanism) is followed: the corner that slides stays on the line of the face it
+slides along (a bilateral constraint; no work is dissipated, so alpha is still the ratio below).
+A joint that slides with friction is not followed (the code's nonlinear analysis is for rocking
+mechanisms; friction's dissipation is not in the ratio). A new contact is not followed either:
+where a moving block meets a fixed block it did not touch at rest (a restrained wall's top
+closing its gap), the curve stops there and says so (the mechanism changes: the wall bears on its
+restraint, and its capacity beyond is another mechanism's, which a limit analysis of the scene with
+the gap closed gives).
 """
 
 from __future__ import annotations
@@ -39,8 +46,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.limit.lp import DIRECTIONS
-from rockyade.limit.mechanism import Mechanism
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.mechanism import VELOCITY_TOL, Mechanism, relative_velocity
+from rockyade.limit.model import RigidBlockModel, _outside
+from rockyade.scene.placement import candidate_pairs, penetration_depth
 
 #: Largest rotation of any block in one step, rad.
 MAX_STEP_ROTATION_RAD = 2.0e-3
@@ -71,7 +79,10 @@ class CapacityCurve:
         unilateral: kept while they bear, released where keeping them all would lock it).
     max_overlap_m
         Largest distance by which the two points of a released hinge passed into each other
-        along its normal, m (no new contact is sought: a check that none was needed).
+        along its normal, m.
+    closed_dk_m
+        Where a gap closed (a moving block met a fixed block it did not touch at rest), the
+        control displacement dk at which it did, m (the curve stops there); else None.
     """
 
     dk_m: NDArray[np.float64]
@@ -81,6 +92,7 @@ class CapacityCurve:
     max_joint_gap_m: float
     opened: tuple[tuple[int, int], ...] = ()
     max_overlap_m: float = 0.0
+    closed_dk_m: float | None = None
 
 
 class _Kinematics:
@@ -132,6 +144,54 @@ class _Kinematics:
                 self.hinge_of.append((k, e))
         self.active = np.ones(len(self.points), dtype=bool)
         self.ever_opened: set[int] = set()
+        self.slides = self._slides(mechanism)
+
+    def _slides(self, mechanism: Mechanism):
+        """The ends of frictionless joints that slide without opening, as (point at rest, group of the
+        body whose face the joint keeps, its outward normal at rest, group of the body whose corner
+        follows that face): the corner stays on the face's line (module docstring)."""
+        model = self.model
+        out = []
+        vel = mechanism.velocities
+        scale = max(1.0, float(np.max(np.abs(vel[:, 2]))) * model.size_m)
+        for slide in mechanism.sliding:
+            itf = model.interfaces[slide.interface]
+            ga = self.group_of.get(itf.a, -1)
+            gb = self.group_of.get(itf.b, -1) if itf.b >= 0 else -1
+            for p in itf.ends_m:
+                dn, dt = relative_velocity(model, vel, itf, p)
+                if abs(dn) > VELOCITY_TOL * scale or abs(dt) <= VELOCITY_TOL * scale:
+                    continue
+                # a's face past b's corner, if a's face goes on where a's points come from; else a's corner
+                # along b's face
+                back = p - np.sign(dt) * itf.tangent * 1e-6 * model.size_m
+                face = self.members[ga] if ga >= 0 else [itf.a]  # a's face goes on in its group's blocks
+                on_a = min(_outside(model.polygons_m[int(i)], back) for i in face) <= 1e-9 * model.size_m
+                if on_a:
+                    out.append((p.copy(), ga, -itf.normal, gb))
+                else:
+                    out.append((p.copy(), gb, itf.normal.copy(), ga))
+        return out
+
+    def _slide_row(self, s: NDArray[np.float64], k: int):
+        """(distance of the corner from the face's line, its 1 x n Jacobian) of slide ``k``."""
+        rest, g_face, normal, g_corner = self.slides[k]
+        x_face, arm_f = self.place(s, g_face, rest)
+        x_corner, arm_c = self.place(s, g_corner, rest)
+        n = normal
+        if g_face >= 0:
+            c, sn = np.cos(s[3 * g_face + 2]), np.sin(s[3 * g_face + 2])
+            n = np.array([c * normal[0] - sn * normal[1], sn * normal[0] + c * normal[1]])
+        gap = x_corner - x_face
+        J = np.zeros(self.n_dof)
+        for group, arm, sign in ((g_corner, arm_c, 1.0), (g_face, arm_f, -1.0)):
+            if group < 0:
+                continue
+            J[3 * group : 3 * group + 2] += sign * n
+            J[3 * group + 2] += sign * (n @ np.array([-arm[1], arm[0]]))
+        if g_face >= 0:
+            J[3 * g_face + 2] += gap @ np.array([-n[1], n[0]])
+        return float(gap @ n), J
 
     @property
     def n_dof(self) -> int:
@@ -186,9 +246,12 @@ class _Kinematics:
     def constraints(self, s: NDArray[np.float64]):
         """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
         rows = [self._rows(s, int(k)) for k in np.flatnonzero(self.active)]
-        if not rows:
+        slid = [self._slide_row(s, k) for k in range(len(self.slides))]
+        if not rows and not slid:
             return np.zeros(0), np.zeros((0, self.n_dof))
-        return np.concatenate([r[0] for r in rows]), np.vstack([r[1] for r in rows])
+        g = np.concatenate([r[0] for r in rows] + [np.array([v for v, _ in slid])])
+        C = np.vstack([r[1] for r in rows] + [J[None, :] for _, J in slid])
+        return g, C
 
     def normal_gaps(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
         """(x_a - x_b) . n at every point (> 0: open), m."""
@@ -228,6 +291,7 @@ class _Kinematics:
             t = np.array([-n[1], n[0]])
             eq.append(t @ J)
             ub.append(-(n @ J))
+        eq += [J for _, J in (self._slide_row(s, k) for k in range(len(self.slides)))]
         g = self.model.g
         pushed = np.zeros(self.n_dof)
         pushed[0::3] = d * g * self.group_mass
@@ -293,6 +357,37 @@ class _Kinematics:
         return float(max(0.0, -gaps.min()))
 
 
+def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int]]:
+    """(moving block, fixed block) pairs that do not touch at rest and lie within a quarter of the
+    assembly's size of each other: where a gap can close (module docstring)."""
+    touching = {frozenset((itf.a, itf.b)) for itf in model.interfaces}
+    touching |= {frozenset((c.a, c.b)) for c in model.corners}
+    fixed = [j for j in range(model.n_blocks) if model.fixed[j]]
+    if not fixed:
+        return []
+    moving = sorted(kin.group_of)
+    bodies = moving + fixed
+    polys = [model.polygons_m[b] for b in bodies]
+    out = []
+    for i, j in candidate_pairs(polys, margin=0.25 * model.size_m):
+        a, b = bodies[i], bodies[j]
+        if model.fixed[a] == model.fixed[b] or frozenset((a, b)) in touching:
+            continue
+        out.append((a, b) if not model.fixed[a] else (b, a))
+    return out
+
+
+def _closed(model: RigidBlockModel, kin: _Kinematics, s, pairs) -> tuple[int, int] | None:
+    """The first watched pair whose blocks overlap in configuration ``s``, else None."""
+    tol = 1e-9 * model.size_m
+    for a, b in pairs:
+        rest = model.polygons_m[a]
+        moved = np.array([kin.place(s, kin.group_of[a], p)[0] for p in rest])
+        if penetration_depth(moved, model.polygons_m[b]) > tol:
+            return a, b
+    return None
+
+
 def _alpha(model: RigidBlockModel, kin: _Kinematics, s, q, direction: str) -> float:
     """alpha by virtual work in configuration ``s`` with velocity ``q`` (module docstring).
 
@@ -352,6 +447,8 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
     h = MAX_STEP_ROTATION_RAD / omega_max
     gap = overlap = 0.0
     stopped = None
+    closed_dk = None
+    watched = _watched_pairs(model, kin)
     while len(dks) < MAX_STEPS:
         q1 = field(s, q)
         if q1 is None:
@@ -373,6 +470,20 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
         if abs(a_new - alphas[-1]) > MAX_STEP_ALPHA * abs(alpha0) and h > 1e-9 * model.size_m:
             h *= 0.5
             continue
+        met = _closed(model, kin, trial, watched)
+        if met is not None and h > 1e-6 * model.size_m:
+            h *= 0.5  # find where the gap closes
+            continue
+        if met is not None:
+            a, b = (model.names[x] for x in met)
+            dk_met = d * float(kin.place(trial, group_k, c_k)[0][0] - c_k[0])
+            closed_dk = 0.5 * (dks[-1] + dk_met)
+            stopped = (
+                f"{a} meets {b} between dk = {dks[-1]:.4g} and {dk_met:.4g} m (alpha = {alphas[-1]:.4g}): a gap "
+                "closes and a new contact forms, which this mechanism does not follow (the capacity beyond is "
+                "another mechanism's: a limit analysis with the gap closed)"
+            )
+            break
         s, q, gap = trial, q_new, max(gap, trial_gap)
         overlap = max(overlap, kin.released_overlap(s))
         dks.append(d * float(kin.place(s, group_k, c_k)[0][0] - c_k[0]))
@@ -390,4 +501,4 @@ def capacity_curve(model: RigidBlockModel, mechanism: Mechanism, direction: str,
         d1, d2 = dk_arr[-2], dk_arr[-1]
         d0 = float(d1 + (d2 - d1) * a1 / (a1 - a2)) if a1 != a2 else float(d2)
     opened = tuple(kin.hinge_of[k] for k in sorted(kin.ever_opened))
-    return CapacityCurve(dk_arr, a_arr, d0, stopped, gap, opened, overlap)
+    return CapacityCurve(dk_arr, a_arr, d0, stopped, gap, opened, overlap, closed_dk)

@@ -19,9 +19,11 @@ d* = dk sum P_i dx_i^2 / (dx_k sum P_i dx_i), a* = alpha g / (e* FC); d0* (at al
 the ultimate displacement du* = 0.4 d0*, and the secant period Ts = 2 pi sqrt(ds* / as*)
 at ds* = 0.4 du* (as* the spectral acceleration of the curve at ds*).
 
-The weights P_i are those of the blocks (masses x g). External loads (:class:`~rockyade.limit.model.PointLoad`)
-are forces without mass: they act in alpha0 and in alpha(dk) but carry no inertia, so
-they do not enter M*, e* or sum P_i.
+The weights P_i are those of the blocks (masses x g, at their centroids) and of the loads they
+carry (Circolare 2019 C8.7.1: "i pesi dei blocchi e i carichi verticali portati"), each at its
+own point with its own virtual displacement dx_i: a load's mass (:class:`~rockyade.limit.model.PointLoad`
+``mass_kg``; by default that of its weight) is a P_i. A load given without mass (``mass_kg = 0``)
+acts in alpha0 and in alpha(dk) but carries no inertia, so it does not enter M*, e* or sum P_i.
 """
 
 from __future__ import annotations
@@ -36,7 +38,7 @@ from numpy.typing import NDArray
 from rockyade.errors import InputError
 from rockyade.limit.finite import CapacityCurve, capacity_curve
 from rockyade.limit.lp import DIRECTIONS
-from rockyade.limit.mechanism import Mechanism
+from rockyade.limit.mechanism import Mechanism, point_velocity
 from rockyade.limit.model import RigidBlockModel
 
 #: The code's confidence factor FC for the limited knowledge level (LC1).
@@ -59,7 +61,7 @@ class KinematicQuantities:
     e_star
         Participating mass fraction e* = M* / (sum of the participating blocks' masses).
     participating_mass_kg
-        sum P_i / g over the blocks that take part, kg.
+        sum P_i / g over the blocks that take part and the loads they carry, kg.
     FC
         Confidence factor.
     a0_star_m_s2
@@ -178,9 +180,9 @@ def kinematic_quantities(
     """
     fc = check_fc(fc)
     d = DIRECTIONS[direction]
-    part = mechanism.moving
-    m = model.masses_kg[part]
-    dx = d * mechanism.velocities[part, 0]
+    points = [(i, p, mass) for i, p, mass in model.weight_points() if mechanism.moving[i]]
+    m = np.array([mass for _, _, mass in points])
+    dx = np.array([d * point_velocity(mechanism.velocities[i], model.centroids_m[i], p)[0] for i, p, _ in points])
     sum_m = float(m.sum())
     s1, s2 = float(np.sum(m * dx)), float(np.sum(m * dx * dx))
     M_star = s1 * s1 / s2
@@ -194,10 +196,11 @@ def kinematic_quantities(
     values: dict[str, float | None] = dict.fromkeys(("d0", "du", "ds", "as", "Ts"))
     if not nonlinear:
         note = "not asked for"
-    elif mechanism.slides:
+    elif any(model.interfaces[s.interface].friction_angle_deg for s in mechanism.sliding):
         note = (
-            "a joint slides: the code's nonlinear analysis follows rocking mechanisms (hinges); "
-            "a sliding block keeps alpha = tan(phi) and never reaches alpha = 0"
+            "a joint slides with friction: the code's nonlinear analysis follows rocking mechanisms (hinges, "
+            "and frictionless sliding on a restraint); a block sliding with friction keeps alpha = tan(phi) and "
+            "never reaches alpha = 0"
         )
     else:
         curve = capacity_curve(model, mechanism, direction, k)

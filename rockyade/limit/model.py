@@ -8,9 +8,15 @@ cohesion) and a tangential force t with |t| <= tan(phi) n (Coulomb), or any t at
 sliding is excluded. The resultant of the two end forces can lie anywhere on the interface,
 which is exactly what a no-tension joint of a rigid block can carry.
 
-External loads (:class:`PointLoad`) are forces without mass: a floor's reaction, an
-overburden. They enter the equilibrium as they are and do not take part in the horizontal
-acceleration (the seismic multiplier acts on the blocks' masses only).
+External loads (:class:`PointLoad`): a floor's reaction, an overburden, each with the mass
+that moves with its block (by default the mass of its weight, -F_y / g: the code counts the
+vertical loads a wall carries among the forces P_i the horizontal acceleration acts on,
+Circolare 2019 C8.7.1; :mod:`rockyade.scene.carried`). A load's mass is merged into its block
+(:func:`rockyade.scene.carried.loaded_mass_properties`): ``masses_kg`` and ``centroids_m`` are
+those of the loaded blocks, so the weight m g and the horizontal force lambda m g of the load
+act at its point; ``loads`` keeps only what is not the weight of a mass
+(:func:`rockyade.scene.carried.residual_force`: all of a massless load). ``given_loads`` are
+the loads as given, their masses resolved, for the report and the code's P_i.
 """
 
 from __future__ import annotations
@@ -19,6 +25,7 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,7 +33,9 @@ from numpy.typing import NDArray
 from rockyade.blocks.geometry import polygon_section
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.scene.placement import placed_blocks, rest_contacts
+from rockyade.limit.contacts import PointContact, point_contacts
+from rockyade.scene.carried import carried_on, load_mass_kg, loaded_mass_properties, residual_force
+from rockyade.scene.placement import TOUCH_TOL, placed_blocks, rest_contacts
 
 #: The base's name in interfaces, hinges and output.
 BASE = "base"
@@ -36,7 +45,7 @@ MAX_LOAD_N = 1.0e12
 
 @dataclass(frozen=True)
 class PointLoad:
-    """A force without mass applied to a block (a floor's reaction, an overburden).
+    """A force applied to a block, with its mass (a floor's reaction, an overburden).
 
     Attributes
     ----------
@@ -48,11 +57,15 @@ class PointLoad:
     force_N
         Force vector (Fx, Fy), N (e.g. (0, -N) for a vertical load N). Its direction stays
         the same when the block moves (a dead load).
+    mass_kg
+        Its mass moving with the block, kg; None: the mass of its weight, -F_y / g (module
+        docstring); 0: a force without mass.
     """
 
     block: int | str
     point_m: tuple[float, float]
     force_N: tuple[float, float]
+    mass_kg: float | None = None
 
 
 @dataclass(frozen=True)
@@ -93,6 +106,26 @@ class Interface:
 
 
 @dataclass(frozen=True)
+class Corner:
+    """A point contact with several ways to hold (:mod:`rockyade.limit.contacts`).
+
+    Attributes
+    ----------
+    a, b
+        Body indices (``b = -1``: the base); ``a`` moves.
+    point_m
+        The point at rest, base frame, m.
+    ways
+        Each way as the interfaces (zero length, at the point) that make it.
+    """
+
+    a: int
+    b: int
+    point_m: tuple[float, float]
+    ways: tuple[tuple[Interface, ...], ...]
+
+
+@dataclass(frozen=True)
 class RigidBlockModel:
     """A scene as rigid blocks, interfaces and loads (module docstring).
 
@@ -101,9 +134,9 @@ class RigidBlockModel:
     names
         Block names, in the scene's order.
     masses_kg
-        (nb,) block masses, kg.
+        (nb,) masses of the loaded blocks (each with the masses it carries), kg.
     centroids_m
-        (nb, 2) centroids at rest, base frame, m.
+        (nb, 2) centroids of the loaded blocks at rest, base frame, m.
     polygons_m
         Block polygons at rest, base frame, m (counter-clockwise).
     fixed
@@ -111,11 +144,20 @@ class RigidBlockModel:
     interfaces
         The joints at rest.
     loads
-        External loads, ``block`` resolved to an index.
+        The forces beyond the carried masses' weights, ``block`` resolved to an index.
     g
         Acceleration of gravity, m/s^2.
     notes
         What of the scene the model leaves out (cohesion, classical overrides), said once each.
+    given_loads
+        The loads as given, ``block`` an index and ``mass_kg`` resolved to kg (module docstring).
+    block_masses_kg, block_centroids_m
+        The blocks' own masses, kg, and centroids, m (None: as ``masses_kg``, ``centroids_m``).
+    corners
+        Point contacts that can hold in more than one way (two corners meeting, one of them on a
+        fixed block or the base: :mod:`rockyade.limit.contacts`), each with its ways as
+        interfaces of zero length; :func:`rockyade.limit.admissible.solve_admissible` chooses.
+        Point contacts with one way are among ``interfaces`` (kind "corner").
     """
 
     names: tuple[str, ...]
@@ -127,6 +169,60 @@ class RigidBlockModel:
     loads: tuple[PointLoad, ...] = ()
     g: float = G
     notes: tuple[str, ...] = ()
+    corners: tuple[Corner, ...] = ()
+    given_loads: tuple[PointLoad, ...] = ()
+    block_masses_kg: NDArray[np.float64] | None = None
+    block_centroids_m: NDArray[np.float64] | None = None
+
+    def weight_points(self) -> list[tuple[int, NDArray[np.float64], float]]:
+        """(block, point at rest, mass kg) of every mass the horizontal acceleration acts on: each
+        moving block's own at its centroid and each carried load's at its point (the code's P_i)."""
+        own_m = self.masses_kg if self.block_masses_kg is None else self.block_masses_kg
+        own_c = self.centroids_m if self.block_centroids_m is None else self.block_centroids_m
+        out = [(int(i), np.asarray(own_c[i], dtype=float), float(own_m[i])) for i in self.moving]
+        for load in self.given_loads:
+            i = int(load.block)
+            if not self.fixed[i] and load.mass_kg:
+                out.append((i, np.asarray(load.point_m, dtype=float), float(load.mass_kg)))
+        return out
+
+    def loads_table(self) -> list[dict[str, Any]]:
+        """Each given load as plain data: its block, point, force, mass and whether the mass
+        takes part in the horizontal acceleration (and so in the code's P_i)."""
+        out = []
+        for q in self.given_loads:
+            i = int(q.block)
+            mass = float(q.mass_kg or 0.0)
+            if self.fixed[i]:
+                why = "on a fixed block: it goes straight to the base"
+            elif mass > 0.0:
+                why = "its mass shakes with its block (a P_i of the kinematic method, Circolare 2019 C8.7.1)"
+            else:
+                why = "given without mass (mass_kg = 0): its horizontal force is taken elsewhere"
+            out.append(
+                {
+                    "block": self.names[i],
+                    "point_m": list(q.point_m),
+                    "force_N": list(q.force_N),
+                    "mass_kg": mass,
+                    "mass_takes_part": bool(mass > 0.0 and not self.fixed[i]),
+                    "why": why,
+                }
+            )
+        return out
+
+    def load_lines(self) -> list[str]:
+        """One line per load for the text reports: force, point and whether its mass takes part."""
+        lines = []
+        for k, q in enumerate(self.loads_table()):
+            fx, fy = q["force_N"]
+            mass = f"with its mass {q['mass_kg']:.4g} kg" if q["mass_takes_part"] else "without mass"
+            lines.append(
+                f"load {k}: ({fx:.4g}, {fy:.4g}) N on {q['block']} at "
+                f"({q['point_m'][0]:.4g}, {q['point_m'][1]:.4g}) m, "
+                f"{mass}: {q['why']}"
+            )
+        return lines
 
     @property
     def n_blocks(self) -> int:
@@ -223,8 +319,33 @@ def _resolve_loads(loads: Sequence[PointLoad], names: tuple[str, ...], polygons)
                 f"{field}.point_m",
                 f"({point[0]:g}, {point[1]:g}) m is not on block {names[index]} (a load acts on its block)",
             )
-        out.append(PointLoad(index, point, force))
+        mass = load.mass_kg
+        if mass is not None:
+            mass = float(mass)
+            if not (math.isfinite(mass) and 0.0 <= mass <= MAX_LOAD_N):
+                raise InputError(f"{field}.mass_kg", f"must be a finite mass in [0, {MAX_LOAD_N:g}] kg, got {mass!r}")
+        out.append(PointLoad(index, point, force, mass))
     return tuple(out)
+
+
+def _carry(
+    masses: NDArray[np.float64], centroids: NDArray[np.float64], fixed, loads: Sequence[PointLoad], g: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], tuple[PointLoad, ...], tuple[PointLoad, ...]]:
+    """The loaded blocks' masses and centroids, the loads with their masses resolved, and the
+    forces left beyond the carried weights (module docstring)."""
+    given = tuple(
+        PointLoad(q.block, q.point_m, q.force_N, load_mass_kg(q, g) if not fixed[int(q.block)] else 0.0) for q in loads
+    )
+    masses, centroids = masses.copy(), centroids.copy()
+    for i in sorted({int(q.block) for q in given if q.mass_kg}):
+        props = loaded_mass_properties(masses[i], centroids[i], 0.0, carried_on(given, i, g))
+        masses[i], centroids[i] = props.mass_kg, props.centroid_m
+    rest = []
+    for q in given:
+        f = residual_force(q, g)
+        if f != (0.0, 0.0):
+            rest.append(PointLoad(q.block, q.point_m, f, 0.0))
+    return masses, centroids, given, tuple(rest)
 
 
 def _pair(value, field: str, unit: str, bound: float) -> tuple[float, float]:
@@ -245,9 +366,31 @@ def _outside(poly: NDArray[np.float64], point: NDArray[np.float64]) -> float:
     return float(np.max(np.einsum("ij,ij->i", point - poly, normals)))
 
 
+def _point_contacts(placed, polygons, fixed, rest) -> list[PointContact]:
+    """The point contacts of the placed blocks where no joint of ``rest`` passes
+    (:func:`rockyade.limit.contacts.point_contacts`)."""
+    tol = TOUCH_TOL * max((b.size_m for b in placed), default=1.0)
+    segments: dict[tuple[int, int], list[NDArray[np.float64]]] = {}
+    for c in rest:
+        segments.setdefault((min(c.a, c.b), max(c.a, c.b)), []).append(np.asarray(c.ends_m, dtype=float))
+
+    def covered(i: int, j: int, p: NDArray[np.float64]) -> bool:
+        for e0, e1 in segments.get((min(i, j), max(i, j)), ()):
+            d = e1 - e0
+            s = float(np.clip((p - e0) @ d / max(float(d @ d), 1e-300), 0.0, 1.0))
+            if np.hypot(*(e0 + s * d - p)) <= tol:
+                return True
+        return False
+
+    return point_contacts(polygons, fixed, covered, tol)
+
+
 def scene_loads(scene) -> tuple[PointLoad, ...]:
     """The scene's ``[[loads]]`` as :class:`PointLoad` (block by name, point and force as given)."""
-    return tuple(PointLoad(q.block, tuple(q.point_m), tuple(q.force_N)) for q in getattr(scene, "loads", ()))
+    return tuple(
+        PointLoad(q.block, tuple(q.point_m), tuple(q.force_N), getattr(q, "mass_kg", None))
+        for q in getattr(scene, "loads", ())
+    )
 
 
 def rigid_block_model(
@@ -264,8 +407,8 @@ def rigid_block_model(
     scene
         A validated :class:`~rockyade.scene.Scene` (an assembly or a column).
     loads
-        External loads, forces without mass (:class:`PointLoad`), added to the scene's own
-        ``[[loads]]`` (which always act).
+        External loads (:class:`PointLoad`, with their mass: by default that of their
+        weight), added to the scene's own ``[[loads]]`` (which always act).
     friction_angle_deg
         Friction angle of every joint, degrees in [0, 90). None: each joint's own from the
         scene (a ``[[joints]]`` entry for the pair, else ``[contact] friction_angle_deg``).
@@ -288,7 +431,8 @@ def rigid_block_model(
     fixed = np.array([b.fixed for b in placed], dtype=bool)
     default = float(scene.contact.friction_angle_deg) if friction_angle_deg is None else friction_angle_deg
     interfaces = []
-    for c in rest_contacts(placed):
+    rest = rest_contacts(placed)
+    for c in rest:
         a, b = c.a, c.b
         normal = np.asarray(c.normal, dtype=float)
         # the moving body first, else the upper body of a bed joint (the normal points into a)
@@ -299,14 +443,44 @@ def rigid_block_model(
         else:
             phi = _friction_of(scene, a, b, default)
         interfaces.append(Interface(a, b, np.asarray(c.ends_m, dtype=float), normal, phi if sliding else None, c.kind))
+    corners = []
+    for pc in _point_contacts(placed, polygons, fixed, rest):
+        if friction_angle_deg is not None or not sliding:
+            phi = friction_angle_deg
+        else:
+            phi = _friction_of(scene, pc.a, pc.b, default)
+        ends = np.array([pc.point_m, pc.point_m])
+        ways = tuple(
+            tuple(Interface(pc.a, pc.b, ends, np.asarray(n), phi if sliding else None, "corner") for n in way)
+            for way in pc.ways
+        )
+        if len(ways) == 1:
+            interfaces.extend(ways[0])
+        elif ways and (fixed[pc.a] or pc.b < 0 or fixed[pc.b]):
+            corners.append(Corner(pc.a, pc.b, pc.point_m, ways))
+    touching = {b for itf in interfaces for b in (itf.a, itf.b)} | {b for c in corners for b in (c.a, c.b)}
+    idle = [names[i] for i in np.flatnonzero(fixed) if i not in touching]
+    notes = _left_out(scene)
+    if idle:
+        shown = ", ".join(idle[:5]) + (" ..." if len(idle) > 5 else "")
+        notes += (
+            f"fixed block(s) {shown} touch no moving block at rest: they take no part in the limit analysis "
+            "(a gap left on purpose, or a block not placed as meant)",
+        )
+    resolved = _resolve_loads(scene_loads(scene) + tuple(loads), names, polygons)
+    loaded_m, loaded_c, given, residual = _carry(masses, centroids, fixed, resolved, float(g))
     return RigidBlockModel(
-        notes=_left_out(scene),
+        corners=tuple(corners),
+        notes=notes,
         names=names,
-        masses_kg=masses,
-        centroids_m=centroids,
+        masses_kg=loaded_m,
+        centroids_m=loaded_c,
         polygons_m=polygons,
         fixed=fixed,
         interfaces=tuple(interfaces),
-        loads=_resolve_loads(scene_loads(scene) + tuple(loads), names, polygons),
+        loads=residual,
         g=float(g),
+        given_loads=given,
+        block_masses_kg=masses,
+        block_centroids_m=centroids,
     )

@@ -97,8 +97,7 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         f"limit analysis of {source}: {plural(model.n_blocks - n_fixed, 'moving block')}{fixed}, "
         f"{plural(len(model.interfaces), 'joint')}; load lambda m g towards {result.direction}; joints: {joints}",
     ]
-    if model.loads:
-        lines.append(f"external loads (without mass): {len(model.loads)}")
+    lines.extend(model.load_lines())
     if result.status == "unstable":
         lines.append("status: unstable: the assembly cannot stand under gravity (and its loads) alone: no")
         lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")

@@ -46,6 +46,7 @@ BOUNDS: dict[str, Bound] = {
     "sample_dt_s": Bound(1.0e-6, 10.0, "s"),
     "length_m": Bound(1.0e-3, 1000.0, "m"),  # width_m, height_m, thickness_m, polygon extent
     "mass_kg": Bound(1.0e-3, 1.0e9, "kg"),
+    "loads.mass_kg": Bound(0.0, 1.0e9, "kg"),  # a load's mass moving with its block (0: without mass)
     "density_kg_m3": Bound(1.0, 1.0e5, "kg/m^3"),
     "alpha_rad": Bound(1.0e-3, math.pi / 2 - 1.0e-3, "rad"),
     "mu": Bound(0.05, 0.9999, ""),

@@ -355,6 +355,14 @@ def _parse_loads(raw: Any, source: str | None) -> tuple[LoadSpec, ...]:
             raise r.error("point_m", f"coordinates must be within +/-{MAX_LENGTH_M:g} m")
         if max(abs(c) for c in force) > MAX_LOAD_N:
             raise r.error("force_N", f"components must be within +/-{MAX_LOAD_N:g} N, got {force}")
+        mass = r.number("mass_kg", None, **BOUNDS["loads.mass_kg"].kwargs())
         r.finish()
-        out.append(LoadSpec(block, (float(point[0]), float(point[1])), (float(force[0]), float(force[1]))))
+        out.append(
+            LoadSpec(
+                block,
+                (float(point[0]), float(point[1])),
+                (float(force[0]), float(force[1])),
+                None if mass is None else float(mass),
+            )
+        )
     return tuple(out)

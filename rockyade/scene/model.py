@@ -29,13 +29,18 @@ A scene is data, never code. Layout::
     [output]                  # optional
     # accel_point = "top_centre" | [x, y] (block frame, m); accel_lowpass_hz = 20.0
 
-    [[loads]]                 # optional: constant forces without mass on named blocks
+    [[loads]]                 # optional: loads carried by named blocks
     block = "specimen1"
     point_m = [0.125, 1.0]    # point of application, base frame at rest, m (on the block)
     force_N = [0.0, -2000.0]  # (fx, fy), N: a dead load (keeps its direction)
+    # mass_kg = 0.0           # its mass moving with the block, kg; default -fy / g
 
-A load is a force without mass: the horizontal base acceleration does not act on it (a floor
-whose mass shakes with the wall is a block). It is a weight carried by the block: it follows
+A load's mass (``mass_kg``) moves rigidly with the block it bears on; by default it is the
+mass of the load's weight, -fy / g (the code counts the vertical loads a wall carries among
+the forces the horizontal acceleration acts on, Circolare 2019 C8.7.1). ``mass_kg = 0`` gives a
+force without mass, on which the horizontal base acceleration does not act (a load whose
+horizontal force goes elsewhere). :mod:`rockyade.scene.carried` merges the masses into their
+blocks for every solver. The force is a weight carried by the block: it follows
 the apparent gravity, scaled by (g + a_v) / g, so that it ramps in with gravity under
 ``gravity-ramp`` and ``pushover`` (a_v = -g at t = 0) and is constant under a horizontal motion.
 Its point is a material point of the block: it moves and turns with the block.
@@ -190,7 +195,7 @@ class JointOverride:
 
 @dataclass(frozen=True)
 class LoadSpec:
-    """One ``[[loads]]`` entry: a constant force without mass on a block (module docstring).
+    """One ``[[loads]]`` entry: a constant force on a block, with its mass (module docstring).
 
     Attributes
     ----------
@@ -200,11 +205,22 @@ class LoadSpec:
         Point of application at rest, base frame, m; a material point of the block.
     force_N
         (fx, fy), N; it keeps its direction when the block turns (a dead load).
+    mass_kg
+        Its mass moving with the block, kg; None: the default, the mass of its weight -fy / g
+        (:func:`rockyade.scene.carried.load_mass_kg`).
     """
 
     block: str
     point_m: tuple[float, float]
     force_N: tuple[float, float]
+    mass_kg: float | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The ``[[loads]]`` table (``mass_kg`` only when given)."""
+        out: dict[str, Any] = {"block": self.block, "point_m": list(self.point_m), "force_N": list(self.force_N)}
+        if self.mass_kg is not None:
+            out["mass_kg"] = self.mass_kg
+        return out
 
 
 @dataclass(frozen=True)
@@ -295,9 +311,7 @@ class Scene:
         if self.joints:
             data["joints"] = [{"blocks": list(j.blocks), **dict(j.values)} for j in self.joints]
         if self.loads:
-            data["loads"] = [
-                {"block": q.block, "point_m": list(q.point_m), "force_N": list(q.force_N)} for q in self.loads
-            ]
+            data["loads"] = [q.as_dict() for q in self.loads]
         return _drop_none(data)
 
     @functools.cached_property
@@ -305,6 +319,8 @@ class Scene:
         """SHA-256 of the canonical scene (first 16 hex digits): same physics, same hash."""
         material = self.to_dict()
         material["motion"] = self.motion.hash_material()
+        if any(q.mass_kg is None for q in self.loads):
+            material["load_mass_default"] = "weight/g"  # loads carried massless before: not the same physics
         text = json.dumps(material, sort_keys=True, separators=(",", ":"), default=str)
         return hashlib.sha256(text.encode()).hexdigest()[:16]
 
@@ -484,6 +500,13 @@ def _check_loads(scene: Scene, names: list[str]) -> None:
                 f"{field_name}.force_N",
                 f"|F| = {magnitude:.4g} N is more than {MAX_LOAD_TO_WEIGHT:g} times the weight of the moving blocks "
                 f"({weight:.4g} N): check the units (N, not kN per metre)",
+                scene.source,
+            )
+        if load.mass_kg is not None and load.mass_kg * G > MAX_LOAD_TO_WEIGHT * weight:
+            raise InputError(
+                f"{field_name}.mass_kg",
+                f"{load.mass_kg:.4g} kg weighs more than {MAX_LOAD_TO_WEIGHT:g} times the moving blocks "
+                f"({weight / G:.4g} kg): check the units (kg)",
                 scene.source,
             )
         block = placed[index]

@@ -79,6 +79,7 @@ from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion, ground_acceleration
 from rockyade.result import Result, column
 from rockyade.scene import Scene
+from rockyade.scene.carried import carried_on, loaded_rocking_parameters, residual_force
 from rockyade.solvers.base import SolverBase, motion_coverage
 from rockyade.solvers.cost import CostEstimate, sample_cost
 
@@ -805,7 +806,12 @@ def housner_model(scene: Scene, g: float = G) -> HousnerModel:
         return model
     cx, cy = placed_blocks(scene)[0].centroid_m
     pivots = ((cx - cy * math.tan(model.alpha_left), 0.0), (cx + cy * math.tan(model.alpha_right), 0.0))
-    return model.with_loads(spec.block().mass_kg, pivots, scene.loads)
+    mass, carried = spec.block().mass_kg, carried_on(scene.loads, spec.name, g)
+    if carried:  # the loads' masses rock with the block (rockyade.scene.carried); spec.mu still overrides
+        props, loaded = loaded_rocking_parameters(mass, (cx, cy), pivots, model.p_left, g, carried)
+        mass = props.mass_kg
+        model = replace(model, **{k: v for k, v in loaded.items() if spec.mu is None or not k.startswith("mu")})
+    return model.with_loads(mass, pivots, [replace(q, force_N=residual_force(q, g)) for q in scene.loads])
 
 
 def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, traj: Trajectory, wall: float) -> dict:
@@ -831,7 +837,7 @@ def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, tr
         "uplift_times_s": traj.uplift_times_s[:200].tolist(),
         "rest_fraction_of_alpha": REST_FRACTION,
         "motion": motion.label if motion is not None else "free",
-        "loads": [{"block": q.block, "point_m": list(q.point_m), "force_N": list(q.force_N)} for q in scene.loads],
+        "loads": [q.as_dict() for q in scene.loads],
     }
 
 

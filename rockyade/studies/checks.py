@@ -12,6 +12,8 @@ CHECKS = (
     "code",
     "fragility_fit",
     "loaded_block",
+    "loaded_mass",
     "loaded_pushover",
     "limit_pushover",
+    "siconos",
 )

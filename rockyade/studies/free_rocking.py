@@ -17,8 +17,9 @@ from rockyade import paper
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.calibration.model import calibrated_model
 from rockyade.errors import CalibrationError
-from rockyade.figures import new_figure, save_figure
-from rockyade.figures.styles import SOLVER_LABELS, plot_solver
+from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
+from rockyade.figures.styles import SOLVER_LABELS
+from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.base import Solver
@@ -192,55 +193,19 @@ def _dem_rows(cases: list[dict], exact: dict, use_yade: bool) -> list[dict]:
 
 
 def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> Figure:
-    """theta(t): rows = parameter sets, columns = calibrations; Housner in every panel."""
+    """theta(t): rows = parameter sets, columns = calibrations; Housner in every panel
+    (drawn by :class:`rockyade.figures.solver_panels.SolverPanelsDisplay`)."""
     spec = paper.specimen(key)
     name = f"free_rocking_{spec.name}.png"
-    fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 7.5), sharex=True)
-    for row, params in zip(axes, PARAMETER_SETS, strict=True):
-        h = exact[(key, params)]
-        alpha = block_alpha(key, params)
-        for ax, cal in zip(row, CALIBRATIONS, strict=True):
-            if h.ok:
-                plot_solver(ax, "housner", h.t, h.series("theta_rad"))
-            case = next(c for c in cases if c["key"] == key and c["params"] == params and c["calibration"] == cal)
-            if case["scene"] is None:
-                ax.text(
-                    0.5,
-                    0.08,
-                    "matched calibration not reachable\n(see free_rocking.csv)",
-                    transform=ax.transAxes,
-                    ha="center",
-                    fontsize=8,
-                    color="0.3",
-                )
-            for solver in ("reference", "yade"):
-                r = case.get(solver)
-                if r is None:
-                    continue
-                if not r.ok:
-                    ax.plot([], [], label=f"{SOLVER_LABELS[solver]}: FAILED, no curve", **_failed_style())
-                    continue
-                sel = table[
-                    (table.block == key)
-                    & (table.parameters == params)
-                    & (table.solver == solver)
-                    & (table.calibration == cal)
-                ]
-                mu = sel["mu_eff"].iloc[0] if len(sel) else math.nan
-                label = f"{'reference DEM' if solver == 'reference' else 'YADE'} (mu_eff {fmt(mu)})"
-                dem = case.get("reference")
-                if solver == "yade" and dem is not None and dem.ok:
-                    label += f", max |YADE - DEM| {max_difference(r, dem):.1e} rad"
-                plot_solver(ax, solver, r.t, r.series("theta_rad"), label)
-            ax.set_title(f"{params} parameters (alpha = {alpha:.3f} rad), {cal} calibration", fontsize=9)
-            ax.axhline(0, color="0.5", lw=0.5)
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="best")
-        row[0].set_ylabel("theta (rad)")
-    for ax in axes[-1]:
-        ax.set_xlabel("time t (s)")
-    fig.suptitle(f"Free rocking of the {spec.label}, released at alpha / 2", fontsize=11)
-    save_figure(fig, report.out / name)
+    rows = [
+        [_panel(key, params, cal, exact[(key, params)], cases, table) for cal in CALIBRATIONS]
+        for params in PARAMETER_SETS
+    ]
+    display = SolverPanelsDisplay(rows, title=f"Free rocking of the {spec.label}, released at alpha / 2").plot(
+        path=report.out / name, figsize=(12, 7.5)
+    )
+    assert display.figure_ is not None
+    fig = display.figure_
     unreachable = [c for c in cases if c["key"] == key and c["scene"] is None]
     extra = (
         " Matched calibration not reachable (see free_rocking.csv) for the "
@@ -263,5 +228,30 @@ def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> 
     return fig
 
 
-def _failed_style() -> dict:
-    return {"color": "red", "ls": "none", "marker": "x"}
+def _panel(key: str, params: str, cal: str, housner: Result, cases: list[dict], table: pd.DataFrame) -> Panel:
+    """One panel of the free-rocking figure: Housner, the reference DEM and YADE for one
+    parameter set and calibration, each DEM with its effective mu."""
+    curves = [Curve("housner", SOLVER_LABELS["housner"], housner.t, housner.series("theta_rad"))] if housner.ok else []
+    case = next(c for c in cases if c["key"] == key and c["params"] == params and c["calibration"] == cal)
+    for solver in ("reference", "yade"):
+        r = case.get(solver)
+        if r is None:
+            continue
+        if not r.ok:
+            curves.append(Curve(solver, f"{SOLVER_LABELS[solver]}: FAILED, no curve"))
+            continue
+        sel = table[
+            (table.block == key) & (table.parameters == params) & (table.solver == solver) & (table.calibration == cal)
+        ]
+        mu = sel["mu_eff"].iloc[0] if len(sel) else math.nan
+        label = f"{'reference DEM' if solver == 'reference' else 'YADE'} (mu_eff {fmt(mu)})"
+        dem = case.get("reference")
+        if solver == "yade" and dem is not None and dem.ok:
+            label += f", max |YADE - DEM| {max_difference(r, dem):.1e} rad"
+        curves.append(Curve(solver, label, r.t, r.series("theta_rad")))
+    return Panel(
+        curves=curves,
+        title=f"{params} parameters (alpha = {block_alpha(key, params):.3f} rad), {cal} calibration",
+        ylabel="theta (rad)" if cal == CALIBRATIONS[0] else "",
+        note="matched calibration not reachable (see free_rocking.csv)" if case["scene"] is None else "",
+    )

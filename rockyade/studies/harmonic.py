@@ -11,8 +11,6 @@ stationary (until the table stops) and free rocking (after).
 
 from __future__ import annotations
 
-import textwrap
-
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
@@ -20,8 +18,8 @@ from matplotlib.figure import Figure
 from rockyade.analysis.patterns import classify_result
 from rockyade.constants import G
 from rockyade.dem.statics import column_uplift
-from rockyade.figures import new_figure, save_figure
-from rockyade.figures.styles import SOLVER_LABELS, plot_solver, shade_harmonic_states
+from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay, Span
+from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.motion.analytic import Harmonic
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
@@ -158,58 +156,27 @@ def _solver_counts(cases: list[dict]) -> dict[str, int]:
 
 
 def draw_figure(report: Report, c: dict) -> Figure:
-    """theta / alpha of each block (upper first) and the table displacement, states shaded."""
+    """theta / alpha of each block (upper first) and the table displacement, states shaded
+    (drawn by :class:`rockyade.figures.solver_panels.SolverPanelsDisplay`)."""
     blocks = c["scene"].blocks
     h = c["harmonic"]
     name = f"harmonic_{c['name']}.png"
     note = no_uplift_note(c["scene"], c["results"])
-    fig, axes = new_figure(
-        report.out / name, len(blocks) + 1, 1, figsize=(10, 2.6 * (len(blocks) + 1) + 0.8), sharex=True
-    )
     t_end = c["scene"].duration_s
+    spans = harmonic_spans(h, t_end)
     t = np.linspace(0, t_end, 4000)
-    axes[0].plot(t, 1e3 * h.kinematics(t)[0], color="0.3", lw=0.8)
-    axes[0].set_ylabel("table disp. (mm)")
-    for ax, spec in zip(axes[1:], reversed(blocks), strict=True):
-        alpha = spec.classical().alpha_rad
-        shade_harmonic_states(ax, h.phases_s, t_end, SETTLE_CYCLES, h.frequency_hz)
-        peak = 0.0
-        for solver, r in c["results"].items():
-            if not r.ok:
-                ax.plot([], [], color="red", ls="none", marker="x", label=f"{SOLVER_LABELS[solver]}: FAILED, no curve")
-                continue
-            y = r.series("theta_rad", spec.name) / alpha
-            peak = max(peak, float(np.max(np.abs(y))))
-            label = SOLVER_LABELS[solver]
-            if solver == "yade" and c["results"].get("reference") is not None and c["results"]["reference"].ok:
-                diff = max_difference(r, c["results"]["reference"], spec.name) / alpha
-                label += f" (max |YADE - DEM| = {diff:.2g} alpha)"
-            plot_solver(ax, solver, r.t, y, label)
-        # theta / alpha: a block that does not rock reads as a flat line on a fixed +/-1.1 scale, not as
-        # autoscaled micro-radians; one that rocks is scaled to its peak (dashed lines: overturning at +/-1)
-        limit = 1.1 if note else min(max(1.15 * peak, 0.2), 2.0)
-        ax.set_ylim(-limit, limit)
-        for level in (-1, 1):
-            ax.axhline(level, color="0.4", lw=0.6, ls="--")
-        ax.set_ylabel(f"{spec.name}: theta / alpha")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7, loc="upper right", ncol=2)
-    shade_harmonic_states(axes[0], h.phases_s, t_end, SETTLE_CYCLES, h.frequency_hz)
-    axes[-1].set_xlabel("time t (s)")
+    table = Panel(trace=(t, 1e3 * h.kinematics(t)[0]), ylabel="table disp. (mm)", hlines=(), spans=spans)
+    panels = [table]
+    for i, spec in enumerate(reversed(blocks)):
+        panels.append(_block_panel(c, spec, spans, note if i == 0 else ""))
     title = f"{c['name'].replace('_', ' ')} ({c['fig']})"
     if note:
         title += ": NO UPLIFT (table acceleration below the uplift acceleration)"
-        axes[1].text(
-            0.01,
-            0.04,
-            "\n".join(textwrap.wrap(note, 110)),
-            transform=axes[1].transAxes,
-            fontsize=7.5,
-            va="bottom",
-            bbox={"facecolor": "white", "edgecolor": "0.5", "alpha": 0.9},
-        )
-    fig.suptitle(title, fontsize=11)
-    save_figure(fig, report.out / name)
+    display = SolverPanelsDisplay([[p] for p in panels], title=title).plot(
+        path=report.out / name, figsize=(10, 2.6 * (len(blocks) + 1) + 0.8)
+    )
+    assert display.figure_ is not None
+    fig = display.figure_
     maxima = []
     for solver, r in c["results"].items():
         if r.ok:
@@ -226,3 +193,44 @@ def draw_figure(report: Report, c: dict) -> Figure:
         "(upper first; dashed lines at +/-1) and the table displacement. Max |theta| (rad): " + "; ".join(maxima) + ".",
     )
     return fig
+
+
+def harmonic_spans(h: Harmonic, t_end: float) -> list[Span]:
+    """The transient, stationary and free-rocking states of a harmonic test, as shaded spans (s):
+    the transient lasts until SETTLE_CYCLES cycles after the ramp up."""
+    transient_end = h.phases_s["ramp_up_end_s"] + SETTLE_CYCLES / h.frequency_hz
+    return [
+        Span(0.0, transient_end, "transient", "#f2d7b6"),
+        Span(transient_end, h.phases_s["end_s"], "stationary", "#d4e6f1"),
+        Span(h.phases_s["end_s"], t_end, "free rocking", "#d5f5e3"),
+    ]
+
+
+def _block_panel(c: dict, spec, spans: list[Span], note: str) -> Panel:
+    """theta / alpha of one block by every solver; a block that does not rock reads as a
+    flat line on a fixed +/-1.1 scale, one that rocks is scaled to its peak (dashed lines:
+    overturning at +/-1)."""
+    alpha = spec.classical().alpha_rad
+    curves, peak = [], 0.0
+    for solver, r in c["results"].items():
+        if not r.ok:
+            curves.append(Curve(solver, f"{SOLVER_LABELS[solver]}: FAILED, no curve"))
+            continue
+        y = r.series("theta_rad", spec.name) / alpha
+        peak = max(peak, float(np.max(np.abs(y))))
+        label = SOLVER_LABELS[solver]
+        if solver == "yade" and c["results"].get("reference") is not None and c["results"]["reference"].ok:
+            diff = max_difference(r, c["results"]["reference"], spec.name) / alpha
+            label += f" (max |YADE - DEM| = {diff:.2g} alpha)"
+        curves.append(Curve(solver, label, r.t, y))
+    limit = 1.1 if no_uplift_note(c["scene"], c["results"]) else min(max(1.15 * peak, 0.2), 2.0)
+    return Panel(
+        curves=curves,
+        ylabel=f"{spec.name}: theta / alpha",
+        ylim=(-limit, limit),
+        hlines=((-1.0, "--"), (1.0, "--")),
+        spans=spans,
+        note=note,
+        legend_loc="upper right",
+        legend_ncol=2,
+    )

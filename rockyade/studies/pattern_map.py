@@ -17,9 +17,8 @@ from dataclasses import replace
 
 import pandas as pd
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
 
-from rockyade.figures import new_figure, save_figure
+from rockyade.figures.rocking_patterns import PatternMapDisplay
 from rockyade.motion.analytic import Harmonic
 from rockyade.motion.spec import MotionSpec
 from rockyade.motion.types import HarmonicMotion
@@ -30,29 +29,6 @@ from rockyade.studies.specimens import biblock_blocks, scene_dict
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
 CYCLES = 10
-COLOURS = {
-    "rest": "#eeeeee",
-    "1": "#f4a261",
-    "2": "#e76f51",
-    "3": "#2a9d8f",
-    "4": "#8ab17d",
-    "overturn-lower": "#264653",
-    "overturn-upper": "#6d597a",
-    "failed": "#000000",
-}
-#: The legend in words (paper Fig. 16 for patterns 1-4).
-PATTERN_NAMES = {
-    "rest": "rest: neither block rocks",
-    "1": "1: both rock, same way",
-    "2": "2: both rock, opposite ways",
-    "3": "3: the stack rocks as one body",
-    "4": "4: only the upper block rocks",
-    "overturn-lower": "OT lower: the lower block overturns",
-    "overturn-upper": "OT upper: the upper block overturns",
-    "failed": "failed run (no result)",
-}
-
-
 def paper_pattern(freq: float, amp: float) -> str | None:
     """The pattern the paper reports for a cell, or None where it reports none."""
     if (4.0 <= freq <= 5.0 and amp > 4.0) or (freq == 6.0 and amp > 3.0) or (freq == 7.0 and amp > 1.0):
@@ -125,7 +101,8 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
 
 def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int, int]]) -> Figure:
     """The map of rocking patterns over base-motion frequency (Hz) and amplitude (mm)
-    (``pattern_map.png`` in the report's folder), the paper's patterns beside the DEM's.
+    (``pattern_map.png`` in the report's folder), the paper's patterns beside the DEM's, drawn by
+    :class:`rockyade.figures.rocking_patterns.PatternMapDisplay`.
 
     Parameters
     ----------
@@ -142,55 +119,9 @@ def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int,
         The figure, written as PNG.
     """
     name = "pattern_map.png"
-    fig, ax = new_figure(report.out / name, figsize=(10.5, 6))
-    f_index = {f: i for i, f in enumerate(FREQUENCIES_HZ)}
-    a_index = {a: j for j, a in enumerate(AMPLITUDES_MM)}
-    for _, row in cells.iterrows():
-        i, j = f_index[row.frequency_hz], a_index[row.amplitude_mm]
-        ax.add_patch(Rectangle((i - 0.5, j - 0.5), 1, 1, color=COLOURS.get(row.pattern_dem, "#000000")))
-        label = row.pattern_dem.replace("overturn-", "OT ") if isinstance(row.pattern_dem, str) else "?"
-        ax.text(
-            i,
-            j,
-            label,
-            ha="center",
-            va="center",
-            fontsize=9,
-            color="white" if label.startswith(("OT", "2", "failed")) else "black",
-        )
-        if not pd.isna(row.pattern_paper):
-            ax.add_patch(
-                Rectangle(
-                    (i - 0.45, j - 0.45),
-                    0.9,
-                    0.9,
-                    fill=False,
-                    lw=2.0,
-                    ec="#1d3557" if row.pattern_paper == "2" else "#e63946",
-                    ls="-" if row.agree else "--",
-                )
-            )
-    ax.set_xlim(-0.5, len(FREQUENCIES_HZ) - 0.5)
-    ax.set_ylim(-0.5, len(AMPLITUDES_MM) - 0.5)
-    ax.set_xticks(range(len(FREQUENCIES_HZ)), [f"{f:g}" for f in FREQUENCIES_HZ])
-    ax.set_yticks(range(len(AMPLITUDES_MM)), [f"{a:g}" for a in AMPLITUDES_MM])
-    ax.set_xlabel("table frequency (Hz)")
-    ax.set_ylabel("table displacement amplitude (mm)")
-    shown = [p for p in COLOURS if p in set(cells.pattern_dem) or p in ("1", "2", "3", "4", "rest")]
-    handles = [Rectangle((0, 0), 1, 1, color=COLOURS[p]) for p in shown]
-    handles += [
-        Rectangle((0, 0), 1, 1, fill=False, ec="#1d3557", lw=2),
-        Rectangle((0, 0), 1, 1, fill=False, ec="#e63946", lw=2),
-        Rectangle((0, 0), 1, 1, fill=False, ec="0.3", lw=2, ls="--"),
-    ]
-    labels = [PATTERN_NAMES[p] for p in shown] + [
-        "paper's region of pattern 2 (opposite ways)",
-        "paper's region of pattern 3 (one body)",
-        "dashed outline: the DEM disagrees",
-    ]
-    ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, title="cell colour: DEM")
-    ax.set_title("Bi-block: dominant rocking pattern (reference DEM) and the paper's regions")
-    save_figure(fig, report.out / name)
+    display = PatternMapDisplay(cells, FREQUENCIES_HZ, AMPLITUDES_MM).plot(path=report.out / name)
+    assert display.figure_ is not None
+    fig = display.figure_
     report.figure(
         name,
         "Dominant pattern per cell (colour, DEM) with the paper's reported regions outlined (blue: "

@@ -8,14 +8,12 @@ paper's: the comparison is between solvers, and with the paper's verdict only lo
 
 from __future__ import annotations
 
-import textwrap
-
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from rockyade.figures import new_figure, save_figure
-from rockyade.figures.styles import SOLVER_LABELS, plot_solver
+from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
+from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import Scene, scene_from_dict
@@ -116,41 +114,31 @@ def draw_figure(
     assert gm is not None and alpha is not None  # a synthetic record; the specimens' measured alpha (specimens.py)
     name = f"random_specimen{key}_record{record}.png"
     note = no_uplift_note(scene, results)
-    fig, axes = new_figure(
-        report.out / name, 2, 1, figsize=(10, 5.8), sharex=True, gridspec_kw={"height_ratios": [1, 2]}
-    )
-    axes[0].plot(gm.t_s, gm.ah_m_s2, color="0.3", lw=0.6)
-    axes[0].set_ylabel("a_g (m/s$^2$)")
+    curves = []
     for solver, r in results.items():
         if not r.ok:
-            axes[1].plot([], [], color="red", ls="none", marker="x", label=f"{SOLVER_LABELS[solver]}: FAILED, no curve")
+            curves.append(Curve(solver, f"{SOLVER_LABELS[solver]}: FAILED, no curve"))
             continue
         verdict = f"collapse at {r.meta['overturn_time_s']:.2f} s" if r.status == "overturned" else "no collapse"
         label = f"{SOLVER_LABELS[solver]}: {verdict}"
         if solver == "yade" and results.get("reference") is not None and results["reference"].ok:
             label += f" (max |YADE - DEM| = {max_difference(r, results['reference']) / alpha:.2g} alpha)"
-        plot_solver(axes[1], solver, r.t, r.series("theta_rad") / alpha, label)
-    axes[1].set_ylim(-1.5, 1.5)
-    axes[1].axhline(1, color="0.5", lw=0.5, ls="--")
-    axes[1].axhline(-1, color="0.5", lw=0.5, ls="--")
-    axes[1].set_ylabel("theta / alpha")
-    axes[1].set_xlabel("time t (s)")
-    axes[1].legend(fontsize=8, loc="upper right")
-    for ax in axes:
-        ax.grid(alpha=0.3)
-    title = f"Specimen {key}, synthetic record {record}, load factor {factor}"
-    if note:
-        title += ": NO UPLIFT"
-        axes[1].text(
-            0.01,
-            0.04,
-            "\n".join(textwrap.wrap(note, 110)),
-            transform=axes[1].transAxes,
-            fontsize=7.5,
-            bbox={"facecolor": "white", "edgecolor": "0.5", "alpha": 0.9},
-        )
-    fig.suptitle(title)
-    save_figure(fig, report.out / name)
+        curves.append(Curve(solver, label, r.t, r.series("theta_rad") / alpha))
+    base = Panel(trace=(gm.t_s, gm.ah_m_s2), ylabel="a_g (m/s²)", hlines=())
+    rotation = Panel(
+        curves=curves,
+        ylabel="theta / alpha",
+        ylim=(-1.5, 1.5),
+        hlines=((1.0, "--"), (-1.0, "--")),
+        note=note,
+        legend_loc="upper right",
+    )
+    title = f"Specimen {key}, synthetic record {record}, load factor {factor}" + (": NO UPLIFT" if note else "")
+    display = SolverPanelsDisplay([[base], [rotation]], title=title, height_ratios=(1, 2)).plot(
+        path=report.out / name, figsize=(10, 5.8)
+    )
+    assert display.figure_ is not None
+    fig = display.figure_
     verdicts = "; ".join(
         f"{s}: {'collapse' if r.status == 'overturned' else r.status}"
         + (f" ({r.meta.get('failure_reason')})" if not r.ok else "")
@@ -159,7 +147,7 @@ def draw_figure(
     report.figure(
         name,
         (f"**{note}** " if note else "")
-        + f"Specimen {key} under record {record} x {factor} (PGA {fmt(gm.pga_m_s2, 3)} m/s^2): base "
+        + f"Specimen {key} under record {record} x {factor} (PGA {fmt(gm.pga_m_s2, 3)} m/s²): base "
         f"acceleration and theta/alpha (beyond +/-1 the block passes its critical angle). {verdicts}.",
     )
     return fig

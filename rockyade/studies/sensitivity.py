@@ -18,8 +18,7 @@ from matplotlib.figure import Figure
 from rockyade import paper
 from rockyade.blocks.restitution import find_peaks
 from rockyade.errors import CalibrationError
-from rockyade.figures import new_figure, save_figure
-from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
+from rockyade.figures.parameter_sensitivity import SensitivityDisplay
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
@@ -111,7 +110,8 @@ def run(report: Report) -> pd.DataFrame:
 
 def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
     """The change of each response (%) when alpha, p or mu changes by -5 % or +5 %, one panel
-    per response, Housner beside the reference DEM (``sensitivity.png`` in the report's folder).
+    per response, Housner beside the reference DEM (``sensitivity.png`` in the report's folder), drawn by
+    :class:`rockyade.figures.parameter_sensitivity.SensitivityDisplay`.
 
     Parameters
     ----------
@@ -125,32 +125,10 @@ def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
     Figure
         The figure, written as PNG.
     """
-    responses = list(dict.fromkeys(table.response))
     name = "sensitivity.png"
-    fig, axes = new_figure(report.out / name, 1, len(responses), figsize=(4.2 * len(responses), 4.2), sharey=True)
-    labels = [f"{p} {c:+.0f}%" for p in ("alpha_rad", "p_rad_s", "mu") for c in (-5, 5)]
-    y = np.arange(len(labels))
-    for ax, response in zip(axes, responses, strict=True):
-        for k, solver in enumerate(("housner", "reference")):
-            sel = table[(table.response == response) & (table.solver == solver)]
-            values = [
-                sel[(sel.parameter == lab.split()[0]) & (np.isclose(sel.change_pct, float(lab.split()[1][:-1])))][
-                    "relative_change_pct"
-                ].iloc[0]
-                for lab in labels
-            ]
-            offset = y + (k - 0.5) * 0.38
-            ax.barh(offset, values, height=0.38, color=SOLVER_STYLES[solver]["color"], label=SOLVER_LABELS[solver])
-            for pos, value in zip(offset, values, strict=True):
-                if np.isnan(value):  # say why there is no bar
-                    ax.text(0, pos, "  DEM: mu not reachable", va="center", fontsize=7, color="0.35")
-        ax.axvline(0, color="0.3", lw=0.6)
-        ax.set_title(response, fontsize=9)
-        ax.set_xlabel("change of the response (%)")
-        ax.grid(alpha=0.3, axis="x")
-    axes[0].set_yticks(y, labels)
-    axes[0].legend(fontsize=8)
-    save_figure(fig, report.out / name)
+    display = SensitivityDisplay(table).plot(path=report.out / name)
+    assert display.figure_ is not None
+    fig = display.figure_
     report.figure(
         name,
         "Relative change of each response when alpha, p or mu of specimen 1 changes by -5 % or +5 % "

@@ -43,7 +43,10 @@ the tolerance, pass or fail):
 * ``limit_pushover``: the limit analysis's multiplier against the reference DEM's pushover
   onset (held levels every 1 % of it from 0.98 of it) within 2 %, for a block, a 20-voussoir
   arch, a wall restrained at its top (three hinges) and a running-bond panel that slides on a
-  bed joint (a slender panel goes below the limit analysis: docs/assemblies.md).
+  bed joint (a slender panel goes below the limit analysis: docs/assemblies.md);
+* ``siconos``: Siconos (nonsmooth contact dynamics) against closed forms: free-rocking
+  restitution against Housner's Eq 4 (0.5 %) and a block's pushover onset against the limit
+  analysis (2 %) (:func:`check_siconos`).
 
 ``kinematic``, ``code``, ``fragility_fit`` and ``loaded_block`` run no solver (the
 limit-analysis programme, Housner's model and the fit only).
@@ -663,6 +666,7 @@ def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
                 _rel(kin.e_star, expected) <= 1e-9,
             )
         )
+    rows += _restrained_wall_rows()
     t60 = _arch_minimum_thickness(60)
     rows.append(
         Row(
@@ -677,6 +681,57 @@ def check_kinematic(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
         )
     )
     return rows, {}
+
+
+def _restrained_wall_rows() -> list[Row]:
+    """The wall restrained at its top against closed forms (docs/assemblies.md, tests/test_restraints.py):
+    the two-block wall's three-hinge mechanism, 17/35 (t 0.3, H 3, split 0.5, restraint 0.3 deep,
+    frictionless); the 8-course tuff wall (H 2.4, t 0.36, 1600 kg/m^3, joints 35 degrees, a roof of
+    6 kN/m at 0.05 m without mass, a frictionless restraint on its far face): the seven lower
+    courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
+    tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
+    from rockyade.limit import limit_analysis
+    from rockyade.scene.generators import restrained_wall, wall_section
+
+    two = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0)
+    lam2 = _known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
+    eight = wall_section(
+        height_m=2.4,
+        thickness_m=0.36,
+        courses=8,
+        top="restrained-far",
+        gap_m=0.0,
+        overburden_n_per_m=6000.0,
+        overburden_eccentricity_m=0.05,
+        density_kg_m3=1600.0,
+        contact={"calibration": "paper", "friction_angle_deg": 35.0},
+    )
+    eight["loads"] = [{**q, "mass_kg": 0.0} for q in eight["loads"]]  # the case's roof: without mass
+    lam8 = _known(limit_analysis(scene_from_dict(eight), direction="+x").load_multiplier, "load multiplier")
+    wc = 1600.0 * G * 0.36 * 0.3
+    expected8 = (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
+    return [
+        Row(
+            "kinematic",
+            "limit",
+            "wall restrained at its top, 2 blocks: lambda",
+            lam2,
+            17 / 35,
+            "three hinges: 17/35",
+            "1e-9",
+            _rel(lam2, 17 / 35) <= 1e-9,
+        ),
+        Row(
+            "kinematic",
+            "limit",
+            "8-course wall restrained on its far face: lambda",
+            lam8,
+            expected8,
+            "top course squeezed up (<= three hinges 1.3619)",
+            "1e-9",
+            _rel(lam8, expected8) <= 1e-9 and lam8 <= 1.3619,
+        ),
+    ]
 
 
 def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
@@ -815,8 +870,11 @@ def loaded_lambda() -> float:
     return (w * b + LOADED_N * (b - LOADED_X_M)) / (w * h_c)
 
 
-def loaded_block_scene(motion: dict[str, Any] | None = None, duration_s: float = 1.0) -> Scene:
-    """The loaded block (:func:`loaded_lambda`) under ``motion`` (default at rest)."""
+def loaded_block_scene(
+    motion: dict[str, Any] | None = None, duration_s: float = 1.0, load_mass_kg: float = 0.0
+) -> Scene:
+    """The loaded block (:func:`loaded_lambda`) under ``motion`` (default at rest); its load
+    without mass unless ``load_mass_kg`` is given."""
     return scene_from_dict(
         {
             "duration_s": duration_s,
@@ -831,9 +889,59 @@ def loaded_block_scene(motion: dict[str, Any] | None = None, duration_s: float =
                 }
             ],
             "motion": motion or rest_motion(),
-            "loads": [{"block": "pier", "point_m": [LOADED_X_M, LOADED_HEIGHT_M], "force_N": [0.0, -LOADED_N]}],
+            "loads": [
+                {
+                    "block": "pier",
+                    "point_m": [LOADED_X_M, LOADED_HEIGHT_M],
+                    "force_N": [0.0, -LOADED_N],
+                    "mass_kg": load_mass_kg,
+                }
+            ],
         }
     )
+
+
+def check_loaded_mass(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The loaded block with the load's mass (its weight / g) shaking with it: the limit
+    analysis and Housner's uplift multiplier against (W b + N d) / (W h_c + N h_N), h_N the
+    load's height (its horizontal force lambda N at its point), and the code's e* with the
+    load as a P_i at h_N: (W h_c + N h_N)^2 / ((W + N) (W h_c^2 + N h_N^2))."""
+    from rockyade.limit import limit_analysis
+    from rockyade.solvers.housner import housner_model
+
+    scene = loaded_block_scene(load_mass_kg=LOADED_N / G)
+    w, n = LOADED_MASS_KG * G, LOADED_N
+    b, h_c, h_n = LOADED_WIDTH_M / 2, LOADED_HEIGHT_M / 2, LOADED_HEIGHT_M
+    expected = (w * b + n * (b - LOADED_X_M)) / (w * h_c + n * h_n)
+    result = limit_analysis(scene, direction="+x")
+    lam = _known(result.load_multiplier, "load multiplier")
+    housner = housner_model(scene).uplift_multiplier(-1)
+    e_star = _kinematic(result).e_star
+    e_expected = (w * h_c + n * h_n) ** 2 / ((w + n) * (w * h_c**2 + n * h_n**2))
+    src = "(W b + N d) / (W h_c + N h_N)"
+    return [
+        Row("loaded_mass", "limit", "lambda towards +x", lam, expected, src, "1e-6", _rel(lam, expected) <= 1e-6),
+        Row(
+            "loaded_mass",
+            "housner",
+            "uplift multiplier about the +x pivot",
+            housner,
+            expected,
+            src,
+            "1e-6",
+            _rel(housner, expected) <= 1e-6,
+        ),
+        Row(
+            "loaded_mass",
+            "limit",
+            "e* with the load a P_i",
+            e_star,
+            e_expected,
+            "(W h_c + N h_N)^2 / ((W + N)(W h_c^2 + N h_N^2))",
+            "1e-6",
+            _rel(e_star, e_expected) <= 1e-6,
+        ),
+    ], {}
 
 
 def check_loaded_block(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
@@ -1015,6 +1123,75 @@ def check_limit_pushover(solvers: list[str]) -> tuple[list[Row], dict[str, Resul
     return rows, {}
 
 
+def check_siconos(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """Siconos (nonsmooth contact dynamics) against closed forms, whatever ``solvers`` says:
+
+    * free rocking of specimen 1's geometry (0.25 x 1.0 m, released at alpha / 2, e = 0): the
+      mean restitution of the first four impacts within 0.5 % of Housner's Eq 4,
+      1 - 1.5 sin^2 alpha (nothing tuned: the model's own);
+    * the pushover onset of the 0.4 x 2 m block of ``limit_pushover`` within 2 % of the limit
+      analysis (b / h = 0.2).
+
+    The frame, the drums, the arch, the restrained wall and the panel are not here: Siconos's
+    friction solver (NSGS) does not converge on stacks of more than two blocks within its
+    iterations (measured, docs/siconos.md)."""
+    from rockyade.analysis.capacity import capacity_curve, pushover_onset
+    from rockyade.blocks.restitution import restitution_per_impact
+    from rockyade.limit import limit_analysis
+    from rockyade.motion.quasistatic import Pushover
+    from rockyade.motion.spec import parse_motion
+
+    rows = []
+    alpha = math.atan(0.25)
+    free = scene_from_dict(
+        {
+            "duration_s": 3.0,
+            "sample_dt_s": 0.002,
+            "blocks": [{"name": "b", "width_m": 0.25, "height_m": 1.0, "thickness_m": 0.754, "mass_kg": 503.0}],
+            "motion": {"type": "free", "theta0_rad": alpha / 2.0},
+        }
+    )
+    result = run(free, "siconos")
+    eq4 = 1.0 - 1.5 * math.sin(alpha) ** 2
+    per_impact = restitution_per_impact(
+        find_peaks(result.frame["t_s"].to_numpy(), result.frame["theta_rad"].to_numpy()), alpha
+    )[:4]
+    mu = float(np.mean(per_impact)) if result.ok and len(per_impact) else math.nan
+    rows.append(
+        Row(
+            "siconos",
+            "siconos",
+            "specimen 1 free rocking: mean restitution of 4 impacts (e = 0)",
+            mu,
+            eq4,
+            "Housner Eq 4, 1 - 1.5 sin^2 alpha",
+            "0.5 %",
+            _rel(mu, eq4) <= 0.005,
+        )
+    )
+    data, _ = limit_pushover_scenes()["block"]
+    expected = _known(limit_analysis(scene_from_dict(data), direction="+x").load_multiplier, "load multiplier")
+    motion = parse_motion(_short_pushover(expected))
+    assert isinstance(motion, Pushover)
+    t_path, _ = motion.lambda_path(0.0)
+    scene = scene_from_dict(data).with_changes(motion=motion, duration_s=float(t_path[-1]) + 0.5)
+    pushed = run(scene, "siconos")
+    onset = pushover_onset(capacity_curve(pushed, scene), scene).multiplier if pushed.ok else math.nan
+    rows.append(
+        Row(
+            "siconos",
+            "siconos",
+            "block 0.4 x 2 m: pushover onset (first held level it did not stand)",
+            onset,
+            expected,
+            "limit analysis",
+            "2 %",
+            _rel(onset, expected) <= 0.02,
+        )
+    )
+    return rows, {}
+
+
 CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Result]]]] = {
     "frame": check_frame,
     "drums": check_drums,
@@ -1026,8 +1203,10 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "code": check_code,
     "fragility_fit": check_fragility_fit,
     "loaded_block": check_loaded_block,
+    "loaded_mass": check_loaded_mass,
     "loaded_pushover": check_loaded_pushover,
     "limit_pushover": check_limit_pushover,
+    "siconos": check_siconos,
 }
 
 

@@ -11,8 +11,10 @@ Three cases (``kind``):
 * ``"point"`` (a column or a stack): the force ``force_N`` on the top block at
   ``eccentricity_m`` from its axis.
 
-The loads are forces without mass (:mod:`rockyade.scene.model`): a floor whose mass shakes
-with the wall is a block.
+Each load carries the mass of its weight, ``mass_kg`` = force / g (the code counts the
+vertical loads a wall carries among the masses the horizontal acceleration acts on,
+Circolare 2019 C8.7.1; :mod:`rockyade.scene.carried`), unless ``with_mass`` is False (a
+force without mass: its horizontal force goes elsewhere).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from rockyade.constants import G
 from rockyade.errors import InputError
 
 KINDS = ("section", "line", "point")
@@ -49,6 +52,11 @@ def _top_face(block) -> tuple[float, float, float]:
     return 0.5 * (float(xs.min()) + float(xs.max())), top, float(xs.max() - xs.min())
 
 
+def _load(block: str, point: list[float], force: float, with_mass: bool) -> dict[str, Any]:
+    """A vertical [[loads]] entry of ``force`` N downwards, with the mass of its weight or none."""
+    return {"block": block, "point_m": point, "force_N": [0.0, -force], "mass_kg": force / G if with_mass else 0.0}
+
+
 def _check(name: str, value: float, bound: float, unit: str) -> float:
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
         raise InputError(name, f"must be a finite number of {unit}, got {value!r}")
@@ -63,6 +71,7 @@ def add_overburden(
     force_N_per_m: float = 0.0,
     force_N: float = 0.0,
     eccentricity_m: float = 0.0,
+    with_mass: bool = True,
 ) -> dict[str, Any]:
     """``scene_dict`` with its overburden as ``[[loads]]`` (module docstring).
 
@@ -78,6 +87,8 @@ def add_overburden(
         Vertical load, N (downwards; "point").
     eccentricity_m
         Distance of the load from the axis of the top block, m (> 0 towards +x).
+    with_mass
+        Each load carries the mass of its weight (``mass_kg`` = force / g), else none.
 
     Returns
     -------
@@ -111,7 +122,7 @@ def add_overburden(
             )
         for block in tops:
             x, y, length = _top_face(block)
-            loads.append({"block": block.name, "point_m": [x, y], "force_N": [0.0, -q * length]})
+            loads.append(_load(block.name, [x, y], q * length, with_mass))
         return {**scene_dict, "loads": loads}
     if len(tops) != 1:
         raise InputError("overburden", f"needs one top block, found {len(tops)}: {[b.name for b in tops][:5]}")
@@ -124,5 +135,5 @@ def add_overburden(
         )
     spec = scene.blocks[block.index]
     force = q * spec.thickness_m if kind == "section" else n
-    loads.append({"block": block.name, "point_m": [x + eccentricity_m, y], "force_N": [0.0, -force]})
+    loads.append(_load(block.name, [x + eccentricity_m, y], force, with_mass))
     return {**scene_dict, "loads": loads}

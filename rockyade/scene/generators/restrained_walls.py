@@ -14,20 +14,23 @@ fixed block (it moves with the base) that restrains the top:
   left.
 
 ``gap_m`` leaves a gap between the wall and the restraint (horizontal for "side", vertical
-for "floor"). The wall's length along its plane is the blocks' ``thickness_m``
+for "floor"); a gap the wall cannot close before it overturns (the wall's thickness for "side",
+sqrt(t^2 + H^2) - H for "floor") is refused. The wall's length along its plane is the blocks' ``thickness_m``
 (``wall_length_m``).
 
 ``restraint_friction_deg`` sets the friction of the joints between the wall and the
-restraint (a ``[[joints]]`` entry; default: the scene's). A restraint that holds the wall by
-friction locks the two-block wall: its upper block must slide up the restraint for the
-three-hinge mechanism of Fig. 2 to form; give 0 (a frictionless, or rolling, restraint; see
-docs/assemblies.md for the mechanism's multiplier).
+restraint (a ``[[joints]]`` entry; default 0, as :func:`~rockyade.scene.generators.wall_section`'s;
+None: the scene's). A restraint that holds the wall by friction locks the two-block wall: its
+upper block must slide up the restraint for the three-hinge mechanism of Fig. 2 to form, which a
+frictionless (or rolling) restraint allows (see docs/assemblies.md for the mechanism's
+multiplier). :func:`~rockyade.scene.generators.wall_section` builds the same section in courses.
 
 Block names: ``wall`` (or ``wall_lower``, ``wall_upper``) and ``restraint`` or ``floor``.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from fractions import Fraction
 from typing import Any
@@ -60,7 +63,7 @@ def restrained_wall(
     restraint_width_m: float = 0.3,
     restraint_height_m: float = 0.3,
     gap_m: float = 0.0,
-    restraint_friction_deg: float | None = None,
+    restraint_friction_deg: float | None = 0.0,
     density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
@@ -86,7 +89,7 @@ def restrained_wall(
     gap_m
         Gap between the wall and the restraint, m.
     restraint_friction_deg
-        Friction angle of the wall-restraint joints, degrees in [0, 90) (None: the scene's).
+        Friction angle of the wall-restraint joints, degrees in [0, 90) (default 0; None: the scene's).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is the paper's calibration
         (slender wall blocks).
@@ -112,6 +115,16 @@ def restrained_wall(
             rect_block("wall_lower", T, lower, zero, zero, length, density),
             rect_block("wall_upper", T, H - lower, zero, lower, length, density),
         ]
+    # a gap the wall cannot close before it overturns (turning about its toe, its centroid over the toe
+    # when its top has moved by its thickness and its top corner has risen by sqrt(t^2 + H^2) - H)
+    reach = float(T) if kind == "side" else math.hypot(float(T), float(H)) - float(H)
+    if float(gap) >= reach:
+        raise InputError(
+            "gap_m",
+            f"must be < {reach:.4g} m with restraint = {kind!r}: the wall overturns (its top moved "
+            f"{'by its thickness' if kind == 'side' else 'up by sqrt(t^2 + H^2) - H'}) before a gap of "
+            f"{float(gap):g} m closes",
+        )
     if kind == "side":
         if rh > H:
             raise InputError(

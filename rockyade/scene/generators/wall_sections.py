@@ -6,10 +6,30 @@ out of the section), standing on the base centred on x = 0, in ``courses`` equal
 (1: one block). The top is:
 
 * ``"free"``: nothing above it (static threshold t / H for the whole wall);
-* ``"restrained"``: a fixed block on each side of its top course, ``restraint_height_m``
-  deep, each ``gap_m`` from the wall (a gap > 0 is required: a restraint flush on both faces
-  clamps the wall), frictionless by default (``restraint_friction_deg``: a wall that slides
-  up a restraint is what lets hinges form);
+* ``"restrained"``: a fixed block on each side of its top, ``restraint_height_m`` deep, each
+  ``gap_m`` from the wall (a gap > 0 is required: restraints flush on both faces clamp the
+  wall);
+* ``"restrained-far"`` (``"restrained-near"``): one fixed block, on the far face (x > 0; the near
+  face, x < 0) only, ``gap_m`` from it; a zero gap is allowed and gives the three-hinge
+  mechanism of the paper's Fig. 2 towards the restraint.
+
+The restraints are frictionless by default (``restraint_friction_deg``: a wall that slides up a
+restraint is what lets hinges form), with the same friction for every course that can touch them
+(the top courses beside them and the course whose corner meets their bottom corner). A gap of the
+wall's thickness or more is refused: a wall turning about its toe overturns (its centroid passes
+the toe) when its top has moved by its thickness, before such a gap closes.
+
+::
+
+                gap_m |<->|          restraint_width_m
+      restraint_near  +---+  wall  +---+  restraint_far
+      (fixed)         |   |   top  |   |  (fixed)    ^ restraint_height_m
+                      +---+ course +---+             v
+                          |  w0n   |
+                          |  ...   |   courses equal, height_m / courses each
+                          |  w01   |
+                  ========+========+======== base
+                          |<------>| thickness_m (centred on x = 0)
 
 and may carry an overburden ``overburden_n_per_m`` (per metre of wall, on the top block at
 ``overburden_eccentricity_m`` from the wall's axis, as ``[[loads]]``; static threshold
@@ -40,7 +60,7 @@ from rockyade.scene.generators.common import (
 )
 from rockyade.scene.generators.overburden import add_overburden
 
-TOPS = ("free", "restrained")
+TOPS = ("free", "restrained", "restrained-far", "restrained-near")
 
 
 def wall_section(
@@ -70,9 +90,10 @@ def wall_section(
     courses
         Equal courses, 1 to 200.
     top
-        "free" or "restrained".
+        "free", "restrained" (both faces), "restrained-far" or "restrained-near" (one face).
     gap_m, restraint_height_m, restraint_width_m
-        The restraints' gap to each face (> 0), depth and width, m ("restrained").
+        The restraints' gap to the wall's face (> 0 with both faces restrained, less than the
+        wall's thickness), depth and width, m.
     restraint_friction_deg
         Friction angle of the wall-restraint joints, degrees in [0, 90).
     overburden_n_per_m, overburden_eccentricity_m
@@ -95,20 +116,32 @@ def wall_section(
     h = H / n
     blocks = [rect_block(f"w{i + 1:02d}", T, h, zero, h * i, length, density) for i in range(n)]
     joints = None
-    if kind == "restrained":
-        if gap <= 0:
+    if kind != "free":
+        if kind == "restrained" and gap <= 0:
             raise InputError(
                 "gap_m",
-                "must be > 0 with top = 'restrained': restraints flush on both faces clamp the wall (it cannot turn)",
+                "must be > 0 with top = 'restrained': restraints flush on both faces clamp the wall (it cannot turn); "
+                "restrain one face (top = 'restrained-far') for the three-hinge mechanism",
+            )
+        if gap >= T:
+            raise InputError(
+                "gap_m",
+                f"must be < thickness_m ({float(T):g} m): the wall overturns when its top has moved by its "
+                f"thickness, before a gap of {float(gap):g} m closes",
             )
         if rh > H:
             raise InputError("restraint_height_m", f"must be <= height_m ({float(H):g} m)")
-        blocks.append(rect_block("restraint_near", rw, rh, -T / 2 - gap - rw / 2, H - rh, length, density, fixed=True))
-        blocks.append(rect_block("restraint_far", rw, rh, T / 2 + gap + rw / 2, H - rh, length, density, fixed=True))
-        top_name = blocks[n - 1]["name"]
+        sides = {"restrained": ("near", "far"), "restrained-far": ("far",), "restrained-near": ("near",)}[kind]
+        sign = {"near": -1, "far": 1}
+        for side in sides:
+            x = sign[side] * (T / 2 + gap + rw / 2)
+            blocks.append(rect_block(f"restraint_{side}", rw, rh, x, H - rh, length, density, fixed=True))
+        # every course beside a restraint, and the one whose top corner meets its bottom corner
+        touching = [blocks[i]["name"] for i in range(n) if h * (i + 1) >= H - rh]
         joints = [
-            {"blocks": [top_name, name], "friction_angle_deg": float(restraint_friction_deg)}
-            for name in ("restraint_near", "restraint_far")
+            {"blocks": [name, f"restraint_{side}"], "friction_angle_deg": float(restraint_friction_deg)}
+            for side in sides
+            for name in touching
         ]
     data = scene_table(
         blocks,

@@ -1,0 +1,346 @@
+"""Siconos's machinery: a scene run by Siconos (nonsmooth contact dynamics), parsed back.
+
+The scene's DEM model (:func:`rockyade.calibration.model.calibrated_model`: the blocks,
+their contact polygons at b_eq and inertias from p, the ground motion, the loads, the
+start) is written as JSON data (:mod:`rockyade.siconos.payload`) and run by
+:mod:`rockyade.siconos.driver` in Debian's ``/usr/bin/python3`` (``python3-siconos``), as
+a subprocess kept warm between runs (:mod:`rockyade.io.worker`, the machinery YADE's
+backend uses: no listening socket, a timeout per run, a crash costs one scene, the log
+kept beside the output). A failure of any kind (a crash, a timeout, an exception inside
+Siconos, a non-finite state, a step the friction-contact solver could not converge, a
+partial output) gives a Result with status ``failed``, the reason and the log path, and
+the samples recorded up to there (``partial: true``): never one that looks complete.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+import time
+import zipfile
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from rockyade import __version__
+from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.model import DemModel
+from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.errors import InputError, SolverUnavailableError, os_error_message
+from rockyade.io.atomic import write_text
+from rockyade.io.worker import Program, run_scene
+from rockyade.result import Result, failed_result
+from rockyade.siconos.calibration import model_restitution
+from rockyade.siconos.payload import Numerics, scene_payload
+
+DRIVER = Path(__file__).resolve().parent / "driver.py"
+SICONOS_PYTHON = os.environ.get("ROCKYADE_SICONOS_PYTHON", "/usr/bin/python3")
+#: A file of Debian's python3-siconos the driver needs (the 2-D Bullet collision manager).
+SICONOS_MODULE = Path(
+    os.environ.get("ROCKYADE_SICONOS_MODULE", "/usr/lib/python3/dist-packages/siconos/mechanics/collision/bullet.py")
+)
+LABEL = "Siconos"
+#: Samples so far are written every so many seconds while a scene runs, s.
+FLUSH_PERIOD_S = 30.0
+
+#: Default timeout: start-up allowance plus this many seconds per body-step, capped.
+TIMEOUT_STARTUP_S = 60.0
+TIMEOUT_PER_BODY_STEP_S = 10e-3
+TIMEOUT_CAP_S = 3600.0
+MAX_TIMEOUT_S = 30 * 86400.0
+
+#: A run fails when a step's friction-contact residual exceeds this (the solver stopped far
+#: from a solution) ...
+FAIL_RESIDUAL = 1e-4
+#: ... or when more than this fraction of the solver's calls (and at least FAIL_UNCONVERGED_MIN
+#: of them) end above its tolerance.
+FAIL_UNCONVERGED_FRACTION = 0.01
+FAIL_UNCONVERGED_MIN = 10
+
+
+def siconos_available() -> bool:
+    """True when Debian's python3-siconos and the Python that runs it are installed."""
+    return Path(SICONOS_PYTHON).is_file() and SICONOS_MODULE.is_file()
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["OMP_NUM_THREADS"] = "1"
+    env.pop("DISPLAY", None)
+    env["PYTHONNOUSERSITE"] = "1"
+    env.pop("PYTHONPATH", None)  # Debian's Python with its own modules only
+    return env
+
+
+def default_timeout(n_steps: int, n_bodies: int) -> float:
+    """Wall-clock limit of a run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
+    body-step (measured on a loaded 2-core machine: 0.9 ms per body-step for a single block,
+    37 ms for a 33-block wall), capped at TIMEOUT_CAP_S."""
+    return min(TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * n_steps * n_bodies, TIMEOUT_CAP_S)
+
+
+def check_timeout(timeout_s: float | None, field: str = "timeout_s") -> float | None:
+    """A user timeout: None or seconds in (0, MAX_TIMEOUT_S].
+
+    Raises
+    ------
+    InputError
+        Not a positive finite number of seconds within the limit.
+    """
+    if timeout_s is None:
+        return None
+    try:
+        value = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
+    if not (0.0 < value <= MAX_TIMEOUT_S):
+        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
+    return value
+
+
+def run_model(
+    model: DemModel,
+    numerics: Numerics,
+    *,
+    timeout_s: float | None = None,
+    accel_lowpass_hz: float | None = None,
+    warm: bool = True,
+    workdir: str | Path | None = None,
+    name: str = "siconos",
+    extra_meta: dict[str, object] | None = None,
+) -> Result:
+    """Run a model in Siconos and return a Result (status ``failed`` on any failure).
+
+    Parameters
+    ----------
+    model
+        The scene's DEM model (geometry, inertia, motion, loads, start).
+    numerics
+        Time step and solver settings.
+    timeout_s
+        Wall-clock limit, s (default :func:`default_timeout`).
+    warm
+        Run in this thread's warm worker; False: in a process of its own.
+    workdir
+        Where ``<name>.siconos.json``, ``.npz`` and ``.log`` are kept; default a temporary
+        folder, removed after a successful run and kept after a failed one.
+    extra_meta
+        More metadata for the Result (calibration, time-step choice).
+    """
+    if not siconos_available():
+        raise SolverUnavailableError(
+            f"Siconos is not installed (looked for {SICONOS_PYTHON} and {SICONOS_MODULE}): "
+            "apt-get install -y --no-install-recommends python3-siconos, or set ROCKYADE_SICONOS_PYTHON"
+        )
+    n_steps = (model.n_samples - 1) * numerics.steps_per_sample
+    timeout = check_timeout(timeout_s)
+    timeout = timeout if timeout is not None else default_timeout(n_steps, len(model.bodies))
+    keep = workdir is not None
+    directory = (Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="rockyade-siconos-"))).resolve()
+    directory.mkdir(parents=True, exist_ok=True)
+    scene_file = directory / f"{name}.siconos.json"
+    out_file = directory / f"{name}.siconos.npz"
+    log_file = directory / f"{name}.siconos.log"
+    partial = directory / f"{name}.siconos.npz.part"
+    for stale in (out_file, partial):
+        stale.unlink(missing_ok=True)
+    payload = scene_payload(model, numerics)
+    program = Program([SICONOS_PYTHON, str(DRIVER)], _env(), LABEL, "timeout_s", FLUSH_PERIOD_S)
+    start = time.perf_counter()
+    try:
+        write_text(scene_file, json.dumps(payload, sort_keys=True) + "\n", durable=False)
+        reason = run_scene(program, scene_file, out_file, log_file, timeout, warm)
+    except OSError as exc:
+        error = exc if exc.filename else OSError(exc.errno, exc.strerror, str(scene_file))
+        reason = f"cannot write {os_error_message(error)}"
+    total = time.perf_counter() - start
+    if reason is not None:
+        partial.unlink(missing_ok=True)
+    extra: dict[str, object] = {
+        "log_path": str(log_file),
+        "total_time_s": total,
+        "timeout_s": timeout,
+        "restitution_e": numerics.restitution,
+        "solver_tol": numerics.solver_tol,
+        "solver_max_iter": numerics.solver_max_iter,
+        "newton_max_iter": numerics.newton_max_iter,
+        "friction_laws": payload["laws"],
+        "friction_solver": numerics.friction_solver,
+        "vertex_disk_radius_m": payload["disk_radius_m"],
+        "dt_s": numerics.dt_s,
+        **(extra_meta or {}),
+    }
+    result = _parse(model, numerics, out_file, reason, log_file, total, accel_lowpass_hz, extra)
+    if result.ok and not keep:
+        shutil.rmtree(directory, ignore_errors=True)
+    return result
+
+
+def _last_error_line(log_file: Path) -> str:
+    try:
+        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+    except OSError:
+        return ""
+    for line in reversed(lines):
+        if "Error" in line or "Exception" in line:
+            return line
+    return ""
+
+
+def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
+    with np.load(out_file, allow_pickle=False) as data:
+        meta = json.loads(str(data["meta"]))
+        arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
+    return meta, arrays
+
+
+def _parse(
+    model: DemModel,
+    numerics: Numerics,
+    out_file: Path,
+    reason: str | None,
+    log_file: Path,
+    total: float,
+    lowpass: float | None,
+    extra: dict[str, object],
+) -> Result:
+    """The driver's output as a Result, or a failed Result saying why (with its samples)."""
+    if reason is None and not out_file.is_file():
+        reason = "Siconos wrote no output file"
+    if reason is not None:
+        detail = _last_error_line(log_file)
+        reason = f"{reason}: {detail}" if detail and detail not in reason else reason
+        kept = None
+        with contextlib.suppress(OSError, ValueError, KeyError, zipfile.BadZipFile):
+            kept = _read_output(out_file)
+        if kept is not None:
+            return _partial_failure(model, numerics, kept[0], kept[1], reason, total, extra)
+        return failed_result("siconos", model.scene_hash, reason, wall_time_s=total, partial=False, **extra)
+    try:
+        meta, arrays = _read_output(out_file)
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
+        return failed_result("siconos", model.scene_hash, f"unreadable Siconos output {out_file.name}: {exc}", **extra)
+    problem = _output_problem(model, meta, arrays)
+    if problem is not None:
+        return _partial_failure(model, numerics, meta, arrays, problem, total, extra)
+    return Result(_frame(model, arrays, lowpass), _run_meta(model, numerics, meta, total, extra, arrays))
+
+
+def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
+    """Why a complete-looking output is not a result, or None."""
+    n = int(meta.get("n_filled", 0))
+    if not meta.get("complete") or arrays["pos"].shape[0] != n:
+        return "partial Siconos output"
+    status = meta["status"]
+    if status == "completed" and n != model.n_samples:
+        return f"Siconos stopped early: {n} of {model.n_samples} samples"
+    if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
+        return (
+            f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s (non-finite state or runaway speed)"
+        )
+    calls = int(meta.get("solver_calls", 0))
+    bad = int(meta.get("unconverged_steps", 0))
+    if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (
+        bad >= FAIL_UNCONVERGED_MIN and bad > FAIL_UNCONVERGED_FRACTION * calls
+    ):
+        return (
+            f"Siconos did not converge: {bad} of {calls} friction-contact solves ended above the tolerance "
+            f"(largest residual {float(meta.get('max_residual', 0.0)):.3g}, "
+            f"first at t = {meta.get('first_unconverged_s')} s); "
+            "try a smaller dt_factor or more solver iterations"
+        )
+    gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
+    if t_blowup is not None:
+        return (
+            f"numerical instability in Siconos at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+        )
+    return None
+
+
+def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Result:
+    """A failed run that keeps what it recorded: status ``failed``, ``partial: true``."""
+    n = min(int(meta.get("n_filled", 0)), arrays["pos"].shape[0])
+    if n == 0:
+        return failed_result("siconos", model.scene_hash, reason, partial=True, wall_time_s=total, **extra)
+    arrays = {k: v[:n] for k, v in arrays.items()}
+    frame = _frame(model, arrays, None)
+    out = _run_meta(model, numerics, {**meta, "status": "failed"}, total, extra, arrays)
+    out.update(
+        status="failed",
+        failure_reason=reason,
+        overturn_time_s=None,
+        overturned_block=None,
+        partial=True,
+        partial_samples=n,
+    )
+    return Result(frame, out)
+
+
+def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None) -> pd.DataFrame:
+    """The common time history, plus the normal force of every contact vertex (``c<i>_fn_N``)."""
+    frame = dem_frame(
+        model,
+        arrays["pos"],
+        arrays["ang"],
+        arrays["angvel"],
+        arrays["vpoint"],
+        arrays["state"],
+        lowpass,
+        n_contacts=arrays["ncont"],
+        slipping=arrays["slip"],
+    )
+    names = model.names
+    forces = {}
+    for i, body in enumerate(model.bodies):
+        prefix = f"{body.name}_" if len(names) > 1 else ""
+        for v in range(len(body.contact_vertices_m)):
+            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
+
+
+def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
+    """The Result's metadata: how the run ended, what ran, and Siconos's own diagnostics."""
+    names = model.names
+    status = meta["status"]
+    overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
+    overturn_time = meta["stop_time_s"] if status == "overturned" else None
+    overturned_block = names[meta["stop_body"]] if status == "overturned" else None
+    if not model.stop_on_overturn and status == "completed":
+        t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
+        falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
+        status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
+    calls = int(meta.get("solver_calls", 0))
+    return {
+        "solver": "siconos",
+        "version": f"Siconos {meta.get('siconos_version')} (rockyade {__version__} driver)",
+        "scene_hash": model.scene_hash,
+        "wall_time_s": meta["wall_time_s"],
+        "startup_time_s": total - meta["wall_time_s"],
+        "status": status,
+        "overturn_time_s": overturn_time,
+        "overturned_block": overturned_block,
+        "overturn_criterion": CRITERION,
+        "overturn_times_s": overturn_times,
+        "blocks": names,
+        "sample_dt_s": model.sample_dt_s,
+        "duration_s": model.duration_s,
+        "n_steps": int(meta.get("steps", 0)),
+        "iterations": int(meta.get("steps", 0)),
+        "solver_calls": calls,
+        "solver_iterations": int(meta.get("solver_iterations", 0)),
+        "solver_iterations_mean": (int(meta.get("solver_iterations", 0)) / calls) if calls else 0.0,
+        "unconverged_steps": int(meta.get("unconverged_steps", 0)),
+        "max_solver_residual": float(meta.get("max_residual", 0.0)),
+        "max_penetration_m": float(meta.get("max_penetration_m", 0.0)),
+        "max_bullet_overlap_m": float(meta.get("max_bullet_overlap_m", 0.0)),
+        "calibration": "siconos (nonsmooth: Newton restitution e, Coulomb friction; geometry and inertia as the DEMs)",
+        "mu_model": {b.name: model_restitution(b) for b in model.bodies if not b.fixed},
+        "bodies": model.body_summary(),
+        "motion": model.motion_label,
+        "process_cpu_s": meta.get("process_cpu_s"),
+        **extra,
+    }

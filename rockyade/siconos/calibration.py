@@ -1,0 +1,118 @@
+"""The classical parameters carried to nonsmooth contact dynamics (paper's idea, Siconos).
+
+* **alpha** through the equivalent base b_eq (paper Eq 11): the blocks are the DEMs'
+  (:mod:`rockyade.dem.build`), base corners where the DEMs put them.
+* **p** through the inertia: the DEMs' centroidal inertia, set so that
+  I_O = M g R / p^2 (:func:`rockyade.blocks.classical.inertia_for_frequency`).
+* **mu** is not a parameter of the model: with a Newton restitution e = 0 at the contacts
+  (a corner that lands stays down) and an instantaneous impact, angular momentum about the
+  landing corner is conserved (the impulse acts there), which is Housner's derivation of
+  his restitution: mu = (I_c + M r_B . r_A) / I_B (general Eq 4,
+  :func:`rockyade.blocks.classical.restitution`), 1 - 1.5 sin^2 alpha for a rectangle.
+  Measured (docs/siconos.md): e = 0.1-0.5 at the corners still gives that value per cycle,
+  so no Newton restitution reaches a target above it; a scene whose calibration asks for a
+  target mu (``contact.calibration = "matched"``) is refused unless its target is within
+  MU_RTOL of the model's own (:func:`check_target_mu`). Under the other calibrations a
+  scene's ``mu`` sets only the DEMs' damping: Siconos runs the geometry's restitution and
+  records both in the Result (``mu_model``, ``mu_scene``).
+* **The time step** (:func:`default_dt`): DT_P_FRACTION / p of the fastest moving block,
+  within [DT_MIN_S, DT_MAX_S], so that one step is the same fraction of the rocking time
+  scale 1/p for every block; halving it changes free-rocking and earthquake peaks by less
+  than DT_PEAK_RTOL (``tests/test_siconos.py``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from rockyade.dem.model import DemBody, DemModel
+from rockyade.errors import InputError
+from rockyade.scene import Scene
+
+#: A target mu within this relative distance of the model's own counts as reached.
+MU_RTOL = 0.01
+#: Default time step: this fraction of 1/p of the fastest moving block ...
+DT_P_FRACTION = 1.0e-3
+#: ... within these bounds, s.
+DT_MIN_S = 2.0e-5
+DT_MAX_S = 1.0e-3
+#: Halving the default step changes peaks by less than this (relative; tested).
+DT_PEAK_RTOL = 0.02
+
+
+def _base_corners(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The left and right base corners of a contact polygon (its lowest vertices)."""
+    y0 = float(vertices[:, 1].min())
+    size = float(np.ptp(vertices, axis=0).max())
+    low = vertices[np.abs(vertices[:, 1] - y0) <= 1e-9 * size]
+    return low[np.argmin(low[:, 0])], low[np.argmax(low[:, 0])]
+
+
+def model_restitution(body: DemBody) -> float:
+    """The restitution of a body rocking on its base with e = 0 (general Eq 4, module
+    docstring): sqrt(mu_left_to_right x mu_right_to_left), the centroid at the origin of
+    the contact polygon's frame and I_c the body's (adjusted) centroidal inertia."""
+    if body.fixed:
+        return math.nan
+    left, right = _base_corners(np.asarray(body.contact_vertices_m, dtype=float))
+    m, ic = body.mass_kg, body.inertia_kgm2
+
+    def ratio(a: np.ndarray, b: np.ndarray) -> float:
+        # centroid at 0: r_G - r_A = -a, r_G - r_B = -b
+        return (ic + m * float(b @ a)) / (ic + m * float(b @ b))
+
+    return math.sqrt(ratio(left, right) * ratio(right, left))
+
+
+def check_target_mu(scene: Scene, model: DemModel) -> dict[str, object]:
+    """The restitution the Siconos model runs against what the scene asks, per moving block.
+
+    Returns
+    -------
+    dict
+        ``mu_model`` (the geometry's, e = 0), ``mu_scene`` (the scene's explicit mu, or
+        None) and a ``mu_note`` when they differ.
+
+    Raises
+    ------
+    InputError
+        The scene asks for a target mu (``contact.calibration = "matched"``) more than
+        MU_RTOL from the model's own: one line with the reachable value.
+    """
+    mu_model: dict[str, float] = {}
+    mu_scene: dict[str, float | None] = {}
+    for spec, body in zip(scene.blocks, model.bodies, strict=True):
+        if body.fixed:
+            continue
+        own = model_restitution(body)
+        mu_model[body.name] = own
+        mu_scene[body.name] = spec.mu
+        if scene.contact.calibration == "matched" and spec.mu is not None and abs(spec.mu - own) > MU_RTOL * own:
+            low, high = own * (1 - MU_RTOL), own * (1 + MU_RTOL)
+            raise InputError(
+                "contact.calibration",
+                f"the siconos solver cannot reach mu = {spec.mu:.4g} for {body.name}: with e = 0 its impacts give the "
+                f"block's own restitution {own:.4g} (Eq 4) and a Newton restitution e > 0 does not raise it; "
+                f"reachable range [{low:.4g}, {high:.4g}]; use calibration 'paper' or drop mu",
+            )
+    out: dict[str, object] = {"mu_model": mu_model, "mu_scene": mu_scene}
+    if any(v is not None and abs(v - mu_model[k]) > MU_RTOL * mu_model[k] for k, v in mu_scene.items()):
+        out["mu_note"] = (
+            "the scene's mu sets the DEMs' damping only; Siconos's impacts give the geometry's restitution (mu_model)"
+        )
+    return out
+
+
+def default_dt(model: DemModel) -> float:
+    """The default time step, s (module docstring)."""
+    p = [b.p_rad_s for b in model.bodies if not b.fixed and math.isfinite(b.p_rad_s) and b.p_rad_s > 0]
+    dt = DT_P_FRACTION / max(p) if p else DT_MAX_S
+    return min(max(dt, DT_MIN_S), DT_MAX_S)
+
+
+def steps_for(sample_dt_s: float, dt_s: float) -> tuple[float, int]:
+    """The step that divides the sample interval, at most ``dt_s``: (step, steps per sample)."""
+    steps = max(1, math.ceil(sample_dt_s / dt_s - 1e-9))
+    return sample_dt_s / steps, steps

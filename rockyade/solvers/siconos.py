@@ -1,0 +1,230 @@
+"""Siconos as a solver: nonsmooth contact dynamics, the third voice (:mod:`rockyade.siconos.backend`).
+
+The blocks are the DEMs' (contact polygons at the equivalent base b_eq, inertia from p),
+but a contact has no stiffness and no dashpot: impacts are instantaneous with a Newton
+restitution e (0 by default: the block's geometry gives Housner's restitution) and Coulomb
+friction, stepped by Moreau-Jean in Debian's Siconos (``python3-siconos``), in a worker
+process kept warm across scenes (no listening socket; a crash or a timeout costs one
+scene). The base motion enters as inertial forces -m a_g(t) in the base frame. See
+``docs/siconos.md``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any, ClassVar
+
+from rockyade.calibration.model import calibrated_model
+from rockyade.dem.model import DemModel
+from rockyade.errors import InputError
+from rockyade.result import Result
+from rockyade.scene import Scene
+from rockyade.siconos.backend import check_timeout, run_model
+from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
+from rockyade.siconos.payload import Numerics
+from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.cost import CostEstimate, dem_cost
+
+#: Largest time step accepted, s.
+DT_LIMIT_S = 0.01
+
+
+def _check_dt(value: Any, field: str) -> float | None:
+    if value is None:
+        return None
+    try:
+        dt = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a time step in s, got {value!r}") from None
+    if not (0.0 < dt <= DT_LIMIT_S):
+        raise InputError(field, f"must be in (0, {DT_LIMIT_S:g}] s, got {value!r}")
+    return dt
+
+
+def _check_factor(value: Any, field: str) -> float:
+    try:
+        factor = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number in (0, 1], got {value!r}") from None
+    if isinstance(value, bool) or not (0.0 < factor <= 1.0):
+        raise InputError(field, f"must be a number in (0, 1], got {value!r}")
+    return factor
+
+
+def _check_tol(value: Any, field: str) -> float:
+    try:
+        tol = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a tolerance in [1e-14, 1e-3], got {value!r}") from None
+    if isinstance(value, bool) or not (1e-14 <= tol <= 1e-3):
+        raise InputError(field, f"must be a tolerance in [1e-14, 1e-3], got {value!r}")
+    return tol
+
+
+def _check_count(low: int, high: int):
+    def check(value: Any, field: str) -> int:
+        if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
+            raise InputError(field, f"must be an integer in [{low}, {high}], got {value!r}")
+        return value
+
+    return check
+
+
+def _check_restitution(value: Any, field: str) -> float:
+    try:
+        e = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number in [0, 1], got {value!r}") from None
+    if isinstance(value, bool) or not (0.0 <= e <= 1.0):
+        raise InputError(field, f"must be a number in [0, 1], got {value!r}")
+    return e
+
+
+def _check_folder(value: Any, field: str) -> str | None:
+    if value is not None and not isinstance(value, (str, Path)):
+        raise InputError(field, f"must be a folder path, got {value!r}")
+    return None if value is None else str(value)
+
+
+@dataclass(frozen=True)
+class SiconosSolver(SolverBase):
+    """Siconos as a solver (module docstring).
+
+    Attributes
+    ----------
+    timeout_s
+        Wall-clock limit of each run, s (default 60 s plus 10 ms per body-step, at most
+        an hour).
+    warm
+        Run in a Siconos process kept warm between runs (one per thread; the default), or
+        in a process of its own (False): the same result; warm saves the start-up.
+    dt_s
+        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 1e-3 / p of
+        the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
+        interval.
+    dt_factor
+        Multiplies the time step, in (0, 1] (1: the step as chosen; 0.5: halved, for
+        convergence checks).
+    restitution
+        Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
+        restitution, Housner's Eq 4).
+    solver_tol, solver_max_iter
+        Tolerance and iteration cap of the friction-contact solver (NSGS).
+    newton_max_iter
+        Newton iterations per step on the nonlinear kinematics (1: linearised once).
+    workdir
+        Where the scene data, output and log are kept (default: a temporary folder, removed
+        after a successful run, kept after a failed one).
+    """
+
+    name: ClassVar[str] = "siconos"
+    OPTIONS: ClassVar = {
+        "timeout_s": check_timeout,
+        "warm": check_flag,
+        "dt_s": _check_dt,
+        "dt_factor": _check_factor,
+        "restitution": _check_restitution,
+        "solver_tol": _check_tol,
+        "solver_max_iter": _check_count(1, 100_000),
+        "newton_max_iter": _check_count(1, 100),
+        "workdir": _check_folder,
+    }
+    #: Siconos's time per body-step, s (cost estimate; benchmarks/bench_siconos.py).
+    SECONDS_PER_BODY_STEP: ClassVar[float] = 1e-3
+
+    timeout_s: float | None = None
+    warm: bool = True
+    dt_s: float | None = None
+    dt_factor: float = 1.0
+    restitution: float = 0.0
+    solver_tol: float = 1e-8
+    solver_max_iter: int = 1000
+    newton_max_iter: int = 1
+    workdir: str | None = None
+
+    def __post_init__(self) -> None:
+        for key in (
+            "timeout_s",
+            "dt_s",
+            "dt_factor",
+            "restitution",
+            "solver_tol",
+            "solver_max_iter",
+            "newton_max_iter",
+        ):
+            object.__setattr__(self, key, self.OPTIONS[key](getattr(self, key), key))
+        object.__setattr__(self, "warm", check_flag(self.warm, "warm"))
+        object.__setattr__(self, "workdir", _check_folder(self.workdir, "workdir"))
+
+    def model(self, scene: Scene) -> DemModel:
+        """The scene's blocks, motion and start as the DEMs build them (a matched calibration's
+        damping search is skipped: Siconos has no damping)."""
+        if scene.contact.calibration == "matched":
+            scene = replace(scene, contact=replace(scene.contact, calibration="paper"))
+        return calibrated_model(scene)
+
+    def numerics(self, model: DemModel) -> tuple[Numerics, dict[str, object]]:
+        """The time step and solver settings for ``model``, and how the step was chosen."""
+        base = self.dt_s if self.dt_s is not None else default_dt(model)
+        dt, steps = steps_for(model.sample_dt_s, base * self.dt_factor)
+        numerics = Numerics(
+            dt_s=dt,
+            steps_per_sample=steps,
+            restitution=self.restitution,
+            solver_tol=self.solver_tol,
+            solver_max_iter=self.solver_max_iter,
+            newton_max_iter=self.newton_max_iter,
+        )
+        how: dict[str, object] = {
+            "dt_factor": self.dt_factor,
+            "dt_source": "user"
+            if self.dt_s is not None
+            else "default (1e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
+            "dt_base_s": base,
+        }
+        return numerics, how
+
+    def run(self, scene: Scene) -> Result:
+        """Run a scene in Siconos (:func:`rockyade.siconos.backend.run_model`).
+
+        Raises
+        ------
+        InputError
+            A target mu the model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`).
+        """
+        model = self.model(scene)
+        mu = check_target_mu(scene, model)
+        numerics, how = self.numerics(model)
+        return run_model(
+            model,
+            numerics,
+            timeout_s=self.timeout_s,
+            accel_lowpass_hz=scene.output.accel_lowpass_hz,
+            warm=self.warm,
+            workdir=self.workdir,
+            name=f"{scene.scene_hash}_{self.name}",
+            extra_meta={**how, **mu},
+        )
+
+    def estimate_cost(self, scene: Scene) -> CostEstimate:
+        """Body-steps at the Siconos time step, SECONDS_PER_BODY_STEP each."""
+        model = self.model(scene)
+        numerics, _ = self.numerics(model)
+        moving = max(1, len(model.moving))
+        steps = float(scene.n_samples - 1) * numerics.steps_per_sample * moving
+        memory = dem_cost(scene, self.name, 0.0)
+        return dataclasses.replace(
+            memory,
+            integration_steps=steps,
+            time_step_s=numerics.dt_s,
+            wall_time_s=memory.wall_time_s + steps * self.SECONDS_PER_BODY_STEP,
+        )
+
+    def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
+        """This solver keeping its files in ``folder`` (the stem is the scene hash's)."""
+        return replace(self, workdir=str(folder))
+
+
+__all__ = ["SiconosSolver"]
