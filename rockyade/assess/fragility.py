@@ -157,6 +157,18 @@ class SceneCannotStandError(RockyadeError):
         )
 
 
+class ZeroCapacityError(RockyadeError):
+    """The scene moves under any horizontal acceleration (the limit analysis' lambda is 0): the
+    default levels, multiples of it, would all be 0 (the command exits 1)."""
+
+    def __init__(self, static_text: str) -> None:
+        super().__init__(
+            f"the scene has no lateral capacity: the limit analysis collapses it at lambda = 0 ({static_text}; a "
+            "joint without friction slides under any horizontal acceleration), so the default levels, multiples "
+            "of it, would all be 0 g: give a friction angle > 0, or your own --levels"
+        )
+
+
 def check_levels(levels: Sequence[float], measure: Measure) -> tuple[float, ...]:
     """Levels in the measure's shown unit (g or m/s), each > 0, at least 2, at most
     :data:`MAX_LEVELS`; returned in SI, sorted and distinct."""
@@ -218,6 +230,8 @@ def fragility_plan(
         raise InputError("--intensity", "ag is the site's: use rockyade assess")
     given = check_levels(levels, measure) if levels is not None else None
     static, static_text = static_acceleration(scene)  # also: a scene that cannot stand stops here
+    if given is None and static <= 0.0:
+        raise ZeroCapacityError(static_text)  # before any record is read or generated
     records = record_measures(motions, measure, executor, progress)
     records.insert(0, "record", [motions.label(i) for i in range(motions.count)])
     notes = []
@@ -256,6 +270,8 @@ def _default_levels(
     measure: Measure, records: pd.DataFrame, static: float, static_text: str
 ) -> tuple[tuple[float, ...], str]:
     """Levels from the static collapse acceleration (module docstring), SI."""
+    if static <= 0.0:
+        raise ZeroCapacityError(static_text)
     if math.isnan(static):
         pga_levels = np.array(FALLBACK_PGA_G) * G
         text = "PGA levels of the fallback (no static mechanism)"

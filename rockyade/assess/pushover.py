@@ -75,16 +75,52 @@ class PushoverCheck:
     motion: Pushover
 
     @property
+    def bound(self) -> str:
+        """What the held levels say of the onset: "measured" (it stood at one level and not at the
+        next), "below" (it did not stand at the first level: the onset is below it), "above" (it
+        stood at every level: the onset is above the last) or "none" (no level was reached)."""
+        measured, below = math.isfinite(self.onset.multiplier), math.isfinite(self.onset.below)
+        if measured:
+            return "measured" if below else "below"
+        return "above" if below else "none"
+
+    @property
     def difference(self) -> float:
-        """(onset - alpha0) / alpha0 (NaN without an onset)."""
+        """(onset - alpha0) / alpha0; NaN unless the onset is bracketed by two held levels
+        (:attr:`bound` "measured"): a level it fell at first is a bound, not an onset."""
+        if self.bound != "measured":
+            return math.nan
         return self.onset.multiplier / self.alpha0 - 1.0
+
+    def onset_words(self) -> str:
+        """The onset against alpha0 in words, with a percentage only where it was measured:
+        "onset λ = 0.5 (stood at 0.495) ...: +1.00 %", "onset below λ = 0.49, the first held level ...",
+        "held at every level up to λ = 0.52 ..."."""
+        a0 = f"alpha0 = {self.alpha0:.4f}"
+        m, below = self.onset.multiplier, self.onset.below
+        bound = self.bound
+        if bound == "measured":
+            return f"onset λ = {m:.4g} (stood at {below:.4g}) against {a0}: {100 * self.difference:+.2f} %"
+        if bound == "below":
+            return (
+                f"onset below λ = {m:.4g}, the first held level ({m / self.alpha0:.2f} alpha0): it did not stand "
+                f"at it, so the onset is not measured, only bounded; {a0} is above it"
+            )
+        if bound == "above":
+            return (
+                f"held at every level up to λ = {below:.4g} ({below / self.alpha0:.2f} alpha0): the onset is above "
+                f"it, not measured; {a0}"
+            )
+        return f"no onset measured: the run ended before the first held level ({a0})"
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data: the onset, its difference from alpha0 in %, the rule, the curve."""
         return {
             "pushover_onset_lambda": self.onset.multiplier,
             "pushover_level_below": self.onset.below,
-            "pushover_onset_minus_alpha0_pct": 100.0 * self.difference,
+            "pushover_onset_minus_alpha0_pct": 100.0 * self.difference if self.bound == "measured" else None,
+            "pushover_onset_bound": self.bound,
+            "pushover_onset_words": self.onset_words(),
             "rule": self.onset.rule,
             "solver": "reference",
             "direction": self.direction,

@@ -198,10 +198,12 @@ def pushover_lines(a: Assessment) -> list[str]:
     levels = p.motion.levels()
     kin = a.limit.kinematic
     assert kin is not None
-    onset_star = p.onset.multiplier * kin.g / (kin.e_star * kin.FC)
-    return [
+    head = (
         f"pushover (reference DEM, towards {p.direction}, levels {levels[0]:.4g} to {levels[-1]:.4g} every "
-        f"{levels[1] - levels[0]:.3g}, held {p.motion.hold_s:g} s; control point: {p.control_block}'s centroid):",
-        f"  onset lambda = {p.onset.multiplier:.4g} (stood at {p.onset.below:.4g}) against alpha0 = {p.alpha0:.4f}: "
-        f"{100 * p.difference:+.2f} %; a* = {onset_star:.4g} m/s^2 against a0* = {kin.a0_star_m_s2:.4g} m/s^2",
-    ]
+        f"{levels[1] - levels[0]:.3g}, held {p.motion.hold_s:g} s; control point: {p.control_block}'s centroid):"
+    )
+    line = f"  {p.onset_words()}"
+    if p.bound == "measured":
+        onset_star = p.onset.multiplier * kin.g / (kin.e_star * kin.FC)
+        line += f"; a* = {onset_star:.4g} m/s² against a0* = {kin.a0_star_m_s2:.4g} m/s²"
+    return [head, line]

@@ -66,7 +66,14 @@ EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports ``yes | head -1``
 class CommandParser(argparse.ArgumentParser):
     """An argument parser whose errors name the nearest choice: ``invalid choice: 'rn'``
     (a command, a sub-command or an option's value) adds "did you mean 'run'?". Sub-command
-    parsers are of this class too (``add_subparsers`` makes them of their parent's class)."""
+    parsers are of this class too (``add_subparsers`` makes them of their parent's class).
+
+    An option is matched by its whole name only (``allow_abbrev=False``): ``--record DIR`` is
+    refused where the option is ``--records``, rather than taken silently as its prefix."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str) -> NoReturn:
         """Print this parser's usage and ``message`` (with the nearest choice), exit 2."""

@@ -384,6 +384,25 @@ def _contact_table(args: argparse.Namespace, kind: str, unit_height_m: float) ->
     return {"calibration": choice, "friction_angle_deg": args.friction_angle_deg}
 
 
+#: An option that means nothing without another: (option, its dest, the other's dest, the other option).
+_NEEDS = [
+    ("--overburden-eccentricity-m", "overburden_eccentricity_m", "overburden_n_per_m", "--overburden-n-per-m"),
+    ("--top-load-eccentricity-m", "top_load_eccentricity_m", "top_load_n", "--top-load-n"),
+]
+
+
+def _check_counts_and_pairs(args: argparse.Namespace, kind: str) -> None:
+    """Refuse, before anything is built, a count the generator would divide by (``--courses 0``)
+    and an option that would be silently ignored (an eccentricity without its load)."""
+    if kind == "wall-section" and not 1 <= args.courses <= 200:
+        raise InputError("--courses", f"must be an integer in [1, 200], got {args.courses} (nothing written)")
+    for option, dest, other, other_option in _NEEDS:
+        if getattr(args, dest, 0.0) != 0.0 and getattr(args, other, 0.0) == 0.0:
+            raise InputError(
+                option, f"has no load to place: give {other_option} > 0 with it, or leave it out (nothing written)"
+            )
+
+
 def _unit_height(args: argparse.Namespace, kind: str) -> float:
     """The block height that sets the default damping of udec joints, m."""
     return {
@@ -533,6 +552,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     check_output_file(out, "--out", (".toml", ".json"))
     if args.draw:
         check_output_file(args.draw, "--draw", ".png")
+    _check_counts_and_pairs(args, kind)
     kwargs = _generator_kwargs(args, kind)
     kwargs["motion"] = _motion_table(args, out)
     if kwargs["duration_s"] is None:

@@ -4,13 +4,18 @@ kinematic quantities (docs/limit.md)."""
 from __future__ import annotations
 
 import argparse
+import math
 import re
+import sys
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_file, json_out, print_wrote
-from rockyade.errors import InputError
+from rockyade.cli.common import add_allow_large, check_output_file, json_out, print_wrote
+from rockyade.errors import InputError, RockyadeError
 
+#: The coulomb rule's progress: first after this many seconds, then at most every PROGRESS_EVERY_S.
+PROGRESS_AFTER_S = 2.0
+PROGRESS_EVERY_S = 5.0
 #: Exit codes: 0 collapse (or no mechanism), 1 unstable under gravity or the coulomb rule's iteration
 #: not converged; bad input exits 2.
 EXIT_UNSTABLE = 1
@@ -22,7 +27,10 @@ def cmd_limit(args: argparse.Namespace) -> int:
         check_output_file(args.plot, "--plot", ".png")
     from rockyade.limit import limit_analysis
     from rockyade.limit.analysis import check_friction_rule
-    from rockyade.limit.model import check_friction_angle
+    from rockyade.limit.cost import check_limit_cost, estimate_limit_cost
+    from rockyade.limit.coulomb import MAX_ITERATIONS
+    from rockyade.limit.lp import TimeLimitError
+    from rockyade.limit.model import check_friction_angle, rigid_block_model
     from rockyade.limit.report import text_report
     from rockyade.scene import load_scene
 
@@ -36,21 +44,38 @@ def cmd_limit(args: argparse.Namespace) -> int:
     except InputError as exc:
         raise InputError("--fc", exc.message) from None
     rule = check_friction_rule(args.friction_rule, "--friction-rule")
-    if not 1 <= args.max_iterations <= 10000:
-        raise InputError("--max-iterations", f"must be an integer in [1, 10000], got {args.max_iterations}")
+    if args.max_iterations is not None and rule != "coulomb":
+        raise InputError(
+            "--max-iterations", "counts the coulomb rule's programmes: give it with --friction-rule coulomb"
+        )
+    max_iterations = MAX_ITERATIONS if args.max_iterations is None else args.max_iterations
+    if not 1 <= max_iterations <= 10000:
+        raise InputError("--max-iterations", f"must be an integer in [1, 10000], got {max_iterations}")
+    time_limit = args.time_limit
+    if time_limit is not None and not (math.isfinite(time_limit) and 0.0 < time_limit <= 1.0e6):
+        raise InputError("--time-limit", f"must be a time in (0, 1e6] s, got {time_limit:g}")
     scene = load_scene(args.scene)
-    result = limit_analysis(
-        scene,
-        direction=args.direction,
-        friction_angle_deg=friction,
-        sliding=not args.no_sliding,
-        fc=fc,
-        friction_rule=rule,
-        max_iterations=args.max_iterations,
-    )
+    model = rigid_block_model(scene, friction_angle_deg=friction, sliding=not args.no_sliding)
+    cost = estimate_limit_cost(model, rule, max_iterations)
+    _say(f"cost: {cost.describe()}")
+    check_limit_cost(cost, allow_large=args.allow_large)
+    progress = _Progress(max_iterations) if rule == "coulomb" else None
+    try:
+        result = limit_analysis(
+            model,
+            direction=args.direction,
+            fc=fc,
+            friction_rule=rule,
+            max_iterations=max_iterations,
+            time_limit_s=time_limit,
+            on_iteration=progress,
+        )
+    except TimeLimitError as exc:
+        raise LimitTimeLimitError(f"error: {exc} (--time-limit {time_limit:g}): no answer") from None
     if args.json:
         data = result.to_dict()
         data["scene"] = str(args.scene)
+        data["cost"] = cost.to_dict()
         json_out(data)
     else:
         print("\n".join(text_report(result, str(args.scene))))
@@ -60,6 +85,28 @@ def cmd_limit(args: argparse.Namespace) -> int:
         draw_mechanism(result, args.plot, title=args.scene.name)
         print_wrote(args.plot, args.json)
     return EXIT_UNSTABLE if result.status in ("unstable", "not_converged") else 0
+
+
+class LimitTimeLimitError(RockyadeError):
+    """The programme stopped at ``--time-limit`` (exit 1)."""
+
+
+def _say(message: str) -> None:
+    """A line on stderr (stdout keeps the answer, and --json's JSON clean)."""
+    print(f"rockyade limit: {message}", file=sys.stderr, flush=True)
+
+
+class _Progress:
+    """The coulomb rule's iterations on stderr: after PROGRESS_AFTER_S, every PROGRESS_EVERY_S."""
+
+    def __init__(self, max_iterations: int) -> None:
+        self.max_iterations = max_iterations
+        self.last = -math.inf
+
+    def __call__(self, iteration: int, multiplier: float, seconds: float) -> None:
+        if seconds >= PROGRESS_AFTER_S and seconds - self.last >= PROGRESS_EVERY_S:
+            self.last = seconds
+            _say(f"coulomb iteration {iteration}/{self.max_iterations}: lambda = {multiplier:.6g}, {seconds:.0f} s")
 
 
 def register(sub: Any) -> None:
@@ -98,10 +145,17 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--max-iterations",
         type=int,
-        default=100,
         metavar="N",
-        help="the coulomb rule's programmes at most, in [1, 10000] (default 100)",
+        help="the coulomb rule's programmes at most, in [1, 10000] (default 100; with --friction-rule coulomb only)",
     )
+    p.add_argument(
+        "--time-limit",
+        type=float,
+        metavar="S",
+        help="stop the programmes after S seconds of wall time (HiGHS's time limit; exit 1 without an answer, "
+        "or the coulomb rule not converged); default none",
+    )
+    add_allow_large(p)
     p.add_argument("--fc", type=float, default=1.35, help="the code's confidence factor FC, in [1, 10] (default 1.35)")
     p.add_argument("--json", action="store_true", help="print the answer as JSON")
     p.add_argument("--plot", type=Path, metavar="PNG", help="draw the assembly at rest and along the mechanism")

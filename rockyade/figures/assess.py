@@ -99,15 +99,30 @@ def plot_fragility(
         lw=0.9,
         label=f"fraction of {n} records that collapse (95 % Wilson)",
     )
-    for value, label, colour, style in marks or []:
-        ax.axvline(value / m.scale, color=colour, ls=style, lw=1.3, label=label)
+    for k, (value, label, colour, style) in enumerate(marks or []):
+        # the first mark (the site's ag in an assessment) wide and below: a capacity at the same value,
+        # drawn thin over it, leaves it showing on both sides
+        ax.axvline(
+            value / m.scale,
+            color=colour,
+            ls=style,
+            lw=3.2 if k == 0 else 1.3,
+            alpha=0.75 if k == 0 else 1.0,
+            zorder=1.5 if k == 0 else 2.5,
+            label=label,
+        )
     ax.set_xlim(0, top)
     ax.set_ylim(-0.03, 1.03)
     ax.set_xlabel(m.label)
     ax.set_ylabel("P(collapse)")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="lower right")
+    _legend_below(ax, 7)
     return fig, ax
+
+
+def _legend_below(ax: Axes, fontsize: float) -> None:
+    """The legend under the axes, outside them: it never covers a point, an error bar or a line."""
+    ax.legend(fontsize=fontsize, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=1, frameon=False)
 
 
 def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
@@ -141,8 +156,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
             color=PUSH,
             lw=1.6,
             ls="-",
-            label=f"reference DEM pushover, force-controlled (held levels): onset lambda {push.onset.multiplier:.4g}, "
-            f"{100 * push.difference:+.1f} % on alpha0",
+            label=f"reference DEM pushover, force-controlled (held levels): {_onset_label(push)}",
         )
     ax.annotate(
         f"a0* = {kin.a0_star_m_s2:.3g}", (0, kin.a0_star_m_s2), xytext=(6, 4), textcoords="offset points", fontsize=8
@@ -187,7 +201,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
     ax.set_ylabel("a* (m/s$^2$)")
     ax.set_title(f"the code's check (e* = {kin.e_star:.3f}, FC = {kin.FC:g}; {a.verdict})", fontsize=9)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=6.5, loc="upper right")
+    _legend_below(ax, 7)
     return fig, ax
 
 
@@ -210,7 +224,7 @@ def _marks(a: Assessment) -> list[tuple[float, str, str, str]]:
 
 def draw_fragility(result: FragilityResult, path: str | Path, title: str | None = None) -> Path:
     """Write :func:`plot_fragility` as a PNG."""
-    fig, ax = new_figure(path, figsize=(6.8, 4.6), layout="constrained")
+    fig, ax = new_figure(path, figsize=(6.8, 5.8), layout="constrained")
     static = result.plan.static_acceleration_m_s2
     marks = []
     if result.measure.kind == "pga" and math.isfinite(static):
@@ -225,7 +239,7 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
     """The capacity curve and demand (left) and, when the dynamics ran, the fragility in ag
     with the code's demand and capacity marked (right); a PNG."""
     panels = 2 if a.dynamic is not None else 1
-    fig, axes = new_figure(path, 1, panels, figsize=(6.4 * panels, 4.8), layout="constrained", squeeze=False)
+    fig, axes = new_figure(path, 1, panels, figsize=(6.4 * panels, 6.2), layout="constrained", squeeze=False)
     plot_capacity(a, axes[0, 0])
     if a.dynamic is not None:
         plot_fragility(a.dynamic, axes[0, 1], marks=_marks(a))
@@ -236,5 +250,16 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
             fontsize=9,
         )
     if title:
-        fig.suptitle(f"{title}: {a.site.describe()}", fontsize=10)
+        fig.suptitle(f"{title}: {a.site.describe().replace('m/s^2', 'm/s²')}", fontsize=10)
     return save_figure(fig, path)
+
+
+def _onset_label(push: Any) -> str:
+    """The pushover's onset for a legend: a percentage only where two held levels bracket it."""
+    if push.bound == "measured":
+        return f"onset λ {push.onset.multiplier:.4g}, {100 * push.difference:+.1f} % on alpha0"
+    if push.bound == "below":
+        return f"onset below λ {push.onset.multiplier:.4g} (the first level)"
+    if push.bound == "above":
+        return f"held at every level up to λ {push.onset.below:.4g}"
+    return "no onset measured"

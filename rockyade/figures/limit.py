@@ -32,6 +32,7 @@ from rockyade.figures.assembly import (
     _draw_blocks,
     _draw_rest_outline,
     _figure_for,
+    _limits,
     _setup_axes,
 )
 from rockyade.figures.common import axes_list, new_figure, save_figure
@@ -76,7 +77,7 @@ def displaced_polygons(result: LimitResult) -> tuple[list[np.ndarray], float]:
 
 def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: str | None = None, *, ax=None):
     """Draw the assembly at rest and along its collapse mechanism (axes in m), and where the
-    nonlinear kinematic analysis reached alpha = 0 its capacity curve a* (m/s^2) against d* (mm).
+    nonlinear kinematic analysis reached alpha = 0 its capacity curve a* (m/s²) against d* (mm).
 
     Parameters
     ----------
@@ -176,10 +177,13 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
 
 def _two_panels(bounds, path: str | Path | None):
     """A figure with the assembly (left) and the capacity curve (right, narrower)."""
-    x0, x1, y0, y1 = bounds
-    aspect = (y1 - y0 + 0.2 * max(x1 - x0, y1 - y0)) / max(x1 - x0, 1e-9)
+    xlim, ylim, _ = _limits(bounds)
+    aspect = (ylim[1] - ylim[0]) / max(xlim[1] - xlim[0], 1e-9)
     width = FIGURE_WIDTH_IN + 4.0
-    height = float(np.clip(FIGURE_WIDTH_IN * aspect, 4.0, MAX_HEIGHT_IN)) + 1.0
+    # the drawing's width: its share of the figure less its legend and labels (about 2 in), so that the
+    # figure is as tall as the drawing at equal scales (no empty band above and below it)
+    drawing_w = width * 2.6 / 3.6 - 2.0
+    height = float(np.clip(drawing_w * aspect, 3.5, MAX_HEIGHT_IN)) + 1.2
     fig, axes = new_figure(path, 1, 2, figsize=(width, height), layout="constrained", width_ratios=[2.6, 1.0])
     return fig, axes[0], axes[1]
 
@@ -188,7 +192,7 @@ def _draw_capacity(ax, kin, d_star: np.ndarray, a_star: np.ndarray) -> None:
     """a*(d*) of the equivalent system with d0*, du*, ds* and the secant of Ts."""
     keep = a_star >= 0.0
     ax.plot(d_star[keep] * 1e3, a_star[keep], color="black", linewidth=1.5, label="a*(d*)")
-    ax.plot([0.0], [kin.a0_star_m_s2], "o", color=HINGE, label=f"a0* = {kin.a0_star_m_s2:.3g} m/s^2")
+    ax.plot([0.0], [kin.a0_star_m_s2], "o", color=HINGE, label=f"a0* = {kin.a0_star_m_s2:.3g} m/s²")
     if kin.d0_star_m is not None:
         ax.axvline(kin.d0_star_m * 1e3, color="0.5", linestyle=":", linewidth=1.0)
         ax.axvline(
@@ -214,7 +218,7 @@ def _draw_capacity(ax, kin, d_star: np.ndarray, a_star: np.ndarray) -> None:
     ax.set_xlim(left=0.0)
     ax.set_ylim(bottom=0.0, top=1.1 * kin.a0_star_m_s2)
     ax.set_xlabel("d* (mm)")
-    ax.set_ylabel("a* (m/s^2)")
+    ax.set_ylabel("a* (m/s²)")
     ax.set_title(f"equivalent system (e* = {kin.e_star:.3f}, FC = {kin.FC:g})", fontsize=9)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="upper right")

@@ -68,14 +68,16 @@ def _way_words(model: RigidBlockModel, corner: Corner, way: int) -> str:
 
 
 def solve_admissible(
-    model: RigidBlockModel, direction: str = "+x", method: str = "highs"
+    model: RigidBlockModel, direction: str = "+x", method: str = "highs", time_limit_s: float | None = None
 ) -> tuple[LPSolution, RigidBlockModel]:
     """The programme's solution with every corner of ``model.corners`` held in one of its ways, the
     lowest (module docstring), and the model solved (those contacts among its interfaces, the
     choice said in its notes). Without such corners: :func:`~rockyade.limit.lp.solve_equilibrium`.
+    ``time_limit_s`` bounds the programmes' time together, s (None: no limit; past it
+    :class:`~rockyade.limit.lp.TimeLimitError`).
     """
     if not model.corners:
-        return solve_equilibrium(model, direction, method), model
+        return solve_equilibrium(model, direction, method, time_limit_s=time_limit_s), model
     count = 0
     order = 0
     heap: list[tuple[float, int, dict[int, int]]] = [(-math.inf, order, {})]
@@ -90,7 +92,8 @@ def solve_admissible(
             raise SolverFailedError(
                 f"the search over {len(model.corners)} corner contacts needed more than {MAX_PROGRAMMES} programmes"
             )
-        sol = solve_equilibrium(_with(model, choice), direction, method)
+        left = None if time_limit_s is None else time_limit_s - spent  # the programmes' time so far
+        sol = solve_equilibrium(_with(model, choice), direction, method, time_limit_s=left)
         count += 1
         spent += sol.solve_time_s
         open_corners = [c for c in range(len(model.corners)) if c not in choice]

@@ -9,7 +9,9 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -32,6 +34,9 @@ FRICTION_NOTE = (
     "running-bond wall's heel units: docs/assemblies.md) (Gilbert, Casapulla & Ahmed 2006; "
     "Ferris & Tin-Loi 2001); the coulomb friction rule (--friction-rule coulomb) gives the non-dilatant answer"
 )
+#: A multiplier this small (in g) is zero: the assembly moves under any horizontal acceleration
+#: (a joint without friction slides); the solver's tolerance is far below it.
+ZERO_MULTIPLIER = 1.0e-9
 #: The friction rules of :func:`limit_analysis` (docs/limit.md, "Friction").
 FRICTION_RULES = ("associated", "coulomb")
 #: What the coulomb rule's answer says of itself.
@@ -183,6 +188,8 @@ def limit_analysis(
     nonlinear: bool = True,
     friction_rule: str = "associated",
     max_iterations: int = MAX_ITERATIONS,
+    time_limit_s: float | None = None,
+    on_iteration: Callable[[int, float, float], None] | None = None,
 ) -> LimitResult:
     """The collapse multiplier, mechanism and kinematic quantities of a scene.
 
@@ -210,6 +217,12 @@ def limit_analysis(
         "not_converged" (no multiplier) when the iteration does not settle.
     max_iterations
         The coulomb rule's programmes at most, an integer in [1, 10000] (default 100).
+    time_limit_s
+        Wall time the programmes may take, s, in (0, 1e6] (None: no limit). The associated programme
+        past it raises :class:`rockyade.limit.lp.TimeLimitError`; the coulomb rule's iteration past it
+        stops with status "not_converged" and a reason that says so.
+    on_iteration
+        The coulomb rule's progress: called after every programme with (iteration, lambda, seconds).
     """
     if direction not in DIRECTIONS:
         raise InputError("direction", f"must be +x or -x, got {direction!r}")
@@ -217,6 +230,10 @@ def limit_analysis(
     if isinstance(max_iterations, bool) or not isinstance(max_iterations, int) or not 1 <= max_iterations <= 10000:
         raise InputError("max_iterations", f"must be an integer in [1, 10000], got {max_iterations!r}")
     fc = check_fc(fc)
+    if time_limit_s is not None and not (
+        isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and 0.0 < time_limit_s <= 1.0e6
+    ):
+        raise InputError("time_limit_s", f"must be a time in (0, 1e6] s, got {time_limit_s!r}")
     if isinstance(scene, RigidBlockModel):
         if loads or friction_angle_deg is not None or not sliding:
             raise InputError("loads", "give loads and friction when building the RigidBlockModel, not here")
@@ -230,13 +247,17 @@ def limit_analysis(
         phi = float(next(a for a in angles if a is not None))
     else:
         phi = "scene"
-    sol, model = solve_admissible(model, direction)
+    t0 = time.perf_counter()
+    sol, model = solve_admissible(model, direction, time_limit_s=time_limit_s)
     rule = friction_rule
     if sol.status != "collapse":
         return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s, rule)
     iterations = 0
     if friction_rule == "coulomb" and phi is not None:
-        iterated = solve_coulomb(model, sol, max_iterations=max_iterations)
+        left = None if time_limit_s is None else time_limit_s - (time.perf_counter() - t0)
+        iterated = solve_coulomb(
+            model, sol, max_iterations=max_iterations, time_limit_s=left, on_iteration=on_iteration
+        )
         iterations, sol = iterated.iterations, iterated.solution
         if not iterated.converged:
             time_s, why = iterated.solve_time_s, iterated.reason
@@ -245,8 +266,10 @@ def limit_analysis(
             )
         sol = replace(sol, solve_time_s=iterated.solve_time_s)
     assert sol.load_multiplier is not None  # a "collapse" always carries its multiplier (lp.py)
+    lam = 0.0 if abs(sol.load_multiplier) <= ZERO_MULTIPLIER else sol.load_multiplier  # -1e-17 is 0, not "-0"
+    sol = replace(sol, load_multiplier=lam)
     mech = mechanism_of(model, sol, "coulomb" if sol.friction_capacity_N is not None else "associated")
-    kin = kinematic_quantities(model, mech, sol.load_multiplier, direction, fc=fc, nonlinear=nonlinear)
+    kin = kinematic_quantities(model, mech, lam, direction, fc=fc, nonlinear=nonlinear)
     return LimitResult(
         "collapse",
         sol.load_multiplier,

@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -46,7 +47,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 from scipy.optimize import linprog
 
-from rockyade.limit.lp import LPSolution, equilibrium_system, solve_equilibrium
+from rockyade.limit.lp import LPSolution, TimeLimitError, equilibrium_system, highs_method, solve_equilibrium
 from rockyade.limit.model import RigidBlockModel
 
 #: Relative change of lambda between successive programmes below which it has settled.
@@ -104,6 +105,8 @@ def solve_coulomb(
     start: LPSolution,
     method: str = "highs",
     max_iterations: int = MAX_ITERATIONS,
+    time_limit_s: float | None = None,
+    on_iteration: Callable[[int, float, float], None] | None = None,
 ) -> CoulombSolution:
     """The non-associated (non-dilatant Coulomb) collapse by the iteration of the module docstring.
 
@@ -117,6 +120,11 @@ def solve_coulomb(
         HiGHS's method (:data:`rockyade.limit.lp.METHODS`).
     max_iterations
         Programmes solved at most.
+    time_limit_s
+        Wall time the iteration may take, s, counted from its call (None: no limit): past it the
+        iteration stops, not converged, and its reason says so.
+    on_iteration
+        Called after every programme with (iteration, lambda, seconds since the call): progress.
 
     Convergence, relaxation and what "converged" means: module docstring.
     """
@@ -134,7 +142,16 @@ def solve_coulomb(
     t0 = time.perf_counter()
     sol = start
     for k in range(1, max_iterations + 1):
-        sol = solve_equilibrium(model, start.direction, method, friction_capacity_N=mu * n_bar)
+        left = None if time_limit_s is None else time_limit_s - (time.perf_counter() - t0)
+        try:
+            if left is not None and left <= 0.0:
+                raise TimeLimitError("no time left")
+            sol = solve_equilibrium(model, start.direction, method, friction_capacity_N=mu * n_bar, time_limit_s=left)
+        except TimeLimitError:
+            reason = f"the time limit of {time_limit_s:g} s was reached after {k - 1} iterations"
+            return CoulombSolution(sol, k - 1, False, tuple(history), elapsed + time.perf_counter() - t0, reason)
+        if on_iteration is not None and sol.load_multiplier is not None:
+            on_iteration(k, sol.load_multiplier, time.perf_counter() - t0)
         if sol.status != "collapse" or sol.normal_N is None or sol.load_multiplier is None:
             reason = f"iteration {k} found no collapse multiplier (status {sol.status})"
             return CoulombSolution(sol, k, False, tuple(history), elapsed + time.perf_counter() - t0, reason)
@@ -234,7 +251,7 @@ def certified(model: RigidBlockModel, solution: LPSolution) -> LPSolution | None
         A_eq=A_eq,
         b_eq=b_eq,
         bounds=np.column_stack([lower, upper]),
-        method="highs",
+        method=highs_method("highs", n_cols),
     )
     if res.status != 0:
         return None

@@ -101,6 +101,12 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     if result.status == "unstable":
         lines.append("status: unstable: the assembly cannot stand under gravity (and its loads) alone: no")
         lines.append("  equilibrium with no-tension joints exists, so there is no load multiplier")
+        if model.loads:
+            from rockyade.limit.standing import unbalanced_loads_of_model
+
+            found = unbalanced_loads_of_model(model)
+            if found is not None:
+                lines.append(f"  {found.message}")
     elif result.status == "no_mechanism":
         lines.append("status: no_mechanism: no horizontal acceleration makes it collapse (lambda is unbounded)")
         if not result.sliding_allowed:
@@ -121,6 +127,11 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     lines.append(
         f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} m/s^2)"
     )
+    if lam == 0.0:
+        lines.append(
+            "  lambda = 0: any horizontal acceleration, however small, moves it (a joint without friction, "
+            "friction angle 0, slides): it has no lateral capacity to assess"
+        )
     n_moving = int(mech.moving.sum())
     opened = f", {plural(len(mech.separating), 'joint')} opening fully" if mech.separating else ""
     lines.append(

@@ -402,7 +402,12 @@ def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = No
     npts, dt = _parse_at2_sampling(lines[3], path, 4)
     file_units = _resolve_units(path, 3, _at2_units(lines[2]), units)
     if not file_units:
-        raise RecordError(path, 3, f"cannot tell the units from {lines[2].strip()!r}; give units explicitly")
+        raise RecordError(
+            path,
+            3,
+            f"cannot tell the units from {lines[2].strip()!r}: give them with --units g, m/s2 or cm/s2 (a scene: "
+            'units = "g" in its [motion])',
+        )
     _check_dt(path, 4, dt, dt_s, "the header says DT =")
     tokens: list[tuple[str, int]] = []
     values: list[float] = []
@@ -727,9 +732,62 @@ def read_record(
         raise InputError("format", f"must be one of {', '.join(FORMATS)}, got {fmt!r}")
     fmt = fmt or detect_format(path, dt_s)
     if fmt == "at2":
-        return read_at2(path, units, dt_s)
-    if fmt == "csv":
-        return read_two_column(path, units, dt_s)
-    if dt_s is None:
+        record = read_at2(path, units, dt_s)
+    elif fmt == "csv":
+        record = read_two_column(path, units, dt_s)
+    elif dt_s is None:
         raise InputError("dt_s", f"a one-column record needs its sampling interval: {SINGLE_HINT}")
-    return read_single_column(path, dt_s, units)
+    else:
+        record = read_single_column(path, dt_s, units)
+    _warn_implausible(record, given=units)
+    return record
+
+
+#: A PGA outside this range, in g, is not that of a record worth a rocking analysis (the strongest
+#: recorded reach about 4 g; below 1e-3 g a motion is felt by few and rocks nothing): values in g read as
+#: cm/s2 come out 981 times too small (0.5 g as 0.0005 g, below 1e-3 g: a lower bound of 1e-4 g would
+#: miss it), values in cm/s2 read as m/s2 or g 100 or 981 times too large (470 cm/s2 as 48 g).
+PLAUSIBLE_PGA_G = (1.0e-3, 5.0)
+_WARNED: set[str] = set()
+
+
+def units_warning(record: Record, given: str | None = None) -> str | None:
+    """Why ``record``'s units look wrong (its PGA outside :data:`PLAUSIBLE_PGA_G`), or None.
+
+    Parameters
+    ----------
+    record
+        The record read.
+    given
+        The units given to the reader (None: the file's own, or the default m/s2).
+    """
+    pga_g = record.pga_m_s2 / STANDARD_GRAVITY
+    low, high = PLAUSIBLE_PGA_G
+    if low <= pga_g <= high:
+        return None
+    side = f"above {high:g} g, more than any record" if pga_g > high else f"below {low:g} g, less than any record"
+    unit = record.units_in_file
+    if given is None:
+        how = f"read as {unit} (the file's own units, or the default m/s2)"
+    else:
+        how = f"read as {unit} (as given)"
+    peak = float(np.max(np.abs(record.accel_m_s2))) / UNITS[unit]  # the file's largest value as written
+    guesses = [
+        f"{name}: PGA {peak * factor / STANDARD_GRAVITY:.3g} g" for name, factor in UNITS.items() if name != unit
+    ]
+    return (
+        f"{record.source}: PGA = {pga_g:.3g} g {how}, {side}: are the units right? the same values in "
+        f"{'; in '.join(guesses)}. Give the units with --units (a scene: units in its [motion]); a units line "
+        "in the file wins over --units, so fix a wrong one in the file"
+    )
+
+
+def _warn_implausible(record: Record, given: str | None) -> None:
+    """Print :func:`units_warning` once per file and process (stderr: the answer on stdout stays clean)."""
+    import sys
+
+    message = units_warning(record, given)
+    if message is None or record.source in _WARNED:
+        return
+    _WARNED.add(record.source)
+    print(f"rockyade: warning: {message}", file=sys.stderr, flush=True)

@@ -92,10 +92,16 @@ def motion_coverage(scene: Scene) -> dict[str, Any]:
 
 
 def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene], Result]:
-    """``run`` whose Result carries ``meta["motion_coverage"]``."""
+    """``run`` whose Result carries ``meta["motion_coverage"]``, refusing first a scene whose loads
+    cannot be carried at rest (:func:`rockyade.limit.standing.check_loads_stand`: its blocks would
+    leave their supports for good, and no solver's answer would mean anything)."""
 
     @functools.wraps(run)
     def wrapper(self: Any, scene: Scene) -> Result:
+        if getattr(scene, "loads", ()):
+            from rockyade.limit.standing import check_loads_stand
+
+            check_loads_stand(scene)
         result = run(self, scene)
         if "motion_coverage" not in result.meta:
             result.meta["motion_coverage"] = motion_coverage(scene)
@@ -110,7 +116,8 @@ class SolverBase:
 
     Subclasses are frozen dataclasses whose fields are their options, with ``name`` and
     ``OPTIONS`` (option -> :data:`OptionCheck`) as class attributes. The ``run`` a subclass
-    defines is wrapped so that its Results carry ``meta["motion_coverage"]``.
+    defines is wrapped so that its Results carry ``meta["motion_coverage"]`` and so that a scene
+    whose loads cannot be carried at rest is refused before it runs, by every solver alike.
     """
 
     name: ClassVar[str] = ""

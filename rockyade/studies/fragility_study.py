@@ -258,23 +258,20 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame, accel
         for text in legend.get_texts():
             if "no curve" in text.get_text():
                 text.set_color("#b2182b")
-    for ax in axes[-1]:
-        ax.set_xlabel(
-            f"PGA of the scaled suite, load factor x ag S ({ACCEL_UNIT_LABELS[accel_unit]}); the load factor "
-            "multiplies the records' accelerations as read"
-        )
+    for ax in axes[-1]:  # short: the two bottom labels sit side by side (the caption says the rest)
+        ax.set_xlabel(f"PGA of the scaled suite, load factor x ag S ({ACCEL_UNIT_LABELS[accel_unit]})")
     for ax in axes[0]:
         other_accel_axis(ax, accel_unit, "x", "PGA")
     for ax in axes[:, 0]:
         ax.set_ylabel("fraction of records that overturn")
     save_figure(fig, report.out / name)
-    notes = _caption_notes(fits, tested)
+    notes = _caption_notes(fits, tested, accel_unit)
     report.figure(
         name,
         f"Collapse fragility of the specimens: fraction of the {len(RECORDS)} records that overturn the block "
         "at each load factor (points) and the fitted lognormal curves (solid within the tested PGA, dotted beyond "
-        "it, in the grey band; a diamond marks a median beyond the largest tested PGA)."
-        + (" " + "; ".join(notes) + "." if notes else ""),
+        "it, in the grey band; a diamond marks a median beyond the largest tested PGA). The load factor "
+        "multiplies the records' accelerations as read." + (" " + "; ".join(notes) + "." if notes else ""),
     )
     return fig
 
@@ -327,12 +324,14 @@ def _draw_fit(
         )
 
 
-def _caption_notes(fits: pd.DataFrame, tested: float) -> list[str]:
-    """What the caption says of extrapolated medians and missing curves."""
+def _caption_notes(fits: pd.DataFrame, tested: float, accel_unit: str = "g") -> list[str]:
+    """What the caption says of extrapolated medians and missing curves (``tested``, the largest
+    tested PGA, in ``accel_unit``)."""
     notes = []
+    unit = "g" if accel_unit == "g" else "m/s²"  # markdown, not matplotlib's mathtext
     for r in fits.itertuples():
         if r.extrapolated:
-            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: median extrapolated beyond {fmt(tested, 3)} m/s^2")
+            notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: median extrapolated beyond {fmt(tested, 3)} {unit}")
         if not r.status.startswith(("fitted", "no collapse", "all collapse")):
             notes.append(f"{r.specimen}, {SOLVER_LABELS[r.solver]}: no curve ({r.status}{_reason(r)})")
     return notes
