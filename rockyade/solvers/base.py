@@ -15,14 +15,22 @@ Every solver derived from :class:`SolverBase` goes through one place on its way 
 ``run`` is wrapped (:meth:`SolverBase.__init_subclass__`) so that every Result it returns,
 failed ones included, carries ``meta["motion_coverage"]``, how much of the scene's base
 motion the run leaves out (:func:`motion_coverage`).
+
+A solver that runs scenes sharing one structure together (one model, many base motions) is
+also a :class:`GroupSolver`: ``group_key(scene)`` says which scenes go together and
+``run_group(scenes, uplift_rad)`` runs them, one :class:`GroupRun` each (no time history).
+Batches and the overturning study ask ``isinstance(solver, GroupSolver)``.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkable
+
+import numpy as np
 
 from rockyade.errors import InputError, RockyadeError
 
@@ -55,6 +63,59 @@ class Solver(Protocol):
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """This solver with the files it keeps in ``folder``, named ``stem`` (default: the
         scene hash and the solver's name); itself when it keeps none."""
+        ...
+
+
+@dataclass(frozen=True)
+class GroupRun:
+    """One run of :meth:`GroupSolver.run_group`.
+
+    Attributes
+    ----------
+    meta
+        The Result's metadata of the run.
+    theta_rad
+        (n,) sampled rotation from rest, rad.
+    sample_dt_s
+        Time between samples, s.
+    metrics
+        Computed by the solver: ``max_abs_theta_rad`` (rad), ``residual_theta_rad`` (rad),
+        ``uplift_time_s`` (s, NaN: never).
+    """
+
+    meta: dict[str, Any]
+    theta_rad: np.ndarray
+    sample_dt_s: float
+    metrics: dict[str, float]
+
+    @property
+    def status(self) -> str:
+        """completed | overturned | failed."""
+        return str(self.meta["status"])
+
+
+@runtime_checkable
+class GroupSolver(Solver, Protocol):
+    """A solver that also runs scenes sharing one structure together (module docstring)."""
+
+    def group_key(self, scene: Scene) -> str | None:
+        """What the scenes run together have in common (equal keys: one group); None: this
+        scene's run goes alone."""
+        ...
+
+    def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
+        """Run scenes of one :meth:`group_key` together, in their order: each run's metadata (as
+        ``run``'s Result, without the history), its sampled rotation and its metrics.
+
+        Parameters
+        ----------
+        scenes
+            Scenes with one group key (not None).
+        uplift_rad
+            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
+        threads
+            Threads the solver may use for the group.
+        """
         ...
 
 

@@ -65,7 +65,7 @@ from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.runner.groups import group_jobs
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import GroupSolver, Solver
 
 TIMING_COLUMNS = ("wall_time_s", "elapsed_s")
 #: Status of a run that a Ctrl-C stopped or kept from starting (summary only).
@@ -478,10 +478,9 @@ def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
 def job_key(task: BatchTask) -> Any:
     """The group of a task (:func:`rockyade.runner.groups.group_jobs`): runs without history
     whose solver runs scenes of one structure together (``group_key``); None: it runs alone."""
-    key = getattr(task.solver, "group_key", None)
-    if task.save_history or key is None:
+    if task.save_history or not isinstance(task.solver, GroupSolver):
         return None
-    k = key(task.scene)
+    k = task.solver.group_key(task.scene)
     return None if k is None else (task.out_dir, repr(task.solver), k)
 
 
@@ -502,8 +501,10 @@ def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
     first = job[0]
     spec = first.scene.blocks[0]
     alpha = spec.classical().alpha_rad
+    solver = first.solver
+    assert isinstance(solver, GroupSolver)  # job_key groups only these
     try:
-        runs = first.solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+        runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
     except Exception:  # a run of its own says what went wrong
         return [_run_task(task) for task in job]
     elapsed = (time.perf_counter() - start) / len(job)
