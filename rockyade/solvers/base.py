@@ -24,6 +24,7 @@ Batches and the overturning study ask ``isinstance(solver, GroupSolver)``.
 
 from __future__ import annotations
 
+import copy
 import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -129,7 +130,31 @@ def check_flag(value: Any, field: str) -> bool:
 def motion_coverage(scene: Scene) -> dict[str, Any]:
     """How much of ``scene``'s base motion its run covers
     (:func:`rockyade.motion.coverage.record_coverage`: status, time, PGA and Arias intensity
-    left out, a sentence); when it cannot be worked out, ``status`` "unknown" and why."""
+    left out, a sentence); when it cannot be worked out, ``status`` "unknown" and why.
+
+    Worked out once per scene content (``scene.scene_hash``, which covers the motion's files by
+    their bytes and the duration): ``rockyade run`` warns of a cut motion before the run and the
+    solver's Result then carries the same coverage without reading the record again. A copy is
+    returned each time.
+    """
+    try:
+        key = scene.scene_hash
+    except (RockyadeError, OSError, ValueError):  # a motion file that cannot be read: said below
+        return _coverage(scene)
+    if key not in _COVERAGE:
+        if len(_COVERAGE) >= _COVERAGE_KEPT:
+            _COVERAGE.pop(next(iter(_COVERAGE)))
+        _COVERAGE[key] = _coverage(scene)
+    return copy.deepcopy(_COVERAGE[key])
+
+
+#: :func:`motion_coverage` of the last scenes, by scene hash (at most ``_COVERAGE_KEPT``).
+_COVERAGE: dict[str, dict[str, Any]] = {}
+_COVERAGE_KEPT = 16
+
+
+def _coverage(scene: Scene) -> dict[str, Any]:
+    """:func:`motion_coverage`, worked out."""
     from rockyade.motion.coverage import record_coverage
 
     try:

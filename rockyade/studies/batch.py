@@ -495,7 +495,7 @@ def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
 
 
 def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
-    from rockyade.analysis.metrics import peak_metrics, uplift_threshold_rad
+    from rockyade.analysis.metrics import block_overturned, block_summary, uplift_threshold_rad
 
     start = time.perf_counter()
     first = job[0]
@@ -516,18 +516,8 @@ def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
         row = _status_row(task, one.meta)
         if one.status != "failed":
             t = np.arange(one.theta_rad.size) * one.sample_dt_s
-            m = one.metrics
-            overturned = one.meta.get("overturned_block") == spec.name or spec.name in (
-                one.meta.get("overturn_times_s") or {}
-            )
-            row.update(
-                max_abs_theta_rad=m["max_abs_theta_rad"],
-                max_theta_over_alpha=m["max_abs_theta_rad"] / alpha,
-                **peak_metrics(t, one.theta_rad, alpha, free),
-                residual_theta_rad=m["residual_theta_rad"],
-                uplift_time_s=m["uplift_time_s"],
-                overturned=overturned,
-            )
+            overturned = block_overturned(one.meta, spec.name)
+            row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned))
         row["elapsed_s"] = elapsed
         try:
             write_json(folder / f"{row['run']}.json", {**one.meta, "summary": row}, durable=False)
