@@ -168,6 +168,7 @@ def test_the_reference_dem_energy_balance_counts_the_loads_work():
     assert math.isfinite(result.meta["initial_potential_energy_J"])
 
 
+@pytest.mark.yade
 def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem():
     """The same release in YADE (the load a non-colliding clump member, its force summed with
     its current arm): theta = 0 crossings within 0.5 % of the reference DEM's."""
