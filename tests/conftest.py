@@ -71,5 +71,5 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     so that ``make check`` (``-m "not slow and not yade"``) leaves it to ``make test``."""
     for item in items:
         callspec = getattr(item, "callspec", None)
-        if callspec is not None and "yade" in callspec.params.values():
+        if callspec is not None and any(isinstance(v, str) and v == "yade" for v in callspec.params.values()):
             item.add_marker(pytest.mark.yade)
