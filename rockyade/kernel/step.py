@@ -17,6 +17,10 @@ The step (:mod:`.integration` for the scheme):
 * the kick with the optional mass-proportional damping (:func:`damping`, :func:`kicked`);
 * the drift (:func:`drifted`) and the blow-up and overturn tests (:func:`blown_up`,
   :func:`beyond_stop_angle`).
+
+numba's on-disk cache keys a compiled function by its own file: after editing this module (or
+:mod:`.contact_law`), delete ``rockyade/kernel/__pycache__`` so that the loops are compiled
+again with the change.
 """
 
 from __future__ import annotations
