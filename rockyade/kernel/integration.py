@@ -28,7 +28,6 @@ from rockyade.kernel.step import (
     MAX_SPEED_M_S,
     MAX_SPIN_RAD_S,
     beyond_stop_angle,
-    blown_up,
     damping,
     drifted,
     kicked,
@@ -164,7 +163,11 @@ def drift(bodies, kin, samples, step: int, dt: float, stop_on_overturn: bool, st
         pos[a, 1] = drifted(pos[a, 1], vel[a, 1], dt)
         ang[a] = drifted(ang[a], angvel[a], dt)
         finite = math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])
-        if not finite or blown_up(vel[a, 0], vel[a, 1], angvel[a]):
+        # the blow-up test of :func:`.step.blown_up` with the positions' finiteness (then the
+        # velocities are finite, and the two forms decide the same); written with > here, which
+        # keeps this loop's compiled code as it was (measured: the other form costs ~3 %)
+        speed2 = vel[a, 0] * vel[a, 0] + vel[a, 1] * vel[a, 1]
+        if not finite or speed2 > MAX_SPEED_M_S * MAX_SPEED_M_S or abs(angvel[a]) > MAX_SPIN_RAD_S:
             status = STATUS_FAILED
             stop_body = a
         elif beyond_stop_angle(ang[a], rest_ang[a], stop_angle[a]) and math.isnan(overturn_t[a]):
