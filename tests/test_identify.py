@@ -52,6 +52,7 @@ def _trial(seed: int):
     return truth, history
 
 
+@pytest.mark.slow
 def test_recovery_and_coverage_over_seeded_trials():
     """alpha and p within 2 %, mu within 0.3 %; the 95 % intervals cover the truth in >= 17 of 20."""
     covered = {k: 0 for k in CLASSICAL}
