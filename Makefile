@@ -7,7 +7,7 @@ STAMP := $(VENV)/.installed-stamp
 WORKERS ?= 2
 OUT ?= reports/paper
 
-.PHONY: setup system test lint run bench bench-all clean
+.PHONY: setup system test lint check run bench bench-all clean
 
 setup: system $(STAMP)
 
@@ -24,6 +24,10 @@ lint: setup
 	$(BIN)/ruff check .
 	$(BIN)/lint-imports
 	$(BIN)/mypy rockyade
+
+# the inner loop: lint, then every test not marked slow or yade (pyproject's markers), in parallel
+check: setup lint
+	$(BIN)/python -m pytest -n $(WORKERS) -q -m "not slow and not yade"
 
 test: setup lint
 	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15

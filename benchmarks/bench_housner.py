@@ -7,8 +7,8 @@ import time
 
 import numpy as np
 
+from rockyade.housner import HousnerModel, solve
 from rockyade.motion.ground import GroundMotion
-from rockyade.solvers.housner import HousnerModel, solve
 
 
 def best_of(fn, repeat: int = 5) -> float:

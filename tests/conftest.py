@@ -64,3 +64,12 @@ def examples_dir() -> Path:
 def rel(a: float, b: float) -> float:
     """Relative difference |a - b| / |b|."""
     return abs(a - b) / abs(b) if b else math.inf
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    """A test run with the parameter ``"yade"`` (a solver) runs the real YADE: marked ``yade``,
+    so that ``make check`` (``-m "not slow and not yade"``) leaves it to ``make test``."""
+    for item in items:
+        callspec = getattr(item, "callspec", None)
+        if callspec is not None and any(isinstance(v, str) and v == "yade" for v in callspec.params.values()):
+            item.add_marker(pytest.mark.yade)

@@ -220,6 +220,7 @@ def running_bond_wall(courses, units, w=0.4, h=0.2):
     return blocks
 
 
+@pytest.mark.slow
 def test_thousand_block_wall_stands_under_gravity():
     """A dry running-bond wall of 1,010 bricks (20 courses of 50 and 51) released under gravity:
     no brick moves by more than 0.2 mm or turns by more than 1e-3 rad, none counts as

@@ -392,6 +392,7 @@ def test_a_fragility_analysis_runs_through_the_runner_and_writes_one_row_per_run
     assert "as read" in data["load_factor"]
 
 
+@pytest.mark.slow
 def test_the_verify_checks_of_limit_analysis_the_code_and_the_fit_pass(tmp_path):
     from rockyade.studies.verify import verify
 
@@ -412,6 +413,7 @@ def test_finite_or_null_makes_json_strict():
     assert finite_or_null(data) == {"beta": None, "band": [1.0, None], "rows": [{"fraction": None, "n": 3}], "s": "x"}
 
 
+@pytest.mark.slow
 def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path, capsys):
     """``rockyade assess --pushover`` on examples/free_standing_wall.toml (alpha0 = b / h = 0.1):
     the reference DEM's onset (held levels every 1 % of alpha0) is within 2 % of alpha0, the

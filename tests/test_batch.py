@@ -75,6 +75,7 @@ def test_batch_runs_isolates_failures_and_resumes(tmp_path):
     )
 
 
+@pytest.mark.slow
 def test_dask_executor_equals_local(tmp_path):
     distributed = pytest.importorskip("distributed")
     tasks_local = _tasks(tmp_path / "local")

@@ -168,6 +168,7 @@ def test_calibrate_matched_json(capsys):
     assert code == 1 and "cannot" in err.lower()
 
 
+@pytest.mark.slow
 def test_motion_commands(capsys, tmp_path, monkeypatch):
     monkeypatch.setenv("ROCKYADE_CACHE", str(tmp_path / "cache"))
     rec = tmp_path / "quake.AT2"

@@ -172,6 +172,7 @@ def _falling_column(duration_s: float) -> dict:
     return data
 
 
+@pytest.mark.slow
 def test_a_run_that_ends_while_blocks_fall_says_falling_and_its_status_follows_the_table(tmp_path, capsys):
     """Issue "What users hit" 3: a run that ended while the drums were in the air marked them
     fallen at the last sample while its status said completed ("8 fell", completed); a run
@@ -273,6 +274,7 @@ def _agreement(scenes) -> tuple[int, int, list[float]]:
     return agree, total, dt
 
 
+@pytest.mark.slow
 def test_dem_overturns_with_housner_on_a_record_suite():
     """Rocking under records is chaotic run by run (the paper: 'very sensitive'), so the
     criterion is checked over a suite: measured 17 of 20 outcomes equal, and no DEM run ends

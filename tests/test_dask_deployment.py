@@ -111,6 +111,7 @@ def _batch(folder: Path, out: str, *extra: str) -> subprocess.Popen[str]:
     )
 
 
+@pytest.mark.slow
 def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(
     tmp_path, cluster
 ):
@@ -133,6 +134,7 @@ def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_list
     assert not (cluster.folder / "remote").exists()  # the run files are the client's, not in the workers' folder
 
 
+@pytest.mark.slow
 def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster):
     runs = 8
     _study(tmp_path, duration_s=400.0, runs=runs)  # runs of a few seconds each

@@ -188,6 +188,7 @@ def test_documented_command_runs_as_printed(command, tmp_path):
     assert proc.returncode == 0, f"{COMMANDS[command]}: {command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("page", "code", "setup"), _python_blocks(), ids=[p for p, _, _ in _python_blocks()])
 def test_documented_python_runs_as_printed(page, code, setup, tmp_path):
     (_fresh_checkout(tmp_path) / "runs").mkdir()

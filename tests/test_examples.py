@@ -62,6 +62,7 @@ def test_a_scene_reads_its_record_relative_to_the_scene_file(tmp_path):
     assert json.loads((tmp_path / "r/x.json").read_text())["status"] == "completed"
 
 
+@pytest.mark.slow
 def test_the_record_generator_runs(tmp_path):
     proc = subprocess.run(
         [sys.executable, str(RECORDS / "make_example_records.py"), "out"], cwd=tmp_path, capture_output=True, text=True

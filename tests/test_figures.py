@@ -130,6 +130,7 @@ def _kept(fig_ax_anim):
     return fig_ax_anim[:2]
 
 
+@pytest.mark.slow
 def test_every_plot_function_returns_fig_and_ax_and_draws_into_given_axes(tmp_path, housner_result):
     """draw_assembly, draw_snapshots and animate wrote files only and returned a count or paths;
     every plot function of rockyade.figures now returns its figure and Axes, takes ``ax=``,

@@ -84,6 +84,7 @@ def test_fragility_of_a_block_under_records_writes_every_output(capsys, tmp_path
     assert data["levels_source"] == "given" and len(data["stripes"]) == 4
 
 
+@pytest.mark.slow
 def test_fragility_with_an_ec8_suite_in_sa(capsys, tmp_path, wall):
     out = tmp_path / "frag"
     code, text, _ = run_cli(
@@ -169,6 +170,7 @@ def test_assess_static_only_gives_the_documented_json(capsys, wall):
     assert "C8.7.1" in linear["source"] and "Eq 3.7" in nonlinear["source"]
 
 
+@pytest.mark.slow
 def test_assess_text_and_files_with_the_dynamics(capsys, tmp_path, wall, records):
     out = tmp_path / "assess"
     code, text, _ = run_cli(

@@ -107,6 +107,7 @@ class _RefusedError(Exception):
         COUNTS["cli exit codes"][f"exit {code}"] += 1
 
 
+@pytest.mark.slow
 @fuzz_settings(60)
 @given(command_lines())
 def test_fuzz_command_lines(argv):

@@ -10,9 +10,10 @@ import pytest
 
 from rockyade.blocks.restitution import effective_restitution, find_peaks, restitution_per_impact
 from rockyade.constants import G
+from rockyade.housner import HousnerModel, solve
 from rockyade.motion.ground import GroundMotion
 from rockyade.scene import scene_from_dict
-from rockyade.solvers.housner import HousnerModel, HousnerSolver, solve
+from rockyade.solvers.housner import HousnerSolver
 
 from .conftest import free_scene_dict
 

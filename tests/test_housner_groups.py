@@ -101,3 +101,16 @@ def test_housner_runs_with_histories_or_of_stacks_go_alone(tmp_path):
     assert HousnerSolver().group_key(one) != HousnerSolver().group_key(other)  # another model
     released = scene_from_dict({**one.to_dict(), "motion": {"type": "free", "theta0_rad": 0.1}})
     assert HousnerSolver().group_key(one) != HousnerSolver().group_key(released)  # free rocking's metrics differ
+
+
+def test_group_solvers_are_declared():
+    """The grouped runs are a declared protocol (GroupSolver), not attributes found by name:
+    Housner and the reference DEM run groups, YADE does not."""
+    from rockyade.solvers.base import GroupSolver, Solver
+    from rockyade.solvers.reference import ReferenceSolver
+    from rockyade.solvers.yade import YadeSolver
+
+    assert isinstance(HousnerSolver(), GroupSolver)
+    assert isinstance(ReferenceSolver(record_energy=False), GroupSolver)
+    assert isinstance(YadeSolver(), Solver)
+    assert not isinstance(YadeSolver(), GroupSolver)

@@ -13,6 +13,7 @@ import pytest
 from rockyade import paper
 from rockyade.cli import main
 from rockyade.errors import InputError
+from rockyade.housner import HousnerModel, solve
 from rockyade.identification.fit import (
     CLASSICAL,
     FreeRockingFit,
@@ -23,7 +24,6 @@ from rockyade.identification.fit import (
 )
 from rockyade.identification.identified import calibrate_from_identified, load_identified
 from rockyade.identification.measurement import measured_history, read_measurement, rotation_from_leds
-from rockyade.solvers.housner import HousnerModel, solve
 from tests.conftest import EXAMPLES
 
 MEASURED = EXAMPLES / "measured" / "specimen1_free_rocking.csv"
@@ -52,6 +52,7 @@ def _trial(seed: int):
     return truth, history
 
 
+@pytest.mark.slow
 def test_recovery_and_coverage_over_seeded_trials():
     """alpha and p within 2 %, mu within 0.3 %; the 95 % intervals cover the truth in >= 17 of 20."""
     covered = {k: 0 for k in CLASSICAL}

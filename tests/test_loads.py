@@ -11,10 +11,10 @@ import pytest
 
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.housner import housner_model
 from rockyade.limit import limit_analysis
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import run
-from rockyade.solvers.housner import housner_model
 
 from .processes import require_yade
 
@@ -231,6 +231,7 @@ def test_the_reference_dem_energy_balance_counts_the_loads_work():
     assert math.isfinite(result.meta["initial_potential_energy_J"])
 
 
+@pytest.mark.yade
 @pytest.mark.parametrize("mass", [0.0, 1500.0 / G])
 def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem(mass):
     """The same release in YADE (the load a non-colliding clump member, its force summed with
@@ -290,7 +291,7 @@ def test_housner_energy_counts_the_loads_potential_and_is_conserved_between_impa
     import dataclasses
     import itertools
 
-    from rockyade.solvers.housner import solve
+    from rockyade.housner import solve
 
     loads = [{"block": "pier", "point_m": [0.1, HEIGHT], "force_N": [300.0, -1500.0]}]
     model = housner_model(block_scene(loads, {"type": "free", "theta0_rad": 0.06}, duration=3.0))

@@ -91,6 +91,29 @@ def test_rockyade_run_warns_on_stderr_when_the_scene_ends_before_its_record(tmp_
     assert "warning" not in capsys.readouterr().err
 
 
+
+def test_rockyade_run_works_out_the_coverage_once_and_its_result_carries_it(tmp_path, monkeypatch):
+    """The warning before the run and the Result's meta["motion_coverage"] are one computation
+    (the record is read and integrated once per run), and the Result's is the warned one."""
+    import rockyade.motion.coverage as coverage
+
+    calls = []
+
+    def counted(motion, duration_s):
+        calls.append(duration_s)
+        return record_coverage(motion, duration_s)
+
+    monkeypatch.setattr(coverage, "record_coverage", counted)
+    scene = tmp_path / "s.json"
+    scene.write_text(json.dumps(_record_scene(2.5)))
+    out = tmp_path / "r.csv"
+    assert main(["run", str(scene), "--solver", "housner", "--out", str(out)]) == 0
+    assert calls == [2.5]
+    meta = json.loads(out.with_suffix(".json").read_text())
+    assert meta["motion_coverage"]["status"] == "cut"
+    assert meta["motion_coverage"]["message"].startswith("the scene ends at 2.5 s")
+
+
 # ---------------------------------------------------------------------- generators' duration
 
 

@@ -305,6 +305,7 @@ def test_an_arch_just_above_its_static_limit_stands_under_gravity_ramp_and_falls
         (0.106, {"type": "gravity-ramp", "ramp_s": 1.0}, False),
     ],
 )
+@pytest.mark.yade
 def test_the_same_arches_in_yade(t_over_r, motion, stands):
     """As above in YADE (a falling arch ends overturned: docs/yade.md)."""
     require_yade()

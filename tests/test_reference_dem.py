@@ -138,6 +138,7 @@ def test_sliding_with_the_coulomb_force():
     assert result.frame["energy_friction_J"].iloc[-1] > 0
 
 
+@pytest.mark.slow
 def test_biblock_upper_block_matches_housner():
     """Free rocking of the upper block of the bi-block (Tables 2, 4, 6).
 

@@ -51,6 +51,7 @@ def test_scene_and_motion_import_no_scipy_or_pandas(module: str) -> None:
     assert heavy == [], f"import {module} imports {heavy[:8]}"
 
 
+@pytest.mark.slow
 def test_the_dem_model_imports_scipy_spatial_only_for_an_alpha_override() -> None:
     # scipy.spatial (0.2-1 s) serves only a block whose base is replaced by its alpha (ConvexHull)
     heavy = _imported_after("import rockyade.calibration.model\nimport rockyade.solvers.reference\n")

@@ -36,6 +36,7 @@ def _legend_texts(fig) -> list[str]:
 # ------------------------------------------------------------------ failed runs
 
 
+@pytest.mark.slow
 def test_paper_exits_nonzero_and_lists_every_failed_run(tmp_path):
     """YADE made unreachable (its module path points nowhere): every YADE run of the
     free-rocking part fails for real; the study says so everywhere and exits 1. 23 DEM cases:
@@ -199,6 +200,7 @@ def _summary(specimen: str, solver: str, collapses: dict[float, int], n_records:
     return rows
 
 
+@pytest.mark.slow
 def test_fragility_flags_extrapolated_medians_and_explains_a_missing_curve(tmp_path):
     summary = pd.DataFrame(
         _summary("specimen1", "reference", {1.3: 1, 1.4: 2, 1.5: 3})  # median far above 1.5 x 2.8 m/s^2
@@ -286,6 +288,7 @@ def test_overturning_marks_frequencies_where_a_solver_never_overturned(tmp_path)
     assert not any(label.startswith("reference DEM: no overturn") for label in lines)
 
 
+@pytest.mark.slow
 def test_overturning_scan_shows_progress(tmp_path, monkeypatch, capfd):
     monkeypatch.setattr(overturning, "FREQUENCY_RATIOS", (6.0,))
     monkeypatch.setattr(overturning, "MAX_RATIO", 2.0)

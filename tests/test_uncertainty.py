@@ -40,6 +40,7 @@ def _study(**changes) -> dict:
     return data
 
 
+@pytest.mark.slow
 def test_small_study_probabilities_match_independent_runs(tmp_path):
     from rockyade.scene import scene_from_dict
     from rockyade.solvers.housner import HousnerSolver
@@ -175,6 +176,7 @@ def test_bad_studies_name_the_field(change, field):
     assert err.value.field == field
 
 
+@pytest.mark.slow
 def test_cli_uncertainty_on_the_example(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     rel = os.path.relpath(EXAMPLES / "studies" / "uncertainty_specimen1.toml", tmp_path)
@@ -217,6 +219,7 @@ def test_recorded_files_and_block_dimensions(tmp_path):
         uncertainty_study_from_dict(dict(data, motion={"files": ["none.csv"], "load_factors": [1.0]}), None, tmp_path)
 
 
+@pytest.mark.slow
 def test_grouped_runs_give_the_same_verdicts_peaks_and_probabilities(tmp_path):
     """Each sample's runs (one block, every record and load factor) as groups, Housner and the
     reference DEM: the same summary (verdicts, peaks, metrics) and tables as one run per job."""

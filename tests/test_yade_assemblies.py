@@ -33,6 +33,9 @@ from rockyade.yade.payload import scene_payload, sphere_radii
 
 from .processes import require_yade
 
+# the module's autouse fixture runs require_yade for every test here
+pytestmark = pytest.mark.yade
+
 G = 9.81
 STIFF = {"K_N_per_m": 1e9, "beta_s": 1e-4, "friction_angle_deg": 35.0}
 

@@ -20,6 +20,8 @@ from .conftest import EXAMPLES
 from .limit_scenes import arch_scene
 from .processes import require_yade
 
+pytestmark = pytest.mark.yade
+
 
 def test_a_collapsing_arch_ends_overturned_in_yade_as_in_the_reference_dem():
     """A 20-voussoir arch of t/R 0.10 (below its static limit 0.1073), dropped: YADE's run stops

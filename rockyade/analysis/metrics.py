@@ -4,7 +4,8 @@ assembly (collapse), and of a stack as one body (:func:`structure_rotation`)."""
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from collections.abc import Mapping
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -57,18 +58,61 @@ def run_metrics(
             continue
         alpha = spec.classical().alpha_rad
         theta = result.series("theta_rad", spec.name)
-        overturned = (
-            fell[spec.name]
-            if spec.name in fell
-            else result.meta.get("overturned_block") == spec.name
-            or spec.name in (result.meta.get("overturn_times_s") or {})
-        )
-        out[spec.name] = {**theta_metrics(t, theta, alpha), **peak_metrics(t, theta, alpha, free, n_impacts),
-                          "overturned": overturned}
-    # the keys in the order of earlier versions
-    order = ("max_abs_theta_rad", "max_theta_over_alpha", "n_peaks", "first_peak_rad", "first_peak_time_s", "mu_eff",
-             "residual_theta_rad", "uplift_time_s", "overturned")
-    return {name: {k: values[k] for k in order} for name, values in out.items()}
+        overturned = fell[spec.name] if spec.name in fell else block_overturned(result.meta, spec.name)
+        out[spec.name] = block_summary(theta_metrics(t, theta, alpha), t, theta, alpha, free, overturned, n_impacts)
+    return out
+
+
+#: The keys of a block's summary (:func:`block_summary`), in the order of earlier versions.
+SUMMARY_KEYS = ("max_abs_theta_rad", "max_theta_over_alpha", "n_peaks", "first_peak_rad", "first_peak_time_s",
+                "mu_eff", "residual_theta_rad", "uplift_time_s", "overturned")
+
+
+def block_summary(
+    theta_values: Mapping[str, float],
+    t: np.ndarray,
+    theta: np.ndarray,
+    alpha_rad: float,
+    free: bool,
+    overturned: bool,
+    n_impacts: int = MU_EFF_IMPACTS,
+) -> dict[str, float]:
+    """One block's summary row (:data:`SUMMARY_KEYS`): of a Result (:func:`run_metrics`) and of
+    a grouped run (:class:`rockyade.solvers.base.GroupRun`, whose solver computed the rotation's
+    metrics).
+
+    Parameters
+    ----------
+    theta_values
+        ``max_abs_theta_rad``, ``residual_theta_rad`` (rad) and ``uplift_time_s`` (s) of the
+        rotation (:func:`theta_metrics`, or the solver's).
+    t, theta
+        The sampled rotation: s and rad.
+    alpha_rad
+        The block's slenderness, rad.
+    free
+        Free rocking (``mu_eff`` is computed for it only).
+    overturned
+        Whether the block overturned (:func:`block_overturned`, or the collapse table's rule in
+        an assembly).
+    n_impacts
+        Impacts used for the effective restitution.
+    """
+    peak = theta_values["max_abs_theta_rad"]
+    values = {
+        **theta_values,
+        "max_theta_over_alpha": peak / alpha_rad,
+        **peak_metrics(t, theta, alpha_rad, free, n_impacts),
+        "overturned": overturned,
+    }
+    return {k: values[k] for k in SUMMARY_KEYS}
+
+
+def block_overturned(meta: Mapping[str, Any], block: str) -> bool:
+    """Whether ``block`` overturned in a run with metadata ``meta`` (the solvers'
+    ``overturned_block``, the first to fall, and ``overturn_times_s``, every block that fell;
+    :mod:`rockyade.dem.overturn`)."""
+    return meta.get("overturned_block") == block or block in (meta.get("overturn_times_s") or {})
 
 
 def uplift_threshold_rad(alpha_rad: float) -> float:

@@ -51,6 +51,7 @@ from rockyade.runner.journal import Journal
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import Solver
+from rockyade.solvers.cost import duration_text
 
 #: Default levels as multiples of the static collapse acceleration (module docstring).
 DEFAULT_FACTORS = tuple(float(2.0 ** (k / 2.0)) for k in range(7))
@@ -116,16 +117,8 @@ class FragilityPlan:
         total = estimate.wall_time_s * self.runs_planned / max(workers, 1)
         return (
             f"cost: {self.runs_planned} runs of {plan.solver.name}, each at most {estimate.describe()}; "
-            f"about {_duration(total)} on {workers} worker(s)"
+            f"about {duration_text(total)} on {workers} worker(s)"
         )
-
-
-def _duration(seconds: float) -> str:
-    if seconds < 120:
-        return f"{seconds:.2g} s"
-    if seconds < 7200:
-        return f"{seconds / 60:.2g} min"
-    return f"{seconds / 3600:.3g} h"
 
 
 def static_acceleration(scene: Scene) -> tuple[float, str]:

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, json_out, print_wrote
-from rockyade.cli.fragility import (
+from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     add_run_options,
     count_and_seed,

@@ -5,9 +5,12 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.errors import InputError
+
+if TYPE_CHECKING:
+    from rockyade.solvers.base import Solver
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
@@ -164,3 +167,38 @@ def print_calibration(result: dict[str, Any], method: str) -> None:
     print(f"  static settlement M g / K = {result['settlement_m']:.3g} m")
     for note in result["notes"]:
         print(f"  note: {note}")
+
+
+def add_yade_timeout(p: Any) -> None:
+    """The ``--yade-timeout`` option (run, compare, batch): YADE's ``timeout_s``."""
+    p.add_argument(
+        "--yade-timeout",
+        type=float,
+        metavar="SECONDS",
+        help="wall-clock limit of each YADE run (default: 60 s plus 50 us per block-step, at most one hour); "
+        "the run is stopped and reported failed when it is reached",
+    )
+
+
+#: Command-line options that set a solver's option: attribute of the arguments -> (option, flag).
+SOLVER_OPTION_FLAGS = {"yade_timeout": ("timeout_s", "--yade-timeout")}
+
+
+def solver_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, str]]:
+    """The solver options given on the command line, and the flags that name them in errors."""
+    options, flags = {}, {}
+    for attr, (option, flag) in SOLVER_OPTION_FLAGS.items():
+        value = getattr(args, attr, None)
+        if value is not None:
+            options[option] = value
+            flags[option] = flag
+    return options, flags
+
+
+def solvers_from_args(names: list[str], args: argparse.Namespace) -> list[Solver]:
+    """The solvers ``names`` with the command line's solver options, each to the solvers that
+    take it (an option none of them takes is refused: ``--yade-timeout`` without yade)."""
+    from rockyade.solvers import make_solvers
+
+    options, flags = solver_options(args)
+    return make_solvers(names, options, flags)

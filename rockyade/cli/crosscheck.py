@@ -23,8 +23,8 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     """Plan (cost line), run the rounds, write the set and swap it in; exit 1 when a run failed."""
     from rockyade.assess import parse_measure, records_in_folder
     from rockyade.assess.motions import MotionSet
-    from rockyade.cli.fragility import float_list, refuse_suite_options_with_records, suite_from
-    from rockyade.cli.run import solver_options
+    from rockyade.cli.common import solver_options
+    from rockyade.cli.fragility_options import float_list, refuse_suite_options_with_records, suite_from
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
     from rockyade.studies.crosscheck import (
@@ -100,7 +100,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade crosscheck``."""
-    from rockyade.cli.run import add_yade_timeout
+    from rockyade.cli.common import add_yade_timeout
 
     p = sub.add_parser(
         "crosscheck",

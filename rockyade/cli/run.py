@@ -7,15 +7,22 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.build import add_snapshot_options, check_run_drawings, write_run_drawings
-from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_file, json_out, total_time
+from rockyade.cli.common import (
+    SOLVER_NAMES,
+    add_allow_large,
+    add_yade_timeout,
+    check_output_file,
+    json_out,
+    solvers_from_args,
+    total_time,
+)
+from rockyade.cli.drawings import add_snapshot_options, check_run_drawings, write_run_drawings
 
 if TYPE_CHECKING:
     import pandas as pd
 
     from rockyade.result import Result
     from rockyade.scene import Scene
-    from rockyade.solvers.base import Solver
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -89,9 +96,9 @@ def _warn_if_the_motion_is_cut(scene: Scene) -> None:
     """One warning line on stderr when the scene ends before its base motion does."""
     import sys
 
-    from rockyade.motion.coverage import record_coverage
+    from rockyade.solvers.base import motion_coverage
 
-    coverage = record_coverage(scene.motion, scene.duration_s)
+    coverage = motion_coverage(scene)  # the run's Result then carries it without working it out again
     if coverage["status"] == "cut":
         where = f"{scene.source}: " if scene.source else ""
         print(f"rockyade: warning: {where}{coverage['message']}", file=sys.stderr)
@@ -210,41 +217,6 @@ def cmd_tables(args: argparse.Namespace) -> int:
         print(format_report(report))
     return 0
 
-
-
-def add_yade_timeout(p: Any) -> None:
-    """The ``--yade-timeout`` option (run, compare, batch): YADE's ``timeout_s``."""
-    p.add_argument(
-        "--yade-timeout",
-        type=float,
-        metavar="SECONDS",
-        help="wall-clock limit of each YADE run (default: 60 s plus 50 us per block-step, at most one hour); "
-        "the run is stopped and reported failed when it is reached",
-    )
-
-
-#: Command-line options that set a solver's option: attribute of the arguments -> (option, flag).
-SOLVER_OPTION_FLAGS = {"yade_timeout": ("timeout_s", "--yade-timeout")}
-
-
-def solver_options(args: argparse.Namespace) -> tuple[dict[str, Any], dict[str, str]]:
-    """The solver options given on the command line, and the flags that name them in errors."""
-    options, flags = {}, {}
-    for attr, (option, flag) in SOLVER_OPTION_FLAGS.items():
-        value = getattr(args, attr, None)
-        if value is not None:
-            options[option] = value
-            flags[option] = flag
-    return options, flags
-
-
-def solvers_from_args(names: list[str], args: argparse.Namespace) -> list[Solver]:
-    """The solvers ``names`` with the command line's solver options, each to the solvers that
-    take it (an option none of them takes is refused: ``--yade-timeout`` without yade)."""
-    from rockyade.solvers import make_solvers
-
-    options, flags = solver_options(args)
-    return make_solvers(names, options, flags)
 
 
 def register(sub: Any) -> None:

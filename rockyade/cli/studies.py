@@ -6,8 +6,15 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import SOLVER_NAMES, add_allow_large, check_output_dir, total_time
-from rockyade.cli.run import add_yade_timeout, solver_options, solvers_from_args
+from rockyade.cli.common import (
+    SOLVER_NAMES,
+    add_allow_large,
+    add_yade_timeout,
+    check_output_dir,
+    solver_options,
+    solvers_from_args,
+    total_time,
+)
 from rockyade.errors import InputError
 
 

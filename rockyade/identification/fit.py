@@ -2,7 +2,7 @@
 
 The paper's experimental parameters (Tables 3-4, E columns) were "adjusted by means of a
 minimized error surface" on free-rocking tests. rockyade does the same with Housner's exact
-solution (:mod:`rockyade.solvers.housner`): the measured rotation is modelled as
+solution (:mod:`rockyade.housner`): the measured rotation is modelled as
 
     theta_m(t) = s theta_H(t - t_r; alpha, p, mu, r alpha) + o        (t >= t_r)
     theta_m(t) = s r alpha + o                                        (t <  t_r, the hold)

@@ -6,7 +6,7 @@ release time, on the measurement grid, with the hold before the release and a se
 
 theta_H is the free rocking of a symmetric block released at rest from theta_0 = r alpha
 (paper Eq 1, base at rest, omega multiplied by mu at each impact), computed by
-:func:`rockyade.solvers.housner.solve`; s is the side the block was tilted to, t_r the release
+:func:`rockyade.housner.solve`; s is the side the block was tilted to, t_r the release
 time and o the sensor offset. The solver is advanced from the release to the first sample
 after it, then sampled on the measurement grid, so the model is exact at the measurement
 times whatever the release time.
@@ -21,8 +21,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.errors import RockyadeError
+from rockyade.housner import HousnerModel, Trajectory, solve
 from rockyade.identification.measurement import MeasuredHistory, measured_history
-from rockyade.solvers.housner import HousnerModel, Trajectory, solve
 
 #: The fitted unknowns, in the order of the parameter vector.
 FIT_PARAMETERS = ("alpha_rad", "p_rad_s", "mu", "release_time_s", "offset_rad", "release_ratio")

@@ -22,9 +22,9 @@ from numpy.typing import NDArray
 from scipy import optimize
 
 from rockyade.blocks.restitution import effective_restitution
+from rockyade.housner import HousnerModel, solve
 from rockyade.identification.measurement import MeasuredHistory
 from rockyade.identification.model import FreeRockingFit, IdentificationError
-from rockyade.solvers.housner import HousnerModel, solve
 
 
 @functools.lru_cache(maxsize=4096)

@@ -18,9 +18,10 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.kernel.contact_law import add_released_energy, add_stored_energy, contact_law
+from rockyade.kernel.contact_law import add_released_energy, add_stored_energy
 from rockyade.kernel.energy import push_dashpot
 from rockyade.kernel.recording import count_point
+from rockyade.kernel.step import base_point
 
 
 class BaseState(NamedTuple):
@@ -86,19 +87,13 @@ def body_on_base(a: int, bodies, joints, settings, kin, world, base, tally, dash
                 shear[a, v] = 0.0
             continue
         touching = True
-        rax = px - pos[a, 0]
-        ray = py - pos[a, 1]
-        vrx = vel[a, 0] - angvel[a] * ray
-        vry = vel[a, 1] + angvel[a] * rax
-        fn, fn_spring, s_new, visc, state, slip_work = contact_law(
-            delta, -vry, -vrx, shear[a, v], kn, ks, cn, cs, tanphi, dt
+        fx, fy, tz, fn, fn_spring, s_new, visc, state, slip_work = base_point(
+            px, py, pos[a, 0], pos[a, 1], vel[a, 0], vel[a, 1], angvel[a], shear[a, v], kn, ks, cn, cs, tanphi, dt
         )
         shear[a, v] = s_new
-        fx = s_new + visc
-        fy = fn
         force[a, 0] += fx
         force[a, 1] += fy
-        torque[a] += rax * fy - ray * fx
+        torque[a] += tz
         if sampling:
             count_point(tally, a, state)
             if record_corners and state > vstate[a, v]:

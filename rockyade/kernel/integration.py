@@ -24,12 +24,18 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-STATUS_COMPLETED, STATUS_OVERTURNED, STATUS_FAILED = 0, 1, 2
+from rockyade.kernel.step import (
+    MAX_SPEED_M_S,
+    MAX_SPIN_RAD_S,
+    beyond_stop_angle,
+    damping,
+    drifted,
+    kicked,
+)
 
-#: Beyond these the state is a numerical blow-up, not rocking (a block overturning under
-#: gravity turns at a few rad/s): the run fails instead of being called overturned.
-MAX_SPEED_M_S = 100.0
-MAX_SPIN_RAD_S = 1000.0
+__all__ = ["MAX_SPEED_M_S", "MAX_SPIN_RAD_S", "STATUS_COMPLETED", "STATUS_FAILED", "STATUS_OVERTURNED"]
+
+STATUS_COMPLETED, STATUS_OVERTURNED, STATUS_FAILED = 0, 1, 2
 
 
 class Motion(NamedTuple):
@@ -110,15 +116,13 @@ def kick(bodies, kin, dt: float, mass_damping: float, record_energy: bool, e_das
         fdy = 0.0
         tdz = 0.0
         if mass_damping > 0.0:
-            fdx = -mass_damping * mass[a] * vel[a, 0]
-            fdy = -mass_damping * mass[a] * vel[a, 1]
-            tdz = -mass_damping * inertia[a] * angvel[a]
+            fdx, fdy, tdz = damping(mass[a], inertia[a], mass_damping, vel[a, 0], vel[a, 1], angvel[a])
             force[a, 0] += fdx
             force[a, 1] += fdy
             torque[a] += tdz
-        vel[a, 0] += dt * force[a, 0] / mass[a]
-        vel[a, 1] += dt * force[a, 1] / mass[a]
-        angvel[a] += dt * torque[a] / inertia[a]
+        vel[a, 0] = kicked(vel[a, 0], force[a, 0], mass[a], dt)
+        vel[a, 1] = kicked(vel[a, 1], force[a, 1], mass[a], dt)
+        angvel[a] = kicked(angvel[a], torque[a], inertia[a], dt)
         if record_energy and mass_damping > 0.0:
             e_dash -= dt * (
                 fdx * 0.5 * (vel[a, 0] + vel_prev[a, 0])
@@ -155,15 +159,18 @@ def drift(bodies, kin, samples, step: int, dt: float, stop_on_overturn: bool, st
     for a in range(moving.size):
         if not moving[a]:
             continue
-        pos[a, 0] += dt * vel[a, 0]
-        pos[a, 1] += dt * vel[a, 1]
-        ang[a] += dt * angvel[a]
+        pos[a, 0] = drifted(pos[a, 0], vel[a, 0], dt)
+        pos[a, 1] = drifted(pos[a, 1], vel[a, 1], dt)
+        ang[a] = drifted(ang[a], angvel[a], dt)
         finite = math.isfinite(pos[a, 0]) and math.isfinite(pos[a, 1]) and math.isfinite(ang[a])
+        # the blow-up test of :func:`.step.blown_up` with the positions' finiteness (then the
+        # velocities are finite, and the two forms decide the same); written with > here, which
+        # keeps this loop's compiled code as it was (measured: the other form costs ~3 %)
         speed2 = vel[a, 0] * vel[a, 0] + vel[a, 1] * vel[a, 1]
         if not finite or speed2 > MAX_SPEED_M_S * MAX_SPEED_M_S or abs(angvel[a]) > MAX_SPIN_RAD_S:
             status = STATUS_FAILED
             stop_body = a
-        elif abs(ang[a] - rest_ang[a]) >= stop_angle[a] and math.isnan(overturn_t[a]):
+        elif beyond_stop_angle(ang[a], rest_ang[a], stop_angle[a]) and math.isnan(overturn_t[a]):
             overturn_t[a] = (step + 1) * dt
             if stop_on_overturn and status == STATUS_COMPLETED:
                 status = STATUS_OVERTURNED

@@ -20,6 +20,8 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.kernel.step import world_x, world_y
+
 
 class World(NamedTuple):
     """The bodies placed in the base frame (filled by :func:`place_body`)."""
@@ -64,8 +66,8 @@ def place_body(a: int, kin, bodies, world) -> None:
     for v in range(bodies.nverts[a]):
         x = verts[a, v, 0]
         y = verts[a, v, 1]
-        px = pos[a, 0] + c * x - s * y
-        py = pos[a, 1] + s * x + c * y
+        px = world_x(pos[a, 0], c, s, x, y)
+        py = world_y(pos[a, 1], c, s, x, y)
         wv[a, v, 0] = px
         wv[a, v, 1] = py
         nx = normals[a, v, 0]

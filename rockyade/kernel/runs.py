@@ -5,7 +5,7 @@ block, joint, time step and length) and differ in their base motion.
 parallel over numba's threads (``prange``), each chunk advanced step by step with the inner
 loop over its runs (:func:`step_runs`: the runs' state held by field), and a run that ends
 drops out of its chunk. Each run's arithmetic is that of
-the single-body loop (:func:`rockyade.kernel.single.run_body`), operation for operation, so
+the single-body loop (:func:`rockyade.kernel.single.run_body`), both from :mod:`.step`, so
 the results are the same bits as one run at a time (:func:`simulate_runs_each`, which runs
 each by ``run_body``; ``tests/test_runs_batched.py``). The summary's metrics are computed
 in the kernel from each run's samples:
@@ -28,15 +28,20 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.kernel.contact_law import contact_law
-from rockyade.kernel.integration import (
-    MAX_SPEED_M_S,
-    MAX_SPIN_RAD_S,
-    STATUS_COMPLETED,
-    STATUS_FAILED,
-    STATUS_OVERTURNED,
-)
+from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
 from rockyade.kernel.single import run_body
+from rockyade.kernel.step import (
+    base_point,
+    beyond_stop_angle,
+    blown_up,
+    damping,
+    drifted,
+    fraction,
+    kicked,
+    lerp,
+    world_x,
+    world_y,
+)
 
 
 class RunsOutput(NamedTuple):
@@ -142,7 +147,7 @@ def _segment(seg, i: int, h: int, mt, mah, mav) -> None:
 @numba.njit(cache=True, nogil=True)
 def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn: float, ks: float, cn: float,
               cs: float, tanphi: float, rest_ang: float, stop_angle: float, g: float, dt: float, n_steps: int,
-              sps: int, damping: float, stop_on_overturn: bool, mt, mah, mav, starts, x0: float, y0: float,
+              sps: int, mass_damping: float, stop_on_overturn: bool, mt, mah, mav, starts, x0: float, y0: float,
               ang0: float, vx0: float, vy0: float, w0: float, status, t_stop, n_filled, overturn_t, pos, ang_s,
               angvel_s) -> None:
     """Step runs ``lo`` to ``hi`` - 1 together (module docstring): each step, the inner loop goes
@@ -155,7 +160,7 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
     ----------
     lo, hi
         The runs stepped by this call.
-    verts, nv, mass, inertia, kn, ks, cn, cs, tanphi, rest_ang, stop_angle, g, dt, n_steps, sps, damping,
+    verts, nv, mass, inertia, kn, ks, cn, cs, tanphi, rest_ang, stop_angle, g, dt, n_steps, sps, mass_damping,
     stop_on_overturn
         As :func:`rockyade.kernel.single.run_body` (SI units).
     mt, mah, mav, starts
@@ -213,9 +218,9 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
                         h += 1
                     hint[i] = h
                     _segment(seg, i, a + h, mt, mah, mav)
-                u = (t - seg[0, i]) / (seg[1, i] - seg[0, i])
-                ah = seg[2, i] + u * (seg[3, i] - seg[2, i])
-                av = seg[4, i] + u * (seg[5, i] - seg[4, i])
+                u = fraction(t, seg[0, i], seg[1, i] - seg[0, i])
+                ah = lerp(u, seg[2, i], seg[3, i] - seg[2, i])
+                av = lerp(u, seg[4, i], seg[5, i] - seg[4, i])
             elif t == t_last[i]:
                 ah = a_last[0, i]
                 av = a_last[1, i]
@@ -226,34 +231,29 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
             fy = -mass * (g + av)
             tz = 0.0
             for v in range(nv):
-                py = yi + s * verts[v, 0] + c * verts[v, 1]
-                delta = -py
-                if delta < 0.0:
+                py = world_y(yi, c, s, verts[v, 0], verts[v, 1])
+                if -py < 0.0:
                     if shear[i, v] != 0.0:
                         shear[i, v] = 0.0
                     continue
-                px = xi + c * verts[v, 0] - s * verts[v, 1]
-                rax = px - xi
-                ray = py - yi
-                vrx = vxi - wi * ray
-                vry = vyi + wi * rax
-                fn, _spring, s_new, visc, _state, _slip = contact_law(
-                    delta, -vry, -vrx, shear[i, v], kn, ks, cn, cs, tanphi, dt
+                px = world_x(xi, c, s, verts[v, 0], verts[v, 1])
+                cfx, cfy, ctz, _fn, _spring, s_new, _visc, _state, _slip = base_point(
+                    px, py, xi, yi, vxi, vyi, wi, shear[i, v], kn, ks, cn, cs, tanphi, dt
                 )
                 shear[i, v] = s_new
-                cfx = s_new + visc
                 fx += cfx
-                fy += fn
-                tz += rax * fn - ray * cfx
+                fy += cfy
+                tz += ctz
             # kick
             w_prev = wi
-            if damping > 0.0:
-                fx += -damping * mass * vxi
-                fy += -damping * mass * vyi
-                tz += -damping * inertia * wi
-            vxi += dt * fx / mass
-            vyi += dt * fy / mass
-            wi += dt * tz / inertia
+            if mass_damping > 0.0:
+                fdx, fdy, tdz = damping(mass, inertia, mass_damping, vxi, vyi, wi)
+                fx += fdx
+                fy += fdy
+                tz += tdz
+            vxi = kicked(vxi, fx, mass, dt)
+            vyi = kicked(vyi, fy, mass, dt)
+            wi = kicked(wi, tz, inertia, dt)
             if sampling:
                 r = run_of[i]
                 pos[r, k, 0] = xi
@@ -266,14 +266,14 @@ def step_runs(lo: int, hi: int, verts, nv: int, mass: float, inertia: float, kn:
                 n_done += 1
                 continue
             # drift, then the blow-up and overturn checks
-            xi += dt * vxi
-            yi += dt * vyi
-            angi += dt * wi
+            xi = drifted(xi, vxi, dt)
+            yi = drifted(yi, vyi, dt)
+            angi = drifted(angi, wi, dt)
             x[i], y[i], ang[i], vx[i], vy[i], w[i] = xi, yi, angi, vxi, vyi, wi
             st = STATUS_COMPLETED
-            if not (vxi * vxi + vyi * vyi <= MAX_SPEED_M_S * MAX_SPEED_M_S and abs(wi) <= MAX_SPIN_RAD_S):
+            if blown_up(vxi, vyi, wi):
                 st = STATUS_FAILED
-            elif abs(angi - rest_ang) >= stop_angle and math.isnan(ot[i]):
+            elif beyond_stop_angle(angi, rest_ang, stop_angle) and math.isnan(ot[i]):
                 ot[i] = (step + 1) * dt
                 if stop_on_overturn:
                     st = STATUS_OVERTURNED

@@ -1,9 +1,9 @@
 """The single-body path: one moving polygon on the moving base, without energy terms.
 
-The same physics as the general loop (:mod:`.simulation`), step for step and operation for
-operation, for the case that most studies run: one block on the base (fragility, overturning
-spectra, uncertainty and sensitivity samples). Its state is held in scalars instead of per-body
-arrays, there are no candidate pairs, no dashpot bookkeeping and no energy terms; the
+The same physics as the general loop (:mod:`.simulation`), step for step: both take a body's
+arithmetic from :mod:`.step` (inlined), for the case that most studies run: one block on the
+base (fragility, overturning spectra, uncertainty and sensitivity samples). Its state is held
+in scalars instead of per-body arrays, there are no candidate pairs, no dashpot bookkeeping and no energy terms; the
 results are the same bits as the general loop's with ``record_energy`` off (the
 ``n_builds``, ``max_pairs`` and ``n_tests`` of the output are those of a lone body: 1, 0, 0).
 
@@ -31,15 +31,21 @@ import math
 import numba
 import numpy as np
 
-from rockyade.kernel.contact_law import STATE_SLIP, contact_law
-from rockyade.kernel.integration import (
-    MAX_SPEED_M_S,
-    MAX_SPIN_RAD_S,
-    STATUS_COMPLETED,
-    STATUS_FAILED,
-    STATUS_OVERTURNED,
-)
+from rockyade.kernel.contact_law import STATE_SLIP
+from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
 from rockyade.kernel.recording import Output, new_samples
+from rockyade.kernel.step import (
+    base_point,
+    beyond_stop_angle,
+    blown_up,
+    damping,
+    drifted,
+    fraction,
+    kicked,
+    lerp,
+    world_x,
+    world_y,
+)
 
 
 def single_body(bodies, joints, record_energy: bool) -> bool:
@@ -67,7 +73,7 @@ def single_body(bodies, joints, record_energy: bool) -> bool:
 @numba.njit(cache=True, nogil=True)
 def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, cn: float, cs: float,
              tanphi: float, rest_ang: float, stop_angle: float, apx: float, apy: float, g: float, dt: float,
-             n_steps: int, sps: int, damping: float, stop_on_overturn: bool, record_corners: bool,
+             n_steps: int, sps: int, mass_damping: float, stop_on_overturn: bool, record_corners: bool,
              mt, mah, mav, x: float, y: float, ang: float, vx: float, vy: float, w: float,
              shear, vstate, s_pos, s_ang, s_angvel, s_vpoint, s_ncont, s_slip, s_state
              ) -> tuple[int, float, int, float]:
@@ -85,7 +91,7 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
         Orientation at rest and |theta| at which the body has overturned, rad.
     apx, apy
         Output point relative to the centroid, body frame, m.
-    g, dt, n_steps, sps, damping
+    g, dt, n_steps, sps, mass_damping
         Gravity (m/s^2), time step (s), steps, steps per sample, mass damping (1/s).
     mt, mah, mav
         Base motion samples: s, m/s^2, m/s^2.
@@ -136,9 +142,9 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
                 ah_span = mah[hint + 1] - ah_lo
                 av_lo = mav[hint]
                 av_span = mav[hint + 1] - av_lo
-            u = (t - m_lo) / m_span
-            ah = ah_lo + u * ah_span
-            av = av_lo + u * av_span
+            u = fraction(t, m_lo, m_span)
+            ah = lerp(u, ah_lo, ah_span)
+            av = lerp(u, av_lo, av_span)
         elif t == t_last:
             ah = mah[n_motion - 1]
             av = mav[n_motion - 1]
@@ -159,25 +165,19 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
         # last step: then no vertex is below the base and every shear spring is already 0,
         # so visiting them changes nothing)
         for v in range(nv):
-            py = y + s * verts[v, 0] + c * verts[v, 1]
-            delta = -py
-            if delta < 0.0:
+            py = world_y(y, c, s, verts[v, 0], verts[v, 1])
+            if -py < 0.0:
                 if shear[v] != 0.0:
                     shear[v] = 0.0
                 continue
-            px = x + c * verts[v, 0] - s * verts[v, 1]
-            rax = px - x
-            ray = py - y
-            vrx = vx - w * ray
-            vry = vy + w * rax
-            fn, _spring, s_new, visc, state, _slip = contact_law(
-                delta, -vry, -vrx, shear[v], kn, ks, cn, cs, tanphi, dt
+            px = world_x(x, c, s, verts[v, 0], verts[v, 1])
+            cfx, cfy, ctz, _fn, _spring, s_new, _visc, state, _slip = base_point(
+                px, py, x, y, vx, vy, w, shear[v], kn, ks, cn, cs, tanphi, dt
             )
             shear[v] = s_new
-            cfx = s_new + visc
             fx += cfx
-            fy += fn
-            tz += rax * fn - ray * cfx
+            fy += cfy
+            tz += ctz
             if sampling:
                 ncont += 1
                 if state == STATE_SLIP:
@@ -186,13 +186,14 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
                     vstate[v] = state
         # kick
         vx_prev, vy_prev, w_prev = vx, vy, w
-        if damping > 0.0:
-            fx += -damping * mass * vx
-            fy += -damping * mass * vy
-            tz += -damping * inertia * w
-        vx += dt * fx / mass
-        vy += dt * fy / mass
-        w += dt * tz / inertia
+        if mass_damping > 0.0:
+            fdx, fdy, tdz = damping(mass, inertia, mass_damping, vx, vy, w)
+            fx += fdx
+            fy += fdy
+            tz += tdz
+        vx = kicked(vx, fx, mass, dt)
+        vy = kicked(vy, fy, mass, dt)
+        w = kicked(w, tz, inertia, dt)
         if sampling:
             k = step // sps
             wm = 0.5 * (w + w_prev)
@@ -213,15 +214,15 @@ def run_body(verts, nv: int, mass: float, inertia: float, kn: float, ks: float, 
         if step == n_steps:
             break
         # drift
-        x += dt * vx
-        y += dt * vy
-        ang += dt * w
+        x = drifted(x, vx, dt)
+        y = drifted(y, vy, dt)
+        ang = drifted(ang, w, dt)
         # the general loop's blow-up test: x, y, theta stay finite while the velocities are
         # finite and bounded (tested every step), so testing the velocities alone (NaN fails
         # both comparisons) decides the same
-        if not (vx * vx + vy * vy <= MAX_SPEED_M_S * MAX_SPEED_M_S and abs(w) <= MAX_SPIN_RAD_S):
+        if blown_up(vx, vy, w):
             status = STATUS_FAILED
-        elif abs(ang - rest_ang) >= stop_angle and math.isnan(overturn_t):
+        elif beyond_stop_angle(ang, rest_ang, stop_angle) and math.isnan(overturn_t):
             overturn_t = (step + 1) * dt
             if stop_on_overturn:
                 status = STATUS_OVERTURNED

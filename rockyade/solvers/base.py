@@ -15,14 +15,23 @@ Every solver derived from :class:`SolverBase` goes through one place on its way 
 ``run`` is wrapped (:meth:`SolverBase.__init_subclass__`) so that every Result it returns,
 failed ones included, carries ``meta["motion_coverage"]``, how much of the scene's base
 motion the run leaves out (:func:`motion_coverage`).
+
+A solver that runs scenes sharing one structure together (one model, many base motions) is
+also a :class:`GroupSolver`: ``group_key(scene)`` says which scenes go together and
+``run_group(scenes, uplift_rad)`` runs them, one :class:`GroupRun` each (no time history).
+Batches and the overturning study ask ``isinstance(solver, GroupSolver)``.
 """
 
 from __future__ import annotations
 
+import copy
 import functools
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkable
+
+import numpy as np
 
 from rockyade.errors import InputError, RockyadeError
 
@@ -58,6 +67,59 @@ class Solver(Protocol):
         ...
 
 
+@dataclass(frozen=True)
+class GroupRun:
+    """One run of :meth:`GroupSolver.run_group`.
+
+    Attributes
+    ----------
+    meta
+        The Result's metadata of the run.
+    theta_rad
+        (n,) sampled rotation from rest, rad.
+    sample_dt_s
+        Time between samples, s.
+    metrics
+        Computed by the solver: ``max_abs_theta_rad`` (rad), ``residual_theta_rad`` (rad),
+        ``uplift_time_s`` (s, NaN: never).
+    """
+
+    meta: dict[str, Any]
+    theta_rad: np.ndarray
+    sample_dt_s: float
+    metrics: dict[str, float]
+
+    @property
+    def status(self) -> str:
+        """completed | overturned | failed."""
+        return str(self.meta["status"])
+
+
+@runtime_checkable
+class GroupSolver(Solver, Protocol):
+    """A solver that also runs scenes sharing one structure together (module docstring)."""
+
+    def group_key(self, scene: Scene) -> str | None:
+        """What the scenes run together have in common (equal keys: one group); None: this
+        scene's run goes alone."""
+        ...
+
+    def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
+        """Run scenes of one :meth:`group_key` together, in their order: each run's metadata (as
+        ``run``'s Result, without the history), its sampled rotation and its metrics.
+
+        Parameters
+        ----------
+        scenes
+            Scenes with one group key (not None).
+        uplift_rad
+            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
+        threads
+            Threads the solver may use for the group.
+        """
+        ...
+
+
 def check_flag(value: Any, field: str) -> bool:
     """A true/false option."""
     if not isinstance(value, bool):
@@ -82,7 +144,31 @@ def check_dt_factor(value: Any, field: str) -> float:
 def motion_coverage(scene: Scene) -> dict[str, Any]:
     """How much of ``scene``'s base motion its run covers
     (:func:`rockyade.motion.coverage.record_coverage`: status, time, PGA and Arias intensity
-    left out, a sentence); when it cannot be worked out, ``status`` "unknown" and why."""
+    left out, a sentence); when it cannot be worked out, ``status`` "unknown" and why.
+
+    Worked out once per scene content (``scene.scene_hash``, which covers the motion's files by
+    their bytes and the duration): ``rockyade run`` warns of a cut motion before the run and the
+    solver's Result then carries the same coverage without reading the record again. A copy is
+    returned each time.
+    """
+    try:
+        key = scene.scene_hash
+    except (RockyadeError, OSError, ValueError):  # a motion file that cannot be read: said below
+        return _coverage(scene)
+    if key not in _COVERAGE:
+        if len(_COVERAGE) >= _COVERAGE_KEPT:
+            _COVERAGE.pop(next(iter(_COVERAGE)))
+        _COVERAGE[key] = _coverage(scene)
+    return copy.deepcopy(_COVERAGE[key])
+
+
+#: :func:`motion_coverage` of the last scenes, by scene hash (at most ``_COVERAGE_KEPT``).
+_COVERAGE: dict[str, dict[str, Any]] = {}
+_COVERAGE_KEPT = 16
+
+
+def _coverage(scene: Scene) -> dict[str, Any]:
+    """:func:`motion_coverage`, worked out."""
     from rockyade.motion.coverage import record_coverage
 
     try:

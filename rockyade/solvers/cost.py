@@ -75,11 +75,13 @@ class CostEstimate:
             steps += f" (dt = {self.time_step_s:.3g} s)"
         return (
             f"{steps}, {self.output_samples:.3g} output samples, {self.motion_samples:.3g} motion samples, "
-            f"~{self.memory_bytes / 1024**3:.2g} GiB, ~{_duration(self.wall_time_s)}"
+            f"~{self.memory_bytes / 1024**3:.2g} GiB, ~{duration_text(self.wall_time_s)}"
         )
 
 
-def _duration(seconds: float) -> str:
+def duration_text(seconds: float) -> str:
+    """A duration for people: seconds below 2 min, minutes below 2 h, else hours (2 or 3
+    significant digits), e.g. "45 s", "3.5 min", "2.25 h"."""
     if seconds < 120:
         return f"{seconds:.2g} s"
     if seconds < 7200:

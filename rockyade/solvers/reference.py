@@ -45,7 +45,7 @@ from rockyade.kernel.single import single_body
 from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag, motion_coverage
+from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, motion_coverage
 from rockyade.solvers.cost import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
@@ -198,34 +198,6 @@ class ReferenceSolver(SolverBase):
             theta = out.ang[r, :n] - model.bodies[0].rest_angle_rad
             runs.append(GroupRun(meta, theta, model.sample_dt_s, metrics))
         return runs
-
-
-@dataclass(frozen=True)
-class GroupRun:
-    """One run of :meth:`ReferenceSolver.run_group`.
-
-    Attributes
-    ----------
-    meta
-        The Result's metadata of the run.
-    theta_rad
-        (n,) sampled rotation from rest, rad.
-    sample_dt_s
-        Time between samples, s.
-    metrics
-        Computed in the kernel: ``max_abs_theta_rad`` (rad), ``residual_theta_rad`` (rad),
-        ``uplift_time_s`` (s, NaN: never).
-    """
-
-    meta: dict[str, Any]
-    theta_rad: np.ndarray
-    sample_dt_s: float
-    metrics: dict[str, float]
-
-    @property
-    def status(self) -> str:
-        """completed | overturned | failed."""
-        return str(self.meta["status"])
 
 
 def model_arrays_motion(model: DemModel) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

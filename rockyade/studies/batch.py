@@ -67,7 +67,7 @@ from rockyade.runner.groups import group_jobs
 from rockyade.runner.journal import claim, read_run, write_run
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import GroupSolver, Solver
 
 TIMING_COLUMNS = ("wall_time_s", "elapsed_s")
 #: Status of a run that a Ctrl-C stopped or kept from starting (summary only).
@@ -480,10 +480,9 @@ def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
 def job_key(task: BatchTask) -> Any:
     """The group of a task (:func:`rockyade.runner.groups.group_jobs`): runs without history
     whose solver runs scenes of one structure together (``group_key``); None: it runs alone."""
-    key = getattr(task.solver, "group_key", None)
-    if task.save_history or key is None:
+    if task.save_history or not isinstance(task.solver, GroupSolver):
         return None
-    k = key(task.scene)
+    k = task.solver.group_key(task.scene)
     return None if k is None else (task.out_dir, repr(task.solver), k)
 
 
@@ -498,14 +497,16 @@ def run_job(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
 
 
 def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
-    from rockyade.analysis.metrics import peak_metrics, uplift_threshold_rad
+    from rockyade.analysis.metrics import block_overturned, block_summary, uplift_threshold_rad
 
     start = time.perf_counter()
     first = job[0]
     spec = first.scene.blocks[0]
     alpha = spec.classical().alpha_rad
+    solver = first.solver
+    assert isinstance(solver, GroupSolver)  # job_key groups only these
     try:
-        runs = first.solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+        runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
     except Exception:  # a run of its own says what went wrong
         return [_run_task(task) for task in job]
     elapsed = (time.perf_counter() - start) / len(job)
@@ -517,18 +518,8 @@ def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
         row = _status_row(task, one.meta)
         if one.status != "failed":
             t = np.arange(one.theta_rad.size) * one.sample_dt_s
-            m = one.metrics
-            overturned = one.meta.get("overturned_block") == spec.name or spec.name in (
-                one.meta.get("overturn_times_s") or {}
-            )
-            row.update(
-                max_abs_theta_rad=m["max_abs_theta_rad"],
-                max_theta_over_alpha=m["max_abs_theta_rad"] / alpha,
-                **peak_metrics(t, one.theta_rad, alpha, free),
-                residual_theta_rad=m["residual_theta_rad"],
-                uplift_time_s=m["uplift_time_s"],
-                overturned=overturned,
-            )
+            overturned = block_overturned(one.meta, spec.name)
+            row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned))
         row["elapsed_s"] = elapsed
         try:
             write_run(folder, row["run"], {**one.meta, "summary": row})

@@ -24,7 +24,7 @@ from rockyade.figures import new_figure, save_figure
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.runner import Executor, run_jobs
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import GroupSolver, Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies.report import Report, run_state
@@ -90,12 +90,11 @@ def amplitude_ratios(max_ratio: float | None = None) -> list[float]:
 def run_scenes(solver: Solver, scenes: list[Scene], alpha: float) -> list[tuple[str, str]]:
     """(status, failure reason) of each scene's run: together when the solver runs them as one
     group (``group_key``, ``run_group``: each run's own result), else one at a time."""
-    key = getattr(solver, "group_key", None)
-    if key is not None and len(scenes) > 1:
-        keys = {key(s) for s in scenes}
+    if isinstance(solver, GroupSolver) and len(scenes) > 1:
+        keys = {solver.group_key(s) for s in scenes}
         if len(keys) == 1 and None not in keys:
             try:
-                runs = solver.run_group(scenes, uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                runs = solver.run_group(scenes, uplift_threshold_rad(alpha))
                 return [(one.status, one.meta.get("failure_reason") or "") for one in runs]
             except Exception:  # a run of its own says what went wrong
                 pass

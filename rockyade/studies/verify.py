@@ -947,8 +947,8 @@ def check_loaded_mass(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]
 def check_loaded_block(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """The loaded block's multiplier (module docstring) from the limit analysis and from
     Housner's uplift multiplier about the +x (right) pivot, against the closed form."""
+    from rockyade.housner import housner_model
     from rockyade.limit import limit_analysis
-    from rockyade.solvers.housner import housner_model
 
     scene = loaded_block_scene()
     expected = loaded_lambda()

@@ -82,6 +82,7 @@ import socket
 import sys
 import time
 import traceback
+from typing import Any
 
 YADE_PY = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
 if YADE_PY not in sys.path:
@@ -205,7 +206,8 @@ def build(scene):
     for b in scene["bodies"]:
         c0, a0 = b["centroid0_m"], b["angle0_rad"]
         r = b["sphere_radius_m"]
-        members, vertex_members = [], []
+        members: list[Any] = []  # YADE bodies
+        vertex_members: list[tuple[int, int]] = []
         for (cx, cy), copies in zip(b["sphere_centers_m"], b["sphere_copies"], strict=True):
             wx, wy = _rotate((cx, cy), a0)
             start = len(members)
@@ -287,7 +289,7 @@ def ground_engines(scene, clumps):
     engines = []
     # zero after the last sample (the reference DEM's convention), and before the first
     times = [t[0] - 1.0, *t, t[-1] + 1e-09, t[-1] + 1000000000.0]
-    by_mass = {}
+    by_mass: dict[float, list[int]] = {}
     for c in clumps:
         if not c["fixed"]:
             by_mass.setdefault(c["mass"], []).append(c["id"])
@@ -476,7 +478,7 @@ class Recorder:
                 self.runner.iterPeriod = self.period
             return
         turned = self.turned
-        row = []
+        row: list[float] = []
         for i, st, angle0, point, fixed, rest, stop_angle in self.per_clump:
             theta = angle0 + turned[i]
             pos, vel = st.pos, st.vel  # one copy of each vector
@@ -539,8 +541,10 @@ class Recorder:
         Also the deepest penetration seen against a Polyhedra prism, in sphere radii: at one
         radius the sphere's centre is inside the prism and YADE's contact loses its normal."""
         vertex_of, polyhedra, block_of_prism = self.vertex_of, self.polyhedra, self.block_of_prism
-        fn_of, state_of = {}, {}  # (block, vertex) -> summed normal force, state
-        points = {}  # (block, other block or -1 for the base) -> vertices touching
+        fn_of: dict[tuple[int, int], float] = {}  # (block, vertex) -> summed normal force
+        state_of: dict[tuple[int, int], int] = {}  # (block, vertex) -> state
+        # (block, other block or -1 for the base) -> the (block, vertex) touching
+        points: dict[tuple[int, int], set[tuple[int, int]]] = {}
         slipping = set()
         for inter in O.interactions.all(True):  # the real ones, in the container's order
             id1, id2 = inter.id1, inter.id2
@@ -585,7 +589,7 @@ class Recorder:
             self.fn_at.append((base + i) * maxv + v)
             self.fn_val.append(fn)
             self.state_val.append(state_of[i, v])
-        counts = {}
+        counts: dict[int, int] = {}
         for (a, b), touching in points.items():
             if b < 0:  # the base: every vertex on it, as the reference DEM
                 counts[a] = counts.get(a, 0) + len(touching)
@@ -807,7 +811,7 @@ def serve(fd):
             os.dup2(log, 1)
             os.dup2(log, 2)
             os.close(log)
-        reply = {"ok": True}
+        reply: dict[str, Any] = {"ok": True}
         try:
             status = main(job["scene"], job["out"], deadline=job.get("deadline"), flush_s=job.get("flush_s"))
             if status == "timeout":  # stopped at its deadline, its samples written
