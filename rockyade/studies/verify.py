@@ -74,10 +74,10 @@ from rockyade.scene.generators import (
     drum_column,
     pulse_motion,
     rest_motion,
-    restrained_wall,
     rocking_frame,
     stack,
     wall,
+    wall_section,
 )
 from rockyade.solvers import run
 from rockyade.studies.checks import CHECKS
@@ -688,9 +688,7 @@ def _restrained_wall_rows() -> list[Row]:
     courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
     tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
     from rockyade.limit import limit_analysis
-    from rockyade.scene.generators import restrained_wall, wall_section
-
-    two = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0)
+    two = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0)
     lam2 = _known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
     eight = wall_section(
         height_m=2.4,
@@ -1075,13 +1073,13 @@ def limit_pushover_scenes(motion: dict[str, Any] | None = None) -> dict[str, tup
         "blocks": [{"name": "pier", "width_m": 0.4, "height_m": 2.0, "thickness_m": 1.0, "mass_kg": 1000.0}],
         "motion": m,
     }
-    restrained = restrained_wall(
-        blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion=m, duration_s=1.0
+    restrained = wall_section(
+        courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0, motion=m, duration_s=1.0
     )
     return {
         "block": (block, None),
         "arch": (arch_data, None),
-        "restrained wall": (restrained, ("wall_lower", (-0.15, 1.5))),
+        "restrained wall": (restrained, ("w01", (-0.15, 1.5))),
         "panel": (panel, None),
     }
 
