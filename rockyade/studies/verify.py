@@ -65,7 +65,7 @@ import pandas as pd
 
 from rockyade.analysis.overlap import max_overlap
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.io.atomic import atomic_open, write_text
 from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
@@ -737,9 +737,9 @@ def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     from rockyade.limit import limit_analysis
 
     kin = _kinematic(limit_analysis(_block_scene(0.25, 2.5), fc=1.35))
-    ag, S, q = 0.25 * G, 1.2, 2.0
+    ag, S, q = 0.25 * CODE_GRAVITY, 1.2, 2.0  # ag in g and a0* with standard gravity (docs/conventions.md)
     linear, nonlinear = code_checks(kin, Site(1, "B", ag), Position())
-    a0 = 0.1 * G / 1.35
+    a0 = 0.1 * CODE_GRAVITY / 1.35
     ts = _known(kin.Ts_s, "Ts")
     du = _known(kin.du_star_m, "du*")
     sde = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2  # TC < Ts < TD
