@@ -1,7 +1,9 @@
 """Physical constants and project-wide numerical conventions."""
 
-#: Acceleration of gravity used throughout, m/s^2. The seed paper's printed values
-#: (e.g. p = 3.78 1/s for specimen 1 via Eq 3) follow from g = 9.81.
+#: Acceleration of gravity of the mechanics, m/s^2: the blocks' weights (scenes, limit analysis, DEMs,
+#: YADE, Housner) and the paper's classical parameters. The seed paper's printed values (e.g.
+#: p = 3.78 1/s for specimen 1 via Eq 3) follow from g = 9.81, so the paper's numbers are reproduced
+#: with it (docs/conventions.md, "g").
 G = 9.81
 
 #: Standard gravity (CGPM 1901), m/s^2: what a record "in g" means (PEER NGA AT2 files and
@@ -9,6 +11,12 @@ G = 9.81
 #: parameters (p, the uplift acceleration g tan(alpha), amplitudes given in g in scenes)
 #: keep :data:`G` = 9.81 as the paper computed them.
 STANDARD_GRAVITY = 9.80665
+
+#: The g of the code check, m/s^2: standard gravity, the same g as records in g. An acceleration
+#: given in g (a site's ag, the PGA of a fragility median, a spectrum in g) is turned into m/s^2
+#: with it, and so is alpha0 into a0* = alpha0 g / (e* FC) (and alpha into a*): ``assess``,
+#: ``fragility``, ``limit`` and ``motion info`` print the same m/s^2 for the same value in g.
+CODE_GRAVITY = STANDARD_GRAVITY
 
 #: Units in which accelerations are reported (printed summaries, figure axes), in m/s^2 per
 #: unit: "g" is standard gravity, as in the records. Engineers read PGA in g, so the

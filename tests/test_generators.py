@@ -415,7 +415,7 @@ def test_frame_gamma_and_frequency():
 def test_restrained_wall_touches_its_fixed_restraint():
     placed = _placed(restrained_wall(wall_height_m=2.4, wall_thickness_m=0.3, restraint_height_m=0.25))
     names = [b.name for b in placed]
-    assert names == ["wall_lower", "wall_upper", "restraint"]
+    assert names == ["w01", "w02", "restraint_far"]
     assert placed[2].fixed
     heads = [c for c in rest_contacts(placed) if c.kind == "head"]
     assert len(heads) == 1 and {heads[0].a, heads[0].b} == {1, 2}

@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import InputError
 from rockyade.limit import PointLoad, limit_analysis, rigid_block_model
 from rockyade.scene import scene_from_dict
@@ -34,7 +34,7 @@ def test_a_block_has_e_star_1_and_d0_star_b_and_the_curve_of_statics(width, heig
     mass = float(result.model.masses_kg[0])
     assert kin.e_star == pytest.approx(1.0, rel=1e-12)
     assert kin.M_star_kg == pytest.approx(mass, rel=1e-12)
-    assert kin.a0_star_m_s2 == pytest.approx((width / height) * G / 1.35, rel=1e-9)
+    assert kin.a0_star_m_s2 == pytest.approx((width / height) * CODE_GRAVITY / 1.35, rel=1e-9)
     assert kin.d0_star_m == pytest.approx(b, rel=1e-6)  # the centroid reaches the pivot's vertical
     assert kin.du_star_m == pytest.approx(0.4 * b, rel=1e-6)
     # alpha(theta) = tan(a - theta) for a block turning about its corner, all along the curve
@@ -44,7 +44,7 @@ def test_a_block_has_e_star_1_and_d0_star_b_and_the_curve_of_statics(width, heig
     assert len(curve.dk_m) > 50 and curve.max_joint_gap_m < 1e-12
     # Ts at ds* = 0.16 b, from the closed form of a*(d*)
     ds = 0.16 * b
-    a_s = math.tan(math.atan2(b, h_c) - _theta_of(np.array([ds]), b, h_c)[0]) * G / 1.35
+    a_s = math.tan(math.atan2(b, h_c) - _theta_of(np.array([ds]), b, h_c)[0]) * CODE_GRAVITY / 1.35
     assert kin.ds_star_m == pytest.approx(ds, rel=1e-6)
     assert kin.as_star_m_s2 == pytest.approx(a_s, rel=1e-5)
     assert kin.Ts_s == pytest.approx(2 * math.pi * math.sqrt(ds / a_s), rel=1e-5)
@@ -141,7 +141,8 @@ def test_fc_scales_a0_star_and_is_checked():
     scene = block_scene(0.4, 2.0)
     a1 = limit_analysis(scene, fc=1.0, sliding=False).kinematic
     a2 = limit_analysis(scene, fc=1.35, sliding=False).kinematic
-    assert a1.a0_star_m_s2 == pytest.approx(0.2 * G) and a2.a0_star_m_s2 == pytest.approx(0.2 * G / 1.35)
+    assert a1.a0_star_m_s2 == pytest.approx(0.2 * CODE_GRAVITY)
+    assert a2.a0_star_m_s2 == pytest.approx(0.2 * CODE_GRAVITY / 1.35)
     assert a1.d0_star_m == pytest.approx(a2.d0_star_m)  # FC scales accelerations only
     for bad in (0.5, 11.0, math.nan):
         with pytest.raises(InputError, match="FC"):

@@ -20,7 +20,7 @@ def test_site_one_by_hand():
     Se(0.07) = 3.413880 + (8.193312 - 3.413880) x 0.07 / 0.139949 = 5.804474;
     Se(1.0) = 8.193312 x 0.419846 / 1.0 = 3.439928; Se(3.0) = 8.193312 x 0.419846 x 2.6 / 9 = 0.993757.
     """
-    sp = ntc_spectrum(0.25, 2.4, 0.3, "B", "T2")
+    sp = ntc_spectrum(0.25, 2.4, 0.3, "B", "T2", g=9.81)
     assert pytest.approx(1.392, rel=1e-12) == sp.S
     assert sp.TC_s == pytest.approx(0.419846, rel=1e-6)
     assert sp.TB_s == pytest.approx(0.139949, rel=1e-5)
@@ -31,14 +31,14 @@ def test_site_one_by_hand():
 
 
 def test_site_two_by_hand():
-    """ag = 0.15 g, F0 = 2.5, TC* = 0.5 s, soil D, topography T1:
+    """ag = 0.15 g, F0 = 2.5, TC* = 0.5 s, soil D, topography T1 (g = 9.81):
 
     SS = 2.40 - 1.50 x 2.5 x 0.15 = 1.8375, above the bound: 1.80; CC = 1.25 x 0.5^-0.5 = 1.767767;
     ST = 1; TC = 0.883883 s, TB = 0.294628 s, TD = 4 x 0.15 + 1.6 = 2.2 s; ag = 1.4715 m/s^2,
     ag S = 2.6487, plateau = 6.62175 m/s^2; Se(0.5) = 6.62175 (plateau);
     Se(1.5) = 6.62175 x 0.883883 / 1.5 = 3.901903; Se(4.0) = 6.62175 x 0.883883 x 2.2 / 16 = 0.804768.
     """
-    sp = ntc_spectrum(0.15, 2.5, 0.5, "D", "T1")
+    sp = ntc_spectrum(0.15, 2.5, 0.5, "D", "T1", g=9.81)
     assert pytest.approx(1.80, rel=1e-12) == sp.S
     assert sp.TC_s == pytest.approx(0.883883, rel=1e-6)
     assert sp.TD_s == pytest.approx(2.2, rel=1e-12)
@@ -87,7 +87,9 @@ def test_a_bad_ntc_site_names_the_option(args, field):
 def test_the_ntc_site_gives_the_checks_ag_and_s():
     site = NtcSite(0.25, 2.4, 0.3, "b", "t2")
     assert site.soil == "B" and site.topography == "T2"
-    assert site.ag_m_s2 == pytest.approx(0.25 * 9.81)
+    # ag in g is turned into m/s^2 with standard gravity, as a record in g and a0* (docs/conventions.md)
+    assert site.ag_m_s2 == pytest.approx(0.25 * 9.80665, rel=1e-12)
+    assert ntc_spectrum(0.25, 2.4, 0.3, "B", "T2").plateau_m_s2 == pytest.approx(8.193312 * 9.80665 / 9.81, rel=1e-9)
     assert pytest.approx(1.392) == site.S
     data = site.to_dict()
     assert data["spectrum_code"] == "ntc2018" and data["SS"] == pytest.approx(1.16)

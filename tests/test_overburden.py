@@ -33,7 +33,7 @@ def test_a_wall_section_carries_its_load_per_metre_times_its_length():
     data = restrained_wall(blocks=1, wall_length_m=2.0, gap_m=0.05)
     loaded = add_overburden(data, "section", force_N_per_m=10000.0, eccentricity_m=0.1)
     assert loaded["loads"] == [
-        {"block": "wall", "point_m": [0.1, 3.0], "force_N": [0.0, -20000.0], "mass_kg": pytest.approx(20000.0 / G)}
+        {"block": "w01", "point_m": [0.1, 3.0], "force_N": [0.0, -20000.0], "mass_kg": pytest.approx(20000.0 / G)}
     ]
     assert "loads" not in data  # the input is not changed
 
@@ -72,7 +72,7 @@ def test_rockyade_build_writes_the_overburden(tmp_path, capsys):
                  "--overburden-eccentricity-m", "0.1", "--motion", "gravity-ramp", "--out", str(out)]) == 0
     scene = load_scene(out)
     assert scene.motion.type == "gravity-ramp"
-    assert [(q.block, q.point_m, q.force_N) for q in scene.loads] == [("wall", (0.1, 3.0), (0.0, -20000.0))]
+    assert [(q.block, q.point_m, q.force_N) for q in scene.loads] == [("w01", (0.1, 3.0), (0.0, -20000.0))]
     assert scene.loads[0].mass_kg == pytest.approx(20000.0 / G)
     assert main(["build", "restrained-wall", "--blocks", "1", "--gap-m", "0.05", "--overburden-n-per-m", "20000",
                  "--overburden-mass", "none", "--out", str(out)]) == 0

@@ -19,7 +19,7 @@ from rockyade.limit import limit_analysis
 from rockyade.motion.quasistatic import GravityRamp, Pushover, gravity_ramp_samples
 from rockyade.motion.spec import parse_motion
 from rockyade.scene import scene_from_dict
-from rockyade.scene.generators import restrained_wall, wall
+from rockyade.scene.generators import wall, wall_section
 from rockyade.scene.placement import placed_blocks
 from rockyade.solvers import run
 
@@ -157,14 +157,14 @@ def test_a_wall_restrained_at_its_top_forms_the_three_hinge_mechanism(solver):
     expected = three_hinge_multiplier(0.3, 3.0, 1.5, 0.3)
     assert expected == pytest.approx(17 / 35, rel=1e-12)
     motion = pushover(expected)
-    data = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion=motion,
-                           duration_s=push_duration(motion))
-    assert data["joints"] == [{"blocks": ["wall_upper", "restraint"], "friction_angle_deg": 0.0}]
+    data = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0, motion=motion,
+                        duration_s=push_duration(motion))
+    assert data["joints"] == [{"blocks": ["w02", "restraint_far"], "friction_angle_deg": 0.0}]
     scene = scene_from_dict(data)
     result = limit_analysis(scene, direction="+x")
     assert result.load_multiplier == pytest.approx(expected, rel=1e-9)
-    assert {(h.a, h.b) for h in result.mechanism.hinges} >= {("wall_lower", "base"), ("wall_upper", "wall_lower")}
-    onset = pushover_onset(capacity_curve(run(scene, solver), scene, block="wall_lower", point_m=(-0.15, 1.5)), scene)
+    assert {(h.a, h.b) for h in result.mechanism.hinges} >= {("w01", "base"), ("w02", "w01")}
+    onset = pushover_onset(capacity_curve(run(scene, solver), scene, block="w01", point_m=(-0.15, 1.5)), scene)
     assert expected <= onset.multiplier <= 1.02 * expected
     assert onset.below <= expected * (1 + 1e-6)
 
@@ -360,8 +360,8 @@ def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_withou
     that the floor clamps the wall."""
     from rockyade.cli import main
 
-    locked = scene_from_dict(restrained_wall(blocks=2, restraint="side", restraint_friction_deg=None,
-                                             motion={"type": "rest"}))
+    locked = scene_from_dict(wall_section(courses=2, top="restrained-far", restraint_friction_deg=None,
+                                          motion={"type": "rest"}))
     assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
     assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
     assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0
@@ -369,3 +369,5 @@ def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_withou
     assert main(["build", "restrained-wall", "--restraint", "floor", "--gap-m", "0.01",
                  "--out", str(tmp_path / "g.toml")]) == 0
     assert "clamps" not in capsys.readouterr().err
+    assert main(["build", "wall-section", "--top", "floor", "--out", str(tmp_path / "h.toml")]) == 0
+    assert "--top floor with no --gap-m" in capsys.readouterr().err

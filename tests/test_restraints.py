@@ -258,11 +258,12 @@ def test_the_three_hinge_mechanism_sliding_on_a_frictionless_restraint_is_follow
 
     theta0 = brentq(alpha, 1e-4, 0.5)
     d0 = centroids(theta0)[0][0]  # the control point: the lower block's centroid
-    data = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion={"type": "rest"})
+    data = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0, motion={"type": "rest"})
+    assert data == restrained_wall(blocks=2, split=0.5, restraint="side", motion={"type": "rest"})  # the alias
     res = limit_analysis(scene_from_dict(data), direction="+x")
     assert res.mechanism.slides and res.load_multiplier == pytest.approx(17 / 35, rel=1e-9)
     kin = res.kinematic
-    assert kin.control_block == "wall_lower"
+    assert kin.control_block == "w01"
     assert kin.curve.d0_m == pytest.approx(d0, rel=1e-4)
     for theta in (0.01, 0.05, 0.1):
         dk = centroids(theta)[0][0]
@@ -316,8 +317,12 @@ def test_one_generator_its_names_defaults_and_gaps(tmp_path):
     with pytest.raises(InputError, match=r"< thickness_m \(0.3 m\).*0.3 m closes") as info:
         wall_section(top="restrained-near", gap_m=0.3)
     assert info.value.field == "gap_m"
-    with pytest.raises(InputError, match=r"must be < 0.01496 m with restraint = 'floor'"):
-        restrained_wall(blocks=1, restraint="floor", gap_m=0.02)
+    with pytest.raises(InputError, match=r"must be < 0.01496 m with top = 'floor'") as info:
+        wall_section(top="floor", gap_m=0.02)
+    assert info.value.field == "gap_m"
+    with pytest.raises(InputError, match=r"must be < wall_thickness_m \(0.3 m\)") as info:
+        restrained_wall(gap_m=0.3)  # the alias names its own parameters
+    assert info.value.field == "gap_m"
     # the same names and defaults: restrained-wall takes wall-section's names, its restraint frictionless
     assert (
         main(

@@ -64,3 +64,61 @@ def test_rockyade_build_wall_section(tmp_path):
     assert [b.width_m for b in scene.blocks] == [0.25, 0.25] and scene.blocks[0].thickness_m == 1.5
     assert scene.loads[0].force_N == (0.0, -7500.0)
     assert main(["build", "wall-section", "--top", "restrained", "--out", str(tmp_path / "x.toml")]) == 2
+
+
+def three_hinge(t: float, h: float, h1: float, hr: float) -> float:
+    """The paper's Fig. 2 by virtual work (docs/assemblies.md): the lower block (h1) turns about the
+    toe, the upper one hinges on it and slides up the restraint's corner (t/2, h - hr)."""
+    h2, w2 = h - h1, h1 / (h - hr - h1)
+    return (h1 * t / 2 + h2 * t * (1 + w2 / 2)) / (h1 * h1 / 2 + h2 * (h1 - w2 * h2 / 2))
+
+
+@pytest.mark.parametrize("split", [0.5, 0.4])
+def test_two_courses_split_at_a_height_form_the_three_hinge_mechanism(split):
+    """--split puts the joint of a two-course wall where the engineer says (17/35 at half height)."""
+    scene = section(courses=2, split=split, top="restrained-far")
+    assert [b.height_m for b in scene.blocks if not b.fixed] == pytest.approx([H * split, H * (1 - split)])
+    expected = three_hinge(T, H, H * split, 0.3)
+    if split == 0.5:
+        assert expected == pytest.approx(17 / 35, rel=1e-12)
+    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(expected, rel=1e-9)
+    with pytest.raises(InputError, match="2 courses") as info:
+        wall_section(courses=3, split=split)
+    assert info.value.field == "split"
+
+
+def test_a_floor_over_the_top_with_a_gap_lets_the_wall_turn():
+    scene = section(top="floor", gap_m=0.01)
+    floor = scene.blocks[-1]
+    assert floor.name == "floor" and floor.fixed and floor.position_m == pytest.approx((-T / 2 + 0.3, H + 0.01))
+    assert [j.blocks for j in scene.joints] == [("w01", "floor")]
+    assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(T / H, rel=1e-9)
+    # the top corner of a wall turning about its toe rises at most sqrt(t^2 + H^2) - H = 0.01496 m
+    with pytest.raises(InputError, match=r"< 0.01496 m with top = 'floor'") as info:
+        wall_section(top="floor", gap_m=0.015)
+    assert info.value.field == "gap_m"
+
+
+@pytest.mark.parametrize(
+    ("former", "now"),
+    [
+        ([], ["--courses", "2", "--top", "restrained-far"]),
+        (["--blocks", "1", "--restraint", "floor", "--gap-m", "0.01", "--wall-height-m", "2.4"],
+         ["--top", "floor", "--gap-m", "0.01", "--height-m", "2.4"]),
+        (["--split", "0.4", "--restraint-friction-deg", "10", "--wall-thickness-m", "0.4"],
+         ["--courses", "2", "--split", "0.4", "--top", "restrained-far", "--restraint-friction-deg", "10",
+          "--thickness-m", "0.4"]),
+    ],
+)
+def test_restrained_wall_is_an_alias_of_wall_section(former, now, tmp_path, capsys):
+    """The alias maps its options onto wall-section's and writes the same scene; its --help says so."""
+    import tomllib
+
+    assert main(["build", "restrained-wall", *former, "--motion", "rest", "--out", str(tmp_path / "a.toml")]) == 0
+    assert main(["build", "wall-section", *now, "--motion", "rest", "--out", str(tmp_path / "b.toml")]) == 0
+    a, b = (tomllib.loads((tmp_path / name).read_text()) for name in ("a.toml", "b.toml"))
+    assert a == b
+    capsys.readouterr()
+    with pytest.raises(SystemExit):
+        main(["build", "restrained-wall", "--help"])
+    assert "alias of `rockyade build wall-section`" in " ".join(capsys.readouterr().out.split())

@@ -56,7 +56,7 @@ from rockyade.assess.stripes import (
     check_fallen_blocks,
     record_measures,
 )
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError, SolverFailedError
 from rockyade.limit import DEFAULT_FC, LimitResult, limit_analysis
 from rockyade.runner import Executor
@@ -294,7 +294,7 @@ def rigid_body_mechanism(limit: LimitResult) -> dict[str, Any] | None:
     s2 = sum(m * dx(p) ** 2 for m, p in points)
     total = sum(m for m, _ in points)
     e_one = s1 * s1 / s2 / total
-    a0_one = kin.alpha0 * model.g / (e_one * kin.FC)
+    a0_one = kin.alpha0 * kin.g / (e_one * kin.FC)
     names = [model.names[i] for i in moving]
     note = (
         f"the mechanism turns {len(names)} blocks ({names[0]} ... {names[-1]}) as one rigid body: they are not "

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from rockyade.assess.site import AnySite, Position
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.limit.kinematic import KinematicQuantities
 

@@ -5,9 +5,9 @@ through the runner, the lognormal fit and its band.
 
     from rockyade.assess import fragility_plan, run_fragility, parse_measure, ec8_suite
 
-    plan = fragility_plan(scene, ec8_suite(1, "B", 0.25 * 9.81), parse_measure("pga"), "housner")
+    plan = fragility_plan(scene, ec8_suite(1, "B", 0.25 * 9.80665), parse_measure("pga"), "housner")
     result = run_fragility(plan)                 # stripes, runs, fit
-    result.fit.fragility.median / 9.81           # median PGA, g
+    result.fit.fragility.median / 9.80665        # median PGA, g (standard gravity)
 
 The stripes (:mod:`rockyade.assess.stripes`): every record scaled, by a load factor on its
 accelerations as read, to each level. Default levels, when none are given: the static
@@ -44,7 +44,7 @@ from rockyade.assess.stripes import (
     run_stripes,
     runs_frame,
 )
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import BatchInterruptedError, InputError, RockyadeError
 from rockyade.runner import Executor
 from rockyade.runner.journal import Journal
@@ -136,7 +136,10 @@ def static_acceleration(scene: Scene) -> tuple[float, str]:
             values.append(float(result.load_multiplier) * result.model.g)
     if not values:
         return math.nan, "no mechanism in either direction"
-    return min(values), f"alpha0 g = {min(values):.4g} m/s^2 ({min(values) / G:.4g} g), limit analysis"
+    return min(values), (
+        f"alpha0 g = {min(values):.4g} m/s^2 (alpha0 x the mechanics' g = {G:g} m/s^2; "
+        f"{min(values) / CODE_GRAVITY:.4g} g in standard gravity), limit analysis"
+    )
 
 
 class SceneCannotStandError(RockyadeError):
@@ -266,7 +269,7 @@ def _default_levels(
     if static <= 0.0:
         raise ZeroCapacityError(static_text)
     if math.isnan(static):
-        pga_levels = np.array(FALLBACK_PGA_G) * G
+        pga_levels = np.array(FALLBACK_PGA_G) * CODE_GRAVITY
         text = "PGA levels of the fallback (no static mechanism)"
     else:
         pga_levels = static * np.array(DEFAULT_FACTORS)

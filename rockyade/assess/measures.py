@@ -10,8 +10,8 @@
   so that its PGA is ag S (shown in g).
 
 Each is proportional to a load factor on the record's accelerations (EN 1998-1's spectrum
-too), so a record of intensity x at load factor 1 has x lambda at lambda. g is 9.81 m/s^2
-(:data:`rockyade.constants.G`).
+too), so a record of intensity x at load factor 1 has x lambda at lambda. A value in g is
+in standard gravity, 9.80665 m/s^2 (:data:`rockyade.constants.CODE_GRAVITY`), as records in g.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
 from rockyade.motion.records import Record

@@ -9,7 +9,7 @@ from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import NOT_APPLICABLE, VERIFIED, Check
 from rockyade.assess.fragility import FragilityPlan, FragilityResult
 from rockyade.assess.stripes import collapse_rule
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.limit.report import hinge_words, plural, sliding_words
 
 
@@ -109,8 +109,8 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     lines = [
         f"assessment of {source}: NTC 2018 kinematic method (NTC 2018 8.7.1, Circolare 2019 C8.7.1), FC = {a.fc:g}",
         f"site: {a.site.describe()}; mechanism {a.position.describe()}",
-        f"g = {G:g} m/s^2 throughout the check (ag in g and a0* = alpha0 g / (e* FC): the verdict does not depend "
-        "on it); records given in g are read with standard gravity 9.80665 m/s^2",
+        f"g = {G:g} m/s^2 (standard gravity) throughout the check (ag in g and a0* = alpha0 g / (e* FC): the verdict "
+        "does not depend on it), as for records given in g; the blocks' weights use the mechanics' 9.81 m/s^2",
     ]
     if lim.status == "no_mechanism":
         lines.append("limit analysis: no horizontal acceleration makes it collapse (no mechanism): no code check")

@@ -12,9 +12,9 @@ The site's elastic spectrum is either
   the importance factor).
 
 One g everywhere in the check: an acceleration given in g (``0.25g``, the site's ag/g) is
-turned into m/s^2 with the project's g = 9.81 m/s^2 (:data:`rockyade.constants.G`), the same g
-that turns the multiplier alpha0 into a0* = alpha0 g / (e* FC): the check a0* >= ag S / q is
-then alpha0 / (e* FC) >= (ag/g) S / q whatever the value of g.
+turned into m/s^2 with standard gravity, 9.80665 m/s^2 (:data:`rockyade.constants.CODE_GRAVITY`,
+the g of records in g), the same g that turns the multiplier alpha0 into a0* = alpha0 g / (e* FC):
+the check a0* >= ag S / q is then alpha0 / (e* FC) >= (ag/g) S / q whatever the value of g.
 
 A mechanism sits at ground level (the default) or at a height Z of a building of height H,
 N storeys and fundamental period T1 (the demand is then the floor's: Circolare 2019
@@ -30,7 +30,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.motion.ec8 import EC8_GROUND, ElasticSpectrum
 from rockyade.motion.ntc2018 import NtcSpectrum, ntc_spectrum, soil_factors, topography_factor
@@ -56,7 +56,7 @@ def parse_acceleration(text: str | float, field: str = "--ag", max_g: float = MA
     Parameters
     ----------
     text
-        The value and its unit (``g``, taken as 9.81 m/s^2 as the project's g, or ``m/s2``);
+        The value and its unit (``g``, taken as standard gravity 9.80665 m/s^2 as the code check's g, or ``m/s2``);
         a bare number is refused (0.25 would be 0.25 m/s^2 or 0.25 g).
     field
         The option named in errors.
@@ -201,7 +201,7 @@ class NtcSite:
 
     @property
     def ag_m_s2(self) -> float:
-        """ag, m/s^2 (ag/g x 9.81)."""
+        """ag, m/s^2 (ag/g x 9.80665, standard gravity)."""
         return self.ag_g * G
 
     @property

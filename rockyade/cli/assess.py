@@ -36,7 +36,7 @@ def _site(args: argparse.Namespace) -> AnySite:
     options ``--spectrum-type`` and ``--ground``)."""
     from rockyade.assess import Site, parse_acceleration
     from rockyade.assess.site import NtcSite
-    from rockyade.constants import G
+    from rockyade.constants import CODE_GRAVITY as G
 
     ec8_given = [o for o in ("spectrum_type", "ground", "importance") if getattr(args, o) is not None]
     ntc_given = [
@@ -305,7 +305,8 @@ def register(sub: Any) -> None:
         "--ag",
         required=True,
         help="the site's peak ground acceleration on type A ground, with its unit: 0.25g or 2.45m/s2 "
-        "(g = 9.81 m/s^2, the same g as in a0* = alpha0 g / (e* FC)); NTC 2018: ag of Allegato A for the limit "
+        "(g: standard gravity, 9.80665 m/s^2, as for records in g and in a0* = alpha0 g / (e* FC)); "
+        "NTC 2018: ag of Allegato A for the limit "
         "state's return period; EC8: agR",
     )
     p.add_argument(

@@ -179,25 +179,32 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
     ),
     "wall-section": (
         "a wall's section out of its plane: height, thickness (through the section) and length (along the wall), "
-        "courses, a free or restrained top, an overburden",
+        "courses, a top free, restrained beside one face or both or under a floor, with or without a gap, "
+        "an overburden",
         [
             Opt("--height-m", 3.0, "the wall's height, m"),
             Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
             Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
-            Opt("--courses", 1, "equal courses (1: one block)", int),
+            Opt("--courses", 1, "courses (1: one block), equal unless --split", int),
+            Opt("--split", None, "2 courses: height of the joint between them / the wall's height, in (0, 1) "
+                "(the two-block wall of the paper's Fig. 2c; default: equal courses)"),
             Opt("--top", "free", "free; restrained (a fixed block beside each face, with a gap > 0); restrained-far or "
-                "restrained-near (one face, x > 0 or x < 0; a zero gap gives the three-hinge mechanism)", str,
-                ("free", "restrained", "restrained-far", "restrained-near")),
-            Opt("--gap-m", 0.0, "restrained: gap between the face and its restraint (< the thickness), m"),
-            Opt("--restraint-height-m", 0.3, "restrained: depth of the restraints, m"),
-            Opt("--restraint-width-m", 0.3, "restrained: width of the restraints, m"),
-            Opt("--restraint-friction-deg", 0.0, "restrained: friction of the wall-restraint joints, deg (0: none)"),
+                "restrained-near (one face, x > 0 or x < 0; a zero gap gives the three-hinge mechanism); floor (a "
+                "fixed slab over the top, the gap above it)", str,
+                ("free", "restrained", "restrained-far", "restrained-near", "floor")),
+            Opt("--gap-m", 0.0, "restrained, floor: gap between the wall and its restraint (one the wall cannot close "
+                "before it overturns is refused), m"),
+            Opt("--restraint-height-m", 0.3, "restrained, floor: depth of the restraints (the slab), m"),
+            Opt("--restraint-width-m", 0.3, "restrained, floor: width of the restraints (the slab's reach past the "
+                "far face), m"),
+            Opt("--restraint-friction-deg", 0.0, "restrained, floor: friction of the wall-restraint joints, deg "
+                "(0: none)"),
             Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
             Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
         ],
     ),
     "restrained-wall": (
-        "a wall restrained at its top by a fixed block (out-of-plane section, the paper's Fig. 2)",
+        "a wall restrained at its top (out-of-plane section, the paper's Fig. 2; an alias of wall-section)",
         [
             Opt("--wall-height-m", 3.0, "wall height, m (or --height-m, as wall-section)", aliases=("--height-m",)),
             Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m (or --thickness-m)",
@@ -224,6 +231,15 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             ),
         ],
     ),
+}
+
+#: Kinds that are aliases of another, with how their options map onto it (said in their --help).
+ALIASES = {
+    "restrained-wall": "It is an alias of `rockyade build wall-section` under its former option names: "
+    "--wall-height-m, --wall-thickness-m, --wall-length-m are --height-m, --thickness-m, --length-m; --blocks "
+    "(1 or 2) is --courses; --split is --split; --restraint side is --top restrained-far, --restraint floor is "
+    "--top floor; the other options are the same, with the same defaults. The blocks carry wall-section's names "
+    "(w01, w02; restraint_far or floor).",
 }
 
 #: Options every kind takes (density, time, motion, contact); not generator parameters
@@ -412,8 +428,9 @@ def _unit_height(args: argparse.Namespace, kind: str) -> float:
         "column": lambda: args.drum_height_m,
         "frame": lambda: args.beam_height_m,
         "stack": lambda: min(args.heights_m),
-        "restrained-wall": lambda: args.wall_height_m * min(args.split, 1 - args.split),
-        "wall-section": lambda: args.height_m / args.courses,
+        "restrained-wall": lambda: args.wall_height_m * (min(args.split, 1 - args.split) if args.blocks == 2 else 1),
+        "wall-section": lambda: args.height_m
+        * (min(args.split, 1 - args.split) if args.split is not None and args.courses == 2 else 1 / args.courses),
     }[kind]()
 
 
@@ -568,12 +585,13 @@ def cmd_build(args: argparse.Namespace) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
     scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
     _check_the_dem_takes_it(scene)
-    if kind == "restrained-wall" and args.restraint == "floor" and not args.gap_m:
+    floor = {"restrained-wall": ("restraint", "--restraint side"), "wall-section": ("top", "--top restrained-far")}
+    if kind in floor and getattr(args, floor[kind][0]) == "floor" and not args.gap_m:
         import sys
 
         print(
-            "rockyade: warning: --restraint floor with no --gap-m: the fixed floor rests on the wall's top and clamps "
-            "it (it cannot rise, hence cannot rock); leave a gap, or use --restraint side",
+            f"rockyade: warning: --{floor[kind][0]} floor with no --gap-m: the fixed floor rests on the wall's top and "
+            f"clamps it (it cannot rise, hence cannot rock); leave a gap, or use {floor[kind][1]}",
             file=sys.stderr,
         )
     summary = _summary(scene)
@@ -654,7 +672,7 @@ def register(sub: Any) -> None:
         k = kinds.add_parser(
             kind,
             help=text,
-            description=f"Generate {text}.",
+            description=f"Generate {text}." + (f" {ALIASES[kind]}" if kind in ALIASES else ""),
             formatter_class=_DefaultsFormatter,
         )
         for opt in options:

@@ -25,7 +25,7 @@ from matplotlib.axes import Axes
 from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import VERIFIED
 from rockyade.assess.fragility import FragilityResult
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY as G
 from rockyade.figures.common import figure_of, new_figure, save_figure
 
 CURVE = "#1f4e79"

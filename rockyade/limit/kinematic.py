@@ -9,7 +9,9 @@ Linear kinematic analysis:
   participating mass fraction e* = g M* / sum P_i, with P_i the weights of the blocks that
   take part and dx_i the virtual horizontal displacements of their centroids;
 * the spectral acceleration that activates the mechanism a0* = alpha0 g / (e* FC), m/s^2,
-  FC the confidence factor (1.35 for the limited knowledge level LC1).
+  FC the confidence factor (1.35 for the limited knowledge level LC1), g the code check's
+  (:data:`rockyade.constants.CODE_GRAVITY`: standard gravity, 9.80665 m/s^2, the same g that turns
+  the site's ag in g into m/s^2; docs/conventions.md).
 
 Nonlinear kinematic analysis: alpha(dk) as the mechanism moves
 (:mod:`rockyade.limit.finite`), dk the horizontal displacement of a control point k (here
@@ -35,6 +37,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.constants import CODE_GRAVITY
 from rockyade.errors import InputError
 from rockyade.limit.finite import CapacityCurve, capacity_curve
 from rockyade.limit.lp import DIRECTIONS
@@ -80,6 +83,9 @@ class KinematicQuantities:
         Secant period 2 pi sqrt(ds* / as*), s.
     nonlinear_note
         Why there is no nonlinear result, else None.
+    g
+        The g of a0* and a*, m/s^2: the code check's, standard gravity
+        (:data:`rockyade.constants.CODE_GRAVITY`).
     """
 
     alpha0: float
@@ -187,7 +193,7 @@ def kinematic_quantities(
     s1, s2 = float(np.sum(m * dx)), float(np.sum(m * dx * dx))
     M_star = s1 * s1 / s2
     e_star = M_star / sum_m
-    a0_star = alpha0 * model.g / (e_star * fc)
+    a0_star = alpha0 * CODE_GRAVITY / (e_star * fc)
     k = control_block(model, mechanism, direction)
     dx_k = d * float(mechanism.velocities[k, 0])
     factor = s2 / (dx_k * s1)
@@ -207,7 +213,7 @@ def kinematic_quantities(
         if curve.d0_m is None:
             note = f"the mechanism could not be followed to alpha = 0: {curve.stopped}"
         else:
-            scale = model.g / (e_star * fc)
+            scale = CODE_GRAVITY / (e_star * fc)
             d_star = curve.dk_m * factor
             a_star = curve.alpha * scale
             d0 = curve.d0_m * factor
@@ -234,5 +240,5 @@ def kinematic_quantities(
         as_star_m_s2=values["as"],
         Ts_s=values["Ts"],
         nonlinear_note=note,
-        g=model.g,
+        g=CODE_GRAVITY,
     )

@@ -125,7 +125,8 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     kin = result.kinematic
     assert lam is not None and mech is not None and kin is not None
     lines.append(
-        f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} m/s^2)"
+        f"status: collapse, load multiplier lambda = {lam:.4f} (a horizontal acceleration of {lam * model.g:.4g} "
+        f"m/s^2, lambda x the mechanics' g = {model.g:g} m/s^2)"
     )
     if lam == 0.0:
         lines.append(
@@ -154,7 +155,8 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
     lines.append(f"kinematic quantities (NTC 2018, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
     lines.append(
         f"  alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f} "
-        f"(of {kin.participating_mass_kg:.4g} kg moving); a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2"
+        f"(of {kin.participating_mass_kg:.4g} kg moving); a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2 "
+        f"(g = {kin.g:g} m/s^2, standard gravity, the code check's)"
     )
     if kin.d0_star_m is not None:
         lines.append(

@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rockyade.constants import STANDARD_GRAVITY
 from rockyade.errors import InputError
 from rockyade.motion.ec8 import ElasticSpectrum
 
@@ -124,7 +125,7 @@ def ntc_spectrum(
     soil: str = "A",
     topography: str = "T1",
     height_ratio: float = 1.0,
-    g: float = 9.81,
+    g: float = STANDARD_GRAVITY,
     damping: float = 0.05,
 ) -> NtcSpectrum:
     """NTC 2018's horizontal elastic spectrum of a site (module docstring).

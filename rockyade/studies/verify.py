@@ -68,7 +68,7 @@ import pandas as pd
 
 from rockyade.analysis.overlap import max_overlap
 from rockyade.blocks.restitution import effective_restitution, find_peaks
-from rockyade.constants import G
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.io.atomic import atomic_open, write_text
 from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
@@ -77,10 +77,10 @@ from rockyade.scene.generators import (
     drum_column,
     pulse_motion,
     rest_motion,
-    restrained_wall,
     rocking_frame,
     stack,
     wall,
+    wall_section,
 )
 from rockyade.solvers import run
 from rockyade.studies.checks import CHECKS
@@ -691,9 +691,7 @@ def _restrained_wall_rows() -> list[Row]:
     courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
     tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
     from rockyade.limit import limit_analysis
-    from rockyade.scene.generators import restrained_wall, wall_section
-
-    two = restrained_wall(blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0)
+    two = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0)
     lam2 = _known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
     eight = wall_section(
         height_m=2.4,
@@ -742,9 +740,9 @@ def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     from rockyade.limit import limit_analysis
 
     kin = _kinematic(limit_analysis(_block_scene(0.25, 2.5), fc=1.35))
-    ag, S, q = 0.25 * G, 1.2, 2.0
+    ag, S, q = 0.25 * CODE_GRAVITY, 1.2, 2.0  # ag in g and a0* with standard gravity (docs/conventions.md)
     linear, nonlinear = code_checks(kin, Site(1, "B", ag), Position())
-    a0 = 0.1 * G / 1.35
+    a0 = 0.1 * CODE_GRAVITY / 1.35
     ts = _known(kin.Ts_s, "Ts")
     du = _known(kin.du_star_m, "du*")
     sde = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2  # TC < Ts < TD
@@ -1078,13 +1076,13 @@ def limit_pushover_scenes(motion: dict[str, Any] | None = None) -> dict[str, tup
         "blocks": [{"name": "pier", "width_m": 0.4, "height_m": 2.0, "thickness_m": 1.0, "mass_kg": 1000.0}],
         "motion": m,
     }
-    restrained = restrained_wall(
-        blocks=2, split=0.5, restraint="side", restraint_friction_deg=0.0, motion=m, duration_s=1.0
+    restrained = wall_section(
+        courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0, motion=m, duration_s=1.0
     )
     return {
         "block": (block, None),
         "arch": (arch_data, None),
-        "restrained wall": (restrained, ("wall_lower", (-0.15, 1.5))),
+        "restrained wall": (restrained, ("w01", (-0.15, 1.5))),
         "panel": (panel, None),
     }
 

@@ -9,12 +9,14 @@ validates and :func:`write_scene` writes as TOML (or JSON)::
     write_scene("wall.toml", scene)
 
 The generators carry the names of ``rockyade build KIND``: :func:`wall`, :func:`column`,
-:func:`stack`, :func:`arch`, :func:`frame`, :func:`restrained_wall` (``restrained-wall``);
+:func:`stack`, :func:`arch`, :func:`frame`, :func:`wall_section` (``wall-section``, a wall's section out of
+its plane, free or restrained at its top; :func:`restrained_wall`, ``restrained-wall``, is its alias);
 :data:`GENERATORS` maps each kind to its function. Their modules are named in the plural so
 that no module hides a function of the same name: ``walls`` (dry walls, running or stack
 bond, openings), ``columns`` (drum columns, stacks), ``arches`` (semicircular and pointed
 arches on piers), ``frames`` (the rocking frame of Makris & Vassiliou 2013),
-``restrained_walls`` (a wall restrained at its top, the paper's Fig. 2), ``common`` (exact
+``wall_sections`` (a wall's out-of-plane section, the paper's Fig. 2), ``restrained_walls``
+(the alias), ``common`` (exact
 numbers, block tables, motions and contacts). ``drum_column`` and ``rocking_frame`` are the
 former names of :func:`column` and :func:`frame`.
 """

@@ -2,7 +2,7 @@
 
 Three cases (``kind``):
 
-* ``"section"`` (a wall's section out of its plane: ``restrained-wall``): the load per metre
+* ``"section"`` (a wall's section out of its plane: ``wall-section``): the load per metre
   of wall ``force_N_per_m`` times the wall's length (the blocks' ``thickness_m``), vertical,
   on the top block at ``eccentricity_m`` from the wall's axis (the top face's centre;
   > 0 towards +x);
