@@ -568,3 +568,24 @@ def test_figure_text_does_not_overlap(tmp_path):
     for i in range(len(boxes)):
         for j in range(i + 1, len(boxes)):
             assert not boxes[i].overlaps(boxes[j]), (texts[i].get_text(), texts[j].get_text())
+
+
+def test_too_few_records_give_no_interval_and_no_verdict():
+    """Two records cannot bound a median: no interval is quoted and no verdict given (as a
+    fragility fit refuses fewer than 5 records); 5 to 9 records carry a warning."""
+    two = pair_verdict("housner", "reference", median_interval([1.044, 1.091]), 0.05)
+    assert two.verdict == "too few records" and "interval" in two.sentence and "nan" not in two.sentence
+    one = pair_verdict("housner", "reference", median_interval([1.02]), 0.05)
+    assert one.verdict == "too few records" and "nan" not in one.sentence
+    six = pair_verdict("a", "b", median_interval([1.0, 1.01, 0.99, 1.02, 0.98, 1.0]), 0.05)
+    assert six.verdict == "agree" and "rough interval" in six.sentence
+
+
+def test_resume_of_a_complete_study_is_refused_and_leaves_it_alone(complete):
+    """--resume over a finished cross-check has nothing to finish: one line naming --resume,
+    and the complete set untouched (before, it ran every run again)."""
+    out, _ = complete
+    before = {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()}
+    with pytest.raises(InputError, match="nothing to resume"):
+        run(None, out, resume=True)  # the refusal comes before the plan is used
+    assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before

@@ -44,6 +44,10 @@ CONFIDENCE = 0.95
 BOOTSTRAP_SEED = 20261127
 #: Default tolerance on a median ratio (5 %); the interval must lie within twice it.
 TOLERANCE = 0.05
+#: Records a paired ratio needs before its interval means anything (as a fragility fit,
+#: :mod:`rockyade.assess.fit`, refuses fewer than 5 records and warns below 10).
+MIN_RECORDS = 5
+ADVISED_RECORDS = 10
 
 #: Status of a collapse search.
 BRACKETED, ABOVE, BELOW, NO_RUNS = (
@@ -291,7 +295,8 @@ def pair_verdict(
     * ``unresolved``: the difference |median - 1| is smaller than a solver's own change with
       dt halved (``dt_change``: solver -> |median of its dt ratio - 1|): it says nothing;
     * ``differ``: the interval excludes 1 +/- ``tolerance``;
-    * ``inconclusive`` otherwise.
+    * ``inconclusive`` otherwise;
+    * ``too few records``: fewer than :data:`MIN_RECORDS` paired records (no interval, no verdict).
 
     Parameters
     ----------
@@ -309,7 +314,15 @@ def pair_verdict(
     if not math.isfinite(m):
         return PairVerdict("inconclusive", f"{a} / {b}: no record with a collapse intensity from both")
     diff = abs(m - 1.0)
+    if ratio.n < MIN_RECORDS:
+        return PairVerdict(
+            "too few records",
+            f"{a} / {b} = {m:.3f} from {ratio.n} record(s): too few for an interval or a verdict "
+            f"(at least {MIN_RECORDS} records, {ADVISED_RECORDS} or more advised)",
+        )
     text = f"{a} / {b} = {m:.3f} (95 % interval {lo:.3f}-{hi:.3f}, {ratio.n} records)"
+    if ratio.n < ADVISED_RECORDS:
+        text += f"; fewer than {ADVISED_RECORDS} records: a rough interval"
     moved = {s: c for s, c in dt_change.items() if s in (a, b) and math.isfinite(c)}
     loudest = max(moved, key=lambda s: moved[s]) if moved else None
     dt_note = ""

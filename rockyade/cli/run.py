@@ -231,7 +231,7 @@ def register(sub: Any) -> None:
         "--solver",
         default="housner",
         choices=SOLVER_NAMES,
-        help="housner (exact classical), reference (standalone DEM) or yade",
+        help="housner (exact classical), reference (standalone DEM), yade or siconos (nonsmooth contact dynamics)",
     )
     p.add_argument("--out", type=Path, help="result CSV (the metadata JSON is written beside it)")
     p.add_argument("--plot", type=Path, help="PNG figure of the time history")

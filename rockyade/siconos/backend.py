@@ -44,6 +44,9 @@ SICONOS_MODULE = Path(
     os.environ.get("ROCKYADE_SICONOS_MODULE", "/usr/lib/python3/dist-packages/siconos/mechanics/collision/bullet.py")
 )
 LABEL = "Siconos"
+#: How a user raises a run's timeout: the command line's --yade-timeout bounds every solver with a
+#: ``timeout_s`` (rockyade.cli.common.SOLVER_OPTION_FLAGS); in Python, SiconosSolver(timeout_s=...).
+TIMEOUT_OPTION = "--yade-timeout (timeout_s in Python)"
 #: Samples so far are written every so many seconds while a scene runs, s.
 FLUSH_PERIOD_S = 30.0
 
@@ -149,7 +152,7 @@ def run_model(
     for stale in (out_file, partial):
         stale.unlink(missing_ok=True)
     payload = scene_payload(model, numerics)
-    program = Program([SICONOS_PYTHON, str(DRIVER)], _env(), LABEL, "timeout_s", FLUSH_PERIOD_S)
+    program = Program([SICONOS_PYTHON, str(DRIVER)], _env(), LABEL, TIMEOUT_OPTION, FLUSH_PERIOD_S)
     start = time.perf_counter()
     try:
         write_text(scene_file, json.dumps(payload, sort_keys=True) + "\n", durable=False)

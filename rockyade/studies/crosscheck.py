@@ -566,6 +566,12 @@ def run_crosscheck(
     stage = partial_dir(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     settle(out)
+    if resume and not (stage / "plan.json").is_file() and _complete(out):
+        raise InputError(
+            "--resume",
+            f"{out} is a complete cross-check and nothing is unfinished: there is nothing to resume "
+            "(run without --resume to run the study again)",
+        )
     stage.mkdir(exist_ok=True)
     start = time.perf_counter()
     with output_lock(stage, "--out"):
