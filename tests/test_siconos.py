@@ -127,12 +127,14 @@ def test_a_two_block_stack_stands_at_rest_with_the_dems_columns():
 
 
 def test_a_run_siconos_cannot_converge_fails_and_keeps_its_samples():
-    """One friction-solver iteration per step cannot hold a stack: the run is ``failed``,
-    says why, and keeps the samples it recorded (``partial``), never looking complete."""
+    """One friction-solver iteration per step cannot hold a stack (it blows up or stays
+    unconverged): the run is ``failed``, says why, and keeps the samples it recorded
+    (``partial``), never looking complete."""
     data = stack(widths_m=[0.4, 0.35], heights_m=0.5, motion=rest_motion(), duration_s=0.3, sample_dt_s=0.01)
     result = SiconosSolver(solver_max_iter=1).run(scene_from_dict(data))
     assert result.status == "failed" and not result.ok
-    assert "did not converge" in result.meta["failure_reason"]
+    reason = result.meta["failure_reason"]
+    assert "did not converge" in reason or "numerical instability" in reason
     assert result.meta["partial"] is True and len(result.frame) == result.meta["partial_samples"] > 0
     assert result.meta["unconverged_steps"] > 0
 

@@ -152,9 +152,15 @@ def dem_cost(scene: Scene, solver: str, seconds_per_body_step: float) -> CostEst
     dt, moving = _cached_dem_time_step(scene)
     steps_per_sample = max(1, math.ceil(scene.sample_dt_s / dt - 1e-9))
     steps = float(scene.n_samples - 1) * steps_per_sample * max(1, moving)
+    return stepped_cost(scene, solver, steps, dt, steps * seconds_per_body_step)
+
+
+def stepped_cost(scene: Scene, solver: str, steps: float, dt: float, run_time_s: float) -> CostEstimate:
+    """The cost of a run of ``steps`` body-steps at ``dt`` (s) taking ``run_time_s`` (s) that
+    records what a DEM run records (a solver with its own time step: Siconos)."""
     corners = sum(len(b.vertices_m or ()) or 4 for b in scene.blocks)
     columns = 2 + 6 * len(scene.blocks) + corners + 7
-    return _estimate(scene, solver, steps, dt, columns, steps * seconds_per_body_step)
+    return _estimate(scene, solver, steps, dt, columns, run_time_s)
 
 
 def sample_cost(scene: Scene, solver: str) -> CostEstimate:
