@@ -30,7 +30,7 @@ def supported_masses(scene: Scene) -> list[float]:
     return [sum(masses[i:]) for i in range(len(masses))]
 
 
-def calibrated_model(scene: Scene, g: float = G) -> DemModel:
+def calibrated_model(scene: Scene, g: float = G, *, rigid_contacts: bool = False) -> DemModel:
     """The scene's DEM model, every moving block's joint calibrated first (module docstring).
 
     The last scene's model is kept: the model is frozen and only read by the solvers, so the
@@ -43,20 +43,23 @@ def calibrated_model(scene: Scene, g: float = G) -> DemModel:
         A validated scene.
     g
         Gravity, m/s^2.
+    rigid_contacts
+        For a rigid-contact solver (Siconos): the penalty springs' settlement check is
+        skipped (:func:`rockyade.dem.build.build_dem_model`).
     """
     global _LAST
-    if _LAST is not None and _LAST[0] is scene and _LAST[1] == g:
+    if _LAST is not None and _LAST[0] is scene and _LAST[1] == g and _LAST[3] == rigid_contacts:
         return _LAST[2]
-    model = _calibrated_model(scene, g)
-    _LAST = (scene, g, model)  # the scene itself, so that its id is not reused while kept
+    model = _calibrated_model(scene, g, rigid_contacts)
+    _LAST = (scene, g, model, rigid_contacts)  # the scene itself, so that its id is not reused while kept
     return model
 
 
-#: The last (scene, g, model) of :func:`calibrated_model`.
-_LAST: tuple[Scene, float, DemModel] | None = None
+#: The last (scene, g, model, rigid_contacts) of :func:`calibrated_model`.
+_LAST: tuple[Scene, float, DemModel, bool] | None = None
 
 
-def _calibrated_model(scene: Scene, g: float) -> DemModel:
+def _calibrated_model(scene: Scene, g: float, rigid_contacts: bool) -> DemModel:
     supported = supported_masses(scene)
     joints = [
         None
@@ -72,4 +75,4 @@ def _calibrated_model(scene: Scene, g: float) -> DemModel:
         ).joint
         for i, spec in enumerate(scene.blocks)
     ]
-    return build_dem_model(scene, joints, g=g)
+    return build_dem_model(scene, joints, g=g, rigid_contacts=rigid_contacts)

@@ -310,6 +310,8 @@ def build_dem_model(
     scene: Scene,
     joints: Sequence[ContactParameters | None],
     g: float = G,
+    *,
+    rigid_contacts: bool = False,
 ) -> DemModel:
     """Resolve a scene and its blocks' own joints into the DEM model both DEM solvers run.
 
@@ -323,12 +325,16 @@ def build_dem_model(
         (:func:`rockyade.calibration.calibrate.calibrate`).
     g
         Gravity, m/s^2.
+    rigid_contacts
+        True for a solver whose contacts are rigid (Siconos: unilateral constraints, no
+        springs): the springs' static settlement is then not checked (it is not the model
+        that runs; ``static_settlement_m`` is NaN). The penalty DEMs leave it False.
 
     Raises
     ------
     InputError
-        Joints that do not match the blocks, a settlement above the limit, or a time step
-        above the stability limit.
+        Joints that do not match the blocks, a settlement above the limit (penalty
+        contacts only), or a time step above the stability limit.
     """
     own = list(joints)
     if len(own) != len(scene.blocks) or any(
@@ -365,7 +371,7 @@ def build_dem_model(
     springs = rest_springs(centroids, fixed, contacts, table)
     mass = mass_vector([b.mass_kg for b in bodies], [b.inertia_kgm2 for b in bodies], fixed)
     dt_stable, w_max = stability_limit(springs, mass, scene.contact.mass_damping_1_s)
-    settlement = _check_settlement(springs, bodies, contacts, table, scene, g)
+    settlement = math.nan if rigid_contacts else _check_settlement(springs, bodies, contacts, table, scene, g)
     pos0, ang0, vel0, angvel0 = _initial_state(scene, bodies, contacts)
     moving = [b for b in bodies if not b.fixed]
     dt_eq7 = time_step_eq7(

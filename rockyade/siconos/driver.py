@@ -57,22 +57,27 @@ import traceback
 import numpy as np
 
 SCENE_FORMAT = "rockyade-siconos-scene-1"
-#: The friction-contact solvers by name: NSGS (iterative), Lemke (pivoting, exact in 2-D).
+#: The friction-contact solvers by name (of Siconos's 3-D problem: a 2-D contact is a 3-D one
+#: whose second tangent sees only a small fictitious arm on the rotation, TWIST_ARM):
+#: Alart-Curnier nonsmooth Newton (a few iterations on a stack, measured) and Gauss-Seidel
+#: (thousands of iterations on a stack: two contacts per joint make it hyperstatic).
 SOLVERS = {
-    "nsgs": "SICONOS_FRICTION_2D_NSGS",
-    "lemke": "SICONOS_FRICTION_2D_LEMKE",
-    "enum": "SICONOS_FRICTION_2D_ENUM",
+    "nsn": "SICONOS_FRICTION_3D_NSN_AC",
+    "nsgs": "SICONOS_FRICTION_3D_NSGS",
 }
+#: The second tangent's arm on the rotation, m (it keeps the local 3x3 problem regular; its
+#: friction torque is at most TWIST_ARM x mu x N).
+TWIST_ARM = 1e-4
+#: A contact's gap is read this much smaller, m, so that a contact closed at the start
+#: (gap 0 up to rounding) is active from the first step.
+GAP_OFFSET_M = 1e-8
+#: A pair whose vertex has left its edge (by this fraction of the edge's length) is open.
+EDGE_SLACK = 1e-3
 #: Beyond these the state is a numerical blow-up, not rocking (as in the DEMs).
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
 #: A contact slips when |tangential| >= SLIP_RATIO x mu x normal.
 SLIP_RATIO = 0.999
-#: The ground: a static box, top face at y = 0, as wide as the scene plus this many times
-#: its largest block on each side, and as deep as that largest block (Bullet loses contacts
-#: against a static hull hundreds of times larger than the blocks: measured, a block sank
-#: 2 cm into a 2 km ground and stuck).
-GROUND_MARGIN_SIZES = 5.0
 
 
 class OutputError(Exception):
@@ -103,28 +108,13 @@ def _siconos():
     import siconos
     import siconos.kernel as sk
     import siconos.numerics as sn
-    from siconos.io.io_base import MechanicsIO
-    from siconos.mechanics.collision import (
-        RigidBody2dDS,
-        SiconosContactor,
-        SiconosContactorSet,
-        SiconosConvexHull2d,
-        SiconosDisk,
-    )
-    from siconos.mechanics.collision.bullet import SiconosBulletCollisionManager, SiconosBulletOptions
+    from siconos.mechanics.collision import RigidBody2dDS
 
     return {
         "version": getattr(siconos, "__version__", None) or _version(),
         "sk": sk,
         "sn": sn,
-        "MechanicsIO": MechanicsIO,
         "RigidBody2dDS": RigidBody2dDS,
-        "SiconosContactor": SiconosContactor,
-        "SiconosContactorSet": SiconosContactorSet,
-        "SiconosConvexHull2d": SiconosConvexHull2d,
-        "SiconosDisk": SiconosDisk,
-        "Manager": SiconosBulletCollisionManager,
-        "Options": SiconosBulletOptions,
     }
 
 
@@ -137,70 +127,173 @@ def _version():
         return "unknown"
 
 
-#: A contactor's offset: x, y, z and a unit quaternion (Siconos's 7-vector, also in 2-D).
-IDENTITY = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
-
-
-def _hull(S, vertices):
-    shape = S["SiconosConvexHull2d"]([list(map(float, v)) for v in vertices])
-    shape.setInsideMargin(0.0)
-    shape.setOutsideMargin(0.0)
-    return shape
-
-
-def _disk(S, radius):
-    shape = S["SiconosDisk"](float(radius))
-    shape.setInsideMargin(0.0)
-    shape.setOutsideMargin(0.0)
-    return shape
-
-
-def _offset(x, y):
-    return [float(x), float(y), 0.0, 1.0, 0.0, 0.0, 0.0]
-
-
 def _world(vertices, centroid, angle):
     c, s = math.cos(angle), math.sin(angle)
     return [[centroid[0] + c * x - s * y, centroid[1] + s * x + c * y] for x, y in vertices]
 
 
+def _rot(angle):
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([[c, -s], [s, c]])
+
+
+def contact_pairs(scene):
+    """The vertex-to-edge contact pairs of a scene, found once from the starting geometry.
+
+    Returns a list of dicts: ``a`` (the body of the vertex), ``v`` (its index), ``b`` (the
+    body of the edge, -1 for the ground), and for a block's edge its start point ``e0``,
+    unit direction ``t`` and outward normal ``n`` in that block's frame and its length ``L``;
+    ``mu`` the pair's friction coefficient. A vertex pairs with the ground when it starts
+    below ``ground_pair_fraction`` of its block's height, and with another block's edge when
+    it is within ``pair_gap_fraction`` of the smaller block's smallest dimension of the edge,
+    its foot within the edge by as much, and its own block lies on the edge's outer side
+    (both of its edges leave the vertex on that side): the reference DEM's contacts.
+    """
+    bodies = scene["bodies"]
+    mu = {}
+    for f in scene["friction_pairs"]:
+        mu[(int(f["a"]), int(f["b"]))] = float(f["mu"])
+        mu[(int(f["b"]), int(f["a"]))] = float(f["mu"])
+    local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
+    size = [float(np.min(np.ptp(v, axis=0))) for v in local]
+    world = [
+        np.asarray(b["centroid0_m"], dtype=float) + local[i] @ _rot(b["angle0_rad"]).T for i, b in enumerate(bodies)
+    ]
+    pairs = []
+    for a, ba in enumerate(bodies):
+        va = world[a]
+        na = len(va)
+        low = float(np.min(va[:, 1]))
+        for k in range(na):
+            if not ba["fixed"] and va[k, 1] - low <= scene["ground_pair_fraction"] * np.ptp(va[:, 1]) and low < size[a]:
+                pairs.append({"a": a, "v": k, "b": -1, "mu": mu[(a, -1)]})
+        for b, bb in enumerate(bodies):
+            if b == a or (ba["fixed"] and bb["fixed"]) or (a, b) not in mu:
+                continue
+            tol = scene["pair_gap_fraction"] * min(size[a], size[b])
+            vb = world[b]
+            nv = len(vb)
+            rb = _rot(-bb["angle0_rad"])
+            for e in range(nv):
+                p0, p1 = vb[e], vb[(e + 1) % nv]
+                length = float(np.hypot(*(p1 - p0)))
+                t = (p1 - p0) / length
+                n = np.array([t[1], -t[0]])  # outward: vertices are counter-clockwise
+                for k in range(na):
+                    p = va[k]
+                    g, sp = float((p - p0) @ n), float((p - p0) @ t)
+                    if not (-tol <= g <= tol and -tol <= sp <= length + tol):
+                        continue
+                    side = [va[k - 1] - p, va[(k + 1) % na] - p]
+                    if any(float(d @ n) < -1e-9 * length for d in side):
+                        continue
+                    pairs.append(
+                        {
+                            "a": a,
+                            "v": k,
+                            "b": b,
+                            "e0": rb @ (p0 - np.asarray(bb["centroid0_m"], dtype=float)),
+                            "t": rb @ t,
+                            "n": rb @ n,
+                            "L": length,
+                            "mu": mu[(a, b)],
+                        }
+                    )
+    return pairs
+
+
+class Contacts:
+    """The contact pairs as Siconos interactions: each a ``LagrangianLinearTIR`` y = C q + e,
+    (normal gap, tangential, twist) with C and e set before each step from the bodies'
+    positions (the gap and its Jacobian at the step's start: the linearised vertex-to-edge
+    distance, exact to first order), and ``NewtonImpactFrictionNSL(e, 0, mu, 3)``."""
+
+    def __init__(self, scene, sk, nsds, ds_of, pairs):
+        self.pairs = pairs
+        self.ds_of = ds_of
+        self.local = [np.asarray(b["vertices_m"], dtype=float) for b in scene["bodies"]]
+        self.static = [(np.asarray(b["centroid0_m"], dtype=float), float(b["angle0_rad"])) for b in scene["bodies"]]
+        self.inters, self.views, self.moving = [], [], []
+        laws = {}
+        for pair in pairs:
+            a, b = pair["a"], pair["b"]
+            moving = [x for x in (a, b) if x >= 0 and ds_of[x] is not None]
+            nsl = laws.get(pair["mu"])
+            if nsl is None:
+                nsl = laws[pair["mu"]] = sk.NewtonImpactFrictionNSL(float(scene["restitution"]), 0.0, pair["mu"], 3)
+            rel = sk.LagrangianLinearTIR(np.zeros((3, 3 * len(moving))), np.zeros(3))
+            inter = sk.Interaction(nsl, rel)
+            if len(moving) == 2:
+                nsds.link(inter, ds_of[moving[0]], ds_of[moving[1]])
+            else:
+                nsds.link(inter, ds_of[moving[0]])
+            self.inters.append(inter)
+            self.views.append((rel.C(), rel.e()))
+            self.moving.append(moving)
+        self.gaps = np.zeros(len(pairs))
+
+    def _state(self, i):
+        ds = self.ds_of[i]
+        if ds is None:
+            c, a = self.static[i]
+            return np.array([c[0], c[1], a])
+        return np.asarray(ds.q(), dtype=float)
+
+    def update(self):
+        """C and e of every pair at the bodies' current positions; the gaps (m) kept."""
+        q = {}
+        for k, pair in enumerate(self.pairs):
+            a, b = pair["a"], pair["b"]
+            qa = q.get(a)
+            if qa is None:
+                qa = q[a] = self._state(a)
+            ra = _rot(qa[2]) @ self.local[a][pair["v"]]
+            point = qa[:2] + ra
+            inside = True
+            if b < 0:
+                n = np.array([0.0, 1.0])
+                gap = point[1]
+                rb = None
+            else:
+                qb = q.get(b)
+                if qb is None:
+                    qb = q[b] = self._state(b)
+                rot = _rot(qb[2])
+                n = rot @ pair["n"]
+                t = rot @ pair["t"]
+                p0 = qb[:2] + rot @ pair["e0"]
+                gap = float((point - p0) @ n)
+                sp = float((point - p0) @ t)
+                slack = EDGE_SLACK * pair["L"]
+                inside = -slack <= sp <= pair["L"] + slack
+                rb = point - qb[:2]
+            tx, ty = -n[1], n[0]
+            C, e = self.views[k]
+            col = 0
+            qq = []
+            for body, sign, r in ((a, 1.0, ra), (b, -1.0, rb)):
+                if body < 0 or self.ds_of[body] is None:
+                    continue
+                C[0, col : col + 3] = (sign * n[0], sign * n[1], sign * (n[1] * r[0] - n[0] * r[1]))
+                C[1, col : col + 3] = (sign * tx, sign * ty, sign * (ty * r[0] - tx * r[1]))
+                C[2, col : col + 3] = (0.0, 0.0, sign * TWIST_ARM)
+                qq.append(q[body])
+                col += 3
+            qv = np.concatenate(qq)
+            self.gaps[k] = gap if inside else math.inf
+            e[0] = (gap - GAP_OFFSET_M if inside else 1.0) - float(C[0] @ qv)
+            e[1] = -float(C[1] @ qv)
+            e[2] = -float(C[2] @ qv)
+
+
 def build(scene, S):
     """The Siconos simulation of a scene: returns a dict of what the stepping needs."""
     sk, sn = S["sk"], S["sn"]
-    options = S["Options"]()
-    options.dimension = 1  # SICONOS_BULLET_2D
-    sizes = [max(np.ptp(np.asarray(b["vertices_m"]), axis=0)) for b in scene["bodies"]]
-    options.contactBreakingThreshold = scene["contact_breaking_fraction"] * min(sizes)
-    # contacts found afresh at every step: Bullet's persistent manifolds keep near-duplicate
-    # points of a disk (measured: up to four per vertex), on which the friction solver stalls
-    options.clearOverlappingPairCache = True
-    options.perturbationIterations = 0
-    options.minimumPointsPerturbationThreshold = 0
-    manager = S["Manager"](options)
-    for law in scene["laws"]:
-        nsl = sk.NewtonImpactFrictionNSL(float(scene["restitution"]), 0.0, float(law["mu"]), 2)
-        manager.insertNonSmoothLaw(nsl, int(law["g1"]), int(law["g2"]))
     t_end = scene["n_steps"] * scene["dt_s"]
     nsds = sk.NonSmoothDynamicalSystem(0.0, t_end)
-    big = max(sizes)
-    xs = [b["centroid0_m"][0] for b in scene["bodies"]]
-    left, right = min(xs) - GROUND_MARGIN_SIZES * big, max(xs) + GROUND_MARGIN_SIZES * big
-    ground = S["SiconosContactorSet"]()
-    ground.append(
-        S["SiconosContactor"](_hull(S, [[left, -big], [right, -big], [right, 0.0], [left, 0.0]]), IDENTITY, 0)
-    )
-    manager.insertStaticContactorSet(ground, IDENTITY)
     bodies = []
-    radius = float(scene["disk_radius_m"])
     for i, b in enumerate(scene["bodies"]):
-        verts = b["vertices_m"]
         if b["fixed"]:
-            at = b["centroid0_m"], b["angle0_rad"]
-            cs = S["SiconosContactorSet"]()
-            cs.append(S["SiconosContactor"](_hull(S, _world(verts, *at)), IDENTITY, int(b["hull_group"])))
-            for x, y in _world(b["disk_centres_m"], *at):
-                cs.append(S["SiconosContactor"](_disk(S, radius), _offset(x, y), int(b["disk_group"])))
-            manager.insertStaticContactorSet(cs, IDENTITY)
             bodies.append(None)
             continue
         x, y = b["centroid0_m"]
@@ -211,29 +304,23 @@ def build(scene, S):
             float(b["mass_kg"]),
             float(b["inertia_kgm2"]),
         )
-        ds.setUseContactorInertia(False)
         ds.setNumber(i + 1)
-        cs = S["SiconosContactorSet"]()
-        cs.append(S["SiconosContactor"](_hull(S, verts), IDENTITY, int(b["hull_group"])))
-        for x, y in b["disk_centres_m"]:
-            cs.append(S["SiconosContactor"](_disk(S, radius), _offset(x, y), int(b["disk_group"])))
-        ds.setContactors(cs)
-        ds.setAllowSelfCollide(False)
         ds.setFExtPtr([0.0, -float(b["mass_kg"]) * scene["g"], 0.0])
         nsds.insertDynamicalSystem(ds)
         bodies.append(ds)
+    contacts = Contacts(scene, sk, nsds, bodies, contact_pairs(scene))
+    contacts.update()
     osi = sk.MoreauJeanOSI(float(scene["theta"]))
     timedisc = sk.TimeDiscretisation(0.0, float(scene["dt_s"]))
     so = sk.solver_options_create(getattr(sn, SOLVERS[scene["friction_solver"]]))
     so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(scene["solver_max_iter"])
     so.dparam[sn.SICONOS_DPARAM_TOL] = float(scene["solver_tol"])
-    problem = sk.FrictionContact(2, so)
+    problem = sk.FrictionContact(3, so)
     problem.setKeepLambdaAndYState(True)
     sim = sk.TimeStepping(nsds, timedisc, osi, problem)
-    sim.insertInteractionManager(manager)
     sim.setNewtonMaxIteration(int(scene["newton_max_iter"]))
     sim.setNewtonTolerance(float(scene["newton_tol"]))
-    return {"sim": sim, "nsds": nsds, "bodies": bodies, "so": so, "manager": manager, "problem": problem}
+    return {"sim": sim, "nsds": nsds, "bodies": bodies, "so": so, "contacts": contacts, "problem": problem}
 
 
 class Recorder:
@@ -242,7 +329,6 @@ class Recorder:
     def __init__(self, scene, built, S, out_path):
         self.scene, self.built, self.S, self.out_path = scene, built, S, out_path
         self.sn = S["sn"]
-        self.io = S["MechanicsIO"]()
         nb = len(scene["bodies"])
         self.nb = nb
         self.ns = scene["n_samples"]
@@ -311,57 +397,29 @@ class Recorder:
         self.status, self.stop_time, self.stop_body = "failed", t, i
         return False
 
-    def _points(self):
-        """The active contacts' rows (MechanicsIO.contactPoints, 2-D: mu, point on A, point
-        on B, normal, force, gap, relative velocity, reaction impulse (normal, tangential),
-        interaction id, DS numbers), or None."""
-        nsds = self.built["nsds"]
-        if nsds.topology().indexSetsSize() < 2:
-            return None
-        cp = self.io.contactPoints(nsds, 1)
-        if cp is None or len(cp) == 0:
-            return None
-        return np.atleast_2d(cp)
-
     def _contacts(self, k):
         """Normal force and state per vertex, contact points and slip per block (module docstring)."""
-        cp = self._points()
-        if cp is None:
-            return
-        overlap = float(-np.min(cp[:, 9]))
-        if overlap > self.max_overlap:
-            self.max_overlap = overlap
+        contacts = self.built["contacts"]
         dt = self.scene["dt_s"]
         points = {}
-        for row in cp:
-            mu = row[0]
-            rn, rt = row[13] / dt, row[14] / dt
+        for pair, inter, gap in zip(contacts.pairs, contacts.inters, contacts.gaps, strict=True):
+            if not math.isfinite(gap):
+                continue
+            lam = inter.lambda_(1)
+            rn = float(lam[0]) / dt
             if rn <= 0.0:
                 continue
-            a, b = int(row[16]) - 1, int(row[17]) - 1
-            pa = row[1:3]
-            slips = abs(rt) >= SLIP_RATIO * mu * rn
-            # the vertex touching: the closest vertex of either body to the contact point
-            best = None
-            for body in {a, b}:
-                if body < 0 or body >= self.nb:
-                    continue
-                world = np.asarray(_world(self.verts[body], self.pos[k, body], self.ang[k, body]))
-                d = np.hypot(world[:, 0] - pa[0], world[:, 1] - pa[1])
-                v = int(np.argmin(d))
-                if best is None or d[v] < best[2]:
-                    best = (body, v, d[v])
-            if best is None:
-                continue
-            body, v, _ = best
+            if -gap > self.max_overlap:
+                self.max_overlap = -gap
+            body, v, other = pair["a"], pair["v"], pair["b"]
+            slips = abs(float(lam[1])) >= SLIP_RATIO * pair["mu"] * float(lam[0])
             self.fn[k, body, v] += rn
             if slips:
                 self.state[k, body, v] = 2
             elif self.state[k, body, v] == 0:
                 self.state[k, body, v] = 1
-            other = -1 if a == b else (b if body == a else a)
-            pair = (body, other) if other < 0 or body < other else (other, body)
-            points.setdefault(pair, set()).add((body, v))
+            key = (body, other) if other < 0 or body < other else (other, body)
+            points.setdefault(key, set()).add((body, v))
             if slips:
                 self.slip[k, body] = True
                 if other >= 0:
@@ -471,6 +529,7 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     next_flush = time.monotonic() + flush_s
     so, sn = built["so"], S["sn"]
     problem = built["problem"]
+    contacts = built["contacts"]
     go = rec.record(0.0)
     step = 0
     while go and step < n_steps:
@@ -483,6 +542,7 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
                 fx, fy = load["force_N"]
                 m0, q = load["arm_Nm"]
                 ds.setFExtPtr([m * ax + fx, m * ay + fy, math.cos(phi) * m0 - math.sin(phi) * q])
+        contacts.update()
         so.iparam[sn.SICONOS_IPARAM_ITER_DONE] = 0
         sim.computeOneStep()
         step += 1

@@ -28,6 +28,14 @@ THETA = 0.5
 #: dimension (the bearing points move this far in from the corners: alpha changes by about
 #: this fraction of b / R).
 DISK_FRACTION = 1e-3
+#: A vertex and another block's edge make a contact pair when, at the start, the vertex is
+#: within this fraction of the smaller block's smallest dimension of the edge, its foot on
+#: the edge's line within the edge by as much, and the vertex's block lies on the edge's
+#: outer side (the vertex-to-edge contacts of the reference DEM).
+PAIR_GAP_FRACTION = 0.05
+#: A vertex and the ground make a pair when the vertex starts below this fraction of its
+#: block's height.
+GROUND_PAIR_FRACTION = 0.3
 #: Beyond this many contact groups, one friction coefficient (the lowest) for all.
 MAX_GROUPS = 64
 
@@ -46,8 +54,9 @@ class Numerics:
         Newton restitution coefficient at every contact (0: perfectly inelastic impacts,
         so that the block's geometry alone sets its restitution, Housner's Eq 4).
     friction_solver
-        The friction-contact solver: "nsgs" (Gauss-Seidel, iterative) or "lemke"
-        (pivoting: exact for the 2-D problem, robust on stacked contacts).
+        The friction-contact solver: "nsn" (Alart-Curnier nonsmooth Newton, the default:
+        a few iterations a step on stacked contacts) or "nsgs" (Gauss-Seidel: thousands of
+        iterations on a stack, whose two contacts per joint make it hyperstatic).
     solver_tol, solver_max_iter
         Tolerance and iteration cap of the friction-contact solver.
     newton_max_iter, newton_tol
@@ -57,7 +66,7 @@ class Numerics:
     dt_s: float
     steps_per_sample: int
     restitution: float = 0.0
-    friction_solver: str = "nsgs"
+    friction_solver: str = "nsn"
     solver_tol: float = 1e-8
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
@@ -99,6 +108,20 @@ def contact_laws(model: DemModel) -> tuple[list[tuple[int, int]], list[dict[str,
         laws.append({"g1": groups[a][1], "g2": groups[b][0], "mu": mu})
         laws.append({"g1": groups[b][1], "g2": groups[a][0], "mu": mu})
     return groups, laws
+
+
+def friction_pairs(model: DemModel) -> list[dict[str, float | int]]:
+    """The friction coefficient of every pair of bodies that may touch (b = -1: the ground),
+    the DEMs' (tan of the joint's friction angle)."""
+    nb = len(model.bodies)
+    out: list[dict[str, float | int]] = []
+    for a in range(nb):
+        if not model.bodies[a].fixed:
+            out.append({"a": a, "b": -1, "mu": _friction(model, a, -1)})
+        for b in range(a + 1, nb):
+            if not (model.bodies[a].fixed and model.bodies[b].fixed):
+                out.append({"a": a, "b": b, "mu": _friction(model, a, b)})
+    return out
 
 
 def disk_radius(model: DemModel) -> float:
@@ -188,6 +211,9 @@ def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
         "contact_breaking_fraction": CONTACT_BREAKING_FRACTION,
         "disk_radius_m": radius,
         "laws": laws,
+        "friction_pairs": friction_pairs(model),
+        "pair_gap_fraction": PAIR_GAP_FRACTION,
+        "ground_pair_fraction": GROUND_PAIR_FRACTION,
         "bodies": bodies,
         "motion": None
         if motion is None

@@ -158,9 +158,15 @@ def dem_cost(scene: Scene, solver: str, seconds_per_body_step: float, dt_factor:
         steps_per_sample = math.ceil(steps_per_sample / dt_factor - 1e-9)
         dt = scene.sample_dt_s / steps_per_sample
     steps = float(scene.n_samples - 1) * steps_per_sample * max(1, moving)
+    return stepped_cost(scene, solver, steps, dt, steps * seconds_per_body_step)
+
+
+def stepped_cost(scene: Scene, solver: str, steps: float, dt: float, run_time_s: float) -> CostEstimate:
+    """The cost of a run of ``steps`` body-steps at ``dt`` (s) taking ``run_time_s`` (s) that
+    records what a DEM run records (a solver with its own time step: Siconos)."""
     corners = sum(len(b.vertices_m or ()) or 4 for b in scene.blocks)
     columns = 2 + 6 * len(scene.blocks) + corners + 7
-    return _estimate(scene, solver, steps, dt, columns, steps * seconds_per_body_step)
+    return _estimate(scene, solver, steps, dt, columns, run_time_s)
 
 
 def sample_cost(scene: Scene, solver: str) -> CostEstimate:

@@ -11,7 +11,6 @@ scene). The base motion enters as inertial forces -m a_g(t) in the base frame. S
 
 from __future__ import annotations
 
-import dataclasses
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
@@ -25,7 +24,7 @@ from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
 from rockyade.solvers.base import SolverBase, check_flag
-from rockyade.solvers.cost import CostEstimate, dem_cost
+from rockyade.solvers.cost import CostEstimate, stepped_cost
 
 #: Largest time step accepted, s.
 DT_LIMIT_S = 0.01
@@ -160,10 +159,11 @@ class SiconosSolver(SolverBase):
 
     def model(self, scene: Scene) -> DemModel:
         """The scene's blocks, motion and start as the DEMs build them (a matched calibration's
-        damping search is skipped: Siconos has no damping)."""
+        damping search is skipped: Siconos has no damping; the penalty springs' settlement
+        check is not made: its contacts are rigid)."""
         if scene.contact.calibration == "matched":
             scene = replace(scene, contact=replace(scene.contact, calibration="paper"))
-        return calibrated_model(scene)
+        return calibrated_model(scene, rigid_contacts=True)
 
     def numerics(self, model: DemModel) -> tuple[Numerics, dict[str, object]]:
         """The time step and solver settings for ``model``, and how the step was chosen."""
@@ -214,13 +214,7 @@ class SiconosSolver(SolverBase):
         numerics, _ = self.numerics(model)
         moving = max(1, len(model.moving))
         steps = float(scene.n_samples - 1) * numerics.steps_per_sample * moving
-        memory = dem_cost(scene, self.name, 0.0)
-        return dataclasses.replace(
-            memory,
-            integration_steps=steps,
-            time_step_s=numerics.dt_s,
-            wall_time_s=memory.wall_time_s + steps * self.SECONDS_PER_BODY_STEP,
-        )
+        return stepped_cost(scene, self.name, steps, numerics.dt_s, steps * self.SECONDS_PER_BODY_STEP)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
         """This solver keeping its files in ``folder`` (the stem is the scene hash's)."""
