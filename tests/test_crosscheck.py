@@ -123,7 +123,10 @@ def test_pair_verdict_says_nothing_below_the_dt_change():
     assert pair_verdict("a", "b", wide_gap, 0.05).verdict == "differ"
     moved = pair_verdict("a", "b", wide_gap, 0.05, {"a": 0.3, "b": 0.0})
     assert moved.verdict == "unresolved" and "says nothing" in moved.sentence
-    assert pair_verdict("a", "b", median_interval([0.7, 1.0, 1.0]), 0.05, {"a": 0.0}).verdict == "inconclusive"
+    assert (
+        pair_verdict("a", "b", median_interval([0.7, 0.7, 1.0, 1.0, 1.0, 1.0]), 0.05, {"a": 0.0}).verdict
+        == "inconclusive"
+    )
     caveat = pair_verdict("a", "b", tight, 0.05, {"b": 0.08})
     assert caveat.verdict == "agree" and "not converged" in caveat.sentence
 

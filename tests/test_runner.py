@@ -45,7 +45,7 @@ def test_options_that_do_not_apply_are_refused_naming_the_option():
     assert info.value.field == "timeout_s" and "reference" in str(info.value)
     with pytest.raises(InputError) as info:
         make_solvers(["housner", "reference"], {"timeout_s": 5}, {"timeout_s": "--yade-timeout"})
-    assert info.value.field == "--yade-timeout" and "yade solver only" in str(info.value)
+    assert info.value.field == "--yade-timeout" and "applies to the yade and siconos solvers only" in str(info.value)
     with pytest.raises(InputError) as info:
         make_solver("yade", timeout_s=-1, fields={"timeout_s": "--yade-timeout"})
     assert info.value.field == "--yade-timeout"
@@ -60,7 +60,7 @@ def test_options_that_do_not_apply_are_refused_naming_the_option():
 def test_the_command_line_refuses_yade_options_without_yade(tmp_path, capsys):
     scene = str(EXAMPLES / "specimen1_free.toml")
     assert main(["run", scene, "--solver", "reference", "--yade-timeout", "5"]) == 2
-    assert "error: --yade-timeout: applies to the yade solver only" in capsys.readouterr().err
+    assert "error: --yade-timeout: applies to the yade and siconos solvers only" in capsys.readouterr().err
     argv = ["compare", scene, "--solvers", "housner,reference", "--yade-timeout", "5", "--out", str(tmp_path / "c")]
     assert main(argv) == 2
     assert "--yade-timeout" in capsys.readouterr().err and not (tmp_path / "c").exists()

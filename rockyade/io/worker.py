@@ -48,7 +48,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
-from rockyade.errors import os_error_message
+from rockyade.errors import InputError, os_error_message
 from rockyade.io.atomic import create_temporary, file_mode
 from rockyade.io.lifetime import child_dies_with_parent
 
@@ -445,4 +445,37 @@ def _copy(text: str, fd: int) -> None:
             os.write(fd, text.encode())
 
 
-__all__ = ["Program", "Worker", "WorkerLostError", "close_workers", "run_scene", "slot"]
+#: The longest timeout a user may give a run, s (30 days).
+MAX_TIMEOUT_S = 30 * 86400.0
+
+
+def check_timeout(timeout_s: float | None, field: str = "timeout_s") -> float | None:
+    """A user timeout of a run in a worker (YADE, Siconos): None (the program's default) or a
+    number of seconds in (0, MAX_TIMEOUT_S].
+
+    Raises
+    ------
+    InputError
+        Not a positive finite number of seconds within the limit, naming ``field``.
+    """
+    if timeout_s is None:
+        return None
+    try:
+        value = float(timeout_s)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
+    if not (0.0 < value <= MAX_TIMEOUT_S):
+        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
+    return value
+
+
+__all__ = [
+    "MAX_TIMEOUT_S",
+    "Program",
+    "Worker",
+    "WorkerLostError",
+    "check_timeout",
+    "close_workers",
+    "run_scene",
+    "slot",
+]

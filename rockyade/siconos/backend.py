@@ -30,9 +30,10 @@ from rockyade import __version__
 from rockyade.dem.frames import dem_frame, energy_gain
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
-from rockyade.errors import InputError, SolverUnavailableError, os_error_message
+from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
 from rockyade.io.worker import Program, run_scene
+from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
 from rockyade.siconos.calibration import model_restitution
 from rockyade.siconos.payload import Numerics, scene_payload
@@ -54,7 +55,6 @@ FLUSH_PERIOD_S = 30.0
 TIMEOUT_STARTUP_S = 60.0
 TIMEOUT_PER_BODY_STEP_S = 10e-3
 TIMEOUT_CAP_S = 3600.0
-MAX_TIMEOUT_S = 30 * 86400.0
 
 #: A run fails when a step's friction-contact residual exceeds this (the solver stopped far
 #: from a solution) ...
@@ -87,22 +87,8 @@ def default_timeout(n_steps: int, n_bodies: int) -> float:
 
 
 def check_timeout(timeout_s: float | None, field: str = "timeout_s") -> float | None:
-    """A user timeout: None or seconds in (0, MAX_TIMEOUT_S].
-
-    Raises
-    ------
-    InputError
-        Not a positive finite number of seconds within the limit.
-    """
-    if timeout_s is None:
-        return None
-    try:
-        value = float(timeout_s)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
-    if not (0.0 < value <= MAX_TIMEOUT_S):
-        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
-    return value
+    """A user timeout checked (:func:`rockyade.io.worker.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
+    return checked_timeout(timeout_s, field)
 
 
 def run_model(

@@ -96,7 +96,8 @@ def make_solvers(
             owners = [n for n in SOLVER_CLASSES if key in solver_class(n).OPTIONS]
             runs = ", ".join(cls.name for cls in classes)
             raise InputError(
-                fields.get(key, key), f"applies to the {' and '.join(owners) or 'no'} solver only; this runs {runs}"
+                fields.get(key, key),
+                f"applies to the {' and '.join(owners) or 'no'} solver{'s' if len(owners) > 1 else ''} only; this runs {runs}",
             )
     return [cls.from_options({k: v for k, v in options.items() if k in cls.OPTIONS}, fields) for cls in classes]
 

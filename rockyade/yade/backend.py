@@ -46,6 +46,7 @@ from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
+from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
 from rockyade.scene import Scene
 from rockyade.yade.payload import scene_payload
@@ -79,7 +80,6 @@ TIMEOUT_PER_BODY_STEP_S = 50e-6
 #: ... capped here unless a larger one is asked for (``--yade-timeout``, ``timeout_s``).
 TIMEOUT_CAP_S = 3600.0
 #: Largest timeout accepted, s (30 days).
-MAX_TIMEOUT_S = 30 * 86400.0
 
 
 def default_timeout(model: DemModel) -> float:
@@ -90,22 +90,8 @@ def default_timeout(model: DemModel) -> float:
 
 
 def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> float | None:
-    """A user timeout checked: None (the default) or a number of seconds in (0, MAX_TIMEOUT_S].
-
-    Raises
-    ------
-    InputError
-        Not a positive finite number of seconds within the limit.
-    """
-    if timeout_s is None:
-        return None
-    try:
-        value = float(timeout_s)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a number of seconds, got {timeout_s!r}") from None
-    if not (0.0 < value <= MAX_TIMEOUT_S):
-        raise InputError(field, f"must be in (0, {MAX_TIMEOUT_S:g}] s, got {timeout_s!r}")
-    return value
+    """A user timeout checked (:func:`rockyade.io.worker.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
+    return checked_timeout(timeout_s, field)
 
 
 def run_model(
