@@ -97,7 +97,8 @@ def make_solvers(
             runs = ", ".join(cls.name for cls in classes)
             raise InputError(
                 fields.get(key, key),
-                f"applies to the {' and '.join(owners) or 'no'} solver{'s' if len(owners) > 1 else ''} only; this runs {runs}",
+                f"applies to the {' and '.join(owners) or 'no'} solver{'s' if len(owners) > 1 else ''} only; "
+                f"this runs {runs}",
             )
     return [cls.from_options({k: v for k, v in options.items() if k in cls.OPTIONS}, fields) for cls in classes]
 
