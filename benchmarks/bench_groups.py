@@ -54,8 +54,9 @@ def fragility(solver: str, repeat: int) -> tuple[int, float, float, bool]:
             folder = _folder()
             try:
                 tasks = fragility_study.tasks(folder, ("1",), RECORDS, LOAD_FACTORS, (solver,))
-                return run_study_tasks(tasks, folder, executor=Executor("threads", 1), progress=False,
-                                       group_runs=grouped)
+                return run_study_tasks(
+                    tasks, folder, executor=Executor("threads", 1), progress=False, group_runs=grouped
+                )
             finally:
                 shutil.rmtree(folder, ignore_errors=True)
 
@@ -84,13 +85,27 @@ def overturning_scans(repeat: int) -> list[tuple[str, int, float, float, bool]]:
 
 
 def _uncertainty_study(solvers: list[str]):
-    return uncertainty_study_from_dict({
-        "name": "bench", "solvers": solvers, "samples": 4, "seed": 7, "duration_s": 25.0, "sample_dt_s": 0.01,
-        "block": {"specimen": "1"},
-        "parameters": {"alpha_rad": {"distribution": "uniform", "mean": 0.235, "plus_minus_pct": 5},
-                       "p_rad_s": {"distribution": "uniform", "mean": 3.84, "plus_minus_pct": 5}},
-        "motion": {"suite": "paper", "records": list(RECORDS), "load_factors": list(LOAD_FACTORS), "pairing": "all"},
-    })
+    return uncertainty_study_from_dict(
+        {
+            "name": "bench",
+            "solvers": solvers,
+            "samples": 4,
+            "seed": 7,
+            "duration_s": 25.0,
+            "sample_dt_s": 0.01,
+            "block": {"specimen": "1"},
+            "parameters": {
+                "alpha_rad": {"distribution": "uniform", "mean": 0.235, "plus_minus_pct": 5},
+                "p_rad_s": {"distribution": "uniform", "mean": 3.84, "plus_minus_pct": 5},
+            },
+            "motion": {
+                "suite": "paper",
+                "records": list(RECORDS),
+                "load_factors": list(LOAD_FACTORS),
+                "pairing": "all",
+            },
+        }
+    )
 
 
 def uncertainty(solver: str, repeat: int) -> tuple[int, float, float, bool]:
@@ -102,8 +117,9 @@ def uncertainty(solver: str, repeat: int) -> tuple[int, float, float, bool]:
         def work(grouped: bool = grouped) -> Any:
             folder = _folder()
             try:
-                return run_uncertainty(study, folder, executor="threads", workers=1, progress=False, figure=False,
-                                       group_runs=grouped).runs
+                return run_uncertainty(
+                    study, folder, executor="threads", workers=1, progress=False, figure=False, group_runs=grouped
+                ).runs
             finally:
                 shutil.rmtree(folder, ignore_errors=True)
 
@@ -115,8 +131,9 @@ def uncertainty(solver: str, repeat: int) -> tuple[int, float, float, bool]:
 def task_making(repeat: int) -> list[tuple[str, int, float]]:
     """The parent's CPU per task to make a study's tasks (scenes read, validated, hashed)."""
     folder = _folder()
-    frag, tasks = best_cpu(lambda: fragility_study.tasks(folder, ("1", "2"), tuple(range(1, 11)),
-                                                         (0.4, 0.8, 1.2, 1.6, 2.0)), repeat)
+    frag, tasks = best_cpu(
+        lambda: fragility_study.tasks(folder, ("1", "2"), tuple(range(1, 11)), (0.4, 0.8, 1.2, 1.6, 2.0)), repeat
+    )
     study = _uncertainty_study(["housner", "reference"])
     samples = draw_samples(study)
     unc, utasks = best_cpu(lambda: build_tasks(study, samples, folder), repeat)

@@ -97,14 +97,28 @@ def kernel_target(repeat: int) -> None:
         np.array_equal(a, b, equal_nan=True) if isinstance(a, np.ndarray) else a == b
         for a, b in zip(general, single, strict=True)
     )
-    print(f"kernel, specimen 2 record 21, 25 s ({model.n_steps} steps), ns/step: "
-          + ", ".join(f"{k} {v:.1f}" for k, v in ns.items()))
-    row("kernel: general loop with energy terms", f"{ns['general, energy']:.1f} ns/step", "-",
-        f"before {BEFORE['kernel_ns_energy']:.1f}")
-    row("kernel: general loop without energy terms", f"{ns['general, no energy']:.1f} ns/step", "-",
-        f"before {BEFORE['kernel_ns_no_energy']:.1f}")
-    row("kernel: single-body path / hand-written floor", f"{ns['single-body path']:.1f} / {ns['floor']:.1f} ns/step",
-        "<= 1.2x", f"{ns['single-body path'] / ns['floor']:.2f}x; bit-identical to the general loop: {same}")
+    print(
+        f"kernel, specimen 2 record 21, 25 s ({model.n_steps} steps), ns/step: "
+        + ", ".join(f"{k} {v:.1f}" for k, v in ns.items())
+    )
+    row(
+        "kernel: general loop with energy terms",
+        f"{ns['general, energy']:.1f} ns/step",
+        "-",
+        f"before {BEFORE['kernel_ns_energy']:.1f}",
+    )
+    row(
+        "kernel: general loop without energy terms",
+        f"{ns['general, no energy']:.1f} ns/step",
+        "-",
+        f"before {BEFORE['kernel_ns_no_energy']:.1f}",
+    )
+    row(
+        "kernel: single-body path / hand-written floor",
+        f"{ns['single-body path']:.1f} / {ns['floor']:.1f} ns/step",
+        "<= 1.2x",
+        f"{ns['single-body path'] / ns['floor']:.2f}x; bit-identical to the general loop: {same}",
+    )
 
 
 def kernel_cpu(tasks) -> tuple[float, float]:
@@ -149,8 +163,9 @@ def overhead_target(repeat: int) -> None:
     def fresh():
         nonlocal n
         n += 1
-        return fragility_study.tasks(out / f"o{n}", specimens=("2",), records=range(1, 11), load_factors=(0.3,),
-                                     solvers=("reference",))
+        return fragility_study.tasks(
+            out / f"o{n}", specimens=("2",), records=range(1, 11), load_factors=(0.3,), solvers=("reference",)
+        )
 
     run_task(fresh()[0])
     run_job(tuple(fresh()[:2]))
@@ -161,13 +176,20 @@ def overhead_target(repeat: int) -> None:
         cpu_one = min(cpu_one, best_cpu(lambda tasks=tasks: [run_task(t) for t in tasks], 1) / len(tasks))
         tasks = fresh()
         cpu_group = min(cpu_group, best_cpu(lambda tasks=tasks: run_job(tuple(tasks)), 1) / len(tasks))
-    row("kernel: 10 runs stepped together (simulate_runs) / one at a time (single-body path), per run",
-        f"{1e3 * kern_group:.1f} / {1e3 * kern_one:.1f} ms CPU", "about 2x faster (issue: 13-18 ns per run-step)",
-        f"{kern_one / kern_group:.2f}x")
+    row(
+        "kernel: 10 runs stepped together (simulate_runs) / one at a time (single-body path), per run",
+        f"{1e3 * kern_group:.1f} / {1e3 * kern_one:.1f} ms CPU",
+        "about 2x faster (issue: 13-18 ns per run-step)",
+        f"{kern_one / kern_group:.2f}x",
+    )
     for label, cpu, kern in (("one run per job", cpu_one, kern_one), ("a group of 10 runs", cpu_group, kern_group)):
-        row(f"overhead of a 25 s batch run, {label}", f"{1e3 * cpu:.1f} ms CPU, kernel {1e3 * kern:.1f} ms",
-            "<= 20 % of the kernel", f"{100 * (cpu - kern) / kern:.0f} % (before: "
-            f"{100 * (BEFORE['run_cpu_ms'] - BEFORE['run_kernel_ms']) / BEFORE['run_kernel_ms']:.0f} %)")
+        row(
+            f"overhead of a 25 s batch run, {label}",
+            f"{1e3 * cpu:.1f} ms CPU, kernel {1e3 * kern:.1f} ms",
+            "<= 20 % of the kernel",
+            f"{100 * (cpu - kern) / kern:.0f} % (before: "
+            f"{100 * (BEFORE['run_cpu_ms'] - BEFORE['run_kernel_ms']) / BEFORE['run_kernel_ms']:.0f} %)",
+        )
 
 
 def cpu_now() -> float:
@@ -192,21 +214,35 @@ def batch_target() -> None:
         figures[(name, workers)] = len(summary) / wall
         per_cpu[(name, workers)] = len(summary) / cpu
         verdicts[(name, workers)] = summary.sort_values("index").status.tolist()
-        print(f"fragility batch, {len(summary)} runs, {name}, {workers} worker(s): {wall:.1f} s wall, {cpu:.1f} s CPU "
-              f"(parent and workers), {len(summary) / wall:.1f} runs/s, {len(summary) / cpu:.1f} runs per CPU-s, "
-              f"{(summary.status == 'overturned').sum()} overturned", flush=True)
+        print(
+            f"fragility batch, {len(summary)} runs, {name}, {workers} worker(s): {wall:.1f} s wall, {cpu:.1f} s CPU "
+            f"(parent and workers), {len(summary) / wall:.1f} runs/s, {len(summary) / cpu:.1f} runs per CPU-s, "
+            f"{(summary.status == 'overturned').sum()} overturned",
+            flush=True,
+        )
     one, grouped1, grouped2 = figures[("per-run", 1)], figures[("grouped", 1)], figures[("grouped", 2)]
     same = verdicts[("per-run", 1)] == verdicts[("grouped", 1)] == verdicts[("grouped", 2)]
-    row("fragility batch, runs/s/core (1 worker, wall)", f"{grouped1:.1f} grouped, {one:.1f} one run per job",
-        ">= 4x before", f"{grouped1 / BEFORE['fragility_runs_s_1w']:.1f}x before ({BEFORE['fragility_runs_s_1w']}), "
-        f"{grouped1 / one:.1f}x one run per job here; same verdicts: {same}")
-    row("fragility batch, runs per CPU-second (1 worker)",
-        f"{per_cpu[('grouped', 1)]:.1f} grouped, {per_cpu[('per-run', 1)]:.1f} one run per job", ">= 4x before",
-        f"{per_cpu[('grouped', 1)] / BEFORE['fragility_runs_s_1w']:.1f}x before (taken as 1 core busy then)")
+    row(
+        "fragility batch, runs/s/core (1 worker, wall)",
+        f"{grouped1:.1f} grouped, {one:.1f} one run per job",
+        ">= 4x before",
+        f"{grouped1 / BEFORE['fragility_runs_s_1w']:.1f}x before ({BEFORE['fragility_runs_s_1w']}), "
+        f"{grouped1 / one:.1f}x one run per job here; same verdicts: {same}",
+    )
+    row(
+        "fragility batch, runs per CPU-second (1 worker)",
+        f"{per_cpu[('grouped', 1)]:.1f} grouped, {per_cpu[('per-run', 1)]:.1f} one run per job",
+        ">= 4x before",
+        f"{per_cpu[('grouped', 1)] / BEFORE['fragility_runs_s_1w']:.1f}x before (taken as 1 core busy then)",
+    )
     cores = os.cpu_count() or 1
-    row(f"parallel efficiency, 2 workers ({cores} cores here)", f"{grouped2:.1f} runs/s",
-        ">= 90 % (on 16 cores: not measurable here)", f"{100 * grouped2 / (2 * grouped1):.0f} % of 2 x 1 worker "
-        f"(before: {100 * BEFORE['fragility_runs_s_2w'] / (2 * BEFORE['fragility_runs_s_1w']):.0f} %)")
+    row(
+        f"parallel efficiency, 2 workers ({cores} cores here)",
+        f"{grouped2:.1f} runs/s",
+        ">= 90 % (on 16 cores: not measurable here)",
+        f"{100 * grouped2 / (2 * grouped1):.0f} % of 2 x 1 worker "
+        f"(before: {100 * BEFORE['fragility_runs_s_2w'] / (2 * BEFORE['fragility_runs_s_1w']):.0f} %)",
+    )
 
 
 def wall_target() -> None:
@@ -221,8 +257,12 @@ def wall_target() -> None:
         run_model(model, record_energy=True)
         wall = min(run_model(model, record_energy=True).meta["wall_time_s"] for _ in range(2))
         per[n] = 1e9 * wall / (model.n_steps * len(model.bodies))
-    row("assembly: ~1,000-block wall at rest per block-step / single block (energy on, kernel, 0.05 s)",
-        f"{per[1000]:.0f} / {per[1]:.0f} ns", "<= 3x", f"{per[1000] / per[1]:.1f}x")
+    row(
+        "assembly: ~1,000-block wall at rest per block-step / single block (energy on, kernel, 0.05 s)",
+        f"{per[1000]:.0f} / {per[1]:.0f} ns",
+        "<= 3x",
+        f"{per[1000] / per[1]:.1f}x",
+    )
     # as a user counts it (issue 17 item 1): `rockyade run --solver reference`'s result,
     # wall_time_s (the kernel, loaded before its timer) / (n_steps x moving blocks); the
     # single block over 2 s so that its fixed costs do not count (the wall's 0.05 s are
@@ -236,8 +276,12 @@ def wall_target() -> None:
         moving = sum(1 for spec in scene.blocks if not spec.fixed)
         metas = [solver.run(scene).meta for _ in range(repeat)]
         user[n] = min(1e9 * m["wall_time_s"] / (m["n_steps"] * moving) for m in metas)
-    row("assembly: the same as `rockyade run` reports it (wall_time_s per block-step; 1 block over 2 s)",
-        f"{user[1000]:.0f} / {user[1]:.0f} ns", "<= 3x", f"{user[1000] / user[1]:.1f}x")
+    row(
+        "assembly: the same as `rockyade run` reports it (wall_time_s per block-step; 1 block over 2 s)",
+        f"{user[1000]:.0f} / {user[1]:.0f} ns",
+        "<= 3x",
+        f"{user[1000] / user[1]:.1f}x",
+    )
 
 
 def main() -> None:
@@ -245,8 +289,10 @@ def main() -> None:
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--no-wall", action="store_true", help="leave out the 1,000-block wall")
     args = parser.parse_args()
-    print(f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (a shared machine: "
-          "read the best of several runs)")
+    print(
+        f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (a shared machine: "
+        "read the best of several runs)"
+    )
     kernel_target(args.repeat)
     overhead_target(args.repeat)
     batch_target()

@@ -136,7 +136,11 @@ def harmonic_scene(amplitude_mm: float, duration: float = 20.0):
             "blocks": [BLOCK],
             "contact": {"calibration": "matched"},
             "motion": {
-                "type": "harmonic", "amplitude_mm": amplitude_mm, "frequency_hz": 3.3, "cycles": 20, "ramp_cycles": 2,
+                "type": "harmonic",
+                "amplitude_mm": amplitude_mm,
+                "frequency_hz": 3.3,
+                "cycles": 20,
+                "ramp_cycles": 2,
             },
         }
     )

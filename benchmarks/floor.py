@@ -17,8 +17,7 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def floor_loop(cx, cy, mass, inertia, kn, ks, cn, cs, tanphi, g, dt, n_steps, sps, stop, mt, mah, mav,
-               x, y, ang, out):
+def floor_loop(cx, cy, mass, inertia, kn, ks, cn, cs, tanphi, g, dt, n_steps, sps, stop, mt, mah, mav, x, y, ang, out):
     """Run the block; ``cx``, ``cy``: (2,) base corners relative to the centroid, m. Returns
     the steps run."""
     vx = 0.0
@@ -96,11 +95,27 @@ def floor_args(arrays: dict) -> tuple:
     j = int(a["base_joint"][0])
     n = int(a["n_steps"]) // int(a["steps_per_sample"]) + 1
     return (
-        cx, cy, float(a["mass"][0]), float(a["inertia"][0]), float(a["kn"][j]), float(a["ks"][j]), float(a["cn"][j]),
-        float(a["cs"][j]), float(a["tanphi"][j]), float(a["g"]), float(a["dt"]), int(a["n_steps"]),
-        int(a["steps_per_sample"]), float(a["stop_angle"][0]), np.asarray(a["mt"], float),
-        np.asarray(a["mah"], float), np.asarray(a["mav"], float), float(a["pos0"][0][0]), float(a["pos0"][0][1]),
-        float(a["ang0"][0]), np.full(n, np.nan),
+        cx,
+        cy,
+        float(a["mass"][0]),
+        float(a["inertia"][0]),
+        float(a["kn"][j]),
+        float(a["ks"][j]),
+        float(a["cn"][j]),
+        float(a["cs"][j]),
+        float(a["tanphi"][j]),
+        float(a["g"]),
+        float(a["dt"]),
+        int(a["n_steps"]),
+        int(a["steps_per_sample"]),
+        float(a["stop_angle"][0]),
+        np.asarray(a["mt"], float),
+        np.asarray(a["mah"], float),
+        np.asarray(a["mav"], float),
+        float(a["pos0"][0][0]),
+        float(a["pos0"][0][1]),
+        float(a["ang0"][0]),
+        np.full(n, np.nan),
     )
 
 

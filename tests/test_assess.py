@@ -447,8 +447,25 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
     assert np.asarray(dem.get_ydata())[0] == pytest.approx(a0)
     plt.close(fig)
     # the command: the option, the words, the JSON
-    assert main(["assess", str(EXAMPLES / "free_standing_wall.toml"), "--spectrum-type", "1", "--ground", "B",
-                 "--ag", "0.25g", "--static-only", "--pushover", "--out", str(tmp_path / "out")]) == 0
+    assert (
+        main(
+            [
+                "assess",
+                str(EXAMPLES / "free_standing_wall.toml"),
+                "--spectrum-type",
+                "1",
+                "--ground",
+                "B",
+                "--ag",
+                "0.25g",
+                "--static-only",
+                "--pushover",
+                "--out",
+                str(tmp_path / "out"),
+            ]
+        )
+        == 0
+    )
     assert "pushover (reference DEM" in capsys.readouterr().out
     written = json.loads((tmp_path / "out" / "assess.json").read_text())
     assert abs(written["pushover_onset_minus_alpha0_pct"]) <= 2.0

@@ -42,7 +42,7 @@ def test_a_grid_over_amplitude_g_runs_on_a_scene_given_in_g(tmp_path):
     amplitude_m_s2. A grid over amplitude_g replaces it (it used to fail naming
     motion.amplitude_m_s2, a key the user never wrote)."""
     grid = '"motion.amplitude_g" = [0.3, 0.5]'
-    path = _study(tmp_path, f'[base]\nfile = {_base("specimen1_pulse.toml")}\n[grid]\n{grid}\n')
+    path = _study(tmp_path, f"[base]\nfile = {_base('specimen1_pulse.toml')}\n[grid]\n{grid}\n")
     tasks = load_study(path, tmp_path / "out").tasks
     assert [t.scene.motion.amplitude_m_s2 for t in tasks] == pytest.approx([0.3 * G, 0.5 * G])
     assert [t.labels["motion.amplitude_g"] for t in tasks] == [0.3, 0.5]
@@ -196,7 +196,7 @@ def test_record_files_in_a_grid_are_named_from_the_study_file(tmp_path, monkeypa
         shutil.copy(EXAMPLES / "records" / name, studies / "records" / name)
     path = _study(
         studies,
-        f'[base]\nfile = {_base("specimen1_record.toml")}\n[grid]\n'
+        f"[base]\nfile = {_base('specimen1_record.toml')}\n[grid]\n"
         '"motion.file" = ["records/ricker_pulse_T0.5s.AT2", "records/ec8_type2_D_record21.AT2"]\n',
     )
     elsewhere = tmp_path / "elsewhere"
@@ -290,8 +290,9 @@ def test_duplicate_grid_points_run_once_and_are_reported(tmp_path, executor, wor
     assert len(list((tmp_path / "runs").glob("*.json"))) == 2
     for column in ("max_abs_theta_rad",):
         assert summary.loc[2, column] == summary.loc[0, column]
-    resumed = run_study_tasks(_duplicates(tmp_path), tmp_path, executor=executor, workers=workers, progress=False,
-                              resume=True)
+    resumed = run_study_tasks(
+        _duplicates(tmp_path), tmp_path, executor=executor, workers=workers, progress=False, resume=True
+    )
     pd.testing.assert_frame_equal(batch.comparable(resumed), batch.comparable(summary))
 
 
@@ -315,8 +316,11 @@ def test_the_batch_command_refuses_a_large_grid_unless_allowed(tmp_path, monkeyp
     from rockyade.cli import main
 
     monkeypatch.setattr(batch, "MAX_RUNS", 1)
-    path = _study(tmp_path, f'solvers = ["housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
-                  '"motion.theta0_rad" = [0.01, 0.02]\n')
+    path = _study(
+        tmp_path,
+        f'solvers = ["housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
+        '"motion.theta0_rad" = [0.01, 0.02]\n',
+    )
     assert main(["batch", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 2
     assert "2 runs, more than the limit of 1" in capsys.readouterr().err
     assert main(["batch", str(path), "--out", str(tmp_path / "out"), "--quiet", "--allow-large"]) == 0
@@ -326,8 +330,9 @@ def test_the_batch_command_refuses_a_large_grid_unless_allowed(tmp_path, monkeyp
 def test_every_result_carries_its_motion_coverage(solver):
     from rockyade.solvers import make_solver
 
-    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_record.toml").to_dict(), "duration_s": 1.0,
-                             "sample_dt_s": 0.01})
+    scene = scene_from_dict(
+        {**load_scene(EXAMPLES / "specimen1_record.toml").to_dict(), "duration_s": 1.0, "sample_dt_s": 0.01}
+    )
     result = make_solver(solver).run(scene)
     coverage = result.meta["motion_coverage"]
     assert coverage["status"] == "cut" and coverage["time_left_out_s"] == pytest.approx(4.0)

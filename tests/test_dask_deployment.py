@@ -56,8 +56,17 @@ class Cluster:
         self.address = json.loads(file.read_text())["address"]
         self.workers = [
             self._start(
-                DASK, "worker", self.address, "--nthreads", "1", *NO_DASHBOARD, "--no-nanny",
-                "--host", "127.0.0.1", "--name", f"w{i}",
+                DASK,
+                "worker",
+                self.address,
+                "--nthreads",
+                "1",
+                *NO_DASHBOARD,
+                "--no-nanny",
+                "--host",
+                "127.0.0.1",
+                "--name",
+                f"w{i}",
             )
             for i in range(workers)
         ]
@@ -107,14 +116,15 @@ def _study(folder: Path, duration_s: float, runs: int) -> None:
 def _batch(folder: Path, out: str, *extra: str) -> subprocess.Popen[str]:
     return subprocess.Popen(
         [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", out, "--quiet", *extra],
-        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
 
 
 @pytest.mark.slow
-def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(
-    tmp_path, cluster
-):
+def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(tmp_path, cluster):
     _study(tmp_path, duration_s=8.0, runs=6)
     local = _batch(tmp_path, "local", "--workers", "2")
     _stdout, stderr = local.communicate(timeout=300)

@@ -32,22 +32,74 @@ BLOCKER.write_text("x")
 
 VALUES = st.one_of(
     st.sampled_from(
-        ["0", "-1", "1", "2", "95", "1e400", "nan", "inf", "-inf", "abc", "", "1_0", "\u0661", "0.001", "1e-300",
-         "30", "N/m", "MN/m", "upper", "7", "g", "cm/s2", "furlong", str(RECORD), str(BLOCKER / "x"),
-         str(FOLDER / "missing.toml"), *SCENES, "--json", "--", "-", "tcp://127.0.0.1:9"]
+        [
+            "0",
+            "-1",
+            "1",
+            "2",
+            "95",
+            "1e400",
+            "nan",
+            "inf",
+            "-inf",
+            "abc",
+            "",
+            "1_0",
+            "\u0661",
+            "0.001",
+            "1e-300",
+            "30",
+            "N/m",
+            "MN/m",
+            "upper",
+            "7",
+            "g",
+            "cm/s2",
+            "furlong",
+            str(RECORD),
+            str(BLOCKER / "x"),
+            str(FOLDER / "missing.toml"),
+            *SCENES,
+            "--json",
+            "--",
+            "-",
+            "tcp://127.0.0.1:9",
+        ]
     ),
     st.text(max_size=8),
 )
 #: Values of the options that write: never a file of the project (a scene must not become a PNG).
 OUTPUTS = st.sampled_from(
-    ["", "-", "x.png", "x.csv", "sub/x.csv", "sub/x.png", "x.toml", str(BLOCKER), str(BLOCKER / "x.csv"),
-     str(FOLDER / "cmp"), "/proc/x.csv"]
+    [
+        "",
+        "-",
+        "x.png",
+        "x.csv",
+        "sub/x.csv",
+        "sub/x.png",
+        "x.toml",
+        str(BLOCKER),
+        str(BLOCKER / "x.csv"),
+        str(FOLDER / "cmp"),
+        "/proc/x.csv",
+    ]
 )
 WRITERS = ("--out", "--plot")
 
 COMMANDS = {
-    "params": ["--specimen", "--width", "--height", "--thickness", "--mass", "--density", "--inertia", "--vertices",
-               "--chamfer", "--scene", "--block"],
+    "params": [
+        "--specimen",
+        "--width",
+        "--height",
+        "--thickness",
+        "--mass",
+        "--density",
+        "--inertia",
+        "--vertices",
+        "--chamfer",
+        "--scene",
+        "--block",
+    ],
     "calibrate": ["--specimen", "--parameters", "--stiffness-scale", "--friction-angle"],
     "run": ["--solver", "--out", "--plot"],
     "motion info": ["--units", "--format", "--dt"],

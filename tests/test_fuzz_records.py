@@ -34,8 +34,32 @@ EXACT_G = np.array([float(f"{v:.7E}") for v in VALUES]) * STANDARD_GRAVITY
 PIECES = st.one_of(
     st.binary(max_size=6),
     st.sampled_from(
-        [b"\xef\xbb\xbf", b"D", b"E", b"d", b"1_0", b"\xd9\xa1", b"\xef\xbc\x91", b"nan", b"inf", b"1e400", b"-",
-         b".", b" ", b"\n", b"\r", b",", b"#", b"NPTS=", b"DT=", b"1E400", b"\x00", b"\xff", b"9" * 30, b"0x10"]
+        [
+            b"\xef\xbb\xbf",
+            b"D",
+            b"E",
+            b"d",
+            b"1_0",
+            b"\xd9\xa1",
+            b"\xef\xbc\x91",
+            b"nan",
+            b"inf",
+            b"1e400",
+            b"-",
+            b".",
+            b" ",
+            b"\n",
+            b"\r",
+            b",",
+            b"#",
+            b"NPTS=",
+            b"DT=",
+            b"1E400",
+            b"\x00",
+            b"\xff",
+            b"9" * 30,
+            b"0x10",
+        ]
     ),
 )
 

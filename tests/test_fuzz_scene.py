@@ -117,8 +117,29 @@ def test_fuzz_scene_json_files(d):
 
 BYTES = st.one_of(
     st.binary(max_size=8),
-    st.sampled_from([b"\xff", b"\xe9", b"\x00", b"\xef\xbb\xbf", b"1_0", b"1e400", b"nan", b"inf", b"[[[[[[", b"]",
-                     b"\n[[blocks]]\n", b" = ", b"\"", b"'", b"9" * 400, b"\xd9\xa1", b"\r\n", b"#", b"0x1F"]),
+    st.sampled_from(
+        [
+            b"\xff",
+            b"\xe9",
+            b"\x00",
+            b"\xef\xbb\xbf",
+            b"1_0",
+            b"1e400",
+            b"nan",
+            b"inf",
+            b"[[[[[[",
+            b"]",
+            b"\n[[blocks]]\n",
+            b" = ",
+            b'"',
+            b"'",
+            b"9" * 400,
+            b"\xd9\xa1",
+            b"\r\n",
+            b"#",
+            b"0x1F",
+        ]
+    ),
 )
 
 

@@ -345,9 +345,7 @@ def test_round_drums_carry_a_cylinders_mass_and_inertia_into_housner_and_both_de
     from rockyade.yade.payload import scene_payload
 
     round_column = scene_from_dict(column(drums=6, diameter_m=0.8, drum_height_m=1.0, density_kg_m3=2700))
-    square = scene_from_dict(
-        column(drums=6, diameter_m=0.8, drum_height_m=1.0, density_kg_m3=2700, section="square")
-    )
+    square = scene_from_dict(column(drums=6, diameter_m=0.8, drum_height_m=1.0, density_kg_m3=2700, section="square"))
     assert sum(b.block().mass_kg for b in round_column.blocks) == pytest.approx(8143.0, abs=0.5)
     assert sum(b.block().mass_kg for b in square.blocks) == pytest.approx(10368.0)
     mass, inertia = round_drum_mass_inertia(0.8, 1.0, 2700.0)

@@ -78,10 +78,23 @@ def test_a_load_on_a_fixed_block_is_refused():
                 "duration_s": 1.0,
                 "sample_dt_s": 0.01,
                 "blocks": [
-                    {"name": "f", "width_m": 1, "height_m": 0.2, "thickness_m": 1, "mass_kg": 10,
-                     "position_m": [0, 0], "fixed": True},
-                    {"name": "b", "width_m": 0.2, "height_m": 1, "thickness_m": 1, "mass_kg": 10,
-                     "position_m": [0.4, 0.2]},
+                    {
+                        "name": "f",
+                        "width_m": 1,
+                        "height_m": 0.2,
+                        "thickness_m": 1,
+                        "mass_kg": 10,
+                        "position_m": [0, 0],
+                        "fixed": True,
+                    },
+                    {
+                        "name": "b",
+                        "width_m": 0.2,
+                        "height_m": 1,
+                        "thickness_m": 1,
+                        "mass_kg": 10,
+                        "position_m": [0.4, 0.2],
+                    },
                 ],
                 "motion": {"type": "rest"},
                 "loads": [{"block": "f", "point_m": [0.5, 0.2], "force_N": [0, -10]}],
@@ -149,8 +162,14 @@ def test_the_engineers_roof_by_hand():
     lam = {}
     kin = {}
     for with_mass in (False, True):
-        data = wall_section(height_m=2.4, thickness_m=0.36, density_kg_m3=1600.0, overburden_n_per_m=6000.0,
-                            overburden_eccentricity_m=0.05, motion={"type": "rest"})
+        data = wall_section(
+            height_m=2.4,
+            thickness_m=0.36,
+            density_kg_m3=1600.0,
+            overburden_n_per_m=6000.0,
+            overburden_eccentricity_m=0.05,
+            motion={"type": "rest"},
+        )
         if not with_mass:
             data["loads"] = [{**q, "mass_kg": 0.0} for q in data["loads"]]
         result = limit_analysis(scene_from_dict(data), direction="+x")

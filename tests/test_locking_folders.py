@@ -64,9 +64,20 @@ def test_the_command_line_run_is_refused_inside_a_running_batch_s_folder(tmp_pat
     out = tmp_path / "batch"
     with Holder(out) as holder:
         proc = subprocess.run(
-            [sys.executable, "-m", "rockyade", "run", str(EXAMPLES / "specimen3_free.toml"), "--solver", "housner",
-             "--out", str(out / "runs" / "mine.csv")],
-            capture_output=True, text=True, timeout=120,
+            [
+                sys.executable,
+                "-m",
+                "rockyade",
+                "run",
+                str(EXAMPLES / "specimen3_free.toml"),
+                "--solver",
+                "housner",
+                "--out",
+                str(out / "runs" / "mine.csv"),
+            ],
+            capture_output=True,
+            text=True,
+            timeout=120,
         )
         assert proc.returncode == 2, proc.stderr
         assert "Traceback" not in proc.stderr and f"pid {holder.proc.pid}" in proc.stderr

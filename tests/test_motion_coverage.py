@@ -91,7 +91,6 @@ def test_rockyade_run_warns_on_stderr_when_the_scene_ends_before_its_record(tmp_
     assert "warning" not in capsys.readouterr().err
 
 
-
 def test_rockyade_run_works_out_the_coverage_once_and_its_result_carries_it(tmp_path, monkeypatch):
     """The warning before the run and the Result's meta["motion_coverage"] are one computation
     (the record is read and integrated once per run), and the Result's is the warned one."""

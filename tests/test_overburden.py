@@ -17,8 +17,13 @@ from rockyade.scene.generators.overburden import add_overburden
 
 @pytest.mark.parametrize("with_mass", [False, True])
 def test_a_column_top_load_gives_the_closed_form_in_the_limit_analysis(with_mass):
-    data = add_overburden(stack(widths_m=[0.4], heights_m=2.0, motion=rest_motion()), "point", force_N=5000.0,
-                          eccentricity_m=-0.1, with_mass=with_mass)
+    data = add_overburden(
+        stack(widths_m=[0.4], heights_m=2.0, motion=rest_motion()),
+        "point",
+        force_N=5000.0,
+        eccentricity_m=-0.1,
+        with_mass=with_mass,
+    )
     assert data["loads"][0]["mass_kg"] == (pytest.approx(5000.0 / G) if with_mass else 0.0)
     scene = scene_from_dict(data)
     w = scene.blocks[0].block().mass_kg * G
@@ -68,18 +73,69 @@ def test_bad_overburdens_are_refused(kind, kwargs, field):
 
 def test_rockyade_build_writes_the_overburden(tmp_path, capsys):
     out = tmp_path / "rw.toml"
-    assert main(["build", "restrained-wall", "--blocks", "1", "--gap-m", "0.05", "--overburden-n-per-m", "20000",
-                 "--overburden-eccentricity-m", "0.1", "--motion", "gravity-ramp", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "build",
+                "restrained-wall",
+                "--blocks",
+                "1",
+                "--gap-m",
+                "0.05",
+                "--overburden-n-per-m",
+                "20000",
+                "--overburden-eccentricity-m",
+                "0.1",
+                "--motion",
+                "gravity-ramp",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     scene = load_scene(out)
     assert scene.motion.type == "gravity-ramp"
     assert [(q.block, q.point_m, q.force_N) for q in scene.loads] == [("w01", (0.1, 3.0), (0.0, -20000.0))]
     assert scene.loads[0].mass_kg == pytest.approx(20000.0 / G)
-    assert main(["build", "restrained-wall", "--blocks", "1", "--gap-m", "0.05", "--overburden-n-per-m", "20000",
-                 "--overburden-mass", "none", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "build",
+                "restrained-wall",
+                "--blocks",
+                "1",
+                "--gap-m",
+                "0.05",
+                "--overburden-n-per-m",
+                "20000",
+                "--overburden-mass",
+                "none",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     assert load_scene(out).loads[0].mass_kg == 0.0
-    assert main(["build", "wall-section", "--overburden-n-per-m", "6000", "--overburden-mass", "none",
-                 "--out", str(out)]) == 0
+    assert (
+        main(["build", "wall-section", "--overburden-n-per-m", "6000", "--overburden-mass", "none", "--out", str(out)])
+        == 0
+    )
     assert load_scene(out).loads[0].mass_kg == 0.0
-    assert main(["build", "column", "--top-load-n", "100", "--top-load-eccentricity-m", "5",
-                 "--out", str(tmp_path / "c.toml")]) == 2
+    assert (
+        main(
+            [
+                "build",
+                "column",
+                "--top-load-n",
+                "100",
+                "--top-load-eccentricity-m",
+                "5",
+                "--out",
+                str(tmp_path / "c.toml"),
+            ]
+        )
+        == 2
+    )
     assert "--top-load-eccentricity-m" in capsys.readouterr().err

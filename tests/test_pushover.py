@@ -68,8 +68,17 @@ def test_gravity_ramp_brings_gravity_in_smoothly():
 
 
 def test_pushover_path_holds_its_levels_and_pushes_the_way_it_says():
-    spec = parse_motion({"type": "pushover", "direction": "+x", "rate_g_per_s": 0.1, "max_lambda": 0.3,
-                         "start_lambda": 0.2, "step_lambda": 0.05, "hold_s": 1.0})
+    spec = parse_motion(
+        {
+            "type": "pushover",
+            "direction": "+x",
+            "rate_g_per_s": 0.1,
+            "max_lambda": 0.3,
+            "start_lambda": 0.2,
+            "step_lambda": 0.05,
+            "hold_s": 1.0,
+        }
+    )
     assert isinstance(spec, Pushover)
     np.testing.assert_allclose(spec.levels(), [0.2, 0.25, 0.3])
     motion = spec.ground_motion(20.0)
@@ -157,8 +166,14 @@ def test_a_wall_restrained_at_its_top_forms_the_three_hinge_mechanism(solver):
     expected = three_hinge_multiplier(0.3, 3.0, 1.5, 0.3)
     assert expected == pytest.approx(17 / 35, rel=1e-12)
     motion = pushover(expected)
-    data = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0, motion=motion,
-                        duration_s=push_duration(motion))
+    data = wall_section(
+        courses=2,
+        split=0.5,
+        top="restrained-far",
+        restraint_friction_deg=0.0,
+        motion=motion,
+        duration_s=push_duration(motion),
+    )
     assert data["joints"] == [{"blocks": ["w02", "restraint_far"], "friction_angle_deg": 0.0}]
     scene = scene_from_dict(data)
     result = limit_analysis(scene, direction="+x")
@@ -287,9 +302,7 @@ def test_a_slender_running_bond_panel_goes_below_the_limit_analysis_by_non_assoc
         (0.106, {"type": "gravity-ramp", "ramp_s": 1.0}, False),
     ],
 )
-def test_an_arch_just_above_its_static_limit_stands_under_gravity_ramp_and_falls_when_dropped(
-    t_over_r, motion, stands
-):
+def test_an_arch_just_above_its_static_limit_stands_under_gravity_ramp_and_falls_when_dropped(t_over_r, motion, stands):
     """The static limit of a 20-voussoir arch is t/R = 0.1073: at 0.108 it stands when gravity
     is ramped in and falls when dropped (``rest``); at 0.106 it falls either way."""
     scene = arch_scene(t_over_r, 20).with_changes(motion=parse_motion(motion), duration_s=2.5)
@@ -343,8 +356,25 @@ def test_rockyade_run_writes_the_capacity_curve_of_a_pushover(tmp_path, capsys):
     from rockyade.cli import main
 
     scene_file = tmp_path / "pier.toml"
-    assert main(["build", "stack", "--widths-m", "0.4", "--heights-m", "2.0", "--motion", "pushover",
-                 "--duration-s", "8", "--out", str(scene_file)]) == 0
+    assert (
+        main(
+            [
+                "build",
+                "stack",
+                "--widths-m",
+                "0.4",
+                "--heights-m",
+                "2.0",
+                "--motion",
+                "pushover",
+                "--duration-s",
+                "8",
+                "--out",
+                str(scene_file),
+            ]
+        )
+        == 0
+    )
     assert main(["run", str(scene_file), "--solver", "reference", "--out", str(tmp_path / "pier.csv")]) == 0
     curve = pd.read_csv(tmp_path / "pier_capacity.csv")
     assert list(curve.columns) == ["t_s", "lambda", "displacement_m", "control_x_m", "control_y_m"]
@@ -360,14 +390,17 @@ def test_with_friction_the_restraint_locks_the_two_block_wall_and_a_floor_withou
     that the floor clamps the wall."""
     from rockyade.cli import main
 
-    locked = scene_from_dict(wall_section(courses=2, top="restrained-far", restraint_friction_deg=None,
-                                          motion={"type": "rest"}))
+    locked = scene_from_dict(
+        wall_section(courses=2, top="restrained-far", restraint_friction_deg=None, motion={"type": "rest"})
+    )
     assert limit_analysis(locked, direction="+x", sliding=False).status == "no_mechanism"
     assert limit_analysis(locked, direction="+x").load_multiplier > 1.3 * 17 / 35
     assert main(["build", "restrained-wall", "--restraint", "floor", "--out", str(tmp_path / "f.toml")]) == 0
     assert "clamps it" in capsys.readouterr().err
-    assert main(["build", "restrained-wall", "--restraint", "floor", "--gap-m", "0.01",
-                 "--out", str(tmp_path / "g.toml")]) == 0
+    assert (
+        main(["build", "restrained-wall", "--restraint", "floor", "--gap-m", "0.01", "--out", str(tmp_path / "g.toml")])
+        == 0
+    )
     assert "clamps" not in capsys.readouterr().err
     assert main(["build", "wall-section", "--top", "floor", "--out", str(tmp_path / "h.toml")]) == 0
     assert "--top floor with no --gap-m" in capsys.readouterr().err

@@ -39,8 +39,10 @@ def _study(folder: Path, duration_s: float, runs: int, sample_dt: float = 0.01) 
     )
     thetas = ", ".join(f"{0.02 + 0.005 * i:.3f}" for i in range(runs))
     study = folder / "study.toml"
-    study.write_text(f'name = "stress"\nsolvers = ["reference"]\n[base]\nfile = "scene.toml"\n'
-                     f'[grid]\n"motion.theta0_rad" = [{thetas}]\n')
+    study.write_text(
+        f'name = "stress"\nsolvers = ["reference"]\n[base]\nfile = "scene.toml"\n'
+        f'[grid]\n"motion.theta0_rad" = [{thetas}]\n'
+    )
     return study
 
 
@@ -55,9 +57,6 @@ def _batch(folder: Path, *extra: str) -> subprocess.Popen[str]:
         text=True,
         start_new_session=True,
     )
-
-
-
 
 
 def _wait_for(condition, timeout: float, what: str) -> None:
@@ -112,7 +111,10 @@ def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
     stamps = {p.name: p.stat().st_mtime_ns for p in _results(out)}
     again = subprocess.run(
         [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", "out", "--quiet", "--resume"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=600,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert again.returncode == 0, again.stderr
     summary = pd.read_csv(out / "summary.csv")
@@ -163,7 +165,10 @@ def test_sigkilled_parent_takes_its_workers_and_resume_loses_nothing(tmp_path):
 
     again = subprocess.run(
         [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", "out", "--quiet", "--resume"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=600,
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=600,
     )
     assert again.returncode == 0, again.stderr
     summary = pd.read_csv(out / "summary.csv")
@@ -256,7 +261,11 @@ def test_unreachable_scheduler_is_an_error_naming_it(tmp_path):
     pytest.importorskip("distributed")
     with pytest.raises(InputError) as info:
         run_study_tasks(
-            _tasks(tmp_path)[:1], tmp_path, executor="dask", scheduler="tcp://127.0.0.1:9", scheduler_timeout_s=1.0,
+            _tasks(tmp_path)[:1],
+            tmp_path,
+            executor="dask",
+            scheduler="tcp://127.0.0.1:9",
+            scheduler_timeout_s=1.0,
             progress=False,
         )
     assert info.value.field == "scheduler" and "no Dask scheduler answered" in str(info.value)
@@ -311,9 +320,15 @@ def test_tiny_tmpfs_full_disk_is_a_clear_failure(tmp_path):
 
 def test_a_second_batch_into_the_same_output_is_refused(tmp_path):
     holder = subprocess.Popen(
-        [sys.executable, "-c", "import sys, time\nfrom rockyade.io.locking import output_lock\n"
-         "with output_lock(sys.argv[1]):\n    print('held', flush=True)\n    time.sleep(60)\n", str(tmp_path)],
-        stdout=subprocess.PIPE, text=True,
+        [
+            sys.executable,
+            "-c",
+            "import sys, time\nfrom rockyade.io.locking import output_lock\n"
+            "with output_lock(sys.argv[1]):\n    print('held', flush=True)\n    time.sleep(60)\n",
+            str(tmp_path),
+        ],
+        stdout=subprocess.PIPE,
+        text=True,
     )
     try:
         assert holder.stdout is not None and holder.stdout.readline().strip() == "held"

@@ -116,8 +116,11 @@ def test_a_consistent_entry_beyond_the_record_bounds_is_regenerated(cache, gener
     arrays = _arrays(cache)
     huge = _with_sample(arrays["accel_m_s2"], 2 * MAX_ABS_ACCEL_M_S2)
     meta = str(arrays["meta"][()])
-    cache.write_bytes(_npz(t_s=arrays["t_s"], accel_m_s2=huge, meta=arrays["meta"], sha256=np.array(
-        _digest(arrays["t_s"], huge, meta))))
+    cache.write_bytes(
+        _npz(
+            t_s=arrays["t_s"], accel_m_s2=huge, meta=arrays["meta"], sha256=np.array(_digest(arrays["t_s"], huge, meta))
+        )
+    )
     with pytest.raises(CacheDamagedError, match="beyond"):
         load_cached_record(cache, SPEC, 1)
     np.testing.assert_array_equal(suite_record(SPEC, 1).accel_m_s2, generated.accel_m_s2)
@@ -189,8 +192,15 @@ def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated)
         probe = subprocess.run(["unshare", "-Urm", "true"], capture_output=True)
         if probe.returncode != 0:
             pytest.skip("needs unshare -Urm (a user namespace) to make a read-only file system as root")
-        argv = ["unshare", "-Urm", "sh", "-c", f'mount -t tmpfs -o ro tmpfs "{folder}" && exec "$0" -c "$1"',
-                sys.executable, code]
+        argv = [
+            "unshare",
+            "-Urm",
+            "sh",
+            "-c",
+            f'mount -t tmpfs -o ro tmpfs "{folder}" && exec "$0" -c "$1"',
+            sys.executable,
+            code,
+        ]
     else:
         folder.chmod(0o500)
         argv = [sys.executable, "-c", code]
@@ -212,8 +222,14 @@ def test_two_processes_regenerating_at_once_both_get_the_record(cache, generated
     )
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     procs = [
-        subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                         cwd=root, env=dict(os.environ))
+        subprocess.Popen(
+            [sys.executable, "-c", code],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=root,
+            env=dict(os.environ),
+        )
         for _ in range(2)
     ]
     outs = [p.communicate(timeout=300) for p in procs]
@@ -231,8 +247,17 @@ def test_a_run_of_a_synthetic_scene_regenerates_a_damaged_entry(tmp_path, monkey
 
     monkeypatch.setenv("ROCKYADE_CACHE", str(tmp_path / "cache"))
     d = free_scene_dict(duration=2.0)
-    d["motion"] = {"type": "synthetic", "suite": "c", "spectrum_type": 2, "ground": "D", "ag_s_m_s2": 2.8,
-                   "seed": 9, "count": 1, "record": 1, "load_factor": 0.2}
+    d["motion"] = {
+        "type": "synthetic",
+        "suite": "c",
+        "spectrum_type": 2,
+        "ground": "D",
+        "ag_s_m_s2": 2.8,
+        "seed": 9,
+        "count": 1,
+        "record": 1,
+        "load_factor": 0.2,
+    }
     scene = tmp_path / "s.json"
     scene.write_text(json.dumps(d))
     assert main(["run", str(scene)]) == 0
@@ -257,7 +282,7 @@ def test_random_and_mutated_bytes_in_a_cache_file_are_damage_never_a_traceback(c
         data=st.one_of(
             st.binary(max_size=300),
             st.builds(
-                lambda pos, chunk, cut: (pristine[:pos] + chunk + pristine[pos + cut :]),
+                lambda pos, chunk, cut: pristine[:pos] + chunk + pristine[pos + cut :],
                 st.integers(0, len(pristine)),
                 st.binary(max_size=8),
                 st.integers(0, 16),

@@ -99,9 +99,7 @@ def test_closed_pipe_ends_quietly():
 
     read_end, write_end = os.pipe()
     fcntl.fcntl(write_end, 1031, 4096)  # F_SETPIPE_SZ: the table does not fit in the pipe
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "rockyade", "tables"], stdout=write_end, stderr=subprocess.PIPE
-    )
+    proc = subprocess.Popen([sys.executable, "-m", "rockyade", "tables"], stdout=write_end, stderr=subprocess.PIPE)
     os.close(write_end)
     with os.fdopen(read_end, "rb") as reader:
         assert reader.readline()
@@ -118,8 +116,21 @@ def test_closed_pipe_ends_quietly():
         (["compare", "SCENE", "--solvers", "housner", "--reference", "yade"], "reference"),
         (["compare", "SCENE", "--solvers", "housner,nope"], "solvers"),
         (["calibrate", "--specimen", "1", "--friction-angle", "95"], "--friction-angle"),
-        (["batch", "STUDY", "--out", "o", "--executor", "dask", "--scheduler", "tcp://127.0.0.1:9",
-          "--scheduler-timeout", "1"], "scheduler"),
+        (
+            [
+                "batch",
+                "STUDY",
+                "--out",
+                "o",
+                "--executor",
+                "dask",
+                "--scheduler",
+                "tcp://127.0.0.1:9",
+                "--scheduler-timeout",
+                "1",
+            ],
+            "scheduler",
+        ),
         (["batch", "STUDY", "--out", "o", "--workers", "0"], "workers"),
         (["run", "SCENE", "--out", "FILE/x.csv"], "--out"),
         (["tables", "--out", "FILE/tables"], "--out"),

@@ -209,7 +209,9 @@ def test_long_harmonic_motion_is_refused_by_its_samples():
 def test_cli_refuses_a_large_run_before_running(tmp_path, capsys):
     scene = tmp_path / "big.toml"
     scene.write_text(
-        (EXAMPLES / "specimen1_free.toml").read_text().replace("sample_dt_s = 0.001", "sample_dt_s = 0.00001")
+        (EXAMPLES / "specimen1_free.toml")
+        .read_text()
+        .replace("sample_dt_s = 0.001", "sample_dt_s = 0.00001")
         .replace("duration_s = 4.0", "duration_s = 100.0")
     )
     assert main(["run", str(scene), "--out", str(tmp_path / "r.csv")]) == 2

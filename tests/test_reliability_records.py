@@ -13,8 +13,12 @@ VALUES = [0.0012345, -0.0023456, 0.0345678, -0.0456789, 0.0056789, -0.0067891, 0
 
 
 def _at2(path, values=VALUES, sampling="NPTS=    7, DT=   .0100 SEC,", fmt="{:15.7E}", per_line=5):
-    lines = ["PEER NGA STRONG MOTION DATABASE RECORD", "Test, 1/1/2000, station, 000",
-             "ACCELERATION TIME SERIES IN UNITS OF G", sampling]
+    lines = [
+        "PEER NGA STRONG MOTION DATABASE RECORD",
+        "Test, 1/1/2000, station, 000",
+        "ACCELERATION TIME SERIES IN UNITS OF G",
+        sampling,
+    ]
     for i in range(0, len(values), per_line):
         lines.append("".join(fmt.format(v) for v in values[i : i + per_line]))
     path.write_text("\n".join(lines) + "\n")

@@ -26,16 +26,18 @@ LOAD_FACTORS = (0.3, 1.2)
 
 
 def _tasks(tmp_path, specimen: str):
-    return fragility_study.tasks(tmp_path / specimen, specimens=(specimen,), records=RECORDS,
-                                 load_factors=LOAD_FACTORS, solvers=("reference",))
+    return fragility_study.tasks(
+        tmp_path / specimen, specimens=(specimen,), records=RECORDS, load_factors=LOAD_FACTORS, solvers=("reference",)
+    )
 
 
 def _kernel_inputs(tasks, repeat: int = 1):
     """The packed structure and the runs' motions (each task ``repeat`` times) of one group."""
     base = calibrated_model(tasks[0].scene)
     models = [replace(base, motion=t.scene.motion.ground_motion(t.scene.duration_s)) for t in tasks] * repeat
-    b, j, _, st, i = pack(model_arrays(base), stop_on_overturn=True, record_energy=False, record_corners=False,
-                          coherent=True)
+    b, j, _, st, i = pack(
+        model_arrays(base), stop_on_overturn=True, record_energy=False, record_corners=False, coherent=True
+    )
     motions = [model_arrays_motion(m) for m in models]
     starts = np.cumsum([0] + [m[0].size for m in motions])
     mt, mah, mav = (np.concatenate([m[k] for m in motions]) for k in range(3))
@@ -72,8 +74,11 @@ def test_a_group_gives_the_reference_solvers_runs(tmp_path):
         for task, one in zip(tasks, group, strict=True):
             alone = solver.run(task.scene)
             name = task.scene.blocks[0].name
-            theta = alone.frame[f"{name}_theta_rad"].to_numpy() if f"{name}_theta_rad" in alone.frame \
+            theta = (
+                alone.frame[f"{name}_theta_rad"].to_numpy()
+                if f"{name}_theta_rad" in alone.frame
                 else alone.frame["theta_rad"].to_numpy()
+            )
             # the same verdict, at the same time, and the same rotations bit for bit
             assert one.status == alone.meta["status"], task.labels
             assert one.meta["overturn_time_s"] == alone.meta["overturn_time_s"]

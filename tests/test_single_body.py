@@ -30,8 +30,13 @@ def _scene(amplitude_g: float, duration_s: float = 3.0):
 @pytest.mark.parametrize(("amplitude_g", "corners"), [(0.35, True), (0.35, False), (3.0, False)])
 def test_single_body_path_gives_the_general_loops_bits(amplitude_g, corners):
     """Rocking (and, at the larger pulse, overturning) runs: every output field identical."""
-    records = pack(model_arrays(calibrated_model(_scene(amplitude_g))), stop_on_overturn=True, record_energy=False,
-                   record_corners=corners, coherent=True)
+    records = pack(
+        model_arrays(calibrated_model(_scene(amplitude_g))),
+        stop_on_overturn=True,
+        record_energy=False,
+        record_corners=corners,
+        coherent=True,
+    )
     assert single_body(records[0], records[1], False)
     general = kernel.simulate(*records)
     single = simulate_single(*records)
@@ -46,8 +51,13 @@ def test_single_body_path_gives_the_general_loops_bits(amplitude_g, corners):
 
 
 def test_energy_terms_and_assemblies_keep_the_general_loop():
-    records = pack(model_arrays(calibrated_model(_scene(0.35))), stop_on_overturn=True, record_energy=True,
-                   record_corners=False, coherent=True)
+    records = pack(
+        model_arrays(calibrated_model(_scene(0.35))),
+        stop_on_overturn=True,
+        record_energy=True,
+        record_corners=False,
+        coherent=True,
+    )
     assert not single_body(records[0], records[1], True)
     stack = calibrated_model(load_scene("examples/biblock_free.toml"))
     records = pack(model_arrays(stack), stop_on_overturn=True, record_energy=False, record_corners=False, coherent=True)

@@ -226,8 +226,12 @@ def test_grouped_runs_give_the_same_verdicts_peaks_and_probabilities(tmp_path):
     from rockyade.studies.batch import comparable
 
     study = uncertainty_study_from_dict(
-        _study(samples=2, duration_s=8.0, solvers=["housner", "reference"],
-               motion={"suite": "paper", "records": [1, 2], "load_factors": [1.0, 2.5], "pairing": "all"})
+        _study(
+            samples=2,
+            duration_s=8.0,
+            solvers=["housner", "reference"],
+            motion={"suite": "paper", "records": [1, 2], "load_factors": [1.0, 2.5], "pairing": "all"},
+        )
     )
     one = run_uncertainty(study, tmp_path / "one", workers=1, progress=False, figure=False, group_runs=False)
     grouped = run_uncertainty(study, tmp_path / "grouped", workers=1, progress=False, figure=False)
@@ -256,7 +260,13 @@ def test_a_samples_scenes_are_the_scenes_read_whole(tmp_path):
     for task in tasks:
         lab = task.labels
         block = dict(study.block, alpha_rad=lab["alpha_rad"], p_rad_s=lab["p_rad_s"], mu=lab["mu"])
-        whole = scene_from_dict({"duration_s": study.duration_s, "sample_dt_s": study.sample_dt_s, "blocks": [block],
-                                 "contact": copy.deepcopy(study.contact),
-                                 "motion": dict(dict(study.motions)[lab["record"]], load_factor=lab["load_factor"])})
+        whole = scene_from_dict(
+            {
+                "duration_s": study.duration_s,
+                "sample_dt_s": study.sample_dt_s,
+                "blocks": [block],
+                "contact": copy.deepcopy(study.contact),
+                "motion": dict(dict(study.motions)[lab["record"]], load_factor=lab["load_factor"]),
+            }
+        )
         assert task.scene == whole and task.scene_hash == whole.scene_hash

@@ -16,8 +16,9 @@ H, T, L, RHO = 3.0, 0.3, 2.0, 2000.0
 
 
 def section(**kwargs):
-    return scene_from_dict(wall_section(height_m=H, thickness_m=T, length_m=L, density_kg_m3=RHO,
-                                        motion={"type": "rest"}, **kwargs))
+    return scene_from_dict(
+        wall_section(height_m=H, thickness_m=T, length_m=L, density_kg_m3=RHO, motion={"type": "rest"}, **kwargs)
+    )
 
 
 @pytest.mark.parametrize("courses", [1, 4])
@@ -39,9 +40,11 @@ def test_an_overburden_gives_w_b_plus_n_d_over_w_h():
     assert scene.loads[0].mass_kg == pytest.approx(n / G)  # the overburden carries its mass by default
     # towards +x the wall turns about (t/2, 0): the load is t/2 - e from it, at height H
     assert limit_analysis(scene, direction="+x").load_multiplier == pytest.approx(
-        (w * T / 2 + n * (T / 2 - e)) / (w * H / 2 + n * H), rel=1e-9)
+        (w * T / 2 + n * (T / 2 - e)) / (w * H / 2 + n * H), rel=1e-9
+    )
     assert limit_analysis(scene, direction="-x").load_multiplier == pytest.approx(
-        (w * T / 2 + n * (T / 2 + e)) / (w * H / 2 + n * H), rel=1e-9)
+        (w * T / 2 + n * (T / 2 + e)) / (w * H / 2 + n * H), rel=1e-9
+    )
 
 
 def test_a_restrained_top_needs_a_gap_and_is_frictionless():
@@ -58,8 +61,27 @@ def test_a_restrained_top_needs_a_gap_and_is_frictionless():
 
 def test_rockyade_build_wall_section(tmp_path):
     out = tmp_path / "ws.toml"
-    assert main(["build", "wall-section", "--height-m", "2.4", "--thickness-m", "0.25", "--length-m", "1.5",
-                 "--courses", "2", "--overburden-n-per-m", "5000", "--out", str(out)]) == 0
+    assert (
+        main(
+            [
+                "build",
+                "wall-section",
+                "--height-m",
+                "2.4",
+                "--thickness-m",
+                "0.25",
+                "--length-m",
+                "1.5",
+                "--courses",
+                "2",
+                "--overburden-n-per-m",
+                "5000",
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
     scene = load_scene(out)
     assert [b.width_m for b in scene.blocks] == [0.25, 0.25] and scene.blocks[0].thickness_m == 1.5
     assert scene.loads[0].force_N == (0.0, -7500.0)
@@ -103,11 +125,25 @@ def test_a_floor_over_the_top_with_a_gap_lets_the_wall_turn():
     ("former", "now"),
     [
         ([], ["--courses", "2", "--top", "restrained-far"]),
-        (["--blocks", "1", "--restraint", "floor", "--gap-m", "0.01", "--wall-height-m", "2.4"],
-         ["--top", "floor", "--gap-m", "0.01", "--height-m", "2.4"]),
-        (["--split", "0.4", "--restraint-friction-deg", "10", "--wall-thickness-m", "0.4"],
-         ["--courses", "2", "--split", "0.4", "--top", "restrained-far", "--restraint-friction-deg", "10",
-          "--thickness-m", "0.4"]),
+        (
+            ["--blocks", "1", "--restraint", "floor", "--gap-m", "0.01", "--wall-height-m", "2.4"],
+            ["--top", "floor", "--gap-m", "0.01", "--height-m", "2.4"],
+        ),
+        (
+            ["--split", "0.4", "--restraint-friction-deg", "10", "--wall-thickness-m", "0.4"],
+            [
+                "--courses",
+                "2",
+                "--split",
+                "0.4",
+                "--top",
+                "restrained-far",
+                "--restraint-friction-deg",
+                "10",
+                "--thickness-m",
+                "0.4",
+            ],
+        ),
     ],
 )
 def test_restrained_wall_is_an_alias_of_wall_section(former, now, tmp_path, capsys):

@@ -357,8 +357,11 @@ def test_instability_inside_yade_gives_failed_result(tmp_path):
 def _warm_yade() -> None:
     """This thread's warm YADE started (a loaded machine can take the whole of a short timeout
     to start YADE, and a run stopped before its first sample has none to keep)."""
-    assert YadeSolver().run(scene_from_dict({**load_scene(EXAMPLES / "specimen3_free.toml").to_dict(),
-                                             "duration_s": 0.2})).ok
+    assert (
+        YadeSolver()
+        .run(scene_from_dict({**load_scene(EXAMPLES / "specimen3_free.toml").to_dict(), "duration_s": 0.2}))
+        .ok
+    )
 
 
 #: A run no machine finishes within the tests' timeouts (2 to 3 s): an hour of specimen 1

@@ -72,6 +72,11 @@ def test_a_failed_yade_run_keeps_its_samples_marked_partial(tmp_path):
     name = batch.run_name(model.scene_hash, "yade")
     parsed.write(runs / f"{name}.csv", {"summary": {"status": "failed"}})
 
-    task = SimpleNamespace(out_dir=str(tmp_path / "study"), scene_hash=model.scene_hash, index=0, labels={},
-                           solver=SimpleNamespace(name="yade"))
+    task = SimpleNamespace(
+        out_dir=str(tmp_path / "study"),
+        scene_hash=model.scene_hash,
+        index=0,
+        labels={},
+        solver=SimpleNamespace(name="yade"),
+    )
     assert batch._completed_row(task) is None

@@ -198,7 +198,8 @@ def test_a_warm_worker_listens_on_no_port_and_dies_with_its_parent():
 
     proc = subprocess.Popen(
         [sys.executable, "-c", RUN_TWICE, str(EXAMPLES / "specimen1_free.toml"), "6.0", "60"],
-        stdout=subprocess.PIPE, text=True,
+        stdout=subprocess.PIPE,
+        text=True,
     )
     assert proc.stdout is not None
     try:
@@ -282,13 +283,16 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
     # visible: the old /tmp is bound to /var/tmp (in this mount namespace only) and those
     # folders bound back into the new, empty /tmp
     needed = sorted(
-        {Path(where).resolve().relative_to("/tmp").parts[0]
-         for where in (sys.prefix, Path(rockyade.__file__).parent) if Path(where).resolve().is_relative_to("/tmp")}
+        {
+            Path(where).resolve().relative_to("/tmp").parts[0]
+            for where in (sys.prefix, Path(rockyade.__file__).parent)
+            if Path(where).resolve().is_relative_to("/tmp")
+        }
     )
     binds = "".join(f"mkdir /tmp/{name} && mount --bind /var/tmp/{name} /tmp/{name} && " for name in needed)
     script = (
         f"mount --bind /tmp /var/tmp && mount -t tmpfs tmpfs /tmp && {binds}mkdir /tmp/ours && "
-        f"TMPDIR=/tmp/ours {sys.executable} -c \"$0\" && echo RAN && ls -A /tmp && echo -- && ls -A /tmp/ours"
+        f'TMPDIR=/tmp/ours {sys.executable} -c "$0" && echo RAN && ls -A /tmp && echo -- && ls -A /tmp/ours'
     )
     proc = subprocess.run(["unshare", "-Urm", "sh", "-c", script, code], capture_output=True, text=True, timeout=300)
     assert "RAN" in proc.stdout, proc.stdout + proc.stderr
@@ -308,8 +312,9 @@ def test_a_full_disk_names_the_file_leaves_no_partial_output_and_resume_goes_on(
     d = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
     d.update(duration_s=4.0, sample_dt_s=0.001)
     (tmp_path / "s.json").write_text(json.dumps(d))
-    (tmp_path / "study.toml").write_text(f'solvers = ["yade"]\nsave_histories = false\n[base]\nfile = '
-                                         f'{json.dumps(str(tmp_path / "s.json"))}\n')
+    (tmp_path / "study.toml").write_text(
+        f'solvers = ["yade"]\nsave_histories = false\n[base]\nfile = {json.dumps(str(tmp_path / "s.json"))}\n'
+    )
     batch = f"{sys.executable} -m rockyade batch {tmp_path / 'study.toml'} --out {disk}/out --quiet --workers 1"
     script = (
         f"mount -t tmpfs -o size=96k tmpfs {disk} && {batch}; echo EXIT=$?; "
@@ -340,7 +345,11 @@ def _yade_batch(folder, runs: int, duration_s: float, *extra: str) -> subprocess
     )
     return subprocess.Popen(
         [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", "out", "--quiet", *extra],
-        cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
     )
 
 

@@ -183,8 +183,10 @@ def pushover_onset(curve: pd.DataFrame, scene: Scene, threshold_m: float = ONSET
             if np.max(np.abs(span - span[0])) > threshold_m or t[-1] < t1 - 1e-9:
                 grown = np.nonzero(np.abs(span - span[0]) > threshold_m)[0]
                 when = float(t[inside][grown[0]]) if grown.size else float(t[inside][-1])
-                rule = (f"first held level at which the control displacement grew by more than {threshold_m:g} m "
-                        "during the hold (or the run ended in it)")
+                rule = (
+                    f"first held level at which the control displacement grew by more than {threshold_m:g} m "
+                    "during the hold (or the run ended in it)"
+                )
                 return Onset(float(level), below, when, rule)
             below = float(level)
         return Onset(math.nan, below, math.nan, "no held level showed the mechanism")

@@ -274,9 +274,7 @@ def _sliding(
     for sup in supports:
         point = np.asarray(sup.point_m, dtype=float)
         xj, yj, thj = _material_point(columns, n, g.name, point, centroids[g.name])
-        xs, ys, ths = _material_point(
-            columns, n, sup.below, point, centroids[sup.below] if sup.below else (0.0, 0.0)
-        )
+        xs, ys, ths = _material_point(columns, n, sup.below, point, centroids[sup.below] if sup.below else (0.0, 0.0))
         # the joint's direction turns with the block under it
         tx = np.cos(ths) * sup.tangent[0] - np.sin(ths) * sup.tangent[1]
         ty = np.sin(ths) * sup.tangent[0] + np.cos(ths) * sup.tangent[1]

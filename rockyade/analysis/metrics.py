@@ -64,8 +64,17 @@ def run_metrics(
 
 
 #: The keys of a block's summary (:func:`block_summary`), in the order of earlier versions.
-SUMMARY_KEYS = ("max_abs_theta_rad", "max_theta_over_alpha", "n_peaks", "first_peak_rad", "first_peak_time_s",
-                "mu_eff", "residual_theta_rad", "uplift_time_s", "overturned")
+SUMMARY_KEYS = (
+    "max_abs_theta_rad",
+    "max_theta_over_alpha",
+    "n_peaks",
+    "first_peak_rad",
+    "first_peak_time_s",
+    "mu_eff",
+    "residual_theta_rad",
+    "uplift_time_s",
+    "overturned",
+)
 
 
 def block_summary(
@@ -153,9 +162,7 @@ def peak_metrics(
 PER_BLOCK_LIMIT = 10
 
 
-def assembly_metrics(
-    scene: Scene, result: Result, report: pd.DataFrame | None = None
-) -> dict[str, float | int | str]:
+def assembly_metrics(scene: Scene, result: Result, report: pd.DataFrame | None = None) -> dict[str, float | int | str]:
     """Aggregate collapse metrics of an assembly's run (:mod:`rockyade.analysis.collapse`):
     ``n_blocks``, ``n_fallen`` (blocks that came down within the run), ``fallen_fraction``,
     ``first_fall_time_s``, ``first_fallen_block``, ``n_falling_at_end`` (blocks still falling

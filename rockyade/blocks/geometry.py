@@ -440,9 +440,7 @@ def _outline(vertices_m: ArrayLike, field_name: str) -> tuple[NDArray[np.float64
 
 
 @lru_cache(maxsize=256)
-def _rectangle_outline(
-    width_m: float, height_m: float, field_name: str
-) -> tuple[NDArray[np.float64], PolygonSection]:
+def _rectangle_outline(width_m: float, height_m: float, field_name: str) -> tuple[NDArray[np.float64], PolygonSection]:
     """:func:`_outline` of a rectangle (m), remembered per size (a wall has a few): its
     vertices are read-only."""
     return _outline(rectangle_vertices(width_m, height_m), field_name)

@@ -169,8 +169,9 @@ def cmd_assess(args: argparse.Namespace) -> int:
         print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
     data: dict[str, Any]
     if dynamic is not None and args.out is not None:
-        with study_output(args.out, identity("assess", args, file_digest(args.scene)), args.resume, ASSESS_SET,
-                          ASSESS_LAST) as output:
+        with study_output(
+            args.out, identity("assess", args, file_digest(args.scene)), args.resume, ASSESS_SET, ASSESS_LAST
+        ) as output:
             try:
                 _dynamics(args, result, scene, dynamic, executor, output.journal)
             except BatchInterruptedError as exc:
@@ -191,8 +192,9 @@ def cmd_assess(args: argparse.Namespace) -> int:
             raise type(exc)(exc.finished, exc.unfinished, None, exc.hard, "--out DIR (then --resume)") from None
     data = _finish(args, result, scene)
     if args.out is not None:
-        with study_output(args.out, identity("assess", args, file_digest(args.scene)), False, ASSESS_SET,
-                          ASSESS_LAST) as output:
+        with study_output(
+            args.out, identity("assess", args, file_digest(args.scene)), False, ASSESS_SET, ASSESS_LAST
+        ) as output:
             _write(args, result, data)
             finish(output)
     return 0
@@ -235,8 +237,11 @@ def _interrupted(args: argparse.Namespace, result: Any, exc: Any, output: Any) -
     from rockyade.assess.stripes import runs_frame
     from rockyade.io.atomic import write_json
 
-    data = {**_static_data(args, result), "partial": True,
-            "dynamic_interrupted": {"finished": exc.finished, "unfinished": exc.unfinished}}
+    data = {
+        **_static_data(args, result),
+        "partial": True,
+        "dynamic_interrupted": {"finished": exc.finished, "unfinished": exc.unfinished},
+    }
     write_json(output.partial / "assess.json", data)
     rows = getattr(exc, "rows", [])
     plan = getattr(exc, "plan", None)

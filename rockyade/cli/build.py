@@ -186,19 +186,38 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
             Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
             Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
             Opt("--courses", 1, "courses (1: one block), equal unless --split", int),
-            Opt("--split", None, "2 courses: height of the joint between them / the wall's height, in (0, 1) "
-                "(the two-block wall of the paper's Fig. 2c; default: equal courses)"),
-            Opt("--top", "free", "free; restrained (a fixed block beside each face, with a gap > 0); restrained-far or "
+            Opt(
+                "--split",
+                None,
+                "2 courses: height of the joint between them / the wall's height, in (0, 1) "
+                "(the two-block wall of the paper's Fig. 2c; default: equal courses)",
+            ),
+            Opt(
+                "--top",
+                "free",
+                "free; restrained (a fixed block beside each face, with a gap > 0); restrained-far or "
                 "restrained-near (one face, x > 0 or x < 0; a zero gap gives the three-hinge mechanism); floor (a "
-                "fixed slab over the top, the gap above it)", str,
-                ("free", "restrained", "restrained-far", "restrained-near", "floor")),
-            Opt("--gap-m", 0.0, "restrained, floor: gap between the wall and its restraint (one the wall cannot close "
-                "before it overturns is refused), m"),
+                "fixed slab over the top, the gap above it)",
+                str,
+                ("free", "restrained", "restrained-far", "restrained-near", "floor"),
+            ),
+            Opt(
+                "--gap-m",
+                0.0,
+                "restrained, floor: gap between the wall and its restraint (one the wall cannot close "
+                "before it overturns is refused), m",
+            ),
             Opt("--restraint-height-m", 0.3, "restrained, floor: depth of the restraints (the slab), m"),
-            Opt("--restraint-width-m", 0.3, "restrained, floor: width of the restraints (the slab's reach past the "
-                "far face), m"),
-            Opt("--restraint-friction-deg", 0.0, "restrained, floor: friction of the wall-restraint joints, deg "
-                "(0: none)"),
+            Opt(
+                "--restraint-width-m",
+                0.3,
+                "restrained, floor: width of the restraints (the slab's reach past the far face), m",
+            ),
+            Opt(
+                "--restraint-friction-deg",
+                0.0,
+                "restrained, floor: friction of the wall-restraint joints, deg (0: none)",
+            ),
             Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
             Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
         ],
@@ -207,10 +226,18 @@ KINDS: dict[str, tuple[str, list[Opt]]] = {
         "a wall restrained at its top (out-of-plane section, the paper's Fig. 2; an alias of wall-section)",
         [
             Opt("--wall-height-m", 3.0, "wall height, m (or --height-m, as wall-section)", aliases=("--height-m",)),
-            Opt("--wall-thickness-m", 0.3, "wall thickness (the section's width), m (or --thickness-m)",
-                aliases=("--thickness-m",)),
-            Opt("--wall-length-m", 1.0, "wall length along its plane (the blocks' out-of-plane thickness), m "
-                "(or --length-m)", aliases=("--length-m",)),
+            Opt(
+                "--wall-thickness-m",
+                0.3,
+                "wall thickness (the section's width), m (or --thickness-m)",
+                aliases=("--thickness-m",),
+            ),
+            Opt(
+                "--wall-length-m",
+                1.0,
+                "wall length along its plane (the blocks' out-of-plane thickness), m (or --length-m)",
+                aliases=("--length-m",),
+            ),
             Opt("--blocks", 2, "1 or 2 wall blocks", int),
             Opt("--split", 0.5, "two blocks: lower block height / wall height"),
             Opt(
@@ -429,8 +456,10 @@ def _unit_height(args: argparse.Namespace, kind: str) -> float:
         "frame": lambda: args.beam_height_m,
         "stack": lambda: min(args.heights_m),
         "restrained-wall": lambda: args.wall_height_m * (min(args.split, 1 - args.split) if args.blocks == 2 else 1),
-        "wall-section": lambda: args.height_m
-        * (min(args.split, 1 - args.split) if args.split is not None and args.courses == 2 else 1 / args.courses),
+        "wall-section": lambda: (
+            args.height_m
+            * (min(args.split, 1 - args.split) if args.split is not None and args.courses == 2 else 1 / args.courses)
+        ),
     }[kind]()
 
 

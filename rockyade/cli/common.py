@@ -56,8 +56,7 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--allow-large",
         action="store_true",
-        help="run even when the cost estimate (integration steps, samples, memory) is above the "
-        "documented limits",
+        help="run even when the cost estimate (integration steps, samples, memory) is above the documented limits",
     )
 
 

@@ -89,8 +89,9 @@ def cmd_fragility(args: argparse.Namespace) -> int:
             rows = getattr(exc, "rows", [])
             if rows:
                 exc.summary_path = str(
-                    write_partial(output, runs_frame(rows, plan.measure), {"finished": exc.finished,
-                                                                          "unfinished": exc.unfinished})
+                    write_partial(
+                        output, runs_frame(rows, plan.measure), {"finished": exc.finished, "unfinished": exc.unfinished}
+                    )
                 )
             raise type(exc)(exc.finished, exc.unfinished, exc.summary_path, exc.hard) from None
         if output.journal.resumed:

@@ -176,9 +176,10 @@ def cmd_synth(args: argparse.Namespace) -> int:
         check_output_file(args.plot, "plot", ".png")
     records = []
     out.mkdir(parents=True, exist_ok=True)
-    with output_lock(out), tqdm(
-        total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet
-    ) as bar:
+    with (
+        output_lock(out),
+        tqdm(total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet) as bar,
+    ):
         for i in range(1, spec.count + 1):
             rec = suite_record(spec, i)
             records.append(rec)

@@ -126,9 +126,7 @@ def _write_collapse(report: pd.DataFrame, path: Path) -> None:
     print(f"wrote {path} (collapse: the state of every block)")
 
 
-def _print_summary(
-    scene: Scene, result: Result, total_s: float = math.nan, report: pd.DataFrame | None = None
-) -> None:
+def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, report: pd.DataFrame | None = None) -> None:
     from rockyade.analysis.metrics import PER_BLOCK_LIMIT, assembly_metrics, run_metrics
     from rockyade.blocks.restitution import MU_EFF_IMPACTS
 
@@ -216,7 +214,6 @@ def cmd_tables(args: argparse.Namespace) -> int:
     else:
         print(format_report(report))
     return 0
-
 
 
 def register(sub: Any) -> None:

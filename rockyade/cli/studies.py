@@ -27,9 +27,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
             "solvers", f"must be a comma-separated list of distinct {', '.join(SOLVER_NAMES)}, got {args.solvers!r}"
         )
     if args.reference is not None and args.reference not in solvers:
-        raise InputError(
-            "reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}"
-        )
+        raise InputError("reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}")
     out: Path = args.out
     check_output_dir(out, "out")
     runners = solvers_from_args(solvers, args)

@@ -214,14 +214,16 @@ def warm_up(single: bool = False, runs: bool = False) -> None:
     if runs:
         from rockyade.kernel.runs import simulate_runs
 
-        b, j, _, s, i = pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=False,
-                             coherent=True)
+        b, j, _, s, i = pack(
+            tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=False, coherent=True
+        )
         empty = np.zeros(0)
         simulate_runs(b, j, s, i, empty, empty, empty, np.zeros(2, dtype=np.int64), 1e-3, 1e-4)
         return
     if single:
-        simulate_single(*pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=True,
-                              coherent=True))
+        simulate_single(
+            *pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=True, coherent=True)
+        )
         return
     if not _compiled_kernel_cached():
         print(

@@ -203,7 +203,6 @@ class DemModel:
         steps = math.ceil(self.sample_dt_s / dt_s - 1e-9)
         return replace(self, dt_s=self.sample_dt_s / steps, steps_per_sample=steps, dt_source="user")
 
-
     def with_dt_factor(self, factor: float) -> DemModel:
         """The model with its time step times ``factor`` in (0, 1] (a solver's ``dt_factor``):
         the steps per sample divided by ``factor`` and rounded up, so that the step still

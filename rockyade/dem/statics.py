@@ -128,8 +128,12 @@ def rest_springs(
                 r += 1
     B = sp.csr_matrix((vals, (rows, cols)), shape=(r, n_dof))
     return RestSprings(
-        B, np.array(ks, dtype=float), np.array(betas, dtype=float), np.array(normals, dtype=bool),
-        np.array(owners, dtype=np.int64), dof_of,
+        B,
+        np.array(ks, dtype=float),
+        np.array(betas, dtype=float),
+        np.array(normals, dtype=bool),
+        np.array(owners, dtype=np.int64),
+        dof_of,
     )
 
 

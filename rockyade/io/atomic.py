@@ -73,9 +73,7 @@ def file_mode() -> int:
 
 
 @contextlib.contextmanager
-def staged_file(
-    path: str | os.PathLike[str], mode: str = "w", durable: bool = True
-) -> Iterator[tuple[IO[Any], Path]]:
+def staged_file(path: str | os.PathLike[str], mode: str = "w", durable: bool = True) -> Iterator[tuple[IO[Any], Path]]:
     """A complete, fsynced temporary file beside ``path`` that the caller renames itself
     (``durable=False``: not fsynced).
 

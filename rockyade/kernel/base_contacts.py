@@ -38,8 +38,9 @@ def new_base_state(nb: int, maxv: int) -> BaseState:
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def base_contacts(bodies, joints, settings, kin, world, base, tally, dash, sampling: bool,
-                  e_el: float, n_dash: int, d_fric: float) -> tuple[float, int, float]:
+def base_contacts(
+    bodies, joints, settings, kin, world, base, tally, dash, sampling: bool, e_el: float, n_dash: int, d_fric: float
+) -> tuple[float, int, float]:
     """Add the base contacts' forces to every moving body.
 
     Parameters
@@ -60,14 +61,28 @@ def base_contacts(bodies, joints, settings, kin, world, base, tally, dash, sampl
     for a in range(moving.size):
         if not moving[a] or (lo[a, 1] > 0.0 and not on_base[a]):
             continue
-        e_el, n_dash, d_fric = body_on_base(a, bodies, joints, settings, kin, world, base, tally, dash, sampling,
-                                            e_el, n_dash, d_fric)
+        e_el, n_dash, d_fric = body_on_base(
+            a, bodies, joints, settings, kin, world, base, tally, dash, sampling, e_el, n_dash, d_fric
+        )
     return e_el, n_dash, d_fric
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def body_on_base(a: int, bodies, joints, settings, kin, world, base, tally, dash, sampling: bool,
-                 e_el: float, n_dash: int, d_fric: float) -> tuple[float, int, float]:
+def body_on_base(
+    a: int,
+    bodies,
+    joints,
+    settings,
+    kin,
+    world,
+    base,
+    tally,
+    dash,
+    sampling: bool,
+    e_el: float,
+    n_dash: int,
+    d_fric: float,
+) -> tuple[float, int, float]:
     """The base contacts of body ``a`` (see :func:`base_contacts`)."""
     wv, shear, vstate = world.wv, base.shear, tally.vstate
     pos, vel, angvel, force, torque = kin.pos, kin.vel, kin.angvel, kin.force, kin.torque

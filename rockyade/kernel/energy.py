@@ -69,8 +69,9 @@ def dashpot_room(record_energy: bool, n_base: int, n_pairs: int, old: Dashpots) 
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def push_dashpot(dash, n: int, a: int, b: int, px: float, py: float, f_normal: float, f_shear: float,
-                 nx: float, ny: float) -> int:
+def push_dashpot(
+    dash, n: int, a: int, b: int, px: float, py: float, f_normal: float, f_shear: float, nx: float, ny: float
+) -> int:
     """Keep contact point ``n`` (between a and b, -1 the base); returns n + 1."""
     ab, data = dash.bodies, dash.data
     ab[n, 0] = a

@@ -40,8 +40,21 @@ from rockyade.kernel.recording import count_point, mark_pair_corners
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def pair_contacts(bodies, joints, settings, kin, world, pairs, tally, dash, clip, sampling: bool,
-                  e_el: float, n_dash: int, d_fric: float) -> tuple[int, float, int, float]:
+def pair_contacts(
+    bodies,
+    joints,
+    settings,
+    kin,
+    world,
+    pairs,
+    tally,
+    dash,
+    clip,
+    sampling: bool,
+    e_el: float,
+    n_dash: int,
+    d_fric: float,
+) -> tuple[int, float, int, float]:
     """Add the forces of every candidate pair's contact points.
 
     Parameters
@@ -69,8 +82,27 @@ def pair_contacts(bodies, joints, settings, kin, world, pairs, tally, dash, clip
             continue
         p_side[k] = side
         p_face[k] = face
-        e_el, n_dash, d_fric = pair_points(k, n_new, ref, inc, face, edge, bodies, joints, settings, kin, world, pairs,
-                                           tally, dash, clip, sampling, e_el, n_dash, d_fric)
+        e_el, n_dash, d_fric = pair_points(
+            k,
+            n_new,
+            ref,
+            inc,
+            face,
+            edge,
+            bodies,
+            joints,
+            settings,
+            kin,
+            world,
+            pairs,
+            tally,
+            dash,
+            clip,
+            sampling,
+            e_el,
+            n_dash,
+            d_fric,
+        )
     return n_tests, e_el, n_dash, d_fric
 
 
@@ -160,8 +192,18 @@ def pair_opened(k: int, pairs, joints, apart: bool, record_energy: bool, d_fric:
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def nearest_old_point(px: float, py: float, n_old: int, used0: bool, used1: bool, o0x: float, o0y: float,
-                      o1x: float, o1y: float, tol2: float) -> int:
+def nearest_old_point(
+    px: float,
+    py: float,
+    n_old: int,
+    used0: bool,
+    used1: bool,
+    o0x: float,
+    o0y: float,
+    o1x: float,
+    o1y: float,
+    tol2: float,
+) -> int:
     """Last step's unused point (0 or 1) nearest to (px, py) within sqrt(tol2), or -1."""
     d0 = math.inf
     d1 = math.inf
@@ -177,9 +219,27 @@ def nearest_old_point(px: float, py: float, n_old: int, used0: bool, used1: bool
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def pair_points(k: int, n_new: int, ref: int, inc: int, face: int, edge: int, bodies, joints, settings, kin, world,
-                pairs, tally, dash, clip, sampling: bool, e_el: float, n_dash: int, d_fric: float
-                ) -> tuple[float, int, float]:
+def pair_points(
+    k: int,
+    n_new: int,
+    ref: int,
+    inc: int,
+    face: int,
+    edge: int,
+    bodies,
+    joints,
+    settings,
+    kin,
+    world,
+    pairs,
+    tally,
+    dash,
+    clip,
+    sampling: bool,
+    e_el: float,
+    n_dash: int,
+    d_fric: float,
+) -> tuple[float, int, float]:
     """The contact law at pair k's ``n_new`` points in ``clip``; their forces, tally and
     energy terms (see :func:`pair_contacts`)."""
     pos, vel, angvel, force, torque = kin.pos, kin.vel, kin.angvel, kin.force, kin.torque

@@ -68,19 +68,54 @@ def carry_pairs(old: PairState, keys, pa, pb, joints, bodies, kin) -> PairState:
     pj = np.empty(n, dtype=np.int64)
     for k in range(n):
         pj[k] = joint_for(
-            pa[k], pb[k], nb, joints.base_joint, joints.own_joint, joints.pair_keys, joints.pair_joint,
-            bodies.fixed, joints.kn,
+            pa[k],
+            pb[k],
+            nb,
+            joints.base_joint,
+            joints.own_joint,
+            joints.pair_keys,
+            joints.pair_joint,
+            bodies.fixed,
+            joints.kn,
         )
-    return PairState(keys, pa, pb, pj, side, face, np.zeros(n, dtype=np.int64), npt, pt, sh, np.zeros(n),
-                     np.zeros((n, 4)), kin.pos.copy(), kin.ang.copy())
+    return PairState(
+        keys,
+        pa,
+        pb,
+        pj,
+        side,
+        face,
+        np.zeros(n, dtype=np.int64),
+        npt,
+        pt,
+        sh,
+        np.zeros(n),
+        np.zeros((n, 4)),
+        kin.pos.copy(),
+        kin.ang.copy(),
+    )
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def no_pairs() -> PairState:
     """An empty pair list."""
     e = np.zeros(0, dtype=np.int64)
-    return PairState(e, e, e, e, e, e, e, e, np.zeros((0, 2, 2)), np.zeros((0, 2, 2)), np.zeros(0), np.zeros((0, 4)),
-                     np.zeros((0, 2)), np.zeros(0))
+    return PairState(
+        e,
+        e,
+        e,
+        e,
+        e,
+        e,
+        e,
+        e,
+        np.zeros((0, 2, 2)),
+        np.zeros((0, 2, 2)),
+        np.zeros(0),
+        np.zeros((0, 4)),
+        np.zeros((0, 2)),
+        np.zeros(0),
+    )
 
 
 @numba.njit(cache=True, nogil=True)

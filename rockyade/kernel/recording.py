@@ -119,8 +119,9 @@ def mark_corner(vstate, body: int, v: int, px: float, py: float, wv, tol2: float
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def mark_pair_corners(tally, world, bodies, a: int, b: int, ref: int, face: int, inc: int, edge: int, px: float,
-                      py: float, state: int) -> None:
+def mark_pair_corners(
+    tally, world, bodies, a: int, b: int, ref: int, face: int, inc: int, edge: int, px: float, py: float, state: int
+) -> None:
     """Raise the states of the vertices at a pair's contact point (px, py): the ends of the
     reference face and of the incident edge (within ``CORNER_TOL_REL`` of the smaller width)."""
     vstate, wv, scale, nverts = tally.vstate, world.wv, bodies.scale, bodies.nverts
@@ -163,8 +164,18 @@ def record_sample(k: int, samples, bodies, kin, tally, record_corners: bool) -> 
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def record_energy_sample(k: int, samples, e_kin: float, e_pot: float, e_el: float, e_dash: float,
-                         e_dash_before: float, e_fric: float, w_base: float, w_base_before: float) -> None:
+def record_energy_sample(
+    k: int,
+    samples,
+    e_kin: float,
+    e_pot: float,
+    e_el: float,
+    e_dash: float,
+    e_dash_before: float,
+    e_fric: float,
+    w_base: float,
+    w_base_before: float,
+) -> None:
     """Sample k of the energy terms; the dashpot and base work are the mean of their values
     before and after the step (half of its work belongs before t_n and half after it)."""
     e = samples.energy

@@ -149,8 +149,9 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
     n_base = np.sum(bodies.nverts * bodies.moving)
     dash = dashpot_room(settings.record_energy, n_base, pairs.keys.size, new_dashpots(1))
     samples = new_samples(nb, maxv, settings.n_steps // settings.steps_per_sample + 1, settings.record_corners)
-    work = Work(kin, world, new_base_state(nb, maxv), pairs, dash, new_tally(nb, maxv), samples, new_totals(),
-                np.zeros((2, 3)))
+    work = Work(
+        kin, world, new_base_state(nb, maxv), pairs, dash, new_tally(nb, maxv), samples, new_totals(), np.zeros((2, 3))
+    )
     # int64, not the literal 0: advance would be compiled twice, for Literal[int](0) and for int64
     step, hint, n_filled = np.int64(0), np.int64(0), np.int64(0)
     n_tests, n_builds, max_pairs = 0, 1, pairs.keys.size
@@ -168,8 +169,24 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
         n_builds += 1
         max_pairs = max(max_pairs, pairs.keys.size)
     s = samples
-    return Output(s.pos, s.ang, s.angvel, s.vpoint, s.corner_states, s.energy, status, n_filled, t_stop, stop_body,
-                  s.n_contacts, s.slipping, s.overturn_time, n_builds, max_pairs, n_tests)
+    return Output(
+        s.pos,
+        s.ang,
+        s.angvel,
+        s.vpoint,
+        s.corner_states,
+        s.energy,
+        status,
+        n_filled,
+        t_stop,
+        stop_body,
+        s.n_contacts,
+        s.slipping,
+        s.overturn_time,
+        n_builds,
+        max_pairs,
+        n_tests,
+    )
 
 
 # Compiled without numba's reference counting (``_nrt=False``): it allocates nothing and
@@ -178,8 +195,9 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
 # to a part inside a loop was counted up and down at each call (an atomic operation each, 15x
 # slower in all).
 @numba.njit(cache=True, nogil=True, _nrt=False)  # type: ignore[call-overload]  # numba's stubs omit _nrt
-def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settings, work
-            ) -> tuple[int, bool, int, float, int, int, int, int]:
+def advance(
+    step0: int, hint: int, n_filled: int, bodies, joints, motion, settings, work
+) -> tuple[int, bool, int, float, int, int, int, int]:
     """Run steps from ``step0`` until the end, an early stop, or a body leaving its margin.
 
     Parameters
@@ -215,10 +233,12 @@ def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settin
         apply_point_loads(bodies, kin, g, av)
         if sampling:
             reset_tally(tally, record_corners)
-        e_el_now, n_dash, d_fric = base_contacts(bodies, joints, settings, kin, world, base, tally, dash, sampling,
-                                                 0.0, 0, 0.0)
-        tests, e_el_now, n_dash, d_fric = pair_contacts(bodies, joints, settings, kin, world, pairs, tally, dash, clip,
-                                                        sampling, e_el_now, n_dash, d_fric)
+        e_el_now, n_dash, d_fric = base_contacts(
+            bodies, joints, settings, kin, world, base, tally, dash, sampling, 0.0, 0, 0.0
+        )
+        tests, e_el_now, n_dash, d_fric = pair_contacts(
+            bodies, joints, settings, kin, world, pairs, tally, dash, clip, sampling, e_el_now, n_dash, d_fric
+        )
         n_tests += tests
         e_dash_before, w_base_before = e_dash, w_base
         e_dash = kick(bodies, kin, dt, settings.mass_damping, record_energy, e_dash)
@@ -232,8 +252,9 @@ def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settin
             record_sample(k, samples, bodies, kin, tally, record_corners)
             if record_energy:
                 e_kin, e_pot = mechanical_energy(bodies, kin, g)
-                record_energy_sample(k, samples, e_kin, e_pot, e_el, e_dash, e_dash_before, e_fric, w_base,
-                                     w_base_before)
+                record_energy_sample(
+                    k, samples, e_kin, e_pot, e_el, e_dash, e_dash_before, e_fric, w_base, w_base_before
+                )
             n_filled = k + 1
         if step == n_steps:
             break
@@ -241,8 +262,9 @@ def advance(step0: int, hint: int, n_filled: int, bodies, joints, motion, settin
         if status != STATUS_COMPLETED:
             t_stop = (step + 1) * dt
             break
-        if nb > 1 and moved_beyond_margin(kin.pos, kin.ang, pairs.pos_at_build, pairs.ang_at_build, bodies.radius,
-                                          bodies.margin, bodies.moving):
+        if nb > 1 and moved_beyond_margin(
+            kin.pos, kin.ang, pairs.pos_at_build, pairs.ang_at_build, bodies.radius, bodies.margin, bodies.moving
+        ):
             rebuild = True
             step += 1
             break

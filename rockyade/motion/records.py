@@ -91,9 +91,7 @@ def normalise_units(units: str, source: str = "units") -> str:
     """Canonical unit name (g, m/s2, cm/s2) or InputError."""
     key = units.strip().lower().replace(" ", "")
     if key in VELOCITY_UNITS:
-        raise InputError(
-            source, f"{units!r} is a velocity unit: a record must hold accelerations, in g, m/s2 or cm/s2"
-        )
+        raise InputError(source, f"{units!r} is a velocity unit: a record must hold accelerations, in g, m/s2 or cm/s2")
     if key not in UNIT_ALIASES:
         raise InputError(
             source, f"must be one of g, m/s2, cm/s2 (aliases: {', '.join(sorted(UNIT_ALIASES))}), got {units!r}"

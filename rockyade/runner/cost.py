@@ -27,6 +27,7 @@ LIMITS: dict[str, float] = {
     "memory_bytes": 2.0 * 1024**3,  # 2 GiB
 }
 
+
 def estimate_cost(scene: Scene, solver: Solver | str) -> CostEstimate:
     """Estimate the cost of running ``scene`` with ``solver`` (a Solver, or a solver's name)."""
     from rockyade.solvers import as_solver
@@ -83,7 +84,6 @@ def check_cost(
     if refusal is not None:
         raise refusal
     return estimate
-
 
 
 __all__ = ["LIMITS", "check_cost", "cost_refusal", "estimate_cost"]

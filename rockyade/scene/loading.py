@@ -106,7 +106,7 @@ def _too_large(path: Path, field: str, size: int) -> InputError:
     return InputError(
         field,
         f"the file has {size:,} bytes, more than the {MAX_SCENE_BYTES:,} ({MAX_SCENE_BYTES // 2**20} MiB) a "
-        "scene file may have: put a long base motion in a record file ([motion] type = \"record\")",
+        'scene file may have: put a long base motion in a record file ([motion] type = "record")',
         str(path),
     )
 

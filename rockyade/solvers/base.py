@@ -136,8 +136,9 @@ def check_dt_factor(value: Any, field: str) -> float:
     0.5: half of it, the convergence check of a cross-check). Below :data:`DT_FACTOR_MIN`
     it is refused (a thousand times the steps is not a check, it is a hang)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not DT_FACTOR_MIN <= float(value) <= 1.0:
-        raise InputError(field, f"must be a number in [{DT_FACTOR_MIN:g}, 1] (a factor on the solver's time step), "
-                         f"got {value!r}")
+        raise InputError(
+            field, f"must be a number in [{DT_FACTOR_MIN:g}, 1] (a factor on the solver's time step), got {value!r}"
+        )
     return float(value)
 
 

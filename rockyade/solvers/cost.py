@@ -130,9 +130,7 @@ def _cached_dem_time_step(scene: Scene) -> tuple[float, int]:
     return _DT_CACHE[key]
 
 
-def _estimate(
-    scene: Scene, solver: str, steps: float, dt: float, columns: int, run_time_s: float
-) -> CostEstimate:
+def _estimate(scene: Scene, solver: str, steps: float, dt: float, columns: int, run_time_s: float) -> CostEstimate:
     values = float(scene.n_samples) * columns
     motion_samples = scene.motion.sample_count(scene.duration_s)
     memory = BASE_MEMORY_BYTES + BYTES_PER_OUTPUT_VALUE * values + BYTES_PER_MOTION_SAMPLE * motion_samples

@@ -145,12 +145,18 @@ class ReferenceSolver(SolverBase):
         start = time.perf_counter()
         base = calibrated_model(scenes[0]).with_dt_factor(self.dt_factor)
         models = [base] + [
-            replace(base, motion=s.motion.ground_motion(s.duration_s), scene_hash=s.scene_hash,
-                    base_at_rest=s.motion.type)
+            replace(
+                base, motion=s.motion.ground_motion(s.duration_s), scene_hash=s.scene_hash, base_at_rest=s.motion.type
+            )
             for s in scenes[1:]
         ]
-        records = pack(model_arrays(base), stop_on_overturn=base.stop_on_overturn, record_energy=False,
-                       record_corners=False, coherent=True)
+        records = pack(
+            model_arrays(base),
+            stop_on_overturn=base.stop_on_overturn,
+            record_energy=False,
+            record_corners=False,
+            coherent=True,
+        )
         if not single_body(records[0], records[1], False):
             raise ValueError("run_group: one moving block without energy terms only (see group_key)")
         motions = [model_arrays_motion(m) for m in models]
@@ -163,8 +169,9 @@ class ReferenceSolver(SolverBase):
         numba.set_num_threads(max(1, min(int(threads), most)))
         try:
             start = time.perf_counter()
-            out = simulate_runs(records[0], records[1], records[3], records[4], mt, mah, mav, starts, uplift_rad,
-                                base.sample_dt_s)
+            out = simulate_runs(
+                records[0], records[1], records[3], records[4], mt, mah, mav, starts, uplift_rad, base.sample_dt_s
+            )
             wall = (time.perf_counter() - start) / max(1, len(scenes))
         finally:
             numba.set_num_threads(before)
@@ -172,9 +179,22 @@ class ReferenceSolver(SolverBase):
         for r, model in enumerate(models):
             n = int(out.n_filled[r])
             one = KernelOutput(
-                out.pos[r, :, None, :], out.ang[r, :, None], out.angvel[r, :, None], None, None, None,
-                int(out.status[r]), n, float(out.t_stop[r]), 0 if out.status[r] != kernel.STATUS_COMPLETED else -1,
-                None, None, out.overturn_time[r : r + 1], 1, 0, 0,
+                out.pos[r, :, None, :],
+                out.ang[r, :, None],
+                out.angvel[r, :, None],
+                None,
+                None,
+                None,
+                int(out.status[r]),
+                n,
+                float(out.t_stop[r]),
+                0 if out.status[r] != kernel.STATUS_COMPLETED else -1,
+                None,
+                None,
+                out.overturn_time[r : r + 1],
+                1,
+                0,
+                0,
             )
             meta = {
                 "solver": self.name,
@@ -205,8 +225,11 @@ def model_arrays_motion(model: DemModel) -> tuple[np.ndarray, np.ndarray, np.nda
     motion = model.motion
     if motion is None:
         return np.zeros(0), np.zeros(0), np.zeros(0)
-    return (np.ascontiguousarray(motion.t_s, dtype=float), np.ascontiguousarray(motion.ah_m_s2, dtype=float),
-            np.ascontiguousarray(motion.av_m_s2, dtype=float))
+    return (
+        np.ascontiguousarray(motion.t_s, dtype=float),
+        np.ascontiguousarray(motion.ah_m_s2, dtype=float),
+        np.ascontiguousarray(motion.av_m_s2, dtype=float),
+    )
 
 
 def run_model(
@@ -370,4 +393,3 @@ def _model_meta(model: DemModel, wall: float) -> dict[str, Any]:
         "bodies": model.body_summary(),
         "motion": model.motion_label,
     }
-

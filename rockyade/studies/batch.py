@@ -553,8 +553,14 @@ def _metrics(scene: Scene, result: Result) -> dict[str, Any]:
 
 def _write_failure(task: BatchTask, row: dict[str, Any], exc: OSError) -> dict[str, Any]:
     """The row of a run whose result could not be written (no file of it is left half-written)."""
-    keep = (*LEADING_COLUMNS, *task.labels, "wall_time_s", "elapsed_s", "motion_time_left_out_s",
-            "motion_pga_left_out_fraction")
+    keep = (
+        *LEADING_COLUMNS,
+        *task.labels,
+        "wall_time_s",
+        "elapsed_s",
+        "motion_time_left_out_s",
+        "motion_pga_left_out_fraction",
+    )
     return {
         **{k: v for k, v in row.items() if k in keep},
         "status": "failed",

@@ -29,6 +29,8 @@ from rockyade.studies.specimens import biblock_blocks, scene_dict
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
 CYCLES = 10
+
+
 def paper_pattern(freq: float, amp: float) -> str | None:
     """The pattern the paper reports for a cell, or None where it reports none."""
     if (4.0 <= freq <= 5.0 and amp > 4.0) or (freq == 6.0 and amp > 3.0) or (freq == 7.0 and amp > 1.0):

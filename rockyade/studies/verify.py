@@ -691,6 +691,7 @@ def _restrained_wall_rows() -> list[Row]:
     courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
     tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
     from rockyade.limit import limit_analysis
+
     two = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0)
     lam2 = _known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
     eight = wall_section(

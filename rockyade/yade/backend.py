@@ -355,8 +355,14 @@ def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     out = _run_meta(model, {**meta, "status": "failed"}, total, extra, arrays)
-    out.update(status="failed", failure_reason=reason, overturn_time_s=None, overturned_block=None, partial=True,
-               partial_samples=n)
+    out.update(
+        status="failed",
+        failure_reason=reason,
+        overturn_time_s=None,
+        overturned_block=None,
+        partial=True,
+        partial_samples=n,
+    )
     return Result(frame, out)
 
 

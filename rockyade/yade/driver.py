@@ -322,8 +322,9 @@ def load_engines(scene, clumps):
             t = list(motion["t_s"])
             times = [t[0] - 1.0, *t, t[-1] + 1e-09, t[-1] + 1000000000.0]
             mags = [mag] + [mag * (g + a) / g for a in motion["av_m_s2"]] + [mag, mag]
-        engines.append(InterpolatingDirectedForceEngine(ids=[c["load_id"]], times=times, magnitudes=mags,
-                                                        direction=direction))
+        engines.append(
+            InterpolatingDirectedForceEngine(ids=[c["load_id"]], times=times, magnitudes=mags, direction=direction)
+        )
     return engines
 
 
