@@ -16,6 +16,7 @@ import time
 
 import pandas as pd
 
+from rockyade.analysis.crosscheck import MIN_RECORDS
 from rockyade.assess import paper_suite_set, parse_measure
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
@@ -27,9 +28,10 @@ SPECIMENS = ("1", "2", "3", "4")
 RECORDS = 30
 #: Bisection resolution of the paper's cross-check (2 %: the verdict's tolerance is 5 %).
 RESOLUTION = 0.02
-#: YADE on a subset: one specimen, the first records, the solvers' own time steps.
+#: YADE on a subset: one specimen, the first records (as many as a paired interval needs,
+#: :data:`rockyade.analysis.crosscheck.MIN_RECORDS`), the solvers' own time steps.
 YADE_SPECIMEN = "1"
-YADE_RECORDS = 3
+YADE_RECORDS = MIN_RECORDS
 
 
 def specimen_scene(key: str) -> Scene:
