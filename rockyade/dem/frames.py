@@ -156,3 +156,26 @@ def load_work(model: DemModel, pos: np.ndarray, ang: np.ndarray) -> np.ndarray:
         potential += fx * pos[:, i, 0] + fy * pos[:, i, 1] + np.cos(ang[:, i]) * q + np.sin(ang[:, i]) * m0
     steps = 0.5 * (scale[1:] + scale[:-1]) * np.diff(potential)
     return np.concatenate([[0.0], np.cumsum(steps)])
+
+
+def worker_frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None) -> pd.DataFrame:
+    """A worker's (YADE's, Siconos's) output arrays as the common time history (:func:`dem_frame`),
+    plus the normal force of every contact vertex (``c<i>_fn_N``, N)."""
+    frame = dem_frame(
+        model,
+        arrays["pos"],
+        arrays["ang"],
+        arrays["angvel"],
+        arrays["vpoint"],
+        arrays["state"],
+        lowpass,
+        n_contacts=arrays["ncont"],
+        slipping=arrays["slip"],
+    )
+    names = model.names
+    forces = {}
+    for i, body in enumerate(model.bodies):
+        prefix = f"{body.name}_" if len(names) > 1 else ""
+        for v in range(len(body.contact_vertices_m)):
+            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
+    return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)

@@ -24,10 +24,9 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from rockyade import __version__
-from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.frames import energy_gain, worker_frame
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import SolverUnavailableError, os_error_message
@@ -216,7 +215,7 @@ def _parse(
     problem = _output_problem(model, meta, arrays)
     if problem is not None:
         return _partial_failure(model, numerics, meta, arrays, problem, total, extra)
-    return Result(_frame(model, arrays, lowpass), _run_meta(model, numerics, meta, total, extra, arrays))
+    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, numerics, meta, total, extra, arrays))
 
 
 def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
@@ -256,7 +255,7 @@ def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Res
     if n == 0:
         return failed_result("siconos", model.scene_hash, reason, partial=True, wall_time_s=total, **extra)
     arrays = {k: v[:n] for k, v in arrays.items()}
-    frame = _frame(model, arrays, None)
+    frame = worker_frame(model, arrays, None)
     out = _run_meta(model, numerics, {**meta, "status": "failed"}, total, extra, arrays)
     out.update(
         status="failed",
@@ -267,28 +266,6 @@ def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Res
         partial_samples=n,
     )
     return Result(frame, out)
-
-
-def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None) -> pd.DataFrame:
-    """The common time history, plus the normal force of every contact vertex (``c<i>_fn_N``)."""
-    frame = dem_frame(
-        model,
-        arrays["pos"],
-        arrays["ang"],
-        arrays["angvel"],
-        arrays["vpoint"],
-        arrays["state"],
-        lowpass,
-        n_contacts=arrays["ncont"],
-        slipping=arrays["slip"],
-    )
-    names = model.names
-    forces = {}
-    for i, body in enumerate(model.bodies):
-        prefix = f"{body.name}_" if len(names) > 1 else ""
-        for v in range(len(body.contact_vertices_m)):
-            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
-    return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
 
 
 def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:

@@ -37,11 +37,10 @@ import zipfile
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from rockyade import __version__
 from rockyade.calibration.model import calibrated_model
-from rockyade.dem.frames import dem_frame, energy_gain
+from rockyade.dem.frames import energy_gain, worker_frame
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
@@ -250,7 +249,7 @@ def _parse(
             return _collapsed(model, meta, arrays, cut, total, extra, lowpass)
     if problem is not None:
         return _partial_failure(model, meta, arrays, problem, total, extra)
-    return Result(_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
+    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
 
 
 def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
@@ -340,7 +339,7 @@ def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
         "the run stopped at a deep sphere-polyhedron overlap after the assembly had started to collapse "
         "(docs/yade.md): its history up to there is kept"
     )
-    return Result(_frame(model, arrays, lowpass), out)
+    return Result(worker_frame(model, arrays, lowpass), out)
 
 
 def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
@@ -351,7 +350,7 @@ def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     arrays = _cut(arrays, n)
     try:
-        frame = _frame(model, arrays, None)
+        frame = worker_frame(model, arrays, None)
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     out = _run_meta(model, {**meta, "status": "failed"}, total, extra, arrays)
@@ -386,28 +385,6 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
     if float(meta.get("max_polyhedra_penetration_over_radius", 0.0)) >= 1.0:
         return DEEP_OVERLAP
     return None
-
-
-def _frame(model: DemModel, arrays: dict[str, np.ndarray], lowpass: float | None) -> pd.DataFrame:
-    """The common time history, plus the normal force of every contact vertex (``c<i>_fn_N``)."""
-    frame = dem_frame(
-        model,
-        arrays["pos"],
-        arrays["ang"],
-        arrays["angvel"],
-        arrays["vpoint"],
-        arrays["state"],
-        lowpass,
-        n_contacts=arrays["ncont"],
-        slipping=arrays["slip"],
-    )
-    names = model.names
-    forces = {}
-    for i, body in enumerate(model.bodies):
-        prefix = f"{body.name}_" if len(names) > 1 else ""
-        for v in range(len(body.contact_vertices_m)):
-            forces[f"{prefix}c{v}_fn_N"] = arrays["fn"][:, i, v]
-    return pd.concat([frame, pd.DataFrame(forces, index=frame.index)], axis=1)
 
 
 def _run_meta(
