@@ -44,8 +44,8 @@ def _scene(example: str, duration: float, **top):
 
 
 def _serving() -> set[int]:
-    """This process's YADE workers."""
-    return {p for p in descendants(os.getpid()) if "--serve" in cmdline(p) and "driver.py" in cmdline(p)}
+    """This process's YADE workers (not the Siconos workers a test run before may have left warm)."""
+    return {p for p in descendants(os.getpid()) if "--serve" in cmdline(p) and "yade/driver.py" in cmdline(p)}
 
 
 def _same(a, b) -> None:
@@ -367,7 +367,7 @@ def test_ctrl_c_in_a_batch_leaves_no_warm_yade_behind(tmp_path, executor, presse
         deadline = time.monotonic() + 180
         yade: set[int] = set()
         while len(yade) < 2 and proc.poll() is None and time.monotonic() < deadline:
-            yade = {p for p in descendants(proc.pid) if "--serve" in cmdline(p) and "driver.py" in cmdline(p)}
+            yade = {p for p in descendants(proc.pid) if "--serve" in cmdline(p) and "yade/driver.py" in cmdline(p)}
             time.sleep(0.1)
         assert len(yade) == 2, "two warm YADE workers"
         time.sleep(1.0)  # the runs are under way
