@@ -79,6 +79,21 @@ def test_free_rocking_restitution_is_housners_eq4():
     assert 0.0 <= meta["max_penetration_m"] < 1e-3
 
 
+def test_a_newton_restitution_does_not_raise_the_per_cycle_mu():
+    """The same release with e = 0.5 at the corners: each impact's restitution is still
+    Housner's within 0.5 % (the landing corner's rebounds end with it at rest, angular
+    momentum about it conserved), which is why a target mu above it is refused."""
+    block = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.5 * math.atan(0.25)}, 3.0)
+    result = make_solver("siconos", restitution=0.5).run(block)
+    assert result.ok, result.meta.get("failure_reason")
+    alpha = math.atan(0.25)
+    eq4 = 1.0 - 1.5 * math.sin(alpha) ** 2
+    peaks = find_peaks(result.frame["t_s"].to_numpy(), result.frame["theta_rad"].to_numpy())
+    per_impact = restitution_per_impact(peaks, alpha)[:4]
+    assert len(per_impact) == 4
+    assert np.all(np.abs(per_impact / eq4 - 1.0) < 0.005), per_impact
+
+
 def test_a_pulse_matches_housner_and_halving_the_step_changes_the_peak_little():
     """A block 0.17 x 1.0 m under the shipped Ricker pulse scaled to 0.3 g: the peak within 3 %
     of Housner's exact solution, and dt halved (dt_factor 0.5) moves it by less than

@@ -9,10 +9,18 @@
   landing corner is conserved (the impulse acts there), which is Housner's derivation of
   his restitution: mu = (I_c + M r_B . r_A) / I_B (general Eq 4,
   :func:`rockyade.blocks.classical.restitution`), 1 - 1.5 sin^2 alpha for a rectangle.
-  Measured (docs/siconos.md): e = 0.1-0.5 at the corners still gives that value per cycle,
-  so no Newton restitution reaches a target above it; a scene whose calibration asks for a
-  target mu (``contact.calibration = "matched"``) is refused unless its target is within
-  MU_RTOL of the model's own (:func:`check_target_mu`). Under the other calibrations a
+  With base corners at +-b_eq = +-R sin(alpha) and I_O = M g R / p^2 this is
+  mu = 1 - 2 M b_eq^2 / I_O = 1 - 2 R p^2 sin^2(alpha) / g: alpha, p and the size fix it.
+  Measured (docs/siconos.md, ``benchmarks/bench_siconos_mu.py``): a Newton restitution
+  e = 0.3-0.6 at the corners still gives that value per cycle (the landing corner's
+  rebounds end with it at rest, angular momentum about it conserved: Housner's impact
+  again), and Siconos's LZB multiple-impact law (``MultipleImpactNSL``, event-driven;
+  frictionless in Siconos 4.4) gives the frictionless rigid value, 0.70 for specimen 1,
+  whatever its restitution, stiffness ratio and exponent (the landing impulse lifts the
+  pivot, so only one contact takes part). So no calibration reaches a target above the
+  model's own; a scene whose calibration asks for a target mu
+  (``contact.calibration = "matched"``) is refused unless its target is within MU_RTOL of
+  the model's own (:func:`check_target_mu`). Under the other calibrations a
   scene's ``mu`` sets only the DEMs' damping: Siconos runs the geometry's restitution and
   records both in the Result (``mu_model``, ``mu_scene``).
 * **The time step** (:func:`default_dt`): DT_P_FRACTION / p of the fastest moving block,
@@ -79,10 +87,12 @@ def check_target_mu(scene: Scene, model: DemModel) -> dict[str, object]:
     ------
     InputError
         The scene asks for a target mu (``contact.calibration = "matched"``) more than
-        MU_RTOL from the model's own: one line with the reachable value.
+        MU_RTOL from the model's own: one line naming every such block with its reachable
+        range (the model's own +- MU_RTOL).
     """
     mu_model: dict[str, float] = {}
     mu_scene: dict[str, float | None] = {}
+    unreachable: list[str] = []
     for spec, body in zip(scene.blocks, model.bodies, strict=True):
         if body.fixed:
             continue
@@ -91,12 +101,17 @@ def check_target_mu(scene: Scene, model: DemModel) -> dict[str, object]:
         mu_scene[body.name] = spec.mu
         if scene.contact.calibration == "matched" and spec.mu is not None and abs(spec.mu - own) > MU_RTOL * own:
             low, high = own * (1 - MU_RTOL), own * (1 + MU_RTOL)
-            raise InputError(
-                "contact.calibration",
-                f"the siconos solver cannot reach mu = {spec.mu:.4g} for {body.name}: with e = 0 its impacts give the "
-                f"block's own restitution {own:.4g} (Eq 4) and a Newton restitution e > 0 does not raise it; "
-                f"reachable range [{low:.4g}, {high:.4g}]; use calibration 'paper' or drop mu",
+            unreachable.append(
+                f"mu = {spec.mu:.4g} for {body.name} (reachable range [{low:.4g}, {high:.4g}], its own {own:.4g})"
             )
+    if unreachable:
+        raise InputError(
+            "contact.calibration",
+            f"the siconos solver cannot reach {', '.join(unreachable)}: with e = 0 a block's impacts give its own "
+            "restitution (Eq 4: 1 - 2 R p^2 sin^2(alpha) / g, fixed by alpha, p and the size), and neither a Newton "
+            "restitution e > 0 nor the LZB multiple-impact law raises it (docs/siconos.md); "
+            "use calibration 'paper' or drop mu",
+        )
     out: dict[str, object] = {"mu_model": mu_model, "mu_scene": mu_scene}
     if any(v is not None and abs(v - mu_model[k]) > MU_RTOL * mu_model[k] for k, v in mu_scene.items()):
         out["mu_note"] = (
