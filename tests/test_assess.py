@@ -26,7 +26,7 @@ from rockyade.assess import (
 )
 from rockyade.assess.assessment import add_pushover
 from rockyade.assess.code import NOT_APPLICABLE, NOT_VERIFIED, VERIFIED, Check, check_code, verdict
-from rockyade.assess.fit import fit_stripes, refit, stripe_table
+from rockyade.assess.fit import fit_stripes, stripe_table
 from rockyade.assess.fragility import EXTEND_RATIO, _next_level, check_levels, fragility_plan, run_fragility
 from rockyade.assess.stripes import StripePlan, run_stripe_task
 from rockyade.constants import CODE_GRAVITY, G
@@ -34,7 +34,6 @@ from rockyade.errors import InputError
 from rockyade.limit import limit_analysis
 from rockyade.motion.records import read_record
 from rockyade.motion.spectra import response_spectrum
-from rockyade.probability.fragility import fit_lognormal
 from rockyade.runner import Executor
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import rest_motion, stack
@@ -263,26 +262,6 @@ def test_a_records_folder_refuses_the_same_record_twice_and_an_empty_folder(tmp_
 
 
 # ---------------------------------------------------------------------- the fit
-
-
-def test_the_bootstrap_refit_is_the_same_maximum_as_fit_lognormal():
-    rng = np.random.default_rng(7)
-    x = np.geomspace(0.5, 6.0, 8)
-    for _ in range(20):
-        median, beta = rng.uniform(1.0, 3.0), rng.uniform(0.2, 0.7)
-        n = np.full(x.size, 15.0)
-        k = rng.binomial(15, stats.norm.cdf(np.log(x / median) / beta)).astype(float)
-        full = fit_lognormal(x, k, n)
-        for start in ((2.0, 0.5), (30.0, 5.0), (0.1, 0.01)):  # near, and far on either side
-            quick = refit(x, k, n, start)
-            if full.status != "fitted":
-                assert quick is None
-                continue
-            assert quick is not None
-            assert quick[0] == pytest.approx(full.median, rel=1e-6)
-            assert quick[1] == pytest.approx(full.beta, rel=1e-5)
-    assert refit(x, np.zeros(8), np.full(8, 5.0), (2.0, 0.5)) is None  # no collapse
-    assert refit(x, np.array([0, 0, 0, 0, 5, 5, 5, 5.0]), np.full(8, 5.0), (2.0, 0.5)) is None  # separated
 
 
 def _synthetic_runs(median: float, beta: float, records: int, levels: np.ndarray, seed: int) -> pd.DataFrame:

@@ -9,11 +9,9 @@ import os
 import numpy as np
 import pandas as pd
 import pytest
-from scipy import stats
 
 from rockyade.analysis.patterns import classify, classify_samples
 from rockyade.errors import InputError
-from rockyade.probability.fragility import fit_lognormal
 from rockyade.scene import load_scene
 from rockyade.studies.batch import comparable, expand, failures, load_study, run_study_tasks
 
@@ -193,37 +191,6 @@ def test_pattern_of_a_real_stack_run():
     scene = scene_from_dict(d)
     report = classify_result(scene, ReferenceSolver().run(scene))
     assert report.dominant == "4"  # 6 Hz / 2 mm: 2.8 m/s^2 lifts the upper block only
-
-
-# ------------------------------------------------------------------ fragility
-
-
-def test_fragility_fit_recovers_a_known_curve():
-    im = np.array([0.5, 1.0, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0])
-    n = np.full(im.size, 100_000)
-    k = np.round(n * stats.norm.cdf(np.log(im / 2.0) / 0.4))
-    fit = fit_lognormal(im, k, n)
-    assert fit.status == "fitted"
-    assert fit.median == pytest.approx(2.0, rel=2e-3) and fit.beta == pytest.approx(0.4, rel=5e-3)
-    assert fit.probability([2.0])[0] == pytest.approx(0.5, abs=1e-3)
-
-
-def test_fragility_fit_on_sampled_outcomes():
-    rng = np.random.default_rng(4)
-    im = np.linspace(0.2, 3.0, 15)
-    n = np.full(im.size, 30)
-    k = rng.binomial(30, stats.norm.cdf(np.log(im / 1.2) / 0.35))
-    fit = fit_lognormal(im, k, n)
-    assert fit.median == pytest.approx(1.2, rel=0.15) and fit.beta == pytest.approx(0.35, rel=0.4)
-
-
-def test_fragility_edge_cases():
-    assert fit_lognormal([1, 2], [0, 0], [30, 30]).status == "no collapse"
-    assert fit_lognormal([1, 2], [30, 30], [30, 30]).status == "all collapse"
-    with pytest.raises(InputError):
-        fit_lognormal([1, 2], [31, 0], [30, 30])
-    with pytest.raises(InputError):
-        fit_lognormal([-1, 2], [1, 2], [30, 30])
 
 
 def test_no_network_listening_in_local_batches(tmp_path):

@@ -34,11 +34,12 @@ def test_the_check_finds_two_labels_drawn_over_each_other():
 def _summary(specimen: str, solver: str, collapses: dict[float, int], n_records: int = 4) -> list[dict]:
     return [
         {
-            "base": specimen,
+            "specimen": specimen,
             "solver": solver,
-            "motion.load_factor": lf,
-            "motion.record": k + 1,
+            "load_factor": lf,
+            "record": k + 1,
             "status": "overturned" if k < collapses.get(lf, 0) else "completed",
+            "collapsed": k < collapses.get(lf, 0),
             "failure_reason": None,
         }
         for lf in fragility_study.LOAD_FACTORS

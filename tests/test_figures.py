@@ -272,3 +272,38 @@ def test_study_displays_draw_into_given_axes_and_keep_what_they_drew(tmp_path, h
     ax3 = fig3.subplots()
     grid = PatternMapDisplay(cells, (1.0, 2.0), (0.5, 1.0)).plot(ax3)
     assert grid.ax_ is ax3 and ax3.texts[0].get_text() == "rest"
+
+
+def test_the_fragility_display_draws_stripes_and_a_curve_solid_where_tested(tmp_path):
+    """One drawing of a fragility curve with its stripes (the paper study's panels and assess's
+    figure): points at the stripes, the curve solid up to the largest tested level and dotted
+    beyond, an extrapolated median marked; a missing curve is a red legend entry."""
+    from rockyade.figures.fragility import MISSING_COLOUR, FragilityCurve, FragilityDisplay, Mark
+    from rockyade.probability.fragility import Fragility
+
+    levels = np.array([0.1, 0.2, 0.3])
+    curve = FragilityCurve(
+        levels,
+        np.array([0.0, 0.2, 0.4]),
+        "stripes",
+        fragility=Fragility(0.35, 0.3, 3),
+        mark_median=True,
+        fraction_lo=np.array([0.0, 0.05, 0.2]),
+        fraction_hi=np.array([0.2, 0.5, 0.6]),
+    )
+    fig = Figure()
+    ax = fig.subplots()
+    display = FragilityDisplay(
+        [curve], 0.5, "PGA (g)", beyond=0.3, marks=[Mark(0.25, "demand")], missing=["YADE: no curve"]
+    ).plot(ax)
+    assert display.figure_ is fig and display.ax_ is ax
+    solid, dotted = ax.lines[0], ax.lines[1]
+    assert solid.get_linestyle() == "-" and max(solid.get_xdata()) <= 0.3 < min(dotted.get_xdata())
+    assert dotted.get_linestyle() == ":"
+    median = ax.lines[2]  # beyond the tested levels: a diamond at P = 0.5
+    assert median.get_marker() == "D" and list(median.get_xydata()[0]) == pytest.approx([0.35, 0.5])
+    assert ax.get_xlabel() == "PGA (g)" and ax.get_xlim() == (0.0, 0.5)
+    texts = {t.get_text(): t.get_color() for t in ax.get_legend().get_texts()}
+    assert texts["YADE: no curve"] == MISSING_COLOUR and "stripes" in texts and "demand" in texts
+    written = FragilityDisplay([curve], 0.5).plot(path=tmp_path / "fragility.png")
+    assert (tmp_path / "fragility.png").stat().st_size > 5_000 and written.figure_ is not fig

@@ -27,7 +27,7 @@ LOAD_FACTORS = (0.3, 1.2)
 
 def _tasks(tmp_path, specimen: str):
     return fragility_study.tasks(
-        tmp_path / specimen, specimens=(specimen,), records=RECORDS, load_factors=LOAD_FACTORS, solvers=("reference",)
+        specimens=(specimen,), records=RECORDS, load_factors=LOAD_FACTORS, solvers=("reference",)
     )
 
 

@@ -189,11 +189,12 @@ def _summary(specimen: str, solver: str, collapses: dict[float, int], n_records:
         for k in range(n_records):
             rows.append(
                 {
-                    "base": specimen,
+                    "specimen": specimen,
                     "solver": solver,
-                    "motion.load_factor": lf,
-                    "motion.record": k + 1,
+                    "load_factor": lf,
+                    "record": k + 1,
                     "status": status or ("overturned" if k < collapses.get(lf, 0) else "completed"),
+                    "collapsed": status is None and k < collapses.get(lf, 0),
                     "failure_reason": "YADE exited with code 1" if status == "failed" else None,
                 }
             )
@@ -312,18 +313,18 @@ def test_fragility_compares_yade_and_the_reference_run_for_run():
             for solver, status in (("yade", y), ("reference", r)):
                 rows.append(
                     {
-                        "base": "specimen2",
-                        "motion.record": record,
-                        "motion.load_factor": lf,
+                        "specimen": "specimen2",
+                        "record": record,
+                        "load_factor": lf,
                         "solver": solver,
                         "status": status,
                     }
                 )
     rows.append(
         {
-            "base": "specimen2",
-            "motion.record": 3,
-            "motion.load_factor": 1.2,
+            "specimen": "specimen2",
+            "record": 3,
+            "load_factor": 1.2,
             "solver": "reference",
             "status": "overturned",
         }

@@ -45,11 +45,12 @@ def _fits():
         for k in range(10):
             rows.append(
                 {
-                    "base": "specimen2",
+                    "specimen": "specimen2",
                     "solver": "reference",
-                    "motion.load_factor": lf,
-                    "motion.record": k + 1,
+                    "load_factor": lf,
+                    "record": k + 1,
                     "status": "overturned" if k < round(10 * min(1.0, lf / 0.8) ** 3) else "completed",
+                    "collapsed": k < round(10 * min(1.0, lf / 0.8) ** 3),
                     "failure_reason": None,
                 }
             )

@@ -7,7 +7,7 @@
   stripes (Baker 2015, :func:`rockyade.probability.fragility.fit_lognormal`).
 * Its band: the records are the sample, so they are resampled (a record keeps its outcomes
   at every level: a nonparametric bootstrap over records, ``BOOTSTRAP_DRAWS`` draws with a
-  fixed seed); each draw is fitted again; the band is
+  fixed seed); each draw is fitted again (the same fit, started from the full one); the band is
   the pointwise 5 %-95 % range of the fitted curves, and the medians' and betas' 5 %-95 %
   ranges are their intervals. Draws whose fit has no slope (separated stripes, no trend)
   give no curve and are counted.
@@ -27,9 +27,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
-from scipy import special, stats
 
-from rockyade.probability.fragility import MAX_BETA, MIN_BETA, Fragility, fit_lognormal, wilson_interval
+from rockyade.probability.fragility import Fragility, fit_lognormal, wilson_interval
 
 #: Bootstrap draws, their seed and the band's two-sided level.
 BOOTSTRAP_DRAWS = 300
@@ -165,80 +164,6 @@ def _fit(levels: NDArray[np.float64], matrix: NDArray[np.float64]) -> Fragility 
     return None if counts is None else fit_lognormal(*counts)
 
 
-def _nll_and_gradient(
-    params: NDArray[np.float64], logx: NDArray[np.float64], k: NDArray[np.float64], n: NDArray[np.float64]
-) -> tuple[float, NDArray[np.float64]]:
-    """The binomial negative log-likelihood of :func:`~rockyade.probability.fragility.fit_lognormal`
-    in (mu = ln median, s = ln beta), and its gradient."""
-    mu, log_beta = params
-    beta = math.exp(log_beta)
-    z = (logx - mu) / beta
-    log_p, log_q = special.log_ndtr(z), special.log_ndtr(-z)
-    log_phi = -0.5 * z * z - 0.5 * math.log(2.0 * math.pi)
-    value = -float(np.sum(k * log_p + (n - k) * log_q))
-    # phi / Phi and phi / (1 - Phi), the inverse Mills ratios, in logs: finite for any z
-    dz = -(k * np.exp(log_phi - log_p) - (n - k) * np.exp(log_phi - log_q))  # d nll / d z
-    return value, np.array([float(np.sum(dz)) * (-1.0 / beta), float(np.sum(dz * -z))])
-
-
-def refit(
-    x: NDArray[np.float64], k: NDArray[np.float64], n: NDArray[np.float64], start: tuple[float, float]
-) -> tuple[float, float] | None:
-    """(median, beta) of :func:`~rockyade.probability.fragility.fit_lognormal` (the same binomial
-    likelihood, the same answer), found fast: Newton steps from ``start`` = (median, beta), the
-    Hessian from central differences of the analytic gradient, each step at most 1 in
-    (ln median, ln beta) and halved until the likelihood grows. A bootstrap draw starts from
-    the full fit, and this takes a fraction of a millisecond; where Newton does not settle
-    inside the fit's bounds, :func:`fit_lognormal` itself answers. None where the fit has no
-    slope (no collapse, all collapse, separated stripes, no trend).
-    """
-    if k.sum() == 0 or np.all(k == n) or np.max(x[k < n]) <= np.min(x[k > 0]):
-        return None
-    quick = _newton(np.log(x), k, n, start)
-    if quick is not None:
-        return quick
-    full = fit_lognormal(x, k, n)
-    return (full.median, full.beta) if full.status == "fitted" else None
-
-
-def _newton(
-    logx: NDArray[np.float64], k: NDArray[np.float64], n: NDArray[np.float64], start: tuple[float, float]
-) -> tuple[float, float] | None:
-    """The maximum by Newton steps (:func:`refit`), or None when it does not settle inside the bounds."""
-    lo = np.array([float(logx.min()) - 5.0, math.log(MIN_BETA)])
-    hi = np.array([float(logx.max()) + 5.0, math.log(MAX_BETA)])
-    p = np.clip([math.log(start[0]), math.log(start[1])], lo + 1e-3, hi - 1e-3)
-    value, grad = _nll_and_gradient(p, logx, k, n)
-    h = 1e-5
-    for _ in range(100):
-        hess = np.empty((2, 2))
-        for j in range(2):
-            e = np.zeros(2)
-            e[j] = h
-            hess[:, j] = (_nll_and_gradient(p + e, logx, k, n)[1] - _nll_and_gradient(p - e, logx, k, n)[1]) / (2 * h)
-        try:
-            step = -np.linalg.solve(0.5 * (hess + hess.T), grad)
-        except np.linalg.LinAlgError:
-            return None
-        if not np.all(np.isfinite(step)) or float(step @ grad) >= 0.0:
-            step = -grad  # not a descent direction: steepest descent
-        step *= min(1.0, 1.0 / max(float(np.max(np.abs(step))), 1e-300))
-        for _halving in range(60):
-            trial = p + step
-            if np.all(trial > lo) and np.all(trial < hi):
-                t_value, t_grad = _nll_and_gradient(trial, logx, k, n)
-                if t_value <= value:
-                    break
-            step *= 0.5
-        else:
-            return None
-        p, value, grad = trial, t_value, t_grad
-        if np.max(np.abs(step)) < 1e-10:
-            edge = np.minimum(p - lo, hi - p)
-            return None if np.any(edge < 1e-6) else (math.exp(p[0]), math.exp(p[1]))
-    return None
-
-
 def fit_stripes(
     runs: pd.DataFrame,
     level_column: str,
@@ -284,12 +209,13 @@ def fit_stripes(
     medians, betas, curves = [], [], []
     for _ in range(draws if best.status == "fitted" else 0):
         counts = _counts(levels, matrix[rng.integers(0, n_records, n_records)])
-        fit = None if counts is None else refit(*counts, (best.median, best.beta))
-        if fit is None:
+        # the same fit, started from the full one: the same maximum, found in a few Newton steps
+        draw = None if counts is None else fit_lognormal(*counts, start=(best.median, best.beta))
+        if draw is None or draw.status != "fitted":
             continue
-        medians.append(fit[0])
-        betas.append(fit[1])
-        curves.append(stats.norm.cdf(np.log(grid / fit[0]) / fit[1]))
+        medians.append(draw.median)
+        betas.append(draw.beta)
+        curves.append(draw.probability(grid))
     tail = 50.0 * (1.0 - BAND_LEVEL)
     if len(curves) >= max(10, draws // 2):
         band = np.percentile(np.array(curves), [tail, 100.0 - tail], axis=0)

@@ -43,11 +43,12 @@ from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, record_summary
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.result import Result
-from rockyade.runner import Executor, Task, run_jobs, run_tasks
+from rockyade.runner import Executor, Task, check_costs, run_jobs
+from rockyade.runner.groups import group_jobs
 from rockyade.runner.journal import Journal
 from rockyade.runner.tasks import solve
 from rockyade.scene import Scene
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import GroupSolver, Solver
 
 #: Free motion after the record, s.
 DEFAULT_TAIL_S = 5.0
@@ -275,6 +276,10 @@ class StripePlan:
             )
         return lf
 
+    def level_labels(self, level: float) -> dict[str, float]:
+        """What names a level in a task's labels: the measure in its shown unit."""
+        return {self.measure.column: self.measure.shown(level)}
+
     def tasks(self, levels_si: Sequence[float], first_index: int = 0) -> list[StripeTask]:
         """One task per record and level (level by level)."""
         out: list[StripeTask] = []
@@ -286,7 +291,7 @@ class StripePlan:
                         first_index + len(out),
                         self.solver,
                         self.scene_for(i, lf),
-                        {"record": self.motions.label(i), self.measure.column: self.measure.shown(level)},
+                        {"record": self.motions.label(i), **self.level_labels(level)},
                         record_index=i,
                         record=self.motions.label(i),
                         level_si=float(level),
@@ -296,6 +301,25 @@ class StripePlan:
                     )
                 )
         return out
+
+
+@dataclass(frozen=True)
+class LoadFactorStripes(StripePlan):
+    """Stripes whose levels are load factors: every record scaled by the same lambda (a suite
+    scaled as a whole, the paper's way; its intensity is then a nominal one, e.g. lambda x ag S,
+    not each record's own). ``levels_si`` given to :meth:`tasks` and :func:`run_stripes` are
+    the load factors themselves (a task's ``level_si`` too), so that each run's load factor is
+    exactly the one asked for; ``measure`` and ``im_si`` are what lambda = 1 stands for."""
+
+    def load_factor(self, i: int, level_si: float) -> float:
+        """The level itself; InputError outside (0, :data:`MAX_LOAD_FACTOR`]."""
+        if not (math.isfinite(level_si) and 0.0 < level_si <= MAX_LOAD_FACTOR):
+            raise InputError("load_factor", f"must be in (0, {MAX_LOAD_FACTOR:g}], got {level_si!r}")
+        return float(level_si)
+
+    def level_labels(self, level: float) -> dict[str, float]:
+        """The load factor."""
+        return {"load_factor": float(level)}
 
 
 def record_measures(
@@ -347,29 +371,87 @@ def run_stripes(
             if row is not None:
                 earlier[task.index] = {**row, "run": task.index}
     todo = [t for t in tasks if t.index not in earlier]
+    check_costs(todo, allow_large)
+    jobs = group_jobs(todo, stripe_group, max(1, min(MAX_RUNS_PER_JOB, -(-len(todo) // (4 * executor.workers)))))
 
-    def on_done(i: int, row: dict[str, Any]) -> None:
+    def on_done(_i: int, job_rows: list[dict[str, Any]]) -> None:
         if journal is not None:
-            task = todo[i]
-            journal.record(run_name(task), {"status": row["status"], "scene_hash": task.scene_hash, "summary": row})
+            for row in job_rows:
+                task = tasks[row["run"] - first_index]
+                journal.record(run_name(task), {"status": row["status"], "scene_hash": task.scene_hash, "summary": row})
 
-    outcome = run_tasks(
-        todo,
-        run_stripe_task,
+    outcome = run_jobs(
+        jobs,
+        run_stripe_job,
         executor=executor,
-        allow_large=allow_large,
-        failed=failed_row,
+        failed=lambda job, reason: [failed_row(task, reason) for task in job],
         on_done=on_done,
         progress=progress,
         desc="runs",
         skipped=len(earlier),
     )
-    by_index = {**earlier, **{todo[i].index: row for i, row in outcome.values.items()}}
+    by_index = {**earlier, **{row["run"]: row for job_rows in outcome.values.values() for row in job_rows}}
     rows = [by_index[k] for k in sorted(by_index)]
     if outcome.unfinished:
-        error = BatchInterruptedError(len(done_rows) + len(rows), len(outcome.unfinished), None, outcome.hard)
+        stopped = sum(len(jobs[i]) for i in outcome.unfinished)
+        error = BatchInterruptedError(len(done_rows) + len(rows), stopped, None, outcome.hard)
         error.rows = [*done_rows, *rows]  # type: ignore[attr-defined]
         raise error
+    return rows
+
+
+#: Most runs of one group in one job (groups are cut so that every worker gets jobs).
+MAX_RUNS_PER_JOB = 64
+
+
+def stripe_group(task: StripeTask) -> str | None:
+    """The group of a run (:func:`rockyade.runner.groups.group_jobs`): runs of one block whose
+    solver steps scenes of one structure together (:class:`rockyade.solvers.base.GroupSolver`,
+    its ``group_key``: the same block, another record or load factor) go to one job; None: it
+    runs alone."""
+    solver = task.solver
+    if not single_block(task.scene) or not isinstance(solver, GroupSolver):
+        return None
+    key = solver.group_key(task.scene)
+    return None if key is None else f"{solver!r}|{key}"
+
+
+def run_stripe_job(job: tuple[StripeTask, ...]) -> list[dict[str, Any]]:
+    """The rows of a job of :func:`stripe_group`'s group (or of one task). Never raises: should
+    the group fail as a whole, its runs are run one by one (:func:`run_stripe_task`).
+
+    A group's runs are the solver's own runs stepped together (the same results, bit for bit,
+    as one at a time: :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`); a run
+    collapses when its status is ``overturned``, and its peak |theta| is that of its sampled
+    rotation, over the block's alpha."""
+    if len(job) == 1:
+        return [run_stripe_task(job[0])]
+    from rockyade.analysis.metrics import uplift_threshold_rad
+
+    start = time.perf_counter()
+    solver = job[0].solver
+    assert isinstance(solver, GroupSolver)  # stripe_group groups only these
+    alpha = job[0].scene.blocks[0].classical().alpha_rad
+    try:
+        runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
+    except Exception:  # a run of its own says what went wrong
+        return [run_stripe_task(task) for task in job]
+    elapsed = (time.perf_counter() - start) / len(job)
+    rows = []
+    for task, one in zip(job, runs, strict=True):
+        row = _row(task, one.status, str(one.meta.get("failure_reason") or ""))
+        row["wall_time_s"] = elapsed
+        if one.status != "failed":
+            theta = one.theta_rad[np.isfinite(one.theta_rad)]
+            peak = float(np.max(np.abs(theta))) if theta.size else math.nan
+            over = one.status == "overturned"
+            row.update(
+                collapsed=over,
+                n_fallen=int(over),
+                max_theta_over_alpha=peak / alpha,
+                max_theta_over_own_alpha=peak / alpha,
+            )
+        rows.append(row)
     return rows
 
 

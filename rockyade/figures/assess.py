@@ -1,9 +1,10 @@
 """Figures of :mod:`rockyade.assess`: a fragility curve, and an assessment (the code's capacity
 curve with the demand beside the fragility in ag).
 
-* :func:`plot_fragility`: the fraction of records that collapse at each stripe (points, 95 %
-  Wilson bars), the lognormal fit (solid over the tested levels, dotted beyond), its 90 %
-  bootstrap band, the median marked;
+* :func:`plot_fragility` (:func:`fragility_display`, a
+  :class:`rockyade.figures.fragility.FragilityDisplay`): the fraction of records that
+  collapse at each stripe (points, 95 % Wilson bars), the lognormal fit (solid over the
+  tested levels, dotted beyond), its 90 % bootstrap band, the median marked;
 * :func:`plot_capacity`: the code's capacity curve a*(d*) of the equivalent system, a0*,
   du* and the secant of Ts, the linear demand (ag S / q, or the floor's at height) and the
   nonlinear one: the site's elastic spectrum in acceleration-displacement form
@@ -27,6 +28,8 @@ from rockyade.assess.code import VERIFIED
 from rockyade.assess.fragility import FragilityResult
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.figures.common import figure_of, new_figure, save_figure
+from rockyade.figures.fragility import FragilityCurve, FragilityDisplay, Mark
+from rockyade.probability.fragility import Fragility
 
 CURVE = "#1f4e79"
 BAND = "#9ecae1"
@@ -40,7 +43,8 @@ PUSH = "#762a83"
 def plot_fragility(
     result: FragilityResult, ax: Axes | None = None, marks: list[tuple[float, str, str, str]] | None = None
 ) -> tuple[Any, Axes]:
-    """The stripes and the fit (module docstring) in the measure's shown unit.
+    """The stripes and the fit (module docstring) in the measure's shown unit
+    (:func:`fragility_display`, drawn).
 
     Parameters
     ----------
@@ -51,73 +55,65 @@ def plot_fragility(
     marks
         Vertical lines: (value in SI, label, colour, line style).
     """
-    if ax is None:
-        fig, ax = new_figure(None, figsize=(6.4, 4.2))
-    else:
-        fig = figure_of(ax)
+    display = fragility_display(result, marks).plot(ax)
+    assert display.ax_ is not None  # set by plot
+    return display.figure_, display.ax_
+
+
+def fragility_display(
+    result: FragilityResult, marks: list[tuple[float, str, str, str]] | None = None
+) -> FragilityDisplay:
+    """The display of a fragility analysis: the fraction of records that collapse at each
+    stripe with its 95 % Wilson interval, the lognormal fit (solid over the tested levels,
+    dotted beyond, its median marked) and its 90 % bootstrap band, in the measure's shown
+    unit; ``marks`` as for :func:`plot_fragility`."""
     m, fit = result.measure, result.fit
     s = result.stripes
     x = s[m.si_column].to_numpy() / m.scale
     top = 1.25 * max([float(x.max()), *(v / m.scale for v, *_ in marks or [])])
-    grid = np.linspace(top / 400, top, 400)
     f = fit.fragility
+    shown = Fragility(f.median / m.scale, f.beta, f.n_points, f.status, f.fraction)
     if f.status == "fitted":
-        if not np.all(np.isnan(fit.band_lo)):
-            ax.fill_between(
-                fit.grid_si / m.scale,
-                fit.band_lo,
-                fit.band_hi,
-                color=BAND,
-                alpha=0.55,
-                lw=0,
-                label="90 % bootstrap band",
-            )
-        p = f.probability(grid * m.scale)
-        inside = grid <= x.max()
-        ax.plot(
-            grid[inside],
-            p[inside],
-            color=CURVE,
-            lw=1.8,
-            label=f"lognormal fit: median {m.shown(f.median):.3g} {m.unit}, beta {f.beta:.2f}",
-        )
-        ax.plot(grid[~inside], p[~inside], color=CURVE, lw=1.4, ls=":")
-        ax.plot([m.shown(f.median)], [0.5], "o", color=CURVE, mfc="white", ms=6, zorder=5)
+        curve_label = f"lognormal fit: median {m.shown(f.median):.3g} {m.unit}, beta {f.beta:.2f}"
     elif f.status == "separated":
-        ax.axvline(m.shown(f.median), color=CURVE, lw=1.4, label=f"threshold near {m.shown(f.median):.3g} {m.unit}")
-    lo = np.clip(s["fraction"] - s["fraction_lo"], 0.0, None)  # >= 0 (the interval's rounding)
-    hi = np.clip(s["fraction_hi"] - s["fraction"], 0.0, None)
+        curve_label = f"threshold near {m.shown(f.median):.3g} {m.unit}"
+    else:
+        curve_label = ""
     n = int(s["n_runs"].max()) if len(s) else 0
-    ax.errorbar(
+    curve = FragilityCurve(
         x,
-        s["fraction"],
-        yerr=[lo, hi],
-        fmt="s",
-        color=POINTS,
-        ms=4.5,
-        capsize=2.5,
-        lw=0.9,
-        label=f"fraction of {n} records that collapse (95 % Wilson)",
+        s["fraction"].to_numpy(),
+        f"fraction of {n} records that collapse (95 % Wilson)",
+        colour=CURVE,
+        point_colour=POINTS,
+        marker="s",
+        filled=True,
+        fraction_lo=s["fraction_lo"].to_numpy(),
+        fraction_hi=s["fraction_hi"].to_numpy(),
+        fragility=shown,
+        curve_label=curve_label,
+        tested_max=float(x.max()),
+        mark_median=True,
+        band=(fit.grid_si / m.scale, fit.band_lo, fit.band_hi),
+        band_label="90 % bootstrap band",
+        band_colour=BAND,
+        lw=1.8,
     )
-    for k, (value, label, colour, style) in enumerate(marks or []):
+    lines = [
         # the first mark (the site's ag in an assessment) wide and below: a capacity at the same value,
         # drawn thin over it, leaves it showing on both sides
-        ax.axvline(
+        Mark(
             value / m.scale,
-            color=colour,
-            ls=style,
-            lw=3.2 if k == 0 else 1.3,
-            alpha=0.75 if k == 0 else 1.0,
-            zorder=1.5 if k == 0 else 2.5,
-            label=label,
+            label,
+            colour,
+            style,
+            3.2 if k == 0 else 1.3,
+            0.75 if k == 0 else 1.0,
+            1.5 if k == 0 else 2.5,
         )
-    ax.set_xlim(0, top)
-    ax.set_ylim(-0.03, 1.03)
-    ax.set_xlabel(m.label)
-    ax.set_ylabel("P(collapse)")
-    ax.grid(alpha=0.3)
-    _legend_below(ax, 7)
-    return fig, ax
+        for k, (value, label, colour, style) in enumerate(marks or [])
+    ]
+    return FragilityDisplay([curve], top, m.label, "P(collapse)", marks=lines, legend="below")
 
 
 def _legend_below(ax: Axes, fontsize: float) -> None:

@@ -6,25 +6,38 @@ overturn it at each load factor, and a lognormal fragility curve fitted by maxim
 likelihood, for the reference DEM and Housner; YADE on a documented subset (specimen 2,
 records 1-10, load factors 0.4, 0.8, 1.2). Intensity: the nominal PGA of the scaled suite,
 load factor x ag S (ag S = 2.8 m/s^2).
+
+The stripes are those of ``rockyade fragility`` and ``rockyade assess``
+(:class:`rockyade.assess.stripes.LoadFactorStripes`, run through :mod:`rockyade.runner` by
+:func:`rockyade.assess.stripes.run_stripes`: a run collapses when the block overturns), and
+the curve is the one fit of :func:`rockyade.probability.fragility.fit_lognormal`.
 """
 
 from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
+from rockyade.assess.measures import Measure
+from rockyade.assess.motions import paper_suite_set
+from rockyade.assess.stripes import LoadFactorStripes, StripeTask, run_stripes
 from rockyade.calibration.model import calibrated_model
 from rockyade.constants import ACCEL_UNIT_LABELS
+from rockyade.errors import InputError
 from rockyade.figures import new_figure, save_figure
 from rockyade.figures.common import accel_scale, other_accel_axis
+from rockyade.figures.fragility import FragilityCurve, FragilityDisplay
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.probability.fragility import Fragility, fit_lognormal
-from rockyade.runner import run_jobs
+from rockyade.runner import Executor, run_jobs
 from rockyade.scene import scene_from_dict
-from rockyade.studies.batch import expand, run_study_tasks
+from rockyade.solvers import as_solver
 from rockyade.studies.report import Report, fmt, run_state
 from rockyade.studies.specimens import block_table, scene_dict
 
@@ -40,13 +53,65 @@ def _base(key: str) -> dict:
     return scene_dict([block_table(key)], motion, DURATION_S, SAMPLE_DT_S, "matched")
 
 
+def stripe_plan(key: str, solver: str, records: Sequence[int] = RECORDS) -> LoadFactorStripes:
+    """The stripes of specimen ``key`` by ``solver``: records 1..n of the paper's suite, each
+    run for :data:`DURATION_S` (20 s of record, 5 s after) at the load factors given to
+    :func:`rockyade.assess.stripes.run_stripes`; the solver without energy terms and contact states
+    (collapse is the question: its runs go to the solver in groups)."""
+    if tuple(records) != tuple(range(1, len(records) + 1)):
+        raise InputError("records", f"must be the suite's first records 1..n, got {tuple(records)}")
+    chosen = as_solver(solver)
+    lean = {f: False for f in ("record_energy", "record_contacts") if getattr(chosen, f, False)}
+    if lean:  # a single block's collapse reads its status and rotation only
+        chosen = dataclasses.replace(chosen, **lean)  # type: ignore[type-var]
+    count = len(records)
+    ag_s = paper_suite().target.ag_s_m_s2
+    return LoadFactorStripes(
+        scene_from_dict(_base(key)),
+        paper_suite_set(count),
+        Measure("pga"),
+        (ag_s,) * count,  # lambda = 1: the suite's nominal PGA, ag S
+        (DURATION_S,) * count,
+        chosen,
+        sample_dt_s=SAMPLE_DT_S,
+        tail_s=0.0,  # the duration is the run's: the record's 20 s and 5 s after
+    )
+
+
 def tasks(
-    out, specimens=paper.SINGLE_SPECIMENS, records=RECORDS, load_factors=LOAD_FACTORS, solvers=("reference", "housner")
-):
-    """Batch tasks of the fragility study."""
-    bases = [(f"specimen{key}", _base(key)) for key in specimens]
-    grid = {"motion.record": list(records), "motion.load_factor": list(load_factors)}
-    return expand(bases, grid, solvers, out, save_history=False)
+    specimens=paper.SINGLE_SPECIMENS, records=RECORDS, load_factors=LOAD_FACTORS, solvers=("reference", "housner")
+) -> list[StripeTask]:
+    """The fragility study's runs (record x load factor, per specimen and solver), as
+    :func:`rockyade.assess.stripes.run_stripes` runs them."""
+    return [
+        task
+        for key in specimens
+        for solver in solvers
+        for task in stripe_plan(key, solver, records).tasks(load_factors)
+    ]
+
+
+def run_runs(
+    specimens=paper.SINGLE_SPECIMENS,
+    records=RECORDS,
+    load_factors=LOAD_FACTORS,
+    solvers=("reference", "housner"),
+    workers: int = 2,
+    desc: str = "fragility",
+) -> pd.DataFrame:
+    """Run the stripes; one row per run (:data:`rockyade.assess.stripes.RUN_COLUMNS`, the level
+    being the load factor) with ``specimen`` (``specimen<key>``) and ``record`` (its number)."""
+    frames = []
+    executor = Executor("local", workers)
+    for key in specimens:
+        for solver in solvers:
+            print(f"[paper] {desc}: specimen {key}, {SOLVER_LABELS.get(solver, solver)}", flush=True)
+            rows = run_stripes(stripe_plan(key, solver, records), list(load_factors), executor)
+            frame = pd.DataFrame(rows).drop(columns=["level_si"])
+            frame.insert(0, "specimen", f"specimen{key}")
+            frame["record"] = frame["record_index"] + 1
+            frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
 
 
 def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
@@ -59,24 +124,31 @@ def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
         calibrated_model(scene_from_dict(_base(key)))
 
 
-def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """(stripes, fits): collapses per load factor, and the fitted curves per specimen and solver."""
+def fit_table(runs: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """(stripes, fits): collapses per load factor, and the fitted curves per specimen and solver.
+
+    Parameters
+    ----------
+    runs
+        One row per run: ``specimen``, ``solver``, ``load_factor``, ``status`` (failed runs
+        are left out of the stripes and counted), ``collapsed``, ``failure_reason``.
+    """
     ag_s = paper_suite().target.ag_s_m_s2
-    done = summary[summary.status != "failed"].copy()
-    done["collapse"] = done.status == "overturned"
+    done = runs[runs.status != "failed"].copy()
+    done["collapse"] = done.collapsed.astype(bool)
     stripes = (
-        done.groupby(["base", "solver", "motion.load_factor"])
+        done.groupby(["specimen", "solver", "load_factor"])
         .agg(n_collapse=("collapse", "sum"), n_records=("collapse", "size"))
         .reset_index()
     )
-    stripes = stripes.rename(columns={"base": "specimen", "motion.load_factor": "load_factor"})
     stripes["pga_m_s2"] = stripes.load_factor * ag_s
     stripes["fraction"] = stripes.n_collapse / stripes.n_records
     fits = []
-    for (specimen, solver), runs in summary.groupby(["base", "solver"]):
+    for (specimen, solver), group_runs in runs.groupby(["specimen", "solver"]):
         group = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
-        failed = runs[runs.status == "failed"]
+        failed = group_runs[group_runs.status == "failed"]
         reasons = failed.get("failure_reason", pd.Series(dtype=object)).dropna().astype(str)
+        reasons = reasons[reasons != ""]
         row = {
             "specimen": specimen,
             "solver": solver,
@@ -87,12 +159,12 @@ def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
             "stripes": len(group),
             "largest_tested_pga_m_s2": float(group.pga_m_s2.max()) if len(group) else np.nan,
             "extrapolated": False,
-            "runs": len(runs),
+            "runs": len(group_runs),
             "failed_runs": len(failed),
             "failure_reason": reasons.value_counts().index[0] if len(reasons) else "",
         }
         if len(group) < 2:
-            row["status"] = f"not fitted: {len(failed)} of {len(runs)} runs failed, {len(group)} stripe(s) left"
+            row["status"] = f"not fitted: {len(failed)} of {len(group_runs)} runs failed, {len(group)} stripe(s) left"
         else:
             fit = fit_lognormal(group.pga_m_s2, group.n_collapse, group.n_records)
             row.update(
@@ -104,12 +176,12 @@ def fit_table(summary: pd.DataFrame) -> tuple[pd.DataFrame, pd.DataFrame]:
     return stripes, pd.DataFrame(fits)
 
 
-def same_runs_table(summary: pd.DataFrame, solver: str = "yade", reference: str = "reference") -> pd.DataFrame:
+def same_runs_table(runs: pd.DataFrame, solver: str = "yade", reference: str = "reference") -> pd.DataFrame:
     """Per specimen and load factor, on the runs both solvers made (same records): how many
     overturn in each, and in how many runs they agree. The YADE subset's curve is fitted on
     its own few stripes; this table compares the two DEMs run for run."""
-    cols = ["base", "motion.record", "motion.load_factor"]
-    done = summary[summary.status != "failed"]
+    cols = ["specimen", "record", "load_factor"]
+    done = runs[runs.status != "failed"]
     a = done[done.solver == solver][[*cols, "status"]]
     b = done[done.solver == reference][[*cols, "status"]]
     both = a.merge(b, on=cols, suffixes=(f"_{solver}", f"_{reference}"))
@@ -119,14 +191,13 @@ def same_runs_table(summary: pd.DataFrame, solver: str = "yade", reference: str 
     over_b = both[f"status_{reference}"] == "overturned"
     both = both.assign(a=over_a, b=over_b, same=over_a == over_b)
     table = (
-        both.groupby(["base", "motion.load_factor"])
+        both.groupby(["specimen", "load_factor"])
         .agg(
             runs=("same", "size"),
             **{f"{solver}_overturned": ("a", "sum"), f"{reference}_overturned": ("b", "sum")},
             same_outcome=("same", "sum"),
         )
         .reset_index()
-        .rename(columns={"base": "specimen", "motion.load_factor": "load_factor"})
     )
     return table
 
@@ -148,23 +219,18 @@ def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str
         "stripes. What ran is stated below.",
     )
     prepare()
-    runs = report.out / "fragility_runs"
-    summary = run_study_tasks(tasks(runs), runs, workers=workers, desc="fragility", resume_option=None)
+    summary = run_runs(workers=workers)
     if use_yade:
-        subset = tasks(
-            report.out / "fragility_yade_runs",
+        yade = run_runs(
             (YADE_SUBSET["specimen"],),
             YADE_SUBSET["records"],
             YADE_SUBSET["load_factors"],
             ("yade",),
+            workers=workers,
+            desc="fragility (YADE)",
         )
-        yade_summary = run_study_tasks(
-            subset, report.out / "fragility_yade_runs", workers=workers, desc="fragility (YADE)", resume_option=None
-        )
-        summary = pd.concat([summary, yade_summary], ignore_index=True)
-    report.record_summary(
-        summary, lambda row: f"{row['base']}, record {row['motion.record']} x {row['motion.load_factor']}"
-    )
+        summary = pd.concat([summary, yade], ignore_index=True)
+    report.record_summary(summary, lambda row: f"{row['specimen']}, record {row['record']} x {row['load_factor']}")
     stripes, fits = fit_table(summary)
     ran = "; ".join(
         f"{SOLVER_LABELS[solver]}: {run_state(report, solver, int((summary.solver == solver).sum()))}"
@@ -182,6 +248,12 @@ def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str
             )
             + ". The fitted curve is not tested there: read these medians as 'above the tested range'."
         )
+    report.table(
+        "fragility_runs.csv",
+        summary,
+        "one row per run: specimen, solver, record, load factor, status, whether the block overturned "
+        "(collapsed) and its peak |theta| / alpha.",
+    )
     report.table("fragility_stripes.csv", stripes, "collapses / records at each load factor, per specimen and solver.")
     same = same_runs_table(summary) if use_yade else pd.DataFrame()
     if len(same):
@@ -214,50 +286,14 @@ def run(report: Report, workers: int = 2, use_yade: bool = True, accel_unit: str
 def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame, accel_unit: str = "g") -> Figure:
     """Per specimen: collapse fractions (points), fitted curves (solid over the tested range,
     dotted beyond it), extrapolated medians flagged and missing curves explained; PGA in
-    ``accel_unit`` ("g", standard gravity, or "m/s2"), the other unit on the top axis."""
-    specimens = sorted(set(fits.specimen))
+    ``accel_unit`` ("g", standard gravity, or "m/s2"), the other unit on the top axis. Each
+    panel is a :class:`rockyade.figures.fragility.FragilityDisplay`."""
     name = "fragility.png"
     unit = accel_scale(accel_unit)
     fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 8.5), sharex=True, sharey=True)
     tested = LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2 / unit
-    x_max = 1.35 * tested  # room to show where an extrapolated curve goes
-    x = np.linspace(0.05 / unit, x_max, 300)
-    markers = {"reference": "o", "housner": "s", "yade": "^"}
-    for ax, specimen in zip(axes.ravel(), specimens, strict=False):
-        missing = []
-        for solver, marker in markers.items():
-            sel = fits[(fits.specimen == specimen) & (fits.solver == solver)]
-            if sel.empty:
-                continue
-            fit = sel.iloc[0]
-            pts = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
-            if pts.empty or not fit.status.startswith(("fitted", "no collapse", "all collapse")):
-                missing.append(_missing_curve(solver, fit))
-                continue
-            subset = fit.runs < fits[fits.specimen == specimen].runs.max()
-            _draw_fit(ax, solver, marker, fit, pts, subset, x, x_max, accel_unit)
-        ax.axvspan(tested, x_max, color="0.92", lw=0, zorder=0)
-        ax.text(
-            x_max,
-            0.5,
-            "beyond the largest tested PGA ",
-            rotation=90,
-            fontsize=6.5,
-            color="0.4",
-            ha="right",
-            va="center",
-        )
-        for text in missing:  # a legend entry, so that it never covers the points
-            ax.plot([], [], ls="none", marker="x", color="#b2182b", label=text)
-        ax.set_title(specimen.replace("specimen", "specimen "))
-        ax.set_xlim(0, x_max)
-        ax.set_ylim(-0.03, 1.32)  # headroom for the legend above the curves
-        ax.set_yticks(np.linspace(0, 1, 6))
-        ax.grid(alpha=0.3)
-        legend = ax.legend(fontsize=7, loc="upper left")  # curves rise to the right: that corner is free
-        for text in legend.get_texts():
-            if "no curve" in text.get_text():
-                text.set_color("#b2182b")
+    for ax, display in zip(axes.ravel(), fragility_displays(stripes, fits, accel_unit), strict=False):
+        display.plot(ax)
     for ax in axes[-1]:  # short: the two bottom labels sit side by side (the caption says the rest)
         ax.set_xlabel(f"PGA of the scaled suite, load factor x ag S ({ACCEL_UNIT_LABELS[accel_unit]})")
     for ax in axes[0]:
@@ -276,21 +312,47 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame, accel
     return fig
 
 
-def _draw_fit(
-    ax,
-    solver: str,
-    marker: str,
-    fit,
-    pts: pd.DataFrame,
-    subset: bool,
-    x: np.ndarray,
-    x_max: float,
-    accel_unit: str = "g",
-) -> None:
-    """One solver's collapse fractions (points) and fitted curve (solid within its tested
-    range, dotted beyond), its median marked when extrapolated; ``subset``: fewer runs than
-    the other solvers (YADE), said in the legend. ``x`` and ``x_max`` in ``accel_unit``."""
-    colour = SOLVER_STYLES[solver]["color"]
+#: Marker of each solver's points.
+MARKERS = {"reference": "o", "housner": "s", "yade": "^"}
+
+
+def fragility_displays(stripes: pd.DataFrame, fits: pd.DataFrame, accel_unit: str = "g") -> list[FragilityDisplay]:
+    """One display per specimen (sorted): each solver's stripes and curve in ``accel_unit``."""
+    unit = accel_scale(accel_unit)
+    tested = LOAD_FACTORS[-1] * paper_suite().target.ag_s_m_s2 / unit
+    x_max = 1.35 * tested  # room to show where an extrapolated curve goes
+    displays = []
+    for specimen in sorted(set(fits.specimen)):
+        curves, missing = [], []
+        for solver, marker in MARKERS.items():
+            sel = fits[(fits.specimen == specimen) & (fits.solver == solver)]
+            if sel.empty:
+                continue
+            fit = sel.iloc[0]
+            pts = stripes[(stripes.specimen == specimen) & (stripes.solver == solver)]
+            if pts.empty or not fit.status.startswith(("fitted", "no collapse", "all collapse")):
+                missing.append(_missing_curve(solver, fit))
+                continue
+            subset = fit.runs < fits[fits.specimen == specimen].runs.max()
+            curves.append(_curve(solver, marker, fit, pts, subset, accel_unit))
+        displays.append(
+            FragilityDisplay(
+                curves,
+                x_max,
+                ylabel="",
+                title=specimen.replace("specimen", "specimen "),
+                beyond=tested,
+                beyond_text="beyond the largest tested PGA",
+                missing=missing,
+                ylim=(-0.03, 1.32),  # headroom for the legend above the curves
+            )
+        )
+    return displays
+
+
+def _curve(solver: str, marker: str, fit, pts: pd.DataFrame, subset: bool, accel_unit: str = "g") -> FragilityCurve:
+    """One solver's collapse fractions and fitted curve in ``accel_unit``, its median marked
+    when extrapolated; ``subset``: fewer runs than the other solvers (YADE), said in the legend."""
     unit = accel_scale(accel_unit)
     if fit.status == "fitted":
         median = f"median {fmt(fit.median_pga_m_s2 / unit, 3)} {ACCEL_UNIT_LABELS[accel_unit]}"
@@ -303,25 +365,17 @@ def _draw_fit(
         label += f" ({fit.failed_runs} of {fit.runs} runs failed)"
     elif subset:  # say how small
         label += f" ({int(pts.n_records.max())} records x {len(pts)} load factors)"
-    ax.plot(pts.pga_m_s2 / unit, pts.fraction, marker, color=colour, ms=4.5, label=label, mfc="none", mew=1.2)
-    if fit.status != "fitted":
-        return
-    curve = Fragility(fit.median_pga_m_s2 / unit, fit.beta, int(fit.stripes)).probability(x)
-    inside = x <= fit.largest_tested_pga_m_s2 / unit
-    ax.plot(x[inside], curve[inside], color=colour, lw=1.3)
-    ax.plot(x[~inside], curve[~inside], color=colour, lw=1.3, ls=":")
-    if fit.extrapolated:  # the median on the dotted curve (an arrow at the edge when beyond it)
-        inside_plot = fit.median_pga_m_s2 / unit <= x_max
-        ax.plot(
-            min(fit.median_pga_m_s2 / unit, x_max),
-            0.5,
-            "D" if inside_plot else ">",
-            color=colour,
-            mfc="white",
-            ms=6,
-            mew=1.3,
-            zorder=5,
-        )
+    fitted = fit.status == "fitted"
+    return FragilityCurve(
+        pts.pga_m_s2.to_numpy() / unit,
+        pts.fraction.to_numpy(),
+        label,
+        colour=SOLVER_STYLES[solver]["color"],
+        marker=marker,
+        fragility=Fragility(fit.median_pga_m_s2 / unit, fit.beta, int(fit.stripes)) if fitted else None,
+        tested_max=fit.largest_tested_pga_m_s2 / unit,
+        mark_median=bool(fitted and fit.extrapolated),
+    )
 
 
 def _caption_notes(fits: pd.DataFrame, tested: float, accel_unit: str = "g") -> list[str]:
