@@ -15,6 +15,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from rockyade import paper
+from rockyade.batch import expand, run_study_tasks
 from rockyade.calibration.model import calibrated_model
 from rockyade.constants import ACCEL_UNIT_LABELS
 from rockyade.figures import new_figure, save_figure
@@ -24,7 +25,6 @@ from rockyade.motion.synthetic import paper_suite, suite_record
 from rockyade.probability.fragility import Fragility, fit_lognormal
 from rockyade.runner import run_jobs
 from rockyade.scene import scene_from_dict
-from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.report import Report, fmt, run_state
 from rockyade.studies.specimens import block_table, scene_dict
 
@@ -46,7 +46,7 @@ def tasks(
     """Batch tasks of the fragility study."""
     bases = [(f"specimen{key}", _base(key)) for key in specimens]
     grid = {"motion.record": list(records), "motion.load_factor": list(load_factors)}
-    return expand(bases, grid, solvers, out, save_history=False)
+    return expand(bases, grid, solvers, save_history=False)
 
 
 def prepare(specimens=paper.SINGLE_SPECIMENS) -> None:
