@@ -17,7 +17,7 @@ def main() -> None:
     fragility_study.prepare()
     out = Path(tempfile.mkdtemp(prefix="rockyade-bench-batch-"))
     tasks = fragility_study.tasks(out / "local", load_factors=LOAD_FACTORS, solvers=("reference",))
-    from rockyade.studies.batch import run_study_tasks
+    from rockyade.batch import run_study_tasks
 
     start = time.perf_counter()
     summary = run_study_tasks(tasks, out / "local", workers=2, progress=False)

@@ -19,11 +19,11 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from rockyade.batch import comparable, run_study_tasks
 from rockyade.runner import Executor
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies import fragility_study, overturning
-from rockyade.studies.batch import comparable, run_study_tasks
 from rockyade.studies.specimens import block_table
 from rockyade.studies.uncertainty import build_tasks, draw_samples, run_uncertainty, uncertainty_study_from_dict
 
@@ -136,7 +136,7 @@ def task_making(repeat: int) -> list[tuple[str, int, float]]:
     )
     study = _uncertainty_study(["housner", "reference"])
     samples = draw_samples(study)
-    unc, utasks = best_cpu(lambda: build_tasks(study, samples, folder), repeat)
+    unc, utasks = best_cpu(lambda: build_tasks(study, samples), repeat)
     shutil.rmtree(folder, ignore_errors=True)
     return [("fragility expand", len(tasks), frag), ("uncertainty build_tasks", len(utasks), unc)]
 

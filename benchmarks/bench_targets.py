@@ -154,28 +154,32 @@ def kernel_cpu(tasks) -> tuple[float, float]:
 
 
 def overhead_target(repeat: int) -> None:
+    from rockyade.batch.running import output, run_job, run_task
     from rockyade.studies import fragility_study
-    from rockyade.studies.batch import run_job, run_task
 
     out = Path(tempfile.mkdtemp(prefix="rockyade-bench-targets-"))
     n = 0
 
     def fresh():
+        """New tasks, and a folder of their own for their files."""
         nonlocal n
         n += 1
-        return fragility_study.tasks(
+        tasks = fragility_study.tasks(
             out / f"o{n}", specimens=("2",), records=range(1, 11), load_factors=(0.3,), solvers=("reference",)
         )
+        return tasks, output(out / f"o{n}")
 
-    run_task(fresh()[0])
-    run_job(tuple(fresh()[:2]))
-    kern_one, kern_group = kernel_cpu(fresh())
+    tasks, where = fresh()
+    run_task(tasks[0], where)
+    tasks, where = fresh()
+    run_job(tuple(tasks[:2]), where)
+    kern_one, kern_group = kernel_cpu(fresh()[0])
     cpu_one = cpu_group = math.inf
     for _ in range(max(1, repeat // 2)):
-        tasks = fresh()
-        cpu_one = min(cpu_one, best_cpu(lambda tasks=tasks: [run_task(t) for t in tasks], 1) / len(tasks))
-        tasks = fresh()
-        cpu_group = min(cpu_group, best_cpu(lambda tasks=tasks: run_job(tuple(tasks)), 1) / len(tasks))
+        tasks, where = fresh()
+        cpu_one = min(cpu_one, best_cpu(lambda t=tasks, w=where: [run_task(x, w) for x in t], 1) / len(tasks))
+        tasks, where = fresh()
+        cpu_group = min(cpu_group, best_cpu(lambda t=tasks, w=where: run_job(tuple(t), w), 1) / len(tasks))
     row(
         "kernel: 10 runs stepped together (simulate_runs) / one at a time (single-body path), per run",
         f"{1e3 * kern_group:.1f} / {1e3 * kern_one:.1f} ms CPU",
@@ -199,8 +203,8 @@ def cpu_now() -> float:
 
 
 def batch_target() -> None:
+    from rockyade.batch import run_study_tasks
     from rockyade.studies import fragility_study
-    from rockyade.studies.batch import run_study_tasks
 
     fragility_study.prepare()
     out = Path(tempfile.mkdtemp(prefix="rockyade-bench-targets-"))

@@ -13,11 +13,13 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from rockyade.batch import comparable, expand, load_study, run_study_tasks, study_tasks
+from rockyade.batch import study as study_file
+from rockyade.batch.running import keeping_files, output
+from rockyade.batch.study import ALTERNATIVES, MAX_RUNS, MAX_RUNS_ALLOWED
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.scene import load_scene, scene_from_dict
-from rockyade.studies import batch
-from rockyade.studies.batch import ALTERNATIVES, MAX_RUNS, MAX_RUNS_ALLOWED, expand, load_study, run_study_tasks
 
 from .conftest import EXAMPLES
 
@@ -43,7 +45,7 @@ def test_a_grid_over_amplitude_g_runs_on_a_scene_given_in_g(tmp_path):
     motion.amplitude_m_s2, a key the user never wrote)."""
     grid = '"motion.amplitude_g" = [0.3, 0.5]'
     path = _study(tmp_path, f"[base]\nfile = {_base('specimen1_pulse.toml')}\n[grid]\n{grid}\n")
-    tasks = load_study(path, tmp_path / "out").tasks
+    tasks = list(study_tasks(load_study(path)))
     assert [t.scene.motion.amplitude_m_s2 for t in tasks] == pytest.approx([0.3 * G, 0.5 * G])
     assert [t.labels["motion.amplitude_g"] for t in tasks] == [0.3, 0.5]
 
@@ -133,7 +135,7 @@ def test_a_grid_key_replaces_its_alternatives(case, tmp_path):
         partner = "height_m" if case == "width_m" else "width_m"
         grid += f'\n"blocks.0.{partner}" = {CASES[partner][2]}'
     path = _study(tmp_path, f"[base]\nfile = {json.dumps(str(base))}\n[grid]\n{grid}\n")
-    (task,) = load_study(path, tmp_path / "out").tasks
+    (task,) = list(study_tasks(load_study(path)))
     expected = values[0]
     if case == "vertices_m":
         expected = 0.8
@@ -182,7 +184,7 @@ def test_a_grid_setting_a_key_and_its_alternative_is_refused(tmp_path):
         '"motion.amplitude_m_s2" = [3.0]\n',
     )
     with pytest.raises(InputError) as info:
-        load_study(path, tmp_path / "out")
+        load_study(path)
     assert info.value.field == "grid.motion.amplitude_m_s2" and "grid.motion.amplitude_g" in info.value.message
 
 
@@ -202,16 +204,55 @@ def test_record_files_in_a_grid_are_named_from_the_study_file(tmp_path, monkeypa
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)
-    tasks = load_study(Path("../studies/study.toml"), "out").tasks
+    tasks = list(study_tasks(load_study(Path("../studies/study.toml"))))
     files = [Path(t.scene.motion.file) for t in tasks]
     names = ("ricker_pulse_T0.5s.AT2", "ec8_type2_D_record21.AT2")
     assert files == [(studies / "records" / n).resolve() for n in names]
     path.write_text(path.read_text().replace("ec8_type2_D_record21", "missing"))
-    with pytest.raises(InputError) as info:
-        load_study(Path("../studies/study.toml"), "out")
+    with pytest.raises(InputError) as info:  # the grid's points are made as they are asked for
+        list(study_tasks(load_study(Path("../studies/study.toml"))))
     tried = str((studies / "records" / "missing.AT2").resolve())
     assert info.value.field == "motion.file" and tried in info.value.message
     assert "motion.file = records/missing.AT2" in info.value.message  # the grid point
+
+
+# ---------------------------------------------------------------------- the study: read once, points as asked
+
+
+def test_a_study_reads_its_base_scene_once_and_makes_its_points_as_they_are_asked_for(tmp_path, monkeypatch):
+    import rockyade.scene as scene_package
+
+    reads = []
+    read = scene_package.load_scene
+    monkeypatch.setattr(scene_package, "load_scene", lambda path: reads.append(path) or read(path))
+    path = _study(
+        tmp_path,
+        f'solvers = ["reference", "housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
+        '"blocks.0.mu" = [0.9, 0.95, 2.0]\n',  # the last is not a valid scene
+    )
+    study = load_study(path)
+    assert study.run_count == 6 and study.solver_names == ("reference", "housner") and len(reads) == 1
+    tasks = study_tasks(study)
+    first = [next(tasks) for _ in range(4)]  # two points x two solvers: the bad point not made yet
+    assert [t.index for t in first] == [0, 1, 2, 3] and [t.labels["blocks.0.mu"] for t in first] == [
+        0.9,
+        0.9,
+        0.95,
+        0.95,
+    ]
+    with pytest.raises(InputError) as info:
+        next(tasks)
+    assert info.value.field == "blocks[0].mu" and "blocks.0.mu = 2.0" in info.value.message
+    assert len(reads) == 1  # every point from the scene read once
+
+
+def test_a_study_made_in_python_checks_its_run_count_when_made(monkeypatch):
+    monkeypatch.setattr(study_file, "MAX_RUNS", 3)
+    base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
+    grid = {"motion.theta0_rad": [0.01, 0.02]}
+    with pytest.raises(InputError, match="4 runs"):
+        study_file.make_study([("s", base)], grid, ["reference", "housner"])
+    assert study_file.make_study([("s", base)], grid, ["reference", "housner"], allow_large=True).run_count == 4
 
 
 # ---------------------------------------------------------------------- huge grids
@@ -226,12 +267,12 @@ def test_a_grid_of_a_billion_runs_is_refused_at_once(tmp_path):
     )
     start = time.perf_counter()
     with pytest.raises(InputError) as info:
-        load_study(path, tmp_path / "out")
+        load_study(path)
     assert time.perf_counter() - start < 1.0
     assert info.value.field == "grid" and "1,000,000,000 runs" in info.value.message
     assert f"{MAX_RUNS:,}" in info.value.message and "--allow-large" in info.value.message
     with pytest.raises(InputError) as info:  # --allow-large does not lift the ceiling
-        load_study(path, tmp_path / "out", allow_large=True)
+        load_study(path, allow_large=True)
     assert f"{MAX_RUNS_ALLOWED:,}" in info.value.message
 
 
@@ -241,21 +282,21 @@ def test_a_list_of_a_million_values_is_refused_at_once(tmp_path):
     path = _study(tmp_path, f'[base]\nfile = {base}\n[grid]\n"motion.cycles" = [{values}]\n')
     start = time.perf_counter()
     with pytest.raises(InputError) as info:
-        load_study(path, tmp_path / "out")
+        load_study(path)
     assert time.perf_counter() - start < 1.0
     assert "bytes" in info.value.message or "1,000,000 runs" in info.value.message
 
 
 def test_allow_large_lifts_the_run_limit(tmp_path, monkeypatch):
-    monkeypatch.setattr(batch, "MAX_RUNS", 3)
+    monkeypatch.setattr(study_file, "MAX_RUNS", 3)
     path = _study(
         tmp_path,
         f'solvers = ["reference", "housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
         '"motion.theta0_rad" = [0.01, 0.02]\n',
     )
     with pytest.raises(InputError, match="4 runs"):
-        load_study(path, tmp_path / "out")
-    assert len(load_study(path, tmp_path / "out", allow_large=True).tasks) == 4
+        load_study(path)
+    assert len(list(study_tasks(load_study(path, allow_large=True)))) == 4
 
 
 # ---------------------------------------------------------------------- outputs, duplicates
@@ -264,9 +305,11 @@ def test_allow_large_lifts_the_run_limit(tmp_path, monkeypatch):
 def test_output_paths_are_absolute_on_the_client(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
-    (task,) = expand([("s", base)], {}, ["yade"], "rel/out")
-    assert Path(task.out_dir) == tmp_path / "rel" / "out"
-    assert Path(task.solver.workdir) == tmp_path / "rel" / "out" / "runs" / "yade"
+    out = output("rel/out")
+    assert Path(out.out_dir) == tmp_path / "rel" / "out" and out.runs == tmp_path / "rel" / "out" / "runs"
+    (task,) = expand([("s", base)], {}, ["yade"])
+    assert task.solver.workdir is None  # the folder goes to the run once, beside the task
+    assert Path(keeping_files(task, out).solver.workdir) == tmp_path / "rel" / "out" / "runs" / "yade"
 
 
 def _duplicates(out: Path) -> list:
@@ -274,7 +317,7 @@ def _duplicates(out: Path) -> list:
     base["duration_s"] = 0.5
     # 0.03 twice, and 0.05 written two ways (the same scene)
     grid = {"motion.theta0_rad": [0.03, 0.05, 0.03, 0.050000000000000000001]}
-    return expand([("s", base)], grid, ["reference"], out)
+    return expand([("s", base)], grid, ["reference"])
 
 
 @pytest.mark.parametrize("executor,workers", [("threads", 1), ("local", 2), ("dask", 2)])
@@ -293,7 +336,7 @@ def test_duplicate_grid_points_run_once_and_are_reported(tmp_path, executor, wor
     resumed = run_study_tasks(
         _duplicates(tmp_path), tmp_path, executor=executor, workers=workers, progress=False, resume=True
     )
-    pd.testing.assert_frame_equal(batch.comparable(resumed), batch.comparable(summary))
+    pd.testing.assert_frame_equal(comparable(resumed), comparable(summary))
 
 
 # ---------------------------------------------------------------------- motion coverage
@@ -303,7 +346,7 @@ def test_the_summary_says_how_much_of_the_record_s_pga_was_left_out(tmp_path):
     base = load_scene(EXAMPLES / "specimen1_record.toml").to_dict()
     base["sample_dt_s"] = 0.01
     grid = {"duration_s": [0.4, 8.0]}  # the Ricker pulse peaks after 0.4 s
-    tasks = expand([("s", base)], grid, ["housner"], tmp_path)
+    tasks = expand([("s", base)], grid, ["housner"])
     summary = run_study_tasks(tasks, tmp_path, executor="threads", workers=1, progress=False)
     short, whole = summary.iloc[0], summary.iloc[1]
     assert short["motion_pga_left_out_fraction"] > 0.5 and short["motion_time_left_out_s"] > 0
@@ -315,7 +358,7 @@ def test_the_summary_says_how_much_of_the_record_s_pga_was_left_out(tmp_path):
 def test_the_batch_command_refuses_a_large_grid_unless_allowed(tmp_path, monkeypatch, capsys):
     from rockyade.cli import main
 
-    monkeypatch.setattr(batch, "MAX_RUNS", 1)
+    monkeypatch.setattr(study_file, "MAX_RUNS", 1)
     path = _study(
         tmp_path,
         f'solvers = ["housner"]\n[base]\nfile = {_base("specimen3_free.toml")}\n[grid]\n'
@@ -348,21 +391,20 @@ def test_a_grid_over_the_motion_gives_the_scenes_read_whole(tmp_path):
     import itertools
 
     from rockyade.scene import load_scene, scene_from_dict
-    from rockyade.studies.batch import expand
 
     base = load_scene("examples/specimen2_record21.toml").to_dict()
     grid = {"motion.record": [3, 21], "motion.load_factor": [0.4, 1.3]}
-    tasks = expand([("s2", base)], grid, ["housner"], tmp_path)
+    tasks = expand([("s2", base)], grid, ["housner"])
     for task, (record, lf) in zip(tasks, itertools.product(*grid.values()), strict=True):
         d = copy.deepcopy(base)
         d["motion"].update(record=record, load_factor=lf)
         whole = scene_from_dict(d)
         assert task.scene == whole and task.scene_hash == whole.scene_hash
     with pytest.raises(InputError) as bad:
-        expand([("s2", base)], {"motion.load_factor": [0.4, -1.0]}, ["housner"], tmp_path)
+        expand([("s2", base)], {"motion.load_factor": [0.4, -1.0]}, ["housner"])
     assert bad.value.field == "motion.load_factor" and "motion.load_factor = -1.0" in bad.value.message
     free = load_scene("examples/specimen1_free.toml").to_dict()
-    tilts = expand([("s1", free)], {"motion.theta0_rad": [0.05, 0.1]}, ["housner"], tmp_path)
+    tilts = expand([("s1", free)], {"motion.theta0_rad": [0.05, 0.1]}, ["housner"])
     assert [t.scene.motion.initial_theta_rad for t in tilts] == [0.05, 0.1]
     with pytest.raises(InputError, match="no block named 'nope'"):  # checked with the blocks, as read whole
-        expand([("s1", free)], {"motion.block": ["nope"]}, ["housner"], tmp_path)
+        expand([("s1", free)], {"motion.block": ["nope"]}, ["housner"])

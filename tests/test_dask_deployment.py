@@ -16,8 +16,8 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from rockyade.batch import comparable
 from rockyade.result import Result
-from rockyade.studies.batch import comparable
 
 from .conftest import EXAMPLES
 from .processes import alive, listening_of_tree

@@ -80,7 +80,7 @@ def test_the_paper_overturning_figure_has_no_overlapping_text(tmp_path):
     )
     report = Report(tmp_path)
     report.section("Overturning")
-    assert overlapping_texts(overturning.draw_figure(report, scan, spectrum)) == []
+    assert overlapping_texts(overturning.draw_figure(report, scan, spectrum).figure_) == []
 
 
 @pytest.fixture

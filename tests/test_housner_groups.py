@@ -8,9 +8,10 @@ import pandas as pd
 import pytest
 
 from rockyade.analysis.metrics import theta_metrics, uplift_threshold_rad
+from rockyade.batch import comparable, expand
+from rockyade.batch.running import job_key, output, run_job, run_task
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.housner import HousnerSolver
-from rockyade.studies.batch import comparable, expand, job_key, run_job, run_task
 
 #: Keys of a run's metadata that are timings (or say the run was batched).
 TIMINGS = {"wall_time_s", "batched"}
@@ -81,11 +82,11 @@ def test_a_housner_batch_gives_the_rows_of_runs_one_at_a_time(tmp_path):
     """The batch's rows (status, peaks, metrics, coverage) from a group and from runs alone."""
     base = _pulses([1.0])[0].to_dict()
     grid = {"motion.amplitude_m_s2": [1.0, 3.4, 6.0, 30.0]}
-    a = expand([("s1", base)], grid, ["housner"], tmp_path / "a", save_history=False)
-    b = expand([("s1", base)], grid, ["housner"], tmp_path / "b", save_history=False)
+    a = expand([("s1", base)], grid, ["housner"], save_history=False)
+    b = expand([("s1", base)], grid, ["housner"], save_history=False)
     assert len({job_key(t) for t in b}) == 1 and job_key(b[0]) is not None
-    one = pd.DataFrame([run_task(t) for t in a]).drop(columns="elapsed_s")
-    grouped = pd.DataFrame(run_job(tuple(b))).drop(columns="elapsed_s")
+    one = pd.DataFrame([run_task(t, output(tmp_path / "a")) for t in a]).drop(columns="elapsed_s")
+    grouped = pd.DataFrame(run_job(tuple(b), output(tmp_path / "b"))).drop(columns="elapsed_s")
     assert set(one.status) == {"completed", "overturned"}
     pd.testing.assert_frame_equal(comparable(one), comparable(grouped))
     assert (tmp_path / "b" / "runs" / f"{b[0].scene_hash}_housner.json").is_file()  # resume reads it
@@ -93,7 +94,7 @@ def test_a_housner_batch_gives_the_rows_of_runs_one_at_a_time(tmp_path):
 
 def test_housner_runs_with_histories_or_of_stacks_go_alone(tmp_path):
     base = _pulses([1.0])[0].to_dict()
-    kept = expand([("s1", base)], {"motion.amplitude_m_s2": [1.0, 2.0]}, ["housner"], tmp_path, save_history=True)
+    kept = expand([("s1", base)], {"motion.amplitude_m_s2": [1.0, 2.0]}, ["housner"], save_history=True)
     assert all(job_key(t) is None for t in kept)
     assert HousnerSolver().group_key(load_scene("examples/biblock_free.toml")) is None
     one = _pulses([1.0])[0]

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
+from rockyade.batch import expand, run_study_tasks
 from rockyade.errors import InputError
 from rockyade.io.locking import DIR_LOCK_NAME, lock_token, output_lock, writing_for
 from rockyade.scene import load_scene
-from rockyade.studies.batch import expand, run_study_tasks
 
 from .conftest import EXAMPLES
 
@@ -89,7 +89,7 @@ def test_a_batch_is_refused_over_a_folder_a_run_is_writing_in(tmp_path):
     (out / DIR_LOCK_NAME).write_text("")  # left by an earlier batch
     with Holder(out / "r.csv"):
         base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
-        tasks = expand([("s", base)], {}, ["housner"], out)
+        tasks = expand([("s", base)], {}, ["housner"])
         with pytest.raises(InputError) as info:
             run_study_tasks(tasks, out, executor="threads", workers=1, progress=False)
         assert info.value.field == "out" and "something inside it" in info.value.message

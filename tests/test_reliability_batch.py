@@ -16,11 +16,11 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from rockyade.batch import comparable, expand, run_study_tasks
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.locking import output_lock
 from rockyade.result import Result
 from rockyade.scene import load_scene
-from rockyade.studies.batch import comparable, expand, run_study_tasks
 
 from .conftest import EXAMPLES
 from .processes import alive, descendants
@@ -247,7 +247,7 @@ def _tasks(out: Path, duration: float = 1.0) -> list:
     base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
     base["duration_s"] = duration
     grid = {"motion.theta0_rad": [0.03, 0.06], "blocks.0.p_rad_s": [3.5, 3.61]}
-    return expand([("specimen3", base)], grid, ["reference", "housner"], out, save_history=True)
+    return expand([("specimen3", base)], grid, ["reference", "housner"], save_history=True)
 
 
 def test_in_process_dask_summary_equals_local(tmp_path):
@@ -344,7 +344,7 @@ def test_a_second_batch_into_the_same_output_is_refused(tmp_path):
 
 def test_a_batch_above_the_cost_limits_is_refused_before_any_run(tmp_path):
     base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
-    tasks = expand([("s", base)], {"contact.dt_s": [1e-5, 1e-8]}, ["reference"], tmp_path)
+    tasks = expand([("s", base)], {"contact.dt_s": [1e-5, 1e-8]}, ["reference"])
     with pytest.raises(InputError) as info:
         run_study_tasks(tasks, tmp_path, workers=1, progress=False)
     assert info.value.field == "allow_large" and "run 1 (base = s, contact.dt_s = 1e-08)" in str(info.value)

@@ -13,6 +13,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rockyade.batch import comparable, expand, load_study, run_study_tasks, study_tasks
+from rockyade.batch.running import keeping_files, output
 from rockyade.cli import main
 from rockyade.errors import InputError
 from rockyade.runner import IN_THIS_THREAD, Executor, Task, run_jobs, run_tasks, solve, solve_scenes
@@ -21,7 +23,6 @@ from rockyade.solvers import make_solver, make_solvers, run, solver_names
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
-from rockyade.studies.batch import comparable, expand, load_study, run_study_tasks
 
 from .conftest import EXAMPLES
 
@@ -71,14 +72,14 @@ def test_a_study_file_refuses_a_yade_timeout_without_yade(tmp_path):
     body = f'yade_timeout_s = 60\n[base]\nfile = "{EXAMPLES / "specimen1_free.toml"}"\n'
     study.write_text('solvers = ["reference"]\n' + body)
     with pytest.raises(InputError) as info:
-        load_study(study, tmp_path / "out")
+        load_study(study)
     assert info.value.field == "yade_timeout_s" and info.value.source == str(study)
     # the command line's value replaces the file's, and is named as the command line names it
     study.write_text('solvers = ["yade"]\n' + body)
-    loaded = load_study(study, tmp_path / "out", {"timeout_s": 7.0}, {"timeout_s": "--yade-timeout"})
-    assert {t.solver.timeout_s for t in loaded.tasks} == {7.0}
+    loaded = load_study(study, {"timeout_s": 7.0}, {"timeout_s": "--yade-timeout"})
+    assert {t.solver.timeout_s for t in study_tasks(loaded)} == {7.0}
     with pytest.raises(InputError) as info:
-        load_study(study, tmp_path / "out", {"timeout_s": 0.0}, {"timeout_s": "--yade-timeout"})
+        load_study(study, {"timeout_s": 0.0}, {"timeout_s": "--yade-timeout"})
     assert info.value.field == "--yade-timeout"
 
 
@@ -86,8 +87,8 @@ def test_yade_files_are_named_by_the_solver_s_options_and_the_scene_hash(tmp_pat
     """A batch places YADE's files under runs/yade/, named by scene hash; a run of its own
     names them after its result."""
     base = load_scene(EXAMPLES / "specimen3_free.toml").to_dict()
-    tasks = expand([("s", base)], {"motion.theta0_rad": [0.03]}, ["yade", "housner"], tmp_path / "out")
-    yade, housner = (t.solver for t in tasks)
+    tasks = expand([("s", base)], {"motion.theta0_rad": [0.03]}, ["yade", "housner"])
+    yade, housner = (keeping_files(t, output(tmp_path / "out")).solver for t in tasks)
     assert yade.workdir == str(tmp_path / "out" / "runs" / "yade") and yade.stem is None
     assert housner == HousnerSolver()  # keeps no files
     assert YadeSolver().keeping_files(tmp_path, "r") == YadeSolver(workdir=str(tmp_path), stem="r")
@@ -109,7 +110,7 @@ class SlowerHousner(HousnerSolver):
 def test_a_solver_the_registry_does_not_know_runs_through_batches(tmp_path):
     base = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
     base["duration_s"] = 1.0
-    tasks = expand([("s", base)], {"motion.theta0_rad": [0.05, 0.1]}, [SlowerHousner()], tmp_path)
+    tasks = expand([("s", base)], {"motion.theta0_rad": [0.05, 0.1]}, [SlowerHousner()])
     with pytest.raises(InputError) as info:  # its own cost model answers
         run_study_tasks(tasks, tmp_path, workers=1, progress=False)
     assert info.value.field == "allow_large"
@@ -202,7 +203,7 @@ def test_a_batch_on_threads_equals_local_processes(tmp_path):
     grid = {"motion.theta0_rad": [0.03, 0.06]}
 
     def batch(out, **executor):
-        tasks = expand([("s", base)], grid, ["reference", "housner"], out)
+        tasks = expand([("s", base)], grid, ["reference", "housner"])
         return run_study_tasks(tasks, out, progress=False, **executor)
 
     local = batch(tmp_path / "a", executor=Executor("local", 2))

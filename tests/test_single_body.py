@@ -8,6 +8,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rockyade.batch import comparable, expand
+from rockyade.batch.running import job_key, output, run_job, run_task
 from rockyade.calibration.model import calibrated_model
 from rockyade.dem.engine import model_arrays
 from rockyade.kernel import simulation as kernel
@@ -16,7 +18,6 @@ from rockyade.kernel.state import pack
 from rockyade.runner.groups import group_jobs
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.reference import ReferenceSolver
-from rockyade.studies.batch import comparable, expand, job_key, run_job, run_task
 
 
 def _scene(amplitude_g: float, duration_s: float = 3.0):
@@ -68,12 +69,12 @@ def test_a_group_gives_the_rows_of_runs_one_at_a_time(tmp_path):
     """Pulses of several amplitudes (some overturn): one job, the same summary rows."""
     base = _scene(0.35).to_dict()
     grid = {"motion.amplitude_m_s2": [1.0, 3.4, 6.0, 30.0]}
-    a = expand([("s1", base)], grid, ["reference"], tmp_path / "a", save_history=False)
-    b = expand([("s1", base)], grid, ["reference"], tmp_path / "b", save_history=False)
+    a = expand([("s1", base)], grid, ["reference"], save_history=False)
+    b = expand([("s1", base)], grid, ["reference"], save_history=False)
     assert not a[0].solver.record_energy  # no history, no energy terms
     assert len({job_key(t) for t in b}) == 1 and job_key(b[0]) is not None
-    one = pd.DataFrame([run_task(t) for t in a]).drop(columns="elapsed_s")
-    grouped = pd.DataFrame(run_job(tuple(b))).drop(columns="elapsed_s")
+    one = pd.DataFrame([run_task(t, output(tmp_path / "a")) for t in a]).drop(columns="elapsed_s")
+    grouped = pd.DataFrame(run_job(tuple(b), output(tmp_path / "b"))).drop(columns="elapsed_s")
     assert set(one.status) == {"completed", "overturned"}
     pd.testing.assert_frame_equal(comparable(one), comparable(grouped))
     assert (tmp_path / "b" / "runs" / f"{b[0].scene_hash}_reference.json").is_file()  # resume reads it
@@ -81,7 +82,7 @@ def test_a_group_gives_the_rows_of_runs_one_at_a_time(tmp_path):
 
 def test_histories_and_other_solvers_run_alone(tmp_path):
     base = _scene(0.35).to_dict()
-    kept = expand([("s1", base)], {"motion.amplitude_m_s2": [1.0, 2.0]}, ["reference"], tmp_path, save_history=True)
+    kept = expand([("s1", base)], {"motion.amplitude_m_s2": [1.0, 2.0]}, ["reference"], save_history=True)
     assert all(job_key(t) is None for t in kept)
     assert ReferenceSolver(record_energy=True).group_key(_scene(0.35)) is None
 

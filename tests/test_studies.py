@@ -151,7 +151,7 @@ def test_a_harmonic_test_without_uplift_says_so_on_a_fixed_scale(tmp_path):
     report = Report(tmp_path)
     report.section("Harmonic")
     case = _harmonic_case("3", 3.0, 4.0)
-    fig = harmonic.draw_figure(report, case)
+    fig = harmonic.draw_figure(report, case).figure_
     assert "NO UPLIFT" in fig._suptitle.get_text()
     assert fig.axes[1].get_ylim() == pytest.approx((-1.1, 1.1))
     assert fig.axes[1].get_ylabel() == "specimen3: theta / alpha"
@@ -166,7 +166,7 @@ def test_a_harmonic_test_that_rocks_is_not_flagged(tmp_path):
     report.section("Harmonic")
     case = _harmonic_case("1", 3.3, 6.0)
     assert no_uplift_note(case["scene"], case["results"]) == ""
-    fig = harmonic.draw_figure(report, case)
+    fig = harmonic.draw_figure(report, case).figure_
     assert "NO UPLIFT" not in fig._suptitle.get_text()
     peak = max(np.max(np.abs(r.series("theta_rad"))) for r in case["results"].values()) / 0.235
     assert peak > 0.05 and fig.axes[1].get_ylim()[1] >= peak
@@ -243,7 +243,7 @@ def test_pattern_legend_is_in_words(tmp_path):
     ]
     report = Report(tmp_path)
     report.section("Patterns")
-    fig = pattern_map.draw_figure(report, cells, {"2": (1, 1), "3": (1, 2)})
+    fig = pattern_map.draw_figure(report, cells, {"2": (1, 1), "3": (1, 2)}).figure_
     labels = _legend_texts(fig)
     assert "2: both rock, opposite ways" in labels and "3: the stack rocks as one body" in labels
     assert "OT upper: the upper block overturns" in labels
@@ -264,7 +264,7 @@ def test_overturning_draws_housner_dots_in_housner_colour(tmp_path):
     )
     report = Report(tmp_path)
     report.section("Overturning")
-    fig = overturning.draw_figure(report, scan, spectrum)
+    fig = overturning.draw_figure(report, scan, spectrum).figure_
     dots = fig.axes[0].collections[0]
     assert "Housner" in dots.get_label()
     assert tuple(dots.get_facecolor()[0][:3]) == pytest.approx(to_rgb(SOLVER_STYLES["housner"]["color"]))
@@ -282,7 +282,7 @@ def test_overturning_marks_frequencies_where_a_solver_never_overturned(tmp_path)
     )
     report = Report(tmp_path)
     report.section("Overturning")
-    fig = overturning.draw_figure(report, scan, spectrum)
+    fig = overturning.draw_figure(report, scan, spectrum).figure_
     lines = {line.get_label(): line for line in fig.axes[0].lines}
     marker = lines[f"Housner: no overturn up to {overturning.MAX_RATIO:g} (the scan's limit)"]
     assert list(marker.get_xdata()) == [10.0] and list(marker.get_ydata()) == [overturning.MAX_RATIO]

@@ -223,7 +223,7 @@ def test_recorded_files_and_block_dimensions(tmp_path):
 def test_grouped_runs_give_the_same_verdicts_peaks_and_probabilities(tmp_path):
     """Each sample's runs (one block, every record and load factor) as groups, Housner and the
     reference DEM: the same summary (verdicts, peaks, metrics) and tables as one run per job."""
-    from rockyade.studies.batch import comparable
+    from rockyade.batch import comparable
 
     study = uncertainty_study_from_dict(
         _study(
@@ -255,7 +255,7 @@ def test_a_samples_scenes_are_the_scenes_read_whole(tmp_path):
 
     study = uncertainty_study_from_dict(_study(samples=2))
     samples = draw_samples(study)
-    tasks = build_tasks(study, samples, tmp_path)
+    tasks = build_tasks(study, samples)
     assert len(tasks) == 3 * 2 * 2
     for task in tasks:
         lab = task.labels

@@ -637,16 +637,16 @@ def test_yade_script_runs_without_the_launcher(tmp_path, monkeypatch, capsys):
 
 def test_study_file_yade_timeout(tmp_path):
     """``yade_timeout_s`` in a study file reaches every task; a bad value names the key."""
+    from rockyade.batch import load_study, study_tasks
     from rockyade.errors import InputError
-    from rockyade.studies.batch import load_study
 
     _short_scene_file(tmp_path)
     body = '\nsolvers = ["yade"]\n[base]\nfile = "s3.json"\n'
     (tmp_path / "ok.toml").write_text("yade_timeout_s = 90" + body)
-    assert {t.solver.timeout_s for t in load_study(tmp_path / "ok.toml", tmp_path / "out").tasks} == {90.0}
+    assert {t.solver.timeout_s for t in study_tasks(load_study(tmp_path / "ok.toml"))} == {90.0}
     (tmp_path / "bad.toml").write_text("yade_timeout_s = -1" + body)
     with pytest.raises(InputError, match="yade_timeout_s"):
-        load_study(tmp_path / "bad.toml", tmp_path / "out")
+        load_study(tmp_path / "bad.toml")
 
 
 def test_yade_dies_with_a_sigkilled_parent(tmp_path):

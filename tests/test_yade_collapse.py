@@ -65,18 +65,17 @@ def test_a_failed_yade_run_keeps_its_samples_marked_partial(tmp_path):
     back = Result.read(out)
     assert back.status == "failed" and back.meta["partial"] is True and len(back.frame) == half
 
-    from rockyade.studies import batch
+    from rockyade.batch import summary
 
     runs = tmp_path / "study" / "runs"
     runs.mkdir(parents=True)
-    name = batch.run_name(model.scene_hash, "yade")
+    name = summary.run_name(model.scene_hash, "yade")
     parsed.write(runs / f"{name}.csv", {"summary": {"status": "failed"}})
 
     task = SimpleNamespace(
-        out_dir=str(tmp_path / "study"),
         scene_hash=model.scene_hash,
         index=0,
         labels={},
         solver=SimpleNamespace(name="yade"),
     )
-    assert batch._completed_row(task) is None
+    assert summary.completed_row(task, runs) is None

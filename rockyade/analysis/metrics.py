@@ -3,6 +3,7 @@ assembly (collapse), and of a stack as one body (:func:`structure_rotation`)."""
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
@@ -206,6 +207,38 @@ def assembly_metrics(scene: Scene, result: Result, report: pd.DataFrame | None =
         "n_moving_at_end": int((~report["final_state"].isin(["rest", "fallen"])).sum()),
         **structure_rotation(scene, result),
     }
+
+
+def summary_metrics(scene: Scene, result: Result) -> dict[str, Any]:
+    """The metrics of a run as one flat summary row (a batch summary's, after its status
+    columns): the assembly's (:func:`assembly_metrics`, positioned scenes), each block's
+    (:func:`run_metrics`; prefixed with the block's name unless the scene has one block;
+    none for an assembly of more than :data:`PER_BLOCK_LIMIT` blocks) and, for two blocks,
+    the dominant rocking pattern and its time fractions (JSON;
+    :func:`rockyade.analysis.patterns.classify_result`).
+
+    Parameters
+    ----------
+    scene
+        The Scene that produced ``result``.
+    result
+        The run's Result (completed or overturned).
+    """
+    row: dict[str, Any] = {}
+    if scene.positioned:
+        row.update(assembly_metrics(scene, result))
+    if not scene.positioned or len(scene.blocks) <= PER_BLOCK_LIMIT:
+        single = len(scene.blocks) == 1
+        for block, values in run_metrics(scene, result).items():
+            for key, value in values.items():
+                row[key if single else f"{block}_{key}"] = value
+    if len(scene.blocks) == 2:
+        from rockyade.analysis.patterns import classify_result
+
+        pattern = classify_result(scene, result)
+        row["pattern"] = pattern.dominant
+        row["pattern_fractions"] = json.dumps(pattern.fractions, sort_keys=True)
+    return row
 
 
 #: Why an assembly that is not a stack has no whole-body rotation measure (docs/assemblies.md).

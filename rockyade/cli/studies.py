@@ -110,15 +110,14 @@ def _with_dt_factor(solvers: list[Any], factor: float, check: bool) -> tuple[lis
 def cmd_batch(args: argparse.Namespace) -> int:
     """Run a study file's grid of scenes."""
     check_output_dir(args.out, "out")
+    from rockyade.batch import failures, load_study, run_study_tasks, study_tasks
     from rockyade.runner import Executor
-    from rockyade.studies.batch import failures, load_study, run_study_tasks
 
     how = Executor(args.executor, args.workers, args.scheduler, args.scheduler_timeout)  # checked before any work
-    study = load_study(args.study, args.out, *solver_options(args), allow_large=args.allow_large)
-    tasks = list(study.tasks)
-    print(f"{study.name}: {len(tasks)} runs ({', '.join(study.solvers)}) -> {args.out}", flush=True)
+    study = load_study(args.study, *solver_options(args), allow_large=args.allow_large)
+    print(f"{study.name}: {study.run_count} runs ({', '.join(study.solver_names)}) -> {args.out}", flush=True)
     summary = run_study_tasks(
-        tasks,
+        study_tasks(study),
         args.out,
         executor=how,
         resume=args.resume,

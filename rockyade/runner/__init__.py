@@ -13,7 +13,7 @@
   however it dies (:mod:`rockyade.runner.workers`); no executor opens a port unless given a
   Dask scheduler's address.
 
-Batches (:mod:`rockyade.studies.batch`) and the studies run on it::
+Batches (:mod:`rockyade.batch`) and the studies run on it::
 
     from rockyade.runner import Executor, solve_scenes
 

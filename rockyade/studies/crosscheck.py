@@ -6,7 +6,7 @@ For each solver, each time-step factor (1, and 0.5 for the convergence check) an
 record, a collapse search: the scan's levels (from the scene's static collapse acceleration,
 as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility.fragility_plan`),
 then bisection to the resolution. The searches advance together, one round at a time; each
-round's runs go through the batch machinery (:func:`rockyade.studies.batch.run_study_tasks`:
+round's runs go through the batch machinery (:func:`rockyade.batch.run_study_tasks`:
 the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
 
 Files. The study works in ``<out>.partial/`` beside ``--out``: ``plan.json`` (what the study
@@ -50,14 +50,15 @@ from rockyade.assess.fragility import FragilityPlan, fragility_plan
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
 from rockyade.assess.stripes import MAX_LOAD_FACTOR
+from rockyade.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.atomic import fsync_dir, write_json
 from rockyade.io.locking import DIR_LOCK_NAME, output_lock
 from rockyade.runner import Executor
+from rockyade.runner.journal import read_run
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
 from rockyade.solvers.base import Solver
-from rockyade.studies.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
 from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 
 #: Time-step factors by default: the solver's own step, and half of it (convergence).
@@ -252,7 +253,7 @@ def crosscheck_plan(
     solver_options
         Options for the solvers that take them.
     allow_large
-        Go beyond :data:`rockyade.studies.batch.MAX_RUNS` expected runs.
+        Go beyond :data:`rockyade.batch.study.MAX_RUNS` expected runs.
 
     Raises
     ------
@@ -390,20 +391,6 @@ def _collapsed(row: Mapping[str, Any], fallen_blocks: int, single: bool) -> bool
     return int(row.get("n_fallen") or 0) >= fallen_blocks
 
 
-def _stored_row(task: BatchTask) -> dict[str, Any] | None:
-    """The summary row a finished run of ``task`` left on disk (completed or overturned, the
-    same scene), or None."""
-    path = Path(task.out_dir) / "runs" / f"{run_name(task.scene_hash, task.solver.name)}.json"
-    try:
-        data = json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
-    if data.get("scene_hash") != task.scene_hash or data.get("status") not in ("completed", "overturned"):
-        return None
-    summary = data.get("summary")
-    return dict(summary) if isinstance(summary, dict) else None
-
-
 class Study:
     """A cross-check being run in its working folder (module docstring)."""
 
@@ -447,7 +434,7 @@ class Study:
             m.column: m.shown(level),
             "load_factor": lf,
         }
-        return batch_task(0, self.solvers[(solver, f)], sp.scene_for(i, lf), labels, self.folder(f), save_history=False)
+        return batch_task(0, self.solvers[(solver, f)], sp.scene_for(i, lf), labels, save_history=False)
 
     def pending(self) -> list[tuple[tuple[str, float, int], float, BatchTask]]:
         """The runs of the next round: each search advanced over the runs on disk first."""
@@ -468,7 +455,9 @@ class Study:
                 missing = []
                 for level in levels:
                     task = self.task(key, level)
-                    row = _stored_row(task)
+                    row = read_run(
+                        self.folder(key[1]) / "runs", run_name(task.scene_hash, task.solver.name), task.scene_hash
+                    )
                     if row is None:
                         missing.append((key, level, task))
                     else:

@@ -11,7 +11,6 @@ from __future__ import annotations
 import math
 
 import pandas as pd
-from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
@@ -192,7 +191,7 @@ def _dem_rows(cases: list[dict], exact: dict, use_yade: bool) -> list[dict]:
     return rows
 
 
-def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> Figure:
+def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> SolverPanelsDisplay:
     """theta(t): rows = parameter sets, columns = calibrations; Housner in every panel
     (drawn by :class:`rockyade.figures.solver_panels.SolverPanelsDisplay`)."""
     spec = paper.specimen(key)
@@ -204,8 +203,6 @@ def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> 
     display = SolverPanelsDisplay(rows, title=f"Free rocking of the {spec.label}, released at alpha / 2").plot(
         path=report.out / name, figsize=(12, 7.5)
     )
-    assert display.figure_ is not None
-    fig = display.figure_
     unreachable = [c for c in cases if c["key"] == key and c["scene"] is None]
     extra = (
         " Matched calibration not reachable (see free_rocking.csv) for the "
@@ -225,7 +222,7 @@ def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> 
         f"and YADE (dashed green, with its largest difference from the DEM), paper (Eq 13, left) and matched "
         f"(right) calibration, theoretical (top) and experimental (bottom) parameters.{extra}",
     )
-    return fig
+    return display
 
 
 def _panel(key: str, params: str, cal: str, housner: Result, cases: list[dict], table: pd.DataFrame) -> Panel:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from rockyade.analysis.patterns import classify_result
 from rockyade.constants import G
@@ -155,7 +154,7 @@ def _solver_counts(cases: list[dict]) -> dict[str, int]:
     return counts
 
 
-def draw_figure(report: Report, c: dict) -> Figure:
+def draw_figure(report: Report, c: dict) -> SolverPanelsDisplay:
     """theta / alpha of each block (upper first) and the table displacement, states shaded
     (drawn by :class:`rockyade.figures.solver_panels.SolverPanelsDisplay`)."""
     blocks = c["scene"].blocks
@@ -175,8 +174,6 @@ def draw_figure(report: Report, c: dict) -> Figure:
     display = SolverPanelsDisplay([[p] for p in panels], title=title).plot(
         path=report.out / name, figsize=(10, 2.6 * (len(blocks) + 1) + 0.8)
     )
-    assert display.figure_ is not None
-    fig = display.figure_
     maxima = []
     for solver, r in c["results"].items():
         if r.ok:
@@ -192,7 +189,7 @@ def draw_figure(report: Report, c: dict) -> Figure:
         + f"{c['fig']}: {h.frequency_hz:g} Hz, {h.amplitude_mm:g} mm table sine; theta / alpha of each block "
         "(upper first; dashed lines at +/-1) and the table displacement. Max |theta| (rad): " + "; ".join(maxima) + ".",
     )
-    return fig
+    return display
 
 
 def harmonic_spans(h: Harmonic, t_end: float) -> list[Span]:

@@ -15,13 +15,12 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from rockyade.analysis.metrics import uplift_threshold_rad
 from rockyade.calibration.model import calibrated_model
 from rockyade.constants import G
-from rockyade.figures import new_figure, save_figure
-from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
+from rockyade.figures.overturning import OverturningSpectrumDisplay
+from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.runner import Executor, run_jobs
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.solvers.base import GroupSolver, Solver
@@ -194,8 +193,9 @@ def run(report: Report, workers: int = 2, grouped: bool = True) -> pd.DataFrame:
     return spectrum
 
 
-def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> Figure:
-    """The overturning spectrum (``overturning_spectrum.png`` in the report's folder).
+def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> OverturningSpectrumDisplay:
+    """The overturning spectrum (``overturning_spectrum.png`` in the report's folder, drawn by
+    :class:`rockyade.figures.overturning.OverturningSpectrumDisplay`).
 
     Parameters
     ----------
@@ -209,61 +209,11 @@ def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> F
 
     Returns
     -------
-    Figure
-        The figure, written as PNG.
+    OverturningSpectrumDisplay
+        The display drawn (its ``figure_`` written as PNG).
     """
     name = "overturning_spectrum.png"
-    fig, ax = new_figure(report.out / name, figsize=(8.5, 5.5))
-    housner_colour = SOLVER_STYLES["housner"]["color"]
-    dem_colour = SOLVER_STYLES["reference"]["color"]
-    h = scan[scan.solver == "housner"]
-    over = h[h.overturned]
-    ax.scatter(
-        over.omega_ratio,
-        over.amplitude_ratio,
-        s=7,
-        color=housner_colour,
-        alpha=0.45,
-        lw=0,
-        label="Housner: overturns (every amplitude scanned)",
-    )
-    ax.plot(
-        spectrum.omega_ratio, spectrum.housner_min_ratio, "-o", color=housner_colour, ms=4, label="Housner: minimum"
-    )
-    ax.plot(
-        spectrum.omega_ratio,
-        spectrum.reference_min_ratio,
-        "--s",
-        color=dem_colour,
-        ms=5,
-        mfc="none",
-        mew=1.3,
-        label="reference DEM: minimum",
-    )
-    for column, colour, who in (
-        ("housner_min_ratio", housner_colour, "Housner"),
-        ("reference_min_ratio", dem_colour, "reference DEM"),
-    ):
-        survived = spectrum[spectrum[column].isna()]  # no overturn up to the largest amplitude scanned
-        if len(survived):
-            ax.plot(
-                survived.omega_ratio,
-                np.full(len(survived), MAX_RATIO),
-                "^",
-                color=colour,
-                ms=9,
-                mfc="none",
-                mew=1.5,
-                clip_on=False,
-                label=f"{who}: no overturn up to {MAX_RATIO:g} (the scan's limit)",
-            )
-    ax.set_xlabel("pulse frequency / frequency parameter, omega_p / p")
-    ax.set_ylabel("pulse amplitude / uplift acceleration, a_p / (g tan alpha)")
-    ax.set_ylim(1.0, MAX_RATIO)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8, loc="upper left")
-    ax.set_title("Overturning under a one-sine pulse (specimen 1)")
-    save_figure(fig, report.out / name)
+    display = OverturningSpectrumDisplay.from_frames(scan, spectrum, MAX_RATIO).plot(path=report.out / name)
     report.figure(
         name,
         "Minimum overturning amplitude of a one-sine acceleration pulse against its frequency (lines), "
@@ -271,4 +221,4 @@ def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> F
         "bands where the block survives (the region is not simply connected). Open triangles at the "
         f"top: no overturn up to {MAX_RATIO:g} g tan alpha, the largest amplitude scanned.",
     )
-    return fig
+    return display

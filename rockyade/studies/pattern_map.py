@@ -16,13 +16,12 @@ from __future__ import annotations
 from dataclasses import replace
 
 import pandas as pd
-from matplotlib.figure import Figure
 
+from rockyade.batch import expand, run_study_tasks
 from rockyade.figures.rocking_patterns import PatternMapDisplay
 from rockyade.motion.analytic import Harmonic
 from rockyade.motion.spec import MotionSpec
 from rockyade.motion.types import HarmonicMotion
-from rockyade.studies.batch import expand, run_study_tasks
 from rockyade.studies.report import Report, run_state
 from rockyade.studies.specimens import biblock_blocks, scene_dict
 
@@ -71,7 +70,6 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
             [(f"{freq:g}Hz", d)],
             {"motion.amplitude_mm": list(AMPLITUDES_MM)},
             ["reference"],
-            report.out / "pattern_map_runs",
             save_history=False,
         )
     tasks = [
@@ -103,7 +101,7 @@ def run(report: Report, workers: int = 2) -> pd.DataFrame:
     return cells
 
 
-def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int, int]]) -> Figure:
+def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int, int]]) -> PatternMapDisplay:
     """The map of rocking patterns over base-motion frequency (Hz) and amplitude (mm)
     (``pattern_map.png`` in the report's folder), the paper's patterns beside the DEM's, drawn by
     :class:`rockyade.figures.rocking_patterns.PatternMapDisplay`.
@@ -119,13 +117,11 @@ def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int,
 
     Returns
     -------
-    Figure
-        The figure, written as PNG.
+    PatternMapDisplay
+        The display drawn (its ``figure_`` written as PNG).
     """
     name = "pattern_map.png"
     display = PatternMapDisplay(cells, FREQUENCIES_HZ, AMPLITUDES_MM).plot(path=report.out / name)
-    assert display.figure_ is not None
-    fig = display.figure_
     report.figure(
         name,
         "Dominant pattern per cell (colour, DEM) with the paper's reported regions outlined (blue: "
@@ -138,4 +134,4 @@ def draw_figure(report: Report, cells: pd.DataFrame, stats: dict[str, tuple[int,
         "frequency, small amplitude) lies below the uplift acceleration of a rigid stack (a_g < g tan alpha): "
         "there the DEM stays at rest."
     )
-    return fig
+    return display

@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
 from rockyade.figures.styles import SOLVER_LABELS
@@ -88,7 +87,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
 
 def draw_figure(
     report: Report, key: str, record: int, factor: float, scene: Scene, results: dict[str, Result]
-) -> Figure:
+) -> SolverPanelsDisplay:
     """One specimen under one synthetic record: the base acceleration (m/s^2) and each
     solver's rotation over alpha (-) against time (s)
     (``random_specimen<key>_record<record>.png`` in the report's folder).
@@ -106,8 +105,8 @@ def draw_figure(
 
     Returns
     -------
-    Figure
-        The figure, written as PNG.
+    SolverPanelsDisplay
+        The display drawn (its ``figure_`` written as PNG).
     """
     gm = scene.motion.ground_motion(scene.duration_s)
     alpha = scene.blocks[0].alpha_rad
@@ -137,8 +136,6 @@ def draw_figure(
     display = SolverPanelsDisplay([[base], [rotation]], title=title, height_ratios=(1, 2)).plot(
         path=report.out / name, figsize=(10, 5.8)
     )
-    assert display.figure_ is not None
-    fig = display.figure_
     verdicts = "; ".join(
         f"{s}: {'collapse' if r.status == 'overturned' else r.status}"
         + (f" ({r.meta.get('failure_reason')})" if not r.ok else "")
@@ -150,4 +147,4 @@ def draw_figure(
         + f"Specimen {key} under record {record} x {factor} (PGA {fmt(gm.pga_m_s2, 3)} m/s²): base "
         f"acceleration and theta/alpha (beyond +/-1 the block passes its critical angle). {verdicts}.",
     )
-    return fig
+    return display

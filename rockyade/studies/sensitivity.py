@@ -13,7 +13,6 @@ import math
 
 import numpy as np
 import pandas as pd
-from matplotlib.figure import Figure
 
 from rockyade import paper
 from rockyade.blocks.restitution import find_peaks
@@ -108,7 +107,7 @@ def run(report: Report) -> pd.DataFrame:
     return table
 
 
-def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
+def draw_figure(report: Report, table: pd.DataFrame) -> SensitivityDisplay:
     """The change of each response (%) when alpha, p or mu changes by -5 % or +5 %, one panel
     per response, Housner beside the reference DEM (``sensitivity.png`` in the report's folder), drawn by
     :class:`rockyade.figures.parameter_sensitivity.SensitivityDisplay`.
@@ -122,17 +121,15 @@ def draw_figure(report: Report, table: pd.DataFrame) -> Figure:
 
     Returns
     -------
-    Figure
-        The figure, written as PNG.
+    SensitivityDisplay
+        The display drawn (its ``figure_`` written as PNG).
     """
     name = "sensitivity.png"
     display = SensitivityDisplay(table).plot(path=report.out / name)
-    assert display.figure_ is not None
-    fig = display.figure_
     report.figure(
         name,
         "Relative change of each response when alpha, p or mu of specimen 1 changes by -5 % or +5 % "
         f"(Housner and the reference DEM; missing bars: the DEM cannot be matched to that mu). "
         f"Base: {paper.specimen(1).label}, experimental parameters.",
     )
-    return fig
+    return display

@@ -4,7 +4,7 @@ The classical parameters are drawn from distributions (:mod:`rockyade.studies.sa
 normal, lognormal or uniform per parameter, or the joint normal of an identification) by
 Latin hypercube with an explicit seed; records bring the record-to-record variation. Each
 (sample, record, load factor, solver) is one run of the batch engine
-(:func:`rockyade.studies.batch.run_study_tasks`, local processes or Dask). The report gives,
+(:func:`rockyade.batch.run_study_tasks`, local processes or Dask). The report gives,
 per solver and load factor, the probability of overturning and of exceeding theta/alpha
 levels with 95 % Wilson bands, lognormal fragility curves against intensity measures
 (:mod:`rockyade.motion.intensity`), and, when every sample runs every record, the spread
@@ -61,6 +61,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rockyade.batch import BatchTask, batch_task, run_study_tasks
 from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open, write_json
 from rockyade.io.fields import TableReader
@@ -69,7 +70,6 @@ from rockyade.io.resultset import replacing_set
 from rockyade.motion.intensity import INTENSITY_MEASURES, check_measure, intensity_measures, scaled
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.solvers import solver_names
-from rockyade.studies.batch import BatchTask, batch_task, run_study_tasks
 from rockyade.studies.sampling import (
     PARAMETERS,
     JointNormal,
@@ -308,7 +308,7 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
     return frame
 
 
-def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | Path) -> list[BatchTask]:
+def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame) -> list[BatchTask]:
     """One batch task per (sample, record, load factor, solver).
 
     A sample's scenes share everything but the motion: the first is read whole, the others
@@ -354,7 +354,7 @@ def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame, out_dir: str | P
                     "mu": float(row.mu),
                 }
                 for solver in solvers:
-                    tasks.append(batch_task(index, solver, scene, labels, out_dir, save_history=False))
+                    tasks.append(batch_task(index, solver, scene, labels, save_history=False))
                     index += 1
     return tasks
 
@@ -430,7 +430,7 @@ def run_uncertainty(
     (``accel_unit``: "g" or "m/s2", the unit of a PGA axis in the figure).
 
     With ``group_runs`` the runs of one sample (one block: every record and load factor)
-    go to the solver as groups (:func:`rockyade.studies.batch.job_key`: one model, the same
+    go to the solver as groups (:func:`rockyade.batch.running.job_key`: one model, the same
     rows); False: one run per job.
 
     Each run is written as it ends (the batch engine's journal: ``runs/``); ``resume`` keeps
@@ -440,7 +440,7 @@ def run_uncertainty(
     out = Path(out)
     samples = draw_samples(study)
     prepare(study)
-    tasks = build_tasks(study, samples, out)
+    tasks = build_tasks(study, samples)
     summary = run_study_tasks(
         tasks,
         out,
