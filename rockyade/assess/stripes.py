@@ -191,7 +191,7 @@ def run_stripe_task(task: StripeTask) -> dict[str, Any]:
     a failed run is a row with status ``failed`` and the reason."""
     start = time.perf_counter()
     result = solve(task)
-    row = _row(task, result.status, str(result.meta.get("failure_reason") or ""))
+    row = _row(task, result.status, str(result.meta.failure_reason or ""))
     row["wall_time_s"] = time.perf_counter() - start
     if result.ok:
         try:

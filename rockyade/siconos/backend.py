@@ -34,6 +34,7 @@ from rockyade.io.atomic import write_text
 from rockyade.io.worker import Program, run_scene
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
+from rockyade.run_meta import RunMeta
 from rockyade.siconos.calibration import model_restitution
 from rockyade.siconos.payload import Numerics, scene_payload
 
@@ -215,7 +216,9 @@ def _parse(
     problem = _output_problem(model, meta, arrays)
     if problem is not None:
         return _partial_failure(model, numerics, meta, arrays, problem, total, extra)
-    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, numerics, meta, total, extra, arrays))
+    return Result(
+        worker_frame(model, arrays, lowpass), RunMeta.from_dict(_run_meta(model, numerics, meta, total, extra, arrays))
+    )
 
 
 def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
@@ -265,7 +268,7 @@ def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Res
         partial=True,
         partial_samples=n,
     )
-    return Result(frame, out)
+    return Result(frame, RunMeta.from_dict(out))
 
 
 def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:

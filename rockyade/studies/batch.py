@@ -61,6 +61,7 @@ from rockyade.io.folders import output_folder
 from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.motion.types import RecordMotion
 from rockyade.result import Result
+from rockyade.run_meta import RunMeta
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.runner.groups import group_jobs
@@ -438,7 +439,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
         if task.save_history and result.ok:
             result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
         else:
-            write_run(runs, name, {**result.meta, "summary": row})
+            write_run(runs, name, {**result.meta.to_dict(), "summary": row})
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = _write_failure(task, row, exc)
     return row
@@ -446,7 +447,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
 
 def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
     """The summary's columns of how much of the base motion a run leaves out
-    (``meta["motion_coverage"]``, :func:`rockyade.motion.coverage.record_coverage`): the time
+    (``meta.motion_coverage``, :func:`rockyade.motion.coverage.record_coverage`): the time
     after the scene's end, s, and the fraction of the motion's PGA the run never sees (0 when
     the run covers the motion; no columns without a base motion)."""
     if not coverage or "pga_left_out_fraction" not in coverage:
@@ -457,20 +458,20 @@ def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
     }
 
 
-def _status_row(task: BatchTask, meta: Mapping[str, Any]) -> dict[str, Any]:
+def _status_row(task: BatchTask, meta: RunMeta) -> dict[str, Any]:
     """The summary row's leading and status columns of a run from its Result's metadata."""
     return {
         "index": task.index,
         "run": run_name(task.scene_hash, task.solver.name),
-        "scene_hash": meta.get("scene_hash"),
+        "scene_hash": meta.scene_hash,
         "solver": task.solver.name,
         **task.labels,
-        "status": meta["status"],
-        "failure_reason": meta.get("failure_reason") or "",
-        "overturn_time_s": meta.get("overturn_time_s"),
-        "overturned_block": meta.get("overturned_block") or "",
-        "wall_time_s": meta.get("wall_time_s"),
-        **coverage_columns(meta.get("motion_coverage")),
+        "status": meta.status,
+        "failure_reason": meta.failure_reason or "",
+        "overturn_time_s": meta.overturn_time_s,
+        "overturned_block": meta.overturned_block or "",
+        "wall_time_s": meta.wall_time_s,
+        **coverage_columns(meta.motion_coverage),
     }
 
 
@@ -522,7 +523,7 @@ def _run_group(job: tuple[BatchTask, ...]) -> list[dict[str, Any]]:
             row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned))
         row["elapsed_s"] = elapsed
         try:
-            write_run(folder, row["run"], {**one.meta, "summary": row})
+            write_run(folder, row["run"], {**one.meta.to_dict(), "summary": row})
         except OSError as exc:
             row = _write_failure(task, row, exc)
         rows.append(row)

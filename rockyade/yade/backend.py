@@ -27,6 +27,7 @@ turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -47,6 +48,7 @@ from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.yade.payload import scene_payload
 from rockyade.yade.worker import run_scene
@@ -157,7 +159,7 @@ def run_model(
     plan = payload.get("contact_plan")
     plan = plan if isinstance(plan, dict) else None
     result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, plan)
-    result.meta["timeout_s"] = timeout
+    result.meta = dataclasses.replace(result.meta, timeout_s=timeout)
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
     else:
@@ -179,8 +181,8 @@ def _keep_files(directory: Path, work: str, name: str, result: Result) -> None:
             os.replace(src, directory / f"{final}{suffix}")
         elif suffix != ".yade.log":  # no output of this run: none of an earlier run's stays beside its log
             (directory / f"{final}{suffix}").unlink(missing_ok=True)
-    if "log_path" in result.meta:
-        result.meta["log_path"] = str(directory / f"{final}.yade.log")
+    if result.meta.log_path is not None:
+        result.meta = dataclasses.replace(result.meta, log_path=str(directory / f"{final}.yade.log"))
 
 
 def _command() -> list[str]:
@@ -249,7 +251,7 @@ def _parse(
             return _collapsed(model, meta, arrays, cut, total, extra, lowpass)
     if problem is not None:
         return _partial_failure(model, meta, arrays, problem, total, extra)
-    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
+    return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(_run_meta(model, meta, total, extra, arrays)))
 
 
 def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
@@ -339,7 +341,7 @@ def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
         "the run stopped at a deep sphere-polyhedron overlap after the assembly had started to collapse "
         "(docs/yade.md): its history up to there is kept"
     )
-    return Result(worker_frame(model, arrays, lowpass), out)
+    return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(out))
 
 
 def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
@@ -362,7 +364,7 @@ def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
         partial=True,
         partial_samples=n,
     )
-    return Result(frame, out)
+    return Result(frame, RunMeta.from_dict(out))
 
 
 def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
