@@ -216,7 +216,7 @@ class RunMeta:
         Raises
         ------
         ValueError
-            A status that is not one of :data:`STATUSES`.
+            A status that is not one of :data:`STATUSES`, or none.
         """
         names = _FIELDS
         known = {k: v for k, v in data.items() if k in names}
@@ -228,6 +228,7 @@ class RunMeta:
         for key in ("solver", "version"):
             if known.get(key) is None:
                 known.pop(key, None)
+        known.setdefault("status", None)  # refused by __post_init__
         return cls(**known, extra=extra)
 
     @classmethod

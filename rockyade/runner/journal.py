@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import shutil
 from collections.abc import Mapping
 from pathlib import Path
@@ -55,6 +56,10 @@ def read_run(folder: str | Path, name: str, scene_hash: str) -> dict[str, Any] |
     """The summary row of run ``name`` if its record says it completed (or overturned) for
     ``scene_hash``; None otherwise (no record, unreadable, failed, another scene).
 
+    A record is strict JSON (:mod:`rockyade.io.strict_json`): a number that was not finite
+    (NaN: a time that never came) was written as null, and a null of the row reads back as NaN,
+    the value a table of numbers holds for it.
+
     Parameters
     ----------
     folder
@@ -74,7 +79,7 @@ def read_run(folder: str | Path, name: str, scene_hash: str) -> dict[str, Any] |
     if not isinstance(data, dict) or not isinstance(data.get("summary"), dict):
         return None
     if data.get("status") in KEPT_STATUSES and data.get("scene_hash") == scene_hash:
-        return dict(data["summary"])
+        return {key: math.nan if value is None else value for key, value in data["summary"].items()}
     return None
 
 
