@@ -241,3 +241,24 @@ def test_mypy_sees_a_misspelt_metadata_attribute(tmp_path):
         [str(snippet), "--follow-imports=silent", "--no-incremental", "--cache-dir", str(tmp_path / "cache")]
     )
     assert status == 1 and '"RunMeta" has no attribute "wall_time"' in out and out.count("error:") == 1, out
+
+
+def test_a_workers_metadata_is_read_into_its_typed_form():
+    """The drivers' JSON (YADE's names, Siconos's; an older driver without the newer keys)."""
+    from rockyade.dem.worker_output import WorkerOutput
+
+    yade = WorkerOutput.from_json(
+        '{"status": "overturned", "stop_time_s": 1.5, "overturn_times_s": {"0": 1.5}, "stop_body": 0, "n_filled": 151,'
+        ' "iterations": 30000, "wall_time_s": 2.0, "yade_version": "2023.02a", "dt_s": 5e-05, "complete": true,'
+        ' "max_polyhedra_penetration_over_radius": 0.2, "deep_overlap_time_s": null, "flushes": 3}'
+    )
+    assert yade.status == "overturned" and yade.steps == 30000 and yade.version == "2023.02a" and yade.complete
+    assert yade.overturn_times_s == {"0": 1.5} and yade.stop_body == 0 and yade.deep_overlap_time_s is None
+    assert yade.max_residual == 0.0 and yade.solver_calls == 0  # Siconos's keys: their defaults
+    older = {"status": "running", "n_filled": 3, "steps": 12, "siconos_version": "4.4", "solver_calls": 12}
+    siconos = WorkerOutput.from_dict({**older, "max_residual": 1e-9, "first_unconverged_s": None})
+    assert siconos.steps == 12 and siconos.version == "4.4" and not siconos.complete and siconos.wall_time_s is None
+    with pytest.raises(KeyError):
+        WorkerOutput.from_dict({"n_filled": 3})
+    with pytest.raises(ValueError):
+        WorkerOutput.from_json("[1, 2]")
