@@ -53,6 +53,7 @@ from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.atomic import fsync_dir, write_json
 from rockyade.io.locking import DIR_LOCK_NAME, output_lock
+from rockyade.io.strict_json import json_text
 from rockyade.runner import Executor
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
@@ -400,8 +401,8 @@ def _stored_row(task: BatchTask) -> dict[str, Any] | None:
         return None
     if data.get("scene_hash") != task.scene_hash or data.get("status") not in ("completed", "overturned"):
         return None
-    summary = data.get("summary")
-    return dict(summary) if isinstance(summary, dict) else None
+    summary = data.get("summary")  # strict JSON: a NaN of the row was written as null
+    return {k: math.nan if v is None else v for k, v in summary.items()} if isinstance(summary, dict) else None
 
 
 class Study:
@@ -578,7 +579,7 @@ def run_crosscheck(
         identity = plan.identity()
         plan_file = stage / "plan.json"
         stored = _read_json(plan_file)
-        if stored is not None and stored != json.loads(json.dumps(identity)) and resume:
+        if stored is not None and stored != json.loads(json_text(identity)) and resume:
             raise InputError(
                 "--resume",
                 f"the unfinished study in {stage} is another study (its plan.json differs): run without "
