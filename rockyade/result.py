@@ -318,7 +318,7 @@ def settle_results(directory: str | os.PathLike[str]) -> None:
     remove_stale_temporaries(directory)
 
 
-def failed_result(solver: str, scene_hash: str | None, reason: str, **values: Any) -> Result:
+def failed_result(solver: str, scene_hash: str | None, reason: str, **values: object) -> Result:
     """A Result with status ``failed``, no samples, and the reason.
 
     Parameters

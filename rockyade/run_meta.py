@@ -19,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Literal, get_args
+from typing import Any, Generic, Literal, TypeVar, get_args
 
 from rockyade import __version__
 
@@ -45,16 +45,19 @@ def as_status(value: object) -> Status:
     raise ValueError(f"status must be one of {STATUSES}, got {value!r}")
 
 
-class FrozenMapping(Mapping[str, Any]):
+V = TypeVar("V")
+
+
+class FrozenMapping(Mapping[str, V], Generic[V]):
     """A read-only mapping (a copy of the one given), picklable (unlike ``MappingProxyType``:
     results come back from worker processes) and equal to any mapping with the same items."""
 
     __slots__ = ("_data",)
 
-    def __init__(self, data: Mapping[str, Any] | None = None) -> None:
-        self._data: dict[str, Any] = dict(data or {})
+    def __init__(self, data: Mapping[str, V] | None = None) -> None:
+        self._data: dict[str, V] = dict(data or {})
 
-    def __getitem__(self, key: str) -> Any:
+    def __getitem__(self, key: str) -> V:
         return self._data[key]
 
     def __iter__(self) -> Iterator[str]:
@@ -66,14 +69,14 @@ class FrozenMapping(Mapping[str, Any]):
     def __repr__(self) -> str:
         return f"FrozenMapping({self._data!r})"
 
-    def __getstate__(self) -> dict[str, Any]:
+    def __getstate__(self) -> dict[str, V]:
         return self._data
 
-    def __setstate__(self, state: dict[str, Any]) -> None:
+    def __setstate__(self, state: dict[str, V]) -> None:
         self._data = state
 
 
-def _frozen(value: Mapping[str, Any] | None) -> FrozenMapping | None:
+def _frozen(value: Mapping[str, V] | None) -> FrozenMapping[V] | None:
     return value if value is None or isinstance(value, FrozenMapping) else FrozenMapping(value)
 
 
@@ -189,7 +192,7 @@ class RunMeta:
         """True unless the run failed (an overturn is a valid outcome)."""
         return self.status != "failed"
 
-    def with_extra(self, **values: Any) -> RunMeta:
+    def with_extra(self, **values: object) -> RunMeta:
         """This metadata with ``values`` added to (or replacing in) :attr:`extra`."""
         return dataclasses.replace(self, extra={**self.extra, **values})
 
@@ -232,7 +235,7 @@ class RunMeta:
         return cls(**known, extra=extra)
 
     @classmethod
-    def failed(cls, solver: str, scene_hash: str | None, reason: str, **values: Any) -> RunMeta:
+    def failed(cls, solver: str, scene_hash: str | None, reason: str, **values: object) -> RunMeta:
         """The metadata of a run that failed with ``reason`` (``values``: more, by field name or extra)."""
         meta = cls.from_dict({"solver": solver, "scene_hash": scene_hash, "status": "failed", **values})
         return dataclasses.replace(meta, failure_reason=reason)

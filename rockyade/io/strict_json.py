@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 
 
-def finite_or_null(data: Any) -> Any:
+def finite_or_null(data: object) -> Any:
     """``data`` made JSON-ready: every float that is not finite (nested in mappings, lists,
     tuples and numpy arrays) replaced by None, numpy scalars and arrays by Python's, paths by
     strings.
@@ -53,7 +53,7 @@ def finite_or_null(data: Any) -> Any:
     return data
 
 
-def json_text(data: Any, indent: int | None = 2) -> str:
+def json_text(data: object, indent: int | None = 2) -> str:
     """Sorted strict JSON of ``data`` (:func:`finite_or_null`), indented as the CLI prints it.
 
     Parameters
@@ -71,7 +71,7 @@ def json_text(data: Any, indent: int | None = 2) -> str:
     return json.dumps(finite_or_null(data), indent=indent, sort_keys=True, allow_nan=False)
 
 
-def null_to_nan(value: Any) -> float:
+def null_to_nan(value: float | None) -> float:
     """A float read from strict JSON: null (a number that was not finite) as NaN.
 
     Parameters
