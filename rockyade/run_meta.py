@@ -221,14 +221,9 @@ class RunMeta:
         ValueError
             A status that is not one of :data:`STATUSES`, or none.
         """
-        names = _FIELDS
-        known = {k: v for k, v in data.items() if k in names}
-        extra = {k: v for k, v in data.items() if k not in names}
-        if known.get("blocks") is None:
-            known.pop("blocks", None)
-        if known.get("rockyade_version") is None:
-            known.pop("rockyade_version", None)
-        for key in ("solver", "version"):
+        known = {k: v for k, v in data.items() if k in _FIELDS}
+        extra = {k: v for k, v in data.items() if k not in _FIELDS}
+        for key in ("blocks", "rockyade_version", "solver", "version"):  # fields that are never None
             if known.get(key) is None:
                 known.pop(key, None)
         known.setdefault("status", None)  # refused by __post_init__

@@ -166,12 +166,17 @@ def test_not_finite_numbers_are_written_as_null_and_read_back_as_nan(tmp_path):
     assert _strict_load(tmp_path / "x.json") == {"v": [1.0, None]}
 
 
-def test_a_journal_record_is_strict_and_its_row_reads_nan_back(tmp_path):
+def test_a_journal_record_is_strict_and_its_row_reads_back_as_written(tmp_path):
+    """NaN, infinity and None of a run's row are all null on disk; the row reads back with each
+    as it was (a resumed study's table equals the one run at once)."""
     meta = dataclasses.replace(_full_meta(), status="completed", wall_time_s=math.nan)
-    write_run(tmp_path, "run1", {**meta.to_dict(), "summary": {"run": "run1", "uplift_time_s": math.nan, "n": 2}})
-    assert _strict_load(tmp_path / "run1.json")["wall_time_s"] is None
-    row = read_run(tmp_path, "run1", "abc123")
-    assert row is not None and row["run"] == "run1" and row["n"] == 2 and math.isnan(row["uplift_time_s"])
+    row = {"run": "run1", "uplift_time_s": np.float64("nan"), "ratio": -math.inf, "overturn_time_s": None, "n": 2}
+    write_run(tmp_path, "run1", {**meta.to_dict(), "summary": row})
+    data = _strict_load(tmp_path / "run1.json")
+    assert data["wall_time_s"] is None and data["summary"]["uplift_time_s"] is None
+    back = read_run(tmp_path, "run1", "abc123")
+    assert back is not None and back["run"] == "run1" and back["n"] == 2 and back["overturn_time_s"] is None
+    assert math.isnan(back["uplift_time_s"]) and back["ratio"] == -math.inf
 
 
 def _refuse(token: str) -> float:

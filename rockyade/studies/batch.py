@@ -65,7 +65,7 @@ from rockyade.run_meta import RunMeta
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.runner.groups import group_jobs
-from rockyade.runner.journal import claim, read_run, write_run
+from rockyade.runner.journal import claim, marked_record, read_run, write_run
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
 from rockyade.solvers.base import GroupSolver, Solver
@@ -437,7 +437,7 @@ def _run_task(task: BatchTask) -> dict[str, Any]:
     row["elapsed_s"] = time.perf_counter() - start
     try:
         if task.save_history and result.ok:
-            result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
+            result.write(runs / f"{name}.csv", marked_record({"summary": row}))  # the JSON, last, marks it complete
         else:
             write_run(runs, name, {**result.meta.to_dict(), "summary": row})
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on

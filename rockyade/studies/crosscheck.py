@@ -55,6 +55,7 @@ from rockyade.io.atomic import fsync_dir, write_json
 from rockyade.io.locking import DIR_LOCK_NAME, output_lock
 from rockyade.io.strict_json import json_text
 from rockyade.runner import Executor
+from rockyade.runner.journal import summary_row
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
 from rockyade.solvers.base import Solver
@@ -401,8 +402,7 @@ def _stored_row(task: BatchTask) -> dict[str, Any] | None:
         return None
     if data.get("scene_hash") != task.scene_hash or data.get("status") not in ("completed", "overturned"):
         return None
-    summary = data.get("summary")  # strict JSON: a NaN of the row was written as null
-    return {k: math.nan if v is None else v for k, v in summary.items()} if isinstance(summary, dict) else None
+    return summary_row(data) if isinstance(data.get("summary"), dict) else None
 
 
 class Study:
