@@ -1,16 +1,18 @@
 """The one Result type every solver returns.
 
 A result is a time history (pandas DataFrame: one row per sample at ``sample_dt_s`` from
-t = 0) plus a metadata dictionary. Columns: ``t_s``, ``ag_m_s2`` (horizontal base
+t = 0) plus its metadata, a :class:`rockyade.run_meta.RunMeta`. Columns: ``t_s``, ``ag_m_s2`` (horizontal base
 acceleration) and per block ``theta_rad``, ``omega_rad_s``, ``x_m``, ``y_m`` (centroid
 displacement relative to the base from its initial position), ``ax_m_s2``, ``ay_m_s2``
 (absolute acceleration at the output point), prefixed ``<block>_`` when the scene has
 several blocks. Solvers may add columns (contact states, energies).
 
-Metadata keys: ``solver``, ``version``, ``scene_hash``, ``wall_time_s`` (the solver
-itself), ``status`` (completed | overturned | failed), ``overturn_time_s``,
-``overturned_block``, ``failure_reason``, ``blocks``, ``sample_dt_s``, and the parameters
-actually used (``contact`` for the DEMs, ``classical`` for Housner).
+Metadata (typed attributes): ``solver``, ``version``, ``scene_hash``, ``wall_time_s`` (the
+solver itself), ``status`` (completed | overturned | failed), ``overturn_time_s``,
+``overturned_block``, ``failure_reason``, ``blocks``, ``sample_dt_s``, ``dt_s``,
+``motion_coverage``, ...; a solver's own values (``contact`` for the DEMs, Siconos's solver
+statistics) in ``meta.extra``. On disk the metadata is the JSON beside the CSV, one flat object
+(:meth:`RunMeta.to_dict`), written as strict JSON (:mod:`rockyade.io.strict_json`).
 
 A Result knows nothing of figures: :mod:`rockyade.figures.histories` draws it
 (``HistoryDisplay.from_result(result)``, ``plot_result(result, ax=...)``).
@@ -24,21 +26,21 @@ import hashlib
 import json
 import os
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from rockyade import __version__
 from rockyade.errors import InputError
-from rockyade.io.atomic import TEMP_SUFFIX, fsync_dir, json_text, remove_stale_temporaries, staged_file
+from rockyade.io.atomic import TEMP_SUFFIX, fsync_dir, remove_stale_temporaries, staged_file
 from rockyade.io.locking import output_lock
+from rockyade.io.strict_json import json_text
+from rockyade.run_meta import RunMeta
 
 if TYPE_CHECKING:
     import pandas as pd
 
-STATUSES = ("completed", "overturned", "failed")
 PER_BLOCK_QUANTITIES = ("theta_rad", "omega_rad_s", "x_m", "y_m", "ax_m_s2", "ay_m_s2")
 CSV_FLOAT_FORMAT = "%.12g"
 
@@ -63,29 +65,23 @@ class Result:
     """A solver's output: time history and metadata (see module docstring)."""
 
     frame: pd.DataFrame
-    meta: dict[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        status = self.meta.get("status")
-        if status not in STATUSES:
-            raise ValueError(f"meta['status'] must be one of {STATUSES}, got {status!r}")
-        self.meta.setdefault("rockyade_version", __version__)
+    meta: RunMeta
 
     # -------------------------------------------------------------- accessors
     @property
     def status(self) -> str:
         """completed | overturned | failed."""
-        return str(self.meta["status"])
+        return self.meta.status
 
     @property
     def ok(self) -> bool:
         """True unless the run failed (an overturn is a valid outcome)."""
-        return self.status != "failed"
+        return self.meta.ok
 
     @property
     def blocks(self) -> list[str]:
         """Block names, bottom to top."""
-        return list(self.meta.get("blocks", []))
+        return list(self.meta.blocks)
 
     @property
     def t(self) -> np.ndarray:
@@ -130,7 +126,7 @@ class Result:
         csv_path = Path(csv_path)
         json_path = csv_path.with_suffix(".json")
         text = csv_text(self.frame, CSV_FLOAT_FORMAT)
-        meta = dict(self.meta)
+        meta = self.meta.to_dict()
         meta.update(extra_meta or {})
         meta["csv_file"] = csv_path.name
         meta["csv_sha256"] = hashlib.sha256(text.encode()).hexdigest()
@@ -188,7 +184,11 @@ class Result:
         frame = pd.read_csv(StringIO(text))
         for key in ("csv_file", "csv_sha256", "columns"):
             meta.pop(key, None)
-        return cls(frame, meta)
+        try:
+            run_meta = RunMeta.from_dict(meta)
+        except (TypeError, ValueError) as exc:
+            raise InputError("result", f"{json_path.name}: unreadable metadata ({exc})") from exc
+        return cls(frame, run_meta)
 
 
 #: Column names written as they are by pandas' CSV writer (no quoting needed).
@@ -318,7 +318,7 @@ def settle_results(directory: str | os.PathLike[str]) -> None:
     remove_stale_temporaries(directory)
 
 
-def failed_result(solver: str, scene_hash: str, reason: str, **extra: Any) -> Result:
+def failed_result(solver: str, scene_hash: str | None, reason: str, **values: object) -> Result:
     """A Result with status ``failed``, no samples, and the reason.
 
     Parameters
@@ -329,17 +329,9 @@ def failed_result(solver: str, scene_hash: str, reason: str, **extra: Any) -> Re
         The scene's hash.
     reason
         Why it failed (``failure_reason``).
-    **extra
-        More metadata.
+    **values
+        More metadata (:meth:`RunMeta.failed`: by field name, others to ``extra``).
     """
-    meta = {
-        "solver": solver,
-        "scene_hash": scene_hash,
-        "status": "failed",
-        "failure_reason": reason,
-        "overturn_time_s": None,
-        **extra,
-    }
     import pandas as pd
 
-    return Result(pd.DataFrame({"t_s": pd.Series(dtype=float)}), meta)
+    return Result(pd.DataFrame({"t_s": pd.Series(dtype=float)}), RunMeta.failed(solver, scene_hash, reason, **values))

@@ -237,14 +237,14 @@ def test_thousand_block_wall_stands_under_gravity():
         }
     )
     result = ReferenceSolver(record_energy=False).run(scene)
-    assert result.status == "completed" and result.meta["overturn_times_s"] == {}
+    assert result.status == "completed" and result.meta.overturn_times_s == {}
     names = result.blocks
     x = np.array([result.series("x_m", n) for n in names])
     y = np.array([result.series("y_m", n) for n in names])
     theta = np.array([result.series("theta_rad", n) for n in names])
     assert np.max(np.hypot(x, y)) < 2e-4
     assert np.max(np.abs(theta)) < 1e-3
-    assert result.meta["broad_phase"]["rebuilds"] == 1
+    assert result.meta.extra["broad_phase"]["rebuilds"] == 1
     # every brick bears on its neighbours: about 2 contact points per joint, 3 joints per brick
     n_contacts = np.array([result.frame[f"{n}_n_contacts"].iloc[-1] for n in names])
     assert np.all(n_contacts >= 2) and 8 <= n_contacts.mean() <= 12

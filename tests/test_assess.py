@@ -386,7 +386,7 @@ def test_finite_or_null_makes_json_strict():
 
     import numpy as np
 
-    from rockyade.assess.strict import finite_or_null
+    from rockyade.io.strict_json import finite_or_null
 
     data = {"beta": math.nan, "band": (1.0, np.float64("inf")), "rows": [{"fraction": -math.inf, "n": 3}], "s": "x"}
     assert finite_or_null(data) == {"beta": None, "band": [1.0, None], "rows": [{"fraction": None, "n": 3}], "s": "x"}

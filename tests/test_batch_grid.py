@@ -377,11 +377,11 @@ def test_every_result_carries_its_motion_coverage(solver):
         {**load_scene(EXAMPLES / "specimen1_record.toml").to_dict(), "duration_s": 1.0, "sample_dt_s": 0.01}
     )
     result = make_solver(solver).run(scene)
-    coverage = result.meta["motion_coverage"]
+    coverage = result.meta.motion_coverage
     assert coverage["status"] == "cut" and coverage["time_left_out_s"] == pytest.approx(4.0)
     assert coverage["message"].startswith("the scene ends at 1 s")
     free = make_solver(solver).run(load_scene(EXAMPLES / "specimen3_free.toml"))
-    assert free.meta["motion_coverage"]["status"] == "no base motion"
+    assert free.meta.motion_coverage["status"] == "no base motion"
 
 
 def test_a_grid_over_the_motion_gives_the_scenes_read_whole(tmp_path):

@@ -151,10 +151,10 @@ def test_run_reference_solver_writes_contacts_and_energy(capsys, examples_dir, t
     )
     assert code == 0 and "upper" in out and "lower" in out
     result = Result.read(out_csv)
-    assert result.meta["solver"] == "reference" and result.blocks == ["lower", "upper"]
+    assert result.meta.solver == "reference" and result.blocks == ["lower", "upper"]
     for col in ("upper_theta_rad", "lower_theta_rad", "upper_c0_state", "energy_balance_error_J"):
         assert col in result.frame.columns
-    assert result.meta["contact"]["upper"]["stiffness_reading"] == "MN/m"
+    assert result.meta.extra["contact"]["upper"]["stiffness_reading"] == "MN/m"
 
 
 def test_calibrate_matched_json(capsys):

@@ -82,7 +82,7 @@ def test_dem_fall_time_agrees_with_housner_overturn():
     assert exact.status == "overturned"
     report = collapse_report(scene, dem).iloc[0]
     assert report["fell"] and report["final_state"] == "fallen"
-    assert report["fall_time_s"] == pytest.approx(exact.meta["overturn_time_s"], abs=0.05)
+    assert report["fall_time_s"] == pytest.approx(exact.meta.overturn_time_s, abs=0.05)
     assert report["tipped_time_s"] < report["fall_time_s"]
     assert abs(report["residual_theta_rad"]) > math.pi / 2 - 0.05
 
@@ -188,7 +188,7 @@ def test_a_run_that_ends_while_blocks_fall_says_falling_and_its_status_follows_t
     in_air = scene_from_dict(_falling_column(round(0.5 * (tip + first), 3)))
     result = run(in_air, "reference")
     report = collapse_report(in_air, result)
-    assert result.status == "completed" and result.meta["overturned_block"] is None
+    assert result.status == "completed" and result.meta.overturned_block is None
     assert not report["fell"].any() and report["falling_at_end"].all()
     assert (report["final_state"] == "falling").all() and report["tipped_time_s"].notna().all()
     states, _ = block_states(in_air, result)
@@ -201,8 +201,8 @@ def test_a_run_that_ends_while_blocks_fall_says_falling_and_its_status_follows_t
     report = collapse_report(landing, result).set_index("block")
     fell = report.index[report["fell"]]
     assert 0 < len(fell) < 8 and report.loc[~report["fell"], "falling_at_end"].all()
-    assert result.status == "overturned" and result.meta["overturned_block"] == report["fall_time_s"].idxmin()
-    assert result.meta["overturn_time_s"] == pytest.approx(report["fall_time_s"].min(), abs=landing.sample_dt_s)
+    assert result.status == "overturned" and result.meta.overturned_block == report["fall_time_s"].idxmin()
+    assert result.meta.overturn_time_s == pytest.approx(report["fall_time_s"].min(), abs=landing.sample_dt_s)
     # the printed line says the same as the table and the status
     scene_file = tmp_path / "column.toml"
     write_scene(scene_file, _falling_column(in_air.duration_s))
@@ -270,7 +270,7 @@ def _agreement(scenes) -> tuple[int, int, list[float]]:
             alpha = scene.blocks[0].classical().alpha_rad
             assert abs(dem.series("theta_rad")[-1]) < alpha
         if exact.status == dem.status == "overturned":
-            dt.append(dem.meta["overturn_time_s"] - exact.meta["overturn_time_s"])
+            dt.append(dem.meta.overturn_time_s - exact.meta.overturn_time_s)
     return agree, total, dt
 
 

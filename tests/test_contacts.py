@@ -310,13 +310,13 @@ def test_assembly_runs_on_when_a_block_falls():
     pulse = {"type": "pulse", "shape": "sine", "amplitude_g": 0.6, "period_s": 0.5}
     result = ReferenceSolver().run(scene(blocks, motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002))
     assert result.status == "overturned" and result.t[-1] == pytest.approx(2.5)
-    assert set(result.meta["overturn_times_s"]) == {"slender"}
-    t_fall = result.meta["overturn_times_s"]["slender"]
-    assert result.meta["overturned_block"] == "slender" and result.meta["overturn_time_s"] == t_fall
+    assert set(result.meta.overturn_times_s) == {"slender"}
+    t_fall = result.meta.overturn_times_s["slender"]
+    assert result.meta.overturned_block == "slender" and result.meta.overturn_time_s == t_fall
     theta = np.abs(result.series("theta_rad", "slender"))
     assert result.t[np.argmax(theta >= math.pi / 2 - LANDING_TOL_RAD)] == pytest.approx(t_fall, abs=0.002)
     column = scene([block("slender", 0.1, 1.0)], motion=pulse, contact=EXPLICIT, duration=2.5, sample_dt=0.002)
     stopped = ReferenceSolver().run(column)
-    assert stopped.status == "overturned" and stopped.meta["overturn_time_s"] == pytest.approx(t_fall, abs=1e-9)
+    assert stopped.status == "overturned" and stopped.meta.overturn_time_s == pytest.approx(t_fall, abs=1e-9)
     out, _ = simulate_model(calibrated_model(column), False, stop_angle_rad=np.array([0.5]))
     assert out.status == kernel.STATUS_OVERTURNED and out.t_stop < t_fall

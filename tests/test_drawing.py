@@ -22,6 +22,7 @@ from rockyade.figures.assembly import (
     write_snapshots,
 )
 from rockyade.result import Result
+from rockyade.run_meta import RunMeta
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import arch, rocking_frame, stack, wall, write_scene
 from rockyade.scene.placement import placed_blocks, rotation_matrix
@@ -50,7 +51,7 @@ def _rocking_result(scene, theta: np.ndarray, t: np.ndarray, pivot_block: str) -
             data[f"{name}_theta_rad"], data[f"{name}_x_m"], data[f"{name}_y_m"] = theta, *(moved - c).T
         else:
             data[f"{name}_theta_rad"] = data[f"{name}_x_m"] = data[f"{name}_y_m"] = np.zeros_like(t)
-    return Result(pd.DataFrame(data), {"status": "completed", "blocks": names, "solver": "synthetic"})
+    return Result(pd.DataFrame(data), RunMeta(status="completed", blocks=tuple(names), solver="synthetic"))
 
 
 def test_draw_writes_a_png_with_names_and_counts_the_names_left_out(tmp_path):

@@ -111,6 +111,7 @@ def _synthetic_frame_result(scene):
     import pandas as pd
 
     from rockyade.result import Result
+    from rockyade.run_meta import RunMeta
 
     t = np.linspace(0.0, 1.0, 21)
     data = {"t_s": t, "ag_m_s2": np.zeros_like(t)}
@@ -118,7 +119,7 @@ def _synthetic_frame_result(scene):
     for name in names:
         data[f"{name}_theta_rad"] = 0.01 * np.sin(np.pi * t)
         data[f"{name}_x_m"] = data[f"{name}_y_m"] = np.zeros_like(t)
-    return Result(pd.DataFrame(data), {"status": "completed", "blocks": names, "solver": "synthetic"})
+    return Result(pd.DataFrame(data), RunMeta(status="completed", blocks=tuple(names), solver="synthetic"))
 
 
 _ANIMATIONS: list = []

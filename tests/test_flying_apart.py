@@ -81,7 +81,7 @@ def test_a_horizontal_load_past_the_overturning_one_is_a_collapse_not_a_flight()
 
 def test_a_carried_load_still_runs():
     result = run(scene([{"block": "b", "point_m": [0.0, 1.4], "force_N": [0.0, -2000.0]}]), "housner")
-    assert result.meta["status"] == "completed"
+    assert result.meta.status == "completed"
 
 
 def test_the_limit_analysis_says_unstable_with_the_same_words(tmp_path, capsys):

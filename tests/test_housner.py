@@ -126,7 +126,7 @@ def test_run_scene_csv_peak_decay_gives_mu(tmp_path):
     peaks = find_peaks(back.t, back.series("theta_rad"))
     mu = effective_restitution(peaks, 0.235, n_impacts=5)
     assert mu == pytest.approx(0.936, abs=2e-5)
-    assert back.meta["status"] == "completed" and back.meta["solver"] == "housner"
+    assert back.meta.status == "completed" and back.meta.solver == "housner"
     assert back.frame["t_s"].iloc[0] == 0.0
     assert np.allclose(np.diff(back.frame["t_s"]), 0.001)
 
@@ -143,8 +143,8 @@ def test_overturned_history_ends_at_overturn():
     scene = scene_from_dict(free_scene_dict(theta0=0.24, duration=5.0))
     result = HousnerSolver().run(scene)
     assert result.status == "overturned"
-    assert result.t[-1] <= result.meta["overturn_time_s"]
-    assert result.meta["overturned_block"] == "specimen1"
+    assert result.t[-1] <= result.meta.overturn_time_s
+    assert result.meta.overturned_block == "specimen1"
 
 
 def test_top_acceleration_at_rest_is_the_base_acceleration():

@@ -67,8 +67,8 @@ def test_a_group_gives_each_runs_own_results(scenes):
         theta = result.series("theta_rad")
         assert one.theta_rad.shape == theta.shape and np.array_equal(one.theta_rad, theta)
         assert one.sample_dt_s == scene.sample_dt_s
-        assert {k: v for k, v in one.meta.items() if k not in TIMINGS} == {
-            k: v for k, v in result.meta.items() if k not in TIMINGS
+        assert {k: v for k, v in one.meta.to_dict().items() if k not in TIMINGS} == {
+            k: v for k, v in result.meta.to_dict().items() if k not in TIMINGS
         }
         expected = theta_metrics(result.t, theta, alpha)
         for key, value in one.metrics.items():

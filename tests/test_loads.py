@@ -192,10 +192,10 @@ def test_housner_onset_under_a_slow_ramp_is_the_closed_form():
     t_end = 10.0
     motion = {"type": "sampled", "accel_m_s2": [0.0, rate * t_end], "t_s": [0.0, t_end]}
     result = run(block_scene(top_load(x, n), motion, duration=t_end), "housner")
-    onset = result.meta["uplift_times_s"][0] * rate / G
+    onset = result.meta.extra["uplift_times_s"][0] * rate / G
     assert onset == pytest.approx(closed_form(n, x + B), rel=1e-9)
     unloaded = run(block_scene([], motion, duration=t_end), "housner")
-    assert unloaded.meta["uplift_times_s"][0] * rate / G == pytest.approx(B / H_C, rel=1e-9)
+    assert unloaded.meta.extra["uplift_times_s"][0] * rate / G == pytest.approx(B / H_C, rel=1e-9)
 
 
 def test_a_horizontal_load_lowers_the_threshold_on_its_side():
@@ -225,7 +225,7 @@ def test_free_rocking_of_a_loaded_block_housner_against_the_reference_dem(mass):
     times = {}
     for name in ("housner", "reference"):
         result = run(loaded, name)
-        assert result.meta["status"] == "completed"
+        assert result.meta.status == "completed"
         theta = result.frame[result.frame.columns[result.frame.columns.str.contains("theta")][0]].to_numpy()
         times[name] = first_crossings(theta, 0.001)
     assert len(times["housner"]) == 3
@@ -239,15 +239,15 @@ def test_a_load_that_tips_the_block_overturns_it_at_rest():
     """A horizontal load above the static threshold (P h > W b): the block at rest tips over in Housner."""
     p = 1.2 * W * B / HEIGHT
     scene = block_scene([{"block": "pier", "point_m": [0.0, HEIGHT], "force_N": [-p, 0.0]}], duration=3.0)
-    assert run(scene, "housner").meta["status"] == "overturned"
+    assert run(scene, "housner").meta.status == "overturned"
 
 
 def test_the_reference_dem_energy_balance_counts_the_loads_work():
     scene = block_scene(top_load(0.1, 1500.0), {"type": "free", "theta0_rad": 0.06}, duration=0.5)
     result = run(scene, "reference")
     weight_height = W * H_C
-    assert result.meta["energy_balance_max_error_J"] < 1e-3 * weight_height
-    assert math.isfinite(result.meta["initial_potential_energy_J"])
+    assert result.meta.extra["energy_balance_max_error_J"] < 1e-3 * weight_height
+    assert math.isfinite(result.meta.extra["initial_potential_energy_J"])
 
 
 @pytest.mark.yade
@@ -261,7 +261,7 @@ def test_free_rocking_of_a_loaded_block_yade_against_the_reference_dem(mass):
     times = {}
     for name in ("reference", "yade"):
         result = run(scene, name)
-        assert result.meta["status"] == "completed"
+        assert result.meta.status == "completed"
         theta = result.frame[result.frame.columns[result.frame.columns.str.contains("theta")][0]].to_numpy()
         times[name] = first_crossings(theta, 0.001)
     assert len(times["yade"]) == 3

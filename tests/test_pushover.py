@@ -327,17 +327,17 @@ def test_the_same_arches_in_yade(t_over_r, motion, stands):
     if stands:
         _check_arch(result, True)
     else:
-        assert result.meta["status"] == "overturned", result.meta.get("failure_reason")
-        assert result.meta["overturn_times_s"] or result.meta.get("stopped_at_deep_overlap_s")
+        assert result.meta.status == "overturned", result.meta.failure_reason
+        assert result.meta.overturn_times_s or result.meta.extra.get("stopped_at_deep_overlap_s")
 
 
 def _check_arch(result, stands):
     if stands:
-        assert result.meta["status"] == "completed" and not result.meta["overturn_times_s"]
+        assert result.meta.status == "completed" and not result.meta.overturn_times_s
         assert max(np.max(np.abs(result.series("theta_rad", n))) for n in result.blocks) < 1e-3
     else:
-        assert result.meta["status"] == "overturned"
-        assert len(result.meta["overturn_times_s"]) > 5
+        assert result.meta.status == "overturned"
+        assert len(result.meta.overturn_times_s) > 5
 
 
 def test_pushover_onset_threshold_is_checked():

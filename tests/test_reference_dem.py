@@ -59,7 +59,7 @@ def test_peak_times_match_housner_with_the_dem_own_p(free_rocking):
     (xi < 1 % at the contact frequency) that its corners chatter at impact and the decay
     per impact scatters; its later peaks drift to 3 % (see the issue note)."""
     key, scene, dem, exact = free_rocking
-    body = dem.meta["bodies"][scene.blocks[0].name]
+    body = dem.meta.bodies[scene.blocks[0].name]
     assert body["p_rad_s"] == pytest.approx(scene.blocks[0].p_rad_s, rel=1e-9)
     assert body["alpha_rad"] == pytest.approx(scene.blocks[0].alpha_rad, rel=1e-9)
     alpha = scene.blocks[0].alpha_rad
@@ -76,16 +76,16 @@ def test_energy_balance(free_rocking):
     specimen 4, stocky and stiff, slips at its corners at every impact: 3.3 % at Eq 7's step,
     halving with the step (1.5 % at dt/2, 0.8 % at dt/4)."""
     key, scene, dem, _ = free_rocking
-    pe0 = dem.meta["initial_potential_energy_J"]
+    pe0 = dem.meta.extra["initial_potential_energy_J"]
     assert pe0 > 0
-    error = dem.meta["energy_balance_max_error_J"] / pe0
+    error = dem.meta.extra["energy_balance_max_error_J"] / pe0
     if key != "4":
         assert error < 0.01
     else:
         assert error < 0.035
         model = calibrated_model(scene)
         finer = run_model(model.with_dt(model.dt_s / 2))
-        finer_error = finer.meta["energy_balance_max_error_J"] / pe0
+        finer_error = finer.meta.extra["energy_balance_max_error_J"] / pe0
         assert finer_error < 0.02
         assert finer_error < 0.55 * error  # first order in dt
     frame = dem.frame
@@ -268,7 +268,7 @@ def test_every_example_runs(examples_dir):
     for path in sorted(examples_dir.glob("*_free.toml")):
         result = ReferenceSolver().run(load_scene(path))
         assert result.status == "completed"
-        assert result.meta["dt_s"] <= result.meta["dt_stability_limit_s"]
+        assert result.meta.dt_s <= result.meta.extra["dt_stability_limit_s"]
         for name in result.blocks:
             assert np.isfinite(result.series("theta_rad", name)).all()
 
@@ -323,7 +323,7 @@ def test_run_many_in_parallel_equals_sequential():
     )
     out = solve_scenes(quiet, [scenes[0], bad], executor=Executor("threads", 2))
     assert out[0].status == "completed" and out[1].status == "failed"
-    assert "CalibrationError" in out[1].meta["failure_reason"]
+    assert "CalibrationError" in out[1].meta.failure_reason
 
 
 def test_friction_energy_of_a_sliding_block_is_coulomb_force_times_slip():
@@ -347,7 +347,7 @@ def test_friction_energy_of_a_sliding_block_is_coulomb_force_times_slip():
     friction = dem.frame["energy_friction_J"].to_numpy()
     assert friction[-1] == pytest.approx(math.tan(math.radians(30.0)) * 250 * G * slip, rel=0.02)
     base_work = abs(dem.frame["work_base_J"].to_numpy()[-1])
-    assert dem.meta["energy_balance_max_error_J"] < 0.02 * base_work
+    assert dem.meta.extra["energy_balance_max_error_J"] < 0.02 * base_work
 
 
 def test_run_compare_and_the_matched_calibration_count_the_same_impacts():

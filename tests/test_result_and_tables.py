@@ -10,11 +10,12 @@ from rockyade import paper
 from rockyade.errors import InputError
 from rockyade.paper.tables import format_report, reproduction_report
 from rockyade.result import Result, failed_result
+from rockyade.run_meta import RunMeta
 
 
 def _result() -> Result:
     frame = pd.DataFrame({"t_s": np.arange(5) * 0.1, "theta_rad": np.linspace(0, 0.1, 5)})
-    return Result(frame, {"status": "completed", "solver": "test", "blocks": ["b"]})
+    return Result(frame, RunMeta(status="completed", solver="test", blocks=("b",)))
 
 
 def test_write_read_round_trip(tmp_path):
@@ -66,9 +67,9 @@ def test_failing_write_keeps_the_old_pair_and_no_temporary_file(tmp_path, monkey
 
 def test_status_is_validated_and_failed_result():
     with pytest.raises(ValueError):
-        Result(pd.DataFrame({"t_s": [0.0]}), {"status": "fine"})
+        RunMeta.from_dict({"status": "fine"})
     r = failed_result("yade", "abc", "YADE exited with 1", log_path="/tmp/x.log")
-    assert not r.ok and r.meta["failure_reason"] == "YADE exited with 1"
+    assert not r.ok and r.meta.failure_reason == "YADE exited with 1"
 
 
 def test_paper_tables_load_with_units_in_columns():

@@ -162,7 +162,7 @@ def test_every_executor_gives_the_results_of_one_thread(executor):
     serial = solve_scenes(solver, scenes, executor=IN_THIS_THREAD)
     parallel = solve_scenes(solver, scenes, executor=executor)
     assert [r.status for r in parallel] == ["completed", "failed", "completed", "completed"]
-    assert "CalibrationError" in parallel[1].meta["failure_reason"]
+    assert "CalibrationError" in parallel[1].meta.failure_reason
     for a, b in zip(parallel, serial, strict=True):
         pd.testing.assert_frame_equal(a.frame, b.frame)
 

@@ -80,9 +80,9 @@ def test_a_group_gives_the_reference_solvers_runs(tmp_path):
                 else alone.frame["theta_rad"].to_numpy()
             )
             # the same verdict, at the same time, and the same rotations bit for bit
-            assert one.status == alone.meta["status"], task.labels
-            assert one.meta["overturn_time_s"] == alone.meta["overturn_time_s"]
-            assert one.meta["overturn_times_s"] == alone.meta["overturn_times_s"]
+            assert one.status == alone.meta.status, task.labels
+            assert one.meta.overturn_time_s == alone.meta.overturn_time_s
+            assert one.meta.overturn_times_s == alone.meta.overturn_times_s
             assert np.array_equal(one.theta_rad, theta), task.labels
             assert one.metrics["max_abs_theta_rad"] == np.max(np.abs(theta))
             assert one.metrics["residual_theta_rad"] == theta[-1]

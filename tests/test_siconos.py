@@ -63,20 +63,20 @@ def test_free_rocking_restitution_is_housners_eq4():
     formula, at the default time step (recorded in meta)."""
     block = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.5 * math.atan(0.25)}, 3.0)
     result = SiconosSolver().run(block)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     alpha = math.atan(0.25)
     eq4 = 1.0 - 1.5 * math.sin(alpha) ** 2
     general = classical_parameters(block.blocks[0].block()).mu
     assert general == pytest.approx(eq4, rel=1e-9)
-    assert result.meta["mu_model"]["b"] == pytest.approx(eq4, rel=1e-9)
+    assert result.meta.extra["mu_model"]["b"] == pytest.approx(eq4, rel=1e-9)
     peaks = find_peaks(result.frame["t_s"].to_numpy(), result.frame["theta_rad"].to_numpy())
     per_impact = restitution_per_impact(peaks, alpha)[:6]
     assert len(per_impact) >= 4
     assert np.all(np.abs(per_impact / eq4 - 1.0) < 0.005), per_impact
     meta = result.meta
-    assert meta["dt_factor"] == 1.0 and 0 < meta["dt_s"] <= 1e-3 and meta["dt_source"].startswith("default")
-    assert meta["unconverged_steps"] == 0 and meta["solver_calls"] > 0
-    assert 0.0 <= meta["max_penetration_m"] < 1e-3
+    assert meta.dt_factor == 1.0 and 0 < meta.dt_s <= 1e-3 and meta.extra["dt_source"].startswith("default")
+    assert meta.unconverged_steps == 0 and meta.extra["solver_calls"] > 0
+    assert 0.0 <= meta.extra["max_penetration_m"] < 1e-3
 
 
 def test_a_newton_restitution_does_not_raise_the_per_cycle_mu():
@@ -108,8 +108,8 @@ def test_a_pulse_matches_housner_and_halving_the_step_changes_the_peak_little():
     full = SiconosSolver().run(scene)
     half = SiconosSolver(dt_factor=0.5).run(scene)
     assert full.ok and half.ok and housner.ok
-    assert half.meta["dt_s"] == pytest.approx(0.5 * full.meta["dt_s"], rel=1e-9)
-    assert half.meta["dt_factor"] == 0.5
+    assert half.meta.dt_s == pytest.approx(0.5 * full.meta.dt_s, rel=1e-9)
+    assert half.meta.dt_factor == 0.5
 
     def peak(r):
         return float(np.max(np.abs(r.frame["theta_rad"].to_numpy())))
@@ -125,7 +125,7 @@ def test_a_two_block_stack_stands_at_rest_with_the_dems_columns():
     data = stack(widths_m=[0.4, 0.35], heights_m=0.5, motion=rest_motion(), duration_s=0.6, sample_dt_s=0.01)
     scene = scene_from_dict(data)
     result = SiconosSolver().run(scene)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     for name in ("b01", "b02"):
         assert np.max(np.abs(result.frame[f"{name}_theta_rad"])) < 1e-6
         assert np.max(np.abs(result.frame[f"{name}_x_m"])) < 1e-5
@@ -138,7 +138,7 @@ def test_a_two_block_stack_stands_at_rest_with_the_dems_columns():
     reference = make_solver("reference").run(scene)
     missing = {c for c in reference.frame.columns if not c.startswith(("energy_", "work_"))} - set(result.frame.columns)
     assert not missing
-    assert result.meta["status"] == "completed" and result.meta["blocks"] == ["b01", "b02"]
+    assert result.meta.status == "completed" and result.meta.blocks == ("b01", "b02")
 
 
 def test_a_tapered_four_block_stack_stands_at_rest():
@@ -149,13 +149,13 @@ def test_a_tapered_four_block_stack_stands_at_rest():
         widths_m=[0.6, 0.52, 0.44, 0.36], heights_m=0.4, motion=rest_motion(), duration_s=0.3, sample_dt_s=0.01
     )
     result = SiconosSolver(dt_s=1e-3).run(scene_from_dict(data))
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     for name in ("b01", "b02", "b03", "b04"):
         assert np.max(np.abs(result.frame[f"{name}_theta_rad"])) < 1e-6
         assert np.max(np.abs(result.frame[f"{name}_x_m"] - result.frame[f"{name}_x_m"].iloc[0])) < 1e-4
         assert np.max(np.abs(result.frame[f"{name}_y_m"] - result.frame[f"{name}_y_m"].iloc[0])) < 1e-4
     assert result.frame["b04_n_contacts"].iloc[-1] == 2
-    assert result.meta["solver_iterations_mean"] < 50
+    assert result.meta.extra["solver_iterations_mean"] < 50
 
 
 def test_a_run_siconos_cannot_converge_fails_and_keeps_its_samples():
@@ -165,18 +165,18 @@ def test_a_run_siconos_cannot_converge_fails_and_keeps_its_samples():
     data = stack(widths_m=[0.4, 0.35], heights_m=0.5, motion=rest_motion(), duration_s=0.3, sample_dt_s=0.01)
     result = SiconosSolver(solver_max_iter=1).run(scene_from_dict(data))
     assert result.status == "failed" and not result.ok
-    reason = result.meta["failure_reason"]
+    reason = result.meta.failure_reason
     assert "did not converge" in reason or "numerical instability" in reason
-    assert result.meta["partial"] is True and len(result.frame) == result.meta["partial_samples"] > 0
-    assert result.meta["unconverged_steps"] > 0
+    assert result.meta.partial is True and len(result.frame) == result.meta.partial_samples > 0
+    assert result.meta.unconverged_steps > 0
 
 
 def test_a_timeout_fails_and_keeps_the_samples_so_far():
     """A run that cannot finish in its time (10,000 s of rocking in 8 s of wall time)."""
     scene = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 10_000.0, sample_dt=0.01)
     result = SiconosSolver(timeout_s=8.0).run(scene)
-    assert result.status == "failed" and "timeout" in result.meta["failure_reason"]
-    assert result.meta["partial"] is True and 0 < len(result.frame) < scene.n_samples
+    assert result.status == "failed" and "timeout" in result.meta.failure_reason
+    assert result.meta.partial is True and 0 < len(result.frame) < scene.n_samples
     again = SiconosSolver().run(_block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 0.2))
     assert again.ok  # the worker goes on with the next scene
 
@@ -250,5 +250,5 @@ def test_the_example_runs_with_the_geometrys_restitution_recorded():
     result = SiconosSolver().run(scene_from_dict(d, base_dir=Path(EXAMPLES)))
     assert result.ok
     own = model_restitution(SiconosSolver().model(scene).bodies[0])
-    assert result.meta["mu_model"]["specimen1"] == pytest.approx(own)
-    assert result.meta["mu_scene"]["specimen1"] == 0.936 and "mu_note" in result.meta
+    assert result.meta.extra["mu_model"]["specimen1"] == pytest.approx(own)
+    assert result.meta.extra["mu_scene"]["specimen1"] == 0.936 and "mu_note" in result.meta.extra

@@ -86,4 +86,4 @@ def test_the_cost_estimate_and_the_run_build_one_model(monkeypatch: pytest.Monke
     estimate = solver.estimate_cost(scene)
     result = solver.run(scene)
     assert len(builds) == 1
-    assert result.ok and estimate.time_step_s == pytest.approx(result.meta["dt_s"], rel=1e-12)
+    assert result.ok and estimate.time_step_s == pytest.approx(result.meta.dt_s, rel=1e-12)

@@ -242,7 +242,7 @@ def test_free_rocking_yade_vs_reference(free_rocking):
     YADE must agree with the reference within that intrinsic sensitivity (and mu within 0.5 %).
     """
     key, scene, y, r = free_rocking
-    assert y.status == "completed", y.meta.get("failure_reason")
+    assert y.status == "completed", y.meta.failure_reason
     alpha = scene.blocks[0].alpha_rad
     py, pr = (find_peaks(x.t, x.series("theta_rad"), 1e-3 * alpha) for x in (y, r))
     amp = np.max(np.abs(py.amplitude_rad[:5] / pr.amplitude_rad[:5] - 1))
@@ -302,7 +302,7 @@ def test_biblock_upper_block_yade_vs_reference():
     (first three peaks and their times, both blocks)."""
     scene = load_scene(EXAMPLES / "biblock_free.toml")
     y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
-    assert y.status == "completed", y.meta.get("failure_reason")
+    assert y.status == "completed", y.meta.failure_reason
     py, pr = (find_peaks(x.t, x.series("theta_rad", "upper"), 1e-4) for x in (y, r))
     assert np.max(np.abs(py.amplitude_rad[:3] / pr.amplitude_rad[:3] - 1)) < 0.03
     assert np.max(np.abs(py.t_s[:3] / pr.t_s[:3] - 1)) < 0.03
@@ -314,8 +314,8 @@ def test_overturning_in_yade():
     scene = load_scene(EXAMPLES / "specimen1_pulse.toml")
     y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
     assert y.status == r.status == "overturned"
-    assert y.meta["overturn_time_s"] == pytest.approx(r.meta["overturn_time_s"], rel=0.02)
-    assert y.t[-1] <= y.meta["overturn_time_s"] + 1e-9
+    assert y.meta.overturn_time_s == pytest.approx(r.meta.overturn_time_s, rel=0.02)
+    assert y.t[-1] <= y.meta.overturn_time_s + 1e-9
 
 
 # ------------------------------------------------------------------ failures and files
@@ -333,8 +333,8 @@ def test_exception_inside_yade_gives_failed_result(tmp_path, monkeypatch):
     monkeypatch.setattr(yade_backend, "scene_payload", broken)
     result = YadeSolver(workdir=tmp_path, stem="bad").run(scene)
     assert result.status == "failed" and not result.ok
-    assert "exited with code 1" in result.meta["failure_reason"] and "KeyError" in result.meta["failure_reason"]
-    assert Path(result.meta["log_path"]).is_file() and "Traceback" in Path(result.meta["log_path"]).read_text()
+    assert "exited with code 1" in result.meta.failure_reason and "KeyError" in result.meta.failure_reason
+    assert Path(result.meta.log_path).is_file() and "Traceback" in Path(result.meta.log_path).read_text()
     out = tmp_path / "bad.csv"
     result.write(out)
     back = Result.read(out)
@@ -351,7 +351,7 @@ def test_instability_inside_yade_gives_failed_result(tmp_path):
     unstable = replace(model, dt_s=model.sample_dt_s / steps, steps_per_sample=steps, n_samples=501)
     result = yade_backend.run_model(unstable, workdir=tmp_path, name="unstable")
     assert result.status == "failed"
-    assert "numerical instability" in result.meta["failure_reason"]
+    assert "numerical instability" in result.meta.failure_reason
 
 
 def _warm_yade() -> None:
@@ -377,9 +377,9 @@ def test_timeout_gives_failed_result(tmp_path):
     start = time.time()
     result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=3.0).run(scene)
     assert time.time() - start < 30
-    assert result.status == "failed" and result.meta["failure_reason"].startswith("timeout")
+    assert result.status == "failed" and result.meta.failure_reason.startswith("timeout")
     # stopped by the driver at the deadline: what it recorded is kept, marked partial
-    assert result.meta["partial"] is True and result.meta["partial_samples"] == len(result.frame) > 0
+    assert result.meta.partial is True and result.meta.partial_samples == len(result.frame) > 0
     assert not list(tmp_path.glob("*.part"))
 
 
@@ -391,10 +391,10 @@ def test_partial_output_is_not_a_result(tmp_path):
     data = npz.read_bytes()
     npz.write_bytes(data[: len(data) // 2])
     parsed = yade_backend._parse(model, npz, None, tmp_path / "ok.yade.log", 1.0, None)
-    assert parsed.status == "failed" and "unreadable" in parsed.meta["failure_reason"]
+    assert parsed.status == "failed" and "unreadable" in parsed.meta.failure_reason
     npz.unlink()
     missing = yade_backend._parse(model, npz, None, tmp_path / "ok.yade.log", 1.0, None)
-    assert missing.status == "failed" and "no output" in missing.meta["failure_reason"]
+    assert missing.status == "failed" and "no output" in missing.meta.failure_reason
 
 
 def test_parallel_runs_do_not_interfere():
@@ -416,7 +416,7 @@ def test_cli_run_yade_keeps_log_beside_result(tmp_path, capsys):
     out = tmp_path / "r.csv"
     assert main(["run", str(EXAMPLES / "specimen3_free.toml"), "--solver", "yade", "--out", str(out)]) == 0
     result = Result.read(out)
-    assert result.meta["solver"] == "yade" and result.meta["version"].startswith("YADE 2023")
+    assert result.meta.solver == "yade" and result.meta.version.startswith("YADE 2023")
     assert (tmp_path / "r.yade.log").is_file() and (tmp_path / "r.yade.json").is_file()
     assert "c0_fn_N" in result.frame.columns
 
@@ -481,7 +481,7 @@ def test_cli_run_yade_with_relative_paths(tmp_path, monkeypatch, capsys):
     _short_scene_file(tmp_path)
     monkeypatch.chdir(tmp_path)
     assert main(["run", "s3.json", "--solver", "yade", "--out", "sub/x.csv"]) == 0
-    assert Result.read(Path("sub/x.csv")).meta["solver"] == "yade"
+    assert Result.read(Path("sub/x.csv")).meta.solver == "yade"
     assert Path("sub/x.yade.log").is_file() and Path("sub/x.yade.json").is_file()
 
 
@@ -538,7 +538,7 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "timeout: YADE did not finish within 2 s" in out
     kept = Result.read(Path("t/long.csv"))
-    assert kept.status == "failed" and kept.meta["partial"] is True and len(kept.frame) > 0
+    assert kept.status == "failed" and kept.meta.partial is True and len(kept.frame) > 0
     # the scene was stopped: its warm YADE waits idle for the next one, and quits when asked
     from rockyade.yade.worker import QUIT_WAIT_S, close_workers
 
@@ -566,7 +566,7 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
     assert Result.read(Path("r/long.csv")).status == "completed"
     failed = Result.read(Path("r/long_failed.csv"))
-    assert failed.status == "failed" and failed.meta["partial"] is True
+    assert failed.status == "failed" and failed.meta.partial is True
     # a failed result is not worth keeping over another failed one
     assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "2"]) == 1
     assert not Path("r/long_failed_failed.csv").exists()
@@ -591,9 +591,9 @@ def test_a_failed_yade_run_never_touches_a_complete_runs_files(tmp_path, monkeyp
     capsys.readouterr()
     assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
     complete = Result.read(Path("r/x.csv"))
-    assert complete.status == "completed" and Path(complete.meta["log_path"]).name == "x.yade.log"
+    assert complete.status == "completed" and Path(complete.meta.log_path).name == "x.yade.log"
     failed = Result.read(Path("r/x_failed.csv"))
-    assert failed.status == "failed" and Path(failed.meta["log_path"]).name == "x_failed.yade.log"
+    assert failed.status == "failed" and Path(failed.meta.log_path).name == "x_failed.yade.log"
     assert Path("r/x_failed.yade.log").is_file() and not list(Path("r").glob("*.running.*"))
 
 

@@ -239,7 +239,7 @@ def test_flush_stack_is_one_joint_per_interface():
     scene = flush_stack(3)
     model = calibrated_model(scene)
     result = YadeSolver().run(scene)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     statics = _statics_end_forces(model)
     yade = _yade_end_forces(model, result)
     weights = np.array([b.mass_kg * G for b in model.bodies])
@@ -259,7 +259,7 @@ def test_frame_at_rest_splits_its_load_as_the_statics():
     scene = frame()
     model = calibrated_model(scene)
     result = YadeSolver().run(scene)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     statics = _statics_end_forces(model)
     yade = _yade_end_forces(model, result)
     np.testing.assert_allclose(yade, statics, rtol=0.02, atol=1e-3 * statics.max())
@@ -272,7 +272,7 @@ def test_pad_case_blocks_do_not_pass_through_each_other():
     scene = pad_case()
     model = calibrated_model(scene)
     result = YadeSolver().run(scene)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     worst = _max_overlap(model, result)
     assert worst < 1e-3
     assert np.max(np.abs(result.series("theta_rad", "top"))) > 0.15  # it did land on the bottom block
@@ -311,7 +311,7 @@ def test_fixed_pedestal_and_rest_rotation_are_the_base_and_no_rotation():
     on_pedestal = _column_pulse([_block("ped", 0.0, 0.0, 0.6, 0.2, fixed=True), _block("col", 0.0, 0.2, 0.25, 1.0)])
     turned = _column_pulse([_block("col", 0.125, 0.5, 1.0, 0.25, rotation_rad=math.pi / 2)])
     for r in (on_base, on_pedestal, turned):
-        assert r.ok, r.meta.get("failure_reason")
+        assert r.ok, r.meta.failure_reason
     theta = on_base.series("theta_rad")
     assert np.max(np.abs(theta)) > 0.5
     np.testing.assert_allclose(on_pedestal.series("theta_rad", "col"), theta, atol=1e-7)
@@ -325,8 +325,8 @@ def test_wall_beyond_30_blocks_stands():
     0.2 mm or turns more than 1e-3 rad."""
     scene = running_bond(courses=8, units=5, duration=0.2)
     result = YadeSolver().run(scene)
-    assert result.ok, result.meta.get("failure_reason")
-    names = result.meta["blocks"]
+    assert result.ok, result.meta.failure_reason
+    names = result.meta.blocks
     assert len(names) > N_LABELS
     for name in names:
         assert np.max(np.abs(result.series("x_m", name))) < 2e-4
@@ -362,7 +362,7 @@ def test_frame_rocks_like_one_column_with_p_hat():
     gamma = beam.mass_kg / sum(c.mass_kg for c in columns)
     p_hat = columns[0].p_rad_s * math.sqrt((1 + 2 * gamma) / (1 + 3 * gamma))
     result = YadeSolver().run(scene)
-    assert result.status in ("completed", "overturned"), result.meta.get("failure_reason")
+    assert result.status in ("completed", "overturned"), result.meta.failure_reason
     column = scene_from_dict(
         {
             "duration_s": scene.duration_s,
@@ -436,7 +436,7 @@ def _compare_with_reference(scene, names, alpha, floors):
     ref, ref_half = _dt_halved(lambda m: reference.run_model(m, record_energy=False), model)
     yade, yade_half = _dt_halved(yade_backend.run_model, model)
     for r in (ref, ref_half, yade, yade_half):
-        assert r.ok, r.meta.get("failure_reason")
+        assert r.ok, r.meta.failure_reason
     mr, mr2, my, my2 = (_metrics(r, names, alpha) for r in (ref, ref_half, yade, yade_half))
     own = np.maximum(_own_change(mr, mr2), _own_change(my, my2))
     tol = np.maximum(floors, 1.5 * own)

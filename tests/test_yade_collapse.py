@@ -31,11 +31,11 @@ def test_a_collapsing_arch_ends_overturned_in_yade_as_in_the_reference_dem():
     scene = arch_scene(0.10, 20).with_changes(motion=parse_motion({"type": "rest"}), duration_s=1.5)
     reference = run(scene, "reference")
     yade = run(scene, "yade")
-    assert reference.meta["status"] == "overturned"
-    assert yade.meta["status"] == "overturned", yade.meta.get("failure_reason")
-    assert yade.meta["overturn_time_s"] == pytest.approx(reference.meta["overturn_time_s"], rel=0.03)
+    assert reference.meta.status == "overturned"
+    assert yade.meta.status == "overturned", yade.meta.failure_reason
+    assert yade.meta.overturn_time_s == pytest.approx(reference.meta.overturn_time_s, rel=0.03)
     assert len(yade.frame) > 100 and np.all(np.isfinite(yade.frame["t_s"]))
-    assert yade.t[-1] >= yade.meta["overturn_time_s"] - yade.meta["sample_dt_s"]
+    assert yade.t[-1] >= yade.meta.overturn_time_s - yade.meta.sample_dt_s
 
 
 def test_a_failed_yade_run_keeps_its_samples_marked_partial(tmp_path):
@@ -56,14 +56,14 @@ def test_a_failed_yade_run_keeps_its_samples_marked_partial(tmp_path):
         np.savez(fh, **{k: v[:half] for k, v in arrays.items()}, meta=np.array(json.dumps(meta)))
     parsed = yade_backend._parse(model, npz, None, tmp_path / "ok.yade.log", 1.0, None)
     assert parsed.status == "failed" and not parsed.ok
-    assert parsed.meta["partial"] is True and parsed.meta["partial_samples"] == half
-    assert "numerical instability" in parsed.meta["failure_reason"]
+    assert parsed.meta.partial is True and parsed.meta.partial_samples == half
+    assert "numerical instability" in parsed.meta.failure_reason
     assert len(parsed.frame) == half
     np.testing.assert_array_equal(parsed.series("theta_rad"), good.series("theta_rad")[:half])
     out = tmp_path / "failed.csv"
     parsed.write(out)
     back = Result.read(out)
-    assert back.status == "failed" and back.meta["partial"] is True and len(back.frame) == half
+    assert back.status == "failed" and back.meta.partial is True and len(back.frame) == half
 
     from rockyade.batch import summary
 

@@ -60,13 +60,13 @@ def test_spinning_block_has_a_continuous_rotation(spin_rad_s, sample_dt_s):
     pos0[0, 1] += 10.0  # falls 4.9 m in 1 s: never lands
     model = replace(model, pos0_m=pos0, angvel0_rad_s=np.array([spin_rad_s]), stop_on_overturn=False)
     y, r = yade_backend.run_model(model), reference.run_model(model)
-    assert y.ok, y.meta.get("failure_reason")
+    assert y.ok, y.meta.failure_reason
     expected = spin_rad_s * y.t
     theta = y.series("theta_rad")
     assert theta[-1] > 3 * math.pi
     np.testing.assert_allclose(theta, expected, atol=1e-6 * spin_rad_s)
     np.testing.assert_allclose(theta, r.series("theta_rad"), atol=1e-6 * spin_rad_s)
-    assert y.meta["max_rotation_step_rad"] < math.pi
+    assert y.meta.extra["max_rotation_step_rad"] < math.pi
 
 
 # ------------------------------------------------------------------ contacts and slip
@@ -89,7 +89,7 @@ def test_sliding_slab_slips_in_yade_as_in_the_reference():
     start of the plateau its two base corners slip, in YADE as in the reference DEM."""
     scene = _slab({"type": "sampled", "t_s": [0.0, 0.05, 2.0], "accel_m_s2": [0.0, 3.0, 3.0]})
     y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
-    assert y.ok, y.meta.get("failure_reason")
+    assert y.ok, y.meta.failure_reason
     for column in ("n_contacts", "slipping"):
         assert y.frame[column].dtype == r.frame[column].dtype
     late = y.t > 0.2
@@ -105,7 +105,7 @@ def test_slab_at_rest_does_not_slip():
     always on, or always off, fails one of these two tests)."""
     scene = _slab({"type": "rest"})
     y = YadeSolver().run(scene)
-    assert y.ok, y.meta.get("failure_reason")
+    assert y.ok, y.meta.failure_reason
     assert not y.frame["slipping"].any()
     # YADE's contacts at a sample are those of the step before (none at t = 0)
     assert y.frame["n_contacts"].iloc[0] == 0
@@ -120,7 +120,7 @@ def test_drums_of_a_rocking_column_slide_as_briefly_as_in_the_reference():
     data.update(duration_s=3.0, motion={"type": "pulse", "shape": "sine", "amplitude_g": 0.25, "period_s": 1.0})
     scene = scene_from_dict(data)
     y, r = YadeSolver().run(scene), ReferenceSolver().run(scene)
-    assert y.ok, y.meta.get("failure_reason")
+    assert y.ok, y.meta.failure_reason
     ry, rr = (collapse_report(scene, x).set_index("block") for x in (y, r))
     top_y, top_r = ry.loc["d08", "sliding_time_s"], rr.loc["d08", "sliding_time_s"]
     assert max(top_y, top_r) < 0.5

@@ -49,10 +49,10 @@ def _serving() -> set[int]:
 
 
 def _same(a, b) -> None:
-    assert a.ok and b.ok, (a.meta.get("failure_reason"), b.meta.get("failure_reason"))
+    assert a.ok and b.ok, (a.meta.failure_reason, b.meta.failure_reason)
     assert a.frame.equals(b.frame)  # bit for bit
     for key in ("status", "overturn_time_s", "iterations", "dt_s", "overturn_times_s"):
-        assert a.meta.get(key) == b.meta.get(key), key
+        assert a.meta.to_dict().get(key) == b.meta.to_dict().get(key), key
 
 
 def test_a_warm_worker_gives_the_results_of_one_process_per_run_bit_for_bit():
@@ -86,8 +86,8 @@ def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypa
     monkeypatch.setattr(yade_backend, "scene_payload", broken)
     bad = YadeSolver(workdir=tmp_path, stem="bad").run(good)
     monkeypatch.undo()
-    assert bad.status == "failed" and "exited with code 1" in bad.meta["failure_reason"]
-    assert "KeyError" in bad.meta["failure_reason"] and "Traceback" in (tmp_path / "bad.yade.log").read_text()
+    assert bad.status == "failed" and "exited with code 1" in bad.meta.failure_reason
+    assert "KeyError" in bad.meta.failure_reason and "Traceback" in (tmp_path / "bad.yade.log").read_text()
     _same(YadeSolver().run(good), reference)  # a fresh worker takes the next scene
 
     # a crash: the worker killed by a signal in the middle of a scene
@@ -104,7 +104,7 @@ def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypa
     os.kill(victim, signal.SIGSEGV)
     thread.join(60)
     crashed = holder["r"]
-    assert crashed.status == "failed" and "exited with code -11" in crashed.meta["failure_reason"]
+    assert crashed.status == "failed" and "exited with code -11" in crashed.meta.failure_reason
     assert not alive(victim)
     _same(YadeSolver().run(good), reference)
 
@@ -122,10 +122,10 @@ def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tm
     slow = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(long)
     assert time.monotonic() - start < 20
     assert slow.status == "failed" and not slow.ok
-    assert slow.meta["failure_reason"].startswith("timeout: YADE did not finish within 2 s")
-    n = slow.meta["partial_samples"]
-    assert slow.meta["partial"] is True and 0 < n == len(slow.frame) < calibrated_model(long).n_samples
-    assert slow.meta["overturn_time_s"] is None
+    assert slow.meta.failure_reason.startswith("timeout: YADE did not finish within 2 s")
+    n = slow.meta.partial_samples
+    assert slow.meta.partial is True and 0 < n == len(slow.frame) < calibrated_model(long).n_samples
+    assert slow.meta.overturn_time_s is None
     assert not list(tmp_path.glob("*.part"))
     complete = YadeSolver(warm=False).run(_scene("specimen1_free.toml", 1.0, sample_dt_s=0.01))
     m = min(n, len(complete.frame))
@@ -133,7 +133,7 @@ def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tm
         assert np.array_equal(slow.frame[column].to_numpy()[:m], complete.frame[column].to_numpy()[:m]), column
     slow.write(tmp_path / "slow.csv")
     back = Result.read(tmp_path / "slow.csv")
-    assert back.status == "failed" and back.meta["partial"] is True and len(back.frame) == n
+    assert back.status == "failed" and back.meta.partial is True and len(back.frame) == n
     again = YadeSolver(timeout_s=30.0).run(short)  # the same worker, a fresh limit
     assert again.ok and _serving() == {pid}
 
@@ -159,9 +159,9 @@ def test_a_killed_yade_run_keeps_the_samples_it_flushed(tmp_path, monkeypatch):
     os.kill(victim, signal.SIGKILL)
     thread.join(60)
     killed = holder["r"]
-    assert killed.status == "failed" and "exited with code -9" in killed.meta["failure_reason"]
-    n = killed.meta["partial_samples"]
-    assert killed.meta["partial"] is True and 0 < n == len(killed.frame) < calibrated_model(long).n_samples
+    assert killed.status == "failed" and "exited with code -9" in killed.meta.failure_reason
+    n = killed.meta.partial_samples
+    assert killed.meta.partial is True and 0 < n == len(killed.frame) < calibrated_model(long).n_samples
     with np.load(npz, allow_pickle=False) as data:
         meta = json.loads(str(data["meta"]))
         assert meta["complete"] is False and meta["status"] == "running" and meta["n_filled"] == n
@@ -274,10 +274,10 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
         f"d = json.loads({json.dumps(d)!r})\ns = scene_from_dict(d)\n"
         "long = scene_from_dict({**d, 'duration_s': 3600.0, 'sample_dt_s': 0.01})\n"
         "r = YadeSolver(timeout_s=0.01, workdir='/tmp/kept0').run(long)\n"  # shorter than YADE's start-up
-        "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
+        "assert r.meta.failure_reason.startswith('timeout'), r.meta\n"
         "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
         "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(long)\n"
-        "assert r.meta['failure_reason'].startswith('timeout'), r.meta\n"
+        "assert r.meta.failure_reason.startswith('timeout'), r.meta\n"
     )
     # a checkout or a virtual environment under /tmp (a fresh clone in /tmp/fresh) stays
     # visible: the old /tmp is bound to /var/tmp (in this mount namespace only) and those

@@ -120,7 +120,7 @@ def block_geometry(scene: Scene, result: Result) -> list[BlockGeometry]:
         The scene that produced ``result`` (its blocks, bottom to top).
     result
         The run's Result (any solver)."""
-    bodies = result.meta.get("bodies") or {}
+    bodies = result.meta.bodies or {}
     out = []
     for spec in scene.blocks:
         if spec.fixed:
@@ -319,11 +319,11 @@ def block_fall_of(g: BlockGeometry, result: Result, columns: _Columns | None = N
 
 def _solver_fall_time(result: Result, name: str) -> float | None:
     """When the solver found the block lying on another face (between samples), s."""
-    if "overturn_times_s" in result.meta:  # both DEMs: per block
-        times = result.meta["overturn_times_s"] or {}
+    if result.meta.overturn_times_s is not None:  # both DEMs: per block
+        times = result.meta.overturn_times_s or {}
         return float(times[name]) if name in times else None
-    if result.meta.get("overturned_block") == name and result.meta.get("overturn_time_s") is not None:
-        return float(result.meta["overturn_time_s"])
+    if result.meta.overturned_block == name and result.meta.overturn_time_s is not None:
+        return float(result.meta.overturn_time_s)
     return None
 
 

@@ -36,9 +36,10 @@ def _metrics(scene: Scene, result: Result, block: str, alpha: float) -> dict[str
         out[f"peak{k + 1}_time_s"] = float(peaks.t_s[k]) if k < len(peaks) else math.nan
     out["mu_eff"] = effective_restitution(peaks, alpha, MU_EFF_IMPACTS) if scene.motion.type == "free" else math.nan
     out["max_abs_theta_rad"] = float(np.nanmax(np.abs(theta))) if theta.size else math.nan
-    overturned = result.status == "overturned" and result.meta.get("overturned_block") == block
+    overturned = result.status == "overturned" and result.meta.overturned_block == block
     out["overturned"] = float(overturned)
-    out["overturn_time_s"] = float(result.meta["overturn_time_s"]) if overturned else math.nan
+    when = result.meta.overturn_time_s
+    out["overturn_time_s"] = float(when) if overturned and when is not None else math.nan
     return out
 
 

@@ -13,6 +13,7 @@ from numpy.typing import NDArray
 
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.result import Result
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 
 if TYPE_CHECKING:
@@ -118,11 +119,11 @@ def block_summary(
     return {k: values[k] for k in SUMMARY_KEYS}
 
 
-def block_overturned(meta: Mapping[str, Any], block: str) -> bool:
+def block_overturned(meta: RunMeta, block: str) -> bool:
     """Whether ``block`` overturned in a run with metadata ``meta`` (the solvers'
     ``overturned_block``, the first to fall, and ``overturn_times_s``, every block that fell;
     :mod:`rockyade.dem.overturn`)."""
-    return meta.get("overturned_block") == block or block in (meta.get("overturn_times_s") or {})
+    return meta.overturned_block == block or block in (meta.overturn_times_s or {})
 
 
 def uplift_threshold_rad(alpha_rad: float) -> float:
@@ -320,7 +321,7 @@ def structure_rotation(scene: Scene, result: Result) -> dict[str, float | str]:
     from rockyade.scene.placement import placed_blocks
 
     placed = {b.name: b for b in placed_blocks(scene)}
-    bodies = result.meta.get("bodies") or {}
+    bodies = result.meta.bodies or {}
     specs = {spec.name: spec for spec in scene.blocks}
     mass = np.array([float(bodies[n]["mass_kg"]) if n in bodies else specs[n].block().mass_kg for n in order])
     rest = np.array([placed[n].centroid_m for n in order])

@@ -52,7 +52,7 @@ def polygons_at(result: Result, k: int) -> dict[str, np.ndarray]:
         Body name -> (n, 2) vertices, m.
     """
     out = {}
-    for name, body in result.meta["bodies"].items():
+    for name, body in (result.meta.bodies or {}).items():
         verts = np.asarray(body["contact_vertices_m"], dtype=float)
         rest = np.asarray(body["rest_centroid_m"], dtype=float)
         if body.get("fixed"):

@@ -152,7 +152,7 @@ def classify_result(scene: Scene, result: Result) -> PatternReport:
         span = (phases["ramp_up_end_s"], min(phases["stationary_end_s"], float(result.t[-1])))
     overturned = None
     if result.status == "overturned":
-        overturned = "lower" if result.meta.get("overturned_block") == lower.name else "upper"
+        overturned = "lower" if result.meta.overturned_block == lower.name else "upper"
     return classify(
         result.t,
         result.series("theta_rad", lower.name),

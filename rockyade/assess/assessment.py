@@ -48,7 +48,6 @@ from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, RecordFiles, ec8_suite
 from rockyade.assess.pushover import PushoverCheck, run_pushover
 from rockyade.assess.site import AnySite, Position, Site
-from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
@@ -58,6 +57,7 @@ from rockyade.assess.stripes import (
 )
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError, SolverFailedError
+from rockyade.io.strict_json import finite_or_null
 from rockyade.limit import DEFAULT_FC, LimitResult, limit_analysis
 from rockyade.runner import Executor
 from rockyade.scene import Scene

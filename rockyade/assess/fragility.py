@@ -33,7 +33,6 @@ import pandas as pd
 from rockyade.assess.fit import StripeFit, fit_stripes, stripe_table
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
-from rockyade.assess.strict import finite_or_null
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
@@ -46,6 +45,7 @@ from rockyade.assess.stripes import (
 )
 from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import BatchInterruptedError, InputError, RockyadeError
+from rockyade.io.strict_json import finite_or_null
 from rockyade.runner import Executor
 from rockyade.runner.journal import Journal
 from rockyade.scene import Scene

@@ -192,7 +192,7 @@ def run_stripe_task(task: StripeTask) -> dict[str, Any]:
     a failed run is a row with status ``failed`` and the reason."""
     start = time.perf_counter()
     result = solve(task)
-    row = _row(task, result.status, str(result.meta.get("failure_reason") or ""))
+    row = _row(task, result.status, str(result.meta.failure_reason or ""))
     row["wall_time_s"] = time.perf_counter() - start
     if result.ok:
         try:
@@ -439,7 +439,7 @@ def run_stripe_job(job: tuple[StripeTask, ...]) -> list[dict[str, Any]]:
     elapsed = (time.perf_counter() - start) / len(job)
     rows = []
     for task, one in zip(job, runs, strict=True):
-        row = _row(task, one.status, str(one.meta.get("failure_reason") or ""))
+        row = _row(task, one.status, str(one.meta.failure_reason or ""))
         row["wall_time_s"] = elapsed
         if one.status != "failed":
             theta = one.theta_rad[np.isfinite(one.theta_rad)]

@@ -56,7 +56,7 @@ from rockyade.io.locking import lock_token, output_lock, writing_for
 from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
 from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
 from rockyade.runner.groups import group_jobs
-from rockyade.runner.journal import claim, write_run
+from rockyade.runner.journal import claim, marked_record, write_run
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import GroupSolver, Solver
@@ -196,9 +196,9 @@ def _run_task(task: BatchTask, out: Output) -> dict[str, Any]:
     row["elapsed_s"] = time.perf_counter() - start
     try:
         if task.save_history and result.ok:
-            result.write(runs / f"{name}.csv", {"summary": row})  # the JSON, last, marks it complete
+            result.write(runs / f"{name}.csv", marked_record({"summary": row}))  # the JSON, last, marks it complete
         else:
-            write_run(runs, name, {**result.meta, "summary": row})
+            write_run(runs, name, {**result.meta.to_dict(), "summary": row})
     except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
         row = write_failure_row(task, row, exc)
     return row
@@ -251,7 +251,7 @@ def _run_group(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
             row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned))
         row["elapsed_s"] = elapsed
         try:
-            write_run(folder, row["run"], {**one.meta, "summary": row})
+            write_run(folder, row["run"], {**one.meta.to_dict(), "summary": row})
         except OSError as exc:
             row = write_failure_row(task, row, exc)
         rows.append(row)

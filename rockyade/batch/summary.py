@@ -18,6 +18,7 @@ import pandas as pd
 
 from rockyade.errors import os_error_message
 from rockyade.io.resultset import replacing_set
+from rockyade.run_meta import RunMeta
 from rockyade.runner import Task
 from rockyade.runner.journal import read_run
 
@@ -53,7 +54,7 @@ def task_run_name(task: Task) -> str:
 
 def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
     """The summary's columns of how much of the base motion a run leaves out
-    (``meta["motion_coverage"]``, :func:`rockyade.motion.coverage.record_coverage`): the time
+    (``meta.motion_coverage``, :func:`rockyade.motion.coverage.record_coverage`): the time
     after the scene's end, s, and the fraction of the motion's PGA the run never sees (0 when
     the run covers the motion; no columns without a base motion)."""
     if not coverage or "pga_left_out_fraction" not in coverage:
@@ -64,20 +65,20 @@ def coverage_columns(coverage: Mapping[str, Any] | None) -> dict[str, Any]:
     }
 
 
-def status_row(task: Task, meta: Mapping[str, Any]) -> dict[str, Any]:
+def status_row(task: Task, meta: RunMeta) -> dict[str, Any]:
     """The row's leading and status columns of a run from its Result's metadata."""
     return {
         "index": task.index,
         "run": task_run_name(task),
-        "scene_hash": meta.get("scene_hash"),
+        "scene_hash": meta.scene_hash,
         "solver": task.solver.name,
         **task.labels,
-        "status": meta["status"],
-        "failure_reason": meta.get("failure_reason") or "",
-        "overturn_time_s": meta.get("overturn_time_s"),
-        "overturned_block": meta.get("overturned_block") or "",
-        "wall_time_s": meta.get("wall_time_s"),
-        **coverage_columns(meta.get("motion_coverage")),
+        "status": meta.status,
+        "failure_reason": meta.failure_reason or "",
+        "overturn_time_s": meta.overturn_time_s,
+        "overturned_block": meta.overturned_block or "",
+        "wall_time_s": meta.wall_time_s,
+        **coverage_columns(meta.motion_coverage),
     }
 
 

@@ -660,7 +660,7 @@ def cmd_draw(args: argparse.Namespace) -> int:
     note = f" ({skipped} block names too small to print)" if skipped and not args.no_labels else ""
     print(f"wrote {out}{note}")
     if result is not None:
-        if result.meta.get("scene_hash") not in (None, scene.scene_hash):
+        if result.meta.scene_hash not in (None, scene.scene_hash):
             print(f"note: {args.result} was computed from another version of this scene (scene hash differs)")
         write_run_drawings(args, scene, result, out)
     return 0

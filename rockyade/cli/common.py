@@ -25,7 +25,7 @@ def json_out(data: object) -> None:
     data
         JSON-ready values (dicts, lists, numbers, strings, numpy scalars and arrays).
     """
-    from rockyade.io.atomic import json_text
+    from rockyade.io.strict_json import json_text
 
     print(json_text(data))
 

@@ -131,12 +131,12 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, repo
     from rockyade.blocks.restitution import MU_EFF_IMPACTS
 
     meta = result.meta
-    wall = meta.get("wall_time_s", math.nan)
-    print(f"solver {meta['solver']}: status {result.status}, wall time {wall:.3g} s (solver), {total_s:.3g} s (total)")
+    wall = meta.wall_time_s if meta.wall_time_s is not None else math.nan
+    print(f"solver {meta.solver}: status {result.status}, wall time {wall:.3g} s (solver), {total_s:.3g} s (total)")
     if not result.ok:
-        print(f"  failure: {meta.get('failure_reason')}")
-        if meta.get("log_path"):
-            print(f"  log: {meta['log_path']}")
+        print(f"  failure: {meta.failure_reason}")
+        if meta.log_path:
+            print(f"  log: {meta.log_path}")
         return
     if scene.positioned:
         a = assembly_metrics(scene, result, report)
@@ -167,7 +167,7 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, repo
             line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, MU_EFF_IMPACTS)} impacts"
         print(line)
     if result.status == "overturned" and not scene.positioned:
-        print(f"  overturned at t = {meta['overturn_time_s']:.4g} s ({meta.get('overturned_block')})")
+        print(f"  overturned at t = {meta.overturn_time_s:.4g} s ({meta.overturned_block})")
 
 
 def _print_structure(m: dict[str, Any], result: Any, scene: Any) -> None:

@@ -51,8 +51,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
             result = solver.keeping_files(out, stem).run(scene)  # YADE's files: <out>/<stem>.yade.*
             result.write(out / f"{stem}_{solver.name}.csv")
             results[solver.name] = result
-            status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
-            print(f"{solver.name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
+            status = result.status if result.ok else f"failed ({result.meta.failure_reason})"
+            wall = result.meta.wall_time_s if result.meta.wall_time_s is not None else float("nan")
+            print(f"{solver.name}: {status}, wall time {wall:.3g} s")
         halved = {}
         for solver in finer:
             result = solver.keeping_files(out, f"{stem}_halfdt").run(scene)

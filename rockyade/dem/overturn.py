@@ -145,7 +145,7 @@ def block_fall(
         Its height, m.
     t_landed_s
         When the solver found it lying on another face between samples
-        (``meta["overturn_times_s"]``), s; a run that stops there ends before a sample shows it.
+        (``meta.overturn_times_s``), s; a run that stops there ends before a sample shows it.
 
     Returns
     -------

@@ -405,7 +405,7 @@ def draw_snapshots(
     norm = Normalize(0.0, _rotation_norm(placed, result, indices))
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
-    solver = result.meta.get("solver", "")
+    solver = result.meta.solver
     heading = title or (_title(scene, None) + (f" ({solver})" if solver else ""))
     if scale != 1.0:
         heading += f"; vertex displacements x{scale:g}"

@@ -72,7 +72,7 @@ class HistoryDisplay:
         ax, path, title
             As for :meth:`plot`.
         """
-        name = label or str(result.meta.get("solver", "result"))
+        name = label or str(result.meta.solver or "result")
         return cls({name: result}, quantity).plot(ax, path=path, title=title)
 
     @classmethod
@@ -217,7 +217,7 @@ def plot_results(
         The figure and its Axes (a list of Axes, bottom block first, when there are several).
     """
     if isinstance(results, Result):
-        results = {str(results.meta.get("solver", "result")): results}
+        results = {str(results.meta.solver or "result"): results}
     display = HistoryDisplay.from_results(results, quantity=quantity, ax=ax, path=path, title=title)
     assert display.figure_ is not None and display.ax_ is not None
     return display.figure_, display.ax_

@@ -17,12 +17,13 @@ from __future__ import annotations
 
 import contextlib
 import errno
-import json
 import os
 import secrets
 from collections.abc import Iterator
 from pathlib import Path
 from typing import IO, Any
+
+from rockyade.io.strict_json import json_text
 
 #: Suffix of every temporary file written here.
 TEMP_SUFFIX = ".tmp"
@@ -163,25 +164,6 @@ def write_text(path: str | os.PathLike[str], text: str, durable: bool = True) ->
 
 
 def write_json(path: str | os.PathLike[str], data: Any, durable: bool = True) -> None:
-    """Write ``data`` as indented JSON to ``path`` atomically (``durable``: see :func:`atomic_open`)."""
+    """Write ``data`` as indented strict JSON (:func:`rockyade.io.strict_json.json_text`: NaN and
+    infinity as null) to ``path`` atomically (``durable``: see :func:`atomic_open`)."""
     write_text(path, json_text(data) + "\n", durable)
-
-
-def json_text(data: Any) -> str:
-    """Indented, sorted JSON of ``data`` (numpy values converted), as the CLI prints it."""
-    return json.dumps(data, indent=2, sort_keys=True, default=_json_default)
-
-
-def _json_default(obj: Any) -> Any:
-    """Convert numpy scalars and arrays for JSON."""
-    import numpy as np
-
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, np.floating):
-        return float(obj)
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, Path):
-        return str(obj)
-    raise TypeError(f"cannot serialise {type(obj).__name__} to JSON")

@@ -27,6 +27,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from rockyade.errors import InputError
 from rockyade.io.atomic import json_text, remove_stale_temporaries, write_json
 
@@ -48,12 +50,60 @@ def write_run(folder: str | Path, name: str, record: Mapping[str, Any], durable:
     record
         Its metadata: ``status``, ``scene_hash`` and ``summary`` (the row) at least.
     """
-    write_json(Path(folder) / f"{name}.json", dict(record), durable=durable)
+    write_json(Path(folder) / f"{name}.json", marked_record(record), durable=durable)
+
+
+#: The key of a record that names the row's numbers that were not finite (strict JSON has
+#: them as null): row key -> ``"nan"``, ``"inf"`` or ``"-inf"``.
+NOT_FINITE_KEY = "summary_not_finite"
+
+
+def marked_record(record: Mapping[str, Any]) -> dict[str, Any]:
+    """``record`` with :data:`NOT_FINITE_KEY` when its ``summary`` row has numbers that are not
+    finite (:func:`write_run` writes it so; a run's Result that carries its row is written so).
+
+    Parameters
+    ----------
+    record
+        A run's record (its ``summary``: the row).
+    """
+    out = dict(record)
+    summary = out.get("summary")
+    if isinstance(summary, Mapping):
+        odd = {
+            k: repr(float(v)) for k, v in summary.items() if isinstance(v, float | np.floating) and not np.isfinite(v)
+        }
+        if odd:
+            out[NOT_FINITE_KEY] = odd
+    return out
+
+
+def summary_row(record: Mapping[str, Any]) -> dict[str, Any]:
+    """The summary row of a run's record as it was written: a record is strict JSON
+    (:mod:`rockyade.io.strict_json`: NaN and infinity as null), and the record names which of
+    the row's nulls were NaN or infinite (:data:`NOT_FINITE_KEY`); a null it does not name was
+    None (a record written before it named them: its NaN tokens read back as NaN).
+
+    Parameters
+    ----------
+    record
+        The record as read (with a ``summary`` mapping).
+    """
+    row = dict(record["summary"])
+    odd = record.get(NOT_FINITE_KEY)
+    if isinstance(odd, Mapping):
+        for key, text in odd.items():
+            if key in row and row[key] is None and text in ("nan", "inf", "-inf"):
+                row[key] = float(text)
+    return row
 
 
 def read_run(folder: str | Path, name: str, scene_hash: str) -> dict[str, Any] | None:
     """The summary row of run ``name`` if its record says it completed (or overturned) for
     ``scene_hash``; None otherwise (no record, unreadable, failed, another scene).
+
+    The row reads back as it was written (:func:`summary_row`: its numbers that were not
+    finite, written as null, are NaN or infinite again).
 
     Parameters
     ----------
@@ -74,7 +124,7 @@ def read_run(folder: str | Path, name: str, scene_hash: str) -> dict[str, Any] |
     if not isinstance(data, dict) or not isinstance(data.get("summary"), dict):
         return None
     if data.get("status") in KEPT_STATUSES and data.get("scene_hash") == scene_hash:
-        return dict(data["summary"])
+        return summary_row(data)
     return None
 
 
@@ -185,4 +235,14 @@ def _differences(earlier: Any, now: Mapping[str, Any]) -> str:
     return shown or "unknown"
 
 
-__all__ = ["IDENTITY_FILE", "KEPT_STATUSES", "Journal", "claim", "read_run", "write_run"]
+__all__ = [
+    "IDENTITY_FILE",
+    "KEPT_STATUSES",
+    "NOT_FINITE_KEY",
+    "Journal",
+    "claim",
+    "marked_record",
+    "read_run",
+    "summary_row",
+    "write_run",
+]

@@ -15,6 +15,7 @@ the samples recorded up to there (``partial: true``): never one that looks compl
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import os
 import shutil
@@ -29,11 +30,13 @@ from rockyade import __version__
 from rockyade.dem.frames import energy_gain, worker_frame
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
 from rockyade.io.worker import Program, run_scene
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
+from rockyade.run_meta import RunMeta
 from rockyade.siconos.calibration import model_restitution
 from rockyade.siconos.payload import Numerics, scene_payload
 
@@ -179,9 +182,9 @@ def _last_error_line(log_file: Path) -> str:
     return ""
 
 
-def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
+def _read_output(out_file: Path) -> tuple[WorkerOutput, dict[str, np.ndarray]]:
     with np.load(out_file, allow_pickle=False) as data:
-        meta = json.loads(str(data["meta"]))
+        meta = WorkerOutput.from_json(str(data["meta"]))
         arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
     return meta, arrays
 
@@ -215,30 +218,28 @@ def _parse(
     problem = _output_problem(model, meta, arrays)
     if problem is not None:
         return _partial_failure(model, numerics, meta, arrays, problem, total, extra)
-    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, numerics, meta, total, extra, arrays))
+    return Result(
+        worker_frame(model, arrays, lowpass), RunMeta.from_dict(_run_meta(model, numerics, meta, total, extra, arrays))
+    )
 
 
-def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
+def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result, or None."""
-    n = int(meta.get("n_filled", 0))
-    if not meta.get("complete") or arrays["pos"].shape[0] != n:
+    n = meta.n_filled
+    if not meta.complete or arrays["pos"].shape[0] != n:
         return "partial Siconos output"
-    status = meta["status"]
+    status = meta.status
     if status == "completed" and n != model.n_samples:
         return f"Siconos stopped early: {n} of {model.n_samples} samples"
     if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
-        return (
-            f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s (non-finite state or runaway speed)"
-        )
-    calls = int(meta.get("solver_calls", 0))
-    bad = int(meta.get("unconverged_steps", 0))
-    if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (
-        bad >= FAIL_UNCONVERGED_MIN and bad > FAIL_UNCONVERGED_FRACTION * calls
-    ):
+        return f"numerical instability in Siconos at t = {meta.stop_time_s} s (non-finite state or runaway speed)"
+    calls = meta.solver_calls
+    bad = meta.unconverged_steps
+    if meta.max_residual > FAIL_RESIDUAL or (bad >= FAIL_UNCONVERGED_MIN and bad > FAIL_UNCONVERGED_FRACTION * calls):
         return (
             f"Siconos did not converge: {bad} of {calls} friction-contact solves ended above the tolerance "
-            f"(largest residual {float(meta.get('max_residual', 0.0)):.3g}, "
-            f"first at t = {meta.get('first_unconverged_s')} s); "
+            f"(largest residual {meta.max_residual:.3g}, "
+            f"first at t = {meta.first_unconverged_s} s); "
             "try a smaller dt_factor or more solver iterations"
         )
     gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
@@ -249,14 +250,22 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
     return None
 
 
-def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Result:
+def _partial_failure(
+    model: DemModel,
+    numerics: Numerics,
+    meta: WorkerOutput,
+    arrays: dict[str, np.ndarray],
+    reason: str,
+    total: float,
+    extra: dict[str, object],
+) -> Result:
     """A failed run that keeps what it recorded: status ``failed``, ``partial: true``."""
-    n = min(int(meta.get("n_filled", 0)), arrays["pos"].shape[0])
+    n = min(meta.n_filled, arrays["pos"].shape[0])
     if n == 0:
         return failed_result("siconos", model.scene_hash, reason, partial=True, wall_time_s=total, **extra)
     arrays = {k: v[:n] for k, v in arrays.items()}
     frame = worker_frame(model, arrays, None)
-    out = _run_meta(model, numerics, {**meta, "status": "failed"}, total, extra, arrays)
+    out = _run_meta(model, numerics, dataclasses.replace(meta, status="failed"), total, extra, arrays)
     out.update(
         status="failed",
         failure_reason=reason,
@@ -265,27 +274,34 @@ def _partial_failure(model, numerics, meta, arrays, reason, total, extra) -> Res
         partial=True,
         partial_samples=n,
     )
-    return Result(frame, out)
+    return Result(frame, RunMeta.from_dict(out))
 
 
-def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
+def _run_meta(
+    model: DemModel,
+    numerics: Numerics,
+    meta: WorkerOutput,
+    total: float,
+    extra: dict[str, object],
+    arrays: dict[str, np.ndarray],
+) -> dict[str, object]:
     """The Result's metadata: how the run ended, what ran, and Siconos's own diagnostics."""
     names = model.names
-    status = meta["status"]
-    overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
-    overturn_time = meta["stop_time_s"] if status == "overturned" else None
-    overturned_block = names[meta["stop_body"]] if status == "overturned" else None
+    status = meta.status
+    overturn_times = {names[int(i)]: t for i, t in meta.overturn_times_s.items()}
+    overturn_time = meta.stop_time_s if status == "overturned" else None
+    overturned_block = names[meta.stop_body] if status == "overturned" and meta.stop_body is not None else None
     if not model.stop_on_overturn and status == "completed":
         t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
         falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
         status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
-    calls = int(meta.get("solver_calls", 0))
+    calls = meta.solver_calls
     return {
         "solver": "siconos",
-        "version": f"Siconos {meta.get('siconos_version')} (rockyade {__version__} driver)",
+        "version": f"Siconos {meta.version} (rockyade {__version__} driver)",
         "scene_hash": model.scene_hash,
-        "wall_time_s": meta["wall_time_s"],
-        "startup_time_s": total - meta["wall_time_s"],
+        "wall_time_s": meta.wall_time_s,
+        "startup_time_s": total - meta.wall_time_s if meta.wall_time_s is not None else None,
         "status": status,
         "overturn_time_s": overturn_time,
         "overturned_block": overturned_block,
@@ -294,19 +310,19 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
         "blocks": names,
         "sample_dt_s": model.sample_dt_s,
         "duration_s": model.duration_s,
-        "n_steps": int(meta.get("steps", 0)),
-        "iterations": int(meta.get("steps", 0)),
+        "n_steps": meta.steps,
+        "iterations": meta.steps,
         "solver_calls": calls,
-        "solver_iterations": int(meta.get("solver_iterations", 0)),
-        "solver_iterations_mean": (int(meta.get("solver_iterations", 0)) / calls) if calls else 0.0,
-        "unconverged_steps": int(meta.get("unconverged_steps", 0)),
-        "max_solver_residual": float(meta.get("max_residual", 0.0)),
-        "max_penetration_m": float(meta.get("max_penetration_m", 0.0)),
-        "max_bullet_overlap_m": float(meta.get("max_bullet_overlap_m", 0.0)),
+        "solver_iterations": meta.solver_iterations,
+        "solver_iterations_mean": (meta.solver_iterations / calls) if calls else 0.0,
+        "unconverged_steps": meta.unconverged_steps,
+        "max_solver_residual": meta.max_residual,
+        "max_penetration_m": meta.max_penetration_m,
+        "max_bullet_overlap_m": meta.max_bullet_overlap_m,
         "calibration": "siconos (nonsmooth: Newton restitution e, Coulomb friction; geometry and inertia as the DEMs)",
         "mu_model": {b.name: model_restitution(b) for b in model.bodies if not b.fixed},
         "bodies": model.body_summary(),
         "motion": model.motion_label,
-        "process_cpu_s": meta.get("process_cpu_s"),
+        "process_cpu_s": meta.process_cpu_s,
         **extra,
     }

@@ -13,7 +13,7 @@ name (from a command line or a study file) and refuses one the solver does not t
 
 Every solver derived from :class:`SolverBase` goes through one place on its way out: its
 ``run`` is wrapped (:meth:`SolverBase.__init_subclass__`) so that every Result it returns,
-failed ones included, carries ``meta["motion_coverage"]``, how much of the scene's base
+failed ones included, carries ``meta.motion_coverage``, how much of the scene's base
 motion the run leaves out (:func:`motion_coverage`).
 
 A solver that runs scenes sharing one structure together (one model, many base motions) is
@@ -25,6 +25,7 @@ Batches and the overturning study ask ``isinstance(solver, GroupSolver)``.
 from __future__ import annotations
 
 import copy
+import dataclasses
 import functools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
@@ -34,6 +35,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkab
 import numpy as np
 
 from rockyade.errors import InputError, RockyadeError
+from rockyade.run_meta import RunMeta
 
 if TYPE_CHECKING:
     from rockyade.result import Result
@@ -84,7 +86,7 @@ class GroupRun:
         ``uplift_time_s`` (s, NaN: never).
     """
 
-    meta: dict[str, Any]
+    meta: RunMeta
     theta_rad: np.ndarray
     sample_dt_s: float
     metrics: dict[str, float]
@@ -92,7 +94,7 @@ class GroupRun:
     @property
     def status(self) -> str:
         """completed | overturned | failed."""
-        return str(self.meta["status"])
+        return self.meta.status
 
 
 @runtime_checkable
@@ -179,7 +181,7 @@ def _coverage(scene: Scene) -> dict[str, Any]:
 
 
 def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene], Result]:
-    """``run`` whose Result carries ``meta["motion_coverage"]``, refusing first a scene whose loads
+    """``run`` whose Result carries ``meta.motion_coverage``, refusing first a scene whose loads
     cannot be carried at rest (:func:`rockyade.limit.standing.check_loads_stand`: its blocks would
     leave their supports for good, and no solver's answer would mean anything)."""
 
@@ -190,8 +192,8 @@ def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene]
 
             check_loads_stand(scene)
         result = run(self, scene)
-        if "motion_coverage" not in result.meta:
-            result.meta["motion_coverage"] = motion_coverage(scene)
+        if result.meta.motion_coverage is None:
+            result.meta = dataclasses.replace(result.meta, motion_coverage=motion_coverage(scene))
         return result
 
     wrapper.records_coverage = True  # type: ignore[attr-defined]
@@ -203,7 +205,7 @@ class SolverBase:
 
     Subclasses are frozen dataclasses whose fields are their options, with ``name`` and
     ``OPTIONS`` (option -> :data:`OptionCheck`) as class attributes. The ``run`` a subclass
-    defines is wrapped so that its Results carry ``meta["motion_coverage"]`` and so that a scene
+    defines is wrapped so that its Results carry ``meta.motion_coverage`` and so that a scene
     whose loads cannot be carried at rest is refused before it runs, by every solver alike.
     """
 

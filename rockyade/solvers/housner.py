@@ -3,6 +3,7 @@ rigid base in, a Result out; runs sharing one model go together (:class:`~rockya
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import time
@@ -20,6 +21,7 @@ from rockyade.housner.integrator import REST_FRACTION, STEPS_PER_RADIAN, Traject
 from rockyade.housner.sdof import HousnerModel, housner_model
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
+from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage
 from rockyade.solvers.cost import CostEstimate, sample_cost
@@ -82,7 +84,7 @@ class HousnerSolver(SolverBase):
         )
         wall = time.perf_counter() - start
         frame = housner_frame(scene, spec.block(), model, motion, traj)
-        return Result(frame, {**_meta(scene, cp, motion, traj, wall), "dt_factor": self.dt_factor, "dt_s": traj.step_s})
+        return Result(frame, _meta(scene, cp, motion, traj, wall, self.dt_factor))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
@@ -148,16 +150,16 @@ class HousnerSolver(SolverBase):
                 self._step_s(model),
             )
             wall = time.perf_counter() - begin
-            meta = {**_meta(scene, cp, motion, traj, wall), "dt_factor": self.dt_factor, "dt_s": traj.step_s}
-            meta["rockyade_version"] = __version__  # as a Result sets it
-            meta["motion_coverage"] = _coverage(scene, motion)
-            meta["batched"] = {"runs": len(scenes), "setup_time_s": setup}
+            meta = _meta(scene, cp, motion, traj, wall, self.dt_factor).with_extra(
+                batched={"runs": len(scenes), "setup_time_s": setup}
+            )
+            meta = dataclasses.replace(meta, motion_coverage=_coverage(scene, motion))
             runs.append(GroupRun(meta, traj.theta_rad, scene.sample_dt_s, _theta_metrics(traj, uplift_rad)))
         return runs
 
 
 def _coverage(scene: Scene, motion: GroundMotion | None) -> dict:
-    """``meta["motion_coverage"]`` of a run from the base motion it ran
+    """``meta.motion_coverage`` of a run from the base motion it ran
     (:func:`rockyade.solvers.base.motion_coverage` builds that motion again)."""
     from rockyade.motion.coverage import record_coverage
 
@@ -178,28 +180,34 @@ def _theta_metrics(traj: Trajectory, uplift_rad: float) -> dict[str, float]:
     }
 
 
-def _meta(scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, traj: Trajectory, wall: float) -> dict:
+def _meta(
+    scene: Scene, cp: ClassicalParameters, motion: GroundMotion | None, traj: Trajectory, wall: float, dt_factor: float
+) -> RunMeta:
     """The Result's metadata: status, events (the first 200 of each) and the parameters."""
     name = scene.blocks[0].name
-    return {
-        "solver": HousnerSolver.name,
-        "version": f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
-        "scene_hash": scene.scene_hash,
-        "wall_time_s": wall,
-        "status": traj.status,
-        "overturn_time_s": traj.overturn_time_s,
-        "overturned_block": name if traj.status == "overturned" else None,
-        "overturn_criterion": "|theta| reached pi/2",
-        "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
-        "blocks": [name],
-        "sample_dt_s": scene.sample_dt_s,
-        "duration_s": scene.duration_s,
-        "classical": {name: cp.as_dict()},
-        "n_impacts": traj.n_impacts,
-        "impacts": traj.impacts[:200].tolist(),
-        "peaks": traj.peaks[:200].tolist(),
-        "uplift_times_s": traj.uplift_times_s[:200].tolist(),
-        "rest_fraction_of_alpha": REST_FRACTION,
-        "motion": motion.label if motion is not None else "free",
-        "loads": [q.as_dict() for q in scene.loads],
-    }
+    return RunMeta(
+        solver=HousnerSolver.name,
+        version=f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
+        scene_hash=scene.scene_hash,
+        wall_time_s=wall,
+        status=as_status(traj.status),
+        overturn_time_s=traj.overturn_time_s,
+        overturned_block=name if traj.status == "overturned" else None,
+        blocks=(name,),
+        sample_dt_s=scene.sample_dt_s,
+        duration_s=scene.duration_s,
+        classical={name: cp.as_dict()},
+        dt_factor=dt_factor,
+        dt_s=traj.step_s,
+        extra={
+            "overturn_criterion": "|theta| reached pi/2",
+            "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
+            "n_impacts": traj.n_impacts,
+            "impacts": traj.impacts[:200].tolist(),
+            "peaks": traj.peaks[:200].tolist(),
+            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
+            "rest_fraction_of_alpha": REST_FRACTION,
+            "motion": motion.label if motion is not None else "free",
+            "loads": [q.as_dict() for q in scene.loads],
+        },
+    )

@@ -17,12 +17,13 @@ another face, |theta| within 0.01 rad of the angle at which the face next to its
 reaches the ground (pi/2 for a rectangle, a little less with the base corners at b_eq). It
 ends a column scene's run (status ``overturned``); in a positioned scene (an assembly) the
 run goes on, since a falling block must not end a wall's run, and the run is ``overturned``
-at the first block's fall. Either way ``meta["overturn_times_s"]`` gives, per block that
+at the first block's fall. Either way ``meta.overturn_times_s`` gives, per block that
 fell, the first time it did.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Sequence
@@ -44,6 +45,7 @@ from rockyade.kernel.runs import simulate_runs
 from rockyade.kernel.single import single_body
 from rockyade.kernel.state import pack
 from rockyade.result import Result
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, motion_coverage
 from rockyade.solvers.cost import CostEstimate, dem_cost
@@ -100,8 +102,7 @@ class ReferenceSolver(SolverBase):
             accel_lowpass_hz=scene.output.accel_lowpass_hz,
             per_corner=not scene.positioned,
         )
-        result.meta["setup_time_s"] = setup
-        result.meta["dt_factor"] = self.dt_factor
+        result.meta = dataclasses.replace(result.meta, setup_time_s=setup, dt_factor=self.dt_factor)
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
@@ -196,20 +197,22 @@ class ReferenceSolver(SolverBase):
                 0,
                 0,
             )
-            meta = {
-                "solver": self.name,
-                "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
-                "scene_hash": model.scene_hash,
-                "wall_time_s": wall,
-                **_outcome(model, one, n, model.stop_on_overturn),
-                "overturn_criterion": CRITERION,
-                "broad_phase": {"rebuilds": 1, "max_candidate_pairs": 0, "separating_axis_tests": 0},
-                **_model_meta(model, wall),
-                "batched": {"runs": len(scenes), "setup_time_s": setup},
-                "setup_time_s": setup / max(1, len(scenes)),
-                "dt_factor": self.dt_factor,
-                "motion_coverage": motion_coverage(scenes[r]),
-            }
+            meta = RunMeta.from_dict(
+                {
+                    "solver": self.name,
+                    "version": f"rockyade {__version__} reference DEM (numba {numba.__version__})",
+                    "scene_hash": model.scene_hash,
+                    "wall_time_s": wall,
+                    **_outcome(model, one, n, model.stop_on_overturn),
+                    "overturn_criterion": CRITERION,
+                    "broad_phase": {"rebuilds": 1, "max_candidate_pairs": 0, "separating_axis_tests": 0},
+                    **_model_meta(model, wall),
+                    "batched": {"runs": len(scenes), "setup_time_s": setup},
+                    "setup_time_s": setup / max(1, len(scenes)),
+                    "dt_factor": self.dt_factor,
+                    "motion_coverage": motion_coverage(scenes[r]),
+                }
+            )
             metrics = {
                 "max_abs_theta_rad": float(out.max_abs_theta[r]),
                 "residual_theta_rad": float(out.residual_theta[r]),
@@ -308,7 +311,7 @@ def run_model(
         + (f", zero-phase low-pass {accel_lowpass_hz:g} Hz" if accel_lowpass_hz else ""),
         **meta_energy,
     }
-    return Result(frame, meta)
+    return Result(frame, RunMeta.from_dict(meta))
 
 
 def _energy_terms(

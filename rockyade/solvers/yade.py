@@ -94,7 +94,7 @@ class YadeSolver(SolverBase):
             accel_lowpass_hz=scene.output.accel_lowpass_hz,
             warm=self.warm,
         )
-        result.meta["dt_factor"] = self.dt_factor
+        result.meta = replace(result.meta, dt_factor=self.dt_factor)
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:

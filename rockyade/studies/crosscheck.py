@@ -54,6 +54,7 @@ from rockyade.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.atomic import fsync_dir, write_json
 from rockyade.io.locking import DIR_LOCK_NAME, output_lock
+from rockyade.io.strict_json import json_text
 from rockyade.runner import Executor
 from rockyade.runner.journal import read_run
 from rockyade.scene import Scene
@@ -567,7 +568,7 @@ def run_crosscheck(
         identity = plan.identity()
         plan_file = stage / "plan.json"
         stored = _read_json(plan_file)
-        if stored is not None and stored != json.loads(json.dumps(identity)) and resume:
+        if stored is not None and stored != json.loads(json_text(identity)) and resume:
             raise InputError(
                 "--resume",
                 f"the unfinished study in {stage} is another study (its plan.json differs): run without "

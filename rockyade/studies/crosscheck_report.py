@@ -314,7 +314,7 @@ def write_summary(
     plan: CrosscheckPlan, summary: Summary, folder: Path, seconds: float, extra: Mapping[str, Any]
 ) -> None:
     """The set's files in ``folder`` (the JSON last: it says whether the set is complete)."""
-    from rockyade.assess.strict import finite_or_null
+    from rockyade.io.strict_json import finite_or_null
 
     for name, frame in (
         ("collapse_intensities.csv", summary.collapse),

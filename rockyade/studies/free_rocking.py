@@ -142,7 +142,7 @@ def _exact_rows(exact: dict) -> list[dict]:
     rows = []
     for (key, params), result in exact.items():
         mu, first = _mu(result, block_alpha(key, params))
-        target = result.meta["classical"][next(iter(result.meta["classical"]))]["mu"]
+        target = result.meta.classical[next(iter(result.meta.classical))]["mu"]
         rows.append(
             {
                 "block": key,
@@ -167,7 +167,7 @@ def _dem_rows(cases: list[dict], exact: dict, use_yade: bool) -> list[dict]:
         target = (
             paper.specimen(c["key"]).experimental["mu"]
             if c["params"] == "experimental"
-            else exact[(c["key"], c["params"])].meta["classical"][paper.specimen(c["key"]).name]["mu"]
+            else exact[(c["key"], c["params"])].meta.classical[paper.specimen(c["key"]).name]["mu"]
         )
         for solver in ("reference", "yade"):
             result = c.get(solver)
@@ -185,7 +185,7 @@ def _dem_rows(cases: list[dict], exact: dict, use_yade: bool) -> list[dict]:
                     "mu_eff": mu,
                     "first_peak_rad": first,
                     "status": result.status if result is not None else "not run",
-                    "note": (result.meta.get("failure_reason") or "") if result is not None else c["note"],
+                    "note": (result.meta.failure_reason or "") if result is not None else c["note"],
                 }
             )
     return rows

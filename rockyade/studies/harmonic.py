@@ -127,7 +127,7 @@ def _rows(c: dict) -> list[dict]:
             "paper": c["fig"],
             "solver": solver,
             "status": r.status,
-            "failure_reason": r.meta.get("failure_reason") or "",
+            "failure_reason": r.meta.failure_reason or "",
         }
         row["table_accel_m_s2"] = accel
         # a rigid column rocks only when the table acceleration exceeds its weakest uplift acceleration
@@ -182,7 +182,7 @@ def draw_figure(report: Report, c: dict) -> SolverPanelsDisplay:
             )
             maxima.append(f"{solver}: {values}")
         else:
-            maxima.append(f"{solver}: FAILED ({r.meta.get('failure_reason')})")
+            maxima.append(f"{solver}: FAILED ({r.meta.failure_reason})")
     report.figure(
         name,
         (f"**{note}** " if note else "")

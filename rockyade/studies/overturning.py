@@ -94,13 +94,13 @@ def run_scenes(solver: Solver, scenes: list[Scene], alpha: float) -> list[tuple[
         if len(keys) == 1 and None not in keys:
             try:
                 runs = solver.run_group(scenes, uplift_threshold_rad(alpha))
-                return [(one.status, one.meta.get("failure_reason") or "") for one in runs]
+                return [(one.status, one.meta.failure_reason or "") for one in runs]
             except Exception:  # a run of its own says what went wrong
                 pass
     out = []
     for scene in scenes:
         result = solver.run(scene)
-        out.append((result.status, result.meta.get("failure_reason") or ""))
+        out.append((result.status, result.meta.failure_reason or ""))
     return out
 
 

@@ -66,10 +66,10 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
                     "solver": solver_name,
                     "status": r.status,
                     "collapse": r.status == "overturned",
-                    "overturn_time_s": r.meta.get("overturn_time_s"),
+                    "overturn_time_s": r.meta.overturn_time_s,
                     "max_theta_over_alpha": float(np.nanmax(np.abs(theta)) / alpha),
                     "paper_collapse": True,
-                    "failure_reason": r.meta.get("failure_reason") or "",
+                    "failure_reason": r.meta.failure_reason or "",
                 }
             )
         draw_figure(report, key, record, factor, scene, results)
@@ -118,7 +118,7 @@ def draw_figure(
         if not r.ok:
             curves.append(Curve(solver, f"{SOLVER_LABELS[solver]}: FAILED, no curve"))
             continue
-        verdict = f"collapse at {r.meta['overturn_time_s']:.2f} s" if r.status == "overturned" else "no collapse"
+        verdict = f"collapse at {r.meta.overturn_time_s:.2f} s" if r.status == "overturned" else "no collapse"
         label = f"{SOLVER_LABELS[solver]}: {verdict}"
         if solver == "yade" and results.get("reference") is not None and results["reference"].ok:
             label += f" (max |YADE - DEM| = {max_difference(r, results['reference']) / alpha:.2g} alpha)"
@@ -138,7 +138,7 @@ def draw_figure(
     )
     verdicts = "; ".join(
         f"{s}: {'collapse' if r.status == 'overturned' else r.status}"
-        + (f" ({r.meta.get('failure_reason')})" if not r.ok else "")
+        + (f" ({r.meta.failure_reason})" if not r.ok else "")
         for s, r in results.items()
     )
     report.figure(

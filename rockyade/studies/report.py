@@ -76,9 +76,7 @@ class Report:
 
     def record_result(self, run: str, result: Any) -> None:
         """Log a :class:`~rockyade.result.Result`."""
-        self.record(
-            run, str(result.meta.get("solver", "?")), result.status, str(result.meta.get("failure_reason") or "")
-        )
+        self.record(run, str(result.meta.solver or "?"), result.status, str(result.meta.failure_reason or ""))
 
     def record_summary(self, summary: pd.DataFrame, label: Callable[[pd.Series], str]) -> None:
         """Log every row of a batch summary (columns ``solver``, ``status``, ``failure_reason``)."""

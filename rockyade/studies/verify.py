@@ -176,7 +176,7 @@ def check_frame(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """
     scene = frame_scene()
     results = {s: run(scene, s) for s in solvers}
-    body = results[solvers[0]].meta["bodies"]
+    body = results[solvers[0]].meta.bodies or {}
     col = scene.blocks[0]
     m_col = col.block().mass_kg
     gamma = scene.blocks[2].block().mass_kg / (2 * m_col)
@@ -433,7 +433,7 @@ def _dt_sensitivity(scene: Scene, solver: str, measure: Callable[[Result], float
     """The measure at the scene's time step and its relative change at half the step."""
     base = run(scene, solver)
     d = scene.to_dict()
-    d["contact"]["dt_s"] = 0.5 * base.meta["dt_s"]
+    d["contact"]["dt_s"] = 0.5 * (base.meta.dt_s if base.meta.dt_s is not None else math.nan)
     finer = run(scene_from_dict(d), solver)
     a, b = measure(base), measure(finer)
     return a, _rel(b, a)

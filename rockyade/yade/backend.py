@@ -27,6 +27,7 @@ turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import json
 import math
 import os
@@ -43,10 +44,12 @@ from rockyade.calibration.model import calibrated_model
 from rockyade.dem.frames import energy_gain, worker_frame
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.yade.payload import scene_payload
 from rockyade.yade.worker import run_scene
@@ -157,7 +160,7 @@ def run_model(
     plan = payload.get("contact_plan")
     plan = plan if isinstance(plan, dict) else None
     result = _parse(model, out_file, reason, log_file, total, accel_lowpass_hz, plan)
-    result.meta["timeout_s"] = timeout
+    result.meta = dataclasses.replace(result.meta, timeout_s=timeout)
     if result.ok and not keep:
         shutil.rmtree(directory, ignore_errors=True)
     else:
@@ -179,8 +182,8 @@ def _keep_files(directory: Path, work: str, name: str, result: Result) -> None:
             os.replace(src, directory / f"{final}{suffix}")
         elif suffix != ".yade.log":  # no output of this run: none of an earlier run's stays beside its log
             (directory / f"{final}{suffix}").unlink(missing_ok=True)
-    if "log_path" in result.meta:
-        result.meta["log_path"] = str(directory / f"{final}.yade.log")
+    if result.meta.log_path is not None:
+        result.meta = dataclasses.replace(result.meta, log_path=str(directory / f"{final}.yade.log"))
 
 
 def _command() -> list[str]:
@@ -239,9 +242,9 @@ def _parse(
         meta, arrays = _read_output(out_file)
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
-    extra["max_polyhedra_penetration_over_radius"] = float(meta.get("max_polyhedra_penetration_over_radius", 0.0))
-    extra["max_rotation_step_rad"] = meta.get("max_rotation_step_rad")
-    extra["rotation_track_period_steps"] = meta.get("rotation_track_period_steps")
+    extra["max_polyhedra_penetration_over_radius"] = meta.max_polyhedra_penetration_over_radius
+    extra["max_rotation_step_rad"] = meta.max_rotation_step_rad
+    extra["rotation_track_period_steps"] = meta.rotation_track_period_steps
     problem = _output_problem(model, meta, arrays)
     if problem == DEEP_OVERLAP:
         cut = _collapse_before_overlap(model, meta, arrays)
@@ -249,10 +252,10 @@ def _parse(
             return _collapsed(model, meta, arrays, cut, total, extra, lowpass)
     if problem is not None:
         return _partial_failure(model, meta, arrays, problem, total, extra)
-    return Result(worker_frame(model, arrays, lowpass), _run_meta(model, meta, total, extra, arrays))
+    return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(_run_meta(model, meta, total, extra, arrays)))
 
 
-def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
+def _read_output(out_file: Path) -> tuple[WorkerOutput, dict[str, np.ndarray]]:
     """The driver's output: its metadata and arrays.
 
     Raises
@@ -261,7 +264,7 @@ def _read_output(out_file: Path) -> tuple[dict, dict[str, np.ndarray]]:
         A missing or unreadable file.
     """
     with np.load(out_file, allow_pickle=False) as data:
-        meta = json.loads(str(data["meta"]))
+        meta = WorkerOutput.from_json(str(data["meta"]))
         arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
     return meta, arrays
 
@@ -276,7 +279,7 @@ DEEP_OVERLAP = (
 DROP_FRACTION = 0.5
 
 
-def _collapse_before_overlap(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> int | None:
+def _collapse_before_overlap(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> int | None:
     """The samples to keep when a deep overlap is part of a collapse, or None (a blow-up).
 
     The rule (docs/yade.md): at the last sample before the overlap (``deep_overlap_time_s``
@@ -285,8 +288,8 @@ def _collapse_before_overlap(model: DemModel, meta: dict, arrays: dict[str, np.n
     its tipping angle alpha, and the energy has not grown up to then (no blow-up by
     :func:`rockyade.dem.frames.energy_gain`).
     """
-    n = int(meta.get("n_filled", 0))
-    when = meta.get("deep_overlap_time_s")
+    n = meta.n_filled
+    when = meta.deep_overlap_time_s
     # the depth is measured at the samples: keep those before the one that saw it
     keep = n if when is None else min(n, math.floor(float(when) / model.sample_dt_s + 1e-9))
     if keep < 3:
@@ -314,14 +317,24 @@ def _cut(arrays: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
     return {k: v[:n] for k, v in arrays.items()}
 
 
-def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
+def _collapsed(
+    model: DemModel,
+    meta: WorkerOutput,
+    arrays: dict[str, np.ndarray],
+    keep: int,
+    total: float,
+    extra: dict[str, object],
+    lowpass: float | None,
+) -> Result:
     """An assembly collapsing up to a deep overlap: its history to the overlap, status
     ``overturned`` (the first block that landed, else the first past its tipping angle)."""
     names = model.names
     t_cut = (keep - 1) * model.sample_dt_s
-    meta = dict(meta)
-    meta["overturn_times_s"] = {i: t for i, t in meta.get("overturn_times_s", {}).items() if float(t) <= t_cut + 1e-12}
-    meta["status"] = "completed"  # re-decided below from the blocks' falls up to the cut
+    meta = dataclasses.replace(
+        meta,
+        overturn_times_s={i: t for i, t in meta.overturn_times_s.items() if t <= t_cut + 1e-12},
+        status="completed",  # re-decided below from the blocks' falls up to the cut
+    )
     arrays = _cut(arrays, keep)
     out = _run_meta(model, meta, total, extra, arrays)
     if out["status"] != "overturned":
@@ -339,21 +352,28 @@ def _collapsed(model, meta, arrays, keep, total, extra, lowpass) -> Result:
         "the run stopped at a deep sphere-polyhedron overlap after the assembly had started to collapse "
         "(docs/yade.md): its history up to there is kept"
     )
-    return Result(worker_frame(model, arrays, lowpass), out)
+    return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(out))
 
 
-def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
+def _partial_failure(
+    model: DemModel,
+    meta: WorkerOutput,
+    arrays: dict[str, np.ndarray],
+    reason: str,
+    total: float,
+    extra: dict[str, object],
+) -> Result:
     """A failed run that keeps what it recorded: status ``failed``, ``partial: true``, the
     samples it has (never read as complete: its status is ``failed``)."""
-    n = min(int(meta.get("n_filled", 0)), arrays["pos"].shape[0])
-    if n == 0 or "wall_time_s" not in meta:
+    n = min(meta.n_filled, arrays["pos"].shape[0])
+    if n == 0 or meta.wall_time_s is None:
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     arrays = _cut(arrays, n)
     try:
         frame = worker_frame(model, arrays, None)
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
-    out = _run_meta(model, {**meta, "status": "failed"}, total, extra, arrays)
+    out = _run_meta(model, dataclasses.replace(meta, status="failed"), total, extra, arrays)
     out.update(
         status="failed",
         failure_reason=reason,
@@ -362,50 +382,50 @@ def _partial_failure(model, meta, arrays, reason, total, extra) -> Result:
         partial=True,
         partial_samples=n,
     )
-    return Result(frame, out)
+    return Result(frame, RunMeta.from_dict(out))
 
 
-def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) -> str | None:
+def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result (partial, short, unstable, a lost
     contact normal), or None when it is one."""
-    n = int(meta.get("n_filled", 0))
-    if not meta.get("complete") or arrays["pos"].shape[0] != n:
+    n = meta.n_filled
+    if not meta.complete or arrays["pos"].shape[0] != n:
         return "partial YADE output"
-    status = meta["status"]
+    status = meta.status
     if status == "completed" and n != model.n_samples:
         return f"YADE stopped early: {n} of {model.n_samples} samples"
     if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
         return (
-            f"numerical instability in YADE at t = {meta.get('stop_time_s')} s (non-finite state, runaway speed or "
+            f"numerical instability in YADE at t = {meta.stop_time_s} s (non-finite state, runaway speed or "
             "spin, or a rotation between two records too large to follow)"
         )
     gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
     if t_blowup is not None:
         return f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
-    if float(meta.get("max_polyhedra_penetration_over_radius", 0.0)) >= 1.0:
+    if meta.max_polyhedra_penetration_over_radius >= 1.0:
         return DEEP_OVERLAP
     return None
 
 
 def _run_meta(
-    model: DemModel, meta: dict, total: float, extra: dict[str, object], arrays: dict[str, np.ndarray]
+    model: DemModel, meta: WorkerOutput, total: float, extra: dict[str, object], arrays: dict[str, np.ndarray]
 ) -> dict[str, object]:
     """The Result's metadata: how the run ended (overturns per block) and what ran."""
     names = model.names
-    status = meta["status"]
-    overturn_times = {names[int(i)]: float(t) for i, t in meta.get("overturn_times_s", {}).items()}
-    overturn_time = meta["stop_time_s"] if status == "overturned" else None
-    overturned_block = names[meta["stop_body"]] if status == "overturned" else None
+    status = meta.status
+    overturn_times = {names[int(i)]: t for i, t in meta.overturn_times_s.items()}
+    overturn_time = meta.stop_time_s if status == "overturned" else None
+    overturned_block = names[meta.stop_body] if status == "overturned" and meta.stop_body is not None else None
     if not model.stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
         t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
         falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
         status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     return {
         "solver": "yade",
-        "version": f"YADE {meta.get('yade_version')} (rockyade {__version__} driver)",
+        "version": f"YADE {meta.version} (rockyade {__version__} driver)",
         "scene_hash": model.scene_hash,
-        "wall_time_s": meta["wall_time_s"],
-        "startup_time_s": total - meta["wall_time_s"],
+        "wall_time_s": meta.wall_time_s,
+        "startup_time_s": total - meta.wall_time_s if meta.wall_time_s is not None else None,
         "status": status,
         "overturn_time_s": overturn_time,
         "overturned_block": overturned_block,
@@ -414,10 +434,10 @@ def _run_meta(
         "blocks": names,
         "sample_dt_s": model.sample_dt_s,
         "duration_s": model.duration_s,
-        "dt_s": meta["dt_s"],
+        "dt_s": meta.dt_s,
         "dt_source": model.dt_source,
         "n_steps": model.n_steps,
-        "iterations": meta["iterations"],
+        "iterations": meta.steps,
         "calibration": model.calibration,
         "contact": model.joint_summary(),
         "bodies": model.body_summary(),
