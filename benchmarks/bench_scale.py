@@ -87,10 +87,10 @@ def measure(scene: Scene, repeat: int = 3) -> dict[str, float]:
         result = run_model(model, record_energy=False, per_corner=False)
         peak = max(peak, tracemalloc.get_traced_memory()[1])
         tracemalloc.stop()
-        walls.append(result.meta["wall_time_s"])
+        walls.append(result.meta.wall_time_s)
     nb = len(model.bodies)
     wall = min(walls)
-    phase = result.meta["broad_phase"]
+    phase = result.meta.extra["broad_phase"]
     return {
         "blocks": nb,
         "status": result.status,

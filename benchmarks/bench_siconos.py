@@ -58,11 +58,11 @@ def single_block_costs() -> None:
     for label, solver in rows:
         seconds, result = timed(solver, scene)
         yade_s = seconds if label.startswith("yade") else yade_s
-        steps = result.meta.get("n_steps") or 0
+        steps = result.meta.n_steps or 0
         peak = float(abs(result.frame["theta_rad"]).max()) if len(result.frame) else float("nan")
         ratio = seconds / yade_s if yade_s else float("nan")
         print(
-            f"  {label:28s} {seconds:7.2f} s  ({ratio:4.1f} x YADE)  dt {result.meta.get('dt_s', float('nan')):.3g} s"
+            f"  {label:28s} {seconds:7.2f} s  ({ratio:4.1f} x YADE)  dt {result.meta.dt_s or float('nan'):.3g} s"
             f"  {1e6 * seconds / max(steps, 1):7.1f} us/step  peak {peak:.5f} rad  {result.status}"
         )
 
@@ -72,7 +72,7 @@ def wall_costs() -> None:
     scene = scene_from_dict(data)
     print(f"running-bond wall of {len(scene.blocks)} blocks at rest, {scene.duration_s:g} s")
     seconds, ref = timed(make_solver("reference"), scene)
-    print(f"  reference DEM: {seconds:.2f} s ({ref.meta.get('n_steps')} steps of {ref.meta.get('dt_s'):.3g} s)")
+    print(f"  reference DEM: {seconds:.2f} s ({ref.meta.n_steps} steps of {ref.meta.dt_s:.3g} s)")
     for options in (
         {"dt_s": 1e-3},
         {"dt_s": 5e-4},

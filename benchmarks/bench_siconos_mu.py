@@ -100,7 +100,7 @@ def moreau_jean() -> None:
         for e in restitutions:
             result = make_solver("siconos", restitution=e).run(_free(friction))
             per = _per_impact(result.frame["t_s"].to_numpy(), result.frame["theta_rad"].to_numpy())
-            status = "" if result.ok else f" ({result.meta.get('status')})"
+            status = "" if result.ok else f" ({result.meta.status})"
             print(_row(f"friction {friction:g} deg, e = {e:g}{status}", per))
 
 

@@ -259,7 +259,7 @@ def wall_target() -> None:
     for n in (1, 1000):
         model = calibrated_model(scene_for(n, "rest", 0.05))
         run_model(model, record_energy=True)
-        wall = min(run_model(model, record_energy=True).meta["wall_time_s"] for _ in range(2))
+        wall = min(run_model(model, record_energy=True).meta.wall_time_s for _ in range(2))
         per[n] = 1e9 * wall / (model.n_steps * len(model.bodies))
     row(
         "assembly: ~1,000-block wall at rest per block-step / single block (energy on, kernel, 0.05 s)",

@@ -112,14 +112,14 @@ def assembly_costs(sizes=(10, 100), duration: float = 0.3) -> list[dict[str, obj
         row: dict[str, object] = {"blocks": nb, "steps": model.n_steps, "dt_s": model.dt_s}
         y = yade_backend.run_model(model)
         if y.ok:
-            row["yade_us_per_block_step"] = 1e6 * y.meta["wall_time_s"] / (model.n_steps * nb)
-            row["yade_startup_s"] = y.meta["startup_time_s"]
+            row["yade_us_per_block_step"] = 1e6 * y.meta.wall_time_s / (model.n_steps * nb)
+            row["yade_startup_s"] = y.meta.startup_time_s
         else:
-            row["yade_error"] = y.meta.get("failure_reason")
+            row["yade_error"] = y.meta.failure_reason
         try:
             run_model(model, record_energy=False)  # compile and warm up
-            r = min((run_model(model, record_energy=False) for _ in range(3)), key=lambda x: x.meta["wall_time_s"])
-            row["reference_us_per_block_step"] = 1e6 * r.meta["wall_time_s"] / (model.n_steps * nb)
+            r = min((run_model(model, record_energy=False) for _ in range(3)), key=lambda x: x.meta.wall_time_s)
+            row["reference_us_per_block_step"] = 1e6 * r.meta.wall_time_s / (model.n_steps * nb)
         except InputError as exc:
             row["reference_error"] = str(exc)
         rows.append(row)
@@ -189,16 +189,16 @@ def warm_vs_cold(runs: int = 20, duration: float = 20.0) -> dict[str, float]:
             else:
                 used += _worker_cpu_s() - worker
             cpu[name] += used
-            assert result.ok, result.meta.get("failure_reason")
+            assert result.ok, result.meta.failure_reason
             results[name].append(result)
     yade_worker.close_workers()
     out: dict[str, float] = {"load_average": max(load, os.getloadavg()[0])}
     for name in solvers:
-        startups = sorted(r.meta["startup_time_s"] for r in results[name][1 if name == "warm" else 0 :])
+        startups = sorted(r.meta.startup_time_s for r in results[name][1 if name == "warm" else 0 :])
         out[f"{name}_runs_per_min"] = 60 * runs / wall[name]
         out[f"{name}_cpu_s"] = cpu[name] / runs
         out[f"{name}_startup_s"] = startups[len(startups) // 2]
-    loops = sorted(r.meta["wall_time_s"] for r in results["warm"])
+    loops = sorted(r.meta.wall_time_s for r in results["warm"])
     out["yade_loop_s"] = loops[len(loops) // 2]
     out["identical"] = float(
         all(w.frame.equals(c.frame) for w, c in zip(results["warm"], results["cold"], strict=True))
@@ -238,10 +238,10 @@ def main() -> None:
         print(f"wall of {row['blocks']} blocks, {row['steps']} steps of {row['dt_s']:.3g} s: {yade}; {ref}")
     model = calibrated_model(scene(20.0))
     run_model(calibrated_model(scene(0.1)), record_energy=False)  # JIT warm-up
-    ref = min(run_model(model, record_energy=False).meta["wall_time_s"] for _ in range(3))
+    ref = min(run_model(model, record_energy=False).meta.wall_time_s for _ in range(3))
     y = yade_backend.run_model(model)
-    assert y.ok, y.meta.get("failure_reason")
-    yade_run, startup = y.meta["wall_time_s"], y.meta["startup_time_s"]
+    assert y.ok, y.meta.failure_reason
+    yade_run, startup = y.meta.wall_time_s, y.meta.startup_time_s
     print(
         f"specimen 1, 20 s simulated, dt = {model.dt_s:.3g} s ({model.n_steps} steps): YADE {yade_run:.2f} s "
         f"({yade_run / 20 * 1e3:.0f} ms per simulated s, {1e6 * yade_run / model.n_steps:.1f} us/step) + "

@@ -85,7 +85,7 @@ def test_a_newton_restitution_does_not_raise_the_per_cycle_mu():
     momentum about it conserved), which is why a target mu above it is refused."""
     block = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.5 * math.atan(0.25)}, 3.0)
     result = make_solver("siconos", restitution=0.5).run(block)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     alpha = math.atan(0.25)
     eq4 = 1.0 - 1.5 * math.sin(alpha) ** 2
     peaks = find_peaks(result.frame["t_s"].to_numpy(), result.frame["theta_rad"].to_numpy())
