@@ -8,7 +8,7 @@ from __future__ import annotations
 import io
 import json
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from importlib import resources
 from typing import Any
 
@@ -21,7 +21,7 @@ from rockyade.constants import G
 from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.scene.generators import drum_column, pulse_motion, rest_motion, rocking_frame, wall
-from rockyade.solvers import run
+from rockyade.solvers import Solver, as_solver, run
 from rockyade.studies.verify_rows import Row, _rel, absolute, at_least, at_most, relative
 
 
@@ -53,7 +53,12 @@ def frame_scene(solver_dt: float | None = None) -> Scene:
     return scene_from_dict(data)
 
 
-def check_frame(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+def _named(solvers: Sequence[str | Solver]) -> dict[str, Solver]:
+    """The solvers by name (a name gives the solver with its default options)."""
+    return {as_solver(s).name: as_solver(s) for s in solvers}
+
+
+def check_frame(solvers: Sequence[str | Solver]) -> tuple[list[Row], dict[str, Result]]:
     """A rocking frame under a one-sine pulse against Housner's column with
     p_hat = p sqrt((1 + 2 gamma) / (1 + 3 gamma)) (Makris & Vassiliou 2013): first impact
     time (s) within 2 %, first peak (rad) within 3 % (module docstring, ``frame``).
@@ -61,7 +66,7 @@ def check_frame(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     Parameters
     ----------
     solvers
-        Names of the solvers to check (e.g. ``["reference", "yade"]``).
+        The solvers to check, by name (e.g. ``["reference", "yade"]``) or with their options.
 
     Returns
     -------
@@ -70,8 +75,9 @@ def check_frame(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
         and the Results the figures are drawn from, by solver.
     """
     scene = frame_scene()
-    results = {s: run(scene, s) for s in solvers}
-    body = results[solvers[0]].meta["bodies"]
+    named = _named(solvers)
+    results = {name: run(scene, solver) for name, solver in named.items()}
+    body = results[next(iter(named))].meta["bodies"]
     col = scene.blocks[0]
     m_col = col.block().mass_kg
     gamma = scene.blocks[2].block().mass_kg / (2 * m_col)
@@ -101,14 +107,16 @@ def check_frame(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     t_exact, peak_exact = _first_impact_and_peak(exact)
     rows = []
     source = f"Housner column, p_hat = {p_hat:.4g} 1/s (gamma {gamma:.3g})"
-    for solver in solvers:
+    for solver in named:
         t_imp, peak = _first_impact_and_peak(results[solver], col.name)
         rows.append(Row("frame", solver, "first impact time (s)", t_imp, t_exact, source, relative(0.02)))
         rows.append(Row("frame", solver, "first peak (rad)", peak, peak_exact, source, relative(0.03)))
     return rows, results
 
 
-def check_drums(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+def check_drums(
+    solvers: Sequence[str | Solver], rate_g_per_s: float = 0.05, duration_s: float = 3.2
+) -> tuple[list[Row], dict[str, Result]]:
     """A column of 8 drums under a slow ramp of base acceleration (m/s^2) uplifts as one body
     at g b / (H / 2), within 2 %, its top and bottom drums turning together within 5 %
     (module docstring, ``drums``).
@@ -116,7 +124,9 @@ def check_drums(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     Parameters
     ----------
     solvers
-        Names of the solvers to check (e.g. ``["reference", "yade"]``).
+        The solvers to check, by name (e.g. ``["reference", "yade"]``) or with their options.
+    rate_g_per_s, duration_s
+        The ramp's rise, g/s, and its length, s (the monolith runs the same ramp).
 
     Returns
     -------
@@ -124,7 +134,7 @@ def check_drums(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
         One :class:`Row` per solver and quantity (value, expected value, tolerance, pass),
         and the Results the figures are drawn from, by solver.
     """
-    rate, duration = 0.05 * G, 3.2
+    rate, duration = rate_g_per_s * G, duration_s
     motion = {"type": "sampled", "t_s": [0.0, duration], "accel_m_s2": [0.0, rate * duration]}
     drums = scene_from_dict(
         drum_column(
@@ -147,8 +157,8 @@ def check_drums(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     _, exact_level = level(exact, None)
     names = [b.name for b in drums.blocks]
     rows = []
-    for solver in solvers:
-        result = run(drums, solver)
+    for solver, how in _named(solvers).items():
+        result = run(drums, how)
         results[solver] = result
         k, bottom = level(result, names[0])
         _, top = level(result, names[-1])

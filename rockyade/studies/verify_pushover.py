@@ -5,12 +5,13 @@ describes each), and the short held-level pushover they share."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 from rockyade.result import Result
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import arch, rest_motion, wall, wall_section
-from rockyade.solvers import run
+from rockyade.solvers import Solver, as_solver, run
 from rockyade.studies.verify_closed import loaded_block_scene, loaded_lambda
 from rockyade.studies.verify_rows import Row, at_most, known, relative
 
@@ -132,34 +133,43 @@ def limit_pushover_scenes(motion: dict[str, Any] | None = None) -> dict[str, tup
     }
 
 
-def check_limit_pushover(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
-    """The limit analysis's multiplier against the reference DEM's pushover onset (the first held
-    level at which the control point moved more than 1 mm) for a block, an arch, a restrained
-    wall and a running-bond panel: within 2 % (:func:`limit_pushover_scenes`). The reference DEM
-    only (YADE's onsets are in tests/test_pushover.py: minutes of CPU)."""
+def limit_pushover_row(check: str, name: str, solver: Solver | str = "reference") -> Row:
+    """The pushover onset of ``limit_pushover_scenes()[name]`` in ``solver`` (the first held level
+    at which the control point moved more than 1 mm; NaN for a failed run) against the limit
+    analysis's multiplier, within 2 %: a row of check ``check``."""
     from rockyade.analysis.capacity import capacity_curve, pushover_onset
     from rockyade.limit import limit_analysis
     from rockyade.motion.quasistatic import Pushover
     from rockyade.motion.spec import parse_motion
 
-    rows = []
-    for name, (data, control) in limit_pushover_scenes().items():
-        expected = known(limit_analysis(scene_from_dict(data), direction="+x").load_multiplier, "load multiplier")
-        motion = parse_motion(_short_pushover(expected))
-        assert isinstance(motion, Pushover)
-        t_path, _ = motion.lambda_path(0.0)
-        scene = scene_from_dict(data).with_changes(motion=motion, duration_s=float(t_path[-1]) + 0.5)
-        block, point = control if control is not None else (None, None)
-        onset = pushover_onset(capacity_curve(run(scene, "reference"), scene, block=block, point_m=point), scene)
-        rows.append(
-            Row(
-                "limit_pushover",
-                "reference",
-                f"{name}: pushover onset (first held level it did not stand)",
-                onset.multiplier,
-                expected,
-                "limit analysis",
-                relative(0.02),
-            )
-        )
-    return rows, {}
+    data, control = limit_pushover_scenes()[name]
+    expected = known(limit_analysis(scene_from_dict(data), direction="+x").load_multiplier, "load multiplier")
+    motion = parse_motion(_short_pushover(expected))
+    assert isinstance(motion, Pushover)
+    t_path, _ = motion.lambda_path(0.0)
+    scene = scene_from_dict(data).with_changes(motion=motion, duration_s=float(t_path[-1]) + 0.5)
+    block, point = control if control is not None else (None, None)
+    result = run(scene, solver)
+    onset = (
+        pushover_onset(capacity_curve(result, scene, block=block, point_m=point), scene).multiplier
+        if result.ok
+        else math.nan
+    )
+    return Row(
+        check,
+        as_solver(solver).name,
+        f"{name}: pushover onset (first held level it did not stand)",
+        onset,
+        expected,
+        "limit analysis",
+        relative(0.02),
+    )
+
+
+def check_limit_pushover(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
+    """The limit analysis's multiplier against the reference DEM's pushover onset (the first held
+    level at which the control point moved more than 1 mm) for a block, an arch, a restrained
+    wall and a running-bond panel: within 2 % (:func:`limit_pushover_scenes`). The reference DEM
+    only (YADE's onsets are in tests/test_pushover.py: minutes of CPU; Siconos's in
+    :func:`rockyade.studies.verify_siconos.check_siconos`)."""
+    return [limit_pushover_row("limit_pushover", name) for name in limit_pushover_scenes()], {}
