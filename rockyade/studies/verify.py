@@ -44,9 +44,17 @@ the tolerance, pass or fail):
   onset (held levels every 1 % of it from 0.98 of it) within 2 %, for a block, a 20-voussoir
   arch, a wall restrained at its top (three hinges) and a running-bond panel that slides on a
   bed joint (a slender panel goes below the limit analysis: docs/assemblies.md);
-* ``siconos``: Siconos (nonsmooth contact dynamics) against closed forms: free-rocking
-  restitution against Housner's Eq 4 (0.5 %) and a block's pushover onset against the limit
-  analysis (2 %) (:func:`check_siconos`).
+* ``siconos``: Siconos (nonsmooth contact dynamics) on the DEMs' scenes: free-rocking
+  restitution against Housner's Eq 4 (0.5 %), the block's pushover onset against the limit
+  analysis (2 %), the rocking frame against Housner's column with p_hat (2 % and 3 %) and a
+  tapered 4-block stack at rest (1e-6 rad, 1e-6 m) (:func:`check_siconos`; the arch, the
+  restrained wall, the panel and the drums wait on corner-to-corner contacts,
+  :data:`rockyade.studies.verify_siconos.SICONOS_PUSHOVERS`).
+
+The checks live by domain: :mod:`rockyade.studies.verify_closed` (no solver),
+:mod:`rockyade.studies.verify_dem`, :mod:`rockyade.studies.verify_pushover`,
+:mod:`rockyade.studies.verify_siconos`; each row holds its tolerance once
+(:mod:`rockyade.studies.verify_rows`).
 
 ``kinematic``, ``code``, ``fragility_fit`` and ``loaded_block`` run no solver (the
 limit-analysis programme, Housner's model and the fit only).
