@@ -22,7 +22,7 @@ from rockyade.result import Result
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.scene.generators import drum_column, pulse_motion, rest_motion, rocking_frame, wall
 from rockyade.solvers import Solver, as_solver, run
-from rockyade.studies.verify_rows import Row, _rel, absolute, at_least, at_most, relative
+from rockyade.studies.verify_rows import Row, absolute, at_least, at_most, relative, relative_difference
 
 
 def _first_impact_and_peak(result: Result, name: str | None = None) -> tuple[float, float]:
@@ -330,7 +330,7 @@ def _dt_sensitivity(scene: Scene, solver: str, measure: Callable[[Result], float
     d["contact"]["dt_s"] = 0.5 * base.meta["dt_s"]
     finer = run(scene_from_dict(d), solver)
     a, b = measure(base), measure(finer)
-    return a, _rel(b, a)
+    return a, relative_difference(b, a)
 
 
 def check_agreement(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:

@@ -12,7 +12,7 @@ from typing import Literal
 ToleranceKind = Literal["relative", "absolute", "at most", "at least"]
 
 
-def _rel(a: float, b: float) -> float:
+def relative_difference(a: float, b: float) -> float:
     """|a - b| / |b| (infinite when b is 0)."""
     return abs(a - b) / abs(b) if b else math.inf
 
@@ -68,7 +68,7 @@ class Tolerance:
     def passes(self, expected: float, value: float) -> bool:
         """Whether ``value`` is within this tolerance of ``expected`` (never for NaN)."""
         if self.kind == "relative":
-            return _rel(value, expected) <= self.value
+            return relative_difference(value, expected) <= self.value
         if self.kind == "absolute":
             return abs(value - expected) <= self.value
         if self.kind == "at most":
