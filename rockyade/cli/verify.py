@@ -51,7 +51,8 @@ def register(sub: Any) -> None:
         "calculation, the fragility fit recovering a known curve, and a block with a top load (its "
         "multiplier from the limit analysis, Housner's uplift and the reference DEM's pushover against the closed "
         "form), and the limit analysis' multiplier against the reference DEM's pushover onset for a block, a "
-        "20-voussoir arch, a wall restrained at its top and a running-bond panel (within 2 %). "
+        "20-voussoir arch, a wall restrained at its top and a running-bond panel (within 2 %), and Siconos against "
+        "closed forms (free-rocking restitution, a block's pushover, the rocking frame, a stack at rest). "
         "Writes verify.csv, a figure per check and index.md; exits 1 if any check fails.",
     )
     p.add_argument("--out", type=Path, required=True, help="output directory")
