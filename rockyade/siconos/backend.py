@@ -227,9 +227,8 @@ def _output_problem(model: DemModel, meta: dict, arrays: dict[str, np.ndarray]) 
     if status == "completed" and n != model.n_samples:
         return f"Siconos stopped early: {n} of {model.n_samples} samples"
     if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
-        return (
-            f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s (non-finite state or runaway speed)"
-        )
+        why = meta.get("failure_reason") or "non-finite state or runaway speed"
+        return f"numerical instability in Siconos at t = {meta.get('stop_time_s')} s ({why})"
     calls = int(meta.get("solver_calls", 0))
     bad = int(meta.get("unconverged_steps", 0))
     if float(meta.get("max_residual", 0.0)) > FAIL_RESIDUAL or (
@@ -300,6 +299,11 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
         "solver_iterations": int(meta.get("solver_iterations", 0)),
         "solver_iterations_mean": (int(meta.get("solver_iterations", 0)) / calls) if calls else 0.0,
         "unconverged_steps": int(meta.get("unconverged_steps", 0)),
+        "retried_steps": int(meta.get("retried_steps", 0)),
+        "retried_steps_converged": int(meta.get("retried_steps_converged", 0)),
+        "fallback_steps": int(meta.get("fallback_steps", 0)),
+        "loose_steps": int(meta.get("loose_steps", 0)),
+        "friction_solvers": meta.get("friction_solvers"),
         "max_solver_residual": float(meta.get("max_residual", 0.0)),
         "max_penetration_m": float(meta.get("max_penetration_m", 0.0)),
         "max_bullet_overlap_m": float(meta.get("max_bullet_overlap_m", 0.0)),
