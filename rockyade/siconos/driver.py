@@ -453,6 +453,8 @@ def build(scene, S):
     sim = sk.TimeStepping(nsds, timedisc, osi, problem)
     sim.setNewtonMaxIteration(int(scene["newton_max_iter"]))
     sim.setNewtonTolerance(float(scene["newton_tol"]))
+    if int(scene["newton_max_iter"]) == 1:  # linear relations: no Newton residuals to compute
+        sim.setNewtonOptions(sk.SICONOS_TS_LINEAR)
     stepper.attach(sim, problem)
     return {"sim": sim, "nsds": nsds, "bodies": bodies, "contacts": contacts, "problem": problem, "stepper": stepper}
 
