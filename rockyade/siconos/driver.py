@@ -512,14 +512,12 @@ class Stepper:
 
     def attach(self, sim, problem):
         self.sim, self.problem = sim, problem
-
-    @property
-    def so(self):
-        return self.problem.numericsSolverOptions()
+        self.so = problem.numericsSolverOptions()
 
     def _use(self, index):
         if index != self.active:
             self.problem.setSolverId(getattr(self.sn, SOLVERS[self.names[index]]))
+            self.so = self.problem.numericsSolverOptions()
             self._set(self.so, self.names[index])
             self.active = index
 
@@ -535,12 +533,13 @@ class Stepper:
             return False, f"Siconos raised {type(exc).__name__}: {exc} ({self.names[self.active]})"
         for ds in self.moving:
             q, v = ds.q(), ds.velocity()
-            if not (np.all(np.isfinite(q)) and np.all(np.isfinite(v))):
+            vx, vy, w = float(v[0]), float(v[1]), float(v[2])
+            if not math.isfinite(float(q[0]) + float(q[1]) + float(q[2]) + vx + vy + w):
                 return False, "non-finite state"
-            if math.hypot(v[0], v[1]) > MAX_SPEED_M_S or abs(v[2]) > MAX_SPIN_RAD_S:
+            if math.hypot(vx, vy) > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
                 return False, "runaway speed"
         if self.problem.getSizeOutput() > 0:
-            res = float(self.so.dparam[sn.SICONOS_DPARAM_RESIDU])
+            res = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
             if not (res <= self.tol):
                 if res <= ACCEPT_FACTOR * self.tol:
                     return True, "loose"
