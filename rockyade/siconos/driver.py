@@ -453,8 +453,6 @@ def build(scene, S):
     sim = sk.TimeStepping(nsds, timedisc, osi, problem)
     sim.setNewtonMaxIteration(int(scene["newton_max_iter"]))
     sim.setNewtonTolerance(float(scene["newton_tol"]))
-    if int(scene["newton_max_iter"]) == 1:  # linear relations: no Newton residuals to compute
-        sim.setNewtonOptions(sk.SICONOS_TS_LINEAR)
     stepper.attach(sim, problem)
     return {"sim": sim, "nsds": nsds, "bodies": bodies, "contacts": contacts, "problem": problem, "stepper": stepper}
 
@@ -468,8 +466,8 @@ class Stepper:
 
     A step fails when Siconos raises, when the solver's residual stays above the tolerance,
     or when the state comes out non-finite or beyond MAX_SPEED_M_S / MAX_SPIN_RAD_S. A failed
-    step is taken again from the state before it (positions and velocities restored, the
-    contacts' C and e recomputed) with each fallback solver in turn (``fallback_solvers``;
+    step is taken again from the state before it (positions, velocities and the contacts'
+    impulses restored, their C and e recomputed) with each fallback solver in turn (``fallback_solvers``;
     NSGS: slow on a hyperstatic stack but unaffected by redundant contacts, on which the
     nonsmooth Newton's LU factorisation is singular). A fallback that succeeds is kept for
     1, 8, 64, ... steps (HOLD_GROWTH) before the first
@@ -551,7 +549,10 @@ class Stepper:
         contacts. Raises StepError when no solver could take it."""
         first = 0 if index >= self.back_at else self.active
         order = [first] + [k for k in range(len(self.names)) if k != first]
-        saved = [(ds, np.array(ds.q()), np.array(ds.velocity())) for ds in self.moving]
+        saved = (
+            [(ds, np.array(ds.q()), np.array(ds.velocity())) for ds in self.moving],
+            [np.array(inter.lambda_(1)) for inter in self.contacts.inters],
+        )
         finite = None  # the first solver whose step stayed finite, unconverged
         why = None
         for n, k in enumerate(order):
@@ -586,10 +587,14 @@ class Stepper:
         return self.problem.getSizeOutput() > 0
 
     def _restore(self, saved):
-        """The positions and velocities before the step, and the contacts at them."""
-        for ds, q, v in saved:
+        """The positions, velocities and contact impulses before the step (the impulses start
+        the next solver: a failed Newton leaves them non-finite), and the contacts' C and e."""
+        states, impulses = saved
+        for ds, q, v in states:
             ds.setQ(q)
             ds.setVelocity(v)
+        for inter, lam in zip(self.contacts.inters, impulses, strict=True):
+            inter.lambda_(1)[:] = lam
         self.contacts.update()
 
 
