@@ -80,8 +80,9 @@ def _env() -> dict[str, str]:
 
 def default_timeout(n_steps: int, n_bodies: int) -> float:
     """Wall-clock limit of a run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
-    body-step (measured on a loaded 2-core machine: 0.9 ms per body-step for a single block,
-    37 ms for a 33-block wall), capped at TIMEOUT_CAP_S."""
+    body-step (measured on a loaded 2-core machine: 0.25-0.9 ms per body-step for a single
+    block, 3-4 ms for a 33-block wall at rest, about 40 ms under a pulse: give such a run its
+    own timeout_s), capped at TIMEOUT_CAP_S."""
     return min(TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * n_steps * n_bodies, TIMEOUT_CAP_S)
 
 
