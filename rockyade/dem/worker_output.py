@@ -68,6 +68,17 @@ class WorkerOutput:
         Siconos: the deepest penetration, m.
     max_bullet_overlap_m
         Siconos: Bullet's largest overlap, m.
+    failure_reason
+        Siconos: why the driver stopped a failed run (the step no solver could take).
+    retried_steps, retried_steps_converged
+        Siconos: steps taken again after the nonsmooth Newton failed, and how many of them a
+        fallback solver then took.
+    fallback_steps
+        Siconos: steps solved by a fallback friction-contact solver.
+    loose_steps
+        Siconos: steps accepted with a residual between the tolerance and 100 times it.
+    friction_solvers
+        Siconos: the friction-contact solvers tried, in order.
     """
 
     status: str
@@ -92,6 +103,12 @@ class WorkerOutput:
     max_residual: float = 0.0
     max_penetration_m: float = 0.0
     max_bullet_overlap_m: float = 0.0
+    failure_reason: str | None = None
+    retried_steps: int = 0
+    retried_steps_converged: int = 0
+    fallback_steps: int = 0
+    loose_steps: int = 0
+    friction_solvers: tuple[str, ...] = ()
 
     @classmethod
     def from_dict(cls, data: Mapping[str, Any]) -> WorkerOutput:
@@ -117,6 +134,9 @@ class WorkerOutput:
         for key in _FLOATS & values.keys():
             values[key] = float(values[key])
         values["complete"] = bool(values.get("complete", False))
+        if "failure_reason" in values:
+            values["failure_reason"] = str(values["failure_reason"])
+        values["friction_solvers"] = tuple(str(n) for n in values.get("friction_solvers", ()))
         values["overturn_times_s"] = FrozenMapping(
             {str(i): float(t) for i, t in dict(values.get("overturn_times_s", {})).items()}
         )
@@ -133,7 +153,18 @@ class WorkerOutput:
 
 _FIELDS = frozenset(f.name for f in fields(WorkerOutput))
 _INTEGERS = frozenset(
-    {"n_filled", "stop_body", "rotation_track_period_steps", "solver_calls", "solver_iterations", "unconverged_steps"}
+    {
+        "n_filled",
+        "stop_body",
+        "rotation_track_period_steps",
+        "solver_calls",
+        "solver_iterations",
+        "unconverged_steps",
+        "retried_steps",
+        "retried_steps_converged",
+        "fallback_steps",
+        "loose_steps",
+    }
 )
 _FLOATS = frozenset(
     {

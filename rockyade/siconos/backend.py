@@ -83,8 +83,9 @@ def _env() -> dict[str, str]:
 
 def default_timeout(n_steps: int, n_bodies: int) -> float:
     """Wall-clock limit of a run, s: TIMEOUT_STARTUP_S plus TIMEOUT_PER_BODY_STEP_S per
-    body-step (measured on a loaded 2-core machine: 0.9 ms per body-step for a single block,
-    37 ms for a 33-block wall), capped at TIMEOUT_CAP_S."""
+    body-step (measured on a loaded 2-core machine: 0.25-0.9 ms per body-step for a single
+    block, 3-4 ms for a 33-block wall at rest, about 40 ms under a pulse: give such a run its
+    own timeout_s), capped at TIMEOUT_CAP_S."""
     return min(TIMEOUT_STARTUP_S + TIMEOUT_PER_BODY_STEP_S * n_steps * n_bodies, TIMEOUT_CAP_S)
 
 
@@ -232,7 +233,8 @@ def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.nd
     if status == "completed" and n != model.n_samples:
         return f"Siconos stopped early: {n} of {model.n_samples} samples"
     if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
-        return f"numerical instability in Siconos at t = {meta.stop_time_s} s (non-finite state or runaway speed)"
+        why = meta.failure_reason or "non-finite state or runaway speed"
+        return f"numerical instability in Siconos at t = {meta.stop_time_s} s ({why})"
     calls = meta.solver_calls
     bad = meta.unconverged_steps
     if meta.max_residual > FAIL_RESIDUAL or (bad >= FAIL_UNCONVERGED_MIN and bad > FAIL_UNCONVERGED_FRACTION * calls):
@@ -316,6 +318,11 @@ def _run_meta(
         "solver_iterations": meta.solver_iterations,
         "solver_iterations_mean": (meta.solver_iterations / calls) if calls else 0.0,
         "unconverged_steps": meta.unconverged_steps,
+        "retried_steps": meta.retried_steps,
+        "retried_steps_converged": meta.retried_steps_converged,
+        "fallback_steps": meta.fallback_steps,
+        "loose_steps": meta.loose_steps,
+        "friction_solvers": list(meta.friction_solvers),
         "max_solver_residual": meta.max_residual,
         "max_penetration_m": meta.max_penetration_m,
         "max_bullet_overlap_m": meta.max_bullet_overlap_m,

@@ -23,16 +23,19 @@ samples, the loads and the time step.
 
 The model (nonsmooth contact dynamics, Moreau-Jean time stepping):
 
-* each moving block is a ``RigidBody2dDS`` (x, y, theta) with a ``SiconosConvexHull2d``
-  contactor (its contact polygon, margins 0) and a small ``SiconosDisk`` inside each vertex,
-  tangent to its two edges; a fixed block and the ground are static contactor sets (they
-  move with the base: not at all in the base frame);
-* contacts are found by Bullet (``SiconosBulletCollisionManager``, 2-D) between a block's
-  vertex disks and the other blocks' hulls or the ground only (the DEMs' vertex-to-edge
-  contacts: a hull-on-hull contact of two flat faces gets a single point in the middle, on
-  which a stack cannot stand), and obey a Newton impact law with Coulomb friction
-  (``NewtonImpactFrictionNSL(e, 0, mu, 2)``) per pair of contactor groups; the one-step
-  problem is ``FrictionContact(2)`` solved by NSGS to the tolerance given;
+* each moving block is a ``RigidBody2dDS`` (x, y, theta); a fixed block and the ground are
+  static (they move with the base: not at all in the base frame);
+* contacts are rockyade's own vertex-to-edge pairs, found once from the starting geometry
+  (``contact_pairs``: the reference DEM's), each a ``LagrangianLinearTIR`` whose C and e
+  are set before every step from the bodies' positions (``Contacts``: numpy over all
+  pairs, plain floats for a few), with ``NewtonImpactFrictionNSL(e, 0, mu, 3)``; of two
+  pairs at coinciding corners only one is active at a time (their rows would make the
+  one-step problem singular);
+* the one-step problem is ``FrictionContact(3)`` solved by the nonsmooth Newton
+  (Alart-Curnier); a step it fails (Siconos raises, the residual stays above the
+  tolerance, the state runs away) is taken again from the state before it by NSGS, then
+  ADMM (``Stepper``: both tolerate the redundant contacts of walls and arches); a step
+  none can take ends the run ``failed`` with the reason and the samples so far;
 * ``MoreauJeanOSI(theta)``; the ground motion enters in the base frame as an inertial
   force -m a_g(t) on every moving block (exact for a rigid base: the base frame translates
   without rotating), with the vertical -m (g + a_v(t)), both evaluated at the middle of each
@@ -64,6 +67,7 @@ SCENE_FORMAT = "rockyade-siconos-scene-1"
 SOLVERS = {
     "nsn": "SICONOS_FRICTION_3D_NSN_AC",
     "nsgs": "SICONOS_FRICTION_3D_NSGS",
+    "admm": "SICONOS_FRICTION_3D_ADMM",
 }
 #: The second tangent's arm on the rotation, m (it keeps the local 3x3 problem regular; its
 #: friction torque is at most TWIST_ARM x mu x N).
@@ -73,9 +77,28 @@ TWIST_ARM = 1e-4
 GAP_OFFSET_M = 1e-8
 #: A pair whose vertex has left its edge (by this fraction of the edge's length) is open.
 EDGE_SLACK = 1e-3
+#: A pair whose vertex lies deeper behind the edge than this fraction of the smaller block's
+#: smallest dimension is open (the vertex crossed the edge's line elsewhere).
+DEEP_FRACTION = 0.25
+#: Up to this many pairs the contact geometry is computed pair by pair in Python floats,
+#: beyond it with numpy over all pairs at once (numpy's per-call overhead: measured).
+SCALAR_PAIRS = 12
+#: Two pairs of the same two bodies are twins when their vertices start this close, as a
+#: fraction of the smallest block dimension (coinciding corners).
+TWIN_FRACTION = 1e-6
 #: Beyond these the state is a numerical blow-up, not rocking (as in the DEMs).
 MAX_SPEED_M_S = 100.0
 MAX_SPIN_RAD_S = 1000.0
+#: The nonsmooth Newton's iteration cap when a fallback solver follows it (it converges in a
+#: few iterations or not at all: on redundant contacts each iteration's LU factorisation fails).
+NSN_MAX_ITER = 100
+#: A step whose residual is above the tolerance but within this factor of it is accepted
+#: (counted as ``loose_steps``) rather than taken again with the next solver.
+ACCEPT_FACTOR = 100.0
+#: A fallback solver that took a step the first solver failed is kept for 1 step, then
+#: HOLD_GROWTH times longer at each new failure of the first solver (a scene whose contacts
+#: are redundant fails it every time, and each failure costs up to solver_max_iter iterations).
+HOLD_GROWTH = 8
 #: A contact slips when |tangential| >= SLIP_RATIO x mu x normal.
 SLIP_RATIO = 0.999
 
@@ -206,14 +229,55 @@ class Contacts:
     """The contact pairs as Siconos interactions: each a ``LagrangianLinearTIR`` y = C q + e,
     (normal gap, tangential, twist) with C and e set before each step from the bodies'
     positions (the gap and its Jacobian at the step's start: the linearised vertex-to-edge
-    distance, exact to first order), and ``NewtonImpactFrictionNSL(e, 0, mu, 3)``."""
+    distance, exact to first order), and ``NewtonImpactFrictionNSL(e, 0, mu, 3)``.
+
+    The geometry of all pairs is computed at once with numpy (``update``); only the copy into
+    each interaction's C and e is a loop. A pair is open (y far positive) when its vertex has
+    left its edge by EDGE_SLACK of the edge's length, when it lies deeper than
+    DEEP_FRACTION of the smaller block's smallest dimension behind the edge (a vertex that
+    crossed the edge's line elsewhere, as voussoirs tumble: not this contact), and when it
+    is the twin of an earlier pair still on its edge: two blocks whose corners coincide
+    (a head joint, the ends of a bed joint, the joints of an arch) give two pairs at one
+    point with one normal, whose rows make the one-step problem singular; one is kept while
+    it holds, the other takes over once the blocks slide apart.
+    """
 
     def __init__(self, scene, sk, nsds, ds_of, pairs):
         self.pairs = pairs
         self.ds_of = ds_of
-        self.local = [np.asarray(b["vertices_m"], dtype=float) for b in scene["bodies"]]
-        self.static = [(np.asarray(b["centroid0_m"], dtype=float), float(b["angle0_rad"])) for b in scene["bodies"]]
-        self.inters, self.views, self.moving = [], [], []
+        bodies = scene["bodies"]
+        nb = len(bodies)
+        m = len(pairs)
+        local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
+        size = [float(np.min(np.ptp(v, axis=0))) for v in local]
+        self.q = np.zeros((nb + 1, 3))  # the bodies' (x, y, theta); row nb: the ground
+        for i, b in enumerate(bodies):
+            self.q[i] = (b["centroid0_m"][0], b["centroid0_m"][1], b["angle0_rad"])
+        self.moving_ids = [i for i, ds in enumerate(ds_of) if ds is not None]
+        self.a = np.array([p["a"] for p in pairs], dtype=int)
+        self.b = np.array([p["b"] if p["b"] >= 0 else nb for p in pairs], dtype=int)
+        self.ground = np.array([p["b"] < 0 for p in pairs], dtype=bool)
+        self.vloc = np.array([local[p["a"]][p["v"]] for p in pairs]).reshape(m, 2)
+        self.e0 = np.array([p["e0"] if p["b"] >= 0 else (0.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
+        self.t = np.array([p["t"] if p["b"] >= 0 else (1.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
+        self.n = np.array([p["n"] if p["b"] >= 0 else (0.0, 1.0) for p in pairs], dtype=float).reshape(m, 2)
+        self.length = np.array([p["L"] if p["b"] >= 0 else math.inf for p in pairs], dtype=float)
+        self.slack = EDGE_SLACK * np.where(self.ground, 0.0, self.length)
+        self.deep = np.array(
+            [DEEP_FRACTION * min(size[p["a"]], size[p["b"]] if p["b"] >= 0 else size[p["a"]]) for p in pairs]
+        )
+        movable = np.array([ds is not None for ds in ds_of] + [False])
+        self.mov_a = movable[self.a].astype(float)
+        self.mov_b = movable[self.b].astype(float)
+        self.twin = twins(scene, pairs)
+        self.inside = np.zeros(m, dtype=bool)
+        self.a_list, self.b_list = self.a.tolist(), self.b.tolist()
+        self.vloc_list, self.n_list, self.e0_list = self.vloc.tolist(), self.n.tolist(), self.e0.tolist()
+        self.slack_list, self.length_list = self.slack.tolist(), self.length.tolist()
+        self.deep_list = (-self.deep).tolist()
+        self.ground_list, self.twin_list = self.ground.tolist(), self.twin.tolist()
+        self.mova_list, self.movb_list = self.mov_a.tolist(), self.mov_b.tolist()
+        self.inters, self.views, self.cols = [], [], []
         laws = {}
         for pair in pairs:
             a, b = pair["a"], pair["b"]
@@ -229,66 +293,137 @@ class Contacts:
                 nsds.link(inter, ds_of[moving[0]])
             self.inters.append(inter)
             self.views.append((rel.C(), rel.e()))
-            self.moving.append(moving)
-        self.gaps = np.zeros(len(pairs))
+            # the columns of the (3, 6) Jacobian [body a | body b] this pair's C keeps
+            self.cols.append(slice(0, 6) if len(moving) == 2 else slice(0, 3) if moving[0] == a else slice(3, 6))
+        self.gaps = np.zeros(m)
+        self.jac = np.zeros((m, 3, 6))
+        self.off = np.zeros((m, 3))
 
-    def _state(self, i):
-        ds = self.ds_of[i]
-        if ds is None:
-            c, a = self.static[i]
-            return np.array([c[0], c[1], a])
-        return np.asarray(ds.q(), dtype=float)
+    def read_state(self):
+        """The moving bodies' (x, y, theta) from Siconos into ``self.q``."""
+        q, ds_of = self.q, self.ds_of
+        for i in self.moving_ids:
+            q[i] = ds_of[i].q()
+
+    def geometry(self):
+        """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs)."""
+        q = self.q
+        qa, qb = q[self.a], q[self.b]
+        ca, sa = np.cos(qa[:, 2]), np.sin(qa[:, 2])
+        cb, sb = np.cos(qb[:, 2]), np.sin(qb[:, 2])
+        vx, vy = self.vloc[:, 0], self.vloc[:, 1]
+        rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
+        px, py = qa[:, 0] + rax, qa[:, 1] + ray
+        nx = cb * self.n[:, 0] - sb * self.n[:, 1]
+        ny = sb * self.n[:, 0] + cb * self.n[:, 1]
+        tx, ty = -ny, nx
+        ex, ey = self.e0[:, 0], self.e0[:, 1]
+        dx = px - (qb[:, 0] + cb * ex - sb * ey)
+        dy = py - (qb[:, 1] + sb * ex + cb * ey)
+        gap = dx * nx + dy * ny
+        sp = dx * tx + dy * ty
+        inside = self.ground | ((sp >= -self.slack) & (sp <= self.length + self.slack))
+        inside &= gap >= -self.deep
+        self.inside[:] = inside
+        has = self.twin >= 0
+        shadowed = np.zeros_like(inside)
+        shadowed[has] = inside[self.twin[has]]
+        closed = inside & ~shadowed
+        rbx, rby = px - qb[:, 0], py - qb[:, 1]
+        J = self.jac
+        ma, mb = self.mov_a, self.mov_b
+        J[:, 0, 0], J[:, 0, 1], J[:, 0, 2] = nx * ma, ny * ma, (ny * rax - nx * ray) * ma
+        J[:, 1, 0], J[:, 1, 1], J[:, 1, 2] = tx * ma, ty * ma, (ty * rax - tx * ray) * ma
+        J[:, 2, 2] = TWIST_ARM * ma
+        J[:, 0, 3], J[:, 0, 4], J[:, 0, 5] = -nx * mb, -ny * mb, -(ny * rbx - nx * rby) * mb
+        J[:, 1, 3], J[:, 1, 4], J[:, 1, 5] = -tx * mb, -ty * mb, -(ty * rbx - tx * rby) * mb
+        J[:, 2, 5] = -TWIST_ARM * mb
+        cq = np.einsum("kij,kj->ki", J[:, :, :3], qa) + np.einsum("kij,kj->ki", J[:, :, 3:], qb)
+        self.off[:] = -cq
+        self.off[:, 0] += np.where(closed, gap - GAP_OFFSET_M, 1.0)
+        self.gaps[:] = np.where(closed, gap, math.inf)
+
+    def geometry_scalar(self):
+        """As :meth:`geometry`, pair by pair in plain Python floats: faster than numpy's
+        per-call overhead for the few pairs of a block or a small stack (SCALAR_PAIRS)."""
+        q, J, off, gaps = self.q, self.jac, self.off, self.gaps
+        for k in range(len(self.pairs)):
+            a, b = self.a_list[k], self.b_list[k]
+            xa, ya, pa = q[a]
+            xb, yb, pb = q[b]
+            ca, sa = math.cos(pa), math.sin(pa)
+            vx, vy = self.vloc_list[k]
+            rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
+            px, py = xa + rax, ya + ray
+            cb, sb = math.cos(pb), math.sin(pb)
+            n0, n1 = self.n_list[k]
+            nx, ny = cb * n0 - sb * n1, sb * n0 + cb * n1
+            tx, ty = -ny, nx
+            ex, ey = self.e0_list[k]
+            dx, dy = px - (xb + cb * ex - sb * ey), py - (yb + sb * ex + cb * ey)
+            gap = dx * nx + dy * ny
+            sp = dx * tx + dy * ty
+            slack, length = self.slack_list[k], self.length_list[k]
+            inside = (self.ground_list[k] or -slack <= sp <= length + slack) and gap >= self.deep_list[k]
+            self.inside[k] = inside
+            twin = self.twin_list[k]
+            closed = inside and not (twin >= 0 and self.inside[twin])
+            rbx, rby = px - xb, py - yb
+            ma, mb = self.mova_list[k], self.movb_list[k]
+            row0 = (nx * ma, ny * ma, (ny * rax - nx * ray) * ma, -nx * mb, -ny * mb, -(ny * rbx - nx * rby) * mb)
+            row1 = (tx * ma, ty * ma, (ty * rax - tx * ray) * ma, -tx * mb, -ty * mb, -(ty * rbx - tx * rby) * mb)
+            row2 = (0.0, 0.0, TWIST_ARM * ma, 0.0, 0.0, -TWIST_ARM * mb)
+            J[k] = (row0, row1, row2)
+            off[k] = (
+                (gap - GAP_OFFSET_M if closed else 1.0)
+                - (row0[0] * xa + row0[1] * ya + row0[2] * pa + row0[3] * xb + row0[4] * yb + row0[5] * pb),
+                -(row1[0] * xa + row1[1] * ya + row1[2] * pa + row1[3] * xb + row1[4] * yb + row1[5] * pb),
+                -(row2[2] * pa + row2[5] * pb),
+            )
+            gaps[k] = gap if closed else math.inf
 
     def update(self):
         """C and e of every pair at the bodies' current positions; the gaps (m) kept."""
-        q = {}
-        for k, pair in enumerate(self.pairs):
-            a, b = pair["a"], pair["b"]
-            qa = q.get(a)
-            if qa is None:
-                qa = q[a] = self._state(a)
-            ra = _rot(qa[2]) @ self.local[a][pair["v"]]
-            point = qa[:2] + ra
-            inside = True
-            if b < 0:
-                n = np.array([0.0, 1.0])
-                gap = point[1]
-                rb = None
-            else:
-                qb = q.get(b)
-                if qb is None:
-                    qb = q[b] = self._state(b)
-                rot = _rot(qb[2])
-                n = rot @ pair["n"]
-                t = rot @ pair["t"]
-                p0 = qb[:2] + rot @ pair["e0"]
-                gap = float((point - p0) @ n)
-                sp = float((point - p0) @ t)
-                slack = EDGE_SLACK * pair["L"]
-                inside = -slack <= sp <= pair["L"] + slack
-                rb = point - qb[:2]
-            tx, ty = -n[1], n[0]
-            C, e = self.views[k]
-            col = 0
-            qq = []
-            for body, sign, r in ((a, 1.0, ra), (b, -1.0, rb)):
-                if body < 0 or self.ds_of[body] is None:
-                    continue
-                C[0, col : col + 3] = (sign * n[0], sign * n[1], sign * (n[1] * r[0] - n[0] * r[1]))
-                C[1, col : col + 3] = (sign * tx, sign * ty, sign * (ty * r[0] - tx * r[1]))
-                C[2, col : col + 3] = (0.0, 0.0, sign * TWIST_ARM)
-                qq.append(q[body])
-                col += 3
-            qv = np.concatenate(qq)
-            self.gaps[k] = gap if inside else math.inf
-            e[0] = (gap - GAP_OFFSET_M if inside else 1.0) - float(C[0] @ qv)
-            e[1] = -float(C[1] @ qv)
-            e[2] = -float(C[2] @ qv)
+        self.read_state()
+        if len(self.pairs) <= SCALAR_PAIRS:
+            self.geometry_scalar()
+        else:
+            self.geometry()
+        J, off = self.jac, self.off
+        for k, (C, e) in enumerate(self.views):
+            C[:] = J[k, :, self.cols[k]]
+            e[:] = off[k]
+
+
+def twins(scene, pairs):
+    """For each pair, the index of an earlier pair at the same point of the same two bodies
+    with the opposite normal (a vertex of each on the other's edge, the corners coinciding),
+    else -1 (:class:`Contacts`)."""
+    bodies = scene["bodies"]
+    world = []
+    for b in bodies:
+        v = np.asarray(b["vertices_m"], dtype=float)
+        world.append(np.asarray(b["centroid0_m"], dtype=float) + v @ _rot(b["angle0_rad"]).T)
+    size = min(float(np.min(np.ptp(w, axis=0))) for w in world)
+    tol = TWIN_FRACTION * size
+    seen = {}
+    out = np.full(len(pairs), -1, dtype=int)
+    for k, p in enumerate(pairs):
+        if p["b"] < 0:
+            continue
+        point = world[p["a"]][p["v"]]
+        key = (min(p["a"], p["b"]), max(p["a"], p["b"]))
+        for j, other in seen.get(key, []):
+            if pairs[j]["a"] != p["a"] and float(np.hypot(*(other - point))) <= tol:
+                out[k] = j
+                break
+        seen.setdefault(key, []).append((k, point))
+    return out
 
 
 def build(scene, S):
     """The Siconos simulation of a scene: returns a dict of what the stepping needs."""
-    sk, sn = S["sk"], S["sn"]
+    sk = S["sk"]
     t_end = scene["n_steps"] * scene["dt_s"]
     nsds = sk.NonSmoothDynamicalSystem(0.0, t_end)
     bodies = []
@@ -312,15 +447,155 @@ def build(scene, S):
     contacts.update()
     osi = sk.MoreauJeanOSI(float(scene["theta"]))
     timedisc = sk.TimeDiscretisation(0.0, float(scene["dt_s"]))
-    so = sk.solver_options_create(getattr(sn, SOLVERS[scene["friction_solver"]]))
-    so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(scene["solver_max_iter"])
-    so.dparam[sn.SICONOS_DPARAM_TOL] = float(scene["solver_tol"])
-    problem = sk.FrictionContact(3, so)
+    stepper = Stepper(scene, S, contacts, bodies)
+    problem = sk.FrictionContact(3, stepper.options(stepper.names[0]))
     problem.setKeepLambdaAndYState(True)
     sim = sk.TimeStepping(nsds, timedisc, osi, problem)
     sim.setNewtonMaxIteration(int(scene["newton_max_iter"]))
     sim.setNewtonTolerance(float(scene["newton_tol"]))
-    return {"sim": sim, "nsds": nsds, "bodies": bodies, "so": so, "contacts": contacts, "problem": problem}
+    stepper.attach(sim, problem)
+    return {"sim": sim, "nsds": nsds, "bodies": bodies, "contacts": contacts, "problem": problem, "stepper": stepper}
+
+
+class StepError(Exception):
+    """A step no friction-contact solver could take (the run ends ``failed`` with this reason)."""
+
+
+class Stepper:
+    """One Moreau-Jean step, retried when the friction-contact solver fails.
+
+    A step fails when Siconos raises, when the solver's residual stays above the tolerance,
+    or when the state comes out non-finite or beyond MAX_SPEED_M_S / MAX_SPIN_RAD_S. A failed
+    step is taken again from the state before it (positions, velocities and the contacts'
+    impulses restored, their C and e recomputed) with each fallback solver in turn (``fallback_solvers``;
+    NSGS: slow on a hyperstatic stack but unaffected by redundant contacts, on which the
+    nonsmooth Newton's LU factorisation is singular). A fallback that succeeds is kept for
+    1, 8, 64, ... steps (HOLD_GROWTH) before the first
+    solver is tried again. A step every solver fails ends the run when it raised or left a
+    non-finite or runaway state (StepError); a step that merely stayed above the
+    tolerance is kept and counted (``unconverged_steps``), as before.
+    """
+
+    def __init__(self, scene, S, contacts, bodies):
+        self.S, self.sk, self.sn = S, S["sk"], S["sn"]
+        self.scene = scene
+        self.contacts = contacts
+        self.moving = [ds for ds in bodies if ds is not None]
+        first = scene["friction_solver"]
+        self.names = [first] + [f for f in scene.get("fallback_solvers", ["nsgs", "admm"]) if f != first]
+        self.tol = float(scene["solver_tol"])
+        self.active = 0
+        self.back_at = 0
+        self.hold = 1
+        self.retries = 0  # steps taken again with a fallback solver
+        self.retried_ok = 0  # ... of which a fallback converged
+        self.fallback_steps = 0  # steps solved by a fallback solver
+        self.loose = 0  # steps accepted between solver_tol and ACCEPT_FACTOR x solver_tol
+        self.sim = self.problem = None
+
+    def options(self, name):
+        """Numerics options of solver ``name`` (SOLVERS) with the scene's tolerance and cap."""
+        sn = self.sn
+        so = self.sk.solver_options_create(getattr(sn, SOLVERS[name]))
+        self._set(so, name)
+        return so
+
+    def _set(self, so, name):
+        sn = self.sn
+        cap = int(self.scene["solver_max_iter"])
+        if name == "nsn" and len(self.names) > 1:
+            cap = min(cap, NSN_MAX_ITER)
+        so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = cap
+        so.dparam[sn.SICONOS_DPARAM_TOL] = self.tol
+
+    def attach(self, sim, problem):
+        self.sim, self.problem = sim, problem
+        self.so = problem.numericsSolverOptions()
+
+    def _use(self, index):
+        if index != self.active:
+            self.problem.setSolverId(getattr(self.sn, SOLVERS[self.names[index]]))
+            self.so = self.problem.numericsSolverOptions()
+            self._set(self.so, self.names[index])
+            self.active = index
+
+    def _attempt(self):
+        """computeOneStep; (ok, why) with why None, "unconverged" or a fatal reason."""
+        sn = self.sn
+        so = self.so
+        so.iparam[sn.SICONOS_IPARAM_ITER_DONE] = 0
+        so.dparam[sn.SICONOS_DPARAM_RESIDU] = 0.0
+        try:
+            self.sim.computeOneStep()
+        except Exception as exc:  # Siconos raises std::exception when its solver fails
+            return False, f"Siconos raised {type(exc).__name__}: {exc} ({self.names[self.active]})"
+        for ds in self.moving:
+            q, v = ds.q(), ds.velocity()
+            vx, vy, w = float(v[0]), float(v[1]), float(v[2])
+            if not math.isfinite(float(q[0]) + float(q[1]) + float(q[2]) + vx + vy + w):
+                return False, "non-finite state"
+            if math.hypot(vx, vy) > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
+                return False, "runaway speed"
+        if self.problem.getSizeOutput() > 0:
+            res = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+            if not (res <= self.tol):
+                if res <= ACCEPT_FACTOR * self.tol:
+                    return True, "loose"
+                return False, "unconverged"
+        return True, None
+
+    def step(self, index):
+        """Take step ``index`` (0-based); returns True when the friction-contact problem had
+        contacts. Raises StepError when no solver could take it."""
+        first = 0 if index >= self.back_at else self.active
+        order = [first] + [k for k in range(len(self.names)) if k != first]
+        saved = (
+            [(ds, np.array(ds.q()), np.array(ds.velocity())) for ds in self.moving],
+            [np.array(inter.lambda_(1)) for inter in self.contacts.inters],
+        )
+        finite = None  # the first solver whose step stayed finite, unconverged
+        why = None
+        for n, k in enumerate(order):
+            if n:
+                self._restore(saved)
+            self._use(k)
+            ok, why = self._attempt()
+            if ok:
+                if n:
+                    self.retried_ok += 1
+                    if first == 0:
+                        self.back_at = index + 1 + self.hold
+                        self.hold *= HOLD_GROWTH
+                if why == "loose":
+                    self.loose += 1
+                break
+            if n == 0:
+                self.retries += 1
+            if why == "unconverged" and finite is None:
+                finite = k
+        else:
+            if finite is None:
+                names = ", ".join(self.names[k] for k in order)
+                t = (index + 1) * self.scene["dt_s"]
+                raise StepError(f"no friction-contact solver could take the step to t = {t:.6g} s ({names}: {why})")
+            if finite != order[-1] or why != "unconverged":
+                self._restore(saved)
+                self._use(finite)
+                self._attempt()
+        if self.active != 0:
+            self.fallback_steps += 1
+        return self.problem.getSizeOutput() > 0
+
+    def _restore(self, saved):
+        """The positions, velocities and contact impulses before the step (the impulses start
+        the next solver: a failed Newton leaves them non-finite), and the contacts' C and e."""
+        states, impulses = saved
+        for ds, q, v in states:
+            ds.setQ(q)
+            ds.setVelocity(v)
+        for inter, lam in zip(self.contacts.inters, impulses, strict=True):
+            inter.lambda_(1)[:] = lam
+        self.contacts.update()
 
 
 class Recorder:
@@ -344,6 +619,7 @@ class Recorder:
         self.verts = [np.asarray(b["vertices_m"], dtype=float) for b in scene["bodies"]]
         self.k = 0
         self.status, self.stop_time, self.stop_body = "completed", None, None
+        self.failure_reason = None
         self.overturn_times = {}
         self.max_penetration = 0.0  # of a vertex below the ground, m (geometric)
         self.max_overlap = 0.0  # Bullet's -gap, m (a disk's includes about 0.44 of its radius)
@@ -371,9 +647,9 @@ class Recorder:
             x, y, phi = float(q[0]), float(q[1]), float(q[2])
             vx, vy, w = float(v[0]), float(v[1]), float(v[2])
             if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(phi) and math.isfinite(w)):
-                return self._fail(t, i)
+                return self._fail(t, i, "non-finite state")
             if math.hypot(vx, vy) > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
-                return self._fail(t, i)
+                return self._fail(t, i, "runaway speed")
             self.pos[k, i] = (x, y)
             self.ang[k, i] = phi
             self.angvel[k, i] = w
@@ -393,8 +669,9 @@ class Recorder:
         self.k = k + 1
         return self.status == "completed"
 
-    def _fail(self, t, i):
+    def _fail(self, t, i, why):
         self.status, self.stop_time, self.stop_body = "failed", t, i
+        self.failure_reason = f"{why} of body {i} at t = {t:.6g} s"
         return False
 
     def _contacts(self, k):
@@ -436,20 +713,21 @@ class Recorder:
         """The numerics solver's iterations and residual after a step (when it ran)."""
         if not had_contacts:
             return
-        sn, so = self.sn, self.built["so"]
+        sn, so = self.sn, self.built["stepper"].so
         it = int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
         res = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
         self.solver_calls += 1
         self.iterations += it
         if res > self.max_residual:
             self.max_residual = res
-        if res > self.scene["solver_tol"] or not math.isfinite(res):
+        if res > ACCEPT_FACTOR * self.scene["solver_tol"] or not math.isfinite(res):
             self.unconverged += 1
             if self.first_unconverged_s is None:
                 self.first_unconverged_s = t
 
     def write(self, complete):
         n = self.k
+        stepper = self.built["stepper"]
         meta = {
             "status": self.status if complete or self.status == "timeout" else "running",
             "stop_time_s": self.stop_time,
@@ -465,6 +743,12 @@ class Recorder:
             "unconverged_steps": self.unconverged,
             "first_unconverged_s": self.first_unconverged_s,
             "max_residual": self.max_residual,
+            "failure_reason": self.failure_reason,
+            "retried_steps": stepper.retries,
+            "retried_steps_converged": stepper.retried_ok,
+            "fallback_steps": stepper.fallback_steps,
+            "loose_steps": stepper.loose,
+            "friction_solvers": stepper.names,
             "max_penetration_m": self.max_penetration,
             "max_bullet_overlap_m": self.max_overlap,
             "complete": complete,
@@ -516,7 +800,6 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     S = _siconos()
     built = build(scene, S)
     rec = Recorder(scene, built, S, out_path)
-    sim = built["sim"]
     moving = [
         (i, ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
         for i, ds in enumerate(built["bodies"])
@@ -527,9 +810,7 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     deadline = math.inf if deadline is None else float(deadline)
     flush_s = math.inf if flush_s is None else float(flush_s)
     next_flush = time.monotonic() + flush_s
-    so, sn = built["so"], S["sn"]
-    problem = built["problem"]
-    contacts = built["contacts"]
+    sim, stepper, contacts = built["sim"], built["stepper"], built["contacts"]
     go = rec.record(0.0)
     step = 0
     while go and step < n_steps:
@@ -543,11 +824,13 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
                 m0, q = load["arm_Nm"]
                 ds.setFExtPtr([m * ax + fx, m * ay + fy, math.cos(phi) * m0 - math.sin(phi) * q])
         contacts.update()
-        so.iparam[sn.SICONOS_IPARAM_ITER_DONE] = 0
-        sim.computeOneStep()
+        try:
+            had = stepper.step(step)
+        except StepError as exc:
+            rec.status, rec.stop_time, rec.failure_reason = "failed", step * dt, str(exc)
+            break
         step += 1
         t = step * dt
-        had = problem.getSizeOutput() > 0
         rec.step_diagnostics(t, had)
         rec.steps = step
         if step % sps == 0:

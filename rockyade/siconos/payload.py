@@ -57,6 +57,11 @@ class Numerics:
         The friction-contact solver: "nsn" (Alart-Curnier nonsmooth Newton, the default:
         a few iterations a step on stacked contacts) or "nsgs" (Gauss-Seidel: thousands of
         iterations on a stack, whose two contacts per joint make it hyperstatic).
+    fallback_solvers
+        Solvers that take again, from the state before it, a step the first one failed
+        (Siconos raised, the residual stayed above ``solver_tol``, or the state ran away):
+        NSGS by default, unaffected by the redundant contacts of a wall or an arch, on which
+        the nonsmooth Newton's LU factorisation is singular.
     solver_tol, solver_max_iter
         Tolerance and iteration cap of the friction-contact solver.
     newton_max_iter, newton_tol
@@ -67,6 +72,7 @@ class Numerics:
     steps_per_sample: int
     restitution: float = 0.0
     friction_solver: str = "nsn"
+    fallback_solvers: tuple[str, ...] = ("nsgs", "admm")
     solver_tol: float = 1e-8
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
@@ -204,6 +210,7 @@ def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
         "restitution": numerics.restitution,
         "theta": THETA,
         "friction_solver": numerics.friction_solver,
+        "fallback_solvers": list(numerics.fallback_solvers),
         "solver_tol": numerics.solver_tol,
         "solver_max_iter": numerics.solver_max_iter,
         "newton_max_iter": numerics.newton_max_iter,

@@ -110,7 +110,8 @@ class SiconosSolver(SolverBase):
         Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
         restitution, Housner's Eq 4).
     solver_tol, solver_max_iter
-        Tolerance and iteration cap of the friction-contact solver (NSGS).
+        Tolerance and iteration cap of the friction-contact solvers (the nonsmooth Newton,
+        then NSGS and ADMM on a step it fails; the Newton stops at 100 iterations at most).
     newton_max_iter
         Newton iterations per step on the nonlinear kinematics (1: linearised once).
     workdir
