@@ -193,11 +193,12 @@ def complete(plan, tmp_path_factory):
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
     assert summary.partial is False and summary.verdicts
-    from rockyade.studies.crosscheck import RESULT_FILES, partial_dir
+    from rockyade.studies.crosscheck import RESULT_FILES, journal_dir
 
     for name in RESULT_FILES:
         assert (out / name).is_file(), name
-    assert not partial_dir(out).exists()
+    assert not journal_dir(out).exists()  # the set complete, the journal goes
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(RESULT_FILES)
     ci = pd.read_csv(out / "collapse_intensities.csv")
     for column in (
         "record",
@@ -240,16 +241,6 @@ def test_small_real_crosscheck(complete, plan):
     assert "## Verdicts" in index and "PARTIAL" not in index and "housner / reference" in index
 
 
-def test_dt_factor_is_recorded_in_every_run(complete):
-    out, _summary = complete
-    for folder, factor in (("dt1", 1.0), ("dt0.5", 0.5)):
-        files = list((out / folder / "runs").glob("*.json"))
-        assert files
-        for path in files[:6]:
-            meta = json.loads(path.read_text())
-            assert meta["dt_factor"] == factor and meta["dt_s"] > 0
-
-
 def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
     import rockyade.studies.crosscheck as cc
 
@@ -268,20 +259,29 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
     out = tmp_path / "out"
     with pytest.raises(BatchInterruptedError):
         run(plan, out)
-    stage = cc.partial_dir(out)
+    stage = cc.journal_dir(out)
     partial = json.loads((stage / "crosscheck.json").read_text())
-    assert partial["partial"] is True and not out.exists()
+    assert partial["partial"] is True and not (out / "crosscheck.json").exists()
     assert "PARTIAL" in (stage / "index.md").read_text()
     first = {p: p.stat().st_mtime_ns for p in stage.rglob("runs/*.json")}
     assert 0 < len(first) < total
+    for path in first:  # each run in the journal says its time-step factor (its folder's) and step
+        meta = json.loads(path.read_text())
+        assert meta["dt_factor"] == float(path.parent.parent.name.removeprefix("dt")) and meta["dt_s"] > 0
+    assert set(pd.read_csv(reference_out / "runs.csv").dt_factor) == {1.0, 0.5}
     monkeypatch.setattr(cc, "run_study_tasks", real)
+    written: list[str] = []
+    real_write = cc.run_study_tasks
+
+    def watch(tasks, *args, **kwargs):  # every run the resumed study makes
+        written.extend(str(t.scene_hash) + t.solver.name + str(t.out_dir) for t in tasks)
+        return real_write(tasks, *args, **kwargs)
+
+    monkeypatch.setattr(cc, "run_study_tasks", watch)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
     assert data["runs_reused"] == len(first)
-    assert data["runs_made"] == total - len(first)  # no run made twice
-    for path, mtime in first.items():  # the first pass's runs were read, not written again
-        moved = out / path.relative_to(stage)
-        assert moved.stat().st_mtime_ns == mtime
+    assert data["runs_made"] == total - len(first) == len(written)  # no run made twice
     same = pd.read_csv(out / "collapse_intensities.csv")
     pd.testing.assert_frame_equal(same, pd.read_csv(reference_out / "collapse_intensities.csv"))
 
@@ -303,8 +303,8 @@ def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypat
     out = tmp_path / "out"
     with pytest.raises(SystemExit):
         run(plan, out)
-    assert not (cc.partial_dir(out) / "crosscheck.json").exists()
-    done = len(list(cc.partial_dir(out).rglob("runs/*.json")))
+    assert not (cc.journal_dir(out) / "crosscheck.json").exists() and not (out / "crosscheck.json").exists()
+    done = len(list(cc.journal_dir(out).rglob("runs/*.json")))
     monkeypatch.setattr(cc, "run_study_tasks", real)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
@@ -343,42 +343,82 @@ def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp
     assert data["plan"]["dt_factors"] == [1.0] and data["runs_reused"] == 0
     ci = pd.read_csv(out / "collapse_intensities.csv")
     assert set(ci.record) == {"rec1.csv"} and set(ci.dt_factor) == {1.0}
-    files = list(out.rglob("runs/*.json"))
-    assert len(files) == data["runs_made"] == len(pd.read_csv(out / "runs.csv"))  # no run of the old set left
-    assert not (out / "dt0.5").exists() and not cc.partial_dir(out).exists()
-    assert not list(out.parent.glob(".out.old-*"))
+    assert data["runs_made"] == len(pd.read_csv(out / "runs.csv"))  # no run of the old set left
+    assert not list(out.rglob("runs/*.json")) and not cc.journal_dir(out).exists()
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(cc.RESULT_FILES)
 
 
-def test_settle_finishes_a_cut_swap(tmp_path):
-    from rockyade.studies.crosscheck import partial_dir, settle
+def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_path):
+    """A real ``rockyade crosscheck`` process sent SIGINT once its first run is in the journal:
+    exit 130, the earlier complete set byte for byte as it was (no file of the new study in it,
+    nothing that looks complete), the partial summary in the journal; --resume then finishes."""
+    import os
+    import shutil
+    import signal
+    import subprocess
+    import sys
+    import time
 
     out = tmp_path / "out"
-    old = tmp_path / ".out.old-abcd"
-    old.mkdir()
-    (old / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "old"}))
-    settle(out)  # killed between the two renames, the new set not complete: the old one comes back
-    assert json.loads((out / "crosscheck.json").read_text())["who"] == "old" and not old.exists()
-    old = tmp_path / ".out.old-efgh"
-    out.rename(old)
-    stage = partial_dir(out)
-    stage.mkdir()
-    (stage / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "new"}))
-    settle(out)  # the new set was complete: it goes in, the old one is removed
-    assert json.loads((out / "crosscheck.json").read_text())["who"] == "new"
-    assert not old.exists() and not stage.exists()
+    shutil.copytree(complete[0], out)
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    argv = [
+        sys.executable,
+        "-m",
+        "rockyade",
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--levels",
+        "0.3,0.6,1.2",
+        "--resolution",
+        "0.02",
+        "--dt-factors",
+        "1",
+        "--tail",
+        "1",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(out),
+    ]
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    journal = out / "partial"
+    deadline = time.monotonic() + 600
+    while not list(journal.rglob("runs/*.json")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()[0]
+    proc.send_signal(signal.SIGINT)
+    text = proc.communicate(timeout=600)[0]
+    assert proc.returncode == 130, text
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    assert after == before  # the previous set untouched, nothing of the new study mixed in
+    assert json.loads((journal / "crosscheck.json").read_text())["partial"] is True
+    assert not list(out.glob(".set.*"))  # no staged set left behind
+    resumed = subprocess.run([*argv, "--resume"], env=env, capture_output=True, text=True, timeout=900)
+    assert resumed.returncode == 0, resumed.stdout + resumed.stderr
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["partial"] is False and data["runs_reused"] >= 1 and data["plan"]["dt_factors"] == [1.0]
+    assert not journal.exists()
 
 
-def test_out_that_is_not_a_crosscheck_is_refused(tmp_path):
-    from rockyade.studies.crosscheck import check_out
+def test_out_that_is_a_link_or_a_file_is_refused(tmp_path):
+    from rockyade.studies.crosscheck import check_out, journal_dir
 
     mine = tmp_path / "mine"
     mine.mkdir()
-    (mine / "notes.txt").write_text("keep me")
-    with pytest.raises(InputError, match="--out"):
-        check_out(mine)
     (tmp_path / "link").symlink_to(mine)
     with pytest.raises(InputError, match="symbolic link"):
         check_out(tmp_path / "link")
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="is a file"):
+        check_out(tmp_path / "file")
+    journal_dir(mine).symlink_to(tmp_path)  # the journal, cleared without --resume, must not be a link
+    with pytest.raises(InputError, match="symbolic link"):
+        check_out(mine)
 
 
 # ---------------------------------------------------------------------- the command
