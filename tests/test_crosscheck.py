@@ -461,6 +461,57 @@ def test_bad_input_is_one_line_and_exit_2(argv, option, records, tmp_path, capsy
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize("kind", ["linked folder", "real folder", "link without suffix", "dangling link"])
+def test_records_folder_refuses_what_it_would_skip_naming_it(kind, records, tmp_path, capsys):
+    """A records folder holding a subfolder (linked or real) or a link that is not a record
+    link: exit 2, one line naming the entry; nothing is skipped silently or followed."""
+    import shutil
+
+    folder = tmp_path / "recs"
+    shutil.copytree(records, folder)
+    shared = write_records(tmp_path / "shared", count=3)
+    entry = {
+        "linked folder": folder / "more",
+        "real folder": folder / "more",
+        "link without suffix": folder / "rec3",
+        "dangling link": folder / "gone.csv",
+    }[kind]
+    if kind == "linked folder":
+        entry.symlink_to(shared)
+    elif kind == "real folder":
+        entry.mkdir()
+        shutil.copy(shared / "rec3.csv", entry / "rec3.csv")
+    elif kind == "link without suffix":
+        entry.symlink_to(shared / "rec3.csv")
+    else:
+        entry.symlink_to(tmp_path / "nothing.csv")
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(folder),
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--records" in err[0] and str(entry) in err[0], err
+    assert not (tmp_path / "o").exists()
+
+
+def test_records_folder_follows_links_to_record_files_and_ignores_hidden_entries(records, tmp_path):
+    from rockyade.assess import records_in_folder
+
+    folder = tmp_path / "links"
+    folder.mkdir()
+    for path in sorted(records.iterdir()):
+        (folder / path.name).symlink_to(path)
+    (folder / ".cache").mkdir()
+    (folder / "README.md").write_text("two records")
+    motions = records_in_folder(folder)
+    assert motions.count == 2 and [Path(p) for p in motions.files] == sorted(p.resolve() for p in records.iterdir())
+
+
 def test_command_writes_the_set(records, tmp_path, capsys):
     out = tmp_path / "cc"
     code = cli(
