@@ -421,6 +421,49 @@ def test_out_that_is_a_link_or_a_file_is_refused(tmp_path):
         check_out(mine)
 
 
+WARM_UP_CHECK = """
+import sys
+from pathlib import Path
+from rockyade.assess import parse_measure, records_in_folder
+from rockyade.runner import Executor
+from rockyade.scene import load_scene
+from rockyade.studies.crosscheck import Study, crosscheck_plan
+from rockyade.kernel.runs import simulate_runs
+from rockyade.kernel.single import simulate_single
+plan = crosscheck_plan(load_scene(Path(sys.argv[1])), records_in_folder(sys.argv[2]), parse_measure("pga"),
+    ["housner", "reference"], levels=[0.3, 0.6], dt_factors=(1.0, 0.5), resolution=0.2,
+    executor=Executor("threads", 1), progress=False)
+assert not simulate_runs.signatures and not simulate_single.signatures
+Study(plan, Path(sys.argv[3]), Executor("local", 2), progress=False, allow_large=False, say=print).warm_up()
+print(len(simulate_runs.signatures), len(simulate_single.signatures))
+"""
+
+
+def test_warm_up_loads_the_kernels_the_workers_run(records, tmp_path):
+    """In a fresh process, the study's warm-up loads the reference DEM's grouped and single-run
+    kernels as the batch runs them (the lean solver, without energy terms): the workers forked
+    for each round inherit them instead of loading (or compiling) them again, each."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    argv = [sys.executable, "-c", WARM_UP_CHECK, str(EXAMPLES / "specimen1_record.toml"), str(records), str(tmp_path)]
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    grouped, single = (int(x) for x in done.stdout.split()[-2:])
+    assert grouped >= 1 and single >= 1
+
+
+def test_cost_line_counts_the_start_up(plan):
+    from rockyade.studies.crosscheck import ROUND_OVERHEAD_S
+
+    line = plan.cost_line(2)
+    assert "start-up" in line and f"{plan.rounds()} rounds" in line
+    assert plan.rounds() >= 2 * len(plan.dt_factors)  # the scan and at least one bisection per factor
+    assert plan.startup_s() >= plan.rounds() * ROUND_OVERHEAD_S
+
+
 # ---------------------------------------------------------------------- the command
 
 

@@ -64,6 +64,15 @@ from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 DT_FACTORS = (1.0, 0.5)
 #: The files of a complete set.
 RESULT_FILES = ("collapse_intensities.csv", "pairs.csv", "runs.csv", "crosscheck.json", "crosscheck.png", "index.md")
+#: Start-up costs the solvers' per-run estimates leave out, measured on a quiet 2-core machine
+#: (docs/verification.md, "Cost"): per round and time-step factor, a pool of worker processes
+#: forked and the round's runs and summary written, s;
+ROUND_OVERHEAD_S = 1.0
+#: loading the in-process solvers' compiled kernels once before the rounds, s;
+WARM_UP_S = 2.0
+#: compiling them when numba's cache lacks them (the first run after an install or a change of
+#: the kernels), CPU s.
+COMPILE_S = 60.0
 #: The file that marks a set complete (written last).
 RESULT_LAST = "crosscheck.json"
 #: The journal's folder in --out while a study is unfinished.
@@ -159,6 +168,21 @@ class CrosscheckPlan:
         bisections = max(0, math.ceil(math.log2(math.log(step) / math.log1p(self.resolution))))
         return len(self.searches()) * (len(scan) + bisections)
 
+    def rounds(self) -> int:
+        """Rounds the study is expected to take: the scan, then one per bisection step, per
+        time-step factor (the searches of one factor advance together)."""
+        per_search = self.expected_runs() / max(1, len(self.searches()))
+        return len(self.dt_factors) * (1 + max(0, round(per_search) - len(self.scan_si)))
+
+    def startup_s(self) -> float:
+        """What the solvers' estimates leave out, s: each round's pool of workers, the warm-up
+        of the in-process kernels and, when numba's cache lacks them, their compilation."""
+        in_process = any(solver_class(s).IN_PROCESS for s in self.solvers)
+        seconds = self.rounds() * ROUND_OVERHEAD_S
+        if in_process:
+            seconds += WARM_UP_S if kernels_cached() else COMPILE_S
+        return seconds
+
     def cost_line(self, workers: int) -> str:
         """The study's expected runs and time, before anything runs."""
         plan = self.stripes.stripes
@@ -169,11 +193,32 @@ class CrosscheckPlan:
         seconds = 0.0
         for s, f, _i in self.searches():
             seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
+        startup = self.startup_s()
+        compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached()
         return (
             f"cost: about {self.expected_runs()} runs ({len(self.searches())} searches of {per_search:.0f} runs: "
             f"{len(self.scan_si)} scan levels, then bisection to {100 * self.resolution:g} %), "
-            f"about {_duration(seconds / max(1, workers))} on {workers} worker(s) by the solvers' estimates"
+            f"about {_duration(seconds / max(1, workers) + startup)} on {workers} worker(s): the solvers' estimates "
+            f"({_duration(seconds / max(1, workers))}) and start-up ({_duration(startup)}: {self.rounds()} rounds"
+            + (", the kernels compiled once: numba's cache lacks them" if compiling else "")
+            + "), on an idle machine"
         )
+
+
+def kernels_cached() -> bool:
+    """Whether numba's on-disk cache holds the in-process solvers' batch kernels (the grouped
+    and single-run reference DEM, Housner's integrator): else the first run compiles them."""
+    from rockyade.housner.integrator import _integrate
+    from rockyade.kernel.runs import simulate_runs
+    from rockyade.kernel.single import simulate_single
+
+    for dispatcher in (simulate_runs, simulate_single, _integrate):
+        try:  # numba's index of the function's cache: empty when missing or of other source (stale)
+            if not dispatcher._cache._cache_file._load_index():
+                return False
+        except Exception:  # numba's internals moved: assume the cache is there (the smaller estimate)
+            return True
+    return True
 
 
 def _solver(name: str, dt_factor: float, solver_options: Mapping[str, Any]) -> Solver:
@@ -443,23 +488,31 @@ class Study:
         return todo
 
     def warm_up(self) -> None:
-        """Load, in this process, the compiled code of the solvers that run groups of runs in
-        process (``run_group``), on a run of 0.05 s: worker processes forked for each round
-        then inherit it rather than load it again (seconds a round on a busy machine)."""
+        """Load (or, on a cold numba cache, compile) in this process the compiled code of the
+        solvers that run in process, as the batch runs them (the lean solver of
+        :func:`rockyade.studies.batch.batch_task`: without energy terms), on a run of 0.05 s: both
+        the grouped path (``run_group``) and the run of its own. The worker processes forked for
+        each round inherit it. Before, the warm-up used the plan's solvers, whose energy terms
+        keep the reference DEM out of groups: every worker of every round loaded the kernels
+        again and, on a cold cache, both workers compiled the same kernels at once (minutes of
+        CPU under load; docs/verification.md, "Cost")."""
         from rockyade.analysis.metrics import uplift_threshold_rad
 
         if self.executor.in_process or not self.plan.scene.blocks:
             return
-        sp = self.plan.stripes.stripes
-        scene = sp.scene_for(0, sp.load_factor(0, self.plan.scan_si[0]))
-        scene = replace(scene, duration_s=min(scene.duration_s, 0.05))
-        alpha = scene.blocks[0].classical().alpha_rad
-        for solver in self.solvers.values():
-            key = getattr(solver, "group_key", None)
-            if key is None or key(scene) is None:
+        level = self.plan.scan_si[0]
+        for (name, f), solver in self.solvers.items():
+            if not getattr(solver, "IN_PROCESS", False):
                 continue
+            task = self.task((name, f, 0), level)
+            scene = replace(task.scene, duration_s=min(task.scene.duration_s, 0.05))
+            lean = task.solver
             try:
-                solver.run_group([scene], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                key = getattr(lean, "group_key", None)
+                if key is not None and key(scene) is not None:
+                    alpha = scene.blocks[0].classical().alpha_rad
+                    lean.run_group([scene], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                lean.run(scene)
             except Exception:  # a warm-up that fails costs only time; the runs say what is wrong
                 continue
 
