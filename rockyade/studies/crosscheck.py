@@ -214,7 +214,8 @@ def kernels_cached() -> bool:
 
     for dispatcher in (simulate_runs, simulate_single, _integrate):
         try:  # numba's index of the function's cache: empty when missing or of other source (stale)
-            if not dispatcher._cache._cache_file._load_index():
+            cache: Any = getattr(dispatcher, "_cache", None)
+            if not cache._cache_file._load_index():
                 return False
         except Exception:  # numba's internals moved: assume the cache is there (the smaller estimate)
             return True
