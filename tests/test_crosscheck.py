@@ -726,3 +726,32 @@ def test_resume_of_a_complete_study_is_refused_and_leaves_it_alone(complete):
     with pytest.raises(InputError, match="nothing to resume"):
         run(None, out, resume=True)  # the refusal comes before the plan is used
     assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before
+
+
+# ---------------------------------------------------------------------- make run's part
+
+
+def test_paper_part_runs_siconos_on_a_subset_it_can_run():
+    """``make run``'s cross-check has YADE and Siconos subsets beside the four specimens; Siconos's
+    uses the paper's calibration, since it cannot reach specimen 1's matched mu (refused)."""
+    from rockyade.siconos.backend import siconos_available
+    from rockyade.siconos.calibration import check_target_mu
+    from rockyade.solvers import make_solver
+    from rockyade.studies import paper_crosscheck as pc
+
+    todo, left_out = pc.jobs(use_yade=False)
+    assert [j.solvers for j in todo][:4] == [("housner", "reference")] * 4
+    assert any("YADE" in why for why in left_out)  # said, not silently dropped
+    siconos = [j for j in todo if "siconos" in j.solvers]
+    if not siconos_available():
+        assert not siconos and any("Siconos" in why for why in left_out)
+        return
+    (job,) = siconos
+    assert job.solvers == ("reference", "siconos") and job.records >= 5 and job.calibration == "paper"
+    solver = make_solver("siconos")
+    matched = pc.specimen_scene(job.specimen)
+    with pytest.raises(InputError, match="cannot reach"):
+        check_target_mu(matched, solver.model(matched))
+    chosen = pc.specimen_scene(job.specimen, job.calibration)
+    check_target_mu(chosen, solver.model(chosen))
+    assert [j.solvers for j in pc.jobs(use_yade=True)[0] if "yade" in j.solvers] == [("reference", "yade")]
