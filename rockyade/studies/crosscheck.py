@@ -180,7 +180,7 @@ class CrosscheckPlan:
         in_process = any(solver_class(s).IN_PROCESS for s in self.solvers)
         seconds = self.rounds() * ROUND_OVERHEAD_S
         if in_process:
-            seconds += WARM_UP_S if kernels_cached() else COMPILE_S
+            seconds += WARM_UP_S if kernels_cached(len(self.scene.blocks) == 1) else COMPILE_S
         return seconds
 
     def cost_line(self, workers: int) -> str:
@@ -194,7 +194,9 @@ class CrosscheckPlan:
         for s, f, _i in self.searches():
             seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
         startup = self.startup_s()
-        compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached()
+        compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached(
+            len(self.scene.blocks) == 1
+        )
         return (
             f"cost: about {self.expected_runs()} runs ({len(self.searches())} searches of {per_search:.0f} runs: "
             f"{len(self.scan_si)} scan levels, then bisection to {100 * self.resolution:g} %), "
@@ -205,14 +207,16 @@ class CrosscheckPlan:
         )
 
 
-def kernels_cached() -> bool:
-    """Whether numba's on-disk cache holds the in-process solvers' batch kernels (the grouped
-    and single-run reference DEM, Housner's integrator): else the first run compiles them."""
+def kernels_cached(single: bool = True) -> bool:
+    """Whether numba's on-disk cache holds the in-process solvers' batch kernels (Housner's
+    integrator; the reference DEM's grouped and single-body kernels for one block, ``single``,
+    its general kernel for several): else the first run compiles them."""
     from rockyade.housner.integrator import _integrate
     from rockyade.kernel.runs import simulate_runs
+    from rockyade.kernel.simulation import simulate
     from rockyade.kernel.single import simulate_single
 
-    for dispatcher in (simulate_runs, simulate_single, _integrate):
+    for dispatcher in (simulate_runs, simulate_single, _integrate) if single else (simulate,):
         try:  # numba's index of the function's cache: empty when missing or of other source (stale)
             cache: Any = getattr(dispatcher, "_cache", None)
             if not cache._cache_file._load_index():
