@@ -193,11 +193,12 @@ def complete(plan, tmp_path_factory):
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
     assert summary.partial is False and summary.verdicts
-    from rockyade.studies.crosscheck import RESULT_FILES, partial_dir
+    from rockyade.studies.crosscheck import RESULT_FILES, journal_dir
 
     for name in RESULT_FILES:
         assert (out / name).is_file(), name
-    assert not partial_dir(out).exists()
+    assert not journal_dir(out).exists()  # the set complete, the journal goes
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(RESULT_FILES)
     ci = pd.read_csv(out / "collapse_intensities.csv")
     for column in (
         "record",
@@ -240,16 +241,6 @@ def test_small_real_crosscheck(complete, plan):
     assert "## Verdicts" in index and "PARTIAL" not in index and "housner / reference" in index
 
 
-def test_dt_factor_is_recorded_in_every_run(complete):
-    out, _summary = complete
-    for folder, factor in (("dt1", 1.0), ("dt0.5", 0.5)):
-        files = list((out / folder / "runs").glob("*.json"))
-        assert files
-        for path in files[:6]:
-            meta = json.loads(path.read_text())
-            assert meta["dt_factor"] == factor and meta["dt_s"] > 0
-
-
 def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
     import rockyade.studies.crosscheck as cc
 
@@ -268,20 +259,29 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
     out = tmp_path / "out"
     with pytest.raises(BatchInterruptedError):
         run(plan, out)
-    stage = cc.partial_dir(out)
+    stage = cc.journal_dir(out)
     partial = json.loads((stage / "crosscheck.json").read_text())
-    assert partial["partial"] is True and not out.exists()
+    assert partial["partial"] is True and not (out / "crosscheck.json").exists()
     assert "PARTIAL" in (stage / "index.md").read_text()
     first = {p: p.stat().st_mtime_ns for p in stage.rglob("runs/*.json")}
     assert 0 < len(first) < total
+    for path in first:  # each run in the journal says its time-step factor (its folder's) and step
+        meta = json.loads(path.read_text())
+        assert meta["dt_factor"] == float(path.parent.parent.name.removeprefix("dt")) and meta["dt_s"] > 0
+    assert set(pd.read_csv(reference_out / "runs.csv").dt_factor) == {1.0, 0.5}
     monkeypatch.setattr(cc, "run_study_tasks", real)
+    written: list[str] = []
+    real_write = cc.run_study_tasks
+
+    def watch(tasks, *args, **kwargs):  # every run the resumed study makes
+        written.extend(str(t.scene_hash) + t.solver.name + str(t.out_dir) for t in tasks)
+        return real_write(tasks, *args, **kwargs)
+
+    monkeypatch.setattr(cc, "run_study_tasks", watch)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
     assert data["runs_reused"] == len(first)
-    assert data["runs_made"] == total - len(first)  # no run made twice
-    for path, mtime in first.items():  # the first pass's runs were read, not written again
-        moved = out / path.relative_to(stage)
-        assert moved.stat().st_mtime_ns == mtime
+    assert data["runs_made"] == total - len(first) == len(written)  # no run made twice
     same = pd.read_csv(out / "collapse_intensities.csv")
     pd.testing.assert_frame_equal(same, pd.read_csv(reference_out / "collapse_intensities.csv"))
 
@@ -303,8 +303,8 @@ def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypat
     out = tmp_path / "out"
     with pytest.raises(SystemExit):
         run(plan, out)
-    assert not (cc.partial_dir(out) / "crosscheck.json").exists()
-    done = len(list(cc.partial_dir(out).rglob("runs/*.json")))
+    assert not (cc.journal_dir(out) / "crosscheck.json").exists() and not (out / "crosscheck.json").exists()
+    done = len(list(cc.journal_dir(out).rglob("runs/*.json")))
     monkeypatch.setattr(cc, "run_study_tasks", real)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
@@ -343,42 +343,125 @@ def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp
     assert data["plan"]["dt_factors"] == [1.0] and data["runs_reused"] == 0
     ci = pd.read_csv(out / "collapse_intensities.csv")
     assert set(ci.record) == {"rec1.csv"} and set(ci.dt_factor) == {1.0}
-    files = list(out.rglob("runs/*.json"))
-    assert len(files) == data["runs_made"] == len(pd.read_csv(out / "runs.csv"))  # no run of the old set left
-    assert not (out / "dt0.5").exists() and not cc.partial_dir(out).exists()
-    assert not list(out.parent.glob(".out.old-*"))
+    assert data["runs_made"] == len(pd.read_csv(out / "runs.csv"))  # no run of the old set left
+    assert not list(out.rglob("runs/*.json")) and not cc.journal_dir(out).exists()
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(cc.RESULT_FILES)
 
 
-def test_settle_finishes_a_cut_swap(tmp_path):
-    from rockyade.studies.crosscheck import partial_dir, settle
+def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_path):
+    """A real ``rockyade crosscheck`` process sent SIGINT once its first run is in the journal:
+    exit 130, the earlier complete set byte for byte as it was (no file of the new study in it,
+    nothing that looks complete), the partial summary in the journal; --resume then finishes."""
+    import os
+    import shutil
+    import signal
+    import subprocess
+    import sys
+    import time
 
     out = tmp_path / "out"
-    old = tmp_path / ".out.old-abcd"
-    old.mkdir()
-    (old / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "old"}))
-    settle(out)  # killed between the two renames, the new set not complete: the old one comes back
-    assert json.loads((out / "crosscheck.json").read_text())["who"] == "old" and not old.exists()
-    old = tmp_path / ".out.old-efgh"
-    out.rename(old)
-    stage = partial_dir(out)
-    stage.mkdir()
-    (stage / "crosscheck.json").write_text(json.dumps({"partial": False, "who": "new"}))
-    settle(out)  # the new set was complete: it goes in, the old one is removed
-    assert json.loads((out / "crosscheck.json").read_text())["who"] == "new"
-    assert not old.exists() and not stage.exists()
+    shutil.copytree(complete[0], out)
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    argv = [
+        sys.executable,
+        "-m",
+        "rockyade",
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--levels",
+        "0.3,0.6,1.2",
+        "--resolution",
+        "0.02",
+        "--dt-factors",
+        "1",
+        "--tail",
+        "1",
+        "--workers",
+        "1",
+        "--quiet",
+        "--out",
+        str(out),
+    ]
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    journal = out / "partial"
+    deadline = time.monotonic() + 600
+    while not list(journal.rglob("runs/*.json")) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.communicate()[0]
+    proc.send_signal(signal.SIGINT)
+    text = proc.communicate(timeout=600)[0]
+    assert proc.returncode == 130, text
+    after = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    assert after == before  # the previous set untouched, nothing of the new study mixed in
+    assert json.loads((journal / "crosscheck.json").read_text())["partial"] is True
+    assert not list(out.glob(".set.*"))  # no staged set left behind
+    resumed = subprocess.run([*argv, "--resume"], env=env, capture_output=True, text=True, timeout=900)
+    assert resumed.returncode == 0, resumed.stdout + resumed.stderr
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["partial"] is False and data["runs_reused"] >= 1 and data["plan"]["dt_factors"] == [1.0]
+    assert not journal.exists()
 
 
-def test_out_that_is_not_a_crosscheck_is_refused(tmp_path):
-    from rockyade.studies.crosscheck import check_out
+def test_out_that_is_a_link_or_a_file_is_refused(tmp_path):
+    from rockyade.studies.crosscheck import check_out, journal_dir
 
     mine = tmp_path / "mine"
     mine.mkdir()
-    (mine / "notes.txt").write_text("keep me")
-    with pytest.raises(InputError, match="--out"):
-        check_out(mine)
     (tmp_path / "link").symlink_to(mine)
     with pytest.raises(InputError, match="symbolic link"):
         check_out(tmp_path / "link")
+    (tmp_path / "file").write_text("x")
+    with pytest.raises(InputError, match="is a file"):
+        check_out(tmp_path / "file")
+    journal_dir(mine).symlink_to(tmp_path)  # the journal, cleared without --resume, must not be a link
+    with pytest.raises(InputError, match="symbolic link"):
+        check_out(mine)
+
+
+WARM_UP_CHECK = """
+import sys
+from pathlib import Path
+from rockyade.assess import parse_measure, records_in_folder
+from rockyade.runner import Executor
+from rockyade.scene import load_scene
+from rockyade.studies.crosscheck import Study, crosscheck_plan
+from rockyade.kernel.runs import simulate_runs
+from rockyade.kernel.single import simulate_single
+plan = crosscheck_plan(load_scene(Path(sys.argv[1])), records_in_folder(sys.argv[2]), parse_measure("pga"),
+    ["housner", "reference"], levels=[0.3, 0.6], dt_factors=(1.0, 0.5), resolution=0.2,
+    executor=Executor("threads", 1), progress=False)
+assert not simulate_runs.signatures and not simulate_single.signatures
+Study(plan, Path(sys.argv[3]), Executor("local", 2), progress=False, allow_large=False, say=print).warm_up()
+print(len(simulate_runs.signatures), len(simulate_single.signatures))
+"""
+
+
+def test_warm_up_loads_the_kernels_the_workers_run(records, tmp_path):
+    """In a fresh process, the study's warm-up loads the reference DEM's grouped and single-run
+    kernels as the batch runs them (the lean solver, without energy terms): the workers forked
+    for each round inherit them instead of loading (or compiling) them again, each."""
+    import os
+    import subprocess
+    import sys
+
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    argv = [sys.executable, "-c", WARM_UP_CHECK, str(EXAMPLES / "specimen1_record.toml"), str(records), str(tmp_path)]
+    done = subprocess.run(argv, env=env, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stderr
+    grouped, single = (int(x) for x in done.stdout.split()[-2:])
+    assert grouped >= 1 and single >= 1
+
+
+def test_cost_line_counts_the_start_up(plan):
+    from rockyade.studies.crosscheck import ROUND_OVERHEAD_S
+
+    line = plan.cost_line(2)
+    assert "start-up" in line and f"{plan.rounds()} rounds" in line
+    assert plan.rounds() >= 2 * len(plan.dt_factors)  # the scan and at least one bisection per factor
+    assert plan.startup_s() >= plan.rounds() * ROUND_OVERHEAD_S
 
 
 # ---------------------------------------------------------------------- the command
@@ -419,6 +502,57 @@ def test_bad_input_is_one_line_and_exit_2(argv, option, records, tmp_path, capsy
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and option in err[0], err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("kind", ["linked folder", "real folder", "link without suffix", "dangling link"])
+def test_records_folder_refuses_what_it_would_skip_naming_it(kind, records, tmp_path, capsys):
+    """A records folder holding a subfolder (linked or real) or a link that is not a record
+    link: exit 2, one line naming the entry; nothing is skipped silently or followed."""
+    import shutil
+
+    folder = tmp_path / "recs"
+    shutil.copytree(records, folder)
+    shared = write_records(tmp_path / "shared", count=3)
+    entry = {
+        "linked folder": folder / "more",
+        "real folder": folder / "more",
+        "link without suffix": folder / "rec3",
+        "dangling link": folder / "gone.csv",
+    }[kind]
+    if kind == "linked folder":
+        entry.symlink_to(shared)
+    elif kind == "real folder":
+        entry.mkdir()
+        shutil.copy(shared / "rec3.csv", entry / "rec3.csv")
+    elif kind == "link without suffix":
+        entry.symlink_to(shared / "rec3.csv")
+    else:
+        entry.symlink_to(tmp_path / "nothing.csv")
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(folder),
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--records" in err[0] and str(entry) in err[0], err
+    assert not (tmp_path / "o").exists()
+
+
+def test_records_folder_follows_links_to_record_files_and_ignores_hidden_entries(records, tmp_path):
+    from rockyade.assess import records_in_folder
+
+    folder = tmp_path / "links"
+    folder.mkdir()
+    for path in sorted(records.iterdir()):
+        (folder / path.name).symlink_to(path)
+    (folder / ".cache").mkdir()
+    (folder / "README.md").write_text("two records")
+    motions = records_in_folder(folder)
+    assert motions.count == 2 and [Path(p) for p in motions.files] == sorted(p.resolve() for p in records.iterdir())
 
 
 def test_command_writes_the_set(records, tmp_path, capsys):
@@ -592,3 +726,32 @@ def test_resume_of_a_complete_study_is_refused_and_leaves_it_alone(complete):
     with pytest.raises(InputError, match="nothing to resume"):
         run(None, out, resume=True)  # the refusal comes before the plan is used
     assert {p: p.stat().st_mtime_ns for p in out.rglob("*") if p.is_file()} == before
+
+
+# ---------------------------------------------------------------------- make run's part
+
+
+def test_paper_part_runs_siconos_on_a_subset_it_can_run():
+    """``make run``'s cross-check has YADE and Siconos subsets beside the four specimens; Siconos's
+    uses the paper's calibration, since it cannot reach specimen 1's matched mu (refused)."""
+    from rockyade.siconos.backend import siconos_available
+    from rockyade.siconos.calibration import check_target_mu
+    from rockyade.solvers import make_solver
+    from rockyade.studies import paper_crosscheck as pc
+
+    todo, left_out = pc.jobs(use_yade=False)
+    assert [j.solvers for j in todo][:4] == [("housner", "reference")] * 4
+    assert any("YADE" in why for why in left_out)  # said, not silently dropped
+    siconos = [j for j in todo if "siconos" in j.solvers]
+    if not siconos_available():
+        assert not siconos and any("Siconos" in why for why in left_out)
+        return
+    (job,) = siconos
+    assert job.solvers == ("reference", "siconos") and job.records >= 5 and job.calibration == "paper"
+    solver = make_solver("siconos")
+    matched = pc.specimen_scene(job.specimen)
+    with pytest.raises(InputError, match="cannot reach"):
+        check_target_mu(matched, solver.model(matched))
+    chosen = pc.specimen_scene(job.specimen, job.calibration)
+    check_target_mu(chosen, solver.model(chosen))
+    assert [j.solvers for j in pc.jobs(use_yade=True)[0] if "yade" in j.solvers] == [("reference", "yade")]

@@ -9,8 +9,9 @@ read** (after the conversion of the file's units to m/s^2; nothing else is done 
 
 * :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt`` and ``.dat`` file of a folder,
   sorted by name (the same accelerogram twice, e.g. an ``.AT2`` and its ``.csv``, is refused;
-  a link to a record file is followed and counted, a link to anything else refused:
-  :func:`record_files`);
+  a link to a record file is followed and counted; a link to anything else, and a
+  subfolder (real or linked: records are read from the folder itself only), refused rather
+  than skipped: :func:`record_files`);
 * :func:`ec8_suite`: a suite compatible with the EC8 spectrum of a spectrum type, ground type
   and ag; :func:`paper_suite_set`: the paper's suite (Type 2, ground D, ag S = 2.8 m/s^2).
 """
@@ -165,22 +166,40 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
 
 def record_files(folder: Path, field: str = "--records") -> list[Path]:
     """The record files of a folder, sorted by name: its files whose names end in one of
-    :data:`RECORD_SUFFIXES`. A symbolic link to a regular file is followed and counted as
-    the file it names (a folder of links to a shared set of records reads as that set); a link
-    to anything else (a folder, nothing) is refused, naming it.
+    :data:`RECORD_SUFFIXES`. A symbolic link named so and leading to a regular file is
+    followed and counted as the file it names (a folder of links to a shared set of records
+    reads as that set). Nothing else is followed or skipped silently: a subfolder (records are
+    not read from it) and any other link (to a folder, to nothing, or without a record
+    suffix) are refused, naming them. Hidden entries (``.name``) and other regular files
+    (a README) are not records and are left alone.
 
     Raises
     ------
     InputError
-        A record link that does not lead to a regular file.
+        A subfolder, or a link that is not a record link.
     """
     files = []
     for p in sorted(folder.iterdir()):
-        if p.suffix.lower() not in RECORD_SUFFIXES:
+        record_name = p.suffix.lower() in RECORD_SUFFIXES
+        if p.is_symlink():
+            if record_name and p.is_file():
+                files.append(p)
+                continue
+            what = "a folder" if p.is_dir() else "a file without a record suffix" if p.is_file() else "nothing"
+            raise InputError(
+                field,
+                f"{p} is a symbolic link to {what} ({os.readlink(p)}), not to a record file; the records are read "
+                f"from {folder} itself, links only to record files ({', '.join(RECORD_SUFFIXES)}): remove or fix it",
+            )
+        if p.name.startswith("."):
             continue
-        if p.is_symlink() and not p.is_file():
-            raise InputError(field, f"{p} is a link to {os.readlink(p)}, not to a record file: remove it or fix it")
-        if p.is_file():
+        if p.is_dir():
+            raise InputError(
+                field,
+                f"{p} is a subfolder: records are read from {folder} itself, not from its subfolders; give "
+                "the subfolder as the records folder, or move its files up",
+            )
+        if record_name and p.is_file():
             files.append(p)
     return files
 

@@ -110,7 +110,8 @@ def register(sub: Any) -> None:
         "bisection; compare the solvers by the median of their paired ratios with a bootstrap 95 %% interval, "
         "the share of runs with the same verdict and the fragility per solver; rerun each solver with dt halved "
         "and report its own change beside. Writes collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, "
-        "crosscheck.png and index.md, replacing --out as a whole when done; works in <out>.partial meanwhile. "
+        "crosscheck.png and index.md, a set replaced as a whole when done; each run is written to --out/partial/ "
+        "as it ends. "
         "Exit 0, 1 when a run failed, 2 on bad input, 130 after Ctrl-C (--resume finishes it). See "
         "docs/verification.md.",
     )

@@ -211,6 +211,9 @@ class SolverBase:
 
     name: ClassVar[str] = ""
     OPTIONS: ClassVar[Mapping[str, OptionCheck]] = {}
+    #: The solver computes in this process (numba code a parent loads once before it forks
+    #: workers); False: it runs another program (YADE, Siconos).
+    IN_PROCESS: ClassVar[bool] = False
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)

@@ -40,6 +40,7 @@ class HousnerSolver(SolverBase):
     """
 
     name: ClassVar[str] = "housner"
+    IN_PROCESS = True
     OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
 
     dt_factor: float = 1.0

@@ -75,6 +75,7 @@ class ReferenceSolver(SolverBase):
     """
 
     name: ClassVar[str] = "reference"
+    IN_PROCESS = True
     OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag, "dt_factor": check_dt_factor}
     #: Kernel time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 150e-9

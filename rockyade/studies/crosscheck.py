@@ -9,20 +9,21 @@ then bisection to the resolution. The searches advance together, one round at a 
 round's runs go through the batch machinery (:func:`rockyade.batch.run_study_tasks`:
 the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
 
-Files. The study works in ``<out>.partial/`` beside ``--out``: ``plan.json`` (what the study
-is), ``dt<f>/runs/`` (one JSON per finished run, by scene hash and solver, one folder per
-time-step factor) and, after Ctrl-C, a summary marked PARTIAL. When every search is done,
-the summary is written there (``collapse_intensities.csv``, ``pairs.csv``, ``runs.csv``,
-``crosscheck.json``, ``crosscheck.png``, ``index.md``) and the folder replaces ``--out`` as a
-whole (the old set renamed aside, the new one renamed in, the old one removed): a crash
-leaves the previous complete set or the new one, never a mix (:func:`settle` finishes a swap
-that a kill cut short).
+Files. ``--out`` holds the complete set (``collapse_intensities.csv``, ``pairs.csv``,
+``runs.csv``, ``crosscheck.png``, ``index.md`` and ``crosscheck.json``, the file that marks it
+complete) and, while a study is unfinished, its journal ``<out>/partial/``
+(:class:`rockyade.runner.journal.Journal`, as every study command has it): ``study.json`` (what
+the study is), ``dt<f>/runs/`` (one JSON per finished run, by scene hash and solver, one
+folder per time-step factor) and, after Ctrl-C, a summary marked PARTIAL. When every search
+is done the summary is written as a new set that replaces the old one as a whole
+(:mod:`rockyade.io.resultset`): an error, Ctrl-C or a kill leaves the previous complete set,
+or the new one, never a mix; then the journal goes.
 
 Resume. Every search is a function of its outcomes, so ``--resume`` replays the searches
-from the runs on disk and runs only what is missing (a run that failed is run again); after
-Ctrl-C or kill -9 no finished run is repeated. Without ``--resume`` an unfinished study in
-``<out>.partial/`` is discarded and the study starts afresh; with it, a study whose plan
-differs is refused.
+from the journal's runs and runs only what is missing (a run that failed is run again); after
+Ctrl-C or kill -9 no finished run is repeated. Without ``--resume`` an unfinished study's
+journal is discarded and the study starts afresh; with it, a study whose identity differs is
+refused.
 """
 
 from __future__ import annotations
@@ -30,9 +31,6 @@ from __future__ import annotations
 import itertools
 import json
 import math
-import os
-import secrets
-import shutil
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -52,11 +50,11 @@ from rockyade.assess.motions import MotionSet
 from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
 from rockyade.errors import BatchInterruptedError, InputError
-from rockyade.io.atomic import fsync_dir, write_json
-from rockyade.io.locking import DIR_LOCK_NAME, output_lock
-from rockyade.io.strict_json import json_text
+from rockyade.io.folders import output_folder
+from rockyade.io.locking import output_lock
+from rockyade.io.resultset import replacing_set, settle
 from rockyade.runner import Executor
-from rockyade.runner.journal import read_run
+from rockyade.runner.journal import IDENTITY_FILE, Journal, read_run
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
 from rockyade.solvers.base import Solver
@@ -66,8 +64,19 @@ from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 DT_FACTORS = (1.0, 0.5)
 #: The files of a complete set.
 RESULT_FILES = ("collapse_intensities.csv", "pairs.csv", "runs.csv", "crosscheck.json", "crosscheck.png", "index.md")
-#: Suffix of the working folder beside --out.
-PARTIAL_SUFFIX = ".partial"
+#: Start-up costs the solvers' per-run estimates leave out, measured on a quiet 2-core machine
+#: (docs/verification.md, "Cost"): per round and time-step factor, a pool of worker processes
+#: forked and the round's runs and summary written, s;
+ROUND_OVERHEAD_S = 1.0
+#: loading the in-process solvers' compiled kernels once before the rounds, s;
+WARM_UP_S = 2.0
+#: compiling them when numba's cache lacks them (the first run after an install or a change of
+#: the kernels), CPU s.
+COMPILE_S = 60.0
+#: The file that marks a set complete (written last).
+RESULT_LAST = "crosscheck.json"
+#: The journal's folder in --out while a study is unfinished.
+PARTIAL_DIR = "partial"
 
 
 @dataclass(frozen=True)
@@ -159,6 +168,21 @@ class CrosscheckPlan:
         bisections = max(0, math.ceil(math.log2(math.log(step) / math.log1p(self.resolution))))
         return len(self.searches()) * (len(scan) + bisections)
 
+    def rounds(self) -> int:
+        """Rounds the study is expected to take: the scan, then one per bisection step, per
+        time-step factor (the searches of one factor advance together)."""
+        per_search = self.expected_runs() / max(1, len(self.searches()))
+        return len(self.dt_factors) * (1 + max(0, round(per_search) - len(self.scan_si)))
+
+    def startup_s(self) -> float:
+        """What the solvers' estimates leave out, s: each round's pool of workers, the warm-up
+        of the in-process kernels and, when numba's cache lacks them, their compilation."""
+        in_process = any(solver_class(s).IN_PROCESS for s in self.solvers)
+        seconds = self.rounds() * ROUND_OVERHEAD_S
+        if in_process:
+            seconds += WARM_UP_S if kernels_cached(len(self.scene.blocks) == 1) else COMPILE_S
+        return seconds
+
     def cost_line(self, workers: int) -> str:
         """The study's expected runs and time, before anything runs."""
         plan = self.stripes.stripes
@@ -169,11 +193,37 @@ class CrosscheckPlan:
         seconds = 0.0
         for s, f, _i in self.searches():
             seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
+        startup = self.startup_s()
+        compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached(
+            len(self.scene.blocks) == 1
+        )
         return (
             f"cost: about {self.expected_runs()} runs ({len(self.searches())} searches of {per_search:.0f} runs: "
             f"{len(self.scan_si)} scan levels, then bisection to {100 * self.resolution:g} %), "
-            f"about {_duration(seconds / max(1, workers))} on {workers} worker(s) by the solvers' estimates"
+            f"about {_duration(seconds / max(1, workers) + startup)} on {workers} worker(s): the solvers' estimates "
+            f"({_duration(seconds / max(1, workers))}) and start-up ({_duration(startup)}: {self.rounds()} rounds"
+            + (", the kernels compiled once: numba's cache lacks them" if compiling else "")
+            + "), on an idle machine"
         )
+
+
+def kernels_cached(single: bool = True) -> bool:
+    """Whether numba's on-disk cache holds the in-process solvers' batch kernels (Housner's
+    integrator; the reference DEM's grouped and single-body kernels for one block, ``single``,
+    its general kernel for several): else the first run compiles them."""
+    from rockyade.housner.integrator import _integrate
+    from rockyade.kernel.runs import simulate_runs
+    from rockyade.kernel.simulation import simulate
+    from rockyade.kernel.single import simulate_single
+
+    for dispatcher in (simulate_runs, simulate_single, _integrate) if single else (simulate,):
+        try:  # numba's index of the function's cache: empty when missing or of other source (stale)
+            cache: Any = getattr(dispatcher, "_cache", None)
+            if not cache._cache_file._load_index():
+                return False
+        except Exception:  # numba's internals moved: assume the cache is there (the smaller estimate)
+            return True
+    return True
 
 
 def _solver(name: str, dt_factor: float, solver_options: Mapping[str, Any]) -> Solver:
@@ -308,60 +358,29 @@ def crosscheck_plan(
 # ---------------------------------------------------------------------- the folders
 
 
-def partial_dir(out: Path) -> Path:
-    """The working folder of a cross-check writing ``out``."""
-    return out.parent / f"{out.name}{PARTIAL_SUFFIX}"
+def journal_dir(out: Path) -> Path:
+    """The journal of an unfinished cross-check writing ``out`` (its runs, its identity and,
+    after Ctrl-C, the partial summary)."""
+    return out / PARTIAL_DIR
 
 
 def _complete(folder: Path) -> bool:
     """The folder holds a complete cross-check set (its JSON says so)."""
     try:
-        data = json.loads((folder / "crosscheck.json").read_text())
+        data = json.loads((folder / RESULT_LAST).read_text())
     except (OSError, ValueError):
         return False
     return isinstance(data, dict) and data.get("partial") is False
 
 
-def settle(out: Path) -> None:
-    """Finish a swap that a kill cut short (module docstring): a complete new set waiting in
-    ``<out>.partial`` goes in; else an old set renamed aside comes back; old sets are removed."""
-    stage = partial_dir(out)
-    olds = sorted(p for p in out.parent.glob(f".{out.name}.old-*") if p.is_dir() and not p.is_symlink())
-    if not out.exists():
-        if stage.is_dir() and not stage.is_symlink() and _complete(stage):
-            os.rename(stage, out)
-        elif olds:
-            os.rename(olds.pop(), out)
-        fsync_dir(out.parent)
-    for old in olds:
-        shutil.rmtree(old, ignore_errors=True)
-
-
 def check_out(out: Path) -> None:
-    """Refuse an ``--out`` that a swap would destroy: a link, a file, or a folder of other
-    files than a cross-check's set (InputError naming ``--out``)."""
-    for path in (out, partial_dir(out)):
+    """Refuse an ``--out`` that is a link or a file, or whose journal folder is a link
+    (InputError naming ``--out``)."""
+    for path in (out, journal_dir(out)):
         if path.is_symlink():
             raise InputError("--out", f"{path} is a symbolic link; give a real folder")
         if path.exists() and not path.is_dir():
             raise InputError("--out", f"{path} is a file; give a folder")
-    if out.is_dir() and any(True for _ in out.iterdir()) and not (out / "crosscheck.json").is_file():
-        raise InputError(
-            "--out",
-            f"{out} holds files that are not a cross-check's result (no crosscheck.json): it would be "
-            "replaced as a whole; give a new or empty folder",
-        )
-
-
-def _swap(stage: Path, out: Path) -> None:
-    """Put the complete set of ``stage`` in place of ``out`` (module docstring)."""
-    old = out.parent / f".{out.name}.old-{secrets.token_hex(4)}"
-    if out.exists():
-        os.rename(out, old)
-    os.rename(stage, out)
-    fsync_dir(out.parent)
-    if old.exists():
-        shutil.rmtree(old, ignore_errors=True)
 
 
 # ---------------------------------------------------------------------- running
@@ -470,23 +489,31 @@ class Study:
         return todo
 
     def warm_up(self) -> None:
-        """Load, in this process, the compiled code of the solvers that run groups of runs in
-        process (``run_group``), on a run of 0.05 s: worker processes forked for each round
-        then inherit it rather than load it again (seconds a round on a busy machine)."""
+        """Load (or, on a cold numba cache, compile) in this process the compiled code of the
+        solvers that run in process, as the batch runs them (the lean solver of
+        :func:`rockyade.batch.batch_task`: without energy terms), on a run of 0.05 s: both
+        the grouped path (``run_group``) and the run of its own. The worker processes forked for
+        each round inherit it. Before, the warm-up used the plan's solvers, whose energy terms
+        keep the reference DEM out of groups: every worker of every round loaded the kernels
+        again and, on a cold cache, both workers compiled the same kernels at once (minutes of
+        CPU under load; docs/verification.md, "Cost")."""
         from rockyade.analysis.metrics import uplift_threshold_rad
 
         if self.executor.in_process or not self.plan.scene.blocks:
             return
-        sp = self.plan.stripes.stripes
-        scene = sp.scene_for(0, sp.load_factor(0, self.plan.scan_si[0]))
-        scene = replace(scene, duration_s=min(scene.duration_s, 0.05))
-        alpha = scene.blocks[0].classical().alpha_rad
-        for solver in self.solvers.values():
-            key = getattr(solver, "group_key", None)
-            if key is None or key(scene) is None:
+        level = self.plan.scan_si[0]
+        for (name, f), solver in self.solvers.items():
+            if not getattr(solver, "IN_PROCESS", False):
                 continue
+            task = self.task((name, f, 0), level)
+            scene = replace(task.scene, duration_s=min(task.scene.duration_s, 0.05))
+            lean = task.solver
             try:
-                solver.run_group([scene], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                key = getattr(lean, "group_key", None)
+                if key is not None and key(scene) is not None:
+                    alpha = scene.blocks[0].classical().alpha_rad
+                    lean.run_group([scene], uplift_threshold_rad(alpha))  # type: ignore[attr-defined]
+                lean.run(scene)
             except Exception:  # a warm-up that fails costs only time; the runs say what is wrong
                 continue
 
@@ -542,72 +569,50 @@ def run_crosscheck(
     allow_large: bool = False,
     say: Callable[[str], None] = print,
 ) -> Summary:
-    """Run the study and replace ``out`` with its complete set (module docstring).
+    """Run the study in ``out``'s journal and replace ``out``'s set with the complete one
+    (module docstring).
 
     Raises
     ------
     InputError
-        ``out`` a swap would destroy, a resume of another study, a run above the cost limits.
+        ``out`` a link or a file, a resume of another study or of nothing, a run above the
+        cost limits, another process writing ``out``.
     BatchInterruptedError
-        Ctrl-C: the partial summary is in ``<out>.partial``; ``--resume`` finishes it.
+        Ctrl-C: the partial summary is in ``<out>/partial``; ``--resume`` finishes it.
     """
     out = Path(out)
     check_out(out)
-    stage = partial_dir(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    settle(out)
-    if resume and not (stage / "plan.json").is_file() and _complete(out):
-        raise InputError(
-            "--resume",
-            f"{out} is a complete cross-check and nothing is unfinished: there is nothing to resume "
-            "(run without --resume to run the study again)",
-        )
-    stage.mkdir(exist_ok=True)
     start = time.perf_counter()
-    with output_lock(stage, "--out"):
-        identity = plan.identity()
-        plan_file = stage / "plan.json"
-        stored = _read_json(plan_file)
-        if stored is not None and stored != json.loads(json_text(identity)) and resume:
+    with output_folder(out), output_lock(out, "--out"):
+        settle(out, RESULT_FILES, RESULT_LAST)
+        unfinished = (journal_dir(out) / IDENTITY_FILE).is_file()
+        if resume and not unfinished and _complete(out):
             raise InputError(
                 "--resume",
-                f"the unfinished study in {stage} is another study (its plan.json differs): run without "
-                "--resume to start afresh",
+                f"{out} is a complete cross-check and nothing is unfinished: there is nothing to resume "
+                "(run without --resume to run the study again)",
             )
-        if stored is not None and not resume:
-            say(f"discarding the unfinished cross-check in {stage} (--resume would have finished it)")
-        if not resume or stored is None:
-            for child in stage.iterdir():
-                if child.name == DIR_LOCK_NAME:
-                    continue
-                if child.is_dir() and not child.is_symlink():
-                    shutil.rmtree(child)
-                else:
-                    child.unlink()
-            write_json(plan_file, identity)
-        study = Study(plan, stage, executor, progress=progress, allow_large=allow_large, say=say)
+        if unfinished and not resume:
+            say(f"discarding the unfinished cross-check in {journal_dir(out)} (--resume would have finished it)")
+        journal = Journal(journal_dir(out), plan.identity(), resume)
+        study = Study(plan, journal.folder, executor, progress=progress, allow_large=allow_large, say=say)
         try:
             study.run()
         except BatchInterruptedError as exc:
             study.pending()  # what the interrupted round finished, read back from disk
             summary = summarise(plan, study.outcomes, partial=True)
-            write_summary(plan, summary, stage, time.perf_counter() - start, {"runs_made": study.ran})
-            say(f"partial summary in {stage / 'index.md'}")
-            raise BatchInterruptedError(len(summary.runs), exc.unfinished, str(stage / "runs.csv"), exc.hard) from None
+            write_summary(plan, summary, journal.folder, time.perf_counter() - start, {"runs_made": study.ran})
+            say(f"partial summary in {journal.folder / 'index.md'}")
+            raise BatchInterruptedError(
+                len(summary.runs), exc.unfinished, str(journal.folder / "runs.csv"), exc.hard
+            ) from None
         summary = summarise(plan, study.outcomes, partial=False)
         seconds = time.perf_counter() - start
-        write_summary(plan, summary, stage, seconds, {"runs_made": study.ran, "runs_reused": study.reused})
+        with replacing_set(out, RESULT_FILES, RESULT_LAST) as stage:
+            write_summary(plan, summary, stage, seconds, {"runs_made": study.ran, "runs_reused": study.reused})
+        journal.clear()
         say(f"{study.ran} run(s) made, {study.reused} found done")
-        (stage / DIR_LOCK_NAME).unlink(missing_ok=True)  # the lock's file must not go into the set
-        _swap(stage, out)
     return summary
-
-
-def _read_json(path: Path) -> Any:
-    try:
-        return json.loads(path.read_text())
-    except (OSError, ValueError):
-        return None
 
 
 __all__ = [
@@ -617,9 +622,8 @@ __all__ = [
     "Summary",
     "check_dt_factors",
     "crosscheck_plan",
+    "journal_dir",
     "parse_solvers",
-    "partial_dir",
     "run_crosscheck",
-    "settle",
     "summarise",
 ]
