@@ -252,3 +252,26 @@ def test_the_example_runs_with_the_geometrys_restitution_recorded():
     own = model_restitution(SiconosSolver().model(scene).bodies[0])
     assert result.meta["mu_model"]["specimen1"] == pytest.approx(own)
     assert result.meta["mu_scene"]["specimen1"] == 0.936 and "mu_note" in result.meta
+
+
+def _short_free_scene(folder: Path, duration_s: float = 0.5) -> Path:
+    """``examples/specimen1_free.toml`` cut to ``duration_s`` (scene mu 0.936, paper calibration)."""
+    text = (EXAMPLES / "specimen1_free.toml").read_text()
+    path = folder / "s1.toml"
+    path.write_text(text.replace("duration_s = 4.0", f"duration_s = {duration_s}"))
+    return path
+
+
+def test_run_and_compare_print_that_siconos_runs_the_models_own_mu(tmp_path, capsys):
+    """The console says, in one line, that Siconos's effective mu is the model's own (mu_model),
+    not the scene's 0.936 (the note was only in the JSON)."""
+    from rockyade.cli import main
+
+    scene = _short_free_scene(tmp_path)
+    own = model_restitution(SiconosSolver().model(load_scene(scene)).bodies[0])
+    assert main(["run", str(scene), "--solver", "siconos"]) == 0
+    notes = [ln for ln in capsys.readouterr().out.splitlines() if "note:" in ln]
+    assert len(notes) == 1 and f"(mu_model): specimen1 {own:.4g} (scene mu 0.936)" in notes[0], notes
+    code = main(["compare", str(scene), "--solvers", "housner,siconos", "--no-dt-check", "--out", str(tmp_path / "c")])
+    notes = [ln for ln in capsys.readouterr().out.splitlines() if "note:" in ln]
+    assert code == 0 and len(notes) == 1 and f"specimen1 {own:.4g}" in notes[0], notes

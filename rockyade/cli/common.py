@@ -132,6 +132,27 @@ def total_time(args: argparse.Namespace) -> float:
     return time.perf_counter() - start if start is not None else float("nan")
 
 
+def mu_note_line(meta: dict[str, Any]) -> str | None:
+    """One console line for a Result's ``mu_note`` (Siconos: the restitution its impacts give
+    is the model's own, mu_model, not the scene's mu), with the numbers; None without a note.
+
+    Parameters
+    ----------
+    meta
+        The Result's metadata (``mu_note``, ``mu_model`` and ``mu_scene``: block -> mu).
+    """
+    note = meta.get("mu_note")
+    if not note:
+        return None
+    model = meta.get("mu_model") or {}
+    scene = meta.get("mu_scene") or {}
+    values = [
+        f"{name} {mu:.4g}" + (f" (scene mu {scene[name]:.4g})" if scene.get(name) is not None else "")
+        for name, mu in model.items()
+    ]
+    return f"note: {note}: " + ", ".join(values) if values else f"note: {note}"
+
+
 def print_calibration(result: dict[str, Any], method: str) -> None:
     """The text of a calibration: each DEM parameter with the equation it comes from.
 

@@ -11,6 +11,7 @@ from rockyade.cli.common import (
     add_allow_large,
     add_yade_timeout,
     check_output_dir,
+    mu_note_line,
     solver_options,
     solvers_from_args,
     total_time,
@@ -53,6 +54,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
             results[solver.name] = result
             status = result.status if result.ok else f"failed ({result.meta.get('failure_reason')})"
             print(f"{solver.name}: {status}, wall time {result.meta.get('wall_time_s', float('nan')):.3g} s")
+            note = mu_note_line(result.meta)
+            if note:
+                print(f"  {note}")
         halved = {}
         for solver in finer:
             result = solver.keeping_files(out, f"{stem}_halfdt").run(scene)
