@@ -6,6 +6,7 @@ test``) turns that into a failure."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -275,3 +276,55 @@ def test_run_and_compare_print_that_siconos_runs_the_models_own_mu(tmp_path, cap
     code = main(["compare", str(scene), "--solvers", "housner,siconos", "--no-dt-check", "--out", str(tmp_path / "c")])
     notes = [ln for ln in capsys.readouterr().out.splitlines() if "note:" in ln]
     assert code == 0 and len(notes) == 1 and f"specimen1 {own:.4g}" in notes[0], notes
+
+
+def test_worker_files_are_kept_only_after_a_failure_each_under_its_own_dt(tmp_path, monkeypatch, capsys):
+    """A completed ``run --out`` leaves only the result beside it and nothing in the temporary
+    folder (its worker files used to sit beside the result); a failed run's files go to the
+    result's folder, named with the dt_factor, so runs at dt and dt/2 keep a log each (they
+    used to share the scene-hash name, the second overwriting the first)."""
+    import tempfile
+
+    from rockyade.cli import main
+
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    out = tmp_path / "x"
+    assert main(["run", str(_short_free_scene(tmp_path)), "--solver", "siconos", "--out", str(out / "s1.csv")]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["s1.csv", "s1.json"] and not list(scratch.iterdir())
+    data = stack(widths_m=[0.4, 0.35], heights_m=0.5, motion=rest_motion(), duration_s=0.3, sample_dt_s=0.01)
+    logs = []
+    for factor in (1.0, 0.5):
+        result = SiconosSolver(solver_max_iter=1, dt_factor=factor).keeping_files(out, "bad").run(scene_from_dict(data))
+        assert not result.ok
+        logs.append(Path(result.meta["log_path"]))
+    assert [p.name for p in logs] == ["bad_dt1.siconos.log", "bad_dt0.5.siconos.log"]
+    assert all(p.parent == out.resolve() and p.is_file() for p in logs) and not list(scratch.iterdir())
+
+
+def test_an_interrupted_run_leaves_no_files(tmp_path):
+    """Ctrl-C (SIGINT) in the middle of a run: its private folder (the scene data, the empty log)
+    is removed, and nothing goes to the folder that keeps a failed run's files."""
+    import signal
+
+    scratch, out = tmp_path / "tmp", tmp_path / "out"
+    scratch.mkdir()
+    scene = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 10_000.0, sample_dt=0.01)
+    data = json.dumps(scene.to_dict())
+    code = (
+        "import json\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.siconos import SiconosSolver\n"
+        f"scene = scene_from_dict(json.loads({data!r}))\n"
+        f"SiconosSolver().keeping_files({str(out)!r}, 'k').run(scene)\n"
+    )
+    env = {**os.environ, "TMPDIR": str(scratch), "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen([sys.executable, "-c", code], env=env, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not list(scratch.glob("rockyade-siconos-*/*.siconos.json")):
+        time.sleep(0.05)
+    assert list(scratch.glob("rockyade-siconos-*/*.siconos.json")), "the run never started"
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode != 0 and "KeyboardInterrupt" in err, err
+    assert not list(scratch.iterdir()) and not out.exists()

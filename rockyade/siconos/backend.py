@@ -31,7 +31,7 @@ from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
-from rockyade.io.worker import Program, run_scene
+from rockyade.io.worker import Program, keep_run_files, run_scene
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
 from rockyade.siconos.calibration import model_restitution
@@ -98,6 +98,7 @@ def run_model(
     accel_lowpass_hz: float | None = None,
     warm: bool = True,
     workdir: str | Path | None = None,
+    failed_dir: str | Path | None = None,
     name: str = "siconos",
     extra_meta: dict[str, object] | None = None,
 ) -> Result:
@@ -114,8 +115,15 @@ def run_model(
     warm
         Run in this thread's warm worker; False: in a process of its own.
     workdir
-        Where ``<name>.siconos.json``, ``.npz`` and ``.log`` are kept; default a temporary
-        folder, removed after a successful run and kept after a failed one.
+        Where ``<name>.siconos.json``, ``.npz`` and ``.log`` are kept after every run.
+    failed_dir
+        Where they are kept after a failed run only (``run --out``'s folder; ignored with
+        ``workdir``). The run itself works in a private temporary folder, removed after a
+        successful run (unless ``workdir``) and when the run is interrupted (Ctrl-C); a failed
+        run's files are moved to ``workdir`` or ``failed_dir``, or stay in that folder
+        (``log_path`` says where).
+    name
+        The files' stem (the solver's: the scene hash or the caller's stem, and dt_factor).
     extra_meta
         More metadata for the Result (calibration, time-step choice).
     """
@@ -127,15 +135,12 @@ def run_model(
     n_steps = (model.n_samples - 1) * numerics.steps_per_sample
     timeout = check_timeout(timeout_s)
     timeout = timeout if timeout is not None else default_timeout(n_steps, len(model.bodies))
-    keep = workdir is not None
-    directory = (Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="rockyade-siconos-"))).resolve()
-    directory.mkdir(parents=True, exist_ok=True)
+    destination = workdir if workdir is not None else failed_dir
+    directory = Path(tempfile.mkdtemp(prefix="rockyade-siconos-")).resolve()
     scene_file = directory / f"{name}.siconos.json"
     out_file = directory / f"{name}.siconos.npz"
     log_file = directory / f"{name}.siconos.log"
     partial = directory / f"{name}.siconos.npz.part"
-    for stale in (out_file, partial):
-        stale.unlink(missing_ok=True)
     payload = scene_payload(model, numerics)
     program = Program([SICONOS_PYTHON, str(DRIVER)], _env(), LABEL, TIMEOUT_OPTION, FLUSH_PERIOD_S)
     start = time.perf_counter()
@@ -145,6 +150,9 @@ def run_model(
     except OSError as exc:
         error = exc if exc.filename else OSError(exc.errno, exc.strerror, str(scene_file))
         reason = f"cannot write {os_error_message(error)}"
+    except BaseException:  # Ctrl-C: an interrupted run leaves none of its files
+        shutil.rmtree(directory, ignore_errors=True)
+        raise
     total = time.perf_counter() - start
     if reason is not None:
         partial.unlink(missing_ok=True)
@@ -163,8 +171,17 @@ def run_model(
         **(extra_meta or {}),
     }
     result = _parse(model, numerics, out_file, reason, log_file, total, accel_lowpass_hz, extra)
-    if result.ok and not keep:
+    if result.ok and workdir is None:
         shutil.rmtree(directory, ignore_errors=True)
+    elif destination is not None:
+        into = Path(destination).resolve()
+        try:
+            into.mkdir(parents=True, exist_ok=True)
+            result.meta["log_path"] = str(keep_run_files(directory, name, name, ".siconos", result.ok, into))
+        except OSError:  # the folder cannot take them: they stay where they are (log_path says so)
+            pass
+        else:
+            shutil.rmtree(directory, ignore_errors=True)
     return result
 
 

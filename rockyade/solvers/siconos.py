@@ -114,8 +114,13 @@ class SiconosSolver(SolverBase):
     newton_max_iter
         Newton iterations per step on the nonlinear kinematics (1: linearised once).
     workdir
-        Where the scene data, output and log are kept (default: a temporary folder, removed
-        after a successful run, kept after a failed one).
+        Where the scene data, output and log are kept after every run (default: none; the
+        run works in a private temporary folder, removed after a successful or interrupted
+        run, kept after a failed one).
+    failed_dir, stem
+        Set by :meth:`keeping_files` (not options): where a failed run's files go, and their
+        stem (default the scene hash and the solver's name); the stem is followed by
+        ``_dt<dt_factor>`` so that runs at two steps never share a name.
     """
 
     name: ClassVar[str] = "siconos"
@@ -142,6 +147,8 @@ class SiconosSolver(SolverBase):
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
     workdir: str | None = None
+    failed_dir: str | None = None
+    stem: str | None = None
 
     def __post_init__(self) -> None:
         for key in (
@@ -156,6 +163,7 @@ class SiconosSolver(SolverBase):
             object.__setattr__(self, key, self.OPTIONS[key](getattr(self, key), key))
         object.__setattr__(self, "warm", check_flag(self.warm, "warm"))
         object.__setattr__(self, "workdir", _check_folder(self.workdir, "workdir"))
+        object.__setattr__(self, "failed_dir", _check_folder(self.failed_dir, "failed_dir"))
 
     def model(self, scene: Scene) -> DemModel:
         """The scene's blocks, motion and start as the DEMs build them (a matched calibration's
@@ -204,7 +212,8 @@ class SiconosSolver(SolverBase):
             accel_lowpass_hz=scene.output.accel_lowpass_hz,
             warm=self.warm,
             workdir=self.workdir,
-            name=f"{scene.scene_hash}_{self.name}",
+            failed_dir=self.failed_dir,
+            name=f"{self.stem or f'{scene.scene_hash}_{self.name}'}_dt{self.dt_factor:g}",
             extra_meta={**how, **mu},
         )
 
@@ -217,8 +226,9 @@ class SiconosSolver(SolverBase):
         return stepped_cost(scene, self.name, steps, numerics.dt_s, steps * self.SECONDS_PER_BODY_STEP)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
-        """This solver keeping its files in ``folder`` (the stem is the scene hash's)."""
-        return replace(self, workdir=str(folder))
+        """This solver keeping a failed run's files in ``folder``, named ``stem`` (default: by
+        scene hash) and the dt_factor; a successful run keeps none (unless ``workdir``)."""
+        return replace(self, failed_dir=str(folder), stem=stem)
 
 
 __all__ = ["SiconosSolver"]
