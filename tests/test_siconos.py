@@ -328,3 +328,23 @@ def test_an_interrupted_run_leaves_no_files(tmp_path):
     _, err = proc.communicate(timeout=60)
     assert proc.returncode != 0 and "KeyboardInterrupt" in err, err
     assert not list(scratch.iterdir()) and not out.exists()
+
+
+def test_the_page_quotes_what_the_run_prints_and_the_version_is_the_packages(capsys):
+    """docs/siconos.md shows the lines ``rockyade run examples/specimen1_free.toml --solver
+    siconos`` prints (it showed 0.915 for 0.91437), and the Result names the Debian package's
+    version (4.4.0+dfsg-2), not only the module's own label (4.5.0)."""
+    from rockyade.cli import main
+
+    from .conftest import ROOT
+
+    assert main(["run", str(EXAMPLES / "specimen1_free.toml"), "--solver", "siconos"]) == 0
+    printed = [ln.strip() for ln in capsys.readouterr().out.splitlines()]
+    quoted = [ln.strip() for ln in (ROOT / "docs/siconos.md").read_text().splitlines() if ln.startswith("    ")]
+    for start in ("specimen1: max |theta|", "note: "):
+        line = next(ln for ln in printed if ln.startswith(start))
+        assert line in quoted, line
+    package = siconos_backend.package_version()
+    if package is not None:  # dpkg knows the installation
+        result = SiconosSolver().run(_block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 0.1))
+        assert result.meta["version"].startswith(f"Siconos {package} (Debian python3-siconos")

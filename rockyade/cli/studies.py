@@ -93,7 +93,7 @@ def _with_dt_factor(solvers: list[Any], factor: float, check: bool) -> tuple[lis
     Raises
     ------
     InputError
-        ``--dt-factor`` out of (0, 1], or given to a solver without the option.
+        ``--dt-factor`` out of [0.001, 1], or given to a solver without the option.
     """
     from dataclasses import replace
 
@@ -231,13 +231,17 @@ def register(sub: Any) -> None:
         "changed the peaks more than the solvers differ.",
     )
     p.add_argument("scene", type=Path, help="scene file")
-    p.add_argument("--solvers", default="housner,reference,yade", help="comma-separated solvers")
+    p.add_argument(
+        "--solvers",
+        default="housner,reference,yade",
+        help=f"comma-separated solvers among {', '.join(SOLVER_NAMES)} (default housner,reference,yade)",
+    )
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
     p.add_argument(
         "--dt-factor",
         type=float,
         default=1.0,
-        help="factor in (0, 1] on every solver's own time step (default 1); each solver is also run at half of "
+        help="factor in [0.001, 1] on every solver's own time step (default 1); each solver is also run at half of "
         "it for the verdict's convergence check",
     )
     p.add_argument("--no-dt-check", action="store_true", help="skip the runs at half the time step")

@@ -15,9 +15,11 @@ the samples recorded up to there (``partial: true``): never one that looks compl
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import shutil
+import subprocess
 import tempfile
 import time
 import zipfile
@@ -67,6 +69,36 @@ FAIL_UNCONVERGED_MIN = 10
 def siconos_available() -> bool:
     """True when Debian's python3-siconos and the Python that runs it are installed."""
     return Path(SICONOS_PYTHON).is_file() and SICONOS_MODULE.is_file()
+
+
+#: The Debian package whose Siconos runs (its version is the one to cite: the module it ships
+#: calls itself 4.5.0, in ``siconos.version`` and its egg-info, while the package is 4.4.0).
+SICONOS_PACKAGE = "python3-siconos"
+
+
+@functools.cache
+def package_version() -> str | None:
+    """The installed Debian package's version (``dpkg-query``), e.g. "4.4.0+dfsg-2"; None
+    where dpkg does not know it (another installation, ``ROCKYADE_SICONOS_PYTHON``)."""
+    try:
+        done = subprocess.run(
+            ["dpkg-query", "-W", "-f=${Version}", SICONOS_PACKAGE], capture_output=True, text=True, timeout=10
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return (done.stdout.strip() or None) if done.returncode == 0 else None
+
+
+def version_label(module_version: object) -> str:
+    """What a Result records as Siconos's version: the Debian package's, and the module's own
+    label when it says otherwise (``module_version``, as the driver reports it)."""
+    package = package_version()
+    module = str(module_version) if module_version not in (None, "") else "unknown"
+    if package is None:
+        return f"Siconos {module}"
+    if package.split("+")[0] == module:
+        return f"Siconos {package} (Debian {SICONOS_PACKAGE})"
+    return f"Siconos {package} (Debian {SICONOS_PACKAGE}; its module calls itself {module})"
 
 
 def _env() -> dict[str, str]:
@@ -299,7 +331,7 @@ def _run_meta(model, numerics, meta, total, extra, arrays) -> dict[str, object]:
     calls = int(meta.get("solver_calls", 0))
     return {
         "solver": "siconos",
-        "version": f"Siconos {meta.get('siconos_version')} (rockyade {__version__} driver)",
+        "version": f"{version_label(meta.get('siconos_version'))}, rockyade {__version__} driver",
         "scene_hash": model.scene_hash,
         "wall_time_s": meta["wall_time_s"],
         "startup_time_s": total - meta["wall_time_s"],

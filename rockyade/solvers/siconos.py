@@ -23,7 +23,7 @@ from rockyade.scene import Scene
 from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
-from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost import CostEstimate, stepped_cost
 
 #: Largest time step accepted, s.
@@ -40,16 +40,6 @@ def _check_dt(value: Any, field: str) -> float | None:
     if not (0.0 < dt <= DT_LIMIT_S):
         raise InputError(field, f"must be in (0, {DT_LIMIT_S:g}] s, got {value!r}")
     return dt
-
-
-def _check_factor(value: Any, field: str) -> float:
-    try:
-        factor = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a number in (0, 1], got {value!r}") from None
-    if isinstance(value, bool) or not (0.0 < factor <= 1.0):
-        raise InputError(field, f"must be a number in (0, 1], got {value!r}")
-    return factor
 
 
 def _check_tol(value: Any, field: str) -> float:
@@ -104,7 +94,7 @@ class SiconosSolver(SolverBase):
         the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
         interval.
     dt_factor
-        Multiplies the time step, in (0, 1] (1: the step as chosen; 0.5: halved, for
+        Multiplies the time step, in [0.001, 1] (1: the step as chosen; 0.5: halved, for
         convergence checks).
     restitution
         Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
@@ -128,7 +118,7 @@ class SiconosSolver(SolverBase):
         "timeout_s": check_timeout,
         "warm": check_flag,
         "dt_s": _check_dt,
-        "dt_factor": _check_factor,
+        "dt_factor": check_dt_factor,
         "restitution": _check_restitution,
         "solver_tol": _check_tol,
         "solver_max_iter": _check_count(1, 100_000),
