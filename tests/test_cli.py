@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import subprocess
 import sys
 
@@ -329,3 +330,62 @@ def test_a_mistyped_option_or_command_shows_that_commands_usage_and_the_nearest_
         main(["motion", "info", "rec.AT2", "--zzzzzz"])
     err = capsys.readouterr().err
     assert stopped.value.code == 2 and "unrecognized arguments: --zzzzzz" in err and "did you mean" not in err
+
+
+def _subparsers():
+    """Every sub-command's parser (nested ones too), by its prog."""
+    import argparse
+
+    from rockyade.cli import build_parser
+
+    found, todo = {}, [build_parser()]
+    while todo:
+        parser = todo.pop()
+        found[parser.prog] = parser
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                todo.extend(action.choices.values())
+    return found
+
+
+def test_no_help_prints_a_doubled_percent_sign():
+    """argparse %-formats help strings but not descriptions: a description written "95 %%"
+    printed as such (crosscheck's did)."""
+    doubled = [prog for prog, parser in _subparsers().items() if "%%" in parser.format_help()]
+    assert not doubled
+
+
+def test_the_solver_options_help_lists_the_registrys_solvers():
+    """crosscheck --help and compare --help name every registered solver (the how-to page
+    sends readers to crosscheck --help for them)."""
+    from rockyade.solvers import solver_names
+
+    parsers = _subparsers()
+    for prog in ("rockyade crosscheck", "rockyade compare"):
+        text = " ".join(parsers[prog].format_help().split())
+        assert "among " + ", ".join(solver_names()) in text, prog
+
+
+def test_one_dt_factor_range_everywhere(capsys):
+    """The time-step factor's range is [DT_FACTOR_MIN, 1] in every check, help and doc: --dt-factors
+    1,1e-6 used to pass crosscheck's own check ((0, 1]) and be refused by the solver with another
+    message; Siconos took any factor in (0, 1]."""
+    from rockyade.errors import InputError
+    from rockyade.solvers import make_solver
+    from rockyade.solvers.base import DT_FACTOR_MIN
+    from rockyade.studies.crosscheck import check_dt_factors
+
+    from .conftest import ROOT
+
+    interval = f"[{DT_FACTOR_MIN:g}, 1]"
+    with pytest.raises(InputError, match=re.escape(interval)) as err:
+        check_dt_factors((1.0, 1e-6))
+    assert err.value.field == "--dt-factors"
+    for name in ("housner", "reference", "yade", "siconos"):
+        with pytest.raises(InputError, match=re.escape(interval)):
+            make_solver(name, dt_factor=1e-6)
+    parsers = _subparsers()
+    assert interval in " ".join(parsers["rockyade compare"].format_help().split())
+    assert interval in " ".join(parsers["rockyade crosscheck"].format_help().split())
+    for page in (ROOT / "docs/siconos.md", ROOT / "docs/verification.md"):
+        assert not re.search(r"dt_factor`? \(in \(0, 1\]", page.read_text()), page

@@ -636,6 +636,31 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
 
+def test_free_rocking_verdict_compares_the_peaks_after_release():
+    """In free rocking max |theta| is the release angle for every solver: the verdict compares the
+    peaks after the release (the table's peak1-4), and a zero step change with a zero gap between
+    solvers is agreement, not "says nothing"."""
+    from rockyade.analysis.compare import FREE_PEAKS, compare, verdict
+    from rockyade.scene import load_scene
+    from rockyade.solvers import make_solver
+
+    scene = load_scene(EXAMPLES / "specimen1_free.toml")
+    results = {n: make_solver(n).run(scene) for n in ("housner", "reference")}
+    table = compare(scene, results, "reference").set_index("metric")
+    gaps = [
+        abs(table.loc[m, "value"] - table.loc[m, "reference_value"])
+        / max(abs(table.loc[m, "value"]), abs(table.loc[m, "reference_value"]))
+        for m in (f"peak{k + 1}_amplitude_rad" for k in range(FREE_PEAKS))
+    ]
+    assert table.loc["max_abs_theta_rad", "difference"] == 0.0  # the release angle: says nothing
+    line = verdict(scene, results, "reference", {"housner": results["housner"]})
+    assert f"the first {FREE_PEAKS} peaks after release within {100 * max(gaps):.1f} % of reference" in line
+    assert max(gaps) > 0.01 and "says nothing" not in line and "less than the difference" in line
+    same = {"housner": results["housner"], "reference": results["housner"]}
+    line = verdict(scene, same, "reference", same)
+    assert "within 0.0 %" in line and "says nothing" not in line and "agree to the step's accuracy" in line
+
+
 # ---------------------------------------------------------------------- real records
 
 

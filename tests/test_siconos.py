@@ -6,6 +6,7 @@ test``) turns that into a failure."""
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import subprocess
@@ -252,3 +253,98 @@ def test_the_example_runs_with_the_geometrys_restitution_recorded():
     own = model_restitution(SiconosSolver().model(scene).bodies[0])
     assert result.meta.extra["mu_model"]["specimen1"] == pytest.approx(own)
     assert result.meta.extra["mu_scene"]["specimen1"] == 0.936 and "mu_note" in result.meta.extra
+
+
+def _short_free_scene(folder: Path, duration_s: float = 0.5) -> Path:
+    """``examples/specimen1_free.toml`` cut to ``duration_s`` (scene mu 0.936, paper calibration)."""
+    text = (EXAMPLES / "specimen1_free.toml").read_text()
+    path = folder / "s1.toml"
+    path.write_text(text.replace("duration_s = 4.0", f"duration_s = {duration_s}"))
+    return path
+
+
+def test_run_and_compare_print_that_siconos_runs_the_models_own_mu(tmp_path, capsys):
+    """The console says, in one line, that Siconos's effective mu is the model's own (mu_model),
+    not the scene's 0.936 (the note was only in the JSON)."""
+    from rockyade.cli import main
+
+    scene = _short_free_scene(tmp_path)
+    own = model_restitution(SiconosSolver().model(load_scene(scene)).bodies[0])
+    assert main(["run", str(scene), "--solver", "siconos"]) == 0
+    notes = [ln for ln in capsys.readouterr().out.splitlines() if "note:" in ln]
+    assert len(notes) == 1 and f"(mu_model): specimen1 {own:.4g} (scene mu 0.936)" in notes[0], notes
+    code = main(["compare", str(scene), "--solvers", "housner,siconos", "--no-dt-check", "--out", str(tmp_path / "c")])
+    notes = [ln for ln in capsys.readouterr().out.splitlines() if "note:" in ln]
+    assert code == 0 and len(notes) == 1 and f"specimen1 {own:.4g}" in notes[0], notes
+
+
+def test_worker_files_are_kept_only_after_a_failure_each_under_its_own_dt(tmp_path, monkeypatch, capsys):
+    """A completed ``run --out`` leaves only the result beside it and nothing in the temporary
+    folder (its worker files used to sit beside the result); a failed run's files go to the
+    result's folder, named with the dt_factor, so runs at dt and dt/2 keep a log each (they
+    used to share the scene-hash name, the second overwriting the first)."""
+    import tempfile
+
+    from rockyade.cli import main
+
+    scratch = tmp_path / "tmp"
+    scratch.mkdir()
+    monkeypatch.setattr(tempfile, "tempdir", str(scratch))
+    out = tmp_path / "x"
+    assert main(["run", str(_short_free_scene(tmp_path)), "--solver", "siconos", "--out", str(out / "s1.csv")]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["s1.csv", "s1.json"] and not list(scratch.iterdir())
+    data = stack(widths_m=[0.4, 0.35], heights_m=0.5, motion=rest_motion(), duration_s=0.3, sample_dt_s=0.01)
+    logs = []
+    for factor in (1.0, 0.5):
+        result = SiconosSolver(solver_max_iter=1, dt_factor=factor).keeping_files(out, "bad").run(scene_from_dict(data))
+        assert not result.ok
+        logs.append(Path(result.meta.log_path or ""))
+    assert [p.name for p in logs] == ["bad_dt1.siconos.log", "bad_dt0.5.siconos.log"]
+    assert all(p.parent == out.resolve() and p.is_file() for p in logs) and not list(scratch.iterdir())
+
+
+def test_an_interrupted_run_leaves_no_files(tmp_path):
+    """Ctrl-C (SIGINT) in the middle of a run: its private folder (the scene data, the empty log)
+    is removed, and nothing goes to the folder that keeps a failed run's files."""
+    import signal
+
+    scratch, out = tmp_path / "tmp", tmp_path / "out"
+    scratch.mkdir()
+    scene = _block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 10_000.0, sample_dt=0.01)
+    data = json.dumps(scene.to_dict())
+    code = (
+        "import json\nfrom rockyade.scene import scene_from_dict\nfrom rockyade.solvers.siconos import SiconosSolver\n"
+        f"scene = scene_from_dict(json.loads({data!r}))\n"
+        f"SiconosSolver().keeping_files({str(out)!r}, 'k').run(scene)\n"
+    )
+    env = {**os.environ, "TMPDIR": str(scratch), "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
+    proc = subprocess.Popen([sys.executable, "-c", code], env=env, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not list(scratch.glob("rockyade-siconos-*/*.siconos.json")):
+        time.sleep(0.05)
+    assert list(scratch.glob("rockyade-siconos-*/*.siconos.json")), "the run never started"
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode != 0 and "KeyboardInterrupt" in err, err
+    assert not list(scratch.iterdir()) and not out.exists()
+
+
+def test_the_page_quotes_what_the_run_prints_and_the_version_is_the_packages(capsys):
+    """docs/siconos.md shows the lines ``rockyade run examples/specimen1_free.toml --solver
+    siconos`` prints (it showed 0.915 for 0.91437), and the Result names the Debian package's
+    version (4.4.0+dfsg-2), not only the module's own label (4.5.0)."""
+    from rockyade.cli import main
+
+    from .conftest import ROOT
+
+    assert main(["run", str(EXAMPLES / "specimen1_free.toml"), "--solver", "siconos"]) == 0
+    printed = [ln.strip() for ln in capsys.readouterr().out.splitlines()]
+    quoted = [ln.strip() for ln in (ROOT / "docs/siconos.md").read_text().splitlines() if ln.startswith("    ")]
+    for start in ("specimen1: max |theta|", "note: "):
+        line = next(ln for ln in printed if ln.startswith(start))
+        assert line in quoted, line
+    package = siconos_backend.package_version()
+    if package is not None:  # dpkg knows the installation
+        result = SiconosSolver().run(_block(0.25, 1.0, {"type": "free", "theta0_rad": 0.1}, 0.1))
+        assert result.meta.version.startswith(f"Siconos {package} (Debian python3-siconos")

@@ -61,7 +61,7 @@ def test_a_33_block_wall_stands_at_rest():
     scene = scene_from_dict(_wall(0.03))
     assert len(scene.blocks) == 33
     result = SiconosSolver(dt_s=1e-3).run(scene)
-    assert result.ok, result.meta.get("failure_reason")
+    assert result.ok, result.meta.failure_reason
     frame = result.frame
     for block in scene.blocks:
         name = block.name
@@ -69,9 +69,9 @@ def test_a_33_block_wall_stands_at_rest():
         assert np.max(np.abs(frame[f"{name}_y_m"] - frame[f"{name}_y_m"].iloc[0])) < 1e-6
         assert np.max(np.abs(frame[f"{name}_theta_rad"] - frame[f"{name}_theta_rad"].iloc[0])) < 1e-6
     meta = result.meta
-    assert meta["retried_steps"] >= 1 and meta["retried_steps_converged"] == meta["retried_steps"]
-    assert meta["fallback_steps"] >= 1 and meta["unconverged_steps"] == 0
-    assert meta["friction_solvers"] == ["nsn", "nsgs", "admm"]
+    assert meta.extra["retried_steps"] >= 1 and meta.extra["retried_steps_converged"] == meta.extra["retried_steps"]
+    assert meta.extra["fallback_steps"] >= 1 and meta.unconverged_steps == 0
+    assert list(meta.extra["friction_solvers"]) == ["nsn", "nsgs", "admm"]
 
 
 def test_an_arch_below_its_minimum_thickness_collapses_and_is_reported_overturned():
@@ -80,9 +80,9 @@ def test_an_arch_below_its_minimum_thickness_collapses_and_is_reported_overturne
     ``overturned``, a voussoir named, as the other solvers report a collapse."""
     scene = scene_from_dict(_arch(0.05, 6, 1.5))
     result = SiconosSolver(dt_s=1e-3).run(scene)
-    assert result.status == "overturned", result.meta.get("failure_reason")
-    assert result.meta["overturned_block"] in result.meta["blocks"]
-    assert 0.0 < result.meta["overturn_time_s"] < 1.5
+    assert result.status == "overturned", result.meta.failure_reason
+    assert result.meta.overturned_block in result.meta.blocks
+    assert 0.0 < (result.meta.overturn_time_s or 0.0) < 1.5
 
 
 def test_a_run_no_solver_can_step_fails_with_its_reason_and_keeps_its_samples():
@@ -101,9 +101,9 @@ def test_a_run_no_solver_can_step_fails_with_its_reason_and_keeps_its_samples():
     )
     result = SiconosSolver(dt_s=1e-3).run(scene)
     assert result.status == "failed" and not result.ok
-    reason = result.meta["failure_reason"]
+    reason = result.meta.failure_reason or ""
     assert "no friction-contact solver could take the step" in reason and "runaway" in reason
-    assert result.meta["partial"] is True and 0 < len(result.frame) == result.meta["partial_samples"] < scene.n_samples
+    assert result.meta.partial is True and 0 < len(result.frame) == result.meta.partial_samples < scene.n_samples
 
 
 def test_the_numpy_contact_geometry_equals_the_pair_by_pair_one(tmp_path):

@@ -6,8 +6,10 @@ DEM): the first peak amplitudes and times, the effective restitution (free rocki
 time window. One long table (CSV) with the value, the reference value and the difference;
 the reference solver is not compared with itself (its values are the ``reference_value``
 column). :func:`verdict` sums it up in one line: the outcome agreement, the largest peak
-difference between solvers and, given runs at half the time step, whether halving the step
-changed the peaks more than the solvers differ (then the difference says nothing).
+difference between solvers (max |theta| under a base motion; in free rocking, where max
+|theta| is the release angle for every solver, the first peaks after the release) and, given
+runs at half the time step, whether halving the step changed the peaks more than the solvers
+differ (then the difference says nothing).
 """
 
 from __future__ import annotations
@@ -94,36 +96,73 @@ def compare(scene: Scene, results: dict[str, Result], reference: str | None = No
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def _peaks(scene: Scene, result: Result) -> dict[str, float]:
-    """Block -> max |theta| of a result (rad); empty for a failed one."""
+#: Free rocking: the verdict compares this many peaks after the release (those of mu_eff).
+FREE_PEAKS = MU_EFF_IMPACTS
+
+#: A relative change below this (0.1 %) is no change: a step change and a solver gap both
+#: under it do not make the difference "say nothing" (0 >= 0 is agreement, not doubt).
+CONVERGED_TOL = 1e-3
+
+
+def _peaks(scene: Scene, result: Result) -> dict[str, tuple[float, ...]]:
+    """Block -> the peaks the verdict compares (rad); empty for a failed result.
+
+    Under a base motion: (max |theta|,). In free rocking max |theta| is the release angle
+    theta0, the same for every solver, so the peaks compared are the first
+    :data:`FREE_PEAKS` amplitudes after the release (the response to the impacts; those
+    :func:`~rockyade.blocks.restitution.effective_restitution` uses), or (max |theta|,) when
+    the block has none (it overturned or never rocked back).
+    """
     if not result.ok:
         return {}
-    return {
-        spec.name: float(np.nanmax(np.abs(result.series("theta_rad", spec.name))))
-        for spec in scene.blocks
-        if not spec.fixed and spec.name in result.blocks
-    }
+    out: dict[str, tuple[float, ...]] = {}
+    for spec in scene.blocks:
+        if spec.fixed or spec.name not in result.blocks:
+            continue
+        theta = result.series("theta_rad", spec.name)
+        largest = (float(np.nanmax(np.abs(theta))),)
+        if scene.motion.type == "free":
+            alpha = spec.classical().alpha_rad
+            amplitudes = find_peaks(result.t, theta, min_peak_rad=max(1e-5, 1e-3 * alpha)).amplitude_rad
+            after = tuple(float(abs(a)) for a in amplitudes[:FREE_PEAKS])
+            out[spec.name] = after or largest
+        else:
+            out[spec.name] = largest
+    return out
 
 
-def _largest_difference(a: dict[str, float], b: dict[str, float]) -> tuple[float, str]:
-    """The largest relative difference |a - b| / max(a, b) over the blocks both have (symmetric:
-    a solver's change with dt and two solvers' gap are measured alike), and its block."""
+def _relative(va: tuple[float, ...], vb: tuple[float, ...]) -> float:
+    """The largest |a - b| / max(a, b) over the peaks both have (NaN: none comparable); when
+    one has no peak after the release and the other has, their first values (max |theta| and
+    the first peak) are compared."""
+    worst = math.nan
+    for a, b in zip(va, vb, strict=False):
+        if math.isfinite(a) and math.isfinite(b) and max(a, b) > 0:
+            d = abs(a - b) / max(a, b)
+            worst = d if not math.isfinite(worst) else max(worst, d)
+    return worst
+
+
+def _largest_difference(a: dict[str, tuple[float, ...]], b: dict[str, tuple[float, ...]]) -> tuple[float, str]:
+    """The largest relative difference |a - b| / max(a, b) over the blocks both have and their
+    peaks (symmetric: a solver's change with dt and two solvers' gap are measured alike), and
+    its block."""
     worst, where = 0.0, ""
     for block, vb in b.items():
-        va = a.get(block, math.nan)
-        if math.isfinite(va) and math.isfinite(vb) and max(va, vb) > 0:
-            d = abs(va - vb) / max(va, vb)
-            if d > worst or not where:
-                worst, where = d, block
+        d = _relative(a.get(block, ()), vb)
+        if math.isfinite(d) and (d > worst or not where):
+            worst, where = d, block
     return (worst, where) if where else (math.nan, "")
 
 
 def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dict[str, Result] | None = None) -> str:
     """One line: do the solvers give the same outcome (overturned or not), how far apart are
-    their peaks |theta| (the largest relative difference from ``reference``, over blocks, of the
-    larger of the two), and,
-    with ``finer`` (solver -> its run at half the time step), did halving the step change a
-    solver's peaks more than the solvers differ (then the difference says nothing).
+    their peaks (the largest relative difference from ``reference``, over blocks, of the
+    larger of the two: max |theta| under a base motion, the first :data:`FREE_PEAKS` peaks
+    after the release in free rocking), and, with ``finer`` (solver -> its run at half the
+    time step), did halving the step change a solver's peaks more than the solvers differ
+    (then the difference says nothing; changes and gaps both below :data:`CONVERGED_TOL`
+    are agreement to the step's accuracy).
 
     Parameters
     ----------
@@ -142,13 +181,14 @@ def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dic
         outcome = f"same outcome ({kinds.pop()})"
     else:
         outcome = "outcomes differ (" + ", ".join(f"{s} {o}" for s, o in outcomes.items()) + ")"
+    what = f"the first {FREE_PEAKS} peaks after release" if scene.motion.type == "free" else "peak |theta|"
     ref = _peaks(scene, results[reference])
     diffs = {s: _largest_difference(_peaks(scene, r), ref) for s, r in results.items() if s != reference}
     diffs = {s: d for s, d in diffs.items() if math.isfinite(d[0])}
     if diffs:
         solver = max(diffs, key=lambda s: diffs[s][0])
         gap, block = diffs[solver]
-        peak = f"peak |theta| within {100 * gap:.1f} % of {reference} (largest: {solver}, {block})"
+        peak = f"{what} within {100 * gap:.1f} % of {reference} (largest: {solver}, {block})"
     else:
         gap, peak = math.nan, "no peaks to compare"
     if not finer:
@@ -161,11 +201,14 @@ def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dic
     if not changes:
         return f"{outcome}; {peak}; halving the step gave no peaks to compare"
     moved = max(changes, key=lambda s: changes[s])
-    step = f"halving the step changed {moved}'s peaks by {100 * changes[moved]:.1f} %"
+    change = changes[moved]
+    step = f"halving the step changed {moved}'s peaks by {100 * change:.1f} %"
     if flips:
         step += f" and the outcome of {', '.join(flips)}"
-    if math.isfinite(gap) and (changes[moved] >= gap or flips):
+    if math.isfinite(gap) and (flips or (change >= gap and change >= CONVERGED_TOL)):
         step += ", not less than the difference between solvers: that difference says nothing"
+    elif math.isfinite(gap) and gap < CONVERGED_TOL:
+        step += f", and the solvers differ by less than {100 * CONVERGED_TOL:g} %: they agree to the step's accuracy"
     elif math.isfinite(gap):
         step += ", less than the difference between solvers"
     return f"{outcome}; {peak}; {step}"

@@ -121,7 +121,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser = CommandParser(
         prog="rockyade",
         description="Seismic rocking of rigid blocks: classical (Housner) parameters, exact "
-        "Housner solver, DEM calibration from the classical parameters, reference DEM and YADE.",
+        "Housner solver, DEM calibration from the classical parameters, reference DEM, YADE and Siconos.",
     )
     parser.add_argument("--version", action="version", version=f"rockyade {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")

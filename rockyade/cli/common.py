@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:
+    from rockyade.run_meta import RunMeta
     from rockyade.solvers.base import Solver
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
@@ -130,6 +131,28 @@ def total_time(args: argparse.Namespace) -> float:
 
     start = getattr(args, "started_at", None)
     return time.perf_counter() - start if start is not None else float("nan")
+
+
+def mu_note_line(meta: RunMeta) -> str | None:
+    """One console line for a Result's ``mu_note`` (Siconos: the restitution its impacts give
+    is the model's own, mu_model, not the scene's mu), with the numbers; None without a note.
+
+    Parameters
+    ----------
+    meta
+        The Result's metadata (``mu_note``, ``mu_model`` and ``mu_scene`` in its ``extra``:
+        block -> mu).
+    """
+    note = meta.extra.get("mu_note")
+    if not note:
+        return None
+    model = meta.extra.get("mu_model") or {}
+    scene = meta.extra.get("mu_scene") or {}
+    values = [
+        f"{name} {mu:.4g}" + (f" (scene mu {scene[name]:.4g})" if scene.get(name) is not None else "")
+        for name, mu in model.items()
+    ]
+    return f"note: {note}: " + ", ".join(values) if values else f"note: {note}"
 
 
 def print_calibration(result: dict[str, Any], method: str) -> None:

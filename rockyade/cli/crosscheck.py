@@ -100,14 +100,14 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade crosscheck``."""
-    from rockyade.cli.common import add_yade_timeout
+    from rockyade.cli.common import SOLVER_NAMES, add_yade_timeout
 
     p = sub.add_parser(
         "crosscheck",
         help="several solvers on one scene over a record set: collapse intensities paired by record, with intervals",
         description="For each solver, each time-step factor and each record, find the collapse intensity (the "
         "smallest scale of the record, in the intensity measure, at which the scene collapses) by a scan then "
-        "bisection; compare the solvers by the median of their paired ratios with a bootstrap 95 %% interval, "
+        "bisection; compare the solvers by the median of their paired ratios with a bootstrap 95 % interval, "
         "the share of runs with the same verdict and the fragility per solver; rerun each solver with dt halved "
         "and report its own change beside. Writes collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, "
         "crosscheck.png and index.md, a set replaced as a whole when done; each run is written to --out/partial/ "
@@ -132,7 +132,7 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--solvers",
         default="housner,reference",
-        help="comma-separated solvers, at least two (default housner,reference)",
+        help=f"comma-separated solvers, at least two, among {', '.join(SOLVER_NAMES)} (default housner,reference)",
     )
     p.add_argument(
         "--intensity",
@@ -151,7 +151,9 @@ def register(sub: Any) -> None:
         help="agreement: median ratio within 1 +/- this, interval within twice (default 0.05)",
     )
     p.add_argument(
-        "--dt-factors", default="1,0.5", help="time-step factors, the first 1 (default 1,0.5: the convergence check)"
+        "--dt-factors",
+        default="1,0.5",
+        help="time-step factors in [0.001, 1], the first 1 (default 1,0.5: the convergence check)",
     )
     p.add_argument("--out", type=Path, required=True, help="output directory (replaced as a whole when done)")
     p.add_argument("--resume", action="store_true", help="finish an interrupted cross-check without repeating a run")

@@ -13,6 +13,7 @@ from rockyade.cli.common import (
     add_yade_timeout,
     check_output_file,
     json_out,
+    mu_note_line,
     solvers_from_args,
     total_time,
 )
@@ -166,6 +167,9 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, repo
         if not math.isnan(m["mu_eff"]):
             line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, MU_EFF_IMPACTS)} impacts"
         print(line)
+    note = mu_note_line(meta)
+    if note:
+        print(f"  {note}")
     if result.status == "overturned" and not scene.positioned:
         print(f"  overturned at t = {meta.overturn_time_s:.4g} s ({meta.overturned_block})")
 

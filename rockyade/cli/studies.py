@@ -11,6 +11,7 @@ from rockyade.cli.common import (
     add_allow_large,
     add_yade_timeout,
     check_output_dir,
+    mu_note_line,
     solver_options,
     solvers_from_args,
     total_time,
@@ -54,6 +55,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
             status = result.status if result.ok else f"failed ({result.meta.failure_reason})"
             wall = result.meta.wall_time_s if result.meta.wall_time_s is not None else float("nan")
             print(f"{solver.name}: {status}, wall time {wall:.3g} s")
+            note = mu_note_line(result.meta)
+            if note:
+                print(f"  {note}")
         halved = {}
         for solver in finer:
             result = solver.keeping_files(out, f"{stem}_halfdt").run(scene)
@@ -90,7 +94,7 @@ def _with_dt_factor(solvers: list[Any], factor: float, check: bool) -> tuple[lis
     Raises
     ------
     InputError
-        ``--dt-factor`` out of (0, 1], or given to a solver without the option.
+        ``--dt-factor`` out of [0.001, 1], or given to a solver without the option.
     """
     from dataclasses import replace
 
@@ -228,13 +232,17 @@ def register(sub: Any) -> None:
         "changed the peaks more than the solvers differ.",
     )
     p.add_argument("scene", type=Path, help="scene file")
-    p.add_argument("--solvers", default="housner,reference,yade", help="comma-separated solvers")
+    p.add_argument(
+        "--solvers",
+        default="housner,reference,yade",
+        help=f"comma-separated solvers among {', '.join(SOLVER_NAMES)} (default housner,reference,yade)",
+    )
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
     p.add_argument(
         "--dt-factor",
         type=float,
         default=1.0,
-        help="factor in (0, 1] on every solver's own time step (default 1); each solver is also run at half of "
+        help="factor in [0.001, 1] on every solver's own time step (default 1); each solver is also run at half of "
         "it for the verdict's convergence check",
     )
     p.add_argument("--no-dt-check", action="store_true", help="skip the runs at half the time step")

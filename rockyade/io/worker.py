@@ -37,6 +37,7 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -445,6 +446,32 @@ def _copy(text: str, fd: int) -> None:
             os.write(fd, text.encode())
 
 
+def keep_run_files(directory: Path, work: str, name: str, tag: str, ok: bool, into: Path | None = None) -> Path:
+    """Give a run's files (``<work><tag>.json``, ``.npz``, ``.log`` in ``directory``) their kept
+    names in ``into`` (default ``directory``): ``<name><tag>.*``, unless the run failed (not
+    ``ok``) and ``<name><tag>.npz`` there is an earlier run's output: then
+    ``<name>_failed<tag>.*`` beside it, so that a failed run never replaces or deletes the
+    files of an earlier one (whose result's ``log_path`` names its own log). Shared by the
+    backends that run in a worker (YADE: ``tag`` ".yade"; Siconos: ".siconos").
+
+    Returns
+    -------
+    Path
+        Where the log went (the Result's ``log_path``).
+    """
+    into = directory if into is None else into
+    final = name
+    if not ok and (into / f"{name}{tag}.npz").exists():
+        final = f"{name}_failed"
+    for suffix in (".json", ".npz", ".log"):
+        src = directory / f"{work}{tag}{suffix}"
+        if src.exists():
+            shutil.move(src, into / f"{final}{tag}{suffix}")  # across file systems too (a temporary folder)
+        elif suffix != ".log":  # no output of this run: none of an earlier run's stays beside its log
+            (into / f"{final}{tag}{suffix}").unlink(missing_ok=True)
+    return into / f"{final}{tag}.log"
+
+
 #: The longest timeout a user may give a run, s (30 days).
 MAX_TIMEOUT_S = 30 * 86400.0
 
@@ -476,6 +503,7 @@ __all__ = [
     "WorkerLostError",
     "check_timeout",
     "close_workers",
+    "keep_run_files",
     "run_scene",
     "slot",
 ]

@@ -16,9 +16,11 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import json
 import os
 import shutil
+import subprocess
 import tempfile
 import time
 import zipfile
@@ -33,7 +35,7 @@ from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
-from rockyade.io.worker import Program, run_scene
+from rockyade.io.worker import Program, keep_run_files, run_scene
 from rockyade.io.worker import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
 from rockyade.run_meta import RunMeta
@@ -72,6 +74,36 @@ def siconos_available() -> bool:
     return Path(SICONOS_PYTHON).is_file() and SICONOS_MODULE.is_file()
 
 
+#: The Debian package whose Siconos runs (its version is the one to cite: the module it ships
+#: calls itself 4.5.0, in ``siconos.version`` and its egg-info, while the package is 4.4.0).
+SICONOS_PACKAGE = "python3-siconos"
+
+
+@functools.cache
+def package_version() -> str | None:
+    """The installed Debian package's version (``dpkg-query``), e.g. "4.4.0+dfsg-2"; None
+    where dpkg does not know it (another installation, ``ROCKYADE_SICONOS_PYTHON``)."""
+    try:
+        done = subprocess.run(
+            ["dpkg-query", "-W", "-f=${Version}", SICONOS_PACKAGE], capture_output=True, text=True, timeout=10
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return (done.stdout.strip() or None) if done.returncode == 0 else None
+
+
+def version_label(module_version: object) -> str:
+    """What a Result records as Siconos's version: the Debian package's, and the module's own
+    label when it says otherwise (``module_version``, as the driver reports it)."""
+    package = package_version()
+    module = str(module_version) if module_version not in (None, "") else "unknown"
+    if package is None:
+        return f"Siconos {module}"
+    if package.split("+")[0] == module:
+        return f"Siconos {package} (Debian {SICONOS_PACKAGE})"
+    return f"Siconos {package} (Debian {SICONOS_PACKAGE}; its module calls itself {module})"
+
+
 def _env() -> dict[str, str]:
     env = dict(os.environ)
     env["OMP_NUM_THREADS"] = "1"
@@ -102,6 +134,7 @@ def run_model(
     accel_lowpass_hz: float | None = None,
     warm: bool = True,
     workdir: str | Path | None = None,
+    failed_dir: str | Path | None = None,
     name: str = "siconos",
     extra_meta: dict[str, object] | None = None,
 ) -> Result:
@@ -118,8 +151,15 @@ def run_model(
     warm
         Run in this thread's warm worker; False: in a process of its own.
     workdir
-        Where ``<name>.siconos.json``, ``.npz`` and ``.log`` are kept; default a temporary
-        folder, removed after a successful run and kept after a failed one.
+        Where ``<name>.siconos.json``, ``.npz`` and ``.log`` are kept after every run.
+    failed_dir
+        Where they are kept after a failed run only (``run --out``'s folder; ignored with
+        ``workdir``). The run itself works in a private temporary folder, removed after a
+        successful run (unless ``workdir``) and when the run is interrupted (Ctrl-C); a failed
+        run's files are moved to ``workdir`` or ``failed_dir``, or stay in that folder
+        (``log_path`` says where).
+    name
+        The files' stem (the solver's: the scene hash or the caller's stem, and dt_factor).
     extra_meta
         More metadata for the Result (calibration, time-step choice).
     """
@@ -131,15 +171,12 @@ def run_model(
     n_steps = (model.n_samples - 1) * numerics.steps_per_sample
     timeout = check_timeout(timeout_s)
     timeout = timeout if timeout is not None else default_timeout(n_steps, len(model.bodies))
-    keep = workdir is not None
-    directory = (Path(workdir) if workdir is not None else Path(tempfile.mkdtemp(prefix="rockyade-siconos-"))).resolve()
-    directory.mkdir(parents=True, exist_ok=True)
+    destination = workdir if workdir is not None else failed_dir
+    directory = Path(tempfile.mkdtemp(prefix="rockyade-siconos-")).resolve()
     scene_file = directory / f"{name}.siconos.json"
     out_file = directory / f"{name}.siconos.npz"
     log_file = directory / f"{name}.siconos.log"
     partial = directory / f"{name}.siconos.npz.part"
-    for stale in (out_file, partial):
-        stale.unlink(missing_ok=True)
     payload = scene_payload(model, numerics)
     program = Program([SICONOS_PYTHON, str(DRIVER)], _env(), LABEL, TIMEOUT_OPTION, FLUSH_PERIOD_S)
     start = time.perf_counter()
@@ -149,6 +186,9 @@ def run_model(
     except OSError as exc:
         error = exc if exc.filename else OSError(exc.errno, exc.strerror, str(scene_file))
         reason = f"cannot write {os_error_message(error)}"
+    except BaseException:  # Ctrl-C: an interrupted run leaves none of its files
+        shutil.rmtree(directory, ignore_errors=True)
+        raise
     total = time.perf_counter() - start
     if reason is not None:
         partial.unlink(missing_ok=True)
@@ -167,8 +207,18 @@ def run_model(
         **(extra_meta or {}),
     }
     result = _parse(model, numerics, out_file, reason, log_file, total, accel_lowpass_hz, extra)
-    if result.ok and not keep:
+    if result.ok and workdir is None:
         shutil.rmtree(directory, ignore_errors=True)
+    elif destination is not None:
+        into = Path(destination).resolve()
+        try:
+            into.mkdir(parents=True, exist_ok=True)
+            log = keep_run_files(directory, name, name, ".siconos", result.ok, into)
+            result.meta = dataclasses.replace(result.meta, log_path=str(log))
+        except OSError:  # the folder cannot take them: they stay where they are (log_path says so)
+            pass
+        else:
+            shutil.rmtree(directory, ignore_errors=True)
     return result
 
 
@@ -300,7 +350,7 @@ def _run_meta(
     calls = meta.solver_calls
     return {
         "solver": "siconos",
-        "version": f"Siconos {meta.version} (rockyade {__version__} driver)",
+        "version": f"{version_label(meta.version)}, rockyade {__version__} driver",
         "scene_hash": model.scene_hash,
         "wall_time_s": meta.wall_time_s,
         "startup_time_s": total - meta.wall_time_s if meta.wall_time_s is not None else None,

@@ -129,12 +129,12 @@ def check_flag(value: Any, field: str) -> bool:
     return value
 
 
-#: Range of ``dt_factor``, the factor on a solver's own time step (0, 1].
+#: Range of ``dt_factor``, the factor on a solver's own time step: [DT_FACTOR_MIN, 1].
 DT_FACTOR_MIN = 1e-3
 
 
 def check_dt_factor(value: Any, field: str) -> float:
-    """A factor on the solver's own time step, in (0, 1] (1: the step the solver chooses;
+    """A factor on the solver's own time step, in [0.001, 1] (1: the step the solver chooses;
     0.5: half of it, the convergence check of a cross-check). Below :data:`DT_FACTOR_MIN`
     it is refused (a thousand times the steps is not a check, it is a hang)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not DT_FACTOR_MIN <= float(value) <= 1.0:

@@ -34,7 +34,7 @@ class HousnerSolver(SolverBase):
     Attributes
     ----------
     dt_factor
-        Factor in (0, 1] on the largest Runge-Kutta step 1 / (``STEPS_PER_RADIAN`` p), the
+        Factor in [0.001, 1] on the largest Runge-Kutta step 1 / (``STEPS_PER_RADIAN`` p), the
         only step of the solution (impacts, uplift and overturning are found by root finding
         to machine precision); recorded in the Result's ``dt_factor`` and ``dt_s``.
     """

@@ -69,7 +69,7 @@ class ReferenceSolver(SolverBase):
         ``n_contacts`` and ``slipping`` per block and, for columns, the state of every
         corner.
     dt_factor
-        Factor in (0, 1] on the model's time step (Eq 7 or the stability limit; 0.5 halves
+        Factor in [0.001, 1] on the model's time step (Eq 7 or the stability limit; 0.5 halves
         it: the convergence check of ``rockyade crosscheck``), recorded in the Result's
         ``dt_factor`` beside the ``dt_s`` used.
     """

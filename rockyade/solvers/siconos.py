@@ -23,7 +23,7 @@ from rockyade.scene import Scene
 from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
-from rockyade.solvers.base import SolverBase, check_flag
+from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost import CostEstimate, stepped_cost
 
 #: Largest time step accepted, s.
@@ -40,16 +40,6 @@ def _check_dt(value: Any, field: str) -> float | None:
     if not (0.0 < dt <= DT_LIMIT_S):
         raise InputError(field, f"must be in (0, {DT_LIMIT_S:g}] s, got {value!r}")
     return dt
-
-
-def _check_factor(value: Any, field: str) -> float:
-    try:
-        factor = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a number in (0, 1], got {value!r}") from None
-    if isinstance(value, bool) or not (0.0 < factor <= 1.0):
-        raise InputError(field, f"must be a number in (0, 1], got {value!r}")
-    return factor
 
 
 def _check_tol(value: Any, field: str) -> float:
@@ -104,7 +94,7 @@ class SiconosSolver(SolverBase):
         the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
         interval.
     dt_factor
-        Multiplies the time step, in (0, 1] (1: the step as chosen; 0.5: halved, for
+        Multiplies the time step, in [0.001, 1] (1: the step as chosen; 0.5: halved, for
         convergence checks).
     restitution
         Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
@@ -115,8 +105,13 @@ class SiconosSolver(SolverBase):
     newton_max_iter
         Newton iterations per step on the nonlinear kinematics (1: linearised once).
     workdir
-        Where the scene data, output and log are kept (default: a temporary folder, removed
-        after a successful run, kept after a failed one).
+        Where the scene data, output and log are kept after every run (default: none; the
+        run works in a private temporary folder, removed after a successful or interrupted
+        run, kept after a failed one).
+    failed_dir, stem
+        Set by :meth:`keeping_files` (not options): where a failed run's files go, and their
+        stem (default the scene hash and the solver's name); the stem is followed by
+        ``_dt<dt_factor>`` so that runs at two steps never share a name.
     """
 
     name: ClassVar[str] = "siconos"
@@ -124,7 +119,7 @@ class SiconosSolver(SolverBase):
         "timeout_s": check_timeout,
         "warm": check_flag,
         "dt_s": _check_dt,
-        "dt_factor": _check_factor,
+        "dt_factor": check_dt_factor,
         "restitution": _check_restitution,
         "solver_tol": _check_tol,
         "solver_max_iter": _check_count(1, 100_000),
@@ -143,6 +138,8 @@ class SiconosSolver(SolverBase):
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
     workdir: str | None = None
+    failed_dir: str | None = None
+    stem: str | None = None
 
     def __post_init__(self) -> None:
         for key in (
@@ -157,6 +154,7 @@ class SiconosSolver(SolverBase):
             object.__setattr__(self, key, self.OPTIONS[key](getattr(self, key), key))
         object.__setattr__(self, "warm", check_flag(self.warm, "warm"))
         object.__setattr__(self, "workdir", _check_folder(self.workdir, "workdir"))
+        object.__setattr__(self, "failed_dir", _check_folder(self.failed_dir, "failed_dir"))
 
     def model(self, scene: Scene) -> DemModel:
         """The scene's blocks, motion and start as the DEMs build them (a matched calibration's
@@ -205,7 +203,8 @@ class SiconosSolver(SolverBase):
             accel_lowpass_hz=scene.output.accel_lowpass_hz,
             warm=self.warm,
             workdir=self.workdir,
-            name=f"{scene.scene_hash}_{self.name}",
+            failed_dir=self.failed_dir,
+            name=f"{self.stem or f'{scene.scene_hash}_{self.name}'}_dt{self.dt_factor:g}",
             extra_meta={**how, **mu},
         )
 
@@ -218,8 +217,9 @@ class SiconosSolver(SolverBase):
         return stepped_cost(scene, self.name, steps, numerics.dt_s, steps * self.SECONDS_PER_BODY_STEP)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
-        """This solver keeping its files in ``folder`` (the stem is the scene hash's)."""
-        return replace(self, workdir=str(folder))
+        """This solver keeping a failed run's files in ``folder``, named ``stem`` (default: by
+        scene hash) and the dt_factor; a successful run keeps none (unless ``workdir``)."""
+        return replace(self, failed_dir=str(folder), stem=stem)
 
 
 __all__ = ["SiconosSolver"]

@@ -55,7 +55,7 @@ class YadeSolver(SolverBase):
         a process of its own (False): the same result, bit for bit; a warm run saves YADE's
         start-up, 0.7-1.0 s.
     dt_factor
-        Factor in (0, 1] on the model's time step (as the reference DEM's), recorded in the
+        Factor in [0.001, 1] on the model's time step (as the reference DEM's), recorded in the
         Result's ``dt_factor`` beside the ``dt_s`` used.
     """
 

@@ -57,7 +57,7 @@ from rockyade.runner import Executor
 from rockyade.runner.journal import IDENTITY_FILE, Journal, read_run
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import DT_FACTOR_MIN, Solver
 from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 
 #: Time-step factors by default: the solver's own step, and half of it (convergence).
@@ -255,11 +255,14 @@ def parse_solvers(text: str, field_name: str = "--solvers") -> tuple[str, ...]:
 
 
 def check_dt_factors(values: Sequence[float], field_name: str = "--dt-factors") -> tuple[float, ...]:
-    """Distinct factors in (0, 1], the first 1 (the solvers' own steps)."""
+    """Distinct factors in [DT_FACTOR_MIN, 1] (every solver's ``dt_factor`` range,
+    :func:`rockyade.solvers.base.check_dt_factor`), the first 1 (the solvers' own steps)."""
     out = tuple(float(v) for v in values)
-    if not out or out[0] != 1.0 or len(set(out)) != len(out) or any(not (0.0 < v <= 1.0) for v in out):
+    if not out or out[0] != 1.0 or len(set(out)) != len(out) or any(not (DT_FACTOR_MIN <= v <= 1.0) for v in out):
         raise InputError(
-            field_name, f"must be distinct factors in (0, 1] on the solvers' time steps, the first 1, got {values!r}"
+            field_name,
+            f"must be distinct factors in [{DT_FACTOR_MIN:g}, 1] on the solvers' time steps, the first 1, "
+            f"got {values!r}",
         )
     return out
 

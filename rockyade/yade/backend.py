@@ -48,6 +48,7 @@ from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.worker import check_timeout as checked_timeout
+from rockyade.io.worker import keep_run_files
 from rockyade.result import Result, failed_result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
@@ -154,6 +155,13 @@ def run_model(
     except OSError as exc:  # a full disk: the run fails naming the file; its temporary files are gone
         error = exc if exc.filename else OSError(exc.errno, exc.strerror, str(scene_file))
         reason = f"cannot write {os_error_message(error)}"
+    except BaseException:  # Ctrl-C: an interrupted run leaves none of its files
+        if keep:
+            for path in (scene_file, out_file, log_file, partial):
+                path.unlink(missing_ok=True)
+        else:
+            shutil.rmtree(directory, ignore_errors=True)
+        raise
     total = time.perf_counter() - start
     if reason is not None:
         partial.unlink(missing_ok=True)  # a worker killed while writing
@@ -169,21 +177,12 @@ def run_model(
 
 
 def _keep_files(directory: Path, work: str, name: str, result: Result) -> None:
-    """Give a run's files (``<work>.yade.*``) their names: ``<name>.yade.*``, unless the run
-    failed and ``<name>.yade.npz`` is an earlier run's output: then ``<name>_failed.yade.*``
-    beside it, so that a failed run never replaces or deletes the files of an earlier one
-    (whose result's ``log_path`` names its own log). ``log_path`` says where the log went."""
-    final = name
-    if not result.ok and (directory / f"{name}.yade.npz").exists():
-        final = f"{name}_failed"
-    for suffix in (".yade.json", ".yade.npz", ".yade.log"):
-        src = directory / f"{work}{suffix}"
-        if src.exists():
-            os.replace(src, directory / f"{final}{suffix}")
-        elif suffix != ".yade.log":  # no output of this run: none of an earlier run's stays beside its log
-            (directory / f"{final}{suffix}").unlink(missing_ok=True)
+    """Give a run's files (``<work>.yade.*``) their names (:func:`rockyade.io.worker.keep_run_files`:
+    ``<name>.yade.*``, or ``<name>_failed.yade.*`` beside an earlier run's output when this one
+    failed). ``log_path`` says where the log went."""
+    log = keep_run_files(directory, work, name, ".yade", result.ok)
     if result.meta.log_path is not None:
-        result.meta = dataclasses.replace(result.meta, log_path=str(directory / f"{final}.yade.log"))
+        result.meta = dataclasses.replace(result.meta, log_path=str(log))
 
 
 def _command() -> list[str]:
