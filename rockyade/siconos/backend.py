@@ -10,6 +10,10 @@ kept beside the output). A failure of any kind (a crash, a timeout, an exception
 Siconos, a non-finite state, a step the friction-contact solver could not converge, a
 partial output) gives a Result with status ``failed``, the reason and the log path, and
 the samples recorded up to there (``partial: true``): never one that looks complete.
+
+Same role as :mod:`rockyade.yade.backend`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 from __future__ import annotations

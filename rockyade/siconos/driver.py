@@ -46,6 +46,10 @@ The model (nonsmooth contact dynamics, Moreau-Jean time stepping):
   normal); per step the numerics solver's iterations and residual are counted (a step whose
   residual stays above the tolerance is "unconverged"); at every sample the deepest
   penetration (-gap) of the contacts.
+
+Same role as :mod:`rockyade.yade.driver`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 import contextlib

@@ -8,6 +8,10 @@ model's alpha is the scene's), masses and centroidal inertias set so that I_O = 
 included) and the overturn angles. The DEMs' contact stiffness and damping are not used:
 a nonsmooth contact has none. The friction coefficient of each pair of bodies is the DEMs'
 (:meth:`rockyade.dem.joints.JointTable.joint_for`).
+
+Same role as :mod:`rockyade.yade.payload`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 from __future__ import annotations

@@ -22,6 +22,10 @@ Runs are independent (own files; a worker runs one scene at a time), so several 
 parallel (the runner, :mod:`rockyade.runner`). The solver, :class:`rockyade.solvers.yade.YadeSolver`,
 turns a scene into a model (:func:`yade_model`) and calls :func:`run_model`;
 :func:`write_script` gives YADE users the same scene as a script of their own.
+
+Same role as :mod:`rockyade.siconos.backend`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 from __future__ import annotations

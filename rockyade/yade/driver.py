@@ -72,6 +72,10 @@ The model, as the reference DEM's:
   of rockyade's overturn criterion, given in the data); the run stops there in a column
   scene (``stop_on_overturn``) and goes on in an assembly; it stops when a state is not
   finite (failed).
+
+Same role as :mod:`rockyade.siconos.driver`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 import contextlib

@@ -3,6 +3,10 @@
 Scenes are data, never code: no value is pasted into Python source for YADE. Everything
 about the contacts (sphere centres, their copies, materials and collision masks) is decided
 here (:mod:`rockyade.yade.contacts`); the driver only builds what the data says.
+
+Same role as :mod:`rockyade.siconos.payload`: each package of an engine that runs in another
+Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
+solver").
 """
 
 from __future__ import annotations
