@@ -90,6 +90,8 @@ RENAMES: list[tuple[str, str]] = [
     ("rockyade/figures/limit.py", "rockyade/figures/collapse_mechanism.py"),
     ("rockyade/figures/identify.py", "rockyade/figures/identification_fit.py"),
     ("rockyade/figures/assess.py", "rockyade/figures/wall_assessment.py"),
+    ("rockyade/figures/fragility.py", "rockyade/figures/fragility_panels.py"),
+    ("rockyade/figures/overturning.py", "rockyade/figures/overturning_spectrum.py"),
     ("rockyade/dem/build.py", "rockyade/dem/model_from_scene.py"),
     # generators are named after the structures they build (arches, columns, frames, walls)
     ("rockyade/dem/frames.py", "rockyade/dem/result_frames.py"),
@@ -127,8 +129,8 @@ LITERAL_EDITS: dict[str, list[tuple[str, str]]] = {
             "  their docstrings: `payload`, `driver` and `backend` of `yade/` and `siconos/`.\n",
         ),
         (
-            "verification (`verify.py`)",
-            "verification (`verification.py`)",
+            "verification (`verify.py`,",
+            "verification (`verification.py`,",
         ),
         (
             "the JSON payload (`payload`, `contacts`)",
