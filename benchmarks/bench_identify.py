@@ -22,7 +22,7 @@ import numpy as np
 from rockyade import paper
 from rockyade.identification.fit import CLASSICAL, identify, synthetic_measurement
 from rockyade.identification.measurement import measured_history
-from rockyade.probability.fragility import wilson_interval
+from rockyade.probability.fragility_curves import wilson_interval
 
 RATES_HZ = (100.0, 200.0, 500.0, 1000.0)
 

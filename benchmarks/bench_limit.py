@@ -18,7 +18,7 @@ import time
 from rockyade.limit.kinematic import kinematic_quantities
 from rockyade.limit.lp import solve_equilibrium
 from rockyade.limit.mechanism import mechanism_of
-from rockyade.limit.model import rigid_block_model
+from rockyade.limit.rigid_blocks import rigid_block_model
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import wall
 

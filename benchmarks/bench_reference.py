@@ -14,11 +14,11 @@ import time
 
 import numpy as np
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.reference import ReferenceSolver, run_model
-from rockyade.studies.specimens import block_table
+from rockyade.studies.specimen_scenes import block_table
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 

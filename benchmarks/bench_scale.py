@@ -29,7 +29,7 @@ import time
 import tracemalloc
 from typing import Any
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.solvers.reference import run_model
 

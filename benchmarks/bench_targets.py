@@ -65,7 +65,7 @@ def best_cpu(fn, repeat: int) -> float:
 
 
 def kernel_target(repeat: int) -> None:
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.dem.engine import model_arrays
     from rockyade.kernel import simulation as kernel
     from rockyade.kernel.single import simulate_single
@@ -128,7 +128,7 @@ def kernel_cpu(tasks) -> tuple[float, float]:
 
     import numba
 
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.dem.engine import model_arrays
     from rockyade.kernel.runs import simulate_runs
     from rockyade.kernel.single import simulate_single
@@ -252,7 +252,7 @@ def batch_target() -> None:
 def wall_target() -> None:
     from bench_scale import scene_for
 
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.solvers.reference import run_model
 
     per = {}

@@ -24,15 +24,15 @@ import sys
 import time
 from pathlib import Path
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.errors import InputError
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.reference import run_model
 from rockyade.solvers.yade import YadeSolver
-from rockyade.studies.specimens import block_table
+from rockyade.studies.specimen_scenes import block_table
 from rockyade.yade import backend as yade_backend
-from rockyade.yade import worker as yade_worker
+from rockyade.yade import warm_worker as yade_worker
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 

@@ -20,12 +20,12 @@ import time
 from pathlib import Path
 
 from rockyade.assess import ec8_suite, parse_measure
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import G
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.studies.crosscheck import crosscheck_plan, run_crosscheck
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.crosscheck_study import crosscheck_plan, run_crosscheck
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 #: Specimen 3's contact stiffness in the matched calibration, N/m.
 K_N_PER_M = 1658536960.7001035

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import G
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.housner import HousnerSolver

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.joints import default_pair_joint
 from rockyade.errors import CalibrationError, InputError
 from rockyade.scene import load_scene, scene_from_dict

@@ -26,8 +26,8 @@ from rockyade.assess import (
 )
 from rockyade.assess.assessment import add_pushover
 from rockyade.assess.code import NOT_APPLICABLE, NOT_VERIFIED, VERIFIED, Check, check_code, verdict
-from rockyade.assess.fit import fit_stripes, stripe_table
-from rockyade.assess.fragility import EXTEND_RATIO, _next_level, check_levels, fragility_plan, run_fragility
+from rockyade.assess.fragility_analysis import EXTEND_RATIO, _next_level, check_levels, fragility_plan, run_fragility
+from rockyade.assess.stripe_fit import fit_stripes, stripe_table
 from rockyade.assess.stripes import StripePlan, run_stripe_task
 from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import InputError
@@ -373,7 +373,7 @@ def test_a_fragility_analysis_runs_through_the_runner_and_writes_one_row_per_run
 
 @pytest.mark.slow
 def test_the_verify_checks_of_limit_analysis_the_code_and_the_fit_pass(tmp_path):
-    from rockyade.studies.verify import verify
+    from rockyade.studies.verification import verify
 
     table = verify(tmp_path, ["kinematic", "code", "fragility_fit"], ["reference"])
     assert set(table["check"]) == {"kinematic", "code", "fragility_fit"}
@@ -401,7 +401,7 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
     from matplotlib import pyplot as plt
 
     from rockyade.cli import main
-    from rockyade.figures.assess import plot_capacity
+    from rockyade.figures.wall_assessment import plot_capacity
     from rockyade.scene import load_scene
 
     scene = load_scene(EXAMPLES / "free_standing_wall.toml")

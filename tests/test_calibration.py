@@ -114,7 +114,7 @@ def test_calibrate_gives_the_joint_the_model_runs(contact, method):
     """One dispatch: the joint that calibrate() returns for a block is the one the model built
     from its scene runs (the model is handed the joints, it calibrates nothing)."""
     from rockyade.calibration.calibrate import calibrate, calibration_method
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.scene import scene_from_dict
 
     from .conftest import free_scene_dict

@@ -15,10 +15,10 @@ import pytest
 
 from rockyade.assess import Position, Site, assess, records_in_folder
 from rockyade.assess.code import CHECK_SOURCES, code_checks
-from rockyade.assess.fit import FEW_RECORDS, MIN_RECORDS, fit_stripes
-from rockyade.assess.fragility import fragility_plan
+from rockyade.assess.fragility_analysis import fragility_plan
 from rockyade.assess.measures import Measure
 from rockyade.assess.site import NtcSite
+from rockyade.assess.stripe_fit import FEW_RECORDS, MIN_RECORDS, fit_stripes
 from rockyade.assess.stripes import run_stripe_task, whole_alpha
 from rockyade.cli import main
 from rockyade.constants import CODE_GRAVITY, G

@@ -27,7 +27,7 @@ from rockyade.analysis.metrics import (
 )
 from rockyade.blocks.geometry import chamfered_rectangle_vertices, rectangle_vertices
 from rockyade.cli import main
-from rockyade.dem.build import contact_polygon
+from rockyade.dem.model_from_scene import contact_polygon
 from rockyade.dem.overturn import (
     LANDING_TOL_RAD,
     block_fall,

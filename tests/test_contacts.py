@@ -8,12 +8,12 @@ import math
 import numpy as np
 import pytest
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.engine import model_arrays, polygon_arrays, simulate_model
 from rockyade.dem.overturn import LANDING_TOL_RAD
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.kernel import simulation as kernel
-from rockyade.kernel.contacts import NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
+from rockyade.kernel.narrowphase import NO_FACE, clip_manifold, incident_edge, joint_for, separating_axis_test
 from rockyade.kernel.state import pack
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix

@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from rockyade.analysis.crosscheck import (
+from rockyade.analysis.crosscheck_statistics import (
     ABOVE,
     BRACKETED,
     MAX_EXTENSIONS,
@@ -151,7 +151,7 @@ def small_plan(records: Path, dt_factors=(1.0, 0.5)):
     from rockyade.assess import parse_measure, records_in_folder
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck import crosscheck_plan
+    from rockyade.studies.crosscheck_study import crosscheck_plan
 
     return crosscheck_plan(
         load_scene(EXAMPLES / "specimen1_record.toml"),
@@ -169,7 +169,7 @@ def small_plan(records: Path, dt_factors=(1.0, 0.5)):
 
 def run(plan, out: Path, resume: bool = False):
     from rockyade.runner import Executor
-    from rockyade.studies.crosscheck import run_crosscheck
+    from rockyade.studies.crosscheck_study import run_crosscheck
 
     return run_crosscheck(plan, out, Executor("threads", 1), resume=resume, progress=False, say=lambda _s: None)
 
@@ -193,7 +193,7 @@ def complete(plan, tmp_path_factory):
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
     assert summary.partial is False and summary.verdicts
-    from rockyade.studies.crosscheck import RESULT_FILES, journal_dir
+    from rockyade.studies.crosscheck_study import RESULT_FILES, journal_dir
 
     for name in RESULT_FILES:
         assert (out / name).is_file(), name
@@ -242,7 +242,7 @@ def test_small_real_crosscheck(complete, plan):
 
 
 def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
-    import rockyade.studies.crosscheck as cc
+    import rockyade.studies.crosscheck_study as cc
 
     reference_out, _ = complete
     total = len(pd.read_csv(reference_out / "runs.csv"))
@@ -288,7 +288,7 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
 
 def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypatch):
     """A process killed mid-study (no summary written): the runs on disk are all it left."""
-    import rockyade.studies.crosscheck as cc
+    import rockyade.studies.crosscheck_study as cc
 
     real = cc.run_study_tasks
     calls = {"n": 0}
@@ -314,7 +314,7 @@ def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypat
 def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp_path, monkeypatch):
     import shutil
 
-    import rockyade.studies.crosscheck as cc
+    import rockyade.studies.crosscheck_study as cc
 
     out = tmp_path / "out"
     shutil.copytree(complete[0], out)
@@ -406,7 +406,7 @@ def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_pa
 
 
 def test_out_that_is_a_link_or_a_file_is_refused(tmp_path):
-    from rockyade.studies.crosscheck import check_out, journal_dir
+    from rockyade.studies.crosscheck_study import check_out, journal_dir
 
     mine = tmp_path / "mine"
     mine.mkdir()
@@ -427,7 +427,7 @@ from pathlib import Path
 from rockyade.assess import parse_measure, records_in_folder
 from rockyade.runner import Executor
 from rockyade.scene import load_scene
-from rockyade.studies.crosscheck import Study, crosscheck_plan
+from rockyade.studies.crosscheck_study import Study, crosscheck_plan
 from rockyade.kernel.runs import simulate_runs
 from rockyade.kernel.single import simulate_single
 plan = crosscheck_plan(load_scene(Path(sys.argv[1])), records_in_folder(sys.argv[2]), parse_measure("pga"),
@@ -456,7 +456,7 @@ def test_warm_up_loads_the_kernels_the_workers_run(records, tmp_path):
 
 
 def test_cost_line_counts_the_start_up(plan):
-    from rockyade.studies.crosscheck import ROUND_OVERHEAD_S
+    from rockyade.studies.crosscheck_study import ROUND_OVERHEAD_S
 
     line = plan.cost_line(2)
     assert "start-up" in line and f"{plan.rounds()} rounds" in line
@@ -587,8 +587,8 @@ def test_command_writes_the_set(records, tmp_path, capsys):
 def test_figure_is_a_display_object(complete):
     from matplotlib.figure import Figure
 
-    from rockyade.figures.common import file_figure
-    from rockyade.figures.crosscheck import PairedRatios
+    from rockyade.figures.canvas import file_figure
+    from rockyade.figures.paired_ratios import PairedRatios
 
     pairs = pd.read_csv(complete[0] / "pairs.csv")
     fig, ax = file_figure()
@@ -673,7 +673,7 @@ def test_real_records_housner_and_the_reference_dem_agree_on_a_slender_block(tmp
     from rockyade.assess import parse_measure, records_in_folder
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck import crosscheck_plan
+    from rockyade.studies.crosscheck_study import crosscheck_plan
 
     folder = tmp_path / "peer"
     folder.mkdir()
@@ -701,7 +701,7 @@ def test_figure_text_does_not_overlap(tmp_path):
     figure (tick labels, axis label, legend) overlap."""
     from matplotlib.text import Text
 
-    from rockyade.figures.crosscheck import PairedRatios
+    from rockyade.figures.paired_ratios import PairedRatios
 
     rows = []
     for k in range(1, 5):

@@ -1,5 +1,5 @@
 """No text drawn over text in the paper study's and the how-to's figures (issue 26 item 8):
-:func:`rockyade.figures.checks.overlapping_texts` compares the window extents of every visible
+:func:`rockyade.figures.legibility.overlapping_texts` compares the window extents of every visible
 text after a draw. The figures are built from small data (or cheap commands) so that this is quick."""
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import pytest
 from matplotlib.figure import Figure
 
 from rockyade.cli import main
-from rockyade.figures.checks import covered_markers, overlapping_texts
+from rockyade.figures.legibility import covered_markers, overlapping_texts
 from rockyade.studies import fragility_study, overturning
 from rockyade.studies.report import Report
 
@@ -87,9 +87,9 @@ def test_the_paper_overturning_figure_has_no_overlapping_text(tmp_path):
 def drawn(monkeypatch):
     """The figures the commands save, kept (they are still written)."""
     figures: list[Figure] = []
-    import rockyade.figures.assess as assess_figures
+    import rockyade.figures.collapse_mechanism as limit_figures
     import rockyade.figures.histories as histories
-    import rockyade.figures.limit as limit_figures
+    import rockyade.figures.wall_assessment as assess_figures
 
     for module in (assess_figures, histories, limit_figures):
         original = module.save_figure

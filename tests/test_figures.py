@@ -142,10 +142,10 @@ def test_every_plot_function_returns_fig_and_ax_and_draws_into_given_axes(tmp_pa
     import pandas as pd
 
     from rockyade.figures.assembly import animate, draw_assembly, draw_snapshots
-    from rockyade.figures.identify import plot_error_surface, plot_fit
-    from rockyade.figures.limit import draw_mechanism
-    from rockyade.figures.uncertainty import plot_uncertainty
-    from rockyade.figures.verify import plot_check
+    from rockyade.figures.collapse_mechanism import draw_mechanism
+    from rockyade.figures.identification_fit import plot_error_surface, plot_fit
+    from rockyade.figures.uncertainty_bands import plot_uncertainty
+    from rockyade.figures.verification_histories import plot_check
     from rockyade.identification.fit import identify
     from rockyade.identification.measurement import read_measurement
     from rockyade.limit.analysis import limit_analysis
@@ -279,8 +279,8 @@ def test_the_fragility_display_draws_stripes_and_a_curve_solid_where_tested(tmp_
     """One drawing of a fragility curve with its stripes (the paper study's panels and assess's
     figure): points at the stripes, the curve solid up to the largest tested level and dotted
     beyond, an extrapolated median marked; a missing curve is a red legend entry."""
-    from rockyade.figures.fragility import MISSING_COLOUR, FragilityCurve, FragilityDisplay, Mark
-    from rockyade.probability.fragility import Fragility
+    from rockyade.figures.fragility_panels import MISSING_COLOUR, FragilityCurve, FragilityDisplay, Mark
+    from rockyade.probability.fragility_curves import Fragility
 
     levels = np.array([0.1, 0.2, 0.3])
     curve = FragilityCurve(

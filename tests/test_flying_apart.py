@@ -10,7 +10,7 @@ from rockyade.cli import main
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.limit import limit_analysis
-from rockyade.limit.report import text_report
+from rockyade.limit.report_text import text_report
 from rockyade.limit.standing import check_loads_stand, unbalanced_loads
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import make_solver, run, solver_names

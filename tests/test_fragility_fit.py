@@ -1,4 +1,4 @@
-"""The one lognormal fragility fit (rockyade.probability.fragility.fit_lognormal): a known
+"""The one lognormal fragility fit (rockyade.probability.fragility_curves.fit_lognormal): a known
 curve recovered, the answers without a finite maximum, the analytic derivatives against
 finite differences, and a warm start that finds the same maximum."""
 
@@ -11,7 +11,7 @@ import pytest
 from scipy import stats
 
 from rockyade.errors import InputError
-from rockyade.probability.fragility import fit_lognormal, nll_and_derivatives
+from rockyade.probability.fragility_curves import fit_lognormal, nll_and_derivatives
 
 
 def test_fragility_fit_recovers_a_known_curve():

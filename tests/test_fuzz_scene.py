@@ -17,7 +17,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rockyade.runner.cost import estimate_cost
+from rockyade.runner.cost_limits import estimate_cost
 from rockyade.scene import load_scene, scene_from_dict
 
 from .conftest import EXAMPLES
@@ -242,7 +242,7 @@ def _get(d: Any, path: tuple) -> Any:
 
 
 def _run(d: dict) -> None:
-    from rockyade.runner.cost import check_cost
+    from rockyade.runner.cost_limits import check_cost
     from rockyade.solvers import make_solver
 
     scene = scene_from_dict(d, source="fuzz.toml")

@@ -32,7 +32,7 @@ from rockyade.scene.generators import (
     wall,
     write_scene,
 )
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_FRICTION_ANGLE_DEG,
     DEFAULT_JKN_PA_PER_M,
     DEFAULT_JOINT_DAMPING_RATIO,
@@ -339,7 +339,7 @@ def test_round_drums_carry_a_cylinders_mass_and_inertia_into_housner_and_both_de
     """Issue "What users hit" 4: drums were square prisms (six 0.8 x 1 m drums of 2700 kg/m^3:
     10,368 kg instead of the cylinders' 8,143 kg). A round drum now writes m = rho pi D^2/4 h
     and I = m (3 r^2 + h^2)/12, and the solvers read them: Housner's p and both DEMs' bodies."""
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.scene.generators import round_drum_mass_inertia
     from rockyade.solvers import run
     from rockyade.yade.payload import scene_payload

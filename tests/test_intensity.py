@@ -19,7 +19,7 @@ from rockyade.motion.intensity import (
     scaled,
     significant_duration,
 )
-from rockyade.probability.fragility import (
+from rockyade.probability.fragility_curves import (
     clopper_pearson_interval,
     fit_lognormal,
     fit_lognormal_points,

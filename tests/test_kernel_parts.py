@@ -18,8 +18,8 @@ from rockyade.kernel.contact_law import (
     contact_law,
 )
 from rockyade.kernel.integration import Motion
-from rockyade.kernel.placement import new_world, place_body
 from rockyade.kernel.state import pack
+from rockyade.kernel.world import new_world, place_body
 from rockyade.motion.ground import GroundMotion, ground_acceleration
 from rockyade.scene.placement import rotation_matrix
 

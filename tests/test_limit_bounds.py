@@ -10,11 +10,11 @@ import pytest
 
 from rockyade.cli import main
 from rockyade.errors import InputError
-from rockyade.limit import cost as limit_cost
+from rockyade.limit import analysis_cost as limit_cost
 from rockyade.limit import limit_analysis
 from rockyade.limit.coulomb import solve_coulomb
 from rockyade.limit.lp import equilibrium_system, highs_method, solve_equilibrium
-from rockyade.limit.model import rigid_block_model
+from rockyade.limit.rigid_blocks import rigid_block_model
 from rockyade.scene import load_scene
 
 WALL = Path(__file__).resolve().parents[1] / "examples" / "assemblies" / "wall_5_courses.toml"

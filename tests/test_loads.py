@@ -339,7 +339,7 @@ def test_the_dem_settlement_check_counts_the_loads():
     block on two springs K settles by (W + N) / (2 K). K is chosen so that the block alone
     settles half the limit (1e-4 of its height): a load N = 0.5 W gives 1.5 x that, and a load
     N = 5 W takes it three times past the limit and is refused (gravity alone, as before, passed it)."""
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.constants import MAX_SETTLEMENT_FRACTION
 
     k = W / (2 * 0.5 * MAX_SETTLEMENT_FRACTION * HEIGHT)

@@ -9,7 +9,7 @@ import pytest
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies import overturning
-from rockyade.studies.specimens import block_table
+from rockyade.studies.specimen_scenes import block_table
 
 
 @pytest.mark.parametrize(

@@ -45,7 +45,7 @@ def test_onset_words_give_a_percentage_only_when_bracketed(multiplier, below, bo
 
 
 def test_the_figure_label_of_an_unbracketed_onset_has_no_nan():
-    from rockyade.figures.assess import _onset_label
+    from rockyade.figures.wall_assessment import _onset_label
 
     assert _onset_label(check(0.49, math.nan)) == "onset below λ 0.49 (the first level)"
     assert "nan" not in _onset_label(check(math.nan, 0.52))

@@ -11,9 +11,9 @@ import pytest
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.calibration.calibrate import calibrate
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import G
-from rockyade.dem.build import build_dem_model, contact_polygon
+from rockyade.dem.model_from_scene import build_dem_model, contact_polygon
 from rockyade.errors import CalibrationError, InputError
 from rockyade.runner import IN_THIS_THREAD, Executor, solve_scenes
 from rockyade.scene import ContactSpec, load_scene, scene_from_dict

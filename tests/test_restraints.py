@@ -36,8 +36,8 @@ import pytest
 
 from rockyade.constants import G
 from rockyade.limit import limit_analysis, rigid_block_model
-from rockyade.limit.contacts import _ways
 from rockyade.limit.mechanism import point_velocity
+from rockyade.limit.point_contacts import _ways
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import wall_section as _generated_section
 

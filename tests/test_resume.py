@@ -484,7 +484,7 @@ def test_a_fragility_opens_no_listening_socket(tmp_path, wall, records, executor
     over the process tree while it runs, to the end)."""
     if executor == "dask":
         pytest.importorskip("dask")
-    from .test_reliability_batch import _listening_sockets_of_tree
+    from .test_robust_batch import _listening_sockets_of_tree
 
     proc = _start(tmp_path, _fragility(tmp_path, "--executor", executor, "--workers", "2"))  # the last --workers
     seen: set[str] = set()

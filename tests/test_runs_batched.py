@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from rockyade.analysis.metrics import uplift_threshold_rad
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.engine import model_arrays
 from rockyade.kernel.runs import CHUNK_RUNS, simulate_runs, simulate_runs_each
 from rockyade.kernel.state import pack

@@ -10,7 +10,7 @@ import pytest
 
 from rockyade.batch import comparable, expand
 from rockyade.batch.running import job_key, output, run_job, run_task
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.engine import model_arrays
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.single import simulate_single, single_body

@@ -54,11 +54,11 @@ def test_scene_and_motion_import_no_scipy_or_pandas(module: str) -> None:
 @pytest.mark.slow
 def test_the_dem_model_imports_scipy_spatial_only_for_an_alpha_override() -> None:
     # scipy.spatial (0.2-1 s) serves only a block whose base is replaced by its alpha (ConvexHull)
-    heavy = _imported_after("import rockyade.calibration.model\nimport rockyade.solvers.reference\n")
+    heavy = _imported_after("import rockyade.calibration.model_stage\nimport rockyade.solvers.reference\n")
     assert not [m for m in heavy if m.startswith("scipy.spatial")], heavy[:8]
     code = (
         "from rockyade.blocks.geometry import Block\n"
-        "from rockyade.dem.build import contact_polygon\n"
+        "from rockyade.dem.model_from_scene import contact_polygon\n"
         "contact_polygon(Block.rectangle(0.25, 1.0, 0.754, mass_kg=503), 0.2)\n"
     )
     assert any(m.startswith("scipy.spatial") for m in _imported_after(code))
@@ -66,7 +66,7 @@ def test_the_dem_model_imports_scipy_spatial_only_for_an_alpha_override() -> Non
 
 def test_the_cost_estimate_and_the_run_build_one_model(monkeypatch: pytest.MonkeyPatch) -> None:
     # rockyade run estimates the cost (the model's time step), then runs: one model build
-    import rockyade.calibration.model as model_module
+    import rockyade.calibration.model_stage as model_module
     from rockyade.scene import scene_from_dict
     from rockyade.solvers import make_solver
 

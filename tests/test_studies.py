@@ -24,7 +24,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies import fragility_study, harmonic, overturning, paper, pattern_map
 from rockyade.studies.report import Report, no_uplift_note
-from rockyade.studies.specimens import biblock_blocks, block_table, scene_dict
+from rockyade.studies.specimen_scenes import biblock_blocks, block_table, scene_dict
 
 ROCKYADE = Path(sys.executable).parent / "rockyade"
 

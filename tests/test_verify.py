@@ -9,7 +9,7 @@ import sys
 import pandas as pd
 import pytest
 
-from rockyade.studies.verify import verify
+from rockyade.studies.verification import verify
 
 
 def _rockyade(*args, cwd):
@@ -45,7 +45,7 @@ def test_bad_check_name_is_refused(tmp_path):
 
 def test_cli_knows_every_check():
     from rockyade.cli.verify import CHECKS as CLI_CHECKS
-    from rockyade.studies.verify import CHECK_FUNCTIONS, CHECKS
+    from rockyade.studies.verification import CHECK_FUNCTIONS, CHECKS
 
     assert CLI_CHECKS == CHECKS == tuple(CHECK_FUNCTIONS)
 

@@ -8,7 +8,7 @@ import math
 import pandas as pd
 import pytest
 
-from rockyade.studies.verify import verify
+from rockyade.studies.verification import verify
 from rockyade.studies.verify_rows import EXACT, Row, Tolerance, absolute, at_least, at_most, relative
 
 

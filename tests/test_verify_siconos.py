@@ -9,7 +9,7 @@ import os
 import pytest
 
 from rockyade.siconos import backend as siconos_backend
-from rockyade.studies.verify import verify
+from rockyade.studies.verification import verify
 from rockyade.studies.verify_siconos import SICONOS_PUSHOVERS
 
 pytestmark = pytest.mark.slow

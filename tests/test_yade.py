@@ -24,7 +24,7 @@ import pytest
 from rockyade import paper
 from rockyade.blocks.restitution import effective_restitution, find_peaks
 from rockyade.calibration.calibrate import calibrate
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import ContactSpec, load_scene, scene_from_dict
@@ -540,7 +540,7 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     kept = Result.read(Path("t/long.csv"))
     assert kept.status == "failed" and kept.meta.partial is True and len(kept.frame) > 0
     # the scene was stopped: its warm YADE waits idle for the next one, and quits when asked
-    from rockyade.yade.worker import QUIT_WAIT_S, close_workers
+    from rockyade.yade.warm_worker import QUIT_WAIT_S, close_workers
 
     start = time.monotonic()
     close_workers()

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from rockyade.blocks.restitution import find_peaks
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.errors import InputError
 from rockyade.scene import scene_from_dict
@@ -28,7 +28,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
 from rockyade.yade import backend as yade_backend
-from rockyade.yade.contacts import BASE_BIT, N_LABELS, body_row, plan_contacts
+from rockyade.yade.contact_plan import BASE_BIT, N_LABELS, body_row, plan_contacts
 from rockyade.yade.payload import scene_payload, sphere_radii
 
 from .processes import require_yade
@@ -116,7 +116,7 @@ def _wanted_and_used(model):
     materials = payload["materials"]
     prisms = [b["prism_mask"] for b in payload["bodies"]]
     plan = plan_contacts(model, sphere_radii(model))
-    from rockyade.yade.contacts import flush_ends
+    from rockyade.yade.contact_plan import flush_ends
 
     flush = flush_ends(model)
     wanted, used = [], []

@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.motion.spec import parse_motion
 from rockyade.result import Result
 from rockyade.scene import load_scene

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from rockyade.analysis.collapse import collapse_report
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers import reference
 from rockyade.solvers.reference import ReferenceSolver

@@ -1,4 +1,4 @@
-"""YADE kept warm (rockyade.yade.worker), with YADE really running: the same results as one
+"""YADE kept warm (rockyade.yade.warm_worker), with YADE really running: the same results as one
 process per run, a crash or a timeout costs one scene, no port, nothing left behind, no
 write through a link, a full disk named and cleaned up."""
 
@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 
 import rockyade
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.result import Result
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.yade import YadeSolver
 from rockyade.yade import backend as yade_backend
-from rockyade.yade import worker as yade_worker
+from rockyade.yade import warm_worker as yade_worker
 
 from .conftest import EXAMPLES
 from .processes import alive, cmdline, descendants, listening_of_tree, require_yade

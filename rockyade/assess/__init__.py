@@ -5,10 +5,10 @@ the rocking dynamics.
 building), ``code`` (the kinematic checks of NTC 2018, Circolare 2019 C8.7.1, on the
 quantities of :mod:`rockyade.limit`), ``measures`` (PGA, PGV, Sa(T), the site's ag),
 ``motions`` (record files, synthetic suites), ``stripes`` (every record scaled to each
-level, run through :mod:`rockyade.runner`, collapse per run), ``fit`` (the lognormal fit of
-:mod:`rockyade.probability.fragility` and its bootstrap band), ``fragility`` (a fragility
+level, run through :mod:`rockyade.runner`, collapse per run), ``stripe_fit`` (the lognormal fit of
+:mod:`rockyade.probability.fragility_curves` and its bootstrap band), ``fragility_analysis`` (a fragility
 analysis of any scene), ``assessment`` (the code's checks and the dynamics beside them) and
-``report`` (text). Figures: :mod:`rockyade.figures.assess`. See docs/limit.md and
+``report_lines`` (text). Figures: :mod:`rockyade.figures.wall_assessment`. See docs/limit.md and
 docs/howto/is-this-wall-safe.md.
 
 Layer: above analysis, probability and runner (it runs solvers through the runner and fits
@@ -17,7 +17,7 @@ curves), below figures and studies.
 
 from rockyade.assess.assessment import Assessment, DynamicSettings, assess
 from rockyade.assess.code import CODES, Check, code_checks
-from rockyade.assess.fragility import (
+from rockyade.assess.fragility_analysis import (
     FragilityPlan,
     FragilityResult,
     SceneCannotStandError,

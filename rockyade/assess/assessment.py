@@ -37,7 +37,7 @@ from rockyade.assess.code import (
     code_checks,
     verdict,
 )
-from rockyade.assess.fragility import (
+from rockyade.assess.fragility_analysis import (
     FragilityPlan,
     FragilityResult,
     SceneCannotStandError,
@@ -89,9 +89,9 @@ class DynamicSettings:
     load_factors
         lambda on the site's scaling; 1 is always added.
     extend
-        Extend the stripes while the median is outside them (:mod:`rockyade.assess.fragility`).
+        Extend the stripes while the median is outside them (:mod:`rockyade.assess.fragility_analysis`).
     fallen_blocks, sample_dt_s, tail_s
-        As :func:`rockyade.assess.fragility.fragility_plan` takes them.
+        As :func:`rockyade.assess.fragility_analysis.fragility_plan` takes them.
     """
 
     records: RecordFiles | None = None
@@ -475,7 +475,7 @@ def add_dynamics(
 ) -> Assessment:
     """Run the dynamic part of an assessment (module docstring) and attach it; the same
     assessment back. ``journal``: where each run is written as it ends, and read back on a
-    resume (:func:`rockyade.assess.fragility.run_fragility`).
+    resume (:func:`rockyade.assess.fragility_analysis.run_fragility`).
 
     Raises
     ------

@@ -293,7 +293,7 @@ def run_study_tasks(
     resume
         Skip runs already completed for the same scene hash; re-run failed ones.
     allow_large
-        Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost`.
+        Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost_limits`.
     resume_option
         The caller's option that resumes, named after Ctrl-C (None: it cannot resume).
     identity

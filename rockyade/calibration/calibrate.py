@@ -1,7 +1,7 @@
 """One calibration: the joint beneath a block, whatever the method.
 
 Every caller computes a block's joint here: the model the DEM solvers run
-(:func:`rockyade.calibration.model.calibrated_model`), ``rockyade calibrate`` and
+(:func:`rockyade.calibration.model_stage.calibrated_model`), ``rockyade calibrate`` and
 ``rockyade calibrate --from`` (identified values, :mod:`rockyade.identification.identified`).
 The method follows from the scene's ``[contact]`` table (:func:`calibration_method`):
 
@@ -15,7 +15,7 @@ The method follows from the scene's ``[contact]`` table (:func:`calibration_meth
 * ``matched``: as ``paper``, then the damping matched so that the reference DEM's effective
   mu equals mu (:mod:`rockyade.calibration.matching`), with xi_min by Eq 15 for that beta.
 
-The model builder (:mod:`rockyade.dem.build`) runs the joints it is given: it knows no
+The model builder (:mod:`rockyade.dem.model_from_scene`) runs the joints it is given: it knows no
 calibration. The matching runs the reference DEM (numba): it is imported when a block is
 matched, so that the other methods stay quick to load.
 """
@@ -36,7 +36,7 @@ from rockyade.dem.joints import ContactParameters, udec_stiffness
 from rockyade.dem.model import time_step_eq7
 from rockyade.errors import InputError
 from rockyade.scene import ContactSpec
-from rockyade.scene.model import CALIBRATIONS
+from rockyade.scene.description import CALIBRATIONS
 
 if TYPE_CHECKING:
     from rockyade.calibration.matching import MatchedBeta

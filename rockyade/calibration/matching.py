@@ -8,7 +8,7 @@ rigid base, with the joint its calibration gives (:mod:`rockyade.calibration.cal
 and a trial damping beta, released at alpha / 2 and measured over its first ``N_IMPACTS``
 impacts after the release; beta is found by Brent's method (scipy) to within ``MU_RTOL``
 of the target. The runs go through the model builder and the engine every DEM solver
-uses (:func:`rockyade.dem.build.build_dem_model`, :func:`rockyade.dem.engine.simulate_model`).
+uses (:func:`rockyade.dem.model_from_scene.build_dem_model`, :func:`rockyade.dem.engine.simulate_model`).
 
 Energy loss in this DEM comes from the dashpots within a bounded range: without damping
 the corner impacts already lose some energy (mu_eff < 1), and with very heavy damping the
@@ -27,9 +27,9 @@ from scipy.optimize import brentq
 from rockyade.blocks.classical import ClassicalParameters, classical_parameters
 from rockyade.blocks.geometry import Block
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
-from rockyade.dem.build import build_dem_model
 from rockyade.dem.engine import simulate_model
 from rockyade.dem.joints import ContactParameters
+from rockyade.dem.model_from_scene import build_dem_model
 from rockyade.errors import CalibrationError, at_least, at_most
 from rockyade.kernel import simulation as kernel
 from rockyade.scene import Scene, scene_from_dict

@@ -122,11 +122,11 @@ def cmd_assess(args: argparse.Namespace) -> int:
     """The checks, the dynamics, the text (or JSON), and with --out the files."""
     from rockyade.assess import assess
     from rockyade.assess.code import check_code
-    from rockyade.assess.report import assessment_lines
+    from rockyade.assess.report_lines import assessment_lines
     from rockyade.cli.resumable import file_digest, finish, identity, study_output
     from rockyade.errors import BatchInterruptedError
     from rockyade.limit.kinematic import check_fc
-    from rockyade.limit.model import check_friction_angle
+    from rockyade.limit.rigid_blocks import check_friction_angle
     from rockyade.scene import load_scene
 
     check_code(args.code)
@@ -254,11 +254,11 @@ def _interrupted(args: argparse.Namespace, result: Any, exc: Any, output: Any) -
 
 def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, Any]:
     """The pushover, the dynamics' text, the JSON."""
-    from rockyade.assess.report import dynamic_lines
+    from rockyade.assess.report_lines import dynamic_lines
 
     if args.pushover:
         from rockyade.assess.assessment import add_pushover
-        from rockyade.assess.report import pushover_lines
+        from rockyade.assess.report_lines import pushover_lines
 
         add_pushover(result, scene)
         if not args.json:
@@ -273,7 +273,7 @@ def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, Any]
 
 def _write(args: argparse.Namespace, result: Any, data: dict[str, Any]) -> None:
     """The result set, replaced as a whole (:mod:`rockyade.io.resultset`)."""
-    from rockyade.figures.assess import draw_assessment
+    from rockyade.figures.wall_assessment import draw_assessment
     from rockyade.io.atomic import write_json
     from rockyade.io.resultset import replacing_set
 

@@ -402,7 +402,7 @@ def _motion_table(args: argparse.Namespace, out: Path) -> dict[str, Any]:
 
 def _default_duration(args: argparse.Namespace, motion: dict[str, Any]) -> float:
     """--duration-s when not given: a record's length plus a tail of free rocking, else 3 s."""
-    from rockyade.scene.generators.common import default_duration_s
+    from rockyade.scene.generators.scene_tables import default_duration_s
 
     if motion.get("type") != "record":
         return default_duration_s(motion)
@@ -558,7 +558,7 @@ def _check_the_dem_takes_it(scene: Any) -> None:
     (joints too soft for the wall's weight) is refused here, naming the option to change."""
     if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
         return  # the matched stage runs the DEM: too slow for a check; run checks it
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
 
     try:
         calibrated_model(scene)

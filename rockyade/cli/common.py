@@ -47,7 +47,7 @@ def print_wrote(path: Path, json_mode: bool = False) -> None:
 
 
 def add_allow_large(p: argparse.ArgumentParser) -> None:
-    """``--allow-large``: run above the documented cost limits (docs/reliability.md).
+    """``--allow-large``: run above the documented cost limits (docs/robustness.md).
 
     Parameters
     ----------

@@ -27,7 +27,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     from rockyade.cli.fragility_options import float_list, refuse_suite_options_with_records, suite_from
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck import (
+    from rockyade.studies.crosscheck_study import (
         check_dt_factors,
         check_out,
         crosscheck_plan,

@@ -34,7 +34,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
     """Run the stripes, fit the curve, write the CSVs, JSON and figure (a set replaced as a
     whole); Ctrl-C writes a partial summary that ``--resume`` goes on from."""
     from rockyade.assess import fragility_plan, parse_measure, records_in_folder, run_fragility
-    from rockyade.assess.report import fit_lines
+    from rockyade.assess.report_lines import fit_lines
     from rockyade.assess.stripes import runs_frame
     from rockyade.cli.resumable import file_digest, finish, identity, study_output, write_partial
     from rockyade.errors import BatchInterruptedError
@@ -98,7 +98,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
             print(f"resumed: {output.journal.resumed} run(s) read back from {output.partial}, not run again")
         for line in fit_lines(result):
             print(line)
-        from rockyade.figures.assess import draw_fragility
+        from rockyade.figures.wall_assessment import draw_fragility
 
         with replacing_set(args.out, FRAGILITY_SET, FRAGILITY_LAST) as stage:
             written = write_tables(stage, result)

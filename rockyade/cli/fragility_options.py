@@ -12,7 +12,7 @@ from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: these are imported when a command runs
     from rockyade.assess import SyntheticSuite
-    from rockyade.assess.fragility import FragilityPlan, FragilityResult
+    from rockyade.assess.fragility_analysis import FragilityPlan, FragilityResult
     from rockyade.runner import Executor
     from rockyade.solvers.base import Solver
 
@@ -115,7 +115,7 @@ def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
 
 def print_plan(plan: FragilityPlan, workers: int, indent: str = "") -> None:
     """The plan and its cost, before anything runs."""
-    from rockyade.assess.report import plan_lines
+    from rockyade.assess.report_lines import plan_lines
 
     for line in [*plan_lines(plan), plan.cost_line(workers)]:
         print(indent + line, flush=True)

@@ -60,7 +60,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         write_json(args.out, data)
     figures = []
     if args.plot:
-        from rockyade.figures.identify import plot_error_surface, plot_fit
+        from rockyade.figures.identification_fit import plot_error_surface, plot_fit
 
         stem = Path(args.measured).stem
         figures = [args.plot / f"{stem}_fit.png", args.plot / f"{stem}_error_surface.png"]

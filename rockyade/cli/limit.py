@@ -27,11 +27,11 @@ def cmd_limit(args: argparse.Namespace) -> int:
         check_output_file(args.plot, "--plot", ".png")
     from rockyade.limit import limit_analysis
     from rockyade.limit.analysis import check_friction_rule
-    from rockyade.limit.cost import check_limit_cost, estimate_limit_cost
+    from rockyade.limit.analysis_cost import check_limit_cost, estimate_limit_cost
     from rockyade.limit.coulomb import MAX_ITERATIONS
     from rockyade.limit.lp import TimeLimitError
-    from rockyade.limit.model import check_friction_angle, rigid_block_model
-    from rockyade.limit.report import text_report
+    from rockyade.limit.report_text import text_report
+    from rockyade.limit.rigid_blocks import check_friction_angle, rigid_block_model
     from rockyade.scene import load_scene
 
     friction = None
@@ -80,7 +80,7 @@ def cmd_limit(args: argparse.Namespace) -> int:
     else:
         print("\n".join(text_report(result, str(args.scene))))
     if args.plot is not None:
-        from rockyade.figures.limit import draw_mechanism
+        from rockyade.figures.collapse_mechanism import draw_mechanism
 
         draw_mechanism(result, args.plot, title=args.scene.name)
         print_wrote(args.plot, args.json)

@@ -31,7 +31,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     import contextlib
 
     from rockyade.io.locking import output_lock
-    from rockyade.runner.cost import check_cost
+    from rockyade.runner.cost_limits import check_cost
     from rockyade.scene import load_scene
 
     for option, suffix in (("out", ".csv"), ("plot", ".png")):

@@ -38,7 +38,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from rockyade.figures import plot_results
     from rockyade.io.atomic import atomic_open
     from rockyade.io.locking import output_lock
-    from rockyade.runner.cost import check_cost
+    from rockyade.runner.cost_limits import check_cost
     from rockyade.scene import load_scene
 
     scene = load_scene(args.scene)

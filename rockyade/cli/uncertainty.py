@@ -10,7 +10,7 @@ from typing import Any
 def cmd_uncertainty(args: argparse.Namespace) -> int:
     """Run an uncertainty study and print its probabilities and fragility fits."""
     from rockyade.cli.common import check_output_dir
-    from rockyade.studies.uncertainty import load_uncertainty_study, run_uncertainty
+    from rockyade.studies.uncertainty_study import load_uncertainty_study, run_uncertainty
 
     check_output_dir(args.out, "--out")
     study = load_uncertainty_study(args.study)

@@ -9,7 +9,7 @@ from typing import Any
 
 from rockyade.cli.common import check_output_dir
 from rockyade.errors import InputError
-from rockyade.studies.checks import CHECKS
+from rockyade.studies.verification_checks import CHECKS
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
@@ -19,7 +19,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     if unknown or not checks:
         raise InputError("only", f"must be a comma-separated list of {', '.join(CHECKS)}, got {args.only!r}")
     check_output_dir(args.out, "out")
-    from rockyade.studies.verify import verify
+    from rockyade.studies.verification import verify
 
     solvers = ["reference"] if args.no_yade else ["reference", "yade"]
     if not args.no_yade:

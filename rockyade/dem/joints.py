@@ -36,7 +36,7 @@ from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # names only: the calibration imports this module without loading the scene machinery
     from rockyade.scene import Scene
-    from rockyade.scene.model import JointOverride
+    from rockyade.scene.description import JointOverride
     from rockyade.scene.placement import RestContact
 
 

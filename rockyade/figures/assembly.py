@@ -41,7 +41,7 @@ from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, new_figure, save_figure
 from rockyade.result import Result, column
 from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
 

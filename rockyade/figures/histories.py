@@ -15,7 +15,7 @@ from pathlib import Path
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
 from rockyade.result import Result
 
 #: Line styles cycled over the results, so that overlapping curves stay distinguishable.

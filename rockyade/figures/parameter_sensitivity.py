@@ -16,7 +16,7 @@ import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 
 

@@ -17,7 +17,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from rockyade.figures.common import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import figure_of, new_figure, save_figure
 
 COLOURS = {
     "rest": "#eeeeee",

@@ -20,7 +20,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
 from rockyade.figures.styles import plot_solver
 
 #: How a failed run shows: a legend entry with a red cross and no curve.

@@ -16,7 +16,7 @@ exactly: the solver is advanced from the release to the first sample after it, t
 on the measurement grid.
 
 Starting point: :func:`rockyade.identification.start.initial_guess` (peaks, zero crossings
-and exact Housner periods). The model: :mod:`rockyade.identification.model`.
+and exact Housner periods). The model: :mod:`rockyade.identification.forward_model`.
 
 95 % intervals: Gauss-Newton covariance s^2 (J^T J)^-1 (J the Jacobian at the optimum,
 s^2 = SSR / (n - 6)) with Student's t quantile (Bates & Watts 1988, Ch. 2). When the
@@ -40,14 +40,14 @@ from numpy.typing import NDArray
 from scipy import optimize, stats
 
 from rockyade.errors import InputError
-from rockyade.identification.measurement import MeasuredHistory
-from rockyade.identification.model import (
+from rockyade.identification.forward_model import (
     FIT_PARAMETERS,
     FreeRockingFit,
     IdentificationError,
     model_history,
     synthetic_measurement,
 )
+from rockyade.identification.measurement import MeasuredHistory
 from rockyade.identification.start import Guess, initial_guess
 
 __all__ = [

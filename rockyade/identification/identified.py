@@ -18,7 +18,7 @@ from rockyade.calibration.calibrate import calibrate
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG
 from rockyade.errors import InputError
 from rockyade.scene import ContactSpec
-from rockyade.scene.model import CALIBRATIONS
+from rockyade.scene.description import CALIBRATIONS
 
 CLASSICAL_KEYS = ("alpha_rad", "p_rad_s", "mu")
 #: Calibration methods offered from identified values (the scene's ``contact.calibration``).

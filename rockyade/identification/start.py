@@ -23,8 +23,8 @@ from scipy import optimize
 
 from rockyade.blocks.restitution import effective_restitution
 from rockyade.housner import HousnerModel, solve
+from rockyade.identification.forward_model import FreeRockingFit, IdentificationError
 from rockyade.identification.measurement import MeasuredHistory
-from rockyade.identification.model import FreeRockingFit, IdentificationError
 
 
 @functools.lru_cache(maxsize=4096)

@@ -6,11 +6,11 @@ Arrays in, arrays out: it knows nothing of scenes or models. One module per part
   ``Initial``) and ``pack``, which makes them from :func:`rockyade.dem.engine.model_arrays`;
 * ``simulation``: the time loop, ``simulate`` (set-up, broad-phase rebuilds, the ``Output``
   record) and ``advance`` (the steps between two rebuilds, as a short sequence of the parts);
-* ``placement``: the polygons in the base frame;
+* ``world``: the polygons in the base frame;
 * ``contact_law``: the joint at one contact point (no-tension spring and dashpot,
   incremental Coulomb-capped shear spring, shear dashpot while sticking), written once;
 * ``base_contacts`` and ``pair_contacts``: where the law applies (vertices below the base;
-  the manifold of each touching pair, from ``contacts``: separating-axis test and clipping);
+  the manifold of each touching pair, from ``narrowphase``: separating-axis test and clipping);
 * ``broadphase`` and ``pairs``: sort and sweep over grown boxes, and what each candidate
   pair keeps between steps;
 * ``integration``: the leap-frog kick and drift, overturn and blow-up checks;

@@ -1,6 +1,6 @@
 """Contacts between bodies: one manifold per candidate pair, the contact law at its points.
 
-Manifold (:mod:`rockyade.kernel.contacts`): the separating-axis test picks the reference
+Manifold (:mod:`rockyade.kernel.narrowphase`): the separating-axis test picks the reference
 face (or finds a separating axis), the incident edge is clipped to the face's side planes,
 and the clipped points below the face are the contact points (at most two), each with the
 pair's joint K (``JointTable.joint_for``).
@@ -34,8 +34,8 @@ import math
 import numba
 
 from rockyade.kernel.contact_law import add_released_energy, add_stored_energy, contact_law
-from rockyade.kernel.contacts import HYSTERESIS_REL, NO_FACE, clip_manifold, incident_edge, separating_axis_test
 from rockyade.kernel.energy import push_dashpot
+from rockyade.kernel.narrowphase import HYSTERESIS_REL, NO_FACE, clip_manifold, incident_edge, separating_axis_test
 from rockyade.kernel.recording import count_point, mark_pair_corners
 
 

@@ -2,7 +2,7 @@
 
 A pair's state: the reference face of its last separating-axis test (side and face, for
 the test's hysteresis), the incident edge, the test's slack and the relative position at
-it (temporal coherence, :func:`rockyade.kernel.contacts.separating_axis_test`), and last
+it (temporal coherence, :func:`rockyade.kernel.narrowphase.separating_axis_test`), and last
 step's contact points with their shear springs (as vectors, :mod:`.pair_contacts`).
 
 A rebuild (:func:`build_pairs`) places the moving bodies, sweeps for the new list
@@ -20,8 +20,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.kernel.broadphase import candidate_pairs
-from rockyade.kernel.contacts import NO_FACE, joint_for
-from rockyade.kernel.placement import place_bodies
+from rockyade.kernel.narrowphase import NO_FACE, joint_for
+from rockyade.kernel.world import place_bodies
 
 
 class PairState(NamedTuple):

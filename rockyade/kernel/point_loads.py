@@ -8,7 +8,7 @@ the centroid is
     T = r x F = cos(theta) (r_b x F) - sin(theta) (r_b . F),
 
 so a body's loads reduce to four numbers fixed at build time: the resultant (Fx, Fy) and
-the sums M0 = sum r_b x F and Q = sum r_b . F (:func:`rockyade.dem.build.load_arrays`).
+the sums M0 = sum r_b x F and Q = sum r_b . F (:func:`rockyade.dem.model_from_scene.load_arrays`).
 The loads are weights carried by the body: they follow the apparent gravity, scaled by
 (g + a_v) / g (so that they ramp in with gravity when a_v goes from -g to 0), and the
 horizontal base acceleration does not act on them (no mass).

@@ -71,7 +71,6 @@ from rockyade.kernel.integration import (
 )
 from rockyade.kernel.pair_contacts import pair_contacts
 from rockyade.kernel.pairs import PairState, build_pairs, no_pairs
-from rockyade.kernel.placement import World, new_world, place_bodies
 from rockyade.kernel.point_loads import apply_point_loads
 from rockyade.kernel.recording import (
     CORNER_TOL_REL,
@@ -84,6 +83,7 @@ from rockyade.kernel.recording import (
     record_sample,
     reset_tally,
 )
+from rockyade.kernel.world import World, new_world, place_bodies
 from rockyade.motion.ground import ground_acceleration
 
 __all__ = [

@@ -1,7 +1,7 @@
 """The lowest admissible mechanism where corners meet: branch and bound over the ways a corner holds.
 
 Where a corner of a moving block meets a corner of a fixed block (or the base), the block may
-pass the other on either side (:mod:`rockyade.limit.contacts`): the admissible motions there are
+pass the other on either side (:mod:`rockyade.limit.point_contacts`): the admissible motions there are
 a union of two half-planes, which one linear programme cannot hold. The collapse multiplier is the
 lowest over the admissible mechanisms (the kinematic theorem), so:
 
@@ -27,7 +27,7 @@ import numpy as np
 from rockyade.errors import SolverFailedError
 from rockyade.limit.lp import LPSolution, solve_equilibrium
 from rockyade.limit.mechanism import VELOCITY_TOL, relative_velocity
-from rockyade.limit.model import Corner, Interface, RigidBlockModel
+from rockyade.limit.rigid_blocks import Corner, Interface, RigidBlockModel
 
 #: Programmes solved at most in one search (each branch point doubles the open branches).
 MAX_PROGRAMMES = 64

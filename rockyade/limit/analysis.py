@@ -24,7 +24,7 @@ from rockyade.limit.coulomb import MAX_ITERATIONS, solve_coulomb
 from rockyade.limit.kinematic import DEFAULT_FC, KinematicQuantities, check_fc, kinematic_quantities
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism, mechanism_of
-from rockyade.limit.model import PointLoad, RigidBlockModel, rigid_block_model
+from rockyade.limit.rigid_blocks import PointLoad, RigidBlockModel, rigid_block_model
 
 #: The note every answer with finite friction carries (docs/limit.md, "Friction").
 FRICTION_NOTE = (

@@ -48,7 +48,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linprog
 
 from rockyade.limit.lp import LPSolution, TimeLimitError, equilibrium_system, highs_method, solve_equilibrium
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: Relative change of lambda between successive programmes below which it has settled.
 LAMBDA_RTOL = 1.0e-6

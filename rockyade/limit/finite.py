@@ -47,7 +47,7 @@ from numpy.typing import NDArray
 
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import VELOCITY_TOL, Mechanism, relative_velocity
-from rockyade.limit.model import RigidBlockModel, _outside
+from rockyade.limit.rigid_blocks import RigidBlockModel, _outside
 from rockyade.scene.placement import candidate_pairs, penetration_depth
 
 #: Largest rotation of any block in one step, rad.

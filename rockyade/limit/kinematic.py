@@ -23,7 +23,7 @@ at ds* = 0.4 du* (as* the spectral acceleration of the curve at ds*).
 
 The weights P_i are those of the blocks (masses x g, at their centroids) and of the loads they
 carry (Circolare 2019 C8.7.1: "i pesi dei blocchi e i carichi verticali portati"), each at its
-own point with its own virtual displacement dx_i: a load's mass (:class:`~rockyade.limit.model.PointLoad`
+own point with its own virtual displacement dx_i: a load's mass (:class:`~rockyade.limit.rigid_blocks.PointLoad`
 ``mass_kg``; by default that of its weight) is a P_i. A load given without mass (``mass_kg = 0``)
 acts in alpha0 and in alpha(dk) but carries no inertia, so it does not enter M*, e* or sum P_i.
 """
@@ -42,7 +42,7 @@ from rockyade.errors import InputError
 from rockyade.limit.finite import CapacityCurve, capacity_curve
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism, point_velocity
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: The code's confidence factor FC for the limited knowledge level (LC1).
 DEFAULT_FC = 1.35

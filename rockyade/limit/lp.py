@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 from scipy.optimize import linprog
 
 from rockyade.errors import InputError, SolverFailedError
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: The multiplier is first sought below this (a horizontal acceleration of 1,000 g); a
 #: solution at the cap is re-solved without it to tell a large multiplier from no mechanism.

@@ -39,7 +39,7 @@ from numpy.typing import NDArray
 
 from rockyade.errors import SolverFailedError
 from rockyade.limit.lp import DIRECTIONS, LPSolution
-from rockyade.limit.model import Interface, RigidBlockModel
+from rockyade.limit.rigid_blocks import Interface, RigidBlockModel
 
 #: Relative velocities below this (in units of the largest centroid velocity, 1) are zero.
 VELOCITY_TOL = 1.0e-6

@@ -30,7 +30,7 @@ from scipy.optimize import linprog
 
 from rockyade.errors import InputError
 from rockyade.limit.lp import equilibrium_system, highs_method
-from rockyade.limit.model import RigidBlockModel, rigid_block_model
+from rockyade.limit.rigid_blocks import RigidBlockModel, rigid_block_model
 
 #: Loads carried up to this fraction of themselves count as carried (the programme's tolerance).
 CARRIED_FRACTION = 1.0 - 1.0e-7

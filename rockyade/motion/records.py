@@ -14,7 +14,7 @@
   extension.
 * Two-column text or CSV: time (s) and acceleration, one separator per line (semicolons,
   else commas, else blanks; decimal commas read where unambiguous,
-  :mod:`rockyade.motion.columns`), ``#`` comments, an optional header line whose
+  :mod:`rockyade.motion.text_columns`), ``#`` comments, an optional header line whose
   acceleration column may name its units (``accel_g``, ``a (cm/s2)``, ``accel_m_s2``, ...).
   A line with one number or with three or more is refused, saying what it holds; more
   columns are read only when a header names each of them and the second as an
@@ -43,8 +43,8 @@ import numpy as np
 
 from rockyade.constants import STANDARD_GRAVITY
 from rockyade.errors import InputError
-from rockyade.motion.columns import DECIMAL_COMMA, split_columns, with_point
 from rockyade.motion.peer import PeerHeader, peer_header
+from rockyade.motion.text_columns import DECIMAL_COMMA, split_columns, with_point
 
 #: factor to m/s^2 per unit name (a record "in g" means standard gravity)
 UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}

@@ -73,7 +73,7 @@ class MotionSpec(ABC):
 
     def sample_count(self, duration_s: float) -> int:
         """Samples of the base acceleration the motion builds (0 when the base does not move),
-        computed without building them: the run's cost estimate (:mod:`rockyade.runner.cost`)."""
+        computed without building them: the run's cost estimate (:mod:`rockyade.runner.cost_limits`)."""
         return 0
 
 

@@ -4,7 +4,7 @@ classical parameters alone cause.
 
 Input: one row per run with ``solver``, ``load_factor``, ``status`` (completed, overturned,
 failed), ``max_theta_over_alpha`` and, for the spread, ``sample``, ``nominal`` and
-``record`` (the runs table of :mod:`rockyade.studies.uncertainty`). Failed runs are
+``record`` (the runs table of :mod:`rockyade.studies.uncertainty_study`). Failed runs are
 counted and left out of every probability. An overturned run exceeds every level.
 """
 
@@ -16,7 +16,7 @@ from collections.abc import Iterable
 import numpy as np
 import pandas as pd
 
-from rockyade.probability.fragility import fit_lognormal_points, wilson_interval
+from rockyade.probability.fragility_curves import fit_lognormal_points, wilson_interval
 
 #: Peak theta/alpha above which a run counts as rocking (for the spread factor).
 ROCKING_RATIO = 0.01

@@ -5,7 +5,7 @@
   worker processes (``local``) or on Dask (its threaded scheduler in this process, or a
   scheduler's address);
 * :func:`~rockyade.runner.dispatch.run_tasks` / :func:`~rockyade.runner.dispatch.run_jobs`:
-  cost checks before anything runs (:mod:`rockyade.runner.cost`), progress on stderr,
+  cost checks before anything runs (:mod:`rockyade.runner.cost_limits`), progress on stderr,
   Ctrl-C (the first stops dispatching, the second the running runs), a failed run never
   stopping the others; :func:`~rockyade.runner.dispatch.solve_scenes`: one solver over
   many scenes, Results in order;

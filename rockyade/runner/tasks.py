@@ -12,7 +12,7 @@ from typing import Any
 
 from rockyade.errors import RockyadeError
 from rockyade.result import Result, failed_result
-from rockyade.runner.cost import cost_refusal
+from rockyade.runner.cost_limits import cost_refusal
 from rockyade.scene import Scene
 from rockyade.solvers.base import Solver
 
@@ -65,7 +65,7 @@ def failed_task(task: Task, reason: str) -> Result:
 
 def check_costs(tasks: Iterable[Task], allow_large: bool = False) -> None:
     """Refuse the lot, before any run, if one run's cost is above the limits
-    (:data:`rockyade.runner.cost.LIMITS`; ``allow_large`` lifts them).
+    (:data:`rockyade.runner.cost_limits.LIMITS`; ``allow_large`` lifts them).
 
     Raises
     ------

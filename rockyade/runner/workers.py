@@ -3,7 +3,7 @@
 A pool worker ignores Ctrl-C (the parent decides), leads its own process group (so that
 killing the group ends the worker and whatever it started, e.g. a YADE process) and is
 killed by the kernel when its parent dies, however it dies (``prctl(PR_SET_PDEATHSIG)``,
-:mod:`rockyade.io.lifetime`; where that is missing, a watchdog thread polls the parent).
+:mod:`rockyade.io.parent_death`; where that is missing, a watchdog thread polls the parent).
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from typing import Any
 
-from rockyade.io.lifetime import die_with_parent
+from rockyade.io.parent_death import die_with_parent
 
 
 def worker_init(parent_pid: int) -> None:

@@ -1,12 +1,12 @@
 """Scenes: the one description of a simulation that every solver reads (TOML or JSON).
 
-``model`` (the validated dataclasses and cross-field checks) and ``loading`` (files and
+``description`` (the validated dataclasses and cross-field checks) and ``loading`` (files and
 dictionaries read field by field). May import ``blocks``, ``motion`` and ``io``.
 """
 
 from typing import Any
 
-from rockyade.scene.model import BlockSpec, ContactSpec, LoadSpec, OutputSpec, Scene
+from rockyade.scene.description import BlockSpec, ContactSpec, LoadSpec, OutputSpec, Scene
 
 __all__ = ["BlockSpec", "ContactSpec", "LoadSpec", "OutputSpec", "Scene", "load_scene", "scene_from_dict"]
 

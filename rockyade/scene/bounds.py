@@ -1,10 +1,10 @@
-"""The documented range of every physical input of a scene (docs/reliability.md lists them).
+"""The documented range of every physical input of a scene (docs/robustness.md lists them).
 
 The ranges keep the inputs physical for rocking blocks from a brick to a monument, and keep
 the arithmetic finite (no subnormal lengths or masses, no frequency that asks for 10^30
 steps). A value outside its range is refused with an
 :class:`~rockyade.errors.InputError` naming the field and the range. The cost of a whole
-run (steps, samples, memory) is bounded separately (:mod:`rockyade.runner.cost`).
+run (steps, samples, memory) is bounded separately (:mod:`rockyade.runner.cost_limits`).
 """
 
 from __future__ import annotations
@@ -89,7 +89,7 @@ def check_block_ranges(block: object, spec: object, field_prefix: str, source: s
     block
         The :class:`rockyade.blocks.geometry.Block` built from ``spec``.
     spec
-        The :class:`rockyade.scene.model.BlockSpec`.
+        The :class:`rockyade.scene.description.BlockSpec`.
     field_prefix
         ``"blocks[i]."``, for the field names in errors.
     """

@@ -19,7 +19,7 @@ from rockyade.errors import InputError
 from rockyade.io.fields import TableReader, plain_data
 from rockyade.motion.spec import parse_motion
 from rockyade.scene.bounds import BOUNDS, check_block_ranges
-from rockyade.scene.model import (
+from rockyade.scene.description import (
     CALIBRATIONS,
     JOINT_OVERRIDE_KEYS,
     MAX_DURATION_S,
@@ -313,7 +313,7 @@ def _parse_output(r: TableReader) -> OutputSpec:
 
 
 def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
-    """The ``[[joints]]`` list: per-pair overrides by block names (see scene.model.JointOverride)."""
+    """The ``[[joints]]`` list: per-pair overrides by block names (see scene.description.JointOverride)."""
     if not isinstance(raw, list):
         raise InputError("joints", "must be a list of tables ([[joints]])", source)
     out = []
@@ -338,7 +338,7 @@ def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
 
 
 def _parse_loads(raw: Any, source: str | None) -> tuple[LoadSpec, ...]:
-    """The ``[[loads]]`` list (see scene.model.LoadSpec); the cross-checks are in ``_check_scene``."""
+    """The ``[[loads]]`` list (see scene.description.LoadSpec); the cross-checks are in ``_check_scene``."""
     if not isinstance(raw, list):
         raise InputError("loads", "must be a list of tables ([[loads]])", source)
     out = []

@@ -1,10 +1,10 @@
 """Siconos's machinery: a scene run by Siconos (nonsmooth contact dynamics), parsed back.
 
-The scene's DEM model (:func:`rockyade.calibration.model.calibrated_model`: the blocks,
+The scene's DEM model (:func:`rockyade.calibration.model_stage.calibrated_model`: the blocks,
 their contact polygons at b_eq and inertias from p, the ground motion, the loads, the
 start) is written as JSON data (:mod:`rockyade.siconos.payload`) and run by
 :mod:`rockyade.siconos.driver` in Debian's ``/usr/bin/python3`` (``python3-siconos``), as
-a subprocess kept warm between runs (:mod:`rockyade.io.worker`, the machinery YADE's
+a subprocess kept warm between runs (:mod:`rockyade.io.warm_program`, the machinery YADE's
 backend uses: no listening socket, a timeout per run, a crash costs one scene, the log
 kept beside the output). A failure of any kind (a crash, a timeout, an exception inside
 Siconos, a non-finite state, a step the friction-contact solver could not converge, a
@@ -33,14 +33,14 @@ from pathlib import Path
 import numpy as np
 
 from rockyade import __version__
-from rockyade.dem.frames import energy_gain, worker_frame
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.dem.result_frames import energy_gain, worker_frame
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
-from rockyade.io.worker import Program, keep_run_files, run_scene
-from rockyade.io.worker import check_timeout as checked_timeout
+from rockyade.io.warm_program import Program, keep_run_files, run_scene
+from rockyade.io.warm_program import check_timeout as checked_timeout
 from rockyade.result import Result, failed_result
 from rockyade.run_meta import RunMeta
 from rockyade.siconos.calibration import model_restitution
@@ -126,7 +126,7 @@ def default_timeout(n_steps: int, n_bodies: int) -> float:
 
 
 def check_timeout(timeout_s: float | None, field: str = "timeout_s") -> float | None:
-    """A user timeout checked (:func:`rockyade.io.worker.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
+    """A user timeout checked (:func:`rockyade.io.warm_program.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
     return checked_timeout(timeout_s, field)
 
 

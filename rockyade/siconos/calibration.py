@@ -1,7 +1,7 @@
 """The classical parameters carried to nonsmooth contact dynamics (paper's idea, Siconos).
 
 * **alpha** through the equivalent base b_eq (paper Eq 11): the blocks are the DEMs'
-  (:mod:`rockyade.dem.build`), base corners where the DEMs put them.
+  (:mod:`rockyade.dem.model_from_scene`), base corners where the DEMs put them.
 * **p** through the inertia: the DEMs' centroidal inertia, set so that
   I_O = M g R / p^2 (:func:`rockyade.blocks.classical.inertia_for_frequency`).
 * **mu** is not a parameter of the model: with a Newton restitution e = 0 at the contacts

@@ -5,7 +5,7 @@ Usage::
     python3 driver.py --serve FD              # how rockyade runs it: many scenes
     python3 driver.py SCENE.json RESULT.npz   # one scene
 
-``--serve FD``: a Siconos worker (:mod:`rockyade.io.worker` starts it). FD is its end of a
+``--serve FD``: a Siconos worker (:mod:`rockyade.io.warm_program` starts it). FD is its end of a
 socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
 then takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
 descriptor of the job's log file (SCM_RIGHTS) onto which its stdout and stderr go while the

@@ -1,6 +1,6 @@
 """A scene as the JSON data the Siconos driver (:mod:`rockyade.siconos.driver`) reads.
 
-Scenes are data, never code. The blocks are the DEMs' (:func:`rockyade.calibration.model.calibrated_model`):
+Scenes are data, never code. The blocks are the DEMs' (:func:`rockyade.calibration.model_stage.calibrated_model`):
 contact polygons with the base corners at the equivalent base b_eq (paper Eq 11, so that the
 model's alpha is the scene's), masses and centroidal inertias set so that I_O = M g R / p^2
 (the scene's p), the ground acceleration samples every solver gets

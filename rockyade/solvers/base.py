@@ -2,7 +2,7 @@
 
 A solver has a ``name`` (the registry's, :func:`rockyade.solvers.solver_names`), runs a
 scene (``run(scene) -> Result``), says what a run will cost before it starts
-(``estimate_cost(scene)``, :mod:`rockyade.runner.cost`) and places the files it keeps, if
+(``estimate_cost(scene)``, :mod:`rockyade.runner.cost_limits`) and places the files it keeps, if
 any (``keeping_files(folder, stem)``: YADE's scene data, output and log; the other solvers
 keep none and return themselves). Solver objects are frozen dataclasses: they pickle, so
 they travel to worker processes and Dask workers with the scene.
@@ -40,7 +40,7 @@ from rockyade.run_meta import RunMeta
 if TYPE_CHECKING:
     from rockyade.result import Result
     from rockyade.scene import Scene
-    from rockyade.solvers.cost import CostEstimate
+    from rockyade.solvers.cost_estimate import CostEstimate
 
 #: Checks an option's value: (value, field named in errors) -> the value to use.
 OptionCheck = Callable[[Any, str], Any]

@@ -24,7 +24,7 @@ from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage
-from rockyade.solvers.cost import CostEstimate, sample_cost
+from rockyade.solvers.cost_estimate import CostEstimate, sample_cost
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ class HousnerSolver(SolverBase):
         return Result(frame, _meta(scene, cp, motion, traj, wall, self.dt_factor))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """One step per output sample (:func:`rockyade.solvers.cost.sample_cost`)."""
+        """One step per output sample (:func:`rockyade.solvers.cost_estimate.sample_cost`)."""
         return sample_cost(scene, self.name)
 
     def group_key(self, scene: Scene) -> str | None:

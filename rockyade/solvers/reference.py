@@ -35,11 +35,11 @@ import numpy as np
 import pandas as pd
 
 from rockyade import __version__
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.engine import KernelOutput, model_arrays, simulate_model, warm_up
-from rockyade.dem.frames import dem_frame, energy_gain, load_work
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.dem.result_frames import dem_frame, energy_gain, load_work
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.runs import simulate_runs
 from rockyade.kernel.single import single_body
@@ -48,7 +48,7 @@ from rockyade.result import Result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, motion_coverage
-from rockyade.solvers.cost import CostEstimate, dem_cost
+from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
     kernel.STATUS_COMPLETED: "completed",
@@ -107,7 +107,7 @@ class ReferenceSolver(SolverBase):
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
+        """Body-steps of the model's time step (:func:`rockyade.solvers.cost_estimate.dem_cost`)."""
         return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP, self.dt_factor)
 
     def group_key(self, scene: Scene) -> str | None:
@@ -319,7 +319,7 @@ def _energy_terms(
     model: DemModel, e: np.ndarray, pos: np.ndarray, ang: np.ndarray
 ) -> tuple[pd.DataFrame, dict[str, float]]:
     """The energy columns (potential energy from the rest state) and their summary; with point
-    loads, their work (from the samples, :func:`rockyade.dem.frames.load_work`) is in the
+    loads, their work (from the samples, :func:`rockyade.dem.result_frames.load_work`) is in the
     balance and in ``work_loads_J``."""
     e_pot_rest = sum(b.mass_kg * model.g * b.rest_centroid_m[1] for b in model.bodies if not b.fixed)
     total = (

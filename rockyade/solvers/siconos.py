@@ -15,7 +15,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
 from rockyade.errors import InputError
 from rockyade.result import Result
@@ -24,7 +24,7 @@ from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
-from rockyade.solvers.cost import CostEstimate, stepped_cost
+from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
 #: Largest time step accepted, s.
 DT_LIMIT_S = 0.01

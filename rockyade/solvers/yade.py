@@ -2,7 +2,7 @@
 
 The model is the reference DEM's (:mod:`rockyade.dem.model`, matched calibration
 included), written as data and run by YADE's own Python in a process of its own, kept warm
-for the next run (:mod:`rockyade.yade.worker`): no listening socket, one OpenMP thread, a
+for the next run (:mod:`rockyade.yade.warm_worker`): no listening socket, one OpenMP thread, a
 timeout per run, its log kept beside its output. A failure
 of any kind (exit code, timeout, exception inside YADE, non-finite state, partial output)
 is a Result with status ``failed``, the reason and the log path.
@@ -18,7 +18,7 @@ from rockyade.errors import InputError
 from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
-from rockyade.solvers.cost import CostEstimate, dem_cost
+from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
 from rockyade.yade.backend import check_timeout, run_model, yade_model
 
 
@@ -98,7 +98,7 @@ class YadeSolver(SolverBase):
         return result
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Body-steps of the model's time step (:func:`rockyade.solvers.cost.dem_cost`)."""
+        """Body-steps of the model's time step (:func:`rockyade.solvers.cost_estimate.dem_cost`)."""
         return dem_cost(scene, self.name, self.SECONDS_PER_BODY_STEP, self.dt_factor)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> YadeSolver:

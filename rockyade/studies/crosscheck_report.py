@@ -1,7 +1,7 @@
-"""The summary of a cross-check (:mod:`rockyade.studies.crosscheck`): collapse intensities,
+"""The summary of a cross-check (:mod:`rockyade.studies.crosscheck_study`): collapse intensities,
 paired ratios with their bootstrap intervals, the convergence in the time step, the verdict
 agreement and the fragility per solver, from the runs' outcomes
-(:mod:`rockyade.analysis.crosscheck`); ``index.md`` in words and numbers; the set's files.
+(:mod:`rockyade.analysis.crosscheck_statistics`); ``index.md`` in words and numbers; the set's files.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from rockyade.analysis.crosscheck import (
+from rockyade.analysis.crosscheck_statistics import (
     BRACKETED,
     CollapseSearch,
     MedianInterval,
@@ -29,7 +29,7 @@ from rockyade.assess.stripes import collapse_rule
 from rockyade.io.atomic import atomic_open, write_json, write_text
 
 if TYPE_CHECKING:
-    from rockyade.studies.crosscheck import CrosscheckPlan, Outcomes
+    from rockyade.studies.crosscheck_study import CrosscheckPlan, Outcomes
 
 
 @dataclass(frozen=True)
@@ -46,7 +46,7 @@ class Summary:
 
 def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summary:
     """Collapse intensities, paired ratios, convergence, verdict agreement and fragility from
-    the outcomes (module docstring of :mod:`rockyade.analysis.crosscheck`)."""
+    the outcomes (module docstring of :mod:`rockyade.analysis.crosscheck_statistics`)."""
     m = plan.measure
     sp = plan.stripes.stripes
     scan = list(plan.scan_si)
@@ -183,8 +183,8 @@ def _pair_row(
 
 def _fragility(plan: CrosscheckPlan, runs: pd.DataFrame) -> list[dict[str, Any]]:
     """Per solver and dt factor, the lognormal fragility of its runs (scan and bisection)
-    with its bootstrap intervals (:func:`rockyade.assess.fit.fit_stripes`)."""
-    from rockyade.assess.fit import fit_stripes
+    with its bootstrap intervals (:func:`rockyade.assess.stripe_fit.fit_stripes`)."""
+    from rockyade.assess.stripe_fit import fit_stripes
 
     m = plan.measure
     out: list[dict[str, Any]] = []
@@ -324,7 +324,7 @@ def write_summary(
         with atomic_open(folder / name) as fh:
             frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
     if not summary.partial:
-        from rockyade.figures.crosscheck import PairedRatios
+        from rockyade.figures.paired_ratios import PairedRatios
 
         PairedRatios.from_pairs(summary.pairs, plan.measure.name, plan.tolerance).save(folder / "crosscheck.png")
     write_text(folder / "index.md", index_text(plan, summary, seconds))

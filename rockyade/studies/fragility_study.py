@@ -10,7 +10,7 @@ load factor x ag S (ag S = 2.8 m/s^2).
 The stripes are those of ``rockyade fragility`` and ``rockyade assess``
 (:class:`rockyade.assess.stripes.LoadFactorStripes`, run through :mod:`rockyade.runner` by
 :func:`rockyade.assess.stripes.run_stripes`: a run collapses when the block overturns), and
-the curve is the one fit of :func:`rockyade.probability.fragility.fit_lognormal`.
+the curve is the one fit of :func:`rockyade.probability.fragility_curves.fit_lognormal`.
 """
 
 from __future__ import annotations
@@ -26,20 +26,20 @@ from rockyade import paper
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import paper_suite_set
 from rockyade.assess.stripes import LoadFactorStripes, StripeTask, run_stripes
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import ACCEL_UNIT_LABELS
 from rockyade.errors import InputError
 from rockyade.figures import new_figure, save_figure
-from rockyade.figures.common import accel_scale, other_accel_axis
-from rockyade.figures.fragility import FragilityCurve, FragilityDisplay
+from rockyade.figures.canvas import accel_scale, other_accel_axis
+from rockyade.figures.fragility_panels import FragilityCurve, FragilityDisplay
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
 from rockyade.motion.synthetic import paper_suite, suite_record
-from rockyade.probability.fragility import Fragility, fit_lognormal
+from rockyade.probability.fragility_curves import Fragility, fit_lognormal
 from rockyade.runner import Executor, run_jobs
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import as_solver
 from rockyade.studies.report import Report, fmt, run_state
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 16))
 RECORDS = tuple(range(1, 31))
@@ -287,7 +287,7 @@ def draw_figure(report: Report, stripes: pd.DataFrame, fits: pd.DataFrame, accel
     """Per specimen: collapse fractions (points), fitted curves (solid over the tested range,
     dotted beyond it), extrapolated medians flagged and missing curves explained; PGA in
     ``accel_unit`` ("g", standard gravity, or "m/s2"), the other unit on the top axis. Each
-    panel is a :class:`rockyade.figures.fragility.FragilityDisplay`."""
+    panel is a :class:`rockyade.figures.fragility_panels.FragilityDisplay`."""
     name = "fragility.png"
     unit = accel_scale(accel_unit)
     fig, axes = new_figure(report.out / name, 2, 2, figsize=(12, 8.5), sharex=True, sharey=True)

@@ -14,7 +14,7 @@ import pandas as pd
 
 from rockyade import paper
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.errors import CalibrationError
 from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
 from rockyade.figures.styles import SOLVER_LABELS
@@ -26,7 +26,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
 from rockyade.studies.report import Report, fmt, max_difference, run_state
-from rockyade.studies.specimens import PARAMETER_SETS, block_alpha, block_table, scene_dict
+from rockyade.studies.specimen_scenes import PARAMETER_SETS, block_alpha, block_table, scene_dict
 
 DURATION_S = 4.0
 N_IMPACTS = MU_EFF_IMPACTS

@@ -26,7 +26,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
 from rockyade.studies.report import Report, fmt, max_difference, no_uplift_note, run_state
-from rockyade.studies.specimens import biblock_blocks, block_table, scene_dict
+from rockyade.studies.specimen_scenes import biblock_blocks, block_table, scene_dict
 
 CYCLES = 20
 RAMP_CYCLES = 2

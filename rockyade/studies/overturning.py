@@ -17,9 +17,9 @@ import numpy as np
 import pandas as pd
 
 from rockyade.analysis.metrics import uplift_threshold_rad
-from rockyade.calibration.model import calibrated_model
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import G
-from rockyade.figures.overturning import OverturningSpectrumDisplay
+from rockyade.figures.overturning_spectrum import OverturningSpectrumDisplay
 from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.runner import Executor, run_jobs
 from rockyade.scene import Scene, scene_from_dict
@@ -27,7 +27,7 @@ from rockyade.solvers.base import GroupSolver, Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies.report import Report, run_state
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 FREQUENCY_RATIOS = tuple(np.round(np.arange(1.0, 10.01, 0.5), 2))
 STEP = 0.05
@@ -195,7 +195,7 @@ def run(report: Report, workers: int = 2, grouped: bool = True) -> pd.DataFrame:
 
 def draw_figure(report: Report, scan: pd.DataFrame, spectrum: pd.DataFrame) -> OverturningSpectrumDisplay:
     """The overturning spectrum (``overturning_spectrum.png`` in the report's folder, drawn by
-    :class:`rockyade.figures.overturning.OverturningSpectrumDisplay`).
+    :class:`rockyade.figures.overturning_spectrum.OverturningSpectrumDisplay`).
 
     Parameters
     ----------

@@ -2,7 +2,7 @@
 
 The four specimens (experimental alpha, p, mu; matched calibration) over the paper's suite
 (30 records) with Housner and the reference DEM, each at its own time step and at half of
-it: per specimen a ``rockyade crosscheck`` (:mod:`rockyade.studies.crosscheck`) into
+it: per specimen a ``rockyade crosscheck`` (:mod:`rockyade.studies.crosscheck_study`) into
 ``crosscheck/specimen<k>/``. YADE and Siconos against the reference DEM on a subset
 (:data:`SUBSET_SPECIMEN`, the first :data:`SUBSET_RECORDS` records, the solvers' own steps:
 ``crosscheck/specimen1_yade/`` and ``crosscheck/specimen1_siconos/``, the latter with the paper's
@@ -20,20 +20,20 @@ from pathlib import Path
 
 import pandas as pd
 
-from rockyade.analysis.crosscheck import MIN_RECORDS
+from rockyade.analysis.crosscheck_statistics import MIN_RECORDS
 from rockyade.assess import paper_suite_set, parse_measure
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.studies.crosscheck import Summary, crosscheck_plan, run_crosscheck
+from rockyade.studies.crosscheck_study import Summary, crosscheck_plan, run_crosscheck
 from rockyade.studies.report import Report
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 SPECIMENS = ("1", "2", "3", "4")
 RECORDS = 30
 #: Bisection resolution of the paper's cross-check (2 %: the verdict's tolerance is 5 %).
 RESOLUTION = 0.02
 #: YADE and Siconos on a subset: one specimen, the first records (as many as a paired interval
-#: needs, :data:`rockyade.analysis.crosscheck.MIN_RECORDS`), the solvers' own time steps.
+#: needs, :data:`rockyade.analysis.crosscheck_statistics.MIN_RECORDS`), the solvers' own time steps.
 SUBSET_SPECIMEN = "1"
 SUBSET_RECORDS = MIN_RECORDS
 #: Siconos's subset: the paper's calibration (Siconos cannot reach specimen 1's matched mu 0.936:
@@ -161,7 +161,7 @@ def run(report: Report, workers: int, use_yade: bool = True) -> None:
         "of a solver at half its step against its own step (kind `dt`), the bootstrap 95 % interval, the share of "
         "scan runs with the same verdict.",
     )
-    from rockyade.figures.crosscheck import PairedRatios
+    from rockyade.figures.paired_ratios import PairedRatios
 
     PairedRatios.from_pairs(table, "PGA").save(report.out / "crosscheck.png")
     report.figure(

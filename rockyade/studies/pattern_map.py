@@ -23,7 +23,7 @@ from rockyade.motion.analytic import Harmonic
 from rockyade.motion.spec import MotionSpec
 from rockyade.motion.types import HarmonicMotion
 from rockyade.studies.report import Report, run_state
-from rockyade.studies.specimens import biblock_blocks, scene_dict
+from rockyade.studies.specimen_scenes import biblock_blocks, scene_dict
 
 FREQUENCIES_HZ = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0)
 AMPLITUDES_MM = (0.5, 1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)

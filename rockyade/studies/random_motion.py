@@ -21,7 +21,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.solvers.yade import YadeSolver
 from rockyade.studies.report import Report, fmt, max_difference, no_uplift_note, run_state
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 CASES = (("2", 21, 0.6), ("3", 18, 0.5))
 DURATION_S = 25.0

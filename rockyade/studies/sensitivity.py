@@ -23,7 +23,7 @@ from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies.report import Report
-from rockyade.studies.specimens import block_table, scene_dict
+from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 CHANGE = 0.05
 THETA0 = 0.1175

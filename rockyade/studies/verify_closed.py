@@ -1,7 +1,7 @@
 """``rockyade verify``'s checks that run no solver: the limit analysis, Housner's uplift
 multiplier, the code's checks and the fragility fit against closed forms and a hand
 calculation (``kinematic``, ``code``, ``fragility_fit``, ``loaded_block``, ``loaded_mass``;
-:mod:`rockyade.studies.verify` describes each)."""
+:mod:`rockyade.studies.verification` describes each)."""
 
 from __future__ import annotations
 
@@ -256,7 +256,7 @@ def check_fragility_fit(solvers: list[str]) -> tuple[list[Row], dict[str, Result
     9 levels from 0.5 to 8."""
     from scipy import stats
 
-    from rockyade.assess.fit import fit_stripes
+    from rockyade.assess.stripe_fit import fit_stripes
 
     rng = np.random.default_rng(11)
     levels = np.geomspace(0.5, 8.0, 9)

@@ -1,7 +1,7 @@
 """``rockyade verify``'s checks of the DEMs (and any solver named) on assemblies: the rocking
 frame and the drum column against closed forms, the pad case's overlaps, a 1,000-block wall at
 rest, the reference DEM against YADE and this version's baseline (``frame``, ``drums``,
-``pad``, ``wall``, ``agreement``, ``baseline``; :mod:`rockyade.studies.verify` describes each)."""
+``pad``, ``wall``, ``agreement``, ``baseline``; :mod:`rockyade.studies.verification` describes each)."""
 
 from __future__ import annotations
 
@@ -277,7 +277,7 @@ def check_pad(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
 def check_wall(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """About 1,000 blocks at rest: they settle elastically to the linear statics of the joints
     (rockyade.dem.statics) and do not move beyond it."""
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.dem.statics import rest_springs, static_displacement
 
     data = wall(courses=32, units_per_course=32, motion=rest_motion(), duration_s=1.5, sample_dt_s=0.005)

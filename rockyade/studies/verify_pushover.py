@@ -1,6 +1,6 @@
 """``rockyade verify``'s pushover checks: the reference DEM's pushover onset against the closed
 form of a loaded block and against the limit analysis of a block, an arch, a restrained wall and
-a running-bond panel (``loaded_pushover``, ``limit_pushover``; :mod:`rockyade.studies.verify`
+a running-bond panel (``loaded_pushover``, ``limit_pushover``; :mod:`rockyade.studies.verification`
 describes each), and the short held-level pushover they share."""
 
 from __future__ import annotations

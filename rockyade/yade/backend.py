@@ -3,7 +3,7 @@
 The DEM model (:mod:`rockyade.dem.model`, the same the reference DEM runs) is written as
 JSON data (:mod:`rockyade.yade.payload`) and run by :mod:`rockyade.yade.driver`
 in Debian's ``/usr/bin/python3.11`` with YADE's modules on the path, as a subprocess kept
-warm between runs (:mod:`rockyade.yade.worker`: one per thread, reset between scenes):
+warm between runs (:mod:`rockyade.yade.warm_worker`: one per thread, reset between scenes):
 
 * no listening socket: the ``yade`` launcher (which opens a Python console on
   0.0.0.0:9000+ and an XMLRPC server on 21000+) is never used, and the worker talks over
@@ -44,20 +44,20 @@ from pathlib import Path
 import numpy as np
 
 from rockyade import __version__
-from rockyade.calibration.model import calibrated_model
-from rockyade.dem.frames import energy_gain, worker_frame
+from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
+from rockyade.dem.result_frames import energy_gain, worker_frame
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
-from rockyade.io.worker import check_timeout as checked_timeout
-from rockyade.io.worker import keep_run_files
+from rockyade.io.warm_program import check_timeout as checked_timeout
+from rockyade.io.warm_program import keep_run_files
 from rockyade.result import Result, failed_result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.yade.payload import scene_payload
-from rockyade.yade.worker import run_scene
+from rockyade.yade.warm_worker import run_scene
 
 #: The script YADE's Python runs, shipped inside the package.
 DRIVER = Path(__file__).resolve().parent / "driver.py"
@@ -97,7 +97,7 @@ def default_timeout(model: DemModel) -> float:
 
 
 def check_timeout(timeout_s: float | None, field: str = "yade_timeout_s") -> float | None:
-    """A user timeout checked (:func:`rockyade.io.worker.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
+    """A user timeout checked (:func:`rockyade.io.warm_program.check_timeout`, in (0, MAX_TIMEOUT_S] s)."""
     return checked_timeout(timeout_s, field)
 
 
@@ -124,7 +124,7 @@ def run_model(
     timeout_s
         Wall-clock limit of the run, s (default :func:`default_timeout`).
     warm
-        Run in this thread's warm YADE worker (:mod:`rockyade.yade.worker`); False: in a
+        Run in this thread's warm YADE worker (:mod:`rockyade.yade.warm_worker`); False: in a
         YADE process of its own (the same result, bit for bit, 0.7-1 s slower).
     """
     if not yade_available():
@@ -181,7 +181,7 @@ def run_model(
 
 
 def _keep_files(directory: Path, work: str, name: str, result: Result) -> None:
-    """Give a run's files (``<work>.yade.*``) their names (:func:`rockyade.io.worker.keep_run_files`:
+    """Give a run's files (``<work>.yade.*``) their names (:func:`rockyade.io.warm_program.keep_run_files`:
     ``<name>.yade.*``, or ``<name>_failed.yade.*`` beside an earlier run's output when this one
     failed). ``log_path`` says where the log went."""
     log = keep_run_files(directory, work, name, ".yade", result.ok)
@@ -289,7 +289,7 @@ def _collapse_before_overlap(model: DemModel, meta: WorkerOutput, arrays: dict[s
     of the driver; the end of the output when an older driver does not say), some moving block
     has reached its landing angle, dropped by more than DROP_FRACTION of its height, or passed
     its tipping angle alpha, and the energy has not grown up to then (no blow-up by
-    :func:`rockyade.dem.frames.energy_gain`).
+    :func:`rockyade.dem.result_frames.energy_gain`).
     """
     n = meta.n_filled
     when = meta.deep_overlap_time_s

@@ -8,7 +8,7 @@ Usage::
     yade run.py                                        # scene.json beside run.py, writes
                                                        # result.npz and result.csv there
 
-``--serve FD``: a YADE worker (:mod:`rockyade.yade.worker` starts it). FD is its end of a
+``--serve FD``: a YADE worker (:mod:`rockyade.yade.warm_worker` starts it). FD is its end of a
 socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
 then takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
 descriptor of the job's log file (SCM_RIGHTS) onto which its stdout and stderr go while the

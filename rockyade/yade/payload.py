@@ -2,7 +2,7 @@
 
 Scenes are data, never code: no value is pasted into Python source for YADE. Everything
 about the contacts (sphere centres, their copies, materials and collision masks) is decided
-here (:mod:`rockyade.yade.contacts`); the driver only builds what the data says.
+here (:mod:`rockyade.yade.contact_plan`); the driver only builds what the data says.
 
 Same role as :mod:`rockyade.siconos.payload`: each package of an engine that runs in another
 Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
@@ -17,7 +17,7 @@ import numpy as np
 
 from rockyade.dem.model import DemModel
 from rockyade.errors import InputError
-from rockyade.yade.contacts import BASE_BIT, plan_contacts
+from rockyade.yade.contact_plan import BASE_BIT, plan_contacts
 
 #: Radius of the vertex spheres: at least this fraction of the largest of the moving
 #: blocks' smallest dimensions ...

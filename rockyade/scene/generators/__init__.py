@@ -16,7 +16,7 @@ that no module hides a function of the same name: ``walls`` (dry walls, running 
 bond, openings), ``columns`` (drum columns, stacks), ``arches`` (semicircular and pointed
 arches on piers), ``frames`` (the rocking frame of Makris & Vassiliou 2013),
 ``wall_sections`` (a wall's out-of-plane section, the paper's Fig. 2), ``restrained_walls``
-(the alias), ``common`` (exact
+(the alias), ``scene_tables`` (exact
 numbers, block tables, motions and contacts). ``drum_column`` and ``rocking_frame`` are the
 former names of :func:`column` and :func:`frame`.
 """
@@ -30,7 +30,9 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generators.arches import arch
 from rockyade.scene.generators.columns import column, drum_column, round_drum_mass_inertia, stack, tapered_widths
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.frames import frame, frame_frequency, frame_gamma, rocking_frame
+from rockyade.scene.generators.restrained_walls import restrained_wall
+from rockyade.scene.generators.scene_tables import (
     free_motion,
     paper_contact,
     pulse_motion,
@@ -38,8 +40,6 @@ from rockyade.scene.generators.common import (
     rest_motion,
     udec_contact,
 )
-from rockyade.scene.generators.frames import frame, frame_frequency, frame_gamma, rocking_frame
-from rockyade.scene.generators.restrained_walls import restrained_wall
 from rockyade.scene.generators.wall_sections import wall_section
 from rockyade.scene.generators.walls import Opening, wall
 

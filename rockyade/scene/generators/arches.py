@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_DENSITY_KG_M3,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
@@ -150,7 +150,7 @@ def arch(
         "blocks" (free) or "fixed" (abutments that move with the base).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is UDEC-style
-        (:func:`~rockyade.scene.generators.common.udec_contact` with the ring depth).
+        (:func:`~rockyade.scene.generators.scene_tables.udec_contact` with the ring depth).
     """
     span = check_length("span_m", span_m)
     depth = check_length("ring_depth_m", ring_depth_m)

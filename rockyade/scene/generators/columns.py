@@ -22,7 +22,7 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_DENSITY_KG_M3,
     DEFAULT_SAMPLE_DT_S,
     check_choice,

@@ -22,7 +22,7 @@ from typing import Any
 from rockyade.blocks.classical import p_rectangle
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_DENSITY_KG_M3,
     DEFAULT_SAMPLE_DT_S,
     check_density,

@@ -27,7 +27,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import DEFAULT_DENSITY_KG_M3, DEFAULT_SAMPLE_DT_S, check_choice, check_count
+from rockyade.scene.generators.scene_tables import DEFAULT_DENSITY_KG_M3, DEFAULT_SAMPLE_DT_S, check_choice, check_count
 from rockyade.scene.generators.wall_sections import wall_section
 
 RESTRAINTS = ("side", "floor")

@@ -54,7 +54,8 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.overburden import add_overburden
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_DENSITY_KG_M3,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
@@ -67,7 +68,6 @@ from rockyade.scene.generators.common import (
     rect_block,
     scene_table,
 )
-from rockyade.scene.generators.overburden import add_overburden
 
 TOPS = ("free", "restrained", "restrained-far", "restrained-near", "floor")
 #: The fixed blocks of each top, by side.

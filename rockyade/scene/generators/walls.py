@@ -31,7 +31,7 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.common import (
+from rockyade.scene.generators.scene_tables import (
     DEFAULT_DENSITY_KG_M3,
     DEFAULT_SAMPLE_DT_S,
     check_choice,
@@ -229,11 +229,11 @@ def wall(
         Density of units and lintels, kg/m^3.
     motion, contact
         The ``[motion]`` and ``[contact]`` tables (default: a one-sine pulse; UDEC-style
-        joints, :func:`~rockyade.scene.generators.common.udec_contact`).
+        joints, :func:`~rockyade.scene.generators.scene_tables.udec_contact`).
     duration_s, sample_dt_s
         Simulated time and output interval, s. The default time is a record's length plus
         :data:`~rockyade.motion.coverage.RECORD_TAIL_S` of free rocking for a ``record`` or
-        ``synthetic`` motion (:func:`~rockyade.scene.generators.common.default_duration_s`),
+        ``synthetic`` motion (:func:`~rockyade.scene.generators.scene_tables.default_duration_s`),
         else 3 s.
 
     Returns

@@ -21,7 +21,7 @@ by run (docs/verification.md):
   step; a difference between solvers smaller than a solver's own change with dt says
   nothing (:func:`pair_verdict`).
 
-Everything here is arithmetic on outcomes: no solver runs (the study, :mod:`rockyade.studies.crosscheck`).
+Everything here is arithmetic on outcomes: no solver runs (the study, :mod:`rockyade.studies.crosscheck_study`).
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ BOOTSTRAP_SEED = 20261127
 #: Default tolerance on a median ratio (5 %); the interval must lie within twice it.
 TOLERANCE = 0.05
 #: Records a paired ratio needs before its interval means anything (as a fragility fit,
-#: :mod:`rockyade.assess.fit`, refuses fewer than 5 records and warns below 10).
+#: :mod:`rockyade.assess.stripe_fit`, refuses fewer than 5 records and warns below 10).
 MIN_RECORDS = 5
 ADVISED_RECORDS = 10
 

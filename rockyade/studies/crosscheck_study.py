@@ -1,10 +1,10 @@
 """``rockyade crosscheck``: several solvers on one scene over a record set, compared by their
-collapse intensities (the statistics: :mod:`rockyade.analysis.crosscheck`; the method and
+collapse intensities (the statistics: :mod:`rockyade.analysis.crosscheck_statistics`; the method and
 what was measured: docs/verification.md).
 
 For each solver, each time-step factor (1, and 0.5 for the convergence check) and each
 record, a collapse search: the scan's levels (from the scene's static collapse acceleration,
-as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility.fragility_plan`),
+as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility_analysis.fragility_plan`),
 then bisection to the resolution. The searches advance together, one round at a time; each
 round's runs go through the batch machinery (:func:`rockyade.batch.run_study_tasks`:
 the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
@@ -39,12 +39,12 @@ from typing import Any
 
 import numpy as np
 
-from rockyade.analysis.crosscheck import (
+from rockyade.analysis.crosscheck_statistics import (
     RESOLUTION,
     TOLERANCE,
     next_levels,
 )
-from rockyade.assess.fragility import FragilityPlan, fragility_plan
+from rockyade.assess.fragility_analysis import FragilityPlan, fragility_plan
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
 from rockyade.assess.stripes import MAX_LOAD_FACTOR
@@ -291,7 +291,7 @@ def crosscheck_plan(
     Parameters
     ----------
     scene, motions, measure
-        As :func:`rockyade.assess.fragility.fragility_plan` takes them.
+        As :func:`rockyade.assess.fragility_analysis.fragility_plan` takes them.
     solvers
         Solver names (at least two).
     levels

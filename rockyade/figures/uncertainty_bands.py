@@ -10,10 +10,10 @@ import numpy as np
 import pandas as pd
 
 from rockyade.constants import ACCEL_UNIT_LABELS, ACCEL_UNIT_TEXT, LOAD_FACTOR_LABEL
-from rockyade.figures.common import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
+from rockyade.figures.canvas import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
 from rockyade.motion.intensity import LABELS
 from rockyade.probability.exceedance import level_column
-from rockyade.probability.fragility import Fragility, wilson_interval
+from rockyade.probability.fragility_curves import Fragility, wilson_interval
 
 SOLVER_COLOURS = {"housner": "C0", "reference": "C1", "yade": "C2"}
 
@@ -42,7 +42,7 @@ def plot_uncertainty(
     Parameters
     ----------
     study, probabilities, runs, fragility, spread
-        The study and its tables (:func:`rockyade.studies.uncertainty.run_uncertainty`).
+        The study and its tables (:func:`rockyade.studies.uncertainty_study.run_uncertainty`).
     path
         PNG to write (atomically); None writes nothing.
     n_bins

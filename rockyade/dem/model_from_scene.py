@@ -8,7 +8,7 @@ placed at rest as the scene says (stacked, or at ``position_m`` rotated by
 ``rotation_rad``).
 
 Joints (:mod:`rockyade.dem.joints`): each moving block's own joint is given, as the
-calibration stage computed it (:func:`rockyade.calibration.model.calibrated_model`
+calibration stage computed it (:func:`rockyade.calibration.model_stage.calibrated_model`
 calibrates, then builds here); this module resolves the joint of every pair touching at
 rest (bed, head, block-base, block-fixed). The time step (Eq 7, kept below the stability
 limit) and the static settlement come from the springs at rest (:mod:`rockyade.dem.statics`).

@@ -6,7 +6,7 @@ likelihood sum_i [n_i ln p_i + (N_i - n_i) ln(1 - p_i)] (Baker 2015, "Efficient 
 fragility function fitting using dynamic structural analysis", Earthquake Spectra 31) by
 Newton steps on its analytic gradient and Hessian (:func:`fit_lognormal`, the one fit of the
 package: the paper study, ``rockyade fragility``, ``assess``, ``uncertainty`` and the
-bootstrap of :mod:`rockyade.assess.fit`, which starts each draw from the full fit).
+bootstrap of :mod:`rockyade.assess.stripe_fit`, which starts each draw from the full fit).
 
 When every run has its own intensity (PGV, Arias intensity, a/(g tan alpha) ... differ
 from record to record at one load factor) each run is its own stripe of one: the

@@ -7,16 +7,16 @@ resets YADE (``O.reset()``: bodies, engines, materials, time step, periodic cell
 own recorder) and waits for the next. Results are the same, bit for bit, as one process
 per scene (``tests/test_yade_worker.py``). The machinery (no port, dies with its parent,
 timeout per scene, a crash costs one scene, samples flushed every FLUSH_PERIOD_S) is
-:mod:`rockyade.io.worker`'s, shared with the Siconos backend; this module names YADE.
+:mod:`rockyade.io.warm_program`'s, shared with the Siconos backend; this module names YADE.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-from rockyade.io import worker as _generic
-from rockyade.io.worker import QUIT_WAIT_S, STOP_GRACE_S, Program, WorkerLostError
-from rockyade.io.worker import Worker as YadeWorker
+from rockyade.io import warm_program as _generic
+from rockyade.io.warm_program import QUIT_WAIT_S, STOP_GRACE_S, Program, WorkerLostError
+from rockyade.io.warm_program import Worker as YadeWorker
 
 #: The program's name in reasons, and the key of its per-thread workers.
 LABEL = "YADE"
@@ -44,7 +44,7 @@ def run_scene(
     timeout: float,
     warm: bool = True,
 ) -> str | None:
-    """Run one scene in YADE; the reason it failed, or None (:func:`rockyade.io.worker.run_scene`)."""
+    """Run one scene in YADE; the reason it failed, or None (:func:`rockyade.io.warm_program.run_scene`)."""
     program = Program(command, env, LABEL, "--yade-timeout", FLUSH_PERIOD_S)
     return _generic.run_scene(program, scene_file, out_file, log_file, timeout, warm)
 

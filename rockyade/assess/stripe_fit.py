@@ -1,10 +1,10 @@
 """The lognormal fragility of stripes, and how sure it is.
 
 * Per stripe: runs, failed runs, collapses, the fraction and its 95 % Wilson interval
-  (:func:`rockyade.probability.fragility.wilson_interval`). Failed runs are left out of
+  (:func:`rockyade.probability.fragility_curves.wilson_interval`). Failed runs are left out of
   every count and probability (and counted).
 * The curve P(collapse | IM = x) = Phi(ln(x / theta) / beta), by maximum likelihood on the
-  stripes (Baker 2015, :func:`rockyade.probability.fragility.fit_lognormal`).
+  stripes (Baker 2015, :func:`rockyade.probability.fragility_curves.fit_lognormal`).
 * Its band: the records are the sample, so they are resampled (a record keeps its outcomes
   at every level: a nonparametric bootstrap over records, ``BOOTSTRAP_DRAWS`` draws with a
   fixed seed); each draw is fitted again (the same fit, started from the full one); the band is
@@ -28,7 +28,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from rockyade.probability.fragility import Fragility, fit_lognormal, wilson_interval
+from rockyade.probability.fragility_curves import Fragility, fit_lognormal, wilson_interval
 
 #: Bootstrap draws, their seed and the band's two-sided level.
 BOOTSTRAP_DRAWS = 300

@@ -1,7 +1,7 @@
 """The cost limits of one run, checked before anything runs.
 
 :func:`check_cost` refuses a run whose estimate (each solver's ``estimate_cost``,
-:mod:`rockyade.solvers.cost`) is above :data:`LIMITS` with an
+:mod:`rockyade.solvers.cost_estimate`) is above :data:`LIMITS` with an
 :class:`~rockyade.errors.InputError` naming what is too large, by how much, and the input
 that sets it; ``allow_large=True`` (``--allow-large`` on ``run``, ``compare`` and
 ``batch``) runs it anyway. The solvers themselves do not check: the command line and the
@@ -14,12 +14,12 @@ from typing import TYPE_CHECKING
 
 from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import Scene
-from rockyade.solvers.cost import CostEstimate
+from rockyade.solvers.cost_estimate import CostEstimate
 
 if TYPE_CHECKING:
     from rockyade.solvers.base import Solver
 
-#: Documented limits of one run (docs/reliability.md); ``allow_large`` lifts them.
+#: Documented limits of one run (docs/robustness.md); ``allow_large`` lifts them.
 LIMITS: dict[str, float] = {
     "integration_steps": 2.0e8,  # body-steps: ~30 s of the reference DEM, hours of YADE
     "output_samples": 2.0e6,  # rows of the result

@@ -11,7 +11,7 @@ upper-side guess beyond:
     seconds ~ SECONDS_PER_NONZERO x nonzeros ** NONZERO_EXPONENT,
     bytes   ~ BASE_MEMORY_BYTES + BYTES_PER_NONZERO x nonzeros,
 
-an order of magnitude, as the runs' estimates (:mod:`rockyade.solvers.cost`). The coulomb rule
+an order of magnitude, as the runs' estimates (:mod:`rockyade.solvers.cost_estimate`). The coulomb rule
 solves one programme per iteration after the associated one: most converge within
 :data:`TYPICAL_ITERATIONS`, and ``--max-iterations`` bounds them.
 
@@ -26,7 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from rockyade.errors import InputError, at_least, at_most
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: The fit of one programme's CPU time, s (module docstring).
 SECONDS_PER_NONZERO = 5.0e-10

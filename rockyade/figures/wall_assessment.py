@@ -2,7 +2,7 @@
 curve with the demand beside the fragility in ag).
 
 * :func:`plot_fragility` (:func:`fragility_display`, a
-  :class:`rockyade.figures.fragility.FragilityDisplay`): the fraction of records that
+  :class:`rockyade.figures.fragility_panels.FragilityDisplay`): the fraction of records that
   collapse at each stripe (points, 95 % Wilson bars), the lognormal fit (solid over the
   tested levels, dotted beyond), its 90 % bootstrap band, the median marked;
 * :func:`plot_capacity`: the code's capacity curve a*(d*) of the equivalent system, a0*,
@@ -25,11 +25,11 @@ from matplotlib.axes import Axes
 
 from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import VERIFIED
-from rockyade.assess.fragility import FragilityResult
+from rockyade.assess.fragility_analysis import FragilityResult
 from rockyade.constants import CODE_GRAVITY as G
-from rockyade.figures.common import figure_of, new_figure, save_figure
-from rockyade.figures.fragility import FragilityCurve, FragilityDisplay, Mark
-from rockyade.probability.fragility import Fragility
+from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.figures.fragility_panels import FragilityCurve, FragilityDisplay, Mark
+from rockyade.probability.fragility_curves import Fragility
 
 CURVE = "#1f4e79"
 BAND = "#9ecae1"

@@ -2,7 +2,7 @@
 
 A display object (computed data in, ``plot(ax=)`` draws, ``figure_`` and ``ax_`` kept)::
 
-    from rockyade.figures.crosscheck import PairedRatios
+    from rockyade.figures.paired_ratios import PairedRatios
 
     display = PairedRatios.from_pairs(pairs)       # pairs.csv of rockyade crosscheck
     display.plot()                                 # on the screen (pyplot), or plot(ax=ax)
@@ -28,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
 
 from rockyade.errors import InputError
-from rockyade.figures.common import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import figure_of, new_figure, save_figure
 
 #: Ratios marked on the axis (those inside its limits).
 TICKS = (0.25, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0, 1.05, 1.1, 1.2, 1.3, 1.5, 2.0, 4.0)

@@ -11,7 +11,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from scipy import stats
 
-from rockyade.figures.common import axes_list, figure_of, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
 from rockyade.identification.fit import CONFIDENCE, Identification, error_surface
 
 

@@ -7,10 +7,10 @@ import math
 
 from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import NOT_APPLICABLE, VERIFIED, Check
-from rockyade.assess.fragility import FragilityPlan, FragilityResult
+from rockyade.assess.fragility_analysis import FragilityPlan, FragilityResult
 from rockyade.assess.stripes import collapse_rule
 from rockyade.constants import CODE_GRAVITY as G
-from rockyade.limit.report import hinge_words, plural, sliding_words
+from rockyade.limit.report_text import hinge_words, plural, sliding_words
 
 
 def _pct(x: float) -> str:

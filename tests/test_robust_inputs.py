@@ -12,7 +12,7 @@ import pytest
 
 from rockyade.cli import main
 from rockyade.errors import InputError
-from rockyade.runner.cost import LIMITS, check_cost, estimate_cost
+from rockyade.runner.cost_limits import LIMITS, check_cost, estimate_cost
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.scene.bounds import BOUNDS
 
@@ -149,7 +149,7 @@ def test_numpy_arrays_and_scalars_are_accepted():
 
 
 def test_every_documented_bound_is_in_the_docs():
-    text = (ROOT / "docs" / "reliability.md").read_text()
+    text = (ROOT / "docs" / "robustness.md").read_text()
     for name, bound in BOUNDS.items():
         row = next((line for line in text.splitlines() if f"`{name}`" in line), None)
         assert row is not None, f"{name} is not documented"
@@ -170,7 +170,7 @@ def _long(duration: float, sample_dt: float, **contact) -> dict:
 
 
 def test_cost_estimate_of_an_example_matches_the_model():
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
 
     d = load_scene(EXAMPLES / "specimen1_harmonic.toml").to_dict()
     d["contact"]["calibration"] = "paper"

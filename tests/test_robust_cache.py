@@ -182,7 +182,7 @@ def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated)
     code = textwrap.dedent(
         """
         from rockyade.motion.synthetic import suite_record
-        from tests.test_reliability_cache import SPEC
+        from tests.test_robust_cache import SPEC
         print(repr(float(suite_record(SPEC, 1).accel_m_s2.sum())))
         """
     )
@@ -216,7 +216,7 @@ def test_two_processes_regenerating_at_once_both_get_the_record(cache, generated
     code = textwrap.dedent(
         """
         from rockyade.motion.synthetic import suite_record
-        from tests.test_reliability_cache import SPEC
+        from tests.test_robust_cache import SPEC
         print(suite_record(SPEC, 1).accel_m_s2.tobytes().hex()[:64])
         """
     )

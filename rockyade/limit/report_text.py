@@ -7,7 +7,7 @@ import numpy as np
 
 from rockyade.limit.analysis import LimitResult
 from rockyade.limit.mechanism import Hinge, Sliding
-from rockyade.limit.model import RigidBlockModel
+from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: Hinges and sliding joints listed in the text (the JSON lists all).
 MAX_LISTED = 20

@@ -2,7 +2,7 @@
 
 Each solver answers ``estimate_cost(scene)`` with a :class:`CostEstimate`
 (:mod:`rockyade.solvers.base`); the runner refuses a run above its limits
-(:mod:`rockyade.runner.cost`). The estimate of a scene run by a solver:
+(:mod:`rockyade.runner.cost_limits`). The estimate of a scene run by a solver:
 
 * **integration steps**: for the DEMs (reference and YADE), the explicit time steps times
   the moving bodies, with the time step the model will use (paper Eq 7, kept below the
@@ -65,7 +65,7 @@ class CostEstimate:
     wall_time_s: float
 
     def over_limits(self, limits: dict[str, float]) -> list[str]:
-        """The limits this run exceeds (names of ``limits``, e.g. :data:`rockyade.runner.cost.LIMITS`)."""
+        """The limits this run exceeds (names of ``limits``, e.g. :data:`rockyade.runner.cost_limits.LIMITS`)."""
         return [name for name, limit in limits.items() if getattr(self, name) > limit]
 
     def describe(self) -> str:
@@ -93,11 +93,11 @@ def dem_time_step(scene: Scene) -> tuple[float, int]:
     """The DEM's time step (s) and its moving bodies, from the model the solvers build.
 
     The step depends on the joints and masses, not on the motion. The model is the one the
-    run builds (:func:`rockyade.calibration.model.calibrated_model` keeps it for the run),
+    run builds (:func:`rockyade.calibration.model_stage.calibrated_model` keeps it for the run),
     except for a matched calibration, estimated with the paper's damping (Eq 13), which the
     matching changes little, on the scene with the base at rest (no motion is built).
     """
-    from rockyade.calibration.model import calibrated_model
+    from rockyade.calibration.model_stage import calibrated_model
     from rockyade.motion.spec import AtRest
 
     contact = scene.contact

@@ -3,15 +3,15 @@
 Every moving block is calibrated by the scene's method
 (:func:`rockyade.calibration.calibrate.calibrate`; a matched one runs short DEM models of
 the block alone first), then the model is built with those joints
-(:func:`rockyade.dem.build.build_dem_model`, which knows no calibration).
+(:func:`rockyade.dem.model_from_scene.build_dem_model`, which knows no calibration).
 """
 
 from __future__ import annotations
 
 from rockyade.calibration.calibrate import calibrate
 from rockyade.constants import G
-from rockyade.dem.build import build_dem_model
 from rockyade.dem.model import DemModel
+from rockyade.dem.model_from_scene import build_dem_model
 from rockyade.scene import Scene
 
 
@@ -45,7 +45,7 @@ def calibrated_model(scene: Scene, g: float = G, *, rigid_contacts: bool = False
         Gravity, m/s^2.
     rigid_contacts
         For a rigid-contact solver (Siconos): the penalty springs' settlement check is
-        skipped (:func:`rockyade.dem.build.build_dem_model`).
+        skipped (:func:`rockyade.dem.model_from_scene.build_dem_model`).
     """
     global _LAST
     if _LAST is not None and _LAST[0] is scene and _LAST[1] == g and _LAST[3] == rigid_contacts:

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from rockyade.constants import ACCEL_UNIT_LABELS
-from rockyade.figures.common import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
+from rockyade.figures.canvas import accel_scale, axes_list, figure_of, new_figure, other_accel_axis, save_figure
 
 
 def plot_accelerogram(

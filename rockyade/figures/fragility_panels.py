@@ -1,7 +1,7 @@
 """Fragility curves with their stripes: the one drawing of ``rockyade paper``'s fragility figure
 and of ``rockyade fragility`` / ``assess``.
 
-What is drawn is computed elsewhere (:func:`rockyade.probability.fragility.fit_lognormal`, the
+What is drawn is computed elsewhere (:func:`rockyade.probability.fragility_curves.fit_lognormal`, the
 stripes of :mod:`rockyade.assess.stripes`) and handed over in the figure's unit
 (:class:`FragilityCurve`: the fraction of records that collapse at each stripe, with or
 without its Wilson interval, the fitted curve, its bootstrap band). :class:`FragilityDisplay`
@@ -25,8 +25,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.common import figure_of, new_figure, save_figure
-from rockyade.probability.fragility import Fragility
+from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.probability.fragility_curves import Fragility
 
 #: How a missing curve shows in the legend: a red cross, its text red.
 MISSING_COLOUR = "#b2182b"

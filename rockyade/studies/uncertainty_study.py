@@ -140,7 +140,7 @@ class UncertaintyStudy:
 def _block_table(r: TableReader, base_dir: Path) -> tuple[dict[str, Any], dict[str, float]]:
     """(block table without alpha/p/mu, nominal alpha/p/mu)."""
     from rockyade.scene import load_scene, scene_from_dict
-    from rockyade.studies.specimens import block_table
+    from rockyade.studies.specimen_scenes import block_table
 
     if r.has("specimen"):
         key = str(r.raw("specimen"))
@@ -497,7 +497,7 @@ def _report(
         _write_csv(stage / "spread.csv", spread)
     fig_path = None
     if figure:
-        from rockyade.figures.uncertainty import plot_uncertainty
+        from rockyade.figures.uncertainty_bands import plot_uncertainty
 
         fig_path = out / "uncertainty.png"
         stage_png = stage / "uncertainty.png"

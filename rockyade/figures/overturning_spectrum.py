@@ -21,7 +21,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from rockyade.figures.common import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import figure_of, new_figure, save_figure
 from rockyade.figures.styles import SOLVER_STYLES
 
 #: The axes' labels (ratios: no unit, shown as (-)).

@@ -12,7 +12,7 @@ module knows no program.
   here as :mod:`rockyade.io.atomic` opens files (a new file under a random name, never
   through a link), and renamed onto the job's log when the job ends.
 * **Dies with its parent.** Its own session (a timeout kills its group) and
-  ``PR_SET_PDEATHSIG`` (:mod:`rockyade.io.lifetime`): the kernel kills it when the thread
+  ``PR_SET_PDEATHSIG`` (:mod:`rockyade.io.parent_death`): the kernel kills it when the thread
   that started it ends, however the process ends. Each thread therefore keeps its own
   worker per program (:func:`run_scene`); a thread that ends closes them; a forked child
   forgets its parent's.
@@ -51,7 +51,7 @@ from typing import IO, Any
 
 from rockyade.errors import InputError, os_error_message
 from rockyade.io.atomic import create_temporary, file_mode
-from rockyade.io.lifetime import child_dies_with_parent
+from rockyade.io.parent_death import child_dies_with_parent
 
 #: Seconds a worker has to stop after ``quit`` before it is killed.
 QUIT_WAIT_S = 5.0

@@ -30,9 +30,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rockyade.assess.fit import StripeFit, fit_stripes, stripe_table
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
+from rockyade.assess.stripe_fit import StripeFit, fit_stripes, stripe_table
 from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
@@ -51,7 +51,7 @@ from rockyade.runner.journal import Journal
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import Solver
-from rockyade.solvers.cost import duration_text
+from rockyade.solvers.cost_estimate import duration_text
 
 #: Default levels as multiples of the static collapse acceleration (module docstring).
 DEFAULT_FACTORS = tuple(float(2.0 ** (k / 2.0)) for k in range(7))
@@ -295,7 +295,7 @@ class FragilityResult:
     runs
         One row per run (:func:`rockyade.assess.stripes.runs_frame`).
     stripes
-        Per level (:func:`rockyade.assess.fit.stripe_table`), the level in SI and shown.
+        Per level (:func:`rockyade.assess.stripe_fit.stripe_table`), the level in SI and shown.
     fit
         The lognormal fit and its band.
     levels_added

@@ -69,7 +69,7 @@ import pandas as pd
 
 from rockyade.io.atomic import atomic_open, write_text
 from rockyade.result import Result
-from rockyade.studies.checks import CHECKS
+from rockyade.studies.verification_checks import CHECKS
 from rockyade.studies.verify_closed import (
     check_code,
     check_fragility_fit,
@@ -101,7 +101,7 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
 
 
 def _figure(check: str, results: dict[str, Result], path: Path) -> None:
-    from rockyade.figures.verify import plot_check
+    from rockyade.figures.verification_histories import plot_check
 
     plot_check(check, results, path)
 
@@ -140,7 +140,7 @@ def _index(table: pd.DataFrame, figures: dict[str, str]) -> str:
         "# rockyade verification report",
         "",
         f"{len(table)} quantities checked, {len(failed)} failed. Each check is described in "
-        "`rockyade.studies.verify` and docs/assemblies.md; `verify.csv` has every row.",
+        "`rockyade.studies.verification` and docs/assemblies.md; `verify.csv` has every row.",
         "",
     ]
     if len(failed):

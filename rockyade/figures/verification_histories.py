@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, new_figure, save_figure
 from rockyade.result import Result
 
 #: check -> (title, [(block in the DEM results or None for a single-block result, legend)])

@@ -35,10 +35,10 @@ from rockyade.figures.assembly import (
     _limits,
     _setup_axes,
 )
-from rockyade.figures.common import axes_list, new_figure, save_figure
+from rockyade.figures.canvas import axes_list, new_figure, save_figure
 from rockyade.limit.analysis import LimitResult
 from rockyade.limit.mechanism import point_velocity
-from rockyade.limit.report import plural
+from rockyade.limit.report_text import plural
 
 #: The largest vertex displacement drawn, as a fraction of the assembly's size.
 DISPLAY_FRACTION = 0.08

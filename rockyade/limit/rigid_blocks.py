@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from rockyade.blocks.geometry import polygon_section
 from rockyade.constants import G
 from rockyade.errors import InputError
-from rockyade.limit.contacts import PointContact, point_contacts
+from rockyade.limit.point_contacts import PointContact, point_contacts
 from rockyade.scene.carried import carried_on, load_mass_kg, loaded_mass_properties, residual_force
 from rockyade.scene.placement import TOUCH_TOL, placed_blocks, rest_contacts
 
@@ -107,7 +107,7 @@ class Interface:
 
 @dataclass(frozen=True)
 class Corner:
-    """A point contact with several ways to hold (:mod:`rockyade.limit.contacts`).
+    """A point contact with several ways to hold (:mod:`rockyade.limit.point_contacts`).
 
     Attributes
     ----------
@@ -155,7 +155,7 @@ class RigidBlockModel:
         The blocks' own masses, kg, and centroids, m (None: as ``masses_kg``, ``centroids_m``).
     corners
         Point contacts that can hold in more than one way (two corners meeting, one of them on a
-        fixed block or the base: :mod:`rockyade.limit.contacts`), each with its ways as
+        fixed block or the base: :mod:`rockyade.limit.point_contacts`), each with its ways as
         interfaces of zero length; :func:`rockyade.limit.admissible.solve_admissible` chooses.
         Point contacts with one way are among ``interfaces`` (kind "corner").
     """
@@ -368,7 +368,7 @@ def _outside(poly: NDArray[np.float64], point: NDArray[np.float64]) -> float:
 
 def _point_contacts(placed, polygons, fixed, rest) -> list[PointContact]:
     """The point contacts of the placed blocks where no joint of ``rest`` passes
-    (:func:`rockyade.limit.contacts.point_contacts`)."""
+    (:func:`rockyade.limit.point_contacts.point_contacts`)."""
     tol = TOUCH_TOL * max((b.size_m for b in placed), default=1.0)
     segments: dict[tuple[int, int], list[NDArray[np.float64]]] = {}
     for c in rest:
