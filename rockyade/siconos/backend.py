@@ -33,18 +33,10 @@ from pathlib import Path
 import numpy as np
 
 from rockyade import __version__
+from rockyade.dem import worker_result
 from rockyade.dem.model import DemModel
 from rockyade.dem.result_frames import worker_frame
 from rockyade.dem.worker_output import WorkerOutput
-from rockyade.dem.worker_result import (
-    energy_problem,
-    failed_partially,
-    incomplete_output,
-    last_error_line,
-    read_output,
-    shared_run_meta,
-    unstable,
-)
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
 from rockyade.io.warm_program import Program, keep_run_files, run_scene
@@ -248,16 +240,16 @@ def _parse(
     if reason is None and not out_file.is_file():
         reason = "Siconos wrote no output file"
     if reason is not None:
-        detail = last_error_line(log_file)
+        detail = worker_result.last_error_line(log_file)
         reason = f"{reason}: {detail}" if detail and detail not in reason else reason
         kept = None
         with contextlib.suppress(OSError, ValueError, KeyError, zipfile.BadZipFile):
-            kept = read_output(out_file)
+            kept = worker_result.read_output(out_file)
         if kept is not None:
             return _partial_failure(model, numerics, kept[0], kept[1], reason, total, extra)
         return failed_result("siconos", model.scene_hash, reason, wall_time_s=total, partial=False, **extra)
     try:
-        meta, arrays = read_output(out_file)
+        meta, arrays = worker_result.read_output(out_file)
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("siconos", model.scene_hash, f"unreadable Siconos output {out_file.name}: {exc}", **extra)
     problem = _output_problem(model, meta, arrays)
@@ -270,10 +262,10 @@ def _parse(
 
 def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result, or None."""
-    incomplete = incomplete_output(model, meta, arrays, "Siconos")
+    incomplete = worker_result.incomplete_output(model, meta, arrays, "Siconos")
     if incomplete is not None:
         return incomplete
-    if unstable(meta, arrays):
+    if worker_result.unstable(meta, arrays):
         why = meta.failure_reason or "non-finite state or runaway speed"
         return f"numerical instability in Siconos at t = {meta.stop_time_s} s ({why})"
     calls = meta.solver_calls
@@ -285,7 +277,7 @@ def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.nd
             f"first at t = {meta.first_unconverged_s} s); "
             "try a smaller dt_factor or more solver iterations"
         )
-    return energy_problem(model, arrays, "Siconos")
+    return worker_result.energy_problem(model, arrays, "Siconos")
 
 
 def _partial_failure(
@@ -304,7 +296,7 @@ def _partial_failure(
     arrays = {k: v[:n] for k, v in arrays.items()}
     frame = worker_frame(model, arrays, None)
     out = _run_meta(model, numerics, dataclasses.replace(meta, status="failed"), total, extra, arrays)
-    return Result(frame, RunMeta.from_dict(failed_partially(out, reason, n)))
+    return Result(frame, RunMeta.from_dict(worker_result.failed_partially(out, reason, n)))
 
 
 def _run_meta(
@@ -320,7 +312,7 @@ def _run_meta(
     return {
         "solver": "siconos",
         "version": f"{version_label(meta.version)}, rockyade {__version__} driver",
-        **shared_run_meta(model, meta, total, arrays),
+        **worker_result.shared_run_meta(model, meta, total, arrays),
         "n_steps": meta.steps,
         "solver_calls": calls,
         "solver_iterations": meta.solver_iterations,

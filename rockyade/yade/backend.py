@@ -45,18 +45,10 @@ import numpy as np
 
 from rockyade import __version__
 from rockyade.calibration.model_stage import calibrated_model
+from rockyade.dem import worker_result
 from rockyade.dem.model import DemModel
 from rockyade.dem.result_frames import energy_gain, worker_frame
 from rockyade.dem.worker_output import WorkerOutput
-from rockyade.dem.worker_result import (
-    energy_problem,
-    failed_partially,
-    incomplete_output,
-    last_error_line,
-    read_output,
-    shared_run_meta,
-    unstable,
-)
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_json, write_text
 from rockyade.io.warm_program import check_timeout as checked_timeout
@@ -228,17 +220,17 @@ def _parse(
     if reason is None and not out_file.is_file():
         reason = "YADE wrote no output file"
     if reason is not None:
-        detail = last_error_line(log_file)
+        detail = worker_result.last_error_line(log_file)
         reason = f"{reason}: {detail}" if detail else reason
         kept = None
         with contextlib.suppress(OSError, ValueError, KeyError, zipfile.BadZipFile):
-            kept = read_output(out_file)
+            kept = worker_result.read_output(out_file)
         if kept is not None:  # a timeout or a lost worker after a flush: the samples it wrote
             return _partial_failure(model, kept[0], kept[1], reason, total, extra)
         extra["wall_time_s"] = total
         return failed_result("yade", model.scene_hash, reason, **extra)
     try:
-        meta, arrays = read_output(out_file)
+        meta, arrays = worker_result.read_output(out_file)
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
     extra["max_polyhedra_penetration_over_radius"] = meta.max_polyhedra_penetration_over_radius
@@ -359,21 +351,21 @@ def _partial_failure(
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     out = _run_meta(model, dataclasses.replace(meta, status="failed"), total, extra, arrays)
-    return Result(frame, RunMeta.from_dict(failed_partially(out, reason, n)))
+    return Result(frame, RunMeta.from_dict(worker_result.failed_partially(out, reason, n)))
 
 
 def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result (partial, short, unstable, a lost
     contact normal), or None when it is one."""
-    incomplete = incomplete_output(model, meta, arrays, "YADE")
+    incomplete = worker_result.incomplete_output(model, meta, arrays, "YADE")
     if incomplete is not None:
         return incomplete
-    if unstable(meta, arrays):
+    if worker_result.unstable(meta, arrays):
         return (
             f"numerical instability in YADE at t = {meta.stop_time_s} s (non-finite state, runaway speed or "
             "spin, or a rotation between two records too large to follow)"
         )
-    blowup = energy_problem(model, arrays, "YADE")
+    blowup = worker_result.energy_problem(model, arrays, "YADE")
     if blowup is not None:
         return blowup
     if meta.max_polyhedra_penetration_over_radius >= 1.0:
@@ -388,7 +380,7 @@ def _run_meta(
     return {
         "solver": "yade",
         "version": f"YADE {meta.version} (rockyade {__version__} driver)",
-        **shared_run_meta(model, meta, total, arrays),
+        **worker_result.shared_run_meta(model, meta, total, arrays),
         "dt_s": meta.dt_s,
         "dt_source": model.dt_source,
         "n_steps": model.n_steps,
