@@ -297,15 +297,8 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
 
 
 def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n.
-
-    Parameters
-    ----------
-    k, n
-        Successes and trials (n > 0).
-    confidence
-        Two-sided level.
-    """
+    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n; parameters as
+    :func:`wilson_interval`."""
     _check_counts(k, n)
     a = 1.0 - confidence
     lo = 0.0 if k == 0 else float(stats.beta.ppf(a / 2, k, n - k + 1))
