@@ -435,7 +435,7 @@ def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
     import threading
 
     from rockyade.runner.stopping import StopRequest
-    from rockyade.runner.threads import run_threads
+    from rockyade.runner.threads import Batch, run_threads
 
     release = threading.Event()
     stop = StopRequest(raise_on_second=True)
@@ -449,7 +449,7 @@ def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
         return i
 
     with pytest.raises(KeyboardInterrupt):  # while job 0 still runs
-        run_threads([0, 1], job, 2, lambda i, v: None, None, stop, started)
+        run_threads(Batch([0, 1], job, lambda i, v: None, None, stop, started), 2)
     assert not release.is_set()
     release.set()
 

@@ -158,12 +158,7 @@ class _Columns:
 def block_states(scene: Scene, result: Result) -> tuple[NDArray[np.int8], list[BlockGeometry]]:
     """(n_samples, n_moving) state codes (see module docstring) and the blocks' geometry.
 
-    Parameters
-    ----------
-    scene
-        The scene that produced ``result`` (its blocks, bottom to top).
-    result
-        The run's Result (any solver)."""
+    Parameters as :func:`block_geometry`."""
     states, geometry, _ = _block_states(scene, result, _Columns(result))
     return states, geometry
 
@@ -338,12 +333,7 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
     ``residual_x_m``, ``residual_y_m``, ``rocking_time_s``, ``sliding_time_s``,
     ``final_state``. Times in s, angles in rad, displacements in m.
 
-    Parameters
-    ----------
-    scene
-        The scene that produced ``result`` (its blocks, bottom to top).
-    result
-        The run's Result (any solver).
+    Parameters as :func:`block_geometry`.
     """
     columns = _Columns(result)
     states, geometry, falls = _block_states(scene, result, columns)
@@ -378,12 +368,7 @@ def collapse_report(scene: Scene, result: Result) -> pd.DataFrame:
 def state_frame(scene: Scene, result: Result) -> pd.DataFrame:
     """The states as a DataFrame: ``t_s`` (s) and one categorical column per moving block.
 
-    Parameters
-    ----------
-    scene
-        The scene that produced ``result`` (its blocks, bottom to top).
-    result
-        The run's Result (any solver)."""
+    Parameters as :func:`block_geometry`."""
     states, geometry = block_states(scene, result)
     data: dict[str, object] = {"t_s": result.t}
     for j, g in enumerate(geometry):

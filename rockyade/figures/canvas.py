@@ -23,7 +23,15 @@ from rockyade.constants import ACCEL_UNIT_LABELS, ACCEL_UNITS
 from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open
 
-__all__ = ["accel_scale", "axes_list", "file_figure", "new_figure", "other_accel_axis", "save_figure"]
+__all__ = [
+    "accel_scale",
+    "axes_list",
+    "file_figure",
+    "new_figure",
+    "other_accel_axis",
+    "save_figure",
+    "single_axes",
+]
 
 
 def new_figure(path: str | Path | None = None, nrows: int = 1, ncols: int = 1, **subplots: Any) -> tuple[Figure, Any]:
@@ -67,6 +75,16 @@ def figure_of(ax: Axes) -> Figure:
     a SubFigure (only a Figure can be saved)."""
     fig = ax.figure
     return fig if isinstance(fig, Figure) else fig.figure
+
+
+def single_axes(ax: Axes | None, path: str | Path | None, figsize: tuple[float, float]) -> tuple[Figure, Axes]:
+    """The figure and axes a one-panel plot draws in: ``ax`` and its figure (:func:`figure_of`),
+    or, when ``ax`` is None, a new figure of ``figsize`` inches (:func:`new_figure`: for
+    ``path``, or pyplot's when None)."""
+    if ax is None:
+        fig, new = new_figure(path, figsize=figsize)
+        return fig, new
+    return figure_of(ax), ax
 
 
 def save_figure(fig: Figure, path: str | Path, dpi: int = 130) -> Path:

@@ -25,7 +25,7 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import save_figure, single_axes
 from rockyade.probability.fragility_curves import Fragility
 
 #: How a missing curve shows in the legend: a red cross, its text red.
@@ -155,10 +155,7 @@ class FragilityDisplay:
         figsize
             Size of a new figure, inches.
         """
-        if ax is None:
-            fig, ax = new_figure(path, figsize=figsize)
-        else:
-            fig = figure_of(ax)
+        fig, ax = single_axes(ax, path, figsize)
         grid = np.linspace(self.x_max / 400, self.x_max, 400)
         for curve in self.curves:
             _draw_curve(ax, curve, grid, self.x_max)

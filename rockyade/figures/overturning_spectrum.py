@@ -21,7 +21,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import save_figure, single_axes
 from rockyade.figures.styles import SOLVER_STYLES
 
 #: The axes' labels (ratios: no unit, shown as (-)).
@@ -109,10 +109,7 @@ class OverturningSpectrumDisplay:
         figsize
             Size of a new figure, inches.
         """
-        if ax is None:
-            fig, ax = new_figure(path, figsize=figsize)
-        else:
-            fig = figure_of(ax)
+        fig, ax = single_axes(ax, path, figsize)
         housner = SOLVER_STYLES["housner"]["color"]
         dem = SOLVER_STYLES["reference"]["color"]
         ax.scatter(

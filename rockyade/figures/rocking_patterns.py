@@ -17,7 +17,7 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 
-from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import save_figure, single_axes
 
 COLOURS = {
     "rest": "#eeeeee",
@@ -77,10 +77,7 @@ class PatternMapDisplay:
         path
             PNG to write (atomically); None writes nothing.
         """
-        if ax is None:
-            fig, ax = new_figure(path, figsize=(10.5, 6))
-        else:
-            fig = figure_of(ax)
+        fig, ax = single_axes(ax, path, (10.5, 6))
         f_index = {f: i for i, f in enumerate(self.frequencies_hz)}
         a_index = {a: j for j, a in enumerate(self.amplitudes_mm)}
         for _, row in self.cells.iterrows():

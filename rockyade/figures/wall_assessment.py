@@ -27,7 +27,7 @@ from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import VERIFIED
 from rockyade.assess.fragility_analysis import FragilityResult
 from rockyade.constants import CODE_GRAVITY as G
-from rockyade.figures.canvas import figure_of, new_figure, save_figure
+from rockyade.figures.canvas import new_figure, save_figure, single_axes
 from rockyade.figures.fragility_panels import FragilityCurve, FragilityDisplay, Mark
 from rockyade.probability.fragility_curves import Fragility
 
@@ -123,10 +123,7 @@ def _legend_below(ax: Axes, fontsize: float) -> None:
 
 def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
     """The code's capacity curve and demand (module docstring)."""
-    if ax is None:
-        fig, ax = new_figure(None, figsize=(6.4, 4.2))
-    else:
-        fig = figure_of(ax)
+    fig, ax = single_axes(ax, None, (6.4, 4.2))
     kin = a.limit.kinematic
     if kin is None:
         ax.text(0.5, 0.5, f"no mechanism ({a.limit.status})", ha="center", va="center", transform=ax.transAxes)

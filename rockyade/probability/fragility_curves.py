@@ -271,6 +271,12 @@ def fit_lognormal_points(im: ArrayLike, collapsed: ArrayLike) -> Fragility:
     return fit_lognormal(levels, n_collapse, n_total)
 
 
+def _check_counts(k: int, n: int) -> None:
+    """Refuse counts that are not a binomial sample: needs 0 <= k <= n and n > 0."""
+    if n <= 0 or k < 0 or k > n:
+        raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
+
+
 def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Wilson score interval of a binomial proportion k / n (Wilson 1927).
 
@@ -281,8 +287,7 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
     confidence
         Two-sided level.
     """
-    if n <= 0 or k < 0 or k > n:
-        raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
+    _check_counts(k, n)
     z = float(stats.norm.ppf(0.5 + confidence / 2.0))
     phat = k / n
     den = 1.0 + z * z / n
@@ -292,17 +297,9 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
 
 
 def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
-    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n.
-
-    Parameters
-    ----------
-    k, n
-        Successes and trials (n > 0).
-    confidence
-        Two-sided level.
-    """
-    if n <= 0 or k < 0 or k > n:
-        raise InputError("n", f"needs 0 <= k <= n and n > 0, got k = {k}, n = {n}")
+    """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n; parameters as
+    :func:`wilson_interval`."""
+    _check_counts(k, n)
     a = 1.0 - confidence
     lo = 0.0 if k == 0 else float(stats.beta.ppf(a / 2, k, n - k + 1))
     hi = 1.0 if k == n else float(stats.beta.ppf(1 - a / 2, k + 1, n - k))

@@ -11,13 +11,11 @@ from __future__ import annotations
 import queue
 import re
 import threading
-from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed, Job, Value, call
+from rockyade.runner.threads import Batch, Job, Value, call, failure_reason
 
 SCHEDULER_ADDRESS = re.compile(r"^(tcp|tls|ucx|inproc)://\S+$")
 
@@ -35,15 +33,7 @@ def check_scheduler(address: str) -> str:
     return address
 
 
-def run_dask_in_process(
-    jobs: Sequence[Job],
-    fn: Callable[[Job], Value],
-    workers: int,
-    done: Callable[[int, Value], None],
-    failed: Failed[Job, Value] | None,
-    stop: StopRequest,
-    started: set[int],
-) -> None:
+def run_dask_in_process(batch: Batch[Job, Value], workers: int) -> None:
     """Dask's threaded scheduler on ``workers`` threads of this process; a stop request makes
     the unstarted jobs return at once, unfinished."""
     try:
@@ -55,10 +45,10 @@ def run_dask_in_process(
     unfinished = object()
 
     def guarded(i: int) -> Any:
-        if stop.event.is_set():
+        if batch.stop.event.is_set():
             return unfinished
-        started.add(i)
-        return i, call(fn, jobs[i], failed)
+        batch.started.add(i)
+        return i, call(batch.fn, batch.jobs[i], batch.failed)
 
     finished: queue.Queue[Any] = queue.Queue()
     end = object()
@@ -78,7 +68,7 @@ def run_dask_in_process(
             finished.put(end)
 
     # the graph's arguments are positions: Dask never looks inside a job
-    graph = {f"run-{i}": (guarded, i) for i in range(len(jobs))}
+    graph = {f"run-{i}": (guarded, i) for i in range(len(batch.jobs))}
     pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="rockyade-dask")
     clean = False
     try:
@@ -92,12 +82,12 @@ def run_dask_in_process(
             try:
                 item = finished.get(timeout=0.1)
             except queue.Empty:
-                if stop.now:
+                if batch.stop.now:
                     raise KeyboardInterrupt from None
                 continue
             if item is end:
                 break
-            done(*item)
+            batch.done(*item)
         if errors:
             raise errors[0]
         clean = True
@@ -107,16 +97,7 @@ def run_dask_in_process(
         pool.shutdown(wait=clean, cancel_futures=True)
 
 
-def run_dask_remote(
-    jobs: Sequence[Job],
-    fn: Callable[[Job], Value],
-    scheduler: str,
-    timeout_s: float,
-    done: Callable[[int, Value], None],
-    failed: Failed[Job, Value] | None,
-    stop: StopRequest,
-    started: set[int],
-) -> None:
+def run_dask_remote(batch: Batch[Job, Value], scheduler: str, timeout_s: float) -> None:
     """A ``distributed`` cluster at ``scheduler``; Ctrl-C cancels what has not finished.
 
     Raises
@@ -139,25 +120,25 @@ def run_dask_remote(
             "scheduler", f"no Dask scheduler answered at {scheduler} within {timeout_s:g} s ({exc})"
         ) from None
     try:
-        futures = client.map(fn, list(jobs), pure=False)
+        futures = client.map(batch.fn, list(batch.jobs), pure=False)
         position = {future.key: i for i, future in enumerate(futures)}
-        started.update(range(len(jobs)))  # the cluster decides when: cancelled ones count as stopped
+        batch.started.update(range(len(batch.jobs)))  # the cluster decides when: cancelled ones count as stopped
         pending = dask_completed(futures)
         while not pending.is_empty():
-            batch = pending.next_batch(block=False)
-            for future in batch:
+            ready = pending.next_batch(block=False)
+            for future in ready:
                 i = position[future.key]
                 try:
                     value = future.result()
                 except Exception as exc:  # a worker lost, a value that does not pickle: this job fails
-                    if failed is None:
+                    if batch.failed is None:
                         raise
-                    value = failed(jobs[i], f"{type(exc).__name__}: {exc}")
-                done(i, value)
-            if stop.requested:
+                    value = batch.failed(batch.jobs[i], failure_reason(exc))
+                batch.done(i, value)
+            if batch.stop.requested:
                 client.cancel([f for f in futures if not f.done()])
                 break
-            if not batch:
-                stop.event.wait(0.1)
+            if not ready:
+                batch.stop.event.wait(0.1)
     finally:
         client.close()

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 from rockyade.errors import InputError
 from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed, Job, Value
+from rockyade.runner.threads import Batch, Failed, Job, Value
 
 EXECUTORS = ("threads", "local", "dask")
 MAX_WORKERS = 1024
@@ -76,22 +76,23 @@ class Executor:
         """Run ``fn(job)`` for each job; ``done(position, value)`` as each ends (in this
         thread). A job that raises, or whose worker dies, gets ``failed(job, reason)`` (None:
         the error is raised here)."""
+        batch = Batch(jobs, fn, done, failed, stop, started)
         if self.kind == "threads":
             from rockyade.runner.threads import run_threads
 
-            run_threads(jobs, fn, self.workers, done, failed, stop, started)
+            run_threads(batch, self.workers)
         elif self.kind == "local":
             from rockyade.runner.local import run_local
 
-            run_local(jobs, fn, self.workers, done, failed, stop, started)
+            run_local(batch, self.workers)
         elif self.scheduler:
             from rockyade.runner.dask_executor import run_dask_remote
 
-            run_dask_remote(jobs, fn, self.scheduler, self.scheduler_timeout_s, done, failed, stop, started)
+            run_dask_remote(batch, self.scheduler, self.scheduler_timeout_s)
         else:
             from rockyade.runner.dask_executor import run_dask_in_process
 
-            run_dask_in_process(jobs, fn, self.workers, done, failed, stop, started)
+            run_dask_in_process(batch, self.workers)
 
 
 #: One job after the other in the calling thread.

@@ -9,42 +9,32 @@ jobs go on.
 from __future__ import annotations
 
 import collections
-from collections.abc import Callable, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, wait
 from concurrent.futures.process import BrokenProcessPool
 
-from rockyade.runner.stopping import StopRequest
-from rockyade.runner.threads import Failed, Job, Value
+from rockyade.runner.threads import Batch, Job, Value, failure_reason
 from rockyade.runner.workers import kill_workers, new_pool, replace_pool
 
 WORKER_DIED = "the worker process died (killed, or out of memory)"
 
 
-def run_local(
-    jobs: Sequence[Job],
-    fn: Callable[[Job], Value],
-    workers: int,
-    done: Callable[[int, Value], None],
-    failed: Failed[Job, Value] | None,
-    stop: StopRequest,
-    started: set[int],
-) -> None:
+def run_local(batch: Batch[Job, Value], workers: int) -> None:
     """Run ``fn(job)`` for every job on ``workers`` processes; ``done(i, value)`` as each ends.
 
     ``fn`` and the jobs must pickle. Returns when every job ended, or when a stop request
     left the others unstarted (or, after a second Ctrl-C, stopped).
     """
-    pending = collections.deque(range(len(jobs)))
+    pending = collections.deque(range(len(batch.jobs)))
     running: dict[Future[Value], int] = {}
     pool = new_pool(workers)
     killed = False
     try:
         while pending or running:
-            while pending and len(running) < workers and not stop.requested:
+            while pending and len(running) < workers and not batch.stop.requested:
                 i = pending.popleft()
                 try:
-                    running[pool.submit(fn, jobs[i])] = i
-                    started.add(i)
+                    running[pool.submit(batch.fn, batch.jobs[i])] = i
+                    batch.started.add(i)
                 except BrokenProcessPool:
                     pending.appendleft(i)
                     pool = replace_pool(pool, workers)
@@ -57,19 +47,21 @@ def run_local(
                 try:
                     value = future.result()
                 except Exception as exc:  # a dead worker, a value that does not pickle: this job fails
-                    if failed is None:
+                    if batch.failed is None:
                         raise
                     broken = broken or isinstance(exc, BrokenProcessPool)
-                    value = failed(jobs[i], WORKER_DIED if isinstance(exc, BrokenProcessPool) else _reason(exc))
-                done(i, value)
-            if stop.now:
+                    value = batch.failed(
+                        batch.jobs[i], WORKER_DIED if isinstance(exc, BrokenProcessPool) else failure_reason(exc)
+                    )
+                batch.done(i, value)
+            if batch.stop.now:
                 kill_workers(pool)
                 killed = True
                 break
-            if broken and failed is not None:  # the pool broke: its other running jobs are lost too
+            if broken and batch.failed is not None:  # the pool broke: its other running jobs are lost too
                 for future, i in list(running.items()):
                     running.pop(future)
-                    done(i, failed(jobs[i], WORKER_DIED))
+                    batch.done(i, batch.failed(batch.jobs[i], WORKER_DIED))
                 pool = replace_pool(pool, workers)
     except BaseException:
         kill_workers(pool)
@@ -77,7 +69,3 @@ def run_local(
         raise
     finally:
         pool.shutdown(wait=not killed, cancel_futures=True)
-
-
-def _reason(exc: BaseException) -> str:
-    return f"{type(exc).__name__}: {exc}"

@@ -33,9 +33,9 @@ from pathlib import Path
 import numpy as np
 
 from rockyade import __version__
+from rockyade.dem import worker_result
 from rockyade.dem.model import DemModel
-from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
-from rockyade.dem.result_frames import energy_gain, worker_frame
+from rockyade.dem.result_frames import worker_frame
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import SolverUnavailableError, os_error_message
 from rockyade.io.atomic import write_text
@@ -226,24 +226,6 @@ def run_model(
     return result
 
 
-def _last_error_line(log_file: Path) -> str:
-    try:
-        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
-    except OSError:
-        return ""
-    for line in reversed(lines):
-        if "Error" in line or "Exception" in line:
-            return line
-    return ""
-
-
-def _read_output(out_file: Path) -> tuple[WorkerOutput, dict[str, np.ndarray]]:
-    with np.load(out_file, allow_pickle=False) as data:
-        meta = WorkerOutput.from_json(str(data["meta"]))
-        arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
-    return meta, arrays
-
-
 def _parse(
     model: DemModel,
     numerics: Numerics,
@@ -258,16 +240,16 @@ def _parse(
     if reason is None and not out_file.is_file():
         reason = "Siconos wrote no output file"
     if reason is not None:
-        detail = _last_error_line(log_file)
+        detail = worker_result.last_error_line(log_file)
         reason = f"{reason}: {detail}" if detail and detail not in reason else reason
         kept = None
         with contextlib.suppress(OSError, ValueError, KeyError, zipfile.BadZipFile):
-            kept = _read_output(out_file)
+            kept = worker_result.read_output(out_file)
         if kept is not None:
             return _partial_failure(model, numerics, kept[0], kept[1], reason, total, extra)
         return failed_result("siconos", model.scene_hash, reason, wall_time_s=total, partial=False, **extra)
     try:
-        meta, arrays = _read_output(out_file)
+        meta, arrays = worker_result.read_output(out_file)
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("siconos", model.scene_hash, f"unreadable Siconos output {out_file.name}: {exc}", **extra)
     problem = _output_problem(model, meta, arrays)
@@ -280,13 +262,10 @@ def _parse(
 
 def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result, or None."""
-    n = meta.n_filled
-    if not meta.complete or arrays["pos"].shape[0] != n:
-        return "partial Siconos output"
-    status = meta.status
-    if status == "completed" and n != model.n_samples:
-        return f"Siconos stopped early: {n} of {model.n_samples} samples"
-    if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
+    incomplete = worker_result.incomplete_output(model, meta, arrays, "Siconos")
+    if incomplete is not None:
+        return incomplete
+    if worker_result.unstable(meta, arrays):
         why = meta.failure_reason or "non-finite state or runaway speed"
         return f"numerical instability in Siconos at t = {meta.stop_time_s} s ({why})"
     calls = meta.solver_calls
@@ -298,12 +277,7 @@ def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.nd
             f"first at t = {meta.first_unconverged_s} s); "
             "try a smaller dt_factor or more solver iterations"
         )
-    gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
-    if t_blowup is not None:
-        return (
-            f"numerical instability in Siconos at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
-        )
-    return None
+    return worker_result.energy_problem(model, arrays, "Siconos")
 
 
 def _partial_failure(
@@ -322,15 +296,7 @@ def _partial_failure(
     arrays = {k: v[:n] for k, v in arrays.items()}
     frame = worker_frame(model, arrays, None)
     out = _run_meta(model, numerics, dataclasses.replace(meta, status="failed"), total, extra, arrays)
-    out.update(
-        status="failed",
-        failure_reason=reason,
-        overturn_time_s=None,
-        overturned_block=None,
-        partial=True,
-        partial_samples=n,
-    )
-    return Result(frame, RunMeta.from_dict(out))
+    return Result(frame, RunMeta.from_dict(worker_result.failed_partially(out, reason, n)))
 
 
 def _run_meta(
@@ -342,32 +308,12 @@ def _run_meta(
     arrays: dict[str, np.ndarray],
 ) -> dict[str, object]:
     """The Result's metadata: how the run ended, what ran, and Siconos's own diagnostics."""
-    names = model.names
-    status = meta.status
-    overturn_times = {names[int(i)]: t for i, t in meta.overturn_times_s.items()}
-    overturn_time = meta.stop_time_s if status == "overturned" else None
-    overturned_block = names[meta.stop_body] if status == "overturned" and meta.stop_body is not None else None
-    if not model.stop_on_overturn and status == "completed":
-        t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
-        falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
-        status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     calls = meta.solver_calls
     return {
         "solver": "siconos",
         "version": f"{version_label(meta.version)}, rockyade {__version__} driver",
-        "scene_hash": model.scene_hash,
-        "wall_time_s": meta.wall_time_s,
-        "startup_time_s": total - meta.wall_time_s if meta.wall_time_s is not None else None,
-        "status": status,
-        "overturn_time_s": overturn_time,
-        "overturned_block": overturned_block,
-        "overturn_criterion": CRITERION,
-        "overturn_times_s": overturn_times,
-        "blocks": names,
-        "sample_dt_s": model.sample_dt_s,
-        "duration_s": model.duration_s,
+        **worker_result.shared_run_meta(model, meta, total, arrays),
         "n_steps": meta.steps,
-        "iterations": meta.steps,
         "solver_calls": calls,
         "solver_iterations": meta.solver_iterations,
         "solver_iterations_mean": (meta.solver_iterations / calls) if calls else 0.0,
@@ -382,8 +328,6 @@ def _run_meta(
         "max_bullet_overlap_m": meta.max_bullet_overlap_m,
         "calibration": "siconos (nonsmooth: Newton restitution e, Coulomb friction; geometry and inertia as the DEMs)",
         "mu_model": {b.name: model_restitution(b) for b in model.bodies if not b.fixed},
-        "bodies": model.body_summary(),
-        "motion": model.motion_label,
         "process_cpu_s": meta.process_cpu_s,
         **extra,
     }

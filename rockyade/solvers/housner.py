@@ -52,6 +52,18 @@ class HousnerSolver(SolverBase):
         """The largest Runge-Kutta step, s: ``dt_factor`` / (``STEPS_PER_RADIAN`` p)."""
         return self.dt_factor / (STEPS_PER_RADIAN * max(model.p_left, model.p_right))
 
+    def _solve(self, scene: Scene, model: HousnerModel, motion: GroundMotion | None) -> Trajectory:
+        """The block's response to ``motion`` from the scene's start, sampled as it asks."""
+        return solve(
+            model,
+            motion,
+            scene.duration_s,
+            scene.motion.initial_theta_rad,
+            scene.motion.initial_omega_rad_s,
+            scene.sample_dt_s,
+            self._step_s(model),
+        )
+
     def run(self, scene: Scene) -> Result:
         """Solve a single-block scene with Housner's equation and return a Result.
 
@@ -74,15 +86,7 @@ class HousnerSolver(SolverBase):
         motion = scene.motion.ground_motion(scene.duration_s)
         warm_up()
         start = time.perf_counter()
-        traj = solve(
-            model,
-            motion,
-            scene.duration_s,
-            scene.motion.initial_theta_rad,
-            scene.motion.initial_omega_rad_s,
-            scene.sample_dt_s,
-            self._step_s(model),
-        )
+        traj = self._solve(scene, model, motion)
         wall = time.perf_counter() - start
         frame = housner_frame(scene, spec.block(), model, motion, traj)
         return Result(frame, _meta(scene, cp, motion, traj, wall, self.dt_factor))
@@ -141,15 +145,7 @@ class HousnerSolver(SolverBase):
         for scene in scenes:
             motion = scene.motion.ground_motion(scene.duration_s)
             begin = time.perf_counter()
-            traj = solve(
-                model,
-                motion,
-                scene.duration_s,
-                scene.motion.initial_theta_rad,
-                scene.motion.initial_omega_rad_s,
-                scene.sample_dt_s,
-                self._step_s(model),
-            )
+            traj = self._solve(scene, model, motion)
             wall = time.perf_counter() - begin
             meta = _meta(scene, cp, motion, traj, wall, self.dt_factor).with_extra(
                 batched={"runs": len(scenes), "setup_time_s": setup}

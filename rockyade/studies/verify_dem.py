@@ -128,11 +128,7 @@ def check_drums(
     rate_g_per_s, duration_s
         The ramp's rise, g/s, and its length, s (the monolith runs the same ramp).
 
-    Returns
-    -------
-    rows, results
-        One :class:`Row` per solver and quantity (value, expected value, tolerance, pass),
-        and the Results the figures are drawn from, by solver.
+    Returns as :func:`check_frame`.
     """
     rate, duration = rate_g_per_s * G, duration_s
     motion = {"type": "sampled", "t_s": [0.0, duration], "accel_m_s2": [0.0, rate * duration]}
@@ -230,16 +226,7 @@ def check_pad(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """A block above a pad on a lower block under a pulse: no overlap beyond 1 mm (module
     docstring, ``pad``).
 
-    Parameters
-    ----------
-    solvers
-        Names of the solvers to check (e.g. ``["reference", "yade"]``).
-
-    Returns
-    -------
-    rows, results
-        One :class:`Row` per solver and quantity (value, expected value, tolerance, pass),
-        and the Results the figures are drawn from, by solver.
+    Parameters and returns as :func:`check_frame` (solvers by name).
     """
     scene = pad_scene()
     rows, results = [], {}
@@ -338,16 +325,7 @@ def check_agreement(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     (rad) within 5 %, peak displacement (m) within 10 % or the DEMs' own changes at half the
     time step (module docstring, ``agreement``); nothing unless both solvers are given.
 
-    Parameters
-    ----------
-    solvers
-        Names of the solvers to check (e.g. ``["reference", "yade"]``).
-
-    Returns
-    -------
-    rows, results
-        One :class:`Row` per solver and quantity (value, expected value, tolerance, pass),
-        and the Results the figures are drawn from, by solver.
+    Parameters and returns as :func:`check_frame` (solvers by name).
     """
     if not {"reference", "yade"} <= set(solvers):
         return [], {}
@@ -402,16 +380,7 @@ def check_baseline(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     (``data/baseline_0_1.csv``): first five peaks (rad) within 1 %, mu_eff within 0.2 %
     (module docstring, ``baseline``).
 
-    Parameters
-    ----------
-    solvers
-        Names of the solvers to check (e.g. ``["reference", "yade"]``).
-
-    Returns
-    -------
-    rows, results
-        One :class:`Row` per solver and quantity (value, expected value, tolerance, pass),
-        and the Results the figures are drawn from, by solver.
+    Parameters and returns as :func:`check_frame` (solvers by name).
     """
     data = resources.files("rockyade.studies").joinpath("data")
     base = pd.read_csv(io.StringIO(data.joinpath("baseline_0_1.csv").read_text()), comment="#")

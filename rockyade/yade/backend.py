@@ -45,8 +45,8 @@ import numpy as np
 
 from rockyade import __version__
 from rockyade.calibration.model_stage import calibrated_model
+from rockyade.dem import worker_result
 from rockyade.dem.model import DemModel
-from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.dem.result_frames import energy_gain, worker_frame
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import InputError, SolverUnavailableError, os_error_message
@@ -194,18 +194,6 @@ def _command() -> list[str]:
     return [YADE_PYTHON, str(DRIVER)]
 
 
-def _last_error_line(log_file: Path) -> str:
-    """The last error line of YADE's log ("" when it has none: a banner is not a reason)."""
-    try:
-        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
-    except OSError:
-        return ""
-    for line in reversed(lines):
-        if "Error" in line or "Exception" in line:
-            return line
-    return ""
-
-
 def _parse(
     model: DemModel,
     out_file: Path,
@@ -232,17 +220,17 @@ def _parse(
     if reason is None and not out_file.is_file():
         reason = "YADE wrote no output file"
     if reason is not None:
-        detail = _last_error_line(log_file)
+        detail = worker_result.last_error_line(log_file)
         reason = f"{reason}: {detail}" if detail else reason
         kept = None
         with contextlib.suppress(OSError, ValueError, KeyError, zipfile.BadZipFile):
-            kept = _read_output(out_file)
+            kept = worker_result.read_output(out_file)
         if kept is not None:  # a timeout or a lost worker after a flush: the samples it wrote
             return _partial_failure(model, kept[0], kept[1], reason, total, extra)
         extra["wall_time_s"] = total
         return failed_result("yade", model.scene_hash, reason, **extra)
     try:
-        meta, arrays = _read_output(out_file)
+        meta, arrays = worker_result.read_output(out_file)
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
         return failed_result("yade", model.scene_hash, f"unreadable YADE output {out_file.name}: {exc}", **extra)
     extra["max_polyhedra_penetration_over_radius"] = meta.max_polyhedra_penetration_over_radius
@@ -256,20 +244,6 @@ def _parse(
     if problem is not None:
         return _partial_failure(model, meta, arrays, problem, total, extra)
     return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(_run_meta(model, meta, total, extra, arrays)))
-
-
-def _read_output(out_file: Path) -> tuple[WorkerOutput, dict[str, np.ndarray]]:
-    """The driver's output: its metadata and arrays.
-
-    Raises
-    ------
-    OSError, ValueError, KeyError, zipfile.BadZipFile
-        A missing or unreadable file.
-    """
-    with np.load(out_file, allow_pickle=False) as data:
-        meta = WorkerOutput.from_json(str(data["meta"]))
-        arrays = {k: data[k] for k in ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")}
-    return meta, arrays
 
 
 #: Why a run with a deep sphere-polyhedron overlap fails (when it is not part of a collapse).
@@ -377,34 +351,23 @@ def _partial_failure(
     except (ValueError, FloatingPointError):  # samples too broken to derive accelerations
         return failed_result("yade", model.scene_hash, reason, partial=True, **extra)
     out = _run_meta(model, dataclasses.replace(meta, status="failed"), total, extra, arrays)
-    out.update(
-        status="failed",
-        failure_reason=reason,
-        overturn_time_s=None,
-        overturned_block=None,
-        partial=True,
-        partial_samples=n,
-    )
-    return Result(frame, RunMeta.from_dict(out))
+    return Result(frame, RunMeta.from_dict(worker_result.failed_partially(out, reason, n)))
 
 
 def _output_problem(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> str | None:
     """Why a complete-looking output is not a result (partial, short, unstable, a lost
     contact normal), or None when it is one."""
-    n = meta.n_filled
-    if not meta.complete or arrays["pos"].shape[0] != n:
-        return "partial YADE output"
-    status = meta.status
-    if status == "completed" and n != model.n_samples:
-        return f"YADE stopped early: {n} of {model.n_samples} samples"
-    if status == "failed" or not np.all(np.isfinite(arrays["pos"])):
+    incomplete = worker_result.incomplete_output(model, meta, arrays, "YADE")
+    if incomplete is not None:
+        return incomplete
+    if worker_result.unstable(meta, arrays):
         return (
             f"numerical instability in YADE at t = {meta.stop_time_s} s (non-finite state, runaway speed or "
             "spin, or a rotation between two records too large to follow)"
         )
-    gain, t_blowup = energy_gain(model, arrays["pos"], arrays["ang"], arrays["angvel"])
-    if t_blowup is not None:
-        return f"numerical instability in YADE at t = {t_blowup:.6g} s (energy created: {gain:.3g} x weight x height)"
+    blowup = worker_result.energy_problem(model, arrays, "YADE")
+    if blowup is not None:
+        return blowup
     if meta.max_polyhedra_penetration_over_radius >= 1.0:
         return DEEP_OVERLAP
     return None
@@ -414,37 +377,15 @@ def _run_meta(
     model: DemModel, meta: WorkerOutput, total: float, extra: dict[str, object], arrays: dict[str, np.ndarray]
 ) -> dict[str, object]:
     """The Result's metadata: how the run ended (overturns per block) and what ran."""
-    names = model.names
-    status = meta.status
-    overturn_times = {names[int(i)]: t for i, t in meta.overturn_times_s.items()}
-    overturn_time = meta.stop_time_s if status == "overturned" else None
-    overturned_block = names[meta.stop_body] if status == "overturned" and meta.stop_body is not None else None
-    if not model.stop_on_overturn and status == "completed":  # an assembly: the collapse table's rule
-        t = np.arange(arrays["ang"].shape[0], dtype=float) * model.sample_dt_s
-        falls = body_falls(model.bodies, t, arrays["pos"], arrays["ang"], overturn_times)
-        status, overturn_time, overturned_block = run_outcome(overturn_times, names, falls, t)
     return {
         "solver": "yade",
         "version": f"YADE {meta.version} (rockyade {__version__} driver)",
-        "scene_hash": model.scene_hash,
-        "wall_time_s": meta.wall_time_s,
-        "startup_time_s": total - meta.wall_time_s if meta.wall_time_s is not None else None,
-        "status": status,
-        "overturn_time_s": overturn_time,
-        "overturned_block": overturned_block,
-        "overturn_criterion": CRITERION,
-        "overturn_times_s": overturn_times,
-        "blocks": names,
-        "sample_dt_s": model.sample_dt_s,
-        "duration_s": model.duration_s,
+        **worker_result.shared_run_meta(model, meta, total, arrays),
         "dt_s": meta.dt_s,
         "dt_source": model.dt_source,
         "n_steps": model.n_steps,
-        "iterations": meta.steps,
         "calibration": model.calibration,
         "contact": model.joint_summary(),
-        "bodies": model.body_summary(),
-        "motion": model.motion_label,
         **extra,
     }
 
