@@ -14,6 +14,7 @@ import pytest
 
 from rockyade.analysis.crosscheck import (
     ABOVE,
+    ALL_FAILED,
     BRACKETED,
     MAX_EXTENSIONS,
     collapse_summary,
@@ -274,7 +275,7 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
     real_write = cc.run_study_tasks
 
     def watch(tasks, *args, **kwargs):  # every run the resumed study makes
-        written.extend(str(t.scene_hash) + t.solver.name + str(t.out_dir) for t in tasks)
+        written.extend(str(t.scene_hash) + repr(t.solver) for t in tasks)
         return real_write(tasks, *args, **kwargs)
 
     monkeypatch.setattr(cc, "run_study_tasks", watch)
@@ -632,6 +633,7 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     )
     out = capsys.readouterr().out
     assert code == 0 and "verdict: same outcome" in out
+    assert "cost: 4 run(s), about" in out and "housner at dt x 0.25" in out  # before any run
     assert (tmp_path / "c" / "specimen1_record_housner_halfdt.json").is_file()
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
@@ -755,3 +757,99 @@ def test_paper_part_runs_siconos_on_a_subset_it_can_run():
     chosen = pc.specimen_scene(job.specimen, job.calibration)
     check_target_mu(chosen, solver.model(chosen))
     assert [j.solvers for j in pc.jobs(use_yade=True)[0] if "yade" in j.solvers] == [("reference", "yade")]
+
+
+# ---------------------------------------------------------------------- refused up front
+
+
+def test_a_scene_a_solver_refuses_is_refused_before_any_run(records, tmp_path, capsys):
+    """Specimen 1's matched mu 0.936 is beyond Siconos's reach: one line naming the field and
+    the solver, exit 2, before any run and with no --out written (before, every Housner run
+    ran, every Siconos run failed and a set with an "inconclusive" verdict replaced --out)."""
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--solvers",
+        "housner,siconos",
+        "--levels",
+        "0.3,0.6",
+        "--resolution",
+        "0.5",
+        "--dt-factors",
+        "1",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "contact.calibration" in err[0] and "siconos" in err[0], err
+    assert "cost:" not in captured.out and not (tmp_path / "o").exists()
+
+
+def test_runs_that_failed_are_said_and_a_pair_whose_solver_always_failed_says_so(plan):
+    """Outcomes where the reference DEM failed every run: the pair's verdict says so with the
+    reason (not "inconclusive"), its searches say "every run failed" (not "no runs") and
+    index.md counts the failures per solver with their first reasons."""
+    from rockyade.studies.crosscheck import Outcomes
+    from rockyade.studies.crosscheck_report import index_text, summarise
+
+    outcomes = Outcomes()
+    low, high = plan.scan_si[0], plan.scan_si[1]
+    for f in plan.dt_factors:
+        for i in plan.records_of("housner"):
+            outcomes.add(("housner", f, i), low, {"status": "completed", "run": "a"}, False)
+            outcomes.add(("housner", f, i), high, {"status": "overturned", "run": "b"}, True)
+            for level in (low, high):
+                row = {"status": "failed", "failure_reason": "InputError: contact.calibration: out of reach"}
+                outcomes.add(("reference", f, i), level, row, None)
+    summary = summarise(plan, outcomes, partial=False)
+    assert all("reference failed every run (4 of 4; first reason: InputError" in v for v in summary.verdicts)
+    assert "inconclusive" not in " ".join(summary.verdicts)
+    mine = summary.collapse[summary.collapse.solver == "reference"]
+    assert set(mine.status) == {ALL_FAILED} and (mine.failed_runs == mine.runs).all()
+    index = index_text(plan, summary, 1.0)
+    assert "## Failed runs" in index and "8 of 16 runs failed" in index
+    assert "- reference at dt x 1: 4 of 4 runs failed (every run); first reasons: InputError" in index
+    assert "housner at dt x" not in index.split("## Failed runs")[1].split("##")[0]
+
+
+def test_a_study_expected_to_take_hours_is_refused_naming_allow_large(records, tmp_path, capsys):
+    """dt x 0.001 makes Siconos's runs hours long: refused before any run, on the run's
+    estimated time (one run) or the study's expected time (all of them), naming --allow-large."""
+    from rockyade.runner.cost import MAX_STUDY_S, check_study_time
+
+    scene = tmp_path / "paper.toml"
+    text = (EXAMPLES / "specimen1_record.toml").read_text().replace('"matched"', '"paper"')
+    scene.write_text(text.replace("records/", str(EXAMPLES / "records") + "/"))
+    argv = ["crosscheck", str(scene), "--records", str(records), "--solvers", "housner,siconos"]
+    argv += ["--levels", "0.3,0.6", "--resolution", "0.5", "--out", str(tmp_path / "o"), "--quiet"]
+    assert cli(*argv, "--dt-factors", "1,0.001") == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "--allow-large" in err[0] and "siconos" in err[0], err
+    assert "round 1" not in captured.out and not (tmp_path / "o").exists()
+    with pytest.raises(InputError, match="expected to take about 9 h on 2 worker"):
+        check_study_time(9 * 3600.0, "the cross-check", 2)
+    check_study_time(MAX_STUDY_S, "the cross-check", 2)  # at the limit: runs
+
+
+def test_compare_prints_its_cost_and_refuses_hours(tmp_path, capsys):
+    """``rockyade compare --dt-factor 0.001`` with Siconos: refused before any run (exit 2, one
+    line naming --allow-large); before, it printed no cost and ran for minutes."""
+    code = cli(
+        "compare",
+        str(EXAMPLES / "specimen1_free.toml"),
+        "--solvers",
+        "housner,siconos",
+        "--dt-factor",
+        "0.001",
+        "--out",
+        str(tmp_path / "c"),
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--allow-large" in err[0] and "siconos" in err[0], err
+    assert not (tmp_path / "c").exists()
+

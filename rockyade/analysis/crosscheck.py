@@ -50,11 +50,12 @@ MIN_RECORDS = 5
 ADVISED_RECORDS = 10
 
 #: Status of a collapse search.
-BRACKETED, ABOVE, BELOW, NO_RUNS = (
+BRACKETED, ABOVE, BELOW, NO_RUNS, ALL_FAILED = (
     "bracketed",
     "no collapse up to the top level",
     "collapsed at the lowest level",
-    ("no runs"),
+    "no runs",
+    "every run failed",
 )
 
 
@@ -146,7 +147,8 @@ class CollapseSearch:
         Of the scan's levels above the scan's first collapse, the fraction that stood (NaN
         with none).
     status
-        :data:`BRACKETED`, :data:`ABOVE`, :data:`BELOW` or :data:`NO_RUNS`.
+        :data:`BRACKETED`, :data:`ABOVE`, :data:`BELOW`, :data:`NO_RUNS` (none made) or
+        :data:`ALL_FAILED` (runs made, none with a verdict).
     runs, failed
         Runs of the search, and those that failed (no verdict).
     """
@@ -173,7 +175,8 @@ def collapse_summary(outcomes: Mapping[float, bool | None], scan: Sequence[float
     known = _known(outcomes)
     failed = sum(1 for v in outcomes.values() if v is None)
     if not known:
-        return CollapseSearch(math.nan, math.nan, math.nan, math.nan, NO_RUNS, len(outcomes), failed)
+        status = ALL_FAILED if outcomes else NO_RUNS
+        return CollapseSearch(math.nan, math.nan, math.nan, math.nan, status, len(outcomes), failed)
     collapses = [level for level, c in known if c]
     if not collapses:
         return CollapseSearch(math.nan, known[-1][0], math.nan, math.nan, ABOVE, len(outcomes), failed)
@@ -347,6 +350,7 @@ def pair_verdict(
 
 __all__ = [
     "ABOVE",
+    "ALL_FAILED",
     "BELOW",
     "BRACKETED",
     "NO_RUNS",

@@ -78,6 +78,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
         tail_s=args.tail,
         progress=not args.quiet,
         allow_large=args.allow_large,
+        workers=args.workers,
     )
     print(f"crosscheck of {args.scene}: {', '.join(names)} over {motions.describe()}", flush=True)
     print(

@@ -54,10 +54,11 @@ from rockyade.io.folders import output_folder
 from rockyade.io.locking import output_lock
 from rockyade.io.resultset import replacing_set, settle
 from rockyade.runner import Executor
+from rockyade.runner.cost import check_cost, check_study_time
 from rockyade.runner.journal import IDENTITY_FILE, Journal, read_run
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import Solver, check_scene
 from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 
 #: Time-step factors by default: the solver's own step, and half of it (convergence).
@@ -183,16 +184,54 @@ class CrosscheckPlan:
             seconds += WARM_UP_S if kernels_cached(len(self.scene.blocks) == 1) else COMPILE_S
         return seconds
 
-    def cost_line(self, workers: int) -> str:
-        """The study's expected runs and time, before anything runs."""
+    def heaviest_scene(self) -> Scene:
+        """The run the study's estimates take for every run: the longest record at the top level."""
         plan = self.stripes.stripes
         longest = int(np.argmax(plan.durations_s))
-        top = max(self.scan_si)
-        scene = plan.scene_for(longest, plan.load_factor(longest, top))
+        return plan.scene_for(longest, plan.load_factor(longest, max(self.scan_si)))
+
+    def run_seconds(self) -> float:
+        """The solvers' estimates summed over the expected runs, s (one worker, no start-up)."""
+        scene = self.heaviest_scene()
         per_search = self.expected_runs() / max(1, len(self.searches()))
         seconds = 0.0
         for s, f, _i in self.searches():
             seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
+        return seconds
+
+    def expected_seconds(self, workers: int) -> float:
+        """The study's expected wall time on ``workers`` workers of an idle machine, s."""
+        return self.run_seconds() / max(1, workers) + self.startup_s()
+
+    def check(self, workers: int, allow_large: bool = False) -> None:
+        """Before anything runs: each solver checks the scene (:meth:`SolverBase.check_scene`:
+        what its runs would refuse, e.g. a mu Siconos cannot reach) and the heaviest run's cost
+        (:func:`rockyade.runner.cost.check_cost`), and the study's expected time is held to
+        :data:`rockyade.runner.cost.MAX_STUDY_S` (``allow_large`` lifts the cost limits).
+
+        Raises
+        ------
+        InputError
+            A solver refusing the scene (its own field, the solver named), a run or the study
+            above the cost limits.
+        """
+        scene = self.heaviest_scene()
+        for name in self.solvers:
+            try:
+                check_scene(self.solver(name, 1.0), self.scene)
+            except InputError as exc:
+                if name in exc.message:
+                    raise
+                raise InputError(exc.field, f"the {name} solver refuses the scene: {exc.message}", exc.source) from None
+            for f in self.dt_factors:
+                check_cost(scene, self.solver(name, f), allow_large, label=f"{name} at dt x {f:g}")
+        if not allow_large:
+            check_study_time(self.expected_seconds(workers), "the cross-check", workers)
+
+    def cost_line(self, workers: int) -> str:
+        """The study's expected runs and time, before anything runs."""
+        per_search = self.expected_runs() / max(1, len(self.searches()))
+        seconds = self.run_seconds()
         startup = self.startup_s()
         compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached(
             len(self.scene.blocks) == 1
@@ -282,6 +321,7 @@ def crosscheck_plan(
     tail_s: float = 5.0,
     progress: bool = True,
     allow_large: bool = False,
+    workers: int = 2,
 ) -> CrosscheckPlan:
     """Check the inputs, measure the records and choose the scan; nothing runs yet.
 
@@ -304,13 +344,17 @@ def crosscheck_plan(
     solver_options
         Options for the solvers that take them.
     allow_large
-        Go beyond :data:`rockyade.batch.study.MAX_RUNS` expected runs.
+        Go beyond :data:`rockyade.batch.study.MAX_RUNS` expected runs, the cost limits of one
+        run and :data:`rockyade.runner.cost.MAX_STUDY_S` of expected time.
+    workers
+        The workers that will run it (the expected time is over them).
 
     Raises
     ------
     InputError
         A bad option (named), a solver that cannot change its time step, a record that
-        cannot be scaled to the levels, a study above the run limit.
+        cannot be scaled to the levels, a solver that refuses the scene
+        (:meth:`CrosscheckPlan.check`), a study above the run, cost or time limits.
     """
     names = tuple(solvers)
     factors = check_dt_factors(dt_factors)
@@ -345,6 +389,7 @@ def crosscheck_plan(
         progress=progress,
     )
     plan = CrosscheckPlan(stripes, names, factors, resolution, tolerance, dict(records_per_solver or {}), options)
+    plan.check(workers, allow_large)
     expected = plan.expected_runs()
     if expected > MAX_RUNS and not allow_large:
         raise InputError(

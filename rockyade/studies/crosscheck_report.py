@@ -19,6 +19,7 @@ from rockyade.analysis.crosscheck import (
     BRACKETED,
     CollapseSearch,
     MedianInterval,
+    PairVerdict,
     collapse_summary,
     median_interval,
     pair_verdict,
@@ -118,6 +119,7 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
             if f == finest:
                 dt_change[solver] = abs(ratio.median - 1.0) if math.isfinite(ratio.median) else math.nan
             pair_rows.append(_pair_row("dt", solver, solver, f, plan.dt_factors[0], ratio, same, n, "", ""))
+    failures = failed_runs(runs)
     verdicts = []
     for f in plan.dt_factors:
         for ia, a in enumerate(plan.solvers):
@@ -125,12 +127,67 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
                 ratio = median_interval(paired_ratios(intensities(a, f), intensities(b, f)).values())
                 same, n = verdict_agreement(scan_verdicts(a, f), scan_verdicts(b, f))
                 v = pair_verdict(a, b, ratio, plan.tolerance, dt_change if len(plan.dt_factors) > 1 else None)
+                v = _failed_verdict(a, b, f, failures) or v
                 pair_rows.append(_pair_row("solvers", a, b, f, f, ratio, same, n, v.verdict, v.sentence))
                 if f == finest or len(plan.dt_factors) == 1:
                     verdicts.append(f"at dt x {f:g}: {v.sentence}")
     pairs = pd.DataFrame(pair_rows, columns=list(PAIR_COLUMNS))
     fragility = _fragility(plan, runs)
     return Summary(collapse, pairs, runs, fragility, verdicts, partial)
+
+
+@dataclass(frozen=True)
+class Failures:
+    """The runs of one solver at one time-step factor that failed (no verdict).
+
+    Attributes
+    ----------
+    failed, runs
+        Runs that failed, and runs made.
+    reasons
+        The first distinct reasons, in the order of the runs (at most three).
+    """
+
+    failed: int
+    runs: int
+    reasons: tuple[str, ...]
+
+    @property
+    def every(self) -> bool:
+        """Every run made failed."""
+        return self.runs > 0 and self.failed == self.runs
+
+
+def failed_runs(runs: pd.DataFrame) -> dict[tuple[str, float], Failures]:
+    """(solver, dt factor) -> its failed runs, for those with at least one."""
+    out: dict[tuple[str, float], Failures] = {}
+    if runs.empty:
+        return out
+    for (solver, f), group in runs.groupby(["solver", "dt_factor"], sort=False):
+        bad = group[group["collapsed"].isna()]
+        if bad.empty:
+            continue
+        reasons: list[str] = []
+        for r in bad["failure_reason"]:
+            text = str(r or "").strip() or "no reason recorded"
+            if text not in reasons:
+                reasons.append(text)
+        out[(str(solver), float(f))] = Failures(len(bad), len(group), tuple(reasons[:3]))
+    return out
+
+
+def _failed_verdict(a: str, b: str, f: float, failures: Mapping[tuple[str, float], Failures]) -> PairVerdict | None:
+    """The verdict of a pair one of whose solvers failed every run at ``f``: no comparison (not
+    "inconclusive"), the first reason said; None otherwise."""
+    for s in (a, b):
+        fail = failures.get((s, float(f)))
+        if fail is not None and fail.every:
+            return PairVerdict(
+                "failed",
+                f"{a} / {b}: no comparison: {s} failed every run ({fail.failed} of {fail.runs}; first reason: "
+                f"{fail.reasons[0]})",
+            )
+    return None
 
 
 PAIR_COLUMNS = (
@@ -237,6 +294,24 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
         "",
     ]
     lines += [f"- {v}" for v in summary.verdicts] or ["- no pair of solvers has collapse intensities to compare"]
+    failures = failed_runs(summary.runs)
+    if failures:
+        total = sum(x.failed for x in failures.values())
+        lines += [
+            "",
+            "## Failed runs",
+            "",
+            f"{total} of {len(summary.runs)} runs failed: they have no verdict, and a search stops at its bracket "
+            "so far (`runs.csv`: status and failure_reason of each).",
+            "",
+        ]
+        for (solver, f), fail in failures.items():
+            lines.append(
+                f"- {solver} at dt x {f:g}: {fail.failed} of {fail.runs} runs failed"
+                + (" (every run)" if fail.every else "")
+                + "; first reasons: "
+                + "; ".join(fail.reasons)
+            )
     pairs = summary.pairs
     dt_rows = pairs[pairs["kind"] == "dt"] if not pairs.empty else pairs
     if len(dt_rows):
