@@ -853,3 +853,16 @@ def test_compare_prints_its_cost_and_refuses_hours(tmp_path, capsys):
     assert code == 2 and len(err) == 1 and "--allow-large" in err[0] and "siconos" in err[0], err
     assert not (tmp_path / "c").exists()
 
+
+def test_records_folder_given_as_a_link_is_named_as_given(records, tmp_path):
+    """--records as a link to a folder: the console and index.md name the link, not its
+    target's folder; one record is "1 record file"."""
+    from rockyade.assess import records_in_folder
+
+    link = tmp_path / "my_records"
+    link.symlink_to(records)
+    motions = records_in_folder(link)
+    assert motions.describe() == f"2 record files of {link}" and str(records) not in motions.describe()
+    assert motions == records_in_folder(records)  # the same records, whatever the folder's name
+    one = write_records(tmp_path / "one", count=1)
+    assert records_in_folder(one).describe() == f"1 record file of {one}"
