@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -866,3 +867,37 @@ def test_records_folder_given_as_a_link_is_named_as_given(records, tmp_path):
     assert motions == records_in_folder(records)  # the same records, whatever the folder's name
     one = write_records(tmp_path / "one", count=1)
     assert records_in_folder(one).describe() == f"1 record file of {one}"
+
+
+def test_below_min_records_no_interval_is_shown_anywhere_and_digits_follow_the_resolution(plan, tmp_path):
+    """Two records (fewer than MIN_RECORDS): the verdict refuses an interval, and so do
+    pairs.csv, the convergence lines, the paired-ratios table and the figure, each saying why;
+    the fragility rows say why they have no numbers; a 10 % resolution gives 2 decimals."""
+    from rockyade.analysis.crosscheck import MIN_RECORDS, ratio_decimals
+    from rockyade.figures.crosscheck import PairedRatios
+    from rockyade.studies.crosscheck import Outcomes
+    from rockyade.studies.crosscheck_report import index_text, summarise
+
+    assert plan.motions.count < MIN_RECORDS and plan.resolution == 0.1
+    assert (ratio_decimals(0.01), ratio_decimals(0.1), ratio_decimals(0.5)) == (3, 2, 1)
+    outcomes = Outcomes()
+    scan = sorted(plan.scan_si)
+    for s, top in (("housner", 1), ("reference", 2)):
+        for f in plan.dt_factors:
+            for i in plan.records_of(s):
+                for k, level in enumerate(scan):
+                    outcomes.add((s, f, i), level, {"status": "completed"}, k >= top)
+    summary = summarise(plan, outcomes, partial=False)
+    assert (summary.pairs.records == 2).all()
+    assert summary.pairs.ratio_low.isna().all() and summary.pairs.ratio_high.isna().all()
+    index = index_text(plan, summary, 1.0)
+    results = index.split("## Verdicts")[1].split("## Files")[0]
+    assert not re.search(r"95 % interval [0-9]", results) and "no interval: 2 record(s), fewer than the 5" in results
+    assert "none (2 < 5 records)" in index
+    verdict = summary.verdicts[0]
+    assert "housner / reference = 0.50 from 2 record(s)" in verdict, verdict
+    fragility = index.split("## Fragility per solver")[1].split("##")[0]
+    rows = [line for line in fragility.splitlines() if line.startswith("| housner") or line.startswith("| reference")]
+    assert rows and all("not fitted" in row for row in rows), rows
+    display = PairedRatios.from_pairs(summary.pairs)
+    assert all("no interval" in label for label in display.labels)

@@ -285,12 +285,35 @@ class PairVerdict:
     sentence: str
 
 
+def ratio_decimals(resolution: float) -> int:
+    """Decimals a median ratio of collapse intensities found to ``resolution`` supports: the
+    resolution's own decimal place, and one more (a median over records is finer than one
+    bracket), at least 1: 3 at 1 %, 2 at 5 % or 10 %, 1 at 50 %."""
+    if not (math.isfinite(resolution) and resolution > 0):
+        return 3
+    return max(1, round(-math.log10(resolution)) + 1)
+
+
+def without_interval(ratio: MedianInterval) -> MedianInterval:
+    """``ratio`` with no interval below :data:`MIN_RECORDS` records (too few to bound a
+    median; every table, file and figure then shows none)."""
+    if ratio.n >= MIN_RECORDS:
+        return ratio
+    return MedianInterval(ratio.median, math.nan, math.nan, ratio.n)
+
+
+def too_few_note(n: int) -> str:
+    """Why a ratio of ``n`` records has no interval."""
+    return f"no interval: {n} record(s), fewer than the {MIN_RECORDS} an interval needs"
+
+
 def pair_verdict(
     a: str,
     b: str,
     ratio: MedianInterval,
     tolerance: float = TOLERANCE,
     dt_change: Mapping[str, float] | None = None,
+    decimals: int = 3,
 ) -> PairVerdict:
     """The verdict on the median ratio of collapse intensities ``a`` / ``b``.
 
@@ -311,6 +334,8 @@ def pair_verdict(
         The tolerance on the median ratio (0.05: 5 %).
     dt_change
         Each solver's own change with dt halved (NaN or absent: not measured).
+    decimals
+        Decimals of the ratios in the sentence (:func:`ratio_decimals` of the resolution).
     """
     dt_change = dict(dt_change or {})
     m, lo, hi = ratio.median, ratio.low, ratio.high
@@ -320,10 +345,11 @@ def pair_verdict(
     if ratio.n < MIN_RECORDS:
         return PairVerdict(
             "too few records",
-            f"{a} / {b} = {m:.3f} from {ratio.n} record(s): too few for an interval or a verdict "
+            f"{a} / {b} = {m:.{decimals}f} from {ratio.n} record(s): too few for an interval or a verdict "
             f"(at least {MIN_RECORDS} records, {ADVISED_RECORDS} or more advised)",
         )
-    text = f"{a} / {b} = {m:.3f} (95 % interval {lo:.3f}-{hi:.3f}, {ratio.n} records)"
+    d = decimals
+    text = f"{a} / {b} = {m:.{d}f} (95 % interval {lo:.{d}f}-{hi:.{d}f}, {ratio.n} records)"
     if ratio.n < ADVISED_RECORDS:
         text += f"; fewer than {ADVISED_RECORDS} records: a rough interval"
     moved = {s: c for s, c in dt_change.items() if s in (a, b) and math.isfinite(c)}
@@ -362,6 +388,9 @@ __all__ = [
     "next_levels",
     "pair_verdict",
     "paired_ratios",
+    "ratio_decimals",
     "scan_levels",
+    "too_few_note",
     "verdict_agreement",
+    "without_interval",
 ]
