@@ -400,6 +400,14 @@ def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_pa
     assert after == before  # the previous set untouched, nothing of the new study mixed in
     assert json.loads((journal / "crosscheck.json").read_text())["partial"] is True
     assert not list(out.glob(".set.*"))  # no staged set left behind
+    # the message says what runs.csv lists (the finished runs: before, "lists them" after the
+    # unfinished count) and its count is runs.csv's; the --resume it names exists (run below)
+    said = re.search(
+        r"interrupted: (\d+) run\(s\) finished, \d+ of the interrupted round unfinished; (\S+) lists the finished runs",
+        text,
+    )
+    assert said is not None and "--resume" in text, text
+    assert Path(said.group(2)) == journal / "runs.csv" and len(pd.read_csv(said.group(2))) == int(said.group(1))
     resumed = subprocess.run([*argv, "--resume"], env=env, capture_output=True, text=True, timeout=900)
     assert resumed.returncode == 0, resumed.stdout + resumed.stderr
     data = json.loads((out / "crosscheck.json").read_text())

@@ -649,7 +649,13 @@ def run_crosscheck(
             write_summary(plan, summary, journal.folder, time.perf_counter() - start, {"runs_made": study.ran})
             say(f"partial summary in {journal.folder / 'index.md'}")
             raise BatchInterruptedError(
-                len(summary.runs), exc.unfinished, str(journal.folder / "runs.csv"), exc.hard
+                len(summary.runs),
+                exc.unfinished,
+                str(journal.folder / "runs.csv"),
+                exc.hard,
+                "--resume",
+                listed="the finished runs (the searches' later runs are chosen from them when resumed)",
+                unfinished_what="of the interrupted round unfinished",
             ) from None
         summary = summarise(plan, study.outcomes, partial=False)
         seconds = time.perf_counter() - start
