@@ -909,3 +909,30 @@ def test_below_min_records_no_interval_is_shown_anywhere_and_digits_follow_the_r
     assert rows and all("not fitted" in row for row in rows), rows
     display = PairedRatios.from_pairs(summary.pairs)
     assert all("no interval" in label for label in display.labels)
+
+
+def test_default_levels_start_at_the_alpha_the_solvers_run(records):
+    """Specimen 1 declares alpha_rad = 0.235: the scan starts at tan(0.235) g, the uplift level
+    of the block the solvers run (before: 0.2501 g from the nominal 0.25 x 1.0 m geometry's
+    limit analysis); an assembly keeps the limit analysis' alpha0."""
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.constants import CODE_GRAVITY, G
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck import classical_static, crosscheck_plan
+
+    scene = load_scene(EXAMPLES / "specimen1_record.toml")
+    assert scene.blocks[0].classical().alpha_rad == 0.235
+    cc = crosscheck_plan(
+        scene,
+        records_in_folder(records),
+        parse_measure("pga"),
+        ["housner", "reference"],
+        dt_factors=(1.0,),
+        executor=Executor("threads", 1),
+        progress=False,
+    )
+    assert cc.scan_si[0] == pytest.approx(math.tan(0.235) * G)
+    assert cc.scan_si[0] / CODE_GRAVITY == pytest.approx(0.2395, abs=1e-4)
+    assert "classical alpha = 0.235 rad" in cc.stripes.levels_source
+    assert classical_static(load_scene(EXAMPLES / "biblock_free.toml")) is None

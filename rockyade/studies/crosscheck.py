@@ -4,7 +4,8 @@ what was measured: docs/verification.md).
 
 For each solver, each time-step factor (1, and 0.5 for the convergence check) and each
 record, a collapse search: the scan's levels (from the scene's static collapse acceleration,
-as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility.fragility_plan`),
+as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility.fragility_plan`;
+for a single block tan(alpha) g with the scene's classical alpha, :func:`classical_static`),
 then bisection to the resolution. The searches advance together, one round at a time; each
 round's runs go through the batch machinery (:func:`rockyade.batch.run_study_tasks`:
 the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
@@ -49,6 +50,7 @@ from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
 from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.folders import output_folder
 from rockyade.io.locking import output_lock
@@ -303,6 +305,25 @@ def check_dt_factors(values: Sequence[float], field_name: str = "--dt-factors") 
     return out
 
 
+def classical_static(scene: Scene) -> tuple[float, str] | None:
+    """A single block's static collapse acceleration from the scene's classical alpha, tan(alpha) g
+    (m/s^2, Housner 1963: a block rocks, and a static load tips it, above it), and its words;
+    None for an assembly (or a block with loads), whose alpha0 is the limit analysis'.
+
+    The classical alpha is what the solvers run (``scene.blocks[0].classical()``, as
+    ``rockyade params`` shows it): a declared ``alpha_rad`` (specimen 1: 0.235 rad) rather than
+    the nominal geometry's atan(b / h) (0.245 rad) that the limit analysis takes.
+    """
+    if len(scene.blocks) != 1 or scene.loads:
+        return None
+    alpha = scene.blocks[0].classical().alpha_rad
+    value = math.tan(alpha) * G
+    return value, (
+        f"tan(alpha) g = {value:.4g} m/s^2 (the scene's classical alpha = {alpha:.4g} rad, as the solvers run it, "
+        f"x the mechanics' g = {G:g} m/s^2; {value / CODE_GRAVITY:.4g} g in standard gravity)"
+    )
+
+
 def crosscheck_plan(
     scene: Scene,
     motions: MotionSet,
@@ -380,6 +401,7 @@ def crosscheck_plan(
         motions,
         measure,
         names[0],
+        static_override=classical_static(scene),
         levels=levels,
         extend=False,
         executor=executor,
