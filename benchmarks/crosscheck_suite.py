@@ -75,6 +75,9 @@ def main() -> None:
     parser.add_argument("--resolution", type=float, default=0.01)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--resume", action="store_true")
+    parser.add_argument(
+        "--allow-large", action="store_true", help="run a study above the cost limits (8 h expected, 1 h a run)"
+    )
     parser.add_argument("--out", type=Path, default=Path("runs/crosscheck"))
     args = parser.parse_args()
     solvers = [s.strip() for s in args.solvers.split(",")]
@@ -95,9 +98,13 @@ def main() -> None:
             resolution=args.resolution,
             executor=executor,
             progress=False,
+            allow_large=args.allow_large,
+            workers=args.workers,
         )
         print(f"[{name}] {plan.cost_line(args.workers)}", flush=True)
-        summary = run_crosscheck(plan, root / f"scene_{name}", executor, resume=args.resume, progress=False)
+        summary = run_crosscheck(
+            plan, root / f"scene_{name}", executor, resume=args.resume, progress=False, allow_large=args.allow_large
+        )
         seconds = time.perf_counter() - start
         print(f"[{name}] {len(summary.runs)} runs in {seconds:.0f} s", flush=True)
         for line in summary.verdicts:

@@ -63,6 +63,10 @@ class BatchInterruptedError(RockyadeError):
         A second Ctrl-C stopped the running runs (the process should end at once).
     resume_option
         The command's option that resumes (named in the message), None: it has none.
+    listed
+        What ``summary_path`` lists, in words (default "them": every run, finished or not).
+    unfinished_what
+        What the unfinished count counts, in words (default "unfinished").
     """
 
     def __init__(
@@ -72,19 +76,21 @@ class BatchInterruptedError(RockyadeError):
         summary_path: str | None,
         hard: bool = False,
         resume_option: str | None = "--resume",
+        listed: str = "them",
+        unfinished_what: str = "unfinished",
     ) -> None:
         self.finished = finished
         self.unfinished = unfinished
         self.summary_path = summary_path
         self.hard = hard
         self.resume_option = resume_option
-        where = f"; {summary_path} lists them" if summary_path else ""
+        where = f"; {summary_path} lists {listed}" if summary_path else ""
         then = (
             f" (run the same command with {resume_option} to finish them)"
             if resume_option
             else " (this command does not resume: run it again)"
         )
-        super().__init__(f"interrupted: {finished} run(s) finished, {unfinished} unfinished{where}{then}")
+        super().__init__(f"interrupted: {finished} run(s) finished, {unfinished} {unfinished_what}{where}{then}")
 
 
 def os_error_message(exc: OSError) -> str:

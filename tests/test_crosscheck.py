@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -14,6 +15,7 @@ import pytest
 
 from rockyade.analysis.crosscheck_statistics import (
     ABOVE,
+    ALL_FAILED,
     BRACKETED,
     MAX_EXTENSIONS,
     collapse_summary,
@@ -274,7 +276,7 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
     real_write = cc.run_study_tasks
 
     def watch(tasks, *args, **kwargs):  # every run the resumed study makes
-        written.extend(str(t.scene_hash) + t.solver.name + str(t.out_dir) for t in tasks)
+        written.extend(str(t.scene_hash) + repr(t.solver) for t in tasks)
         return real_write(tasks, *args, **kwargs)
 
     monkeypatch.setattr(cc, "run_study_tasks", watch)
@@ -398,6 +400,14 @@ def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_pa
     assert after == before  # the previous set untouched, nothing of the new study mixed in
     assert json.loads((journal / "crosscheck.json").read_text())["partial"] is True
     assert not list(out.glob(".set.*"))  # no staged set left behind
+    # the message says what runs.csv lists (the finished runs: before, "lists them" after the
+    # unfinished count) and its count is runs.csv's; the --resume it names exists (run below)
+    said = re.search(
+        r"interrupted: (\d+) run\(s\) finished, \d+ of the interrupted round unfinished; (\S+) lists the finished runs",
+        text,
+    )
+    assert said is not None and "--resume" in text, text
+    assert Path(said.group(2)) == journal / "runs.csv" and len(pd.read_csv(said.group(2))) == int(said.group(1))
     resumed = subprocess.run([*argv, "--resume"], env=env, capture_output=True, text=True, timeout=900)
     assert resumed.returncode == 0, resumed.stdout + resumed.stderr
     data = json.loads((out / "crosscheck.json").read_text())
@@ -632,6 +642,7 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     )
     out = capsys.readouterr().out
     assert code == 0 and "verdict: same outcome" in out
+    assert "cost: 4 run(s), about" in out and "housner at dt x 0.25" in out  # before any run
     assert (tmp_path / "c" / "specimen1_record_housner_halfdt.json").is_file()
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
@@ -780,3 +791,173 @@ def test_paper_part_runs_siconos_on_a_subset_it_can_run():
     chosen = pc.specimen_scene(job.specimen, job.calibration)
     check_target_mu(chosen, solver.model(chosen))
     assert [j.solvers for j in pc.jobs(use_yade=True)[0] if "yade" in j.solvers] == [("reference", "yade")]
+
+
+# ---------------------------------------------------------------------- refused up front
+
+
+def test_a_scene_a_solver_refuses_is_refused_before_any_run(records, tmp_path, capsys):
+    """Specimen 1's matched mu 0.936 is beyond Siconos's reach: one line naming the field and
+    the solver, exit 2, before any run and with no --out written (before, every Housner run
+    ran, every Siconos run failed and a set with an "inconclusive" verdict replaced --out)."""
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "specimen1_record.toml"),
+        "--records",
+        str(records),
+        "--solvers",
+        "housner,siconos",
+        "--levels",
+        "0.3,0.6",
+        "--resolution",
+        "0.5",
+        "--dt-factors",
+        "1",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "contact.calibration" in err[0] and "siconos" in err[0], err
+    assert "cost:" not in captured.out and not (tmp_path / "o").exists()
+
+
+def test_runs_that_failed_are_said_and_a_pair_whose_solver_always_failed_says_so(plan):
+    """Outcomes where the reference DEM failed every run: the pair's verdict says so with the
+    reason (not "inconclusive"), its searches say "every run failed" (not "no runs") and
+    index.md counts the failures per solver with their first reasons."""
+    from rockyade.studies.crosscheck_report import index_text, summarise
+    from rockyade.studies.crosscheck_study import Outcomes
+
+    outcomes = Outcomes()
+    low, high = plan.scan_si[0], plan.scan_si[1]
+    for f in plan.dt_factors:
+        for i in plan.records_of("housner"):
+            outcomes.add(("housner", f, i), low, {"status": "completed", "run": "a"}, False)
+            outcomes.add(("housner", f, i), high, {"status": "overturned", "run": "b"}, True)
+            for level in (low, high):
+                row = {"status": "failed", "failure_reason": "InputError: contact.calibration: out of reach"}
+                outcomes.add(("reference", f, i), level, row, None)
+    summary = summarise(plan, outcomes, partial=False)
+    assert all("reference failed every run (4 of 4; first reason: InputError" in v for v in summary.verdicts)
+    assert "inconclusive" not in " ".join(summary.verdicts)
+    mine = summary.collapse[summary.collapse.solver == "reference"]
+    assert set(mine.status) == {ALL_FAILED} and (mine.failed_runs == mine.runs).all()
+    index = index_text(plan, summary, 1.0)
+    assert "## Failed runs" in index and "8 of 16 runs failed" in index
+    assert "- reference at dt x 1: 4 of 4 runs failed (every run); first reasons: InputError" in index
+    assert "housner at dt x" not in index.split("## Failed runs")[1].split("##")[0]
+
+
+def test_a_study_expected_to_take_hours_is_refused_naming_allow_large(records, tmp_path, capsys):
+    """dt x 0.001 makes Siconos's runs hours long: refused before any run, on the run's
+    estimated time (one run) or the study's expected time (all of them), naming --allow-large."""
+    from rockyade.runner.cost_limits import MAX_STUDY_S, check_study_time
+
+    scene = tmp_path / "paper.toml"
+    text = (EXAMPLES / "specimen1_record.toml").read_text().replace('"matched"', '"paper"')
+    scene.write_text(text.replace("records/", str(EXAMPLES / "records") + "/"))
+    argv = ["crosscheck", str(scene), "--records", str(records), "--solvers", "housner,siconos"]
+    argv += ["--levels", "0.3,0.6", "--resolution", "0.5", "--out", str(tmp_path / "o"), "--quiet"]
+    assert cli(*argv, "--dt-factors", "1,0.001") == 2
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert len(err) == 1 and "--allow-large" in err[0] and "siconos" in err[0], err
+    assert "round 1" not in captured.out and not (tmp_path / "o").exists()
+    with pytest.raises(InputError, match="expected to take about 9 h on 2 worker"):
+        check_study_time(9 * 3600.0, "the cross-check", 2)
+    check_study_time(MAX_STUDY_S, "the cross-check", 2)  # at the limit: runs
+
+
+def test_compare_prints_its_cost_and_refuses_hours(tmp_path, capsys):
+    """``rockyade compare --dt-factor 0.001`` with Siconos: refused before any run (exit 2, one
+    line naming --allow-large); before, it printed no cost and ran for minutes."""
+    code = cli(
+        "compare",
+        str(EXAMPLES / "specimen1_free.toml"),
+        "--solvers",
+        "housner,siconos",
+        "--dt-factor",
+        "0.001",
+        "--out",
+        str(tmp_path / "c"),
+    )
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "--allow-large" in err[0] and "siconos" in err[0], err
+    assert not (tmp_path / "c").exists()
+
+
+def test_records_folder_given_as_a_link_is_named_as_given(records, tmp_path):
+    """--records as a link to a folder: the console and index.md name the link, not its
+    target's folder; one record is "1 record file"."""
+    from rockyade.assess import records_in_folder
+
+    link = tmp_path / "my_records"
+    link.symlink_to(records)
+    motions = records_in_folder(link)
+    assert motions.describe() == f"2 record files of {link}" and str(records) not in motions.describe()
+    assert motions == records_in_folder(records)  # the same records, whatever the folder's name
+    one = write_records(tmp_path / "one", count=1)
+    assert records_in_folder(one).describe() == f"1 record file of {one}"
+
+
+def test_below_min_records_no_interval_is_shown_anywhere_and_digits_follow_the_resolution(plan, tmp_path):
+    """Two records (fewer than MIN_RECORDS): the verdict refuses an interval, and so do
+    pairs.csv, the convergence lines, the paired-ratios table and the figure, each saying why;
+    the fragility rows say why they have no numbers; a 10 % resolution gives 2 decimals."""
+    from rockyade.analysis.crosscheck_statistics import MIN_RECORDS, ratio_decimals
+    from rockyade.figures.paired_ratios import PairedRatios
+    from rockyade.studies.crosscheck_report import index_text, summarise
+    from rockyade.studies.crosscheck_study import Outcomes
+
+    assert plan.motions.count < MIN_RECORDS and plan.resolution == 0.1
+    assert (ratio_decimals(0.01), ratio_decimals(0.1), ratio_decimals(0.5)) == (3, 2, 1)
+    outcomes = Outcomes()
+    scan = sorted(plan.scan_si)
+    for s, top in (("housner", 1), ("reference", 2)):
+        for f in plan.dt_factors:
+            for i in plan.records_of(s):
+                for k, level in enumerate(scan):
+                    outcomes.add((s, f, i), level, {"status": "completed"}, k >= top)
+    summary = summarise(plan, outcomes, partial=False)
+    assert (summary.pairs.records == 2).all()
+    assert summary.pairs.ratio_low.isna().all() and summary.pairs.ratio_high.isna().all()
+    index = index_text(plan, summary, 1.0)
+    results = index.split("## Verdicts")[1].split("## Files")[0]
+    assert not re.search(r"95 % interval [0-9]", results) and "no interval: 2 record(s), fewer than the 5" in results
+    assert "none (2 < 5 records)" in index
+    verdict = summary.verdicts[0]
+    assert "housner / reference = 0.50 from 2 record(s)" in verdict, verdict
+    fragility = index.split("## Fragility per solver")[1].split("##")[0]
+    rows = [line for line in fragility.splitlines() if line.startswith("| housner") or line.startswith("| reference")]
+    assert rows and all("not fitted" in row for row in rows), rows
+    display = PairedRatios.from_pairs(summary.pairs)
+    assert all("no interval" in label for label in display.labels)
+
+
+def test_default_levels_start_at_the_alpha_the_solvers_run(records):
+    """Specimen 1 declares alpha_rad = 0.235: the scan starts at tan(0.235) g, the uplift level
+    of the block the solvers run (before: 0.2501 g from the nominal 0.25 x 1.0 m geometry's
+    limit analysis); an assembly keeps the limit analysis' alpha0."""
+    from rockyade.assess import parse_measure, records_in_folder
+    from rockyade.constants import CODE_GRAVITY, G
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+    from rockyade.studies.crosscheck_study import classical_static, crosscheck_plan
+
+    scene = load_scene(EXAMPLES / "specimen1_record.toml")
+    assert scene.blocks[0].classical().alpha_rad == 0.235
+    cc = crosscheck_plan(
+        scene,
+        records_in_folder(records),
+        parse_measure("pga"),
+        ["housner", "reference"],
+        dt_factors=(1.0,),
+        executor=Executor("threads", 1),
+        progress=False,
+    )
+    assert cc.scan_si[0] == pytest.approx(math.tan(0.235) * G)
+    assert cc.scan_si[0] / CODE_GRAVITY == pytest.approx(0.2395, abs=1e-4)
+    assert "classical alpha = 0.235 rad" in cc.stripes.levels_source
+    assert classical_static(load_scene(EXAMPLES / "biblock_free.toml")) is None

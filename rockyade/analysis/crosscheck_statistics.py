@@ -50,11 +50,12 @@ MIN_RECORDS = 5
 ADVISED_RECORDS = 10
 
 #: Status of a collapse search.
-BRACKETED, ABOVE, BELOW, NO_RUNS = (
+BRACKETED, ABOVE, BELOW, NO_RUNS, ALL_FAILED = (
     "bracketed",
     "no collapse up to the top level",
     "collapsed at the lowest level",
-    ("no runs"),
+    "no runs",
+    "every run failed",
 )
 
 
@@ -146,7 +147,8 @@ class CollapseSearch:
         Of the scan's levels above the scan's first collapse, the fraction that stood (NaN
         with none).
     status
-        :data:`BRACKETED`, :data:`ABOVE`, :data:`BELOW` or :data:`NO_RUNS`.
+        :data:`BRACKETED`, :data:`ABOVE`, :data:`BELOW`, :data:`NO_RUNS` (none made) or
+        :data:`ALL_FAILED` (runs made, none with a verdict).
     runs, failed
         Runs of the search, and those that failed (no verdict).
     """
@@ -173,7 +175,8 @@ def collapse_summary(outcomes: Mapping[float, bool | None], scan: Sequence[float
     known = _known(outcomes)
     failed = sum(1 for v in outcomes.values() if v is None)
     if not known:
-        return CollapseSearch(math.nan, math.nan, math.nan, math.nan, NO_RUNS, len(outcomes), failed)
+        status = ALL_FAILED if outcomes else NO_RUNS
+        return CollapseSearch(math.nan, math.nan, math.nan, math.nan, status, len(outcomes), failed)
     collapses = [level for level, c in known if c]
     if not collapses:
         return CollapseSearch(math.nan, known[-1][0], math.nan, math.nan, ABOVE, len(outcomes), failed)
@@ -282,12 +285,35 @@ class PairVerdict:
     sentence: str
 
 
+def ratio_decimals(resolution: float) -> int:
+    """Decimals a median ratio of collapse intensities found to ``resolution`` supports: the
+    resolution's own decimal place, and one more (a median over records is finer than one
+    bracket), at least 1: 3 at 1 %, 2 at 5 % or 10 %, 1 at 50 %."""
+    if not (math.isfinite(resolution) and resolution > 0):
+        return 3
+    return max(1, round(-math.log10(resolution)) + 1)
+
+
+def without_interval(ratio: MedianInterval) -> MedianInterval:
+    """``ratio`` with no interval below :data:`MIN_RECORDS` records (too few to bound a
+    median; every table, file and figure then shows none)."""
+    if ratio.n >= MIN_RECORDS:
+        return ratio
+    return MedianInterval(ratio.median, math.nan, math.nan, ratio.n)
+
+
+def too_few_note(n: int) -> str:
+    """Why a ratio of ``n`` records has no interval."""
+    return f"no interval: {n} record(s), fewer than the {MIN_RECORDS} an interval needs"
+
+
 def pair_verdict(
     a: str,
     b: str,
     ratio: MedianInterval,
     tolerance: float = TOLERANCE,
     dt_change: Mapping[str, float] | None = None,
+    decimals: int = 3,
 ) -> PairVerdict:
     """The verdict on the median ratio of collapse intensities ``a`` / ``b``.
 
@@ -308,6 +334,8 @@ def pair_verdict(
         The tolerance on the median ratio (0.05: 5 %).
     dt_change
         Each solver's own change with dt halved (NaN or absent: not measured).
+    decimals
+        Decimals of the ratios in the sentence (:func:`ratio_decimals` of the resolution).
     """
     dt_change = dict(dt_change or {})
     m, lo, hi = ratio.median, ratio.low, ratio.high
@@ -317,10 +345,11 @@ def pair_verdict(
     if ratio.n < MIN_RECORDS:
         return PairVerdict(
             "too few records",
-            f"{a} / {b} = {m:.3f} from {ratio.n} record(s): too few for an interval or a verdict "
+            f"{a} / {b} = {m:.{decimals}f} from {ratio.n} record(s): too few for an interval or a verdict "
             f"(at least {MIN_RECORDS} records, {ADVISED_RECORDS} or more advised)",
         )
-    text = f"{a} / {b} = {m:.3f} (95 % interval {lo:.3f}-{hi:.3f}, {ratio.n} records)"
+    d = decimals
+    text = f"{a} / {b} = {m:.{d}f} (95 % interval {lo:.{d}f}-{hi:.{d}f}, {ratio.n} records)"
     if ratio.n < ADVISED_RECORDS:
         text += f"; fewer than {ADVISED_RECORDS} records: a rough interval"
     moved = {s: c for s, c in dt_change.items() if s in (a, b) and math.isfinite(c)}
@@ -347,6 +376,7 @@ def pair_verdict(
 
 __all__ = [
     "ABOVE",
+    "ALL_FAILED",
     "BELOW",
     "BRACKETED",
     "NO_RUNS",
@@ -358,6 +388,9 @@ __all__ = [
     "next_levels",
     "pair_verdict",
     "paired_ratios",
+    "ratio_decimals",
     "scan_levels",
+    "too_few_note",
     "verdict_agreement",
+    "without_interval",
 ]

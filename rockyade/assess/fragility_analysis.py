@@ -190,6 +190,7 @@ def fragility_plan(
     sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
     tail_s: float = DEFAULT_TAIL_S,
     progress: bool = True,
+    static_override: tuple[float, str] | None = None,
 ) -> FragilityPlan:
     """Read (or generate) the records, measure them and choose the levels; nothing runs yet.
 
@@ -214,6 +215,10 @@ def fragility_plan(
         Fallen blocks that make a collapse (several blocks).
     sample_dt_s, tail_s
         Output sampling and free motion after each record, s.
+    static_override
+        The static collapse acceleration (m/s^2) and its words, in place of the limit
+        analysis' (:func:`static_acceleration`, still run: a scene that cannot stand stops);
+        ``rockyade crosscheck`` gives a single block's classical one.
     """
     executor = executor or Executor("local", 2)
     solver = as_solver(solver or default_solver(scene))
@@ -225,7 +230,8 @@ def fragility_plan(
     if measure.kind == "ag":
         raise InputError("--intensity", "ag is the site's: use rockyade assess")
     given = check_levels(levels, measure) if levels is not None else None
-    static, static_text = static_acceleration(scene)  # also: a scene that cannot stand stops here
+    static_found = static_acceleration(scene)  # also: a scene that cannot stand stops here
+    static, static_text = static_override if static_override is not None else static_found
     if given is None and static <= 0.0:
         raise ZeroCapacityError(static_text)  # before any record is read or generated
     records = record_measures(motions, measure, executor, progress)

@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -52,10 +52,15 @@ class RecordFiles:
         Absolute paths.
     units
         Units of files that do not name theirs (``g``, ``m/s2``, ``cm/s2``); None: m/s^2.
+    folder
+        The folder as the user gave it (a link stays a link), for people (:meth:`describe`);
+        None: the first file's folder. Not part of what the records are (not compared, not in
+        :meth:`to_dict`).
     """
 
     files: tuple[str, ...]
     units: str | None = None
+    folder: str | None = field(default=None, compare=False)
 
     @property
     def count(self) -> int:
@@ -76,8 +81,8 @@ class RecordFiles:
 
     def describe(self) -> str:
         """One line."""
-        folder = Path(self.files[0]).parent if self.files else Path(".")
-        return f"{self.count} record files of {folder}"
+        folder = self.folder if self.folder is not None else Path(self.files[0]).parent if self.files else Path(".")
+        return f"{self.count} record file{'' if self.count == 1 else 's'} of {folder}"
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
@@ -158,7 +163,7 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
         raise InputError(field, f"{len(files)} record files in {path}, more than {MAX_RECORDS}")
     if units is not None:
         units = normalise_units(units, "--units")
-    records = RecordFiles(tuple(str(f.resolve()) for f in files), units)
+    records = RecordFiles(tuple(str(f.resolve()) for f in files), units, str(folder))
     read = [records.record(i) for i in range(records.count)]
     _refuse_duplicates(read, [f.name for f in files], field)
     return records

@@ -78,6 +78,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
         tail_s=args.tail,
         progress=not args.quiet,
         allow_large=args.allow_large,
+        workers=args.workers,
     )
     print(f"crosscheck of {args.scene}: {', '.join(names)} over {motions.describe()}", flush=True)
     print(
@@ -142,7 +143,8 @@ def register(sub: Any) -> None:
     p.add_argument(
         "--levels",
         help="the scan's levels in the measure's unit, comma-separated (default: the scene's static collapse "
-        "acceleration times 1 to 8, as rockyade fragility)",
+        "acceleration times 1 to 8, as rockyade fragility; a single block's is tan(alpha) g with the scene's "
+        "classical alpha, the one the solvers run)",
     )
     p.add_argument("--resolution", default="0.01", help="bisection to a bracket of ratio 1 + this (default 0.01)")
     p.add_argument(

@@ -38,12 +38,29 @@ def cmd_compare(args: argparse.Namespace) -> int:
     from rockyade.figures import plot_results
     from rockyade.io.atomic import atomic_open
     from rockyade.io.locking import output_lock
-    from rockyade.runner.cost_limits import check_cost
+    from rockyade.runner.cost_limits import check_cost, check_study_time
     from rockyade.scene import load_scene
+    from rockyade.solvers.base import check_scene
+    from rockyade.solvers.cost_estimate import duration_text
 
     scene = load_scene(args.scene)
-    for solver in runners:
-        check_cost(scene, solver, allow_large=args.allow_large)
+    estimates = []
+    for solver in [*runners, *finer]:
+        check_scene(solver, scene)
+        estimates.append(check_cost(scene, solver, allow_large=args.allow_large))
+    seconds = sum(e.wall_time_s for e in estimates)
+    print(
+        f"cost: {len(estimates)} run(s), about {duration_text(seconds)} in all, one after another on an idle machine ("
+        + ", ".join(
+            f"{e.solver}{' at dt x ' + format(getattr(s, 'dt_factor', 1.0), 'g') if k >= len(runners) else ''}: "
+            f"{duration_text(e.wall_time_s)}"
+            for k, (s, e) in enumerate(zip([*runners, *finer], estimates, strict=True))
+        )
+        + ")",
+        flush=True,
+    )
+    if not args.allow_large:
+        check_study_time(seconds, "the comparison")
     stem = args.scene.stem
     results = {}
     out.mkdir(parents=True, exist_ok=True)

@@ -93,13 +93,12 @@ class PairedRatios:
         labels = []
         for _, r in pairs.iterrows():
             scene = f"{r['scene']}: " if "scene" in pairs.columns else ""
-            n = f"(n = {r['records']})"
+            bare = not math.isfinite(float(r["ratio_low"])) and int(r["records"]) > 0
+            n = f"(n = {r['records']}{', no interval' if bare else ''})"
             if r["kind"] == "dt":
                 labels.append(f"{scene}{r['solver_a']}: dt x {r['dt_factor_a']:g} / dt x {r['dt_factor_b']:g} {n}")
             else:
-                labels.append(
-                    f"{scene}{r['solver_a']} / {r['solver_b']}, dt x {r['dt_factor_a']:g} (n = {r['records']})"
-                )
+                labels.append(f"{scene}{r['solver_a']} / {r['solver_b']}, dt x {r['dt_factor_a']:g} {n}")
         return cls(
             labels,
             pairs["median_ratio"].to_numpy(dtype=float),

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 from rockyade.errors import InputError, at_least, at_most
 from rockyade.scene import Scene
-from rockyade.solvers.cost_estimate import CostEstimate
+from rockyade.solvers.cost_estimate import CostEstimate, duration_text
 
 if TYPE_CHECKING:
     from rockyade.solvers.base import Solver
@@ -25,7 +25,40 @@ LIMITS: dict[str, float] = {
     "output_samples": 2.0e6,  # rows of the result
     "motion_samples": 2.0e7,  # samples of the base motion
     "memory_bytes": 2.0 * 1024**3,  # 2 GiB
+    "wall_time_s": 3600.0,  # the solver's estimate, s: binds Siconos (1 ms a body-step), whose steps cost most
 }
+
+
+#: Documented limit of a study's expected wall time (docs/robustness.md), s: the sum of its
+#: runs' estimates over its workers (``rockyade crosscheck``, ``rockyade compare``), a night's
+#: work; ``allow_large`` lifts it.
+MAX_STUDY_S = 8 * 3600.0
+
+
+def check_study_time(seconds: float, what: str, workers: int = 1, limit_s: float = MAX_STUDY_S) -> None:
+    """Refuse a study expected to take more than ``limit_s`` (s) of wall time.
+
+    Parameters
+    ----------
+    seconds
+        The study's expected wall time on ``workers`` workers, s (the solvers' estimates).
+    what
+        Names the study in the error (e.g. "the cross-check").
+    workers
+        Its workers (said in the error).
+
+    Raises
+    ------
+    InputError
+        ``allow_large`` (``--allow-large``) named, with the time and the limit.
+    """
+    if seconds > limit_s:
+        raise InputError(
+            "allow_large",
+            f"{what} is expected to take about {duration_text(seconds)} on {workers} worker(s), above the limit "
+            f"of {duration_text(limit_s)}: fewer records, solvers or levels, a coarser time step or resolution, or "
+            "pass --allow-large (allow_large=True) to run it anyway",
+        )
 
 
 def estimate_cost(scene: Scene, solver: Solver | str) -> CostEstimate:
@@ -40,6 +73,7 @@ _WHAT = {
     "output_samples": ("output samples", "a larger sample_dt_s or a shorter duration_s"),
     "motion_samples": ("base-motion samples", "a shorter motion (start_s, cycles, record length)"),
     "memory_bytes": ("bytes of memory", "a larger sample_dt_s, a shorter duration_s or motion"),
+    "wall_time_s": ("s of wall time (estimated)", "a larger time step (dt_factor nearer 1), a shorter duration_s"),
 }
 
 
@@ -86,4 +120,4 @@ def check_cost(
     return estimate
 
 
-__all__ = ["LIMITS", "check_cost", "cost_refusal", "estimate_cost"]
+__all__ = ["LIMITS", "MAX_STUDY_S", "check_cost", "check_study_time", "cost_refusal", "estimate_cost"]

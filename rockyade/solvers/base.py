@@ -122,6 +122,14 @@ class GroupSolver(Solver, Protocol):
         ...
 
 
+def check_scene(solver: Solver, scene: Scene) -> None:
+    """``solver.check_scene(scene)`` where the solver has it (:meth:`SolverBase.check_scene`):
+    raise the InputError its run would raise, before any run starts."""
+    check = getattr(solver, "check_scene", None)
+    if check is not None:
+        check(scene)
+
+
 def check_flag(value: Any, field: str) -> bool:
     """A true/false option."""
     if not isinstance(value, bool):
@@ -245,6 +253,12 @@ class SolverBase:
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """Itself: this solver keeps no files."""
         return self
+
+    def check_scene(self, scene: Scene) -> None:
+        """Refuse, before anything runs, a scene that :meth:`run` would refuse with an
+        InputError whatever its motion (e.g. a target the solver cannot reach); nothing here:
+        a solver that refuses scenes overrides it."""
+        return None
 
     if TYPE_CHECKING:  # declared for the checker only: every subclass defines both (Solver protocol)
 

@@ -208,6 +208,17 @@ class SiconosSolver(SolverBase):
             extra_meta={**how, **mu},
         )
 
+    def check_scene(self, scene: Scene) -> None:
+        """Refuse before any run what :meth:`run` refuses whatever the motion: a target mu the
+        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`).
+
+        Raises
+        ------
+        InputError
+            As :meth:`run` would.
+        """
+        check_target_mu(scene, self.model(scene))
+
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Body-steps at the Siconos time step, SECONDS_PER_BODY_STEP each."""
         model = self.model(scene)

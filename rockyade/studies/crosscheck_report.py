@@ -17,13 +17,18 @@ import pandas as pd
 
 from rockyade.analysis.crosscheck_statistics import (
     BRACKETED,
+    MIN_RECORDS,
     CollapseSearch,
     MedianInterval,
+    PairVerdict,
     collapse_summary,
     median_interval,
     pair_verdict,
     paired_ratios,
+    ratio_decimals,
+    too_few_note,
     verdict_agreement,
+    without_interval,
 )
 from rockyade.assess.stripes import collapse_rule
 from rockyade.io.atomic import atomic_open, write_json, write_text
@@ -117,20 +122,86 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
             same, n = verdict_agreement(scan_verdicts(solver, f), scan_verdicts(solver, plan.dt_factors[0]))
             if f == finest:
                 dt_change[solver] = abs(ratio.median - 1.0) if math.isfinite(ratio.median) else math.nan
-            pair_rows.append(_pair_row("dt", solver, solver, f, plan.dt_factors[0], ratio, same, n, "", ""))
+            row = _pair_row("dt", solver, solver, f, plan.dt_factors[0], without_interval(ratio), same, n, "", "")
+            pair_rows.append(row)
+    failures = failed_runs(runs)
     verdicts = []
     for f in plan.dt_factors:
         for ia, a in enumerate(plan.solvers):
             for b in plan.solvers[ia + 1 :]:
                 ratio = median_interval(paired_ratios(intensities(a, f), intensities(b, f)).values())
                 same, n = verdict_agreement(scan_verdicts(a, f), scan_verdicts(b, f))
-                v = pair_verdict(a, b, ratio, plan.tolerance, dt_change if len(plan.dt_factors) > 1 else None)
-                pair_rows.append(_pair_row("solvers", a, b, f, f, ratio, same, n, v.verdict, v.sentence))
+                v = pair_verdict(
+                    a,
+                    b,
+                    ratio,
+                    plan.tolerance,
+                    dt_change if len(plan.dt_factors) > 1 else None,
+                    ratio_decimals(plan.resolution),
+                )
+                v = _failed_verdict(a, b, f, failures) or v
+                pair_rows.append(
+                    _pair_row("solvers", a, b, f, f, without_interval(ratio), same, n, v.verdict, v.sentence)
+                )
                 if f == finest or len(plan.dt_factors) == 1:
                     verdicts.append(f"at dt x {f:g}: {v.sentence}")
     pairs = pd.DataFrame(pair_rows, columns=list(PAIR_COLUMNS))
     fragility = _fragility(plan, runs)
     return Summary(collapse, pairs, runs, fragility, verdicts, partial)
+
+
+@dataclass(frozen=True)
+class Failures:
+    """The runs of one solver at one time-step factor that failed (no verdict).
+
+    Attributes
+    ----------
+    failed, runs
+        Runs that failed, and runs made.
+    reasons
+        The first distinct reasons, in the order of the runs (at most three).
+    """
+
+    failed: int
+    runs: int
+    reasons: tuple[str, ...]
+
+    @property
+    def every(self) -> bool:
+        """Every run made failed."""
+        return self.runs > 0 and self.failed == self.runs
+
+
+def failed_runs(runs: pd.DataFrame) -> dict[tuple[str, float], Failures]:
+    """(solver, dt factor) -> its failed runs, for those with at least one."""
+    out: dict[tuple[str, float], Failures] = {}
+    if runs.empty:
+        return out
+    for (solver, f), group in runs.groupby(["solver", "dt_factor"], sort=False):
+        bad = group[group["collapsed"].isna()]
+        if bad.empty:
+            continue
+        reasons: list[str] = []
+        for r in bad["failure_reason"]:
+            text = str(r or "").strip() or "no reason recorded"
+            if text not in reasons:
+                reasons.append(text)
+        out[(str(solver), float(f))] = Failures(len(bad), len(group), tuple(reasons[:3]))
+    return out
+
+
+def _failed_verdict(a: str, b: str, f: float, failures: Mapping[tuple[str, float], Failures]) -> PairVerdict | None:
+    """The verdict of a pair one of whose solvers failed every run at ``f``: no comparison (not
+    "inconclusive"), the first reason said; None otherwise."""
+    for s in (a, b):
+        fail = failures.get((s, float(f)))
+        if fail is not None and fail.every:
+            return PairVerdict(
+                "failed",
+                f"{a} / {b}: no comparison: {s} failed every run ({fail.failed} of {fail.runs}; first reason: "
+                f"{fail.reasons[0]})",
+            )
+    return None
 
 
 PAIR_COLUMNS = (
@@ -209,6 +280,19 @@ def _fragility(plan: CrosscheckPlan, runs: pd.DataFrame) -> list[dict[str, Any]]
     return out
 
 
+def _fixed(v: float, decimals: int) -> str:
+    return f"{v:.{decimals}f}" if isinstance(v, (int, float)) and math.isfinite(v) else "-"
+
+
+def _interval_text(r: Any, decimals: int) -> str:
+    """A pairs row's interval in words: the interval, or why there is none."""
+    if math.isfinite(r.ratio_low):
+        return f"95 % interval {_fixed(r.ratio_low, decimals)}-{_fixed(r.ratio_high, decimals)}, {r.records} records"
+    if 0 < r.records < MIN_RECORDS:
+        return too_few_note(int(r.records))
+    return f"{r.records} records"
+
+
 def _fmt(v: float, digits: int = 4) -> str:
     return f"{v:.{digits}g}" if isinstance(v, (int, float)) and math.isfinite(v) else "-"
 
@@ -237,15 +321,33 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
         "",
     ]
     lines += [f"- {v}" for v in summary.verdicts] or ["- no pair of solvers has collapse intensities to compare"]
+    failures = failed_runs(summary.runs)
+    if failures:
+        total = sum(x.failed for x in failures.values())
+        lines += [
+            "",
+            "## Failed runs",
+            "",
+            f"{total} of {len(summary.runs)} runs failed: they have no verdict, and a search stops at its bracket "
+            "so far (`runs.csv`: status and failure_reason of each).",
+            "",
+        ]
+        for (solver, f), fail in failures.items():
+            lines.append(
+                f"- {solver} at dt x {f:g}: {fail.failed} of {fail.runs} runs failed"
+                + (" (every run)" if fail.every else "")
+                + "; first reasons: "
+                + "; ".join(fail.reasons)
+            )
     pairs = summary.pairs
     dt_rows = pairs[pairs["kind"] == "dt"] if not pairs.empty else pairs
+    d = ratio_decimals(plan.resolution)
     if len(dt_rows):
         lines += ["", "## Convergence in the time step", ""]
         for _, r in dt_rows.iterrows():
             lines.append(
                 f"- {r.solver_a}: collapse intensity at dt x {r.dt_factor_a:g} / at dt x {r.dt_factor_b:g} = "
-                f"{_fmt(r.median_ratio)} (95 % interval {_fmt(r.ratio_low)}-{_fmt(r.ratio_high)}, "
-                f"{r.records} records); "
+                f"{_fixed(r.median_ratio, d)} ({_interval_text(r, d)}); "
                 f"the same verdict in {r.same_verdict_runs} of {r.compared_runs} scan runs"
             )
     lines += [
@@ -256,9 +358,16 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
     for _, r in pairs[pairs["kind"] == "solvers"].iterrows() if not pairs.empty else []:
+        interval = (
+            f"{_fixed(r.ratio_low, d)}-{_fixed(r.ratio_high, d)}"
+            if math.isfinite(r.ratio_low)
+            else f"none ({r.records} < {MIN_RECORDS} records)"
+            if 0 < r.records < MIN_RECORDS
+            else "-"
+        )
         lines.append(
-            f"| {r.solver_a} | {r.solver_b} | {r.dt_factor_a:g} | {r.records} | {_fmt(r.median_ratio)} | "
-            f"{_fmt(r.ratio_low)}-{_fmt(r.ratio_high)} | {r.same_verdict_runs}/{r.compared_runs} | {r.verdict} |"
+            f"| {r.solver_a} | {r.solver_b} | {r.dt_factor_a:g} | {r.records} | {_fixed(r.median_ratio, d)} | "
+            f"{interval} | {r.same_verdict_runs}/{r.compared_runs} | {r.verdict} |"
         )
     lines += [
         "",
@@ -269,6 +378,11 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
     ]
     key = f"median_{m.unit.replace('/', '_')}"
     for fr in summary.fragility:
+        median = fr.get(key, math.nan)
+        if not (isinstance(median, (int, float)) and math.isfinite(median)):
+            why = str(fr.get("status") or "not fitted").replace("|", "/")
+            lines.append(f"| {fr['solver']} | {fr['dt_factor']:g} | {why} | - | - | - |")
+            continue
         mi = fr.get(f"median_interval_{m.unit.replace('/', '_')}", [math.nan, math.nan])
         bi = fr.get("beta_interval", [math.nan, math.nan])
         lines.append(

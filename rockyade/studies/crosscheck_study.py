@@ -4,7 +4,8 @@ what was measured: docs/verification.md).
 
 For each solver, each time-step factor (1, and 0.5 for the convergence check) and each
 record, a collapse search: the scan's levels (from the scene's static collapse acceleration,
-as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility_analysis.fragility_plan`),
+as ``rockyade fragility`` chooses its stripes, :func:`rockyade.assess.fragility_analysis.fragility_plan`;
+for a single block tan(alpha) g with the scene's classical alpha, :func:`classical_static`),
 then bisection to the resolution. The searches advance together, one round at a time; each
 round's runs go through the batch machinery (:func:`rockyade.batch.run_study_tasks`:
 the runner's executors, grouped runs, a JSON per finished run written as it ends, Ctrl-C).
@@ -49,15 +50,17 @@ from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
 from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.batch import MAX_RUNS, BatchTask, batch_task, run_name, run_study_tasks
+from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.io.folders import output_folder
 from rockyade.io.locking import output_lock
 from rockyade.io.resultset import replacing_set, settle
 from rockyade.runner import Executor
+from rockyade.runner.cost_limits import check_cost, check_study_time
 from rockyade.runner.journal import IDENTITY_FILE, Journal, read_run
 from rockyade.scene import Scene
 from rockyade.solvers import make_solver, solver_class, solver_names
-from rockyade.solvers.base import DT_FACTOR_MIN, Solver
+from rockyade.solvers.base import DT_FACTOR_MIN, Solver, check_scene
 from rockyade.studies.crosscheck_report import Summary, summarise, write_summary
 
 #: Time-step factors by default: the solver's own step, and half of it (convergence).
@@ -183,16 +186,54 @@ class CrosscheckPlan:
             seconds += WARM_UP_S if kernels_cached(len(self.scene.blocks) == 1) else COMPILE_S
         return seconds
 
-    def cost_line(self, workers: int) -> str:
-        """The study's expected runs and time, before anything runs."""
+    def heaviest_scene(self) -> Scene:
+        """The run the study's estimates take for every run: the longest record at the top level."""
         plan = self.stripes.stripes
         longest = int(np.argmax(plan.durations_s))
-        top = max(self.scan_si)
-        scene = plan.scene_for(longest, plan.load_factor(longest, top))
+        return plan.scene_for(longest, plan.load_factor(longest, max(self.scan_si)))
+
+    def run_seconds(self) -> float:
+        """The solvers' estimates summed over the expected runs, s (one worker, no start-up)."""
+        scene = self.heaviest_scene()
         per_search = self.expected_runs() / max(1, len(self.searches()))
         seconds = 0.0
         for s, f, _i in self.searches():
             seconds += self.solver(s, f).estimate_cost(scene).wall_time_s * per_search
+        return seconds
+
+    def expected_seconds(self, workers: int) -> float:
+        """The study's expected wall time on ``workers`` workers of an idle machine, s."""
+        return self.run_seconds() / max(1, workers) + self.startup_s()
+
+    def check(self, workers: int, allow_large: bool = False) -> None:
+        """Before anything runs: each solver checks the scene (:meth:`SolverBase.check_scene`:
+        what its runs would refuse, e.g. a mu Siconos cannot reach) and the heaviest run's cost
+        (:func:`rockyade.runner.cost_limits.check_cost`), and the study's expected time is held to
+        :data:`rockyade.runner.cost_limits.MAX_STUDY_S` (``allow_large`` lifts the cost limits).
+
+        Raises
+        ------
+        InputError
+            A solver refusing the scene (its own field, the solver named), a run or the study
+            above the cost limits.
+        """
+        scene = self.heaviest_scene()
+        for name in self.solvers:
+            try:
+                check_scene(self.solver(name, 1.0), self.scene)
+            except InputError as exc:
+                if name in exc.message:
+                    raise
+                raise InputError(exc.field, f"the {name} solver refuses the scene: {exc.message}", exc.source) from None
+            for f in self.dt_factors:
+                check_cost(scene, self.solver(name, f), allow_large, label=f"{name} at dt x {f:g}")
+        if not allow_large:
+            check_study_time(self.expected_seconds(workers), "the cross-check", workers)
+
+    def cost_line(self, workers: int) -> str:
+        """The study's expected runs and time, before anything runs."""
+        per_search = self.expected_runs() / max(1, len(self.searches()))
+        seconds = self.run_seconds()
         startup = self.startup_s()
         compiling = any(solver_class(s).IN_PROCESS for s in self.solvers) and not kernels_cached(
             len(self.scene.blocks) == 1
@@ -267,6 +308,25 @@ def check_dt_factors(values: Sequence[float], field_name: str = "--dt-factors") 
     return out
 
 
+def classical_static(scene: Scene) -> tuple[float, str] | None:
+    """A single block's static collapse acceleration from the scene's classical alpha, tan(alpha) g
+    (m/s^2, Housner 1963: a block rocks, and a static load tips it, above it), and its words;
+    None for an assembly (or a block with loads), whose alpha0 is the limit analysis'.
+
+    The classical alpha is what the solvers run (``scene.blocks[0].classical()``, as
+    ``rockyade params`` shows it): a declared ``alpha_rad`` (specimen 1: 0.235 rad) rather than
+    the nominal geometry's atan(b / h) (0.245 rad) that the limit analysis takes.
+    """
+    if len(scene.blocks) != 1 or scene.loads:
+        return None
+    alpha = scene.blocks[0].classical().alpha_rad
+    value = math.tan(alpha) * G
+    return value, (
+        f"tan(alpha) g = {value:.4g} m/s^2 (the scene's classical alpha = {alpha:.4g} rad, as the solvers run it, "
+        f"x the mechanics' g = {G:g} m/s^2; {value / CODE_GRAVITY:.4g} g in standard gravity)"
+    )
+
+
 def crosscheck_plan(
     scene: Scene,
     motions: MotionSet,
@@ -285,6 +345,7 @@ def crosscheck_plan(
     tail_s: float = 5.0,
     progress: bool = True,
     allow_large: bool = False,
+    workers: int = 2,
 ) -> CrosscheckPlan:
     """Check the inputs, measure the records and choose the scan; nothing runs yet.
 
@@ -307,13 +368,17 @@ def crosscheck_plan(
     solver_options
         Options for the solvers that take them.
     allow_large
-        Go beyond :data:`rockyade.batch.study.MAX_RUNS` expected runs.
+        Go beyond :data:`rockyade.batch.study.MAX_RUNS` expected runs, the cost limits of one
+        run and :data:`rockyade.runner.cost_limits.MAX_STUDY_S` of expected time.
+    workers
+        The workers that will run it (the expected time is over them).
 
     Raises
     ------
     InputError
         A bad option (named), a solver that cannot change its time step, a record that
-        cannot be scaled to the levels, a study above the run limit.
+        cannot be scaled to the levels, a solver that refuses the scene
+        (:meth:`CrosscheckPlan.check`), a study above the run, cost or time limits.
     """
     names = tuple(solvers)
     factors = check_dt_factors(dt_factors)
@@ -339,6 +404,7 @@ def crosscheck_plan(
         motions,
         measure,
         names[0],
+        static_override=classical_static(scene),
         levels=levels,
         extend=False,
         executor=executor,
@@ -348,6 +414,7 @@ def crosscheck_plan(
         progress=progress,
     )
     plan = CrosscheckPlan(stripes, names, factors, resolution, tolerance, dict(records_per_solver or {}), options)
+    plan.check(workers, allow_large)
     expected = plan.expected_runs()
     if expected > MAX_RUNS and not allow_large:
         raise InputError(
@@ -607,7 +674,13 @@ def run_crosscheck(
             write_summary(plan, summary, journal.folder, time.perf_counter() - start, {"runs_made": study.ran})
             say(f"partial summary in {journal.folder / 'index.md'}")
             raise BatchInterruptedError(
-                len(summary.runs), exc.unfinished, str(journal.folder / "runs.csv"), exc.hard
+                len(summary.runs),
+                exc.unfinished,
+                str(journal.folder / "runs.csv"),
+                exc.hard,
+                "--resume",
+                listed="the finished runs (the searches' later runs are chosen from them when resumed)",
+                unfinished_what="of the interrupted round unfinished",
             ) from None
         summary = summarise(plan, study.outcomes, partial=False)
         seconds = time.perf_counter() - start
