@@ -13,11 +13,10 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
-
-import numpy as np
 
 
 def finite_or_null(data: object) -> Any:
@@ -40,14 +39,20 @@ def finite_or_null(data: object) -> Any:
         return {k: finite_or_null(v) for k, v in data.items()}
     if isinstance(data, list | tuple):
         return [finite_or_null(v) for v in data]
-    if isinstance(data, np.ndarray):
-        return finite_or_null(data.tolist())
-    if isinstance(data, bool | np.bool_):
-        return bool(data)
-    if isinstance(data, np.integer):
-        return int(data)
-    if isinstance(data, float | np.floating):
-        return float(data) if math.isfinite(data) else None
+    np = sys.modules.get("numpy")  # numpy values exist only once numpy is imported: never import it here
+    if np is not None:
+        if isinstance(data, np.ndarray):
+            return finite_or_null(data.tolist())
+        if isinstance(data, np.bool_):
+            return bool(data)
+        if isinstance(data, np.integer):
+            return int(data)
+        if isinstance(data, np.floating):
+            data = float(data)
+    if isinstance(data, bool):
+        return data
+    if isinstance(data, float):
+        return data if math.isfinite(data) else None
     if isinstance(data, Path):
         return str(data)
     return data
