@@ -21,6 +21,18 @@ def require_yade() -> None:
     pytest.skip(message)
 
 
+def require_siconos() -> None:
+    """Skip without Siconos; fail instead where ``ROCKYADE_REQUIRE_SICONOS=1`` (``make test``, CI)."""
+    from rockyade.siconos import backend as siconos_backend
+
+    if siconos_backend.siconos_available():
+        return
+    message = f"Siconos is not installed ({siconos_backend.SICONOS_MODULE}): apt-get install python3-siconos"
+    if os.environ.get("ROCKYADE_REQUIRE_SICONOS") == "1":
+        pytest.fail(message)
+    pytest.skip(message)
+
+
 def descendants(pid: int) -> set[int]:
     """Every process below ``pid``."""
     found: set[int] = set()

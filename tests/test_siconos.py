@@ -29,19 +29,14 @@ from rockyade.solvers import make_solver
 from rockyade.solvers.siconos import SiconosSolver
 
 from .conftest import EXAMPLES
-from .processes import listening_of_tree
+from .processes import listening_of_tree, require_siconos
 
 RECORDS = EXAMPLES / "records"
 
 
 @pytest.fixture(scope="module", autouse=True)
 def _siconos_present():
-    if siconos_backend.siconos_available():
-        return
-    message = f"Siconos is not installed ({siconos_backend.SICONOS_MODULE}): apt-get install python3-siconos"
-    if os.environ.get("ROCKYADE_REQUIRE_SICONOS") == "1":
-        pytest.fail(message)
-    pytest.skip(message)
+    require_siconos()
 
 
 def _block(width: float, height: float, motion: dict, duration: float, sample_dt: float = 0.002):

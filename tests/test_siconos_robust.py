@@ -9,7 +9,6 @@ absent; ``ROCKYADE_REQUIRE_SICONOS=1`` (``make test``) turns that into a failure
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 
 import numpy as np
@@ -22,15 +21,12 @@ from rockyade.siconos import backend as siconos_backend
 from rockyade.siconos.payload import scene_payload
 from rockyade.solvers.siconos import SiconosSolver
 
+from .processes import require_siconos
+
 
 @pytest.fixture(scope="module", autouse=True)
 def _siconos_present():
-    if siconos_backend.siconos_available():
-        return
-    message = f"Siconos is not installed ({siconos_backend.SICONOS_MODULE}): apt-get install python3-siconos"
-    if os.environ.get("ROCKYADE_REQUIRE_SICONOS") == "1":
-        pytest.fail(message)
-    pytest.skip(message)
+    require_siconos()
 
 
 def _wall(duration_s: float) -> dict:

@@ -4,25 +4,19 @@ into a failure."""
 
 from __future__ import annotations
 
-import os
-
 import pytest
 
-from rockyade.siconos import backend as siconos_backend
 from rockyade.studies.verification import verify
 from rockyade.studies.verify_siconos import SICONOS_PUSHOVERS
+
+from .processes import require_siconos
 
 pytestmark = pytest.mark.slow
 
 
 @pytest.fixture(scope="module", autouse=True)
 def _siconos_present():
-    if siconos_backend.siconos_available():
-        return
-    message = f"Siconos is not installed ({siconos_backend.SICONOS_MODULE}): apt-get install python3-siconos"
-    if os.environ.get("ROCKYADE_REQUIRE_SICONOS") == "1":
-        pytest.fail(message)
-    pytest.skip(message)
+    require_siconos()
 
 
 def test_siconos_rows_pass_against_closed_forms(tmp_path):
