@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from rockyade.cli.common import add_allow_large, check_output_dir
+from rockyade.cli.fragility_options import add_record_source
 from rockyade.errors import InputError
 
 
@@ -117,16 +118,7 @@ def register(sub: Any) -> None:
         "docs/verification.md.",
     )
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
-    source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument("--records", type=Path, metavar="DIR", help="a folder of record files (.at2, .csv, .txt, .dat)")
-    source.add_argument(
-        "--suite",
-        choices=("ec8", "paper"),
-        help="a synthetic suite: ec8 (with --spectrum-type, --ground, --ag) or the paper's",
-    )
-    p.add_argument("--spectrum-type", type=int, help="EC8 spectrum type of --suite ec8: 1 or 2")
-    p.add_argument("--ground", help="EC8 ground type of --suite ec8: A, B, C, D or E")
-    p.add_argument("--ag", help="design ground acceleration of --suite ec8, with its unit: 0.25g or 2.45m/s2")
+    add_record_source(p)
     p.add_argument("--count", type=int, help="records of a synthetic suite (default 20; the paper's: 30)")
     p.add_argument("--seed", type=int, help="seed of the synthetic suite (default 1)")
     p.add_argument("--units", help="units of record files that do not name theirs: g, m/s2, cm/s2 (default m/s2)")

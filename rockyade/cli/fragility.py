@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 from rockyade.cli.common import check_output_dir
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
+    add_record_source,
     add_run_options,
     executor_from,
     float_list,
@@ -128,16 +129,7 @@ def register(sub: Any) -> None:
         "docs/howto/is-this-wall-safe.md.",
     )
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
-    source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument("--records", type=Path, metavar="DIR", help="a folder of record files (.at2, .csv, .txt, .dat)")
-    source.add_argument(
-        "--suite",
-        choices=("ec8", "paper"),
-        help="a spectrum-compatible synthetic suite: ec8 (with --spectrum-type, --ground, --ag) or the paper's",
-    )
-    p.add_argument("--spectrum-type", type=int, help="EC8 spectrum type of --suite ec8: 1 or 2")
-    p.add_argument("--ground", help="EC8 ground type of --suite ec8: A, B, C, D or E")
-    p.add_argument("--ag", help="design ground acceleration of --suite ec8, with its unit: 0.25g or 2.45m/s2")
+    add_record_source(p)
     p.add_argument(
         "--intensity",
         default="pga",

@@ -83,6 +83,21 @@ def refuse_suite_options_with_records(args: argparse.Namespace) -> None:
             raise InputError("--" + option, "applies to a synthetic suite, not to --records")
 
 
+def add_record_source(p: argparse.ArgumentParser) -> None:
+    """The record set of a study of many records: ``--records DIR`` or ``--suite``, with the EC8
+    suite's ``--spectrum-type``, ``--ground`` and ``--ag``."""
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--records", type=Path, metavar="DIR", help="a folder of record files (.at2, .csv, .txt, .dat)")
+    source.add_argument(
+        "--suite",
+        choices=("ec8", "paper"),
+        help="a spectrum-compatible synthetic suite: ec8 (with --spectrum-type, --ground, --ag) or the paper's",
+    )
+    p.add_argument("--spectrum-type", type=int, help="EC8 spectrum type of --suite ec8: 1 or 2")
+    p.add_argument("--ground", help="EC8 ground type of --suite ec8: A, B, C, D or E")
+    p.add_argument("--ag", help="design ground acceleration of --suite ec8, with its unit: 0.25g or 2.45m/s2")
+
+
 def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
     """Options shared by ``fragility`` and ``assess``: solver, workers, records, collapse, sampling."""
     from rockyade.cli.resumable import add_executor_options
