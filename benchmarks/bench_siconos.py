@@ -1,20 +1,22 @@
 """Siconos's cost per run against YADE (warm) and the reference DEM, on the same scenes.
 
 * A 30 s single-block run: specimen 1's geometry (0.25 x 1.0 m) under the shipped EC8
-  record scaled to 0.15 g, each solver warm (YADE's worker started and the reference DEM's
-  kernel compiled by a first run): wall time per run; Siconos at its default step and halved.
+  record scaled to 0.15 g (no uplift) and 0.3 g (rocking), each solver warm (YADE's worker
+  started and the reference DEM's kernel compiled by a first run): wall time per run, rounds
+  in alternation; Siconos at its default step and halved.
 * A dry running-bond wall of 33 blocks, 0.1 s at rest and under a 0.2 g sine pulse of
   0.1 s: Siconos's ms per step and what the time step, the friction solver's tolerance, its
   iteration cap and the Newton iterations buy (retried and unconverged steps, the largest
   residual, the peak drift), beside the reference DEM's.
 
-Run: ``python benchmarks/bench_siconos.py [block] [wall]`` (prints a table; the load
+Run: ``python benchmarks/bench_siconos.py [block] [wall] [--repeat=N]`` (prints a table; the load
 average is printed with it: on a shared machine compare ratios, not seconds).
 """
 
 from __future__ import annotations
 
 import os
+import statistics
 import time
 from pathlib import Path
 
@@ -25,15 +27,16 @@ from rockyade.solvers import make_solver
 RECORD = Path(__file__).resolve().parents[1] / "examples" / "records" / "ec8_type2_D_record21.AT2"
 
 
-def single_block(duration_s: float = 30.0):
-    """Specimen 1's geometry under the record at 0.15 g (it rocks, it does not overturn)."""
+def single_block(duration_s: float = 30.0, pga_g: float = 0.15):
+    """Specimen 1's geometry under the record at ``pga_g`` (0.15 g: no uplift; 0.3 g: it rocks,
+    it does not overturn)."""
     return scene_from_dict(
         {
             "duration_s": duration_s,
             "sample_dt_s": 0.01,
             "blocks": [{"name": "b", "width_m": 0.25, "height_m": 1.0, "thickness_m": 0.754, "mass_kg": 503.0}],
             "contact": {"calibration": "paper"},
-            "motion": {"type": "record", "file": str(RECORD), "target_pga_m_s2": 0.15 * 9.81},
+            "motion": {"type": "record", "file": str(RECORD), "target_pga_m_s2": pga_g * 9.81},
         }
     )
 
@@ -44,9 +47,10 @@ def timed(solver, scene):
     return time.perf_counter() - start, result
 
 
-def single_block_costs() -> None:
-    scene = single_block()
-    print(f"single block, {scene.duration_s:g} s simulated (load average {os.getloadavg()[0]:.1f})")
+def single_block_costs(repeat: int = 3) -> None:
+    """Each solver's wall time on the 30 s single-block run, ``repeat`` rounds in alternation
+    (one run of each solver per round): the median time and the median of the per-round
+    ratios to YADE, which a machine's load shifts less than the seconds."""
     rows = [
         ("yade (warm)", make_solver("yade")),
         ("reference", make_solver("reference")),
@@ -55,17 +59,32 @@ def single_block_costs() -> None:
     ]
     for _, solver in rows[:3]:
         solver.run(single_block(1.0))  # warm: worker started, kernel compiled
-    yade_s = None
-    for label, solver in rows:
-        seconds, result = timed(solver, scene)
-        yade_s = seconds if label.startswith("yade") else yade_s
-        steps = result.meta.n_steps or 0
-        peak = float(abs(result.frame["theta_rad"]).max()) if len(result.frame) else float("nan")
-        ratio = seconds / yade_s if yade_s else float("nan")
+    for pga_g in (0.15, 0.3):
+        scene = single_block(pga_g=pga_g)
+        load = os.getloadavg()[0]
         print(
-            f"  {label:28s} {seconds:7.2f} s  ({ratio:4.1f} x YADE)  dt {result.meta.dt_s or float('nan'):.3g} s"
-            f"  {1e6 * seconds / max(steps, 1):7.1f} us/step  peak {peak:.5f} rad  {result.status}"
+            f"single block, {scene.duration_s:g} s simulated at {pga_g:g} g, {repeat} rounds (load average {load:.1f})"
         )
+        seconds: dict[str, list[float]] = {label: [] for label, _ in rows}
+        ratios: dict[str, list[float]] = {label: [] for label, _ in rows}
+        last = {}
+        for _ in range(repeat):
+            yade_s = None
+            for label, solver in rows:
+                elapsed, last[label] = timed(solver, scene)
+                yade_s = elapsed if yade_s is None else yade_s
+                seconds[label].append(elapsed)
+                ratios[label].append(elapsed / yade_s)
+        for label, _ in rows:
+            result = last[label]
+            steps = result.meta.n_steps or 0
+            median_s = statistics.median(seconds[label])
+            peak = float(abs(result.frame["theta_rad"]).max()) if len(result.frame) else float("nan")
+            print(
+                f"  {label:28s} {median_s:7.2f} s  ({statistics.median(ratios[label]):4.2f} x YADE, rounds"
+                f" {min(ratios[label]):.2f}-{max(ratios[label]):.2f})  dt {result.meta.dt_s or float('nan'):.3g} s"
+                f"  {1e6 * median_s / max(steps, 1):7.1f} us/step  peak {peak:.5f} rad  {result.status}"
+            )
 
 
 def wall_costs(duration_s: float = 0.1) -> None:
@@ -125,8 +144,9 @@ def drift(result) -> float:
 if __name__ == "__main__":
     import sys
 
-    parts = sys.argv[1:] or ["block", "wall"]
+    parts = [a for a in sys.argv[1:] if not a.startswith("--repeat=")] or ["block", "wall"]
+    rounds = [int(a.split("=", 1)[1]) for a in sys.argv[1:] if a.startswith("--repeat=")]
     if "block" in parts:
-        single_block_costs()
+        single_block_costs(rounds[-1] if rounds else 3)
     if "wall" in parts:
         wall_costs()

@@ -4,6 +4,7 @@ processes read from /proc (children, liveness)."""
 from __future__ import annotations
 
 import os
+import signal
 from pathlib import Path
 
 import pytest
@@ -119,3 +120,10 @@ def cmdline(pid: int) -> str:
         return Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
     except OSError:
         return ""
+
+
+def sigint_default() -> None:
+    """``preexec_fn`` of a child that a test interrupts with SIGINT: SIGINT's default action in
+    it, whatever the test run inherited (a shell starts a background job with SIGINT ignored,
+    and a Python started so ignores Ctrl-C)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -29,6 +29,7 @@ from rockyade.analysis.crosscheck_statistics import (
 from rockyade.errors import BatchInterruptedError, InputError
 
 from .conftest import external_records_dir, needs_records
+from .processes import sigint_default
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
@@ -387,7 +388,9 @@ def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_pa
         str(out),
     ]
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    proc = subprocess.Popen(argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    proc = subprocess.Popen(
+        argv, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, preexec_fn=sigint_default
+    )
     journal = out / "partial"
     deadline = time.monotonic() + 600
     while not list(journal.rglob("runs/*.json")) and proc.poll() is None and time.monotonic() < deadline:
@@ -850,14 +853,27 @@ def test_runs_that_failed_are_said_and_a_pair_whose_solver_always_failed_says_so
     assert "housner at dt x" not in index.split("## Failed runs")[1].split("##")[0]
 
 
-def test_a_study_expected_to_take_hours_is_refused_naming_allow_large(records, tmp_path, capsys):
-    """dt x 0.001 makes Siconos's runs hours long: refused before any run, on the run's
-    estimated time (one run) or the study's expected time (all of them), naming --allow-large."""
+def long_records(folder: Path, duration_s: float = 30.0) -> Path:
+    """Two records of ``duration_s`` (a sine pulse, then calm), m/s^2."""
+    folder.mkdir(parents=True, exist_ok=True)
+    t = np.arange(0.0, duration_s + 1e-9, 0.01)
+    for k, period in enumerate((0.45, 0.8)):
+        a = 3.0 * np.sin(2 * np.pi * t / period) * np.exp(-(((t - 1.2) / 0.6) ** 2))
+        lines = [f"# long record {k + 1}", "t_s,accel_m_s2"] + [f"{x:.4f},{y:.6g}" for x, y in zip(t, a, strict=True)]
+        (folder / f"long{k + 1}.csv").write_text("\n".join(lines) + "\n")
+    return folder
+
+
+def test_a_study_expected_to_take_hours_is_refused_naming_allow_large(tmp_path, capsys):
+    """dt x 0.001 makes Siconos's runs of 30 s records hours long (about 115 million steps of
+    60 us): refused before any run, on the run's estimated time (one run) or the study's
+    expected time (all of them), naming --allow-large."""
     from rockyade.runner.cost_limits import MAX_STUDY_S, check_study_time
 
     scene = tmp_path / "paper.toml"
     text = (EXAMPLES / "specimen1_record.toml").read_text().replace('"matched"', '"paper"')
     scene.write_text(text.replace("records/", str(EXAMPLES / "records") + "/"))
+    records = long_records(tmp_path / "long")
     argv = ["crosscheck", str(scene), "--records", str(records), "--solvers", "housner,siconos"]
     argv += ["--levels", "0.3,0.6", "--resolution", "0.5", "--out", str(tmp_path / "o"), "--quiet"]
     assert cli(*argv, "--dt-factors", "1,0.001") == 2
@@ -871,11 +887,15 @@ def test_a_study_expected_to_take_hours_is_refused_naming_allow_large(records, t
 
 
 def test_compare_prints_its_cost_and_refuses_hours(tmp_path, capsys):
-    """``rockyade compare --dt-factor 0.001`` with Siconos: refused before any run (exit 2, one
-    line naming --allow-large); before, it printed no cost and ran for minutes."""
+    """``rockyade compare --dt-factor 0.001`` with Siconos on 30 s of free rocking (about 115
+    million steps: hours): refused before any run (exit 2, one line naming --allow-large);
+    before, it printed no cost and ran for minutes."""
+    scene = tmp_path / "long.toml"
+    scene.write_text((EXAMPLES / "specimen1_free.toml").read_text().replace("duration_s = 4.0", "duration_s = 30.0"))
+    assert "duration_s = 30.0" in scene.read_text()
     code = cli(
         "compare",
-        str(EXAMPLES / "specimen1_free.toml"),
+        str(scene),
         "--solvers",
         "housner,siconos",
         "--dt-factor",

@@ -23,6 +23,7 @@ from rockyade.runner.journal import Journal, read_run, write_run
 from rockyade.scene.generators import rest_motion, stack, write_scene
 
 from .conftest import EXAMPLES
+from .processes import sigint_default
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -171,7 +172,14 @@ def _records_in(partial: Path) -> set[str]:
 def _start(folder: Path, argv: list[str]) -> subprocess.Popen[str]:
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     return subprocess.Popen(
-        argv, cwd=folder, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True, env=env
+        argv,
+        cwd=folder,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        env=env,
+        preexec_fn=sigint_default,
     )
 
 

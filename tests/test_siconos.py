@@ -29,7 +29,7 @@ from rockyade.solvers import make_solver
 from rockyade.solvers.siconos import SiconosSolver
 
 from .conftest import EXAMPLES
-from .processes import listening_of_tree, require_siconos
+from .processes import listening_of_tree, require_siconos, sigint_default
 
 RECORDS = EXAMPLES / "records"
 
@@ -313,7 +313,9 @@ def test_an_interrupted_run_leaves_no_files(tmp_path):
         f"SiconosSolver().keeping_files({str(out)!r}, 'k').run(scene)\n"
     )
     env = {**os.environ, "TMPDIR": str(scratch), "PYTHONPATH": str(Path(__file__).resolve().parents[1])}
-    proc = subprocess.Popen([sys.executable, "-c", code], env=env, stderr=subprocess.PIPE, text=True)
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code], env=env, stderr=subprocess.PIPE, text=True, preexec_fn=sigint_default
+    )
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and not list(scratch.glob("rockyade-siconos-*/*.siconos.json")):
         time.sleep(0.05)

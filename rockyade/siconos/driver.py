@@ -302,12 +302,24 @@ class Contacts:
         self.gaps = np.zeros(m)
         self.jac = np.zeros((m, 3, 6))
         self.off = np.zeros((m, 3))
+        self.q_floats = [tuple(row) for row in self.q.tolist()]
+        # the scalar path writes each pair's C row by row: (row, column of C, column of [a | b])
+        self.col_lists = [list(range(6))[c] for c in self.cols]
 
     def read_state(self):
         """The moving bodies' (x, y, theta) from Siconos into ``self.q``."""
         q, ds_of = self.q, self.ds_of
         for i in self.moving_ids:
             q[i] = ds_of[i].q()
+
+    def read_state_floats(self):
+        """The bodies' (x, y, theta) as tuples of floats (the ground's and fixed bodies' kept
+        from the start): the scalar path's state, without numpy's per-element cost."""
+        qf, ds_of = self.q_floats, self.ds_of
+        for i in self.moving_ids:
+            x, y, phi = ds_of[i].q().tolist()
+            qf[i] = (x, y, phi)
+        return qf
 
     def geometry(self):
         """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs)."""
@@ -348,9 +360,11 @@ class Contacts:
         self.gaps[:] = np.where(closed, gap, math.inf)
 
     def geometry_scalar(self):
-        """As :meth:`geometry`, pair by pair in plain Python floats: faster than numpy's
-        per-call overhead for the few pairs of a block or a small stack (SCALAR_PAIRS)."""
-        q, J, off, gaps = self.q, self.jac, self.off, self.gaps
+        """As :meth:`geometry` followed by the copy into C and e, pair by pair in plain Python
+        floats: faster than numpy's per-call overhead for the few pairs of a block or a small
+        stack (SCALAR_PAIRS). Writes each pair's C and e directly (not ``jac`` and ``off``)."""
+        q, gaps, inside_flags = self.read_state_floats(), self.gaps, self.inside
+        gap_list = [0.0] * len(self.pairs)
         for k in range(len(self.pairs)):
             a, b = self.a_list[k], self.b_list[k]
             xa, ya, pa = q[a]
@@ -369,30 +383,35 @@ class Contacts:
             sp = dx * tx + dy * ty
             slack, length = self.slack_list[k], self.length_list[k]
             inside = (self.ground_list[k] or -slack <= sp <= length + slack) and gap >= self.deep_list[k]
-            self.inside[k] = inside
+            inside_flags[k] = inside
             twin = self.twin_list[k]
-            closed = inside and not (twin >= 0 and self.inside[twin])
+            closed = inside and not (twin >= 0 and inside_flags[twin])
             rbx, rby = px - xb, py - yb
             ma, mb = self.mova_list[k], self.movb_list[k]
             row0 = (nx * ma, ny * ma, (ny * rax - nx * ray) * ma, -nx * mb, -ny * mb, -(ny * rbx - nx * rby) * mb)
             row1 = (tx * ma, ty * ma, (ty * rax - tx * ray) * ma, -tx * mb, -ty * mb, -(ty * rbx - tx * rby) * mb)
             row2 = (0.0, 0.0, TWIST_ARM * ma, 0.0, 0.0, -TWIST_ARM * mb)
-            J[k] = (row0, row1, row2)
-            off[k] = (
-                (gap - GAP_OFFSET_M if closed else 1.0)
-                - (row0[0] * xa + row0[1] * ya + row0[2] * pa + row0[3] * xb + row0[4] * yb + row0[5] * pb),
-                -(row1[0] * xa + row1[1] * ya + row1[2] * pa + row1[3] * xb + row1[4] * yb + row1[5] * pb),
-                -(row2[2] * pa + row2[5] * pb),
+            C, e = self.views[k]
+            cols = self.col_lists[k]
+            for j, col in enumerate(cols):
+                C[0, j] = row0[col]
+                C[1, j] = row1[col]
+                C[2, j] = row2[col]
+            e[0] = (gap - GAP_OFFSET_M if closed else 1.0) - (
+                row0[0] * xa + row0[1] * ya + row0[2] * pa + row0[3] * xb + row0[4] * yb + row0[5] * pb
             )
-            gaps[k] = gap if closed else math.inf
+            e[1] = -(row1[0] * xa + row1[1] * ya + row1[2] * pa + row1[3] * xb + row1[4] * yb + row1[5] * pb)
+            e[2] = -(row2[2] * pa + row2[5] * pb)
+            gap_list[k] = gap if closed else math.inf
+        gaps[:] = gap_list
 
     def update(self):
         """C and e of every pair at the bodies' current positions; the gaps (m) kept."""
-        self.read_state()
         if len(self.pairs) <= SCALAR_PAIRS:
             self.geometry_scalar()
-        else:
-            self.geometry()
+            return
+        self.read_state()
+        self.geometry()
         J, off = self.jac, self.off
         for k, (C, e) in enumerate(self.views):
             C[:] = J[k, :, self.cols[k]]
@@ -554,8 +573,8 @@ class Stepper:
         first = 0 if index >= self.back_at else self.active
         order = [first] + [k for k in range(len(self.names)) if k != first]
         saved = (
-            [(ds, np.array(ds.q()), np.array(ds.velocity())) for ds in self.moving],
-            [np.array(inter.lambda_(1)) for inter in self.contacts.inters],
+            [(ds, ds.q().tolist(), ds.velocity().tolist()) for ds in self.moving],
+            [inter.lambda_(1).tolist() for inter in self.contacts.inters],
         )
         finite = None  # the first solver whose step stayed finite, unconverged
         why = None
@@ -779,11 +798,18 @@ class Recorder:
         _write_replacing(self.out_path, write)
 
 
-def base_forces(scene):
-    """(n_steps, 2) the inertial force per unit mass at each step's middle, m/s^2:
-    (-a_h, -(g + a_v)), the samples linear between, zero outside the record."""
-    n, dt, g = scene["n_steps"], scene["dt_s"], scene["g"]
-    t = (np.arange(n) + 0.5) * dt
+#: Steps whose base forces are computed at a time (base_force_steps).
+FORCE_CHUNK = 4096
+
+
+def base_forces(scene, start=0, stop=None):
+    """(stop - start, 2) the inertial force per unit mass at the middle of steps ``start`` to
+    ``stop`` (default: the last), m/s^2: (-a_h, -(g + a_v)), the samples linear between, zero
+    outside the record."""
+    dt, g = scene["dt_s"], scene["g"]
+    stop = scene["n_steps"] if stop is None else stop
+    t = (np.arange(start, stop) + 0.5) * dt
+    n = len(t)
     out = np.zeros((n, 2))
     out[:, 1] = -g
     motion = scene["motion"]
@@ -792,6 +818,13 @@ def base_forces(scene):
         out[:, 0] -= np.interp(t, ts, np.asarray(motion["ah_m_s2"], dtype=float), left=0.0, right=0.0)
         out[:, 1] -= np.interp(t, ts, np.asarray(motion["av_m_s2"], dtype=float), left=0.0, right=0.0)
     return out
+
+
+def base_force_steps(scene):
+    """The base forces step by step as (a_x, a_y) float pairs, m/s^2, computed FORCE_CHUNK steps
+    at a time (a long run's whole array as Python floats would take gigabytes)."""
+    for start in range(0, scene["n_steps"], FORCE_CHUNK):
+        yield from base_forces(scene, start, min(start + FORCE_CHUNK, scene["n_steps"])).tolist()
 
 
 def main(scene_path, out_path, deadline=None, flush_s=None):
@@ -805,11 +838,11 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     built = build(scene, S)
     rec = Recorder(scene, built, S, out_path)
     moving = [
-        (i, ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
+        (ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
         for i, ds in enumerate(built["bodies"])
         if ds is not None
     ]
-    forces = base_forces(scene)
+    forces = base_force_steps(scene)
     dt, sps, n_steps = scene["dt_s"], scene["steps_per_sample"], scene["n_steps"]
     deadline = math.inf if deadline is None else float(deadline)
     flush_s = math.inf if flush_s is None else float(flush_s)
@@ -818,8 +851,8 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     go = rec.record(0.0)
     step = 0
     while go and step < n_steps:
-        ax, ay = forces[step]
-        for _i, ds, m, load in moving:
+        ax, ay = next(forces)
+        for ds, m, load in moving:
             if load is None:
                 ds.setFExtPtr([m * ax, m * ay, 0.0])
             else:

@@ -126,8 +126,14 @@ class SiconosSolver(SolverBase):
         "newton_max_iter": _check_count(1, 100),
         "workdir": _check_folder,
     }
-    #: Siconos's time per body-step, s (cost estimate; benchmarks/bench_siconos.py).
-    SECONDS_PER_BODY_STEP: ClassVar[float] = 1e-3
+    #: Siconos's time per step of one moving block, s, and how it grows with n moving blocks:
+    #: SECONDS_PER_STEP x n ** STEP_EXPONENT (cost estimate). Measured on the 2-core machine
+    #: (docs/siconos.md, benchmarks/bench_siconos.py): one block 55-75 us a step; the 13-block
+    #: arch at rest 86 ms; the 20-voussoir arch collapsing 50 ms; the 33-block wall 98 ms at
+    #: rest and 1.3 s under a pulse (NSGS's iterations on the hyperstatic joints): n ** 2.5
+    #: gives 36, 107 and 380 ms for these, within a factor of 4 of each.
+    SECONDS_PER_STEP: ClassVar[float] = 6e-5
+    STEP_EXPONENT: ClassVar[float] = 2.5
 
     timeout_s: float | None = None
     warm: bool = True
@@ -220,12 +226,14 @@ class SiconosSolver(SolverBase):
         check_target_mu(scene, self.model(scene))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Body-steps at the Siconos time step, SECONDS_PER_BODY_STEP each."""
+        """Steps at the Siconos time step, SECONDS_PER_STEP x n ** STEP_EXPONENT each for n
+        moving blocks (the one-step problem's assembly and solution grow faster than n)."""
         model = self.model(scene)
         numerics, _ = self.numerics(model)
         moving = max(1, len(model.moving))
-        steps = float(scene.n_samples - 1) * numerics.steps_per_sample * moving
-        return stepped_cost(scene, self.name, steps, numerics.dt_s, steps * self.SECONDS_PER_BODY_STEP)
+        steps = float(scene.n_samples - 1) * numerics.steps_per_sample
+        per_step = self.SECONDS_PER_STEP * moving**self.STEP_EXPONENT
+        return stepped_cost(scene, self.name, steps * moving, numerics.dt_s, steps * per_step)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
         """This solver keeping a failed run's files in ``folder``, named ``stem`` (default: by
