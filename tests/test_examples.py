@@ -25,7 +25,7 @@ GALLERY = sorted((EXAMPLES / "gallery").glob("*.py"))
 @pytest.mark.parametrize("name", ["ec8_type2_D_record21", "ricker_pulse_T0.5s"])
 def test_example_records_read_alike_in_both_formats(name):
     at2 = read_record(RECORDS / f"{name}.AT2")
-    csv = read_record(RECORDS / f"{name}.csv")
+    csv = read_record(RECORDS.parent / "records_csv" / f"{name}.csv")
     assert "SYNTHETIC" in at2.title
     assert at2.npts == csv.npts and at2.dt_s == pytest.approx(csv.dt_s)
     # the AT2 holds 8 significant digits in g (standard gravity); the reader's g may differ by 0.04 %
@@ -33,7 +33,7 @@ def test_example_records_read_alike_in_both_formats(name):
 
 
 def test_the_ricker_record_is_the_pulse_it_says():
-    rec = read_record(RECORDS / "ricker_pulse_T0.5s.csv")
+    rec = read_record(RECORDS.parent / "records_csv" / "ricker_pulse_T0.5s.csv")
     expected = Pulse("ricker", amplitude_m_s2=3.0, period_s=0.5, start_s=1.0).acceleration(rec.t_s)
     np.testing.assert_allclose(rec.accel_m_s2, expected, atol=1e-7)
 
@@ -87,3 +87,14 @@ def test_gallery_script_runs_and_writes_its_figure(script, tmp_path):
 
 def test_the_gallery_has_scripts():
     assert len(GALLERY) >= 3
+
+
+@pytest.mark.parametrize("folder", ["records", "records_csv"])
+def test_each_shipped_records_folder_is_a_suite(folder):
+    """`--records examples/records` (and `examples/records_csv`) reads as a suite of the two
+    example records: the AT2 and CSV twins live in separate folders, so neither counts twice."""
+    from rockyade.assess.motions import records_in_folder
+
+    suite = records_in_folder(EXAMPLES / folder)
+    names = sorted(Path(f).stem for f in suite.files)
+    assert names == ["ec8_type2_D_record21", "ricker_pulse_T0.5s"]

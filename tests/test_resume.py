@@ -362,7 +362,7 @@ def test_linked_records_are_followed_and_counted(tmp_path, records):
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     shutil.copy(EXAMPLES / "records" / "ec8_type2_D_record21.AT2", elsewhere / "b.AT2")
-    half = pd.read_csv(EXAMPLES / "records" / "ec8_type2_D_record21.csv", comment="#")
+    half = pd.read_csv(EXAMPLES / "records_csv" / "ec8_type2_D_record21.csv", comment="#")
     half["accel_m_s2"] *= 0.5  # another accelerogram
     half.to_csv(elsewhere / "c.csv", index=False)
     mixed = tmp_path / "mixed"

@@ -48,12 +48,22 @@ def installed(tmp_path_factory) -> Path:
     tmp = tmp_path_factory.mktemp("wheel")
     src = tmp / "src"
     shutil.copytree(ROOT, src, ignore=SKIP)
-    _run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "--quiet", "-w", str(tmp / "dist")], tmp)
+    build = _run([sys.executable, "-m", "pip", "wheel", str(src), "--no-deps", "-v", "-w", str(tmp / "dist")], tmp)
+    (tmp / "build.log").write_text(build.stdout + build.stderr)
     [wheel] = (tmp / "dist").glob("rockyade-*.whl")
     _run([sys.executable, "-m", "venv", str(tmp / "venv")], tmp)
     bin_dir = tmp / "venv" / "bin"
     _run([str(bin_dir / "python"), "-m", "pip", "install", "--quiet", "--disable-pip-version-check", str(wheel)], tmp)
     return bin_dir
+
+
+def test_building_the_wheel_prints_no_packaging_warning(installed):
+    """Every folder of examples/ is declared (setup.py), so setuptools has nothing to warn about
+    (it printed 'Package rockyade.examples.assemblies is absent from the packages configuration'
+    for each of them, some 270 lines at set-up)."""
+    log = (installed.parent.parent / "build.log").read_text()
+    assert "absent from the `packages` configuration" not in log
+    assert "BuildBackendWarning" not in log and "SetuptoolsDeprecationWarning" not in log
 
 
 def test_the_wheel_carries_the_package_data_and_runs_from_another_folder(installed, tmp_path):

@@ -75,8 +75,13 @@ def main(out: Path) -> None:
     """Write every example record into ``out``."""
     for name, (accel, dt, title) in example_records().items():
         write_text(out / f"{name}.AT2", at2_text(accel, dt, title))
-        write_text(out / f"{name}.csv", csv_text(accel, dt, title))
-        print(f"wrote {out / name}.AT2 and .csv: {accel.size} samples at {dt:g} s, PGA {np.abs(accel).max():.4g} m/s^2")
+        csv_folder = out.parent / f"{out.name}_csv"
+        csv_folder.mkdir(parents=True, exist_ok=True)
+        write_text(csv_folder / f"{name}.csv", csv_text(accel, dt, title))
+        print(
+            f"wrote {out / name}.AT2 and {csv_folder / name}.csv: {accel.size} samples at {dt:g} s, "
+            f"PGA {np.abs(accel).max():.4g} m/s^2"
+        )
 
 
 if __name__ == "__main__":
