@@ -205,12 +205,12 @@ def test_a_scene_that_cannot_stand_has_no_verdict():
         ]
     )
     with pytest.raises(SceneCannotStandError):
-        assess(overhang, Site(1, "B", 0.1 * G))
+        assess(overhang, Site(1, "B", 0.1 * G), fc=1.35)
 
 
 def test_the_dynamic_part_is_refused_at_height():
     with pytest.raises(InputError) as info:
-        assess(wall_scene(), Site(1, "B", 0.1 * G), position=Position(6.0, 9.0, 3), dynamic=DynamicSettings())
+        assess(wall_scene(), Site(1, "B", 0.1 * G), fc=1.35, position=Position(6.0, 9.0, 3), dynamic=DynamicSettings())
     assert info.value.field == "--static-only"
 
 
@@ -405,7 +405,7 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
     from rockyade.scene import load_scene
 
     scene = load_scene(EXAMPLES / "free_standing_wall.toml")
-    a = assess(scene, Site(1, "B", 0.25 * G, 1.0), direction="+x")
+    a = assess(scene, Site(1, "B", 0.25 * G, 1.0), fc=1.35, direction="+x")
     add_pushover(a, scene)
     kin, push = a.limit.kinematic, a.pushover
     assert kin is not None and push is not None
@@ -431,6 +431,8 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
             [
                 "assess",
                 str(EXAMPLES / "free_standing_wall.toml"),
+                "--knowledge-level",
+                "LC1",
                 "--spectrum-type",
                 "1",
                 "--ground",

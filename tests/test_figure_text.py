@@ -110,6 +110,8 @@ def drawn(monkeypatch):
         [
             "assess",
             "free_standing_wall.toml",
+            "--knowledge-level",
+            "LC1",
             "--spectrum-type",
             "1",
             "--ground",
