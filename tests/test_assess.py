@@ -38,7 +38,7 @@ from rockyade.runner import Executor
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import rest_motion, stack
 
-from .conftest import EXAMPLES
+from .conftest import EC8_LC1, EXAMPLES
 from .limit_scenes import block_scene, positioned_scene
 
 THREADS = Executor("threads", 1)
@@ -431,14 +431,7 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
             [
                 "assess",
                 str(EXAMPLES / "free_standing_wall.toml"),
-                "--knowledge-level",
-                "LC1",
-                "--spectrum-type",
-                "1",
-                "--ground",
-                "B",
-                "--ag",
-                "0.25g",
+                *EC8_LC1,
                 "--static-only",
                 "--pushover",
                 "--out",

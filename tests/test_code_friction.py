@@ -11,23 +11,14 @@ frictionless 1.3019, the closed form of tests/test_restraints.py.
 from __future__ import annotations
 
 import json
-import math
 
 import pytest
 
 from rockyade.cli import main
-from rockyade.constants import G
 from rockyade.limit import limit_analysis
+from rockyade.studies.verify_assess import squeezed_top
 
 from .limit_scenes import block_scene, corner_friction_wall
-
-
-def squeezed_top() -> float:
-    """The frictionless corner's mechanism (tests/test_restraints.py): the seven lower courses turn
-    about the toe, the top course is squeezed up: (W_L t/2 + (W_c + N)(t + 2.1 tan 35)) / (W_L 1.05)."""
-    wc = 1600.0 * G * 0.36 * 0.3
-    wl = 7 * wc
-    return (wl * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (wl * 1.05)
 
 
 def test_the_code_takes_the_coulomb_multiplier_where_the_mechanism_slides():

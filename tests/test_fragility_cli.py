@@ -11,7 +11,7 @@ import pytest
 from rockyade.cli import main
 from rockyade.scene.generators import rest_motion, stack, write_scene
 
-from .conftest import EXAMPLES
+from .conftest import EC8_LC1, EXAMPLES
 
 #: What the assessment's JSON holds at least (the brief's keys and the checks).
 ASSESS_KEYS = (
@@ -158,14 +158,7 @@ def test_assess_static_only_gives_the_documented_json(capsys, wall):
         capsys,
         "assess",
         wall,
-        "--knowledge-level",
-        "LC1",
-        "--spectrum-type",
-        "1",
-        "--ground",
-        "B",
-        "--ag",
-        "0.25g",
+        *EC8_LC1,
         "--static-only",
         "--json",
     )
@@ -189,14 +182,7 @@ def test_assess_text_and_files_with_the_dynamics(capsys, tmp_path, wall, records
         capsys,
         "assess",
         wall,
-        "--knowledge-level",
-        "LC1",
-        "--spectrum-type",
-        "1",
-        "--ground",
-        "B",
-        "--ag",
-        "0.25g",
+        *EC8_LC1,
         "--records",
         records,
         "--load-factors",
@@ -228,14 +214,7 @@ def test_assess_at_height_uses_the_floor_demand(capsys, wall):
         capsys,
         "assess",
         wall,
-        "--knowledge-level",
-        "LC1",
-        "--spectrum-type",
-        "1",
-        "--ground",
-        "B",
-        "--ag",
-        "0.25g",
+        *EC8_LC1,
         "--z",
         "6",
         "--building-height",

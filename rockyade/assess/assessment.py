@@ -37,6 +37,7 @@ from rockyade.assess.code import (
     code_checks,
     verdict,
 )
+from rockyade.assess.directions import load_sides, toward_loaded_side
 from rockyade.assess.fragility_analysis import (
     FragilityPlan,
     FragilityResult,
@@ -341,28 +342,6 @@ def rigid_body_mechanism(limit: LimitResult) -> dict[str, Any] | None:
         "a0_star_one_body_m_s2": a0_one,
         "note": note,
     }
-
-
-def load_sides(limit: LimitResult) -> list[dict[str, Any]]:
-    """Each load on a moving block with the side of the block's axis it bears on: ``+x``, ``-x`` or
-    ``axis`` (within 1e-6 of the block's width), with its offset from the block's own centroid, m."""
-    model = limit.model
-    own = model.centroids_m if model.block_centroids_m is None else model.block_centroids_m
-    out = []
-    for k, q in enumerate(model.given_loads):
-        i = int(q.block)
-        if model.fixed[i]:
-            continue
-        width = float(np.ptp(model.polygons_m[i][:, 0]))
-        offset = float(q.point_m[0]) - float(own[i][0])
-        side = "axis" if abs(offset) <= 1e-6 * width else ("+x" if offset > 0 else "-x")
-        out.append({"load": k, "block": model.names[i], "offset_m": offset, "side": side, "force_N": list(q.force_N)})
-    return out
-
-
-def toward_loaded_side(limit: LimitResult) -> list[int]:
-    """The loads (their index) on the side the governing mechanism turns to (:func:`load_sides`)."""
-    return [q["load"] for q in load_sides(limit) if q["side"] == limit.direction]
 
 
 def _limit(

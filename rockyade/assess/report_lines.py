@@ -5,8 +5,9 @@ from __future__ import annotations
 
 import math
 
-from rockyade.assess.assessment import Assessment, load_sides, toward_loaded_side
+from rockyade.assess.assessment import Assessment
 from rockyade.assess.code import NOT_APPLICABLE, Q_CLAUSE, VERIFIED, Check
+from rockyade.assess.directions import load_sides, toward_loaded_side
 from rockyade.assess.fragility_analysis import FragilityPlan, FragilityResult
 from rockyade.assess.stripes import collapse_rule
 from rockyade.constants import CODE_GRAVITY as G

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, replace
+from typing import Any
 
 import numpy as np
 
@@ -282,15 +283,22 @@ def rigid_body_classical(
         I_O_kgm2=governing.I_O_kgm2,
         I_c_kgm2=inertia_c_kgm2,
         centroid_height_m=cy,
-        uplift_accel_m_s2=min(left.uplift_accel_m_s2, right.uplift_accel_m_s2),
-        left=left,
-        right=right,
-        mu_left_to_right=mu_lr,
-        mu_right_to_left=mu_rl,
         symmetric=symmetric,
         source={"alpha_rad": "geometry", "p_rad_s": "geometry", "mu": "geometry"},
         carried_kg=carried_kg,
+        **_sides(left, right),
     )
+
+
+def _sides(left: Pivot, right: Pivot) -> dict[str, Any]:
+    """The fields of :class:`ClassicalParameters` that follow from its two directions."""
+    return {
+        "left": left,
+        "right": right,
+        "mu_left_to_right": left.mu,
+        "mu_right_to_left": right.mu,
+        "uplift_accel_m_s2": min(left.uplift_accel_m_s2, right.uplift_accel_m_s2),
+    }
 
 
 def with_overrides(
@@ -306,7 +314,7 @@ def with_overrides(
     acceleration is g tan(alpha))."""
     check_classical_overrides(alpha_rad, p_rad_s, mu)
     left, right, source = cp.left, cp.right, dict(cp.source)
-    a, p, m, mu_lr, mu_rl = cp.alpha_rad, cp.p_rad_s, cp.mu, cp.mu_left_to_right, cp.mu_right_to_left
+    a, p, m = cp.alpha_rad, cp.p_rad_s, cp.mu
     if alpha_rad is not None:
         a, source["alpha_rad"] = float(alpha_rad), "override"
         up = uplift_acceleration(a, g)
@@ -316,22 +324,9 @@ def with_overrides(
         left, right = (replace(pv, p_rad_s=p) for pv in (left, right))
     if mu is not None:
         m, source["mu"] = float(mu), "override"
-        mu_lr = mu_rl = m
         left, right = (replace(pv, mu=m) for pv in (left, right))
     symmetric = cp.symmetric or (alpha_rad is not None and p_rad_s is not None and mu is not None)
-    return replace(
-        cp,
-        alpha_rad=a,
-        p_rad_s=p,
-        mu=m,
-        uplift_accel_m_s2=min(left.uplift_accel_m_s2, right.uplift_accel_m_s2),
-        left=left,
-        right=right,
-        mu_left_to_right=mu_lr,
-        mu_right_to_left=mu_rl,
-        symmetric=symmetric,
-        source=source,
-    )
+    return replace(cp, alpha_rad=a, p_rad_s=p, mu=m, symmetric=symmetric, source=source, **_sides(left, right))
 
 
 def classical_parameters(

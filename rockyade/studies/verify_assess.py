@@ -137,14 +137,21 @@ def corner_friction_wall(corner_friction_deg: float = 35.0) -> Scene:
     return scene_from_dict(data)
 
 
+def squeezed_top() -> float:
+    """The restrained wall's multiplier towards its restraint with the corner frictionless (tests/test_restraints.py):
+    the seven lower courses turn about the toe and the top course (W_c = 1600 g 0.36 0.3 a course) and the roof
+    (N = 6000 N, without mass) rise t + 2.1 tan 35: (W_L t/2 + (W_c + N)(t + 2.1 tan 35)) / (W_L 1.05), W_L = 7 W_c."""
+    wc = 1600.0 * G * 0.36 * 0.3
+    return (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
+
+
 def check_code_friction(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """The restrained wall towards its restraint: with the corner frictionless both rules give the
     closed form (W_L t/2 + (W_c + N)(t + 2.1 tan 35)) / (W_L 1.05) = 1.3019 (tests/test_restraints.py);
     with it at 35 degrees the coulomb multiplier lies below the associated one and the code takes it."""
     from rockyade.limit import limit_analysis
 
-    wc = 1600.0 * G * 0.36 * 0.3
-    closed = (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
+    closed = squeezed_top()
     free = limit_analysis(corner_friction_wall(0.0), "+x", coulomb_check=True, nonlinear=False)
     rough = limit_analysis(corner_friction_wall(35.0), "+x", coulomb_check=True, nonlinear=False)
     if rough.friction_check is None or rough.load_multiplier is None:
@@ -152,25 +159,20 @@ def check_code_friction(solvers: list[str]) -> tuple[list[Row], dict[str, Result
     coulomb = known(rough.friction_check.coulomb_multiplier, "coulomb multiplier")
     code = known(rough.for_code.load_multiplier, "code multiplier")
     closed_src = "(W_L t/2 + (W_c + N)(t + 2.1 tan 35)) / (W_L 1.05)"
+    rows = [
+        Row(
+            "code_friction",
+            "limit",
+            f"frictionless corner: {what} lambda",
+            known(lam, "lambda"),
+            closed,
+            closed_src,
+            relative(1e-9),
+        )
+        for what, lam in (("associated", free.load_multiplier), ("the code's", free.for_code.load_multiplier))
+    ]
     return [
-        Row(
-            "code_friction",
-            "limit",
-            "frictionless corner: associated lambda",
-            known(free.load_multiplier, "lambda"),
-            closed,
-            closed_src,
-            relative(1e-9),
-        ),
-        Row(
-            "code_friction",
-            "limit",
-            "frictionless corner: the code's lambda",
-            known(free.for_code.load_multiplier, "lambda"),
-            closed,
-            closed_src,
-            relative(1e-9),
-        ),
+        *rows,
         Row(
             "code_friction",
             "limit",
