@@ -4,9 +4,9 @@ The rigid-block model puts a hinge at the edge of its joint, where a rigid, infi
 material would carry the joint's normal force N on a line. Masonry of compressive strength fm
 carries it on a compressed zone of finite width. With the equivalent rectangular stress block of
 0.85 fm over the zone (the block of NTC 2018 7.8.2.2.1, Eq 7.8.2, for masonry in combined
-compression and bending, Mu = (l^2 t sigma0 / 2)(1 - sigma0 / (0.85 fd)); EN 1996-1-1 6.1.2.2 uses
-the same rectangular block), a joint of length L and depth t (the wall's length out of the
-section) carrying N has a compressed zone of width
+compression and bending, Mu = (l^2 t sigma0 / 2)(1 - sigma0 / (0.85 fd)); EN 1996-1-1 6.1.2.2,
+Eq 6.4, Phi_i = 1 - 2 e_i / t, is a rectangular block too, at fd), a joint of length L and depth
+t (the wall's length out of the section) carrying N has a compressed zone of width
 
     a = N / (0.85 fm t),
 
@@ -45,7 +45,8 @@ STRESS_BLOCK_FACTOR = 0.85
 STRESS_BLOCK = (
     "equivalent rectangular stress block 0.85 fm over the compressed zone a = N / (0.85 fm t), the hinge at its "
     "resultant a / 2 inside the joint's edge (NTC 2018 7.8.2.2.1 Eq 7.8.2, Mu = (l^2 t sigma0 / 2)(1 - sigma0 / "
-    "(0.85 fd)); EN 1996-1-1 6.1.2.2; the hinge moved into the section as Circolare 2019 C8.7.1 allows)"
+    "(0.85 fd)); a rectangular block as EN 1996-1-1 6.1.2.2 Eq 6.4; the hinge moved into the section as Circolare "
+    "2019 C8.7.1 allows)"
 )
 #: fm accepted, MPa: (0, FM_MAX_MPA].
 FM_MAX_MPA = 1.0e9
