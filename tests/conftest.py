@@ -10,6 +10,8 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
+#: An EC8 site (Type 1, ground B, ag = 0.25 g) and the knowledge level LC1 (FC = 1.35) of ``rockyade assess``.
+EC8_LC1 = ["--knowledge-level", "LC1", "--spectrum-type", "1", "--ground", "B", "--ag", "0.25g"]
 
 #: Environment variable naming a folder of external records (PEER NGA .AT2 files) that
 #: some tests read. rockyade ships no real record; these tests skip when it is unset.

@@ -58,3 +58,12 @@ def positioned_scene(blocks: list[dict], friction_deg: float = 30.0, joints: lis
     if joints:
         data["joints"] = joints
     return scene_from_dict(data)
+
+
+def corner_friction_wall(corner_friction_deg: float = 35.0):
+    """The 8-course tuff wall restrained on the far face of its top course, its roof without mass and the
+    restraint's contact with the top corner of the course below at ``corner_friction_deg``
+    (:func:`rockyade.studies.verify_assess.corner_friction_wall`)."""
+    from rockyade.studies.verify_assess import corner_friction_wall as scene
+
+    return scene(corner_friction_deg)

@@ -38,7 +38,7 @@ from rockyade.runner import Executor
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import rest_motion, stack
 
-from .conftest import EXAMPLES
+from .conftest import EC8_LC1, EXAMPLES
 from .limit_scenes import block_scene, positioned_scene
 
 THREADS = Executor("threads", 1)
@@ -205,12 +205,12 @@ def test_a_scene_that_cannot_stand_has_no_verdict():
         ]
     )
     with pytest.raises(SceneCannotStandError):
-        assess(overhang, Site(1, "B", 0.1 * G))
+        assess(overhang, Site(1, "B", 0.1 * G), fc=1.35)
 
 
 def test_the_dynamic_part_is_refused_at_height():
     with pytest.raises(InputError) as info:
-        assess(wall_scene(), Site(1, "B", 0.1 * G), position=Position(6.0, 9.0, 3), dynamic=DynamicSettings())
+        assess(wall_scene(), Site(1, "B", 0.1 * G), fc=1.35, position=Position(6.0, 9.0, 3), dynamic=DynamicSettings())
     assert info.value.field == "--static-only"
 
 
@@ -405,7 +405,7 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
     from rockyade.scene import load_scene
 
     scene = load_scene(EXAMPLES / "free_standing_wall.toml")
-    a = assess(scene, Site(1, "B", 0.25 * G, 1.0), direction="+x")
+    a = assess(scene, Site(1, "B", 0.25 * G, 1.0), fc=1.35, direction="+x")
     add_pushover(a, scene)
     kin, push = a.limit.kinematic, a.pushover
     assert kin is not None and push is not None
@@ -431,12 +431,7 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
             [
                 "assess",
                 str(EXAMPLES / "free_standing_wall.toml"),
-                "--spectrum-type",
-                "1",
-                "--ground",
-                "B",
-                "--ag",
-                "0.25g",
+                *EC8_LC1,
                 "--static-only",
                 "--pushover",
                 "--out",

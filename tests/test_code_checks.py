@@ -30,6 +30,8 @@ from rockyade.scene.generators import rest_motion, stack
 from .conftest import EXAMPLES
 
 NTC = ["--ag", "0.2g", "--f0", "2.4", "--tc-star", "0.3", "--soil", "B"]
+#: The knowledge level LC1 (FC = 1.35), which ``rockyade assess`` needs.
+LC1 = ["--knowledge-level", "LC1"]
 
 
 def courses(n: int, width: float = 0.3, height: float = 2.4):
@@ -92,16 +94,15 @@ def test_every_check_names_its_clause_and_formula():
 
 def test_the_checks_not_made_are_in_the_output_itself(tmp_path, capsys):
     scene = roof_wall(tmp_path, capsys)
-    assert main(["assess", str(scene), *NTC, "--static-only", "--json"]) == 0
+    assert main(["assess", str(scene), *LC1, *NTC, "--static-only", "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["notes"], "the JSON lists the checks not made"
     not_made = [n for n in data["notes"] if n.startswith("not made: ")]
     assert any("sliding mechanisms" in n for n in not_made) and any("SLD" in n for n in not_made)
     assert all(c["source"] for c in data["checks"])
     assert data["site"]["spectrum_code"] == "ntc2018" and data["g_m_s2"] == CODE_GRAVITY
-    assert (
-        main(["assess", str(scene), *NTC, "--static-only", "--z", "6", "--building-height", "9", "--storeys", "3"]) == 0
-    )
+    height = ["--z", "6", "--building-height", "9", "--storeys", "3"]
+    assert main(["assess", str(scene), *LC1, *NTC, "--static-only", *height]) == 0
     text = capsys.readouterr().out
     assert "checks not made:" in text and "the nonlinear check at height" in text
     assert "clause: Circolare 2009 C8A.4.2.3 form, kept (NOT the 2019 form)" in text
@@ -111,12 +112,12 @@ def test_every_load_says_whether_its_mass_takes_part(tmp_path, capsys):
     """The engineer's roof: alpha0 = 0.1050 with its mass (test_loads checks it by hand), 0.1979 without."""
     for mass, alpha0, words in (("carried", 0.1050, "with its mass 611.6 kg"), ("none", 0.1979, "without mass")):
         scene = roof_wall(tmp_path, capsys, mass)
-        assert main(["assess", str(scene), *NTC, "--static-only", "--json"]) == 0
+        assert main(["assess", str(scene), *LC1, *NTC, "--static-only", "--json"]) == 0
         data = json.loads(capsys.readouterr().out)
         [load] = data["loads"]
         assert load["mass_takes_part"] == (mass == "carried")
         assert round(data["alpha0"], 4) == alpha0
-        assert main(["assess", str(scene), *NTC, "--static-only"]) == 0
+        assert main(["assess", str(scene), *LC1, *NTC, "--static-only"]) == 0
         assert words in capsys.readouterr().out
         assert main(["limit", str(scene)]) == 0
         assert words in capsys.readouterr().out
@@ -127,11 +128,11 @@ def test_courses_that_turn_as_one_body_are_said_to_and_their_e_star_explained():
     n = 4 is 0.25 / (1/3 - 1/192) = 0.76190; the same body as one block has e* = 1, so a0* is
     1 / 0.76190 = 1.3125 times the monolith's."""
     site = Site(1, "B", 0.25 * G)
-    result = assess(courses(4), site)
+    result = assess(courses(4), site, fc=1.35)
     rigid = result.to_dict()["rigid_body_mechanism"]
     assert rigid["e_star_blocks"] == pytest.approx(0.25 / (1 / 3 - 1 / 192), rel=1e-9)
     assert rigid["e_star_one_body"] == pytest.approx(1.0, rel=1e-9)
-    monolith = assess(courses(1), site)
+    monolith = assess(courses(1), site, fc=1.35)
     assert rigid["a0_star_one_body_m_s2"] == pytest.approx(monolith.limit.kinematic.a0_star_m_s2, rel=1e-9)
     assert any("not expected to act as separate blocks" in n for n in result.notes)
     assert monolith.to_dict()["rigid_body_mechanism"] is None
@@ -139,33 +140,16 @@ def test_courses_that_turn_as_one_body_are_said_to_and_their_e_star_explained():
 
 def test_assess_takes_the_ntc_spectrum_unless_ec8_is_asked_for(tmp_path, capsys):
     scene = str(EXAMPLES / "free_standing_wall.toml")
-    assert main(["assess", scene, "--ag", "0.2g", "--static-only"]) == 2
+    assert main(["assess", scene, *LC1, "--ag", "0.2g", "--static-only"]) == 2
     assert "--f0" in capsys.readouterr().err
-    assert main(["assess", scene, *NTC, "--ground", "B", "--static-only"]) == 2
+    assert main(["assess", scene, *LC1, *NTC, "--ground", "B", "--static-only"]) == 2
     assert "EC8 option" in capsys.readouterr().err
-    assert main(["assess", scene, "--spectrum", "ec8", "--ag", "0.25g", "--ground", "B", "--static-only"]) == 2
+    ec8 = ["assess", scene, *LC1, "--spectrum", "ec8"]
+    assert main([*ec8, "--ag", "0.25g", "--ground", "B", "--static-only"]) == 2
     assert "--spectrum-type" in capsys.readouterr().err
-    assert (
-        main(
-            [
-                "assess",
-                scene,
-                "--spectrum",
-                "ec8",
-                "--spectrum-type",
-                "1",
-                "--ground",
-                "B",
-                "--ag",
-                "0.25g",
-                "--static-only",
-                "--json",
-            ]
-        )
-        == 0
-    )
+    assert main([*ec8, "--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--static-only", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["site"]["spectrum_code"] == "ec8"
-    assert main(["assess", scene, *NTC, "--count", "3"]) == 2
+    assert main(["assess", scene, *LC1, *NTC, "--count", "3"]) == 2
     assert "--records" in capsys.readouterr().err
 
 

@@ -15,6 +15,8 @@ from rockyade.figures.legibility import covered_markers, overlapping_texts
 from rockyade.studies import fragility_study, overturning
 from rockyade.studies.report import Report
 
+from .conftest import EC8_LC1
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
@@ -110,12 +112,7 @@ def drawn(monkeypatch):
         [
             "assess",
             "free_standing_wall.toml",
-            "--spectrum-type",
-            "1",
-            "--ground",
-            "B",
-            "--ag",
-            "0.25g",
+            *EC8_LC1,
             "--static-only",
             "--out",
             "OUT/wall",

@@ -11,7 +11,7 @@ import pytest
 from rockyade.cli import main
 from rockyade.scene.generators import rest_motion, stack, write_scene
 
-from .conftest import EXAMPLES
+from .conftest import EC8_LC1, EXAMPLES
 
 #: What the assessment's JSON holds at least (the brief's keys and the checks).
 ASSESS_KEYS = (
@@ -155,7 +155,12 @@ def test_a_level_out_of_a_records_reach_is_refused_before_any_run(capsys, tmp_pa
 
 def test_assess_static_only_gives_the_documented_json(capsys, wall):
     code, text, _ = run_cli(
-        capsys, "assess", wall, "--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--static-only", "--json"
+        capsys,
+        "assess",
+        wall,
+        *EC8_LC1,
+        "--static-only",
+        "--json",
     )
     assert code == 0
     data = json.loads(text)
@@ -177,12 +182,7 @@ def test_assess_text_and_files_with_the_dynamics(capsys, tmp_path, wall, records
         capsys,
         "assess",
         wall,
-        "--spectrum-type",
-        "1",
-        "--ground",
-        "B",
-        "--ag",
-        "0.25g",
+        *EC8_LC1,
         "--records",
         records,
         "--load-factors",
@@ -214,12 +214,7 @@ def test_assess_at_height_uses_the_floor_demand(capsys, wall):
         capsys,
         "assess",
         wall,
-        "--spectrum-type",
-        "1",
-        "--ground",
-        "B",
-        "--ag",
-        "0.25g",
+        *EC8_LC1,
         "--z",
         "6",
         "--building-height",
@@ -255,7 +250,7 @@ def test_assess_at_height_uses_the_floor_demand(capsys, wall):
 def test_assess_bad_input_exits_2_naming_the_option(capsys, wall, site, extra, option):
     given = {"--spectrum-type": "1", "--ground": "B", "--ag": "0.25g", **site}
     argv = [x for pair in given.items() for x in pair] + extra
-    code, _, err = run_cli(capsys, "assess", wall, *argv, "--quiet")
+    code, _, err = run_cli(capsys, "assess", wall, "--knowledge-level", "LC1", *argv, "--quiet")
     assert code == 2, err
     assert err.count("\n") == 1 and option in err and "Traceback" not in err
 
@@ -268,7 +263,9 @@ def test_a_wall_that_cannot_stand_exits_1_without_a_number(capsys, tmp_path):
         {"name": "b", "width_m": 0.4, "height_m": 0.2, "position_m": [0.35, 1], **common},
     ]
     write_scene(path, {"duration_s": 1.0, "sample_dt_s": 0.01, "blocks": blocks, "motion": rest_motion()})
-    code, out, err = run_cli(capsys, "assess", path, "--spectrum-type", "1", "--ground", "B", "--ag", "0.2g")
+    code, out, err = run_cli(
+        capsys, "assess", path, "--knowledge-level", "LC1", "--spectrum-type", "1", "--ground", "B", "--ag", "0.2g"
+    )
     assert code == 1 and "cannot stand" in err and out == ""
     code, out, err = run_cli(capsys, "fragility", path, "--suite", "paper", "--count", "1", "--out", tmp_path / "o")
     assert code == 1 and "cannot stand" in err

@@ -46,6 +46,8 @@ def test_motion_info_and_assess_print_the_same_m_s2_for_the_same_g(tmp_path, cap
     args = [
         "assess",
         str(scene),
+        "--knowledge-level",
+        "LC1",
         "--spectrum",
         "ec8",
         "--spectrum-type",
@@ -77,6 +79,8 @@ def test_limit_and_assess_print_the_same_a0_star(capsys):
         [
             "assess",
             str(scene),
+            "--knowledge-level",
+            "LC1",
             "--spectrum",
             "ec8",
             "--spectrum-type",

@@ -199,17 +199,17 @@ def test_assess_passes_the_rule_through_and_always_says_the_friction_note(tmp_pa
     path = tmp_path / "panel.toml"
     write_scene(path, _panel_data())
     site = ["--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--static-only", "--direction", "+x"]
-    assert main(["assess", str(path), *site, "--json"]) == 0
+    assert main(["assess", str(path), "--knowledge-level", "LC1", *site, "--json"]) == 0
     associated = json.loads(capsys.readouterr().out)
     assert associated["load_multiplier"] == pytest.approx(0.5, rel=1e-9)
     assert associated["mechanism"]["friction_rule"] == "associated" and associated["mechanism"]["sliding"] == []
     assert any("--friction-rule coulomb" in note for note in associated["limit_notes"])
-    assert main(["assess", str(path), *site, "--friction-rule", "coulomb", "--json"]) == 0
+    assert main(["assess", str(path), "--knowledge-level", "LC1", *site, "--friction-rule", "coulomb", "--json"]) == 0
     coulomb = json.loads(capsys.readouterr().out)
     assert coulomb["mechanism"]["friction_rule"] == "coulomb" and coulomb["mechanism"]["iterations"] > 1
     assert abs(coulomb["load_multiplier"] / HEEL - 1.0) <= 0.02
-    assert main(["assess", str(path), *site]) == 0
+    assert main(["assess", str(path), "--knowledge-level", "LC1", *site]) == 0
     out = capsys.readouterr().out
     assert "note: with finite friction the rigid-block programme assumes associated" in out
-    assert main(["assess", str(path), *site, "--friction-rule", "tresca"]) == 2
+    assert main(["assess", str(path), "--knowledge-level", "LC1", *site, "--friction-rule", "tresca"]) == 2
     assert "--friction-rule: must be one of associated, coulomb" in capsys.readouterr().err

@@ -466,9 +466,9 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
     """Ctrl-C in the dynamics of ``assess --out``: the static answer is written (marked
     partial) with the runs that finished, and ``--resume`` runs only the others."""
     factors = ",".join(f"{0.5 + 0.1 * i:.1f}" for i in range(15))
-    argv = [sys.executable, "-m", "rockyade", "assess", "wall.toml", "--spectrum-type", "1", "--ground", "B", "--ag",
-            "0.25g", "--records", "records", "--load-factors", factors, "--no-extend", "--solver", "reference",
-            "--tail", "20", "--workers", "1", "--out", "a", "--quiet"]  # fmt: skip
+    argv = [sys.executable, "-m", "rockyade", "assess", "wall.toml", "--knowledge-level", "LC1", "--spectrum-type", "1",
+            "--ground", "B", "--ag", "0.25g", "--records", "records", "--load-factors", factors, "--no-extend",
+            "--solver", "reference", "--tail", "20", "--workers", "1", "--out", "a", "--quiet"]  # fmt: skip
     proc = _start(tmp_path, argv)
     partial = tmp_path / "a" / "partial"
     _wait_for_records(proc, partial, 2)

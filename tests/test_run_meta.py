@@ -213,9 +213,9 @@ file = "{EXAMPLES / "specimen1_pulse.toml"}"
     shutil.copy(EXAMPLES / "records" / "ricker_pulse_T0.5s.AT2", records)
     wall = tmp_path / "wall.toml"
     write_scene(wall, stack(widths_m=[0.25], heights_m=1.0, thickness_m=1.0, layout="column", motion=rest_motion()))
-    argv = ["assess", str(wall), "--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--records", str(records),
-            "--load-factors", "0.5,8", "--no-extend", "--solver", "housner", "--workers", "1",
-            "--out", str(tmp_path / "assess"), "--quiet"]  # fmt: skip
+    argv = ["assess", str(wall), "--knowledge-level", "LC1", "--spectrum-type", "1", "--ground", "B", "--ag", "0.25g",
+            "--records", str(records), "--load-factors", "0.5,8", "--no-extend", "--solver", "housner",
+            "--workers", "1", "--out", str(tmp_path / "assess"), "--quiet"]  # fmt: skip
     assert main(argv) == 0
     capsys.readouterr()
 

@@ -79,6 +79,20 @@ def test_loaded_mass_check_gives_the_closed_form_with_the_loads_mass(tmp_path):
     assert table["value"].to_numpy()[2] == pytest.approx(25810.0**2 / (17810.0 * 41810.0), rel=1e-6)
 
 
+def test_the_checks_an_engineer_signs_pass(tmp_path):
+    """``--only loaded_classical,code_friction,crushing`` (issue 33): the loaded wall's alpha 0.0841 rad
+    towards +x and 0.1239 towards -x, each mu and uplift multiplier by hand; the frictionless corner's
+    1.3019 under both rules, the 35 degree corner's coulomb 1.6205 below the associated 3.5891 and
+    taken; a block's (B - a) / H with crushing, and the rigid multiplier as fm tends to infinity."""
+    table = verify(tmp_path / "report", ["loaded_classical", "code_friction", "crushing"], ["reference"])
+    assert table["passed"].all(), table.to_string()
+    assert list(table["check"]).count("loaded_classical") == 8 and list(table["check"]).count("crushing") == 3
+    alphas = table[table["quantity"].str.startswith("alpha towards")]["value"].to_numpy()
+    assert alphas.round(4).tolist() == [0.0841, 0.1239]
+    friction = table[table["check"] == "code_friction"].set_index("quantity")["value"]
+    assert friction["35 deg corner: the code's lambda = the lower"] == pytest.approx(1.6205, abs=5e-5)
+
+
 def test_limit_pushover_check_passes_against_the_closed_forms(tmp_path):
     """``limit_pushover``: the limit analysis gives b/h = 0.2 for the block, 17/35 for the restrained
     wall's three hinges, tan(30 deg) for the sliding panel and 0.1494 for the arch, and the

@@ -11,10 +11,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.blocks.classical import ClassicalParameters
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
+from rockyade.constants import G
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
+from rockyade.scene.carried import loaded_classical
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -55,13 +58,15 @@ def run_metrics(
 
             report = collapse_report(scene, result)
         fell = dict(zip(report["block"], report["fell"], strict=True))
+    classical = loaded_classical(scene, G)
     for spec in scene.blocks:
         if spec.fixed:
             continue
-        alpha = spec.classical().alpha_rad
+        cp = classical[spec.name]
         theta = result.series("theta_rad", spec.name)
         overturned = fell[spec.name] if spec.name in fell else block_overturned(result.meta, spec.name)
-        out[spec.name] = block_summary(theta_metrics(t, theta, alpha), t, theta, alpha, free, overturned, n_impacts)
+        values = theta_metrics(t, theta, cp.alpha_rad, cp)
+        out[spec.name] = block_summary(values, t, theta, cp.alpha_rad, free, overturned, n_impacts, cp)
     return out
 
 
@@ -87,6 +92,7 @@ def block_summary(
     free: bool,
     overturned: bool,
     n_impacts: int = MU_EFF_IMPACTS,
+    classical: ClassicalParameters | None = None,
 ) -> dict[str, float]:
     """One block's summary row (:data:`SUMMARY_KEYS`): of a Result (:func:`run_metrics`) and of
     a grouped run (:class:`rockyade.solvers.base.GroupRun`, whose solver computed the rotation's
@@ -100,7 +106,7 @@ def block_summary(
     t, theta
         The sampled rotation: s and rad.
     alpha_rad
-        The block's slenderness, rad.
+        The block's slenderness, rad (the governing side's when it has two).
     free
         Free rocking (``mu_eff`` is computed for it only).
     overturned
@@ -108,11 +114,16 @@ def block_summary(
         an assembly).
     n_impacts
         Impacts used for the effective restitution.
+    classical
+        The classical parameters of the body that rocks (a loaded block's:
+        :func:`rockyade.scene.carried.loaded_classical`): ``max_theta_over_alpha`` is then each
+        side's rotation over that side's alpha (:meth:`ClassicalParameters.theta_over_alpha`);
+        None: the peak over ``alpha_rad``.
     """
     peak = theta_values["max_abs_theta_rad"]
     values = {
         **theta_values,
-        "max_theta_over_alpha": peak / alpha_rad,
+        "max_theta_over_alpha": peak / alpha_rad if classical is None else classical.theta_over_alpha(theta),
         **peak_metrics(t, theta, alpha_rad, free, n_impacts),
         "overturned": overturned,
     }
@@ -131,16 +142,20 @@ def uplift_threshold_rad(alpha_rad: float) -> float:
     return 1e-4 * alpha_rad
 
 
-def theta_metrics(t: np.ndarray, theta: np.ndarray, alpha_rad: float) -> dict[str, float]:
+def theta_metrics(
+    t: np.ndarray, theta: np.ndarray, alpha_rad: float, classical: ClassicalParameters | None = None
+) -> dict[str, float]:
     """``max_abs_theta_rad``, ``max_theta_over_alpha``, ``residual_theta_rad`` and
     ``uplift_time_s`` of one block's sampled rotation (``t`` in s, ``theta`` in rad; NaN
-    samples ignored). :func:`rockyade.kernel.runs.simulate_runs` computes the same in the kernel."""
+    samples ignored). :func:`rockyade.kernel.runs.simulate_runs` computes the same in the kernel.
+    With ``classical`` (the body's parameters, each side its own alpha) the ratio is taken
+    against the alpha of the side the block turns to (:meth:`ClassicalParameters.theta_over_alpha`)."""
     finite = theta[np.isfinite(theta)]
     lifted = np.nonzero(np.abs(theta) > uplift_threshold_rad(alpha_rad))[0]
     peak = float(np.max(np.abs(finite))) if finite.size else math.nan
     return {
         "max_abs_theta_rad": peak,
-        "max_theta_over_alpha": peak / alpha_rad,
+        "max_theta_over_alpha": peak / alpha_rad if classical is None else classical.theta_over_alpha(theta),
         "residual_theta_rad": float(finite[-1]) if finite.size else math.nan,
         "uplift_time_s": float(t[lifted[0]]) if lifted.size else math.nan,
     }
@@ -301,9 +316,10 @@ def structure_rotation(scene: Scene, result: Result) -> dict[str, float | str]:
     Returns
     -------
     dict
-        ``structure``: "stack of N" or "none"; ``structure_alpha_rad`` (towards the side of
-        the peak), ``structure_max_theta_rad`` (signed: counter-clockwise about the left
-        corner > 0), ``structure_max_theta_over_alpha``; NaN and ``structure_note`` saying why
+        ``structure``: "stack of N" or "none"; ``structure_alpha_rad`` (of the side the stack
+        turns to at its peak: the largest rotation over its side's alpha; one block: each side's
+        alpha with its loads' masses), ``structure_max_theta_rad`` (signed: counter-clockwise about
+        the left corner > 0), ``structure_max_theta_over_alpha``; NaN and ``structure_note`` saying why
         for an assembly that is not a stack (:data:`NO_WHOLE_ROTATION`). Angles in rad.
     """
     nan: dict[str, float | str] = {
@@ -336,20 +352,21 @@ def structure_rotation(scene: Scene, result: Result) -> dict[str, float | str]:
     about_left = np.arctan2(-(g[:, 0] - left[0]), g[:, 1] - left[1]) + alpha_left  # > 0: CCW, towards -x
     about_right = np.arctan2(-(g[:, 0] - right[0]), g[:, 1] - right[1]) - alpha_right  # < 0: CW
     theta = np.where(g[:, 0] <= g0[0], about_left, about_right)
-    if len(order) == 1:  # one block: its own alpha (the DEM's, or a measured override)
-        name = order[0]
-        own = bodies[name]["alpha_rad"] if name in bodies else specs[name].classical().alpha_rad
-        alpha_left = alpha_right = float(own)
+    if len(order) == 1:  # one block: each side's alpha as it rocks (the loads' masses in; an overridden
+        # alpha's equivalent base, as the DEMs' contact polygon)
+        cp = loaded_classical(scene, G)[order[0]]
+        alpha_left, alpha_right = cp.left.alpha_rad, cp.right.alpha_rad
     finite = np.isfinite(theta)
     if not finite.any():
         return {**nan, "structure": f"stack of {len(order)}", "structure_note": "no finite sample"}
-    k = int(np.nanargmax(np.abs(theta)))
+    ratio = np.where(theta >= 0, theta / alpha_left, -theta / alpha_right)  # each side over its own alpha
+    k = int(np.nanargmax(ratio))
     alpha = alpha_left if theta[k] >= 0 else alpha_right
     return {
         "structure": f"stack of {len(order)}",
         "structure_alpha_rad": float(alpha),
         "structure_max_theta_rad": float(theta[k]),
-        "structure_max_theta_over_alpha": float(abs(theta[k]) / alpha),
+        "structure_max_theta_over_alpha": float(ratio[k]),
         "structure_note": "",
     }
 

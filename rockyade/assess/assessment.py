@@ -37,6 +37,7 @@ from rockyade.assess.code import (
     code_checks,
     verdict,
 )
+from rockyade.assess.directions import load_sides, toward_loaded_side
 from rockyade.assess.fragility_analysis import (
     FragilityPlan,
     FragilityResult,
@@ -58,7 +59,8 @@ from rockyade.assess.stripes import (
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError, SolverFailedError
 from rockyade.io.strict_json import finite_or_null
-from rockyade.limit import DEFAULT_FC, LimitResult, limit_analysis
+from rockyade.limit import LimitResult, limit_analysis
+from rockyade.limit.kinematic import check_fc
 from rockyade.runner import Executor
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
@@ -130,7 +132,8 @@ class Assessment:
     limit
         The governing limit analysis (its mechanism and the code's quantities).
     other_direction
-        The other direction's limit analysis (when both were solved), for the record.
+        The other direction's limit analysis (when both were solved), for the record (the answer its
+        code's quantities take, as ``limit``).
     checks
         The code's checks.
     dynamic
@@ -138,6 +141,16 @@ class Assessment:
     pushover
         The reference DEM's pushover at the mechanism's control point (None unless asked:
         :func:`add_pushover`).
+    fc_source
+        Where FC comes from (the knowledge level and its clause, or ``--fc``).
+    analysis
+        The governing direction's limit analysis as solved (``limit`` is its ``for_code``: the coulomb
+        pass's where the mechanism slides with friction and it is lower; ``friction_check`` and
+        ``crushing`` say how it was chosen).
+    direction_asked
+        ``+x`` or ``-x`` when one direction was asked for, None for both.
+    other_analysis
+        The other direction's limit analysis as solved (``other_direction`` is its ``for_code``).
     """
 
     code: str
@@ -150,6 +163,10 @@ class Assessment:
     dynamic: FragilityResult | None = None
     notes: list[str] = field(default_factory=list)
     pushover: PushoverCheck | None = None
+    fc_source: str = ""
+    analysis: LimitResult | None = None
+    direction_asked: str | None = None
+    other_analysis: LimitResult | None = None
 
     @property
     def verdict(self) -> str:
@@ -183,6 +200,7 @@ class Assessment:
         out: dict[str, Any] = {
             "code": self.code,
             "FC": self.fc,
+            "FC_source": self.fc_source,
             "status": self.limit.status,
             "verdict": self.verdict,
             "verdict_rule": "verified when one of the checks that apply is met (the linear check with q and the "
@@ -201,14 +219,27 @@ class Assessment:
         out["mechanism"] = {k: lim[k] for k in keys}
         out["limit_notes"] = lim["notes"]
         out["loads"] = lim["loads"]
+        full = self.analysis.to_dict() if self.analysis is not None else lim
+        out["code_friction"] = full.get("code_friction")
+        out["fm_MPa"] = full.get("fm_MPa")
+        out["crushing"] = full.get("crushing")
+        out["load_sides"] = load_sides(self.limit)
+        out["governing"] = {
+            "direction": self.limit.direction,
+            "directions_examined": [self.direction_asked] if self.direction_asked else ["+x", "-x"],
+            "towards_a_loaded_side": toward_loaded_side(self.limit),
+        }
         out["rigid_body_mechanism"] = rigid_body_mechanism(self.limit)
         if self.other_direction is not None:
             o = self.other_direction
+            check = self.other_analysis.friction_check if self.other_analysis is not None else None
             out["other_direction"] = {
                 "direction": o.direction,
                 "status": o.status,
                 "alpha0": o.load_multiplier,
                 "a0_star_m_s2": o.kinematic.a0_star_m_s2 if o.kinematic is not None else None,
+                "friction_rule": o.friction_rule,
+                "code_friction": check.to_dict() if check is not None else None,
             }
         out["checks"] = [c.to_dict() for c in self.checks]
         cap = self.code_capacity_ag_m_s2
@@ -319,12 +350,24 @@ def _limit(
     friction_angle_deg: float | None,
     sliding: bool,
     fc: float,
-    rule: str = "associated",
+    rule: str | None = None,
+    fm_MPa: float | None = None,
 ) -> tuple[LimitResult, LimitResult | None]:
-    """(governing, other): the direction given, or both keeping the smaller a0*."""
+    """(governing, other) as solved: the direction given, or both, keeping the smaller a0* of the answer
+    the code takes (:attr:`rockyade.limit.LimitResult.for_code`). ``rule`` None: associated with a
+    coulomb pass where the mechanism slides with friction (the lower multiplier taken)."""
     directions = [direction] if direction else ["+x", "-x"]
     results = [
-        limit_analysis(scene, d, friction_angle_deg=friction_angle_deg, sliding=sliding, fc=fc, friction_rule=rule)
+        limit_analysis(
+            scene,
+            d,
+            friction_angle_deg=friction_angle_deg,
+            sliding=sliding,
+            fc=fc,
+            friction_rule=rule or "associated",
+            coulomb_check=rule is None,
+            fm_MPa=fm_MPa,
+        )
         for d in directions
     ]
     if any(r.status == "unstable" for r in results):
@@ -338,7 +381,12 @@ def _limit(
     collapsing = [r for r in results if r.status == "collapse"]
     if not collapsing:
         return results[0], (results[1] if len(results) > 1 else None)
-    best = min(collapsing, key=lambda r: r.kinematic.a0_star_m_s2 if r.kinematic is not None else math.inf)
+
+    def a0(r: LimitResult) -> float:
+        kin = r.for_code.kinematic
+        return kin.a0_star_m_s2 if kin is not None else math.inf
+
+    best = min(collapsing, key=a0)
     other = next((r for r in results if r is not best), None)
     return best, other
 
@@ -390,13 +438,15 @@ def assess(
     scene: Scene,
     site: AnySite,
     *,
+    fc: float,
+    fc_source: str = "",
     code: str = "ntc2018",
     position: Position | None = None,
-    fc: float = DEFAULT_FC,
     direction: str | None = None,
     friction_angle_deg: float | None = None,
     sliding: bool = True,
-    friction_rule: str = "associated",
+    friction_rule: str | None = None,
+    fm_MPa: float | None = None,
     dynamic: DynamicSettings | None = None,
     executor: Executor | None = None,
     allow_large: bool = False,
@@ -411,17 +461,24 @@ def assess(
         The wall (any scene).
     site
         The site's spectrum.
+    fc
+        The confidence factor FC, the engineer's choice (no default): from the knowledge level,
+        :func:`rockyade.assess.code.confidence_factor` (LC1 1.35, LC2 1.20, LC3 1.00).
+    fc_source
+        Where it comes from, for the output.
     code
         ``ntc2018``.
     position
         At ground level (default) or at a height of a building.
-    fc
-        The confidence factor FC (default 1.35).
     direction
         ``+x``, ``-x``, or None for both (the smaller a0* governs).
     friction_angle_deg, sliding, friction_rule
-        The joints of the limit analysis (:func:`rockyade.limit.limit_analysis`); a coulomb rule
-        that does not converge raises SolverFailedError.
+        The joints of the limit analysis (:func:`rockyade.limit.limit_analysis`); ``friction_rule``
+        None: associated, with a coulomb pass where its mechanism slides with friction, the code taking
+        the lower multiplier; a coulomb rule that does not converge raises SolverFailedError.
+    fm_MPa
+        The masonry's compressive strength at the hinges, MPa (None: rigid blocks;
+        :mod:`rockyade.limit.crushing`).
     dynamic
         The dynamic part's settings; None: the code's checks only.
     executor
@@ -446,9 +503,13 @@ def assess(
             "the dynamic part shakes the scene's base with ground motions; a mechanism at height is shaken by its "
             "floor (not modelled): pass --static-only for the code's check at height",
         )
-    best, other = _limit(scene, direction, friction_angle_deg, sliding, fc, friction_rule)
+    fc = check_fc(fc)
+    solved, other = _limit(scene, direction, friction_angle_deg, sliding, fc, friction_rule, fm_MPa)
+    best = solved.for_code
     checks = code_checks(best.kinematic, site, position) if best.kinematic is not None else []
-    out = Assessment(code, fc, site, position, best, other, checks)
+    other_code = other.for_code if other is not None else None
+    out = Assessment(code, fc, site, position, best, other_code, checks, fc_source=fc_source, analysis=solved)
+    out.direction_asked, out.other_analysis = direction, other
     if best.status == "no_mechanism":
         out.notes.append("no horizontal acceleration makes the scene collapse statically: no code check")
     if any(c.status == NOT_APPLICABLE for c in checks):
@@ -456,7 +517,7 @@ def assess(
     rigid = rigid_body_mechanism(best)
     if rigid is not None:
         out.notes.append(rigid["note"])
-    out.notes.extend(checks_not_made(best.kinematic, position))
+    out.notes.extend(checks_not_made(best.kinematic, position, direction, fm_MPa is not None))
     if dynamic is not None:
         add_dynamics(out, scene, dynamic, executor, allow_large=allow_large, progress=progress, on_plan=on_plan)
     return out

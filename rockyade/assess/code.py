@@ -41,6 +41,51 @@ from rockyade.limit.kinematic import KinematicQuantities
 CODES = ("ntc2018",)
 #: Behaviour factor of the linear kinematic check (Circolare 2019 C8.7.1).
 Q_FACTOR = 2.0
+#: Where q comes from, printed beside every linear check.
+Q_CLAUSE = "Circolare 2019 C8.7.1"
+#: The confidence factor of each knowledge level for masonry buildings (NTC 2018 8.5.4; Circolare 2019
+#: C8.5.4, Tab. C8.5.IV): limited (LC1), adequate (LC2), accurate (LC3).
+KNOWLEDGE_LEVELS = {"LC1": 1.35, "LC2": 1.20, "LC3": 1.00}
+KNOWLEDGE_CLAUSE = "NTC 2018 8.5.4, Circolare 2019 C8.5.4 Tab. C8.5.IV"
+
+
+def confidence_factor(level: str | None, fc: float | None) -> tuple[float, str]:
+    """FC and where it comes from: the knowledge level (``LC1``, ``LC2``, ``LC3``: 1.35, 1.20, 1.00) or
+    the engineer's own value; one of the two, never a default (the code's check is the engineer's).
+
+    Raises
+    ------
+    InputError
+        Neither given, or both (naming ``--knowledge-level`` and ``--fc``); an unknown level (naming
+        ``--knowledge-level``); FC outside [1, 10] (naming ``--fc``).
+    """
+    if level is None and fc is None:
+        raise InputError(
+            "--knowledge-level",
+            "the code check needs the confidence factor: give the knowledge level, --knowledge-level LC1, LC2 or LC3 "
+            f"(FC 1.35, 1.20, 1.00; {KNOWLEDGE_CLAUSE}), or --fc FC",
+        )
+    if level is not None and fc is not None:
+        raise InputError("--fc", "give the knowledge level (--knowledge-level) or FC (--fc), not both")
+    if level is not None:
+        key = str(level).strip().upper()
+        if key not in KNOWLEDGE_LEVELS:
+            raise InputError("--knowledge-level", f"must be LC1, LC2 or LC3 ({KNOWLEDGE_CLAUSE}), got {level!r}")
+        value = KNOWLEDGE_LEVELS[key]
+        return value, f"knowledge level {key}, {KNOWLEDGE_CLAUSE}"
+    assert fc is not None
+    from rockyade.limit.kinematic import check_fc
+
+    try:
+        value = check_fc(fc)
+    except InputError as exc:
+        raise InputError("--fc", exc.message) from None
+    return (
+        value,
+        f"as given (--fc; the knowledge levels of {KNOWLEDGE_CLAUSE}: LC1 1.35, LC2 1.20, LC3 1.00)",
+    )
+
+
 #: The clause every check comes from.
 CLAUSE = "NTC 2018 8.7.1, Circolare 2019 C8.7.1 (kinematic analysis of local mechanisms)"
 #: Each check's clause and formula (the check's ``source``).
@@ -178,7 +223,7 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
                 "m/s^2",
                 terms={"ag_m_s2": ag, "S": S, "q": q},
                 ag_capacity_m_s2=ag * a0 / demand,
-                source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g}; "
+                source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g} ({Q_CLAUSE}); "
                 f"S from {site.spectrum_clause.split(';')[0]}",
             )
         )
@@ -226,16 +271,28 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
             "m/s^2",
             terms={"Se_T1_m_s2": se_t1, "T1_s": T1, "psi": psi, "gamma": gamma, "q": q, "ag_m_s2": ag, "S": S},
             ag_capacity_m_s2=ag * a0 / demand,
-            source=f"{CHECK_SOURCES['linear, at height']}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g}; "
+            source=f"{CHECK_SOURCES['linear, at height']}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g} ({Q_CLAUSE}); "
             f"T1: {position.period_source}; Se from {site.spectrum_clause}",
         )
     )
     return checks
 
 
-def checks_not_made(kin: KinematicQuantities | None, position: Position) -> list[str]:
+def checks_not_made(
+    kin: KinematicQuantities | None, position: Position, direction: str | None = None, crushing: bool = False
+) -> list[str]:
     """The checks of the kinematic method this tool does not make, each with the reason (for
-    the output's notes)."""
+    the output's notes).
+
+    Parameters
+    ----------
+    kin, position
+        The governing mechanism's quantities, where it is.
+    direction
+        The one direction examined (``--direction``), or None for both.
+    crushing
+        Whether the masonry's compressive strength was taken at the hinges (``--fm``).
+    """
     out = []
     if position.at_height:
         out.append(
@@ -250,18 +307,26 @@ def checks_not_made(kin: KinematicQuantities | None, position: Position) -> list
         )
     out.append(
         "not made: a check of sliding mechanisms as such (the code's kinematic method is written for rocking "
-        "mechanisms): the limit analysis lets joints slide with associated friction, which bounds a sliding "
-        "multiplier from above (--friction-rule coulomb for the non-dilatant one)"
+        "mechanisms): the limit analysis lets joints slide, and where its mechanism slides with friction the "
+        "quantities take the lower of the associated (dilatant) and the coulomb (non-dilatant) multipliers; the "
+        "coulomb rule is an iterated heuristic, not a bound"
     )
     out.append(
         "not made: the damage limit state (SLD) and operational checks; only the life-safety checks (SLV) with the "
         "site's spectrum as given"
     )
-    out.append(
-        "not made: the finite compressive strength of the masonry at the hinges (rigid blocks: each hinge at the "
-        "edge of its joint), which lowers alpha0; and mechanisms outside the scene's section (in-plane, corners, "
-        "roof thrust): only the section's mechanisms towards +x and -x are examined"
+    examined = (
+        f"only the section's mechanism towards {direction} is examined (--direction {direction}): the other "
+        "direction is not checked"
+        if direction
+        else "only the section's mechanisms towards +x and -x are examined"
     )
+    if not crushing:
+        out.append(
+            "not made: the finite compressive strength of the masonry at the hinges (rigid blocks: each hinge at the "
+            "edge of its joint), which lowers alpha0 (--fm MPa takes it)"
+        )
+    out.append(f"not made: mechanisms outside the scene's section (in-plane, corners, roof thrust): {examined}")
     return out
 
 

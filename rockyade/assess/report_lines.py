@@ -6,11 +6,13 @@ from __future__ import annotations
 import math
 
 from rockyade.assess.assessment import Assessment
-from rockyade.assess.code import NOT_APPLICABLE, VERIFIED, Check
+from rockyade.assess.code import NOT_APPLICABLE, Q_CLAUSE, VERIFIED, Check
+from rockyade.assess.directions import load_sides, toward_loaded_side
 from rockyade.assess.fragility_analysis import FragilityPlan, FragilityResult
 from rockyade.assess.stripes import collapse_rule
 from rockyade.constants import CODE_GRAVITY as G
-from rockyade.limit.report_text import hinge_words, plural, sliding_words
+from rockyade.limit.crushing import STRESS_BLOCK
+from rockyade.limit.report_text import code_basis_lines, hinge_words, plural, sliding_words
 
 
 def _pct(x: float) -> str:
@@ -85,12 +87,13 @@ def _check_line(check: Check) -> str:
     if check.status == NOT_APPLICABLE:
         return f"  {check.name}: {check.inequality}: not applicable ({check.reason})\n    clause: {check.source}"
     t = check.terms
+    q_words = f" (q = {t['q']:g}, {Q_CLAUSE})" if "q" in t else ""
     if check.quantity == "a0*" and "T1_s" not in t:
-        demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}"
+        demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}{q_words}"
     elif check.quantity == "a0*":
         demand = (
             f"Se(T1) psi gamma / q = {t['Se_T1_m_s2']:.4g} x {t['psi']:.4g} x {t['gamma']:.4g} / {t['q']:g} = "
-            f"{check.demand:.4g} {unit} (T1 = {t['T1_s']:.3g} s)"
+            f"{check.demand:.4g} {unit} (T1 = {t['T1_s']:.3g} s){q_words}"
         )
     else:
         demand = f"SDe(Ts = {t['Ts_s']:.4g} s) = Se (Ts / 2 pi)^2 = {check.demand:.4g} {unit}"
@@ -102,12 +105,51 @@ def _check_line(check: Check) -> str:
     )
 
 
+def _examined(a: Assessment) -> str:
+    """Which directions were examined, for the verdict line."""
+    if a.direction_asked:
+        return f" (the only one examined: --direction {a.direction_asked})"
+    return " (the lower a0* of +x and -x)"
+
+
+def _load_side_words(a: Assessment) -> str:
+    """The side each load bears on, in words (:func:`rockyade.assess.assessment.load_sides`)."""
+    sides = load_sides(a.limit)
+    if not sides:
+        return "no load on the moving blocks"
+    words = []
+    for q in sides[:3]:
+        where = "on its axis" if q["side"] == "axis" else f"{abs(q['offset_m']):.4g} m towards {q['side']} of its axis"
+        words.append(f"load {q['load']} bears on {q['block']} {where}")
+    return ", ".join(words) + (" ..." if len(sides) > 3 else "")
+
+
+def loaded_side_line(a: Assessment) -> str:
+    """One line when the governing mechanism turns towards the side a load bears on (a floor's or a
+    roof's, whose bearing may hold the wall that way), naming the options that model it; else ""."""
+    loads = toward_loaded_side(a.limit)
+    model = a.limit.model
+    restrained = any(model.fixed[i] for itf in model.interfaces for i in (itf.a, itf.b) if i >= 0)
+    if not loads or restrained:  # a scene with restraints models what holds the wall already
+        return ""
+    names = ", ".join(f"load {k}" for k in loads[:3])
+    other = "-x" if a.limit.direction == "+x" else "+x"
+    near_far = "restrained-far" if a.limit.direction == "+x" else "restrained-near"
+    return (
+        f"note: the governing mechanism turns towards {a.limit.direction}, the side {names} bears on: if that is a "
+        f"floor or a roof that holds the wall's top, model it (rockyade build wall-section --top floor, or --top "
+        f"{near_far}: a restraint on that face) or check the other direction alone (--direction {other})"
+    )
+
+
 def assessment_lines(a: Assessment, source: str) -> list[str]:
     """The text of ``rockyade assess``: the mechanism, its quantities and the code's checks
     (:func:`dynamic_lines` gives the dynamic part)."""
     lim, kin = a.limit, a.limit.kinematic
+    fc_from = f" ({a.fc_source})" if a.fc_source else ""
     lines = [
-        f"assessment of {source}: NTC 2018 kinematic method (NTC 2018 8.7.1, Circolare 2019 C8.7.1), FC = {a.fc:g}",
+        f"assessment of {source}: NTC 2018 kinematic method (NTC 2018 8.7.1, Circolare 2019 C8.7.1), FC = {a.fc:g}"
+        + fc_from,
         f"site: {a.site.describe()}; mechanism {a.position.describe()}",
         f"g = {G:g} m/s^2 (standard gravity) throughout the check (ag in g and a0* = alpha0 g / (e* FC): the verdict "
         "does not depend on it), as for records given in g; the blocks' weights use the mechanics' 9.81 m/s^2",
@@ -121,7 +163,14 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     if a.other_direction is not None and a.other_direction.load_multiplier is not None:
         o = a.other_direction
         o_a0 = o.kinematic.a0_star_m_s2 if o.kinematic is not None else math.nan
-        other = f"; towards {o.direction}: alpha0 = {o.load_multiplier:.4f}, a0* = {o_a0:.4g} m/s^2"
+        check = a.other_analysis.friction_check if a.other_analysis is not None else None
+        rule = ""
+        if check is not None and check.coulomb_multiplier is not None:
+            rule = (
+                f" (it slides with friction: {check.taken}; associated {check.associated:.4f}, "
+                f"coulomb {check.coulomb_multiplier:.4f})"
+            )
+        other = f"; towards {o.direction}: alpha0 = {o.load_multiplier:.4f}{rule}, a0* = {o_a0:.4g} m/s^2"
     n = int(mech.moving.sum())
     joints = f"{plural(len(mech.hinges), 'hinge')}, {plural(len(mech.sliding), 'sliding joint')}"
     lines.append(
@@ -131,6 +180,11 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
     lines += model.load_lines()
     lines += ["  " + hinge_words(model, h) for h in mech.hinges[:5]]
     lines += ["  " + sliding_words(model, s, mech.velocities) for s in mech.sliding[:5]]
+    if a.analysis is not None:
+        lines += code_basis_lines(a.analysis)
+    side = loaded_side_line(a)
+    if side:
+        lines.append(side)
     lines.append(
         f"kinematic quantities: alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f}; "
         f"a0* = alpha0 g / (e* FC) = {kin.a0_star_m_s2:.4g} m/s^2"
@@ -144,11 +198,23 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         lines.append(f"  nonlinear: none ({kin.nonlinear_note})")
     lines.append("checks made:")
     lines += [_check_line(c) for c in a.checks]
+    crushing = a.analysis.crushing if a.analysis is not None else None
+    if crushing is not None:
+        rigid = crushing.history[0] if crushing.history else math.nan
+        taken = (
+            "the rigid model's multiplier is taken: with the hinges moved the coulomb iteration settled higher"
+            if a.analysis is not None and a.analysis.rigid is not None and lim is a.analysis.rigid.for_code
+            else f"alpha0 = {kin.alpha0:.4f} with the hinges moved against {rigid:.4f} with rigid ones"
+        )
+        lines.append(
+            f"  masonry crushing at the hinges, fm = {crushing.fm_MPa:g} MPa: {taken}\n    clause: {STRESS_BLOCK}"
+        )
     cap = a.code_capacity_ag_m_s2
     site_ag = a.site.ag_m_s2 / G
     lines.append(
         f"code verdict: {a.verdict.upper() if a.verdict != VERIFIED else 'verified'}"
         + (f" (the code's capacity is ag = {cap / G:.4g} g; the site's ag is {site_ag:.4g} g)" if cap == cap else "")
+        + f", governed by the mechanism towards {lim.direction}{_examined(a)}; {_load_side_words(a)}"
     )
     # the friction caveat holds for any finite friction (a rocking mechanism can be too high as well)
     lines += [f"note: {note}" for note in lim.notes]

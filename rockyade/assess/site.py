@@ -215,6 +215,11 @@ class NtcSite:
         return soil_factors(self.soil, self.ag_g, self.F0, self.tc_star_s)[0]
 
     @property
+    def CC(self) -> float:
+        """The coefficient of TC = CC TC* (Tab. 3.2.IV)."""
+        return soil_factors(self.soil, self.ag_g, self.F0, self.tc_star_s)[1]
+
+    @property
     def ST(self) -> float:
         """Topographic amplification ST (Tab. 3.2.V, at ``height_ratio``)."""
         return topography_factor(self.topography, self.height_ratio)
@@ -240,7 +245,8 @@ class NtcSite:
         ratio = f" at {self.height_ratio:g} of the relief's height" if self.topography != "T1" else ""
         return (
             f"NTC 2018 spectrum (3.2.3.2.1): ag = {self.ag_g:.4g} g ({self.ag_m_s2:.4g} m/s^2), F0 = {self.F0:g}, "
-            f"TC* = {self.tc_star_s:g} s; soil {self.soil} (SS = {self.SS:.4g}), topography {self.topography}"
+            f"TC* = {self.tc_star_s:g} s; soil {self.soil} (SS = {self.SS:.4g}, CC = {self.CC:.5g}), "
+            f"topography {self.topography}"
             f"{ratio} (ST = {self.ST:.4g}): S = {self.S:.4g}, TB = {sp.TB_s:.4g} s, TC = {sp.TC_s:.4g} s, "
             f"TD = {sp.TD_s:.4g} s"
         )
@@ -255,7 +261,7 @@ class NtcSite:
             "TC_star_s": self.tc_star_s,
             "soil": self.soil,
             "SS": self.SS,
-            "CC": soil_factors(self.soil, self.ag_g, self.F0, self.tc_star_s)[1],
+            "CC": self.CC,
             "topography": self.topography,
             "topography_height_ratio": self.height_ratio,
             "ST": self.ST,

@@ -41,6 +41,8 @@ import pandas as pd
 
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, record_summary
+from rockyade.blocks.classical import ClassicalParameters
+from rockyade.constants import G
 from rockyade.errors import BatchInterruptedError, InputError
 from rockyade.result import Result
 from rockyade.runner import Executor, Task, check_costs, run_jobs
@@ -48,6 +50,7 @@ from rockyade.runner.groups import group_jobs
 from rockyade.runner.journal import Journal
 from rockyade.runner.tasks import solve
 from rockyade.scene import Scene
+from rockyade.scene.carried import loaded_classical
 from rockyade.solvers.base import GroupSolver, Solver
 
 #: Free motion after the record, s.
@@ -135,7 +138,7 @@ def whole_alpha(scene: Scene) -> float:
     multipliers towards +x and -x (for one block its alpha; for a stack turning about its base
     the whole's alpha, b / h_c = tan alpha); NaN without a mechanism."""
     if single_block(scene):
-        return float(scene.blocks[0].classical().alpha_rad)
+        return float(_classical(scene).alpha_rad)
     from rockyade.limit import limit_analysis
 
     lams = []
@@ -149,16 +152,23 @@ def whole_alpha(scene: Scene) -> float:
     return math.atan(min(lams)) if lams else math.nan
 
 
+def _classical(scene: Scene) -> ClassicalParameters:
+    """The single block's classical parameters as it rocks (the masses of its loads in, each side
+    its own alpha: :func:`rockyade.scene.carried.loaded_classical`)."""
+    return loaded_classical(scene, G)[scene.blocks[0].name]
+
+
 def collapse_of(scene: Scene, result: Result, fallen_blocks: int = 1) -> tuple[bool, int, float, float]:
     """(collapsed, blocks fallen, largest peak |theta| / the block's own alpha, largest peak
-    |theta| in rad) of a run (module docstring)."""
+    |theta| in rad) of a run (module docstring); a single block's rotation on each side over
+    that side's alpha (:meth:`rockyade.blocks.classical.ClassicalParameters.theta_over_alpha`)."""
     if single_block(scene):
         spec = scene.blocks[0]
         theta = np.asarray(result.series("theta_rad", spec.name), dtype=float)
         finite = theta[np.isfinite(theta)]
         peak = float(np.max(np.abs(finite))) if finite.size else math.nan
         over = result.status == "overturned"
-        return over, int(over), peak / spec.classical().alpha_rad, peak
+        return over, int(over), _classical(scene).theta_over_alpha(theta), peak
     from rockyade.analysis.collapse import collapse_report
 
     report = collapse_report(scene, result)
@@ -200,7 +210,8 @@ def run_stripe_task(task: StripeTask) -> dict[str, Any]:
         except Exception as exc:  # an analysis that fails is this run's failure, not the batch's
             row.update(status="failed", failure_reason=f"collapse analysis: {type(exc).__name__}: {exc}")
         else:
-            whole = peak / task.whole_alpha_rad if math.isfinite(task.whole_alpha_rad) else ratio
+            single = single_block(task.scene) or not math.isfinite(task.whole_alpha_rad)
+            whole = ratio if single else peak / task.whole_alpha_rad
             row.update(
                 collapsed=bool(collapsed),
                 n_fallen=fallen,
@@ -431,7 +442,8 @@ def run_stripe_job(job: tuple[StripeTask, ...]) -> list[dict[str, Any]]:
     start = time.perf_counter()
     solver = job[0].solver
     assert isinstance(solver, GroupSolver)  # stripe_group groups only these
-    alpha = job[0].scene.blocks[0].classical().alpha_rad
+    cp = _classical(job[0].scene)
+    alpha = cp.alpha_rad
     try:
         runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
     except Exception:  # a run of its own says what went wrong
@@ -442,15 +454,9 @@ def run_stripe_job(job: tuple[StripeTask, ...]) -> list[dict[str, Any]]:
         row = _row(task, one.status, str(one.meta.failure_reason or ""))
         row["wall_time_s"] = elapsed
         if one.status != "failed":
-            theta = one.theta_rad[np.isfinite(one.theta_rad)]
-            peak = float(np.max(np.abs(theta))) if theta.size else math.nan
             over = one.status == "overturned"
-            row.update(
-                collapsed=over,
-                n_fallen=int(over),
-                max_theta_over_alpha=peak / alpha,
-                max_theta_over_own_alpha=peak / alpha,
-            )
+            ratio = cp.theta_over_alpha(one.theta_rad)
+            row.update(collapsed=over, n_fallen=int(over), max_theta_over_alpha=ratio, max_theta_over_own_alpha=ratio)
         rows.append(row)
     return rows
 

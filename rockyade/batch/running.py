@@ -227,11 +227,14 @@ def run_job(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
 
 def _run_group(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
     from rockyade.analysis.metrics import block_overturned, block_summary, uplift_threshold_rad
+    from rockyade.constants import G
+    from rockyade.scene.carried import loaded_classical
 
     start = time.perf_counter()
     first = job[0]
     spec = first.scene.blocks[0]
-    alpha = spec.classical().alpha_rad
+    cp = loaded_classical(first.scene, G)[spec.name]  # the body that rocks: each side its own alpha
+    alpha = cp.alpha_rad
     solver = first.solver
     assert isinstance(solver, GroupSolver)  # job_key groups only these
     try:
@@ -248,7 +251,7 @@ def _run_group(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
         if one.status != "failed":
             t = np.arange(one.theta_rad.size) * one.sample_dt_s
             overturned = block_overturned(one.meta, spec.name)
-            row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned))
+            row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned, classical=cp))
         row["elapsed_s"] = elapsed
         try:
             write_run(folder, row["run"], {**one.meta.to_dict(), "summary": row})

@@ -121,11 +121,11 @@ def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
 def cmd_assess(args: argparse.Namespace) -> int:
     """The checks, the dynamics, the text (or JSON), and with --out the files."""
     from rockyade.assess import assess
-    from rockyade.assess.code import check_code
+    from rockyade.assess.code import check_code, confidence_factor
     from rockyade.assess.report_lines import assessment_lines
     from rockyade.cli.resumable import file_digest, finish, identity, study_output
     from rockyade.errors import BatchInterruptedError
-    from rockyade.limit.kinematic import check_fc
+    from rockyade.limit.crushing import check_fm
     from rockyade.limit.rigid_blocks import check_friction_angle
     from rockyade.scene import load_scene
 
@@ -134,16 +134,14 @@ def cmd_assess(args: argparse.Namespace) -> int:
         check_output_dir(args.out, "--out")
     elif args.resume:
         raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
-    try:
-        fc = check_fc(args.fc)
-    except InputError as exc:
-        raise InputError("--fc", exc.message) from None
+    fc, fc_source = confidence_factor(args.knowledge_level, args.fc)
     friction = None
     if args.friction_angle_deg is not None:
         friction = check_friction_angle(args.friction_angle_deg, "--friction-angle-deg")
     from rockyade.limit.analysis import check_friction_rule
 
-    rule = check_friction_rule(args.friction_rule, "--friction-rule")
+    rule = None if args.friction_rule is None else check_friction_rule(args.friction_rule, "--friction-rule")
+    fm = None if args.fm is None else check_fm(args.fm, "--fm")
     site, position = _site(args), _position(args)
     dynamic = _dynamic(args)
     if dynamic is not None and dynamic.records is None and site.spectrum_code != "ec8":
@@ -160,10 +158,12 @@ def cmd_assess(args: argparse.Namespace) -> int:
         code=args.code,
         position=position,
         fc=fc,
+        fc_source=fc_source,
         direction=direction,
         friction_angle_deg=friction,
         sliding=not args.no_sliding,
         friction_rule=rule,
+        fm_MPa=fm,
     )
     if not args.json:
         print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
@@ -338,7 +338,13 @@ def register(sub: Any) -> None:
     ec8.add_argument("--spectrum-type", type=int, help="EC8 elastic spectrum type: 1 or 2")
     ec8.add_argument("--ground", help="EC8 ground type: A, B, C, D or E")
     ec8.add_argument("--importance", type=float, help="importance factor gamma_I, in [0.5, 2] (default 1)")
-    p.add_argument("--fc", type=float, default=1.35, help="the code's confidence factor FC, in [1, 10] (default 1.35)")
+    p.add_argument(
+        "--knowledge-level",
+        metavar="LC",
+        help="the knowledge level of the building, LC1, LC2 or LC3: FC = 1.35, 1.20, 1.00 (NTC 2018 8.5.4, "
+        "Circolare 2019 C8.5.4 Tab. C8.5.IV); this or --fc is required",
+    )
+    p.add_argument("--fc", type=float, help="the code's confidence factor FC, in [1, 10], instead of --knowledge-level")
     p.add_argument(
         "--direction",
         choices=("both", "+x", "-x"),
@@ -352,10 +358,17 @@ def register(sub: Any) -> None:
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
     p.add_argument(
         "--friction-rule",
-        default="associated",
         metavar="RULE",
-        help="the limit analysis's friction: associated (default; sliding joints dilate) or coulomb (non-dilatant, "
-        "iterated: see rockyade limit)",
+        help="the limit analysis's friction: associated (alone: sliding joints dilate, an upper bound) or coulomb "
+        "(alone: non-dilatant, iterated: see rockyade limit); default: associated, and where its mechanism slides "
+        "with friction a coulomb pass too, the check taking the lower multiplier (both printed)",
+    )
+    p.add_argument(
+        "--fm",
+        type=float,
+        metavar="MPA",
+        help="the masonry's compressive strength fm, MPa (> 0): the hinges move into their joints by the stress "
+        "block 0.85 fm (NTC 2018 7.8.2.2.1), iterated with the limit analysis' normal forces; default: rigid blocks",
     )
     height = p.add_argument_group("a mechanism at height (default: at ground level)")
     height.add_argument("--z", type=float, metavar="M", help="height of the mechanism above the foundation, m")

@@ -29,6 +29,7 @@ def cmd_limit(args: argparse.Namespace) -> int:
     from rockyade.limit.analysis import check_friction_rule
     from rockyade.limit.analysis_cost import check_limit_cost, estimate_limit_cost
     from rockyade.limit.coulomb import MAX_ITERATIONS
+    from rockyade.limit.crushing import check_fm
     from rockyade.limit.lp import TimeLimitError
     from rockyade.limit.report_text import text_report
     from rockyade.limit.rigid_blocks import check_friction_angle, rigid_block_model
@@ -43,11 +44,16 @@ def cmd_limit(args: argparse.Namespace) -> int:
         fc = check_fc(args.fc)
     except InputError as exc:
         raise InputError("--fc", exc.message) from None
-    rule = check_friction_rule(args.friction_rule, "--friction-rule")
-    if args.max_iterations is not None and rule != "coulomb":
+    # no --friction-rule: associated, with a coulomb pass for the code's quantities where the mechanism slides
+    # with friction (docs/limit.md); an explicit rule is that rule alone
+    coulomb_check = args.friction_rule is None
+    rule = check_friction_rule(args.friction_rule or "associated", "--friction-rule")
+    if args.max_iterations is not None and rule != "coulomb" and not coulomb_check:
         raise InputError(
-            "--max-iterations", "counts the coulomb rule's programmes: give it with --friction-rule coulomb"
+            "--max-iterations",
+            "counts the coulomb rule's programmes: give it with --friction-rule coulomb (or without --friction-rule)",
         )
+    fm = None if args.fm is None else check_fm(args.fm, "--fm")
     max_iterations = MAX_ITERATIONS if args.max_iterations is None else args.max_iterations
     if not 1 <= max_iterations <= 10000:
         raise InputError("--max-iterations", f"must be an integer in [1, 10000], got {max_iterations}")
@@ -57,9 +63,16 @@ def cmd_limit(args: argparse.Namespace) -> int:
     scene = load_scene(args.scene)
     model = rigid_block_model(scene, friction_angle_deg=friction, sliding=not args.no_sliding)
     cost = estimate_limit_cost(model, rule, max_iterations)
-    _say(f"cost: {cost.describe()}")
+    extra = ""
+    if coulomb_check and any(itf.friction_angle_deg for itf in model.interfaces):
+        programmes = estimate_limit_cost(model, "coulomb", max_iterations).describe().split("; ")[-2]
+        extra = f"; and a coulomb pass ({programmes}) if the mechanism slides with friction"
+        extra += " (--friction-rule associated skips it)"
+    if fm is not None:
+        extra += "; the hinges moved by crushing: a programme per iteration to a fixed point (a few)"
+    _say(f"cost: {cost.describe()}{extra}")
     check_limit_cost(cost, allow_large=args.allow_large)
-    progress = _Progress(max_iterations) if rule == "coulomb" else None
+    progress = _Progress(max_iterations) if rule == "coulomb" or coulomb_check else None
     try:
         result = limit_analysis(
             model,
@@ -69,6 +82,8 @@ def cmd_limit(args: argparse.Namespace) -> int:
             max_iterations=max_iterations,
             time_limit_s=time_limit,
             on_iteration=progress,
+            coulomb_check=coulomb_check,
+            fm_MPa=fm,
         )
     except TimeLimitError as exc:
         raise LimitTimeLimitError(f"error: {exc} (--time-limit {time_limit:g}): no answer") from None
@@ -137,16 +152,25 @@ def register(sub: Any) -> None:
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
     p.add_argument(
         "--friction-rule",
-        default="associated",
         metavar="RULE",
-        help="associated (default: the linear programme, sliding joints dilate) or coulomb (sliding without "
-        "dilatancy, by iterated programmes: Gilbert, Casapulla & Ahmed 2006; exit 1 if it does not converge)",
+        help="associated (the linear programme alone, sliding joints dilate) or coulomb (sliding without "
+        "dilatancy, by iterated programmes: Gilbert, Casapulla & Ahmed 2006; exit 1 if it does not converge); "
+        "default: associated, and where its mechanism slides with friction a coulomb pass too, the code's "
+        "quantities taking the lower multiplier (both printed)",
+    )
+    p.add_argument(
+        "--fm",
+        type=float,
+        metavar="MPA",
+        help="the masonry's compressive strength fm, MPa (> 0): each hinge moves into its joint by the stress "
+        "block's resultant, a / 2 with a = N / (0.85 fm t) (NTC 2018 7.8.2.2.1), iterated with the programme's "
+        "normal forces; default: rigid blocks (hinges at the joints' edges)",
     )
     p.add_argument(
         "--max-iterations",
         type=int,
         metavar="N",
-        help="the coulomb rule's programmes at most, in [1, 10000] (default 100; with --friction-rule coulomb only)",
+        help="the coulomb rule's programmes at most, in [1, 10000] (default 100; not with --friction-rule associated)",
     )
     p.add_argument(
         "--time-limit",

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -161,9 +162,15 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, repo
         from rockyade.analysis.metrics import structure_rotation
 
         _print_structure(structure_rotation(scene, result), result, scene)
+    classical = meta.classical or {}
     for name, m in run_metrics(scene, result, report=report).items():
         theta, ratio = m["max_abs_theta_rad"], m["max_theta_over_alpha"]
-        line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha)"
+        cp = classical.get(name) or {}
+        loaded = bool(cp) and (cp["carried_kg"] > 0 or not cp["symmetric"])
+        if loaded and len(scene.blocks) <= PER_BLOCK_LIMIT:
+            print(f"  {name}: {loaded_words(cp)}")
+        side = " of the side it turns to" if loaded else ""
+        line = f"  {name}: max |theta| = {theta:.5g} rad ({ratio:.3g} alpha{side})"
         if not math.isnan(m["mu_eff"]):
             line += f", effective mu = {m['mu_eff']:.5g} over {min(m['n_peaks'] - 1, MU_EFF_IMPACTS)} impacts"
         print(line)
@@ -172,6 +179,21 @@ def _print_summary(scene: Scene, result: Result, total_s: float = math.nan, repo
         print(f"  {note}")
     if result.status == "overturned" and not scene.positioned:
         print(f"  overturned at t = {meta.overturn_time_s:.4g} s ({meta.overturned_block})")
+
+
+def loaded_words(cp: Mapping[str, Any]) -> str:
+    """A loaded (or asymmetric) block's classical parameters, each direction its own, in words
+    (``meta.classical``: :func:`rockyade.solvers.base.classical_meta`)."""
+    from rockyade.constants import G
+
+    sides = [cp["right"], cp["left"]]  # towards +x first
+    carried = f"with the {cp['carried_kg']:.5g} kg its loads carry, " if cp["carried_kg"] > 0 else ""
+    each = "; ".join(
+        f"towards {s['turns_to']}: alpha = {s['alpha_rad']:.4f} rad, R = {s['R_m']:.4g} m, p = {s['p_rad_s']:.4g} "
+        f"rad/s, mu = {s['mu']:.4f}, uplift at {s['uplift_accel_m_s2']:.4g} m/s^2 ({s['uplift_accel_m_s2'] / G:.4g} g)"
+        for s in sides
+    )
+    return f"rocks as one body of {cp['mass_kg']:.5g} kg ({carried}centroid {cp['centroid_height_m']:.4g} m up): {each}"
 
 
 def _print_structure(m: dict[str, Any], result: Any, scene: Any) -> None:

@@ -13,7 +13,7 @@ from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.housner.integrator import _theta_dd
 from rockyade.scene import Scene
-from rockyade.scene.carried import carried_on, loaded_rocking_parameters, residual_force
+from rockyade.scene.carried import loaded_classical, residual_force
 
 
 @dataclass(frozen=True)
@@ -172,20 +172,20 @@ class HousnerModel:
 def housner_model(scene: Scene, g: float = G) -> HousnerModel:
     """The single block of ``scene`` as Housner's model, with its point loads (modified Eq 1).
 
+    The classical parameters are those of the block as it rocks, with the masses of the loads it
+    carries (:func:`rockyade.scene.carried.loaded_classical`: each direction its own alpha, p and
+    restitution); the loads' forces that are not the weights of those masses act as point loads.
     The pivots are the base corners at the equivalent base x_c -/+ h_c tan(alpha) (the real
     corners when alpha comes from the geometry), in the base frame at rest.
     """
     from rockyade.scene.placement import placed_blocks
 
     spec = scene.blocks[0]
-    model = HousnerModel.from_classical(spec.classical(), g)
     if not scene.loads:
-        return model
-    cx, cy = placed_blocks(scene)[0].centroid_m
-    pivots = ((cx - cy * math.tan(model.alpha_left), 0.0), (cx + cy * math.tan(model.alpha_right), 0.0))
-    mass, carried = spec.block().mass_kg, carried_on(scene.loads, spec.name, g)
-    if carried:  # the loads' masses rock with the block (rockyade.scene.carried); spec.mu still overrides
-        props, loaded = loaded_rocking_parameters(mass, (cx, cy), pivots, model.p_left, g, carried)
-        mass = props.mass_kg
-        model = replace(model, **{k: v for k, v in loaded.items() if spec.mu is None or not k.startswith("mu")})
-    return model.with_loads(mass, pivots, [replace(q, force_N=residual_force(q, g)) for q in scene.loads])
+        return HousnerModel.from_classical(spec.classical(), g)
+    bare = spec.classical()
+    cx, cy = placed_blocks(scene)[0].centroid_m  # the block's own centroid: its pivots at rest
+    pivots = ((cx - cy * math.tan(bare.left.alpha_rad), 0.0), (cx + cy * math.tan(bare.right.alpha_rad), 0.0))
+    cp = loaded_classical(scene, g)[spec.name]
+    model = HousnerModel.from_classical(cp, g)
+    return model.with_loads(cp.mass_kg, pivots, [replace(q, force_N=residual_force(q, g)) for q in scene.loads])

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 from rockyade.errors import InputError
 from rockyade.limit.admissible import solve_admissible
 from rockyade.limit.coulomb import MAX_ITERATIONS, solve_coulomb
+from rockyade.limit.crushing import Crushing, check_fm, iterate_crushing
 from rockyade.limit.kinematic import DEFAULT_FC, KinematicQuantities, check_fc, kinematic_quantities
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import Mechanism, mechanism_of
@@ -44,6 +45,65 @@ COULOMB_NOTE = (
     "Coulomb friction without dilatancy, by iterated linear programmes (Gilbert, Casapulla & Ahmed 2006): "
     "a heuristic, not guaranteed to find the lowest collapse load"
 )
+
+
+def slides_with_friction(model: RigidBlockModel, mechanism: Mechanism | None) -> bool:
+    """Whether a joint of ``mechanism`` slides where it has friction (angle > 0): where the associated
+    (dilatant) rule and Coulomb's non-dilatant one part (frictionless sliding, on a restraint, is the
+    same under both)."""
+    if mechanism is None:
+        return False
+    return any(model.interfaces[s.interface].friction_angle_deg for s in mechanism.sliding)
+
+
+@dataclass(frozen=True)
+class FrictionCheck:
+    """The coulomb pass of an associated answer whose mechanism slides with friction: the code's
+    quantities take the lower of the two multipliers (a check an engineer signs must not take the
+    dilatant upper bound; docs/limit.md, "Friction in the code's quantities").
+
+    Attributes
+    ----------
+    associated
+        The associated (dilatant) multiplier.
+    coulomb
+        The coulomb rule's answer (status ``collapse``, or ``not_converged``: then the associated one
+        stands, and the output says so).
+    """
+
+    associated: float
+    coulomb: LimitResult
+
+    @property
+    def coulomb_multiplier(self) -> float | None:
+        """The non-dilatant multiplier, or None (not converged)."""
+        return self.coulomb.load_multiplier if self.coulomb.status == "collapse" else None
+
+    @property
+    def taken(self) -> str:
+        """``coulomb`` when it converged at a multiplier no higher than the associated one, else ``associated``."""
+        lam = self.coulomb_multiplier
+        return "coulomb" if lam is not None and lam <= self.associated else "associated"
+
+    @property
+    def ratio(self) -> float:
+        """associated / coulomb (NaN without a coulomb multiplier)."""
+        lam = self.coulomb_multiplier
+        return self.associated / lam if lam else math.nan
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data (the JSON's ``code_friction``)."""
+        return {
+            "associated": self.associated,
+            "coulomb": self.coulomb_multiplier,
+            "coulomb_status": self.coulomb.status,
+            "coulomb_iterations": self.coulomb.iterations,
+            "coulomb_reason": self.coulomb.reason,
+            "associated_over_coulomb": self.ratio,
+            "taken": self.taken,
+            "why": "the associated mechanism slides with friction: its multiplier bounds Coulomb's non-dilatant one "
+            "from above; the code's quantities take the lower of the two",
+        }
 
 
 def check_friction_rule(value: str, field: str = "friction_rule") -> str:
@@ -103,6 +163,25 @@ class LimitResult:
     friction_rule: str = "associated"
     iterations: int = 0
     reason: str = ""
+    friction_check: FrictionCheck | None = None
+    crushing: Crushing | None = None
+    rigid: LimitResult | None = None
+
+    @property
+    def for_code(self) -> LimitResult:
+        """The answer whose mechanism and quantities the code's check takes: the coulomb pass's when
+        the associated mechanism slides with friction and the coulomb multiplier is the lower
+        (:class:`FrictionCheck`), else this one; with the masonry's compressive strength
+        (``crushing``) and the coulomb rule, the rigid model's answer where it is lower (crushing
+        cannot raise the capacity, while the coulomb iteration, a heuristic, may settle at another,
+        higher fixed point once the hinges have moved: ``rigid``)."""
+        check = self.friction_check
+        code = check.coulomb if check is not None and check.taken == "coulomb" else self
+        if self.rigid is not None and code.load_multiplier is not None:
+            other = self.rigid.for_code
+            if other.load_multiplier is not None and other.load_multiplier < code.load_multiplier:
+                return other
+        return code
 
     @property
     def sliding_allowed(self) -> bool:
@@ -149,6 +228,9 @@ class LimitResult:
         }
         keys = ("alpha0", "e_star", "M_star_kg", "a0_star_m_s2", "d0_star_m", "du_star_m", "Ts_s")
         out.update(dict.fromkeys(keys))
+        out["code_friction"] = None if self.friction_check is None else self.friction_check.to_dict()
+        out["fm_MPa"] = None if self.crushing is None else self.crushing.fm_MPa
+        out["crushing"] = None if self.crushing is None else self.crushing.to_dict()
         if self.mechanism is not None:
             mech = self.mechanism
             out["mechanism"] = {
@@ -170,11 +252,21 @@ class LimitResult:
                 }
                 for k, itf in enumerate(model.interfaces)
             ]
-        if self.kinematic is not None:
-            kin = self.kinematic.to_dict()
+        code = self.for_code  # the code's quantities: the coulomb pass's where it governs (FrictionCheck)
+        if code.kinematic is not None:
+            kin = code.kinematic.to_dict()
             out["kinematic"] = kin
             for key in keys:
                 out[key] = kin[key]
+        if code is not self:
+            out["code_mechanism"] = code.to_dict()
+        out["code_multiplier"] = code.load_multiplier
+        out["code_friction_rule"] = code.friction_rule
+        if self.rigid is not None:
+            out["rigid"] = {
+                "load_multiplier": self.rigid.load_multiplier,
+                "code_multiplier": self.rigid.for_code.load_multiplier,
+            }
         return out
 
 
@@ -190,6 +282,8 @@ def limit_analysis(
     max_iterations: int = MAX_ITERATIONS,
     time_limit_s: float | None = None,
     on_iteration: Callable[[int, float, float], None] | None = None,
+    coulomb_check: bool = False,
+    fm_MPa: float | None = None,
 ) -> LimitResult:
     """The collapse multiplier, mechanism and kinematic quantities of a scene.
 
@@ -223,6 +317,15 @@ def limit_analysis(
         stops with status "not_converged" and a reason that says so.
     on_iteration
         The coulomb rule's progress: called after every programme with (iteration, lambda, seconds).
+    coulomb_check
+        Under the associated rule, when the mechanism slides where a joint has friction, also solve
+        the coulomb rule (from the same model) and attach it (``friction_check``): the code's
+        quantities (``for_code``) take the lower multiplier. Not run when the mechanism does not
+        slide with friction (the two rules then give the same mechanism's work).
+    fm_MPa
+        The masonry's compressive strength, MPa in (0, 1e9]: the hinges move into the joints by the
+        stress block's resultant, iterated with the programme's normal forces to a fixed point
+        (:mod:`rockyade.limit.crushing`); None: rigid blocks (hinges at the joints' edges).
     """
     if direction not in DIRECTIONS:
         raise InputError("direction", f"must be +x or -x, got {direction!r}")
@@ -234,12 +337,68 @@ def limit_analysis(
         isinstance(time_limit_s, (int, float)) and math.isfinite(time_limit_s) and 0.0 < time_limit_s <= 1.0e6
     ):
         raise InputError("time_limit_s", f"must be a time in (0, 1e6] s, got {time_limit_s!r}")
+    if fm_MPa is not None:
+        fm_MPa = check_fm(fm_MPa)
     if isinstance(scene, RigidBlockModel):
         if loads or friction_angle_deg is not None or not sliding:
             raise InputError("loads", "give loads and friction when building the RigidBlockModel, not here")
         model = scene
     else:
         model = rigid_block_model(scene, loads=loads, friction_angle_deg=friction_angle_deg, sliding=sliding)
+    options: dict[str, Any] = dict(fc=fc, max_iterations=max_iterations, on_iteration=on_iteration)
+    if fm_MPa is not None:
+        start = time.perf_counter()
+        _, crushed_model, crushing = iterate_crushing(
+            model,
+            fm_MPa,
+            lambda m: limit_analysis(m, direction, nonlinear=False, friction_rule=friction_rule, **options),
+        )
+        left = None if time_limit_s is None else max(time_limit_s - (time.perf_counter() - start), 1e-3)
+        result = limit_analysis(
+            crushed_model, direction, nonlinear=nonlinear, friction_rule=friction_rule, time_limit_s=left, **options
+        )
+        result = replace(result, crushing=crushing)
+    else:
+        result = _limit_analysis(
+            model, direction, fc, nonlinear, friction_rule, max_iterations, time_limit_s, on_iteration
+        )
+    if coulomb_check and friction_rule == "associated" and slides_with_friction(result.model, result.mechanism):
+        assert result.load_multiplier is not None  # a mechanism comes with its multiplier
+        coulomb = limit_analysis(
+            model,
+            direction,
+            nonlinear=nonlinear,
+            friction_rule="coulomb",
+            time_limit_s=time_limit_s,
+            fm_MPa=fm_MPa,
+            **options,
+        )
+        result = replace(result, friction_check=FrictionCheck(result.load_multiplier, coulomb))
+    if fm_MPa is not None and (friction_rule == "coulomb" or result.friction_check is not None):
+        rigid = limit_analysis(
+            model,
+            direction,
+            nonlinear=nonlinear,
+            friction_rule=friction_rule,
+            time_limit_s=time_limit_s,
+            coulomb_check=coulomb_check,
+            **options,
+        )
+        result = replace(result, rigid=rigid)
+    return result
+
+
+def _limit_analysis(
+    model: RigidBlockModel,
+    direction: str,
+    fc: float,
+    nonlinear: bool,
+    friction_rule: str,
+    max_iterations: int,
+    time_limit_s: float | None,
+    on_iteration: Callable[[int, float, float], None] | None,
+) -> LimitResult:
+    """:func:`limit_analysis` of a model with its joints as they are (checked arguments)."""
     angles = {itf.friction_angle_deg for itf in model.interfaces}
     if angles == {None} or not model.interfaces:
         phi: float | str | None = None

@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from rockyade.limit.analysis import LimitResult
+from rockyade.limit.analysis import LimitResult, slides_with_friction
+from rockyade.limit.crushing import STRESS_BLOCK
 from rockyade.limit.mechanism import Hinge, Sliding
 from rockyade.limit.rigid_blocks import RigidBlockModel
 
@@ -74,6 +75,78 @@ def sliding_words(model: RigidBlockModel, slide: Sliding, velocities: np.ndarray
 
 def _fmt(value: float | None, unit: str = "", digits: int = 4) -> str:
     return "-" if value is None else f"{value:.{digits}g}{unit}"
+
+
+def _friction_sliders(result: LimitResult) -> str:
+    """The joints of the mechanism that slide with friction, named (at most three)."""
+    assert result.mechanism is not None
+    model = result.model
+    named = [f"{s.a} on {s.b}" for s in result.mechanism.sliding if model.interfaces[s.interface].friction_angle_deg]
+    return ", ".join(named[:3]) + (" ..." if len(named) > 3 else "")
+
+
+def code_basis_lines(result: LimitResult) -> list[str]:
+    """Which answer the code's quantities take, in words (:attr:`LimitResult.for_code`): both friction
+    rules' multipliers where the mechanism slides with friction, the masonry's crushing at the hinges."""
+    lines: list[str] = []
+    if result.status != "collapse" or result.load_multiplier is None:
+        return lines
+    check = result.friction_check
+    if check is not None:
+        sliders = _friction_sliders(result)
+        lam_c = check.coulomb_multiplier
+        if lam_c is None:
+            lines.append(
+                f"friction: the mechanism slides with friction ({sliders}); the coulomb (non-dilatant) pass did not "
+                f"converge ({check.coulomb.reason}): the code's quantities take the associated lambda = "
+                f"{check.associated:.4f}, an upper bound of the non-dilatant one"
+            )
+        else:
+            lines.append(
+                f"friction: the mechanism slides with friction ({sliders}): associated (dilatant) lambda = "
+                f"{check.associated:.4f}, coulomb (non-dilatant) lambda = {lam_c:.4f} (associated / coulomb = "
+                f"{check.ratio:.3g}); the code's quantities take the {check.taken} one, the lower of the two"
+            )
+    elif result.friction_rule == "associated" and slides_with_friction(result.model, result.mechanism):
+        lines.append(
+            f"friction: the mechanism slides with friction ({_friction_sliders(result)}); no coulomb pass was asked "
+            "(--friction-rule associated): the code's quantities take the associated lambda, an upper bound of the "
+            "non-dilatant one"
+        )
+    elif result.friction_rule == "associated" and result.sliding_allowed:
+        lines.append(
+            "friction: the mechanism does not slide where a joint has friction: the associated and the coulomb rules "
+            "give it the same work, so no coulomb pass is needed"
+        )
+    crushing = result.crushing
+    if crushing is not None:
+        lines.append(f"masonry crushing at the hinges, fm = {crushing.fm_MPa:g} MPa: {STRESS_BLOCK}")
+        first = crushing.history[0] if crushing.history else float("nan")
+        state = (
+            f"a fixed point in {plural(crushing.iterations, 'iteration')}"
+            if crushing.converged
+            else f"NOT a fixed point ({crushing.reason})"
+        )
+        big = crushing.largest_shift
+        where = ""
+        if big is not None:
+            where = (
+                f"; the largest shift {big['shift_m'] * 1e3:.3g} mm, {big['a']} on {big['b']} (N = "
+                f"{big['normal_N'] / 1e3:.4g} kN, a = {big['width_m'] * 1e3:.3g} mm over {big['length_m']:.4g} m)"
+            )
+        lines.append(
+            f"  lambda = {result.load_multiplier:.4f} with the hinges moved, {first:.4f} with rigid ones: "
+            f"{state}{where}"
+        )
+        if crushing.crushed:
+            lines.append(f"  crushed (cannot carry their normal force): {', '.join(crushing.crushed[:5])}")
+    if result.rigid is not None and result.for_code is result.rigid.for_code:
+        code = result.for_code
+        lines.append(
+            f"  with the hinges moved the coulomb iteration (a heuristic) settled above the rigid model's lambda = "
+            f"{code.load_multiplier:.4f}; crushing cannot raise the capacity: the code's quantities take the rigid one"
+        )
+    return lines
 
 
 def text_report(result: LimitResult, source: str = "scene") -> list[str]:
@@ -152,6 +225,18 @@ def text_report(result: LimitResult, source: str = "scene") -> list[str]:
         f"checks: kinematic constraints met to {mech.checks.max_closing:.1e}, {work} to "
         f"{mech.checks.virtual_work_residual:.1e} (relative)"
     )
+    lines.extend(code_basis_lines(result))
+    code = result.for_code
+    if code is not result:
+        assert code.kinematic is not None and code.mechanism is not None and code.load_multiplier is not None
+        kin, cm = code.kinematic, code.mechanism
+        lines.append(
+            f"kinematic quantities of the {code.friction_rule} mechanism (lambda = {code.load_multiplier:.4f}: "
+            f"{plural(int(cm.moving.sum()), 'block')} moving, {plural(len(cm.hinges), 'hinge')}, "
+            f"{plural(len(cm.sliding), 'sliding joint')}; --json's code_mechanism), the code's:"
+        )
+        lines.extend("  " + hinge_words(code.model, h) for h in cm.hinges[:MAX_LISTED])
+        lines.extend("  " + sliding_words(code.model, sl, cm.velocities) for sl in cm.sliding[:MAX_LISTED])
     lines.append(f"kinematic quantities (NTC 2018, Circolare 2019 C8.7.1; FC = {kin.FC:g}):")
     lines.append(
         f"  alpha0 = {kin.alpha0:.4f}; M* = {kin.M_star_kg:.4g} kg, e* = {kin.e_star:.4f} "

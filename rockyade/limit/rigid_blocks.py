@@ -158,6 +158,9 @@ class RigidBlockModel:
         fixed block or the base: :mod:`rockyade.limit.point_contacts`), each with its ways as
         interfaces of zero length; :func:`rockyade.limit.admissible.solve_admissible` chooses.
         Point contacts with one way are among ``interfaces`` (kind "corner").
+    depths_m
+        (nb,) the blocks' depth out of the section (the scene's ``thickness_m``: a wall's length), m;
+        the joints' depth where the masonry's compressive strength counts (:mod:`rockyade.limit.crushing`).
     """
 
     names: tuple[str, ...]
@@ -173,6 +176,7 @@ class RigidBlockModel:
     given_loads: tuple[PointLoad, ...] = ()
     block_masses_kg: NDArray[np.float64] | None = None
     block_centroids_m: NDArray[np.float64] | None = None
+    depths_m: NDArray[np.float64] | None = None
 
     def weight_points(self) -> list[tuple[int, NDArray[np.float64], float]]:
         """(block, point at rest, mass kg) of every mass the horizontal acceleration acts on: each
@@ -483,4 +487,5 @@ def rigid_block_model(
         given_loads=given,
         block_masses_kg=masses,
         block_centroids_m=centroids,
+        depths_m=np.array([float(spec.thickness_m) for spec in scene.blocks]),
     )

@@ -27,9 +27,12 @@ and the kinematic quantities) takes the loaded block's mass properties from
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
+
+from rockyade.blocks.classical import ClassicalParameters, rigid_body_classical, with_overrides
 
 
 @dataclass(frozen=True)
@@ -129,21 +132,6 @@ def loaded_mass_properties(
     return MassProperties(total, (cx, cy), float(inertia), extra)
 
 
-def pivot_restitution(props: MassProperties, pivot_from: Sequence[float], pivot_to: Sequence[float]) -> float:
-    """omega after / omega before when the pivot moves from ``pivot_from`` to ``pivot_to``
-    (angular momentum about the new pivot conserved, Housner 1963 generalised to any centroid):
-
-        mu = (I_c + M r_from . r_to) / (I_c + M |r_to|^2),   r = c - pivot.
-
-    For a rectangle with its centroid on its axis this is 1 - 1.5 sin^2(alpha).
-    """
-    c = props.centroid_m
-    rf = (c[0] - pivot_from[0], c[1] - pivot_from[1])
-    rt = (c[0] - pivot_to[0], c[1] - pivot_to[1])
-    m, i_c = props.mass_kg, props.inertia_c_kgm2
-    return (i_c + m * (rf[0] * rt[0] + rf[1] * rt[1])) / (i_c + m * (rt[0] * rt[0] + rt[1] * rt[1]))
-
-
 def carried_on(loads: Sequence[Any], block: str | int, g: float) -> list[tuple[tuple[float, float], float]]:
     """(point, mass) of each load on ``block`` (matched by the load's ``block`` field) with a mass."""
     out = []
@@ -155,56 +143,74 @@ def carried_on(loads: Sequence[Any], block: str | int, g: float) -> list[tuple[t
     return out
 
 
-def loaded_rocking_parameters(
-    mass_kg: float,
-    centroid_m: Sequence[float],
-    pivots_m: Sequence[Sequence[float]],
-    p_left: float,
-    g: float,
-    carried: Sequence[tuple[Sequence[float], float]],
-) -> tuple[MassProperties, dict[str, float]]:
-    """Housner's parameters of a single block with the masses it carries.
+def loaded_classical(scene: Any, g: float) -> dict[str, ClassicalParameters]:
+    """The classical parameters of every moving block of ``scene`` as it rocks: with the masses of
+    the loads it carries merged in and the moments of its loads without mass, by block name.
 
-    The block's own centroidal inertia comes from its left-pivot p (Eq 3: I_O = M g R / p^2,
-    which also honours an overridden p); the loaded block's alpha, p (Eq 3 again) and pivot
-    restitution (:func:`pivot_restitution`) follow from :func:`loaded_mass_properties`.
+    A block without loads has its own (``spec.classical()``). A loaded block is one rigid body
+    (:func:`loaded_mass_properties`) rocking on the block's two base corners (the equivalent base
+    x_c -/+ h_c tan(alpha) where alpha is overridden, paper Eq 11), its own centroidal inertia
+    from its left-pivot p (Eq 3: I_O = M g R / p^2, which honours an overridden p), and each
+    direction gets its own alpha, R, p, restitution and uplift acceleration
+    (:func:`rockyade.blocks.classical.rigid_body_classical`); an overridden mu stays.
 
     Parameters
     ----------
-    mass_kg, centroid_m
-        The block's own mass, kg, and centroid at rest (base frame), m.
-    pivots_m
-        (left pivot, right pivot), base frame, m.
-    p_left
-        The block's own frequency parameter about its left pivot, rad/s.
+    scene
+        A validated scene (its ``blocks`` and ``loads``).
     g
         Acceleration of gravity, m/s^2.
-    carried
-        (point, mass) of each carried load, base frame, m and kg.
-
-    Returns
-    -------
-    MassProperties, dict
-        The loaded block, and ``alpha_left``, ``alpha_right``, ``p_left``, ``p_right``,
-        ``mu_left_to_right``, ``mu_right_to_left`` (rad, rad/s, dimensionless).
     """
-    import math
+    out: dict[str, ClassicalParameters] = {}
+    loaded = {str(q.block) for q in getattr(scene, "loads", ())}
+    placed = None
+    for index, spec in enumerate(scene.blocks):
+        if spec.fixed:
+            continue
+        bare = spec.classical()
+        if spec.name not in loaded:
+            out[spec.name] = bare
+            continue
+        if placed is None:
+            from rockyade.scene.placement import placed_blocks
 
-    left, right = pivots_m[0], pivots_m[1]
-    r_left = math.hypot(centroid_m[0] - left[0], centroid_m[1] - left[1])
-    inertia_c = mass_kg * g * r_left / (p_left * p_left) - mass_kg * r_left * r_left
-    props = loaded_mass_properties(mass_kg, centroid_m, inertia_c, carried)
-    cx, cy = props.centroid_m
-    m = props.mass_kg
+            placed = placed_blocks(scene)
+        out[spec.name] = _loaded_block(spec, placed[index], [q for q in scene.loads if q.block == spec.name], bare, g)
+    return out
 
-    def p_about(pivot: Sequence[float]) -> float:
-        return math.sqrt(m * g * math.hypot(cx - pivot[0], cy - pivot[1]) / props.inertia_about(pivot))
 
-    return props, {
-        "alpha_left": math.atan2(cx - left[0], cy),
-        "alpha_right": math.atan2(right[0] - cx, cy),
-        "p_left": p_about(left),
-        "p_right": p_about(right),
-        "mu_left_to_right": pivot_restitution(props, left, right),
-        "mu_right_to_left": pivot_restitution(props, right, left),
-    }
+def _loaded_block(
+    spec: Any, placed: Any, loads: Sequence[Any], bare: ClassicalParameters, g: float
+) -> ClassicalParameters:
+    """:func:`loaded_classical` of one block with its loads (base frame at rest), in its own frame."""
+    block = spec.block()
+    cx, cy = (float(v) for v in block.centroid_m)
+    c, s = math.cos(placed.rotation_rad), math.sin(placed.rotation_rad)
+
+    def own(point: Sequence[float]) -> tuple[float, float]:  # base frame -> block frame
+        dx, dy = float(point[0]) - placed.centroid_m[0], float(point[1]) - placed.centroid_m[1]
+        return (cx + c * dx + s * dy, cy - s * dx + c * dy)
+
+    pivots = ((cx - cy * math.tan(bare.left.alpha_rad), 0.0), (cx + cy * math.tan(bare.right.alpha_rad), 0.0))
+    mass = block.mass_kg
+    r_left = math.hypot(cx - pivots[0][0], cy)
+    inertia_c = mass * g * r_left / (bare.left.p_rad_s**2) - mass * r_left * r_left
+    props = loaded_mass_properties(mass, (cx, cy), inertia_c, [(own(q.point_m), load_mass_kg(q, g)) for q in loads])
+    moments = [0.0, 0.0]
+    for q in loads:
+        fx, fy = residual_force(q, g)
+        fx, fy = c * fx + s * fy, -s * fx + c * fy  # the force in the block frame
+        px, py = own(q.point_m)
+        for k, (x0, y0) in enumerate(pivots):
+            moments[k] += (px - x0) * fy - (py - y0) * fx
+    cp = rigid_body_classical(
+        props.mass_kg,
+        props.centroid_m,
+        props.inertia_c_kgm2,
+        pivots,
+        g,
+        load_moments_Nm=(moments[0], moments[1]),
+        carried_kg=props.carried_kg,
+    )
+    cp = replace(cp, source={k: v if v == "override" else "geometry and loads" for k, v in bare.source.items()})
+    return with_overrides(cp, mu=spec.mu, g=g) if spec.mu is not None else cp

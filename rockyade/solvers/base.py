@@ -188,8 +188,20 @@ def _coverage(scene: Scene) -> dict[str, Any]:
         return {"status": "unknown", "message": f"{type(exc).__name__}: {exc}"}
 
 
+def classical_meta(scene: Scene) -> dict[str, Any]:
+    """``meta.classical`` of a run: per moving block, the classical parameters of the body that
+    rocks, the masses of the loads it carries merged in, each direction its own alpha, R, p, mu
+    and uplift acceleration (:func:`rockyade.scene.carried.loaded_classical`), as every solver
+    reports them."""
+    from rockyade.constants import G
+    from rockyade.scene.carried import loaded_classical
+
+    return {name: cp.as_dict() for name, cp in loaded_classical(scene, G).items()}
+
+
 def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene], Result]:
-    """``run`` whose Result carries ``meta.motion_coverage``, refusing first a scene whose loads
+    """``run`` whose Result carries ``meta.motion_coverage`` and ``meta.classical``
+    (:func:`classical_meta`), refusing first a scene whose loads
     cannot be carried at rest (:func:`rockyade.limit.standing.check_loads_stand`: its blocks would
     leave their supports for good, and no solver's answer would mean anything)."""
 
@@ -202,6 +214,8 @@ def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene]
         result = run(self, scene)
         if result.meta.motion_coverage is None:
             result.meta = dataclasses.replace(result.meta, motion_coverage=motion_coverage(scene))
+        if result.meta.classical is None:
+            result.meta = dataclasses.replace(result.meta, classical=classical_meta(scene))
         return result
 
     wrapper.records_coverage = True  # type: ignore[attr-defined]

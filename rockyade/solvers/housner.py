@@ -15,6 +15,7 @@ import numpy as np
 
 from rockyade import __version__
 from rockyade.blocks.classical import ClassicalParameters
+from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.housner.history import housner_frame
 from rockyade.housner.integrator import REST_FRACTION, STEPS_PER_RADIAN, Trajectory, solve, warm_up
@@ -23,6 +24,7 @@ from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
+from rockyade.scene.carried import loaded_classical
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage
 from rockyade.solvers.cost_estimate import CostEstimate, sample_cost
 
@@ -81,7 +83,7 @@ class HousnerSolver(SolverBase):
                 scene.source,
             )
         spec = scene.blocks[0]
-        cp = spec.classical()
+        cp = loaded_classical(scene, G)[spec.name]  # the body that rocks, with the masses its loads carry
         model = housner_model(scene)
         motion = scene.motion.ground_motion(scene.duration_s)
         warm_up()
@@ -137,7 +139,7 @@ class HousnerSolver(SolverBase):
         first = scenes[0]
         if len(first.blocks) != 1:
             raise InputError("blocks", "run_group: one block per scene only (see group_key)", first.source)
-        cp = first.blocks[0].classical()
+        cp = loaded_classical(first, G)[first.blocks[0].name]
         model = housner_model(first)
         warm_up()
         setup = time.perf_counter() - start

@@ -47,7 +47,7 @@ from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
-from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, motion_coverage
+from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, classical_meta, motion_coverage
 from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
 
 _STATUS_NAMES = {
@@ -178,6 +178,7 @@ class ReferenceSolver(SolverBase):
         finally:
             numba.set_num_threads(before)
         runs = []
+        classical = classical_meta(scenes[0])  # one structure: the same body in every run
         for r, model in enumerate(models):
             n = int(out.n_filled[r])
             one = KernelOutput(
@@ -212,6 +213,7 @@ class ReferenceSolver(SolverBase):
                     "setup_time_s": setup / max(1, len(scenes)),
                     "dt_factor": self.dt_factor,
                     "motion_coverage": motion_coverage(scenes[r]),
+                    "classical": classical,
                 }
             )
             metrics = {

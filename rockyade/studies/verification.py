@@ -37,6 +37,16 @@ the tolerance, pass or fail):
   0.05 m from its axis, pushed towards +x (the load at d = 0.15 m from the pivot):
   lambda = (W b + N d) / (W h_c) = 0.32232 from the limit analysis and from Housner's uplift
   multiplier with the load's moment (modified Eq 1), within 1e-6;
+* ``loaded_classical``: a 0.45 x 3.2 m tuff wall with 12 kN/m at 0.125 m from its axis, with its
+  mass: each direction's alpha, mu and uplift multiplier against the hand calculation (the loaded
+  body's centroid and inertia, the angular momentum about the new pivot), and the limit analysis'
+  multiplier each way against (W b + N d) / (W h_c + N h_N);
+* ``code_friction``: the 8-course wall restrained on the far face of its top course: with the
+  restraint's corner contact frictionless both friction rules give the closed form 1.3019; at 35
+  degrees the coulomb multiplier (1.6205) lies below the associated one (3.5891) and the code's
+  quantities take the lower;
+* ``crushing``: the masonry's compressive strength at the hinges: a block's multiplier against
+  (B - a) / H, a = W / (0.85 fm t), and as fm tends to infinity the rigid one (a block, 6 courses);
 * ``loaded_pushover``: the reference DEM's pushover onset of that block (levels held 0.4 s
   every 1 % of the closed form from 0.98 of it) within 2 % of the closed form, and the last
   level at which it stood at most the closed form;
@@ -56,7 +66,8 @@ The checks live by domain: :mod:`rockyade.studies.verify_closed` (no solver),
 :mod:`rockyade.studies.verify_siconos`; each row holds its tolerance once
 (:mod:`rockyade.studies.verify_rows`).
 
-``kinematic``, ``code``, ``fragility_fit`` and ``loaded_block`` run no solver (the
+``kinematic``, ``code``, ``fragility_fit``, ``loaded_block``, ``loaded_classical``, ``code_friction``
+and ``crushing`` run no solver (the
 limit-analysis programme, Housner's model and the fit only).
 """
 
@@ -70,6 +81,7 @@ import pandas as pd
 from rockyade.io.atomic import atomic_open, write_text
 from rockyade.result import Result
 from rockyade.studies.verification_checks import CHECKS
+from rockyade.studies.verify_assess import check_code_friction, check_crushing, check_loaded_classical
 from rockyade.studies.verify_closed import (
     check_code,
     check_fragility_fit,
@@ -94,6 +106,9 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "fragility_fit": check_fragility_fit,
     "loaded_block": check_loaded_block,
     "loaded_mass": check_loaded_mass,
+    "loaded_classical": check_loaded_classical,
+    "code_friction": check_code_friction,
+    "crushing": check_crushing,
     "loaded_pushover": check_loaded_pushover,
     "limit_pushover": check_limit_pushover,
     "siconos": check_siconos,

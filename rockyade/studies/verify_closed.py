@@ -143,24 +143,12 @@ def _restrained_wall_rows() -> list[Row]:
     courses turn about the toe and the top course is squeezed up, (W_L t/2 + (W_c + N)(t + 2.1
     tan 35)) / (W_L 1.05), below the three-hinge mechanism's 1.3619."""
     from rockyade.limit import limit_analysis
+    from rockyade.studies.verify_assess import corner_friction_wall, squeezed_top
 
     two = wall_section(courses=2, split=0.5, top="restrained-far", restraint_friction_deg=0.0)
     lam2 = known(limit_analysis(scene_from_dict(two), direction="+x").load_multiplier, "load multiplier")
-    eight = wall_section(
-        height_m=2.4,
-        thickness_m=0.36,
-        courses=8,
-        top="restrained-far",
-        gap_m=0.0,
-        overburden_n_per_m=6000.0,
-        overburden_eccentricity_m=0.05,
-        density_kg_m3=1600.0,
-        contact={"calibration": "paper", "friction_angle_deg": 35.0},
-    )
-    eight["loads"] = [{**q, "mass_kg": 0.0} for q in eight["loads"]]  # the case's roof: without mass
-    lam8 = known(limit_analysis(scene_from_dict(eight), direction="+x").load_multiplier, "load multiplier")
-    wc = 1600.0 * G * 0.36 * 0.3
-    expected8 = (7 * wc * 0.18 + (wc + 6000.0) * (0.36 + 2.1 * math.tan(math.radians(35.0)))) / (7 * wc * 1.05)
+    lam8 = known(limit_analysis(corner_friction_wall(0.0), direction="+x").load_multiplier, "load multiplier")
+    expected8 = squeezed_top()
     # expected8 (1.3019) lies 4 % below the three hinges' 1.3619: within 1e-9 of it, lam8 is below them too
     return [
         Row(
