@@ -7,7 +7,7 @@ by its settings and number, so that a task pickles small and the record is read 
 cache where the run happens). **A load factor multiplies the record's accelerations as
 read** (after the conversion of the file's units to m/s^2; nothing else is done to them).
 
-* :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt`` and ``.dat`` file of a folder,
+* :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt``, ``.dat`` and ``.asc`` (ESM) file of a folder,
   sorted by name (the same accelerogram twice, e.g. an ``.AT2`` and its ``.csv``, is refused;
   a link to a record file is followed and counted; a link to anything else, and a
   subfolder (real or linked: records are read from the folder itself only), refused rather
@@ -35,7 +35,7 @@ from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
 from rockyade.motion.types import RecordMotion, SyntheticMotion
 
 #: File names a records folder is read for (case-insensitive suffixes).
-RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".dat")
+RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".dat", ".asc")
 #: Records of a set, at most.
 MAX_RECORDS = 1000
 #: Records of a synthetic suite, at most (generation takes about a second each).

@@ -21,11 +21,12 @@ def _read(args: argparse.Namespace):
 
 
 def _add_record_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("record", type=Path, help="record file: PEER .AT2, two-column time/acceleration, or one column")
+    p.add_argument("record", type=Path, help="record file: PEER .AT2, ESM ASCII (.ASC), two-column time/acceleration, or one column")
     p.add_argument(
         "--format",
-        choices=["at2", "csv", "single"],
-        help="file format (default: from the content: a PEER header is at2, one number a line with --dt is single)",
+        choices=["at2", "csv", "single", "esm"],
+        help="file format (default: from the content: a PEER header is at2, an ESM header (KEY: value lines, "
+        "SAMPLING_INTERVAL_S, NDATA) is esm, one number a line with --dt is single)",
     )
     p.add_argument(
         "--units",
