@@ -85,7 +85,9 @@ def _check_line(check: Check) -> str:
     if check.status == NOT_APPLICABLE:
         return f"  {check.name}: {check.inequality}: not applicable ({check.reason})\n    clause: {check.source}"
     t = check.terms
-    if check.quantity == "a0*" and "T1_s" not in t:
+    if check.demand_text:
+        demand = check.demand_text
+    elif check.quantity == "a0*" and "T1_s" not in t:
         demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}"
     elif check.quantity == "a0*":
         demand = (
