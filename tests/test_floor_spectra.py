@@ -203,3 +203,13 @@ def test_the_ntc_site_reaches_the_floor_spectrum_through_its_own_spectrum():
     linear, _ = code_checks(kin, site, Position(6.0, 9.0, 3, T1_s=0.3))
     se_t1 = 0.2 * G * 1.2 * 2.4  # T1 = 0.3 s on the plateau TB = 0.14 s .. TC = 0.42 s
     assert linear.terms["a_Z_m_s2"] == pytest.approx(se_t1 * (9 / 7) * (6 / 9) * math.sqrt(1.01), rel=1e-12)
+
+
+def test_the_verify_row_of_the_worked_example_passes(tmp_path):
+    """``rockyade verify --only floor_spectrum``: the how-to's mechanism at height against its hand calculation."""
+    from rockyade.studies.verification import verify
+
+    table = verify(tmp_path, ["floor_spectrum"], ["reference"])
+    assert len(table) == 7 and set(table["check"]) == {"floor_spectrum"}
+    assert table["passed"].all(), table[~table["passed"]].to_string()
+    assert table["difference"].abs().max() < 1e-3

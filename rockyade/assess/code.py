@@ -44,7 +44,7 @@ from typing import Any
 
 import numpy as np
 
-from rockyade.assess.floor_spectra import SLD_DAMPING, FloorSpectrum, displacement_demand, secant_period
+from rockyade.assess.floor_spectra import SLD_DAMPING, displacement_demand, secant_period
 from rockyade.assess.site import AnySite, Position
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
@@ -267,11 +267,11 @@ def height_checks_2019(kin: KinematicQuantities, site: AnySite, position: Positi
     """The linear and nonlinear checks of a mechanism at height by Circolare 2019 C8.7.1 on the
     floor spectrum of C7.2.3 (module docstring)."""
     ag, a0 = site.ag_m_s2, kin.a0_star_m_s2
-    floor = FloorSpectrum(site.spectrum, position.period_s, position.gamma, position.psi, position.xi1)
+    floor = position.floor(site.spectrum)
     common = {"T1_s": floor.T1_s, "psi": floor.psi1, "gamma": floor.gamma1, "xi1": floor.building_damping}
     where = (
         f"T1: {position.period_source}; xi1 = {100 * floor.building_damping:g} %; psi(Z) = Z/H, gamma = 3N/(2N+1) "
-        f"(Eq C7.2.10); Se from {site.spectrum_clause}"
+        f"(Eq C7.2.10); Se from {site.spectrum_clause.split(';')[0]}"
     )
     T0 = position.T0_s
     sez_t0 = float(floor.psa([T0], SLD_DAMPING)[0])

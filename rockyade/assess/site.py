@@ -32,7 +32,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
-from rockyade.assess.floor_spectra import BUILDING_DAMPING, SLV_DAMPING, check_damping
+from rockyade.assess.floor_spectra import BUILDING_DAMPING, SLV_DAMPING, FloorSpectrum, check_damping
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.motion.ec8 import EC8_GROUND, ElasticSpectrum
@@ -370,6 +370,11 @@ class Position:
             isinstance(t0, (int, float)) and math.isfinite(t0) and 0.0 <= t0 <= MAX_MECHANISM_PERIOD_S
         ):
             raise InputError("--mechanism-period", f"must be in [0, {MAX_MECHANISM_PERIOD_S:g}] s, got {t0!r}")
+
+    def floor(self, spectrum: ElasticSpectrum) -> FloorSpectrum:
+        """The floor spectrum at this height over the site's ``spectrum`` (Circolare 2019 C7.2.3,
+        first mode: gamma, psi, T1, xi1 of this position)."""
+        return FloorSpectrum(spectrum, self.period_s, self.gamma, self.psi, self.xi1)
 
     @property
     def method(self) -> str:

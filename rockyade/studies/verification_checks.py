@@ -15,5 +15,6 @@ CHECKS = (
     "loaded_mass",
     "loaded_pushover",
     "limit_pushover",
+    "floor_spectrum",
     "siconos",
 )
