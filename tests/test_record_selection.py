@@ -75,6 +75,17 @@ def test_the_set_written_is_compatible_when_checked_independently(selection):
     assert meta["worst_deviation"] == pytest.approx(ratio.min() - 1, abs=1e-6)  # the lower edge is the closer here
 
 
+def test_the_shipped_selection_is_what_the_command_writes(selection):
+    """examples/site_selection (which the docs' assess command reads) is the fixture's set."""
+    shipped = EXAMPLES / "site_selection"
+    assert (shipped / "selection.csv").read_bytes() == (selection / "selection.csv").read_bytes()
+    for name in pd.read_csv(shipped / "selection.csv")["record"]:
+        assert (shipped / name).read_bytes() == (RECORDS / name).read_bytes()
+    meta = json.loads((shipped / "selection.json").read_text())
+    assert meta["compatible"] and meta["records_folder"] == "examples/site_records"
+    assert records_in_folder(shipped).count == 7
+
+
 def test_selecting_again_gives_the_same_set_and_replaces_it_whole(selection, tmp_path, capsys):
     out = tmp_path / "again"
     shutil.copytree(selection, out)

@@ -108,9 +108,14 @@ class RecordFiles:
         verdict = "compatible" if s.get("compatible") else "NOT compatible"
         dev, period = s.get("worst_deviation"), s.get("worst_deviation_period_s")
         worst = f"worst deviation {100 * dev:+.1f} % at {period:.3g} s" if dev is not None and period else ""
+        few = (
+            "; fewer than 7 records: NTC 2018 7.3.5 takes the most unfavourable record's effects, not the mean"
+            if self.count < 7
+            else ""
+        )
         return (
             f"{text}: the selection {s['selection']} (rockyade motion select), each scaled by its factor, {verdict} "
-            f"with the site's spectrum (NTC 2018 3.2.3.6; {worst}); lambda = 1 is its scaling"
+            f"with the site's spectrum (NTC 2018 3.2.3.6; {worst}); lambda = 1 is its scaling{few}"
         )
 
     def to_dict(self) -> dict[str, Any]:

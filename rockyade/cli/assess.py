@@ -334,7 +334,8 @@ def register(sub: Any) -> None:
         "--records",
         type=Path,
         metavar="DIR",
-        help="your records (a folder of .at2/.csv/.txt/.dat files), each scaled to PGA = ag S at load factor 1 "
+        help="your records (a folder of .at2/.asc/.csv/.txt/.dat files), each scaled to PGA = ag S at load factor 1, "
+        "or a selection written by 'rockyade motion select' for this site (each record scaled by its factor) "
         "(default: a synthetic suite compatible with the site's spectrum)",
     )
     dyn.add_argument(

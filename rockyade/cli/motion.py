@@ -422,7 +422,8 @@ def _write_selection(args, chosen, folder, records, shown, spectra, target, t_ra
             verdict=chosen.summary(),
         )
 
-    written = write_selection(args.out, sources, table, meta, draw)
+    given = [str(Path(args.records) / source.name) for source in sources]
+    written = write_selection(args.out, sources, table, meta, draw, given)
     print_wrote(Path(f"{', '.join(written)} in {args.out}"), args.json)
 
 

@@ -100,6 +100,7 @@ def write_selection(
     table: pd.DataFrame,
     meta: dict[str, Any],
     draw: Callable[[Path], None],
+    shown: Sequence[str] | None = None,
 ) -> list[str]:
     """Write a selection into ``out`` as one result set (module docstring); the files written.
 
@@ -115,6 +116,9 @@ def write_selection(
         ``selection.json``'s content (the records' SHA-256 are added here).
     draw
         Writes ``spectra.png`` at the path it is given.
+    shown
+        Each source as the user named it (its folder as given), for ``selection.json``
+        (default: the source paths).
     """
     from rockyade.io.atomic import write_json
     from rockyade.io.folders import output_folder
@@ -131,9 +135,9 @@ def write_selection(
         previous = _previous_records(out)
         with replacing_set(out, [*FIXED_FILES[:-1], *previous, *names, SELECTION_JSON], SELECTION_JSON) as stage:
             records = []
-            for source, name in zip(sources, names, strict=True):
+            for source, name, given in zip(sources, names, shown or [str(p) for p in sources], strict=True):
                 shutil.copyfile(source, stage / name)
-                records.append({"file": name, "sha256": sha256(stage / name), "source": str(source)})
+                records.append({"file": name, "sha256": sha256(stage / name), "source": given})
             with (stage / SELECTION_CSV).open("w", encoding="utf-8", newline="") as fh:
                 table.to_csv(fh, index=False, float_format="%.8g", lineterminator="\n")
             draw(stage / SPECTRA_PNG)
