@@ -19,6 +19,7 @@ from rockyade.assess.site import NtcSite
 from rockyade.cli import main
 from rockyade.errors import InputError
 from rockyade.motion.analytic import Pulse
+from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.records import read_record
 from rockyade.motion.selection import (
     BAND_ABOVE,
@@ -233,3 +234,20 @@ def test_the_range_and_the_count_follow_the_code():
         with pytest.raises(InputError, match=option):
             check_count(count, records, max_response)
     assert math.isclose(BAND_BELOW, 0.10) and math.isclose(BAND_ABOVE, 0.30)
+
+
+def test_the_records_needed_are_estimated_from_how_the_best_set_improves():
+    """14 records scattered about the target (log-normal, sigma 0.6 at each period): no set of 7 is
+    compatible; the trend of random subsets says about 32 such records would do, and 32 drawn from
+    the same scatter do give a compatible set (band use 0.86)."""
+    periods = np.geomspace(0.15, 2.0, 30)
+    pool = np.exp(np.random.default_rng(5).normal(0.0, 0.6, (40, periods.size)))
+    estimate = records_needed(pool[:14], 7, (0.5, 2.0))
+    assert estimate["records_needed"] == 32 and "reaches 1 at about n = 32" in estimate["why"]
+    assert [t["pool"] for t in estimate["trend"]] == [7, 8, 9, 11, 12, 14]
+    names = [f"r{i}" for i in range(40)]
+    target = ElasticSpectrum(1.0, 1.0, 0.1, 0.4, 2.0)
+    spectra = pool * target.psa(periods)
+    assert not select(spectra[:14], names[:14], target, periods, 7, estimate=False).compatible
+    larger = select(spectra[:32], names[:32], target, periods, 7, estimate=False)
+    assert larger.compatible and larger.rho == pytest.approx(0.862, abs=0.005)

@@ -498,8 +498,8 @@ def register(sub: Any) -> None:
         "select",
         help="records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)",
         description="Pick from a folder of records (PEER .AT2, ESM .ASC, text) a set of --count records and a "
-        "scale factor for each whose mean 5 %% spectrum lies nowhere more than 10 %% below the site's elastic "
-        "spectrum nor more than 30 %% above it over 0.15-2.0 s (0.15 s-2 T1 when longer), NTC 2018 3.2.3.6. "
+        "scale factor for each whose mean 5 % spectrum lies nowhere more than 10 % below the site's elastic "
+        "spectrum nor more than 30 % above it over 0.15-2.0 s (0.15 s-2 T1 when longer), NTC 2018 3.2.3.6. "
         "Writes selection.csv, spectra.png, selection.json and the chosen records into --out (a set that "
         "'assess --records' reads); exit 1 with the best deviation reached and an estimate of the records "
         "needed when no set is compatible. See docs/howto/base-motions.md.",

@@ -412,14 +412,23 @@ def records_needed(ratios: NDArray[np.float64], count: int, bounds: tuple[float,
             "records of other spectral shapes are needed",
         }
     needed = math.exp(-intercept / slope)
-    shown = int(min(math.ceil(needed), MAX_ESTIMATE))
+    trend_words = (
+        f"the best band use of random subsets of the folder falls as rho ~ n^-{-slope:.2f} "
+        f"({', '.join(f'{r:.2f} with {s}' for s, r in points)})"
+    )
+    if needed > MAX_ESTIMATE:
+        return {
+            "records_needed": None,
+            "trend": trend,
+            "exponent": float(-slope),
+            "why": f"{trend_words}: it would reach 1 only beyond {MAX_ESTIMATE} records like these; records of other "
+            "spectral shapes are needed",
+        }
     return {
-        "records_needed": shown,
+        "records_needed": int(math.ceil(needed)),
         "trend": trend,
         "exponent": float(-slope),
-        "why": f"extrapolated from the best band use of random subsets of the folder: rho ~ n^-{-slope:.2f} "
-        f"({', '.join(f'{r:.2f} with {s}' for s, r in points)}), which reaches 1 at about n = "
-        f"{shown if needed <= MAX_ESTIMATE else f'more than {MAX_ESTIMATE}'} records like these",
+        "why": f"{trend_words}, which reaches 1 at about n = {math.ceil(needed)} records like these",
     }
 
 
