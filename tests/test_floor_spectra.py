@@ -129,25 +129,7 @@ def test_the_2009_form_is_kept_by_name_and_says_so():
 
 
 def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, capsys):
-    scene = tmp_path / "wall.toml"
-    assert (
-        main(
-            [
-                "build",
-                "wall-section",
-                "--height-m",
-                "2.4",
-                "--thickness-m",
-                "0.36",
-                "--motion",
-                "rest",
-                "--out",
-                str(scene),
-            ]
-        )
-        == 0
-    )
-    capsys.readouterr()
+    scene = wall(tmp_path, capsys)
     assert main(["assess", str(scene), *NTC, "--static-only", *HEIGHT]) == 0
     text = capsys.readouterr().out
     assert "linear, at height: a0* = " in text and "SeZ(T0 = 0 s, 5 %) / q" in text
@@ -167,25 +149,7 @@ def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, ca
     ],
 )
 def test_bad_floor_options_are_refused_naming_them(tmp_path, capsys, extra, option):
-    scene = tmp_path / "wall.toml"
-    assert (
-        main(
-            [
-                "build",
-                "wall-section",
-                "--height-m",
-                "2.4",
-                "--thickness-m",
-                "0.36",
-                "--motion",
-                "rest",
-                "--out",
-                str(scene),
-            ]
-        )
-        == 0
-    )
-    capsys.readouterr()
+    scene = wall(tmp_path, capsys)
     assert main(["assess", str(scene), *NTC, "--static-only", *HEIGHT, *extra]) == 2
     assert option in capsys.readouterr().err
 
