@@ -425,7 +425,7 @@ def records_needed(ratios: NDArray[np.float64], count: int, bounds: tuple[float,
             "spectral shapes are needed",
         }
     return {
-        "records_needed": int(math.ceil(needed)),
+        "records_needed": math.ceil(needed),
         "trend": trend,
         "exponent": float(-slope),
         "why": f"{trend_words}, which reaches 1 at about n = {math.ceil(needed)} records like these",
