@@ -251,3 +251,17 @@ def test_the_records_needed_are_estimated_from_how_the_best_set_improves():
     assert not select(spectra[:14], names[:14], target, periods, 7, estimate=False).compatible
     larger = select(spectra[:32], names[:32], target, periods, 7, estimate=False)
     assert larger.compatible and larger.rho == pytest.approx(0.862, abs=0.005)
+
+
+@pytest.mark.slow
+def test_the_example_records_are_what_their_script_writes(tmp_path):
+    import subprocess
+    import sys
+
+    script = RECORDS / "make_site_records.py"
+    proc = subprocess.run([sys.executable, str(script), "out"], cwd=tmp_path, capture_output=True, text=True)
+    assert proc.returncode == 0, proc.stderr
+    fresh = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert len(fresh) == 10
+    for name in fresh:
+        assert (RECORDS / name).read_bytes() == (tmp_path / "out" / name).read_bytes(), name
