@@ -86,8 +86,10 @@ def test_every_check_names_its_clause_and_formula():
         assert "Circolare" in check.source and ">=" in check.source
         assert check.source.startswith(CHECK_SOURCES[check.name])
     assert "NTC 2018 3.2.3.2.1" in ground[0].source and "Eq 3.2.12" in ground[1].source
-    [at_height] = height
-    assert "Circolare 2009 C8A.4.2.3 form, kept (NOT the 2019 form)" in at_height.source
+    linear, nonlinear = height  # Circolare 2019 C8.7.1 on the floor spectra of C7.2.3
+    assert "C8.7.1.2.1.7" in linear.source and "Eq C8.7.1.12" in nonlinear.source
+    [form_2009] = code_checks(kin, site, Position(6.0, 9.0, 3, height_check="circolare2009"))
+    assert form_2009.source.startswith(CHECK_SOURCES[form_2009.name]) and "superseded" in form_2009.source
     ec8 = code_checks(kin, Site(1, "B", 0.25 * G), Position())
     assert "EN 1998-1" in ec8[1].source
 
@@ -104,8 +106,8 @@ def test_the_checks_not_made_are_in_the_output_itself(tmp_path, capsys):
     height = ["--z", "6", "--building-height", "9", "--storeys", "3"]
     assert main(["assess", str(scene), *LC1, *NTC, "--static-only", *height]) == 0
     text = capsys.readouterr().out
-    assert "checks not made:" in text and "the nonlinear check at height" in text
-    assert "clause: Circolare 2009 C8A.4.2.3 form, kept (NOT the 2019 form)" in text
+    assert "checks not made:" in text and "the floor spectrum's higher modes" in text
+    assert "clause: Circolare 2019 C8.7.1.2.1.8, nonlinear kinematic analysis at height" in text
 
 
 def test_every_load_says_whether_its_mass_takes_part(tmp_path, capsys):

@@ -18,7 +18,13 @@ from .conftest import ROOT
 
 TITLE = "Modeling the dynamic behavior of masonry walls as rigid blocks"
 DOCS = sorted((ROOT / "docs").rglob("*.md"))
-PAGES = [ROOT / "README.md", *DOCS, ROOT / "examples/records/README.md", ROOT / "examples/gallery/README.md"]
+PAGES = [
+    ROOT / "README.md",
+    *DOCS,
+    ROOT / "examples/records/README.md",
+    ROOT / "examples/site_records/README.md",
+    ROOT / "examples/gallery/README.md",
+]
 BIN = Path(sys.executable).parent
 #: Paths of the development machine that users do not have (spelled so that this file
 #: does not contain them).

@@ -224,7 +224,7 @@ def test_assess_at_height_uses_the_floor_demand(capsys, wall):
         "--static-only",
     )
     assert code == 0
-    assert "Se(T1) psi gamma / q" in text and "Ct H^(3/4)" in text
+    assert "SeZ(T0 = 0 s, 5 %) / q" in text and "Ct H^(3/4)" in text
     assert text.rstrip().endswith("dynamics: not run (--static-only)")
 
 

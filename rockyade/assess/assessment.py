@@ -404,11 +404,15 @@ def dynamic_plan(
         motions = ec8_suite(site.spectrum_type, site.ground, site.ag_m_s2, settings.count, settings.seed)
     else:
         motions = settings.records
+        motions.check_site(site.to_dict())  # a selection scales its records to one site's spectrum
     table = record_measures(motions, None, executor, progress)
     table.insert(0, "record", [motions.label(i) for i in range(motions.count)])
     if settings.records is None:
         im = np.full(motions.count, site.ag_m_s2)  # the suite's own ag
         how = f"the suite's target ag = {site.ag_m_s2 / G:.4g} g for every record"
+    elif settings.records.scale_factors is not None:
+        im = np.full(motions.count, site.ag_m_s2)  # the selection's factors scale each record to the site
+        how = "each record scaled by its selection's factor to the site's spectrum (rockyade motion select)"
     else:
         im = table["pga_m_s2"].to_numpy() / site.S  # scaled so that PGA = ag S at lambda = 1
         how = f"each record's PGA / S (S = {site.S:g}): lambda = 1 scales its PGA to ag S"

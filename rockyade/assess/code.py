@@ -10,11 +10,21 @@ clause and formula (:data:`CHECK_SOURCES`):
 * nonlinear kinematic analysis, a mechanism at ground level: du* >= SDe(Ts), with the
   elastic displacement spectrum SDe(T) = Se(T) (T / 2 pi)^2 (NTC 2018 3.2.3.2.3 Eq 3.2.12;
   EN 1998-1 3.2.2.2 Eq 3.7), for Ts up to 4 s;
-* linear kinematic analysis, a mechanism at height Z of a building of height H, N storeys
-  and period T1: a0* >= Se(T1) psi(Z) gamma / q, psi(Z) = Z / H, gamma = 3 N / (2 N + 1). This
-  is the form of Circolare 2009 C8A.4.2.3, kept: Circolare 2019 C8.7.1 takes the demand at
-  height from the floor spectra of NTC 2018 7.2.3 / Circolare 2019 C7.2.3, which is not
-  implemented here; the output says so in the check's own source.
+* a mechanism at height Z of a building of height H, N storeys and period T1, by Circolare 2019
+  C8.7.1 with the floor spectrum SeZ of C7.2.3 (:mod:`rockyade.assess.floor_spectra`; first
+  mode, psi(Z) = Z / H, gamma = 3 N / (2 N + 1), the building's damping xi1):
+
+  - linear (C8.7.1.2.1.7 on C8.7.1.2.1.5): ag,SLV = q ag,SLD, ag,SLD the ag at which the floor's
+    demand at the mechanism's period T0 and 5 % damping, SeZ(T0) (= a_Z, the floor's peak, at
+    T0 = 0, a mechanism rigid until it moves: Eqs C8.7.1.8 and C7.2.8; Eqs C8.7.1.9 and C7.2.5
+    for T0 > 0), reaches a0*: the check a0* >= SeZ(T0) / q;
+  - nonlinear (C8.7.1.2.1.8): d_SLV = 0.4 d0* (C8.7.1.2.1.6, the du* of the ground's check)
+    >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2) (Eq C8.7.1.12, not below SeZ(T1, xi) b^2 T1^2 / (4 pi^2)
+    when T_SLV > b T1), with T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) on the capacity curve
+    (Eq C8.7.1.10) and the mechanism's damping xi = 8 %;
+
+  or, asked for by name (``circolare2009``), the superseded form of Circolare 2009 C8A.4.2.3:
+  a0* >= Se(T1) psi(Z) gamma / q (linear only).
 
 with the behaviour factor q = 2. The linear and the nonlinear analyses are two ways of checking
 the same mechanism (the linear one, with q, the simpler and more conservative): the mechanism
@@ -32,6 +42,9 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
+from rockyade.assess.floor_spectra import SLD_DAMPING, displacement_demand, secant_period
 from rockyade.assess.site import AnySite, Position
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
@@ -94,9 +107,15 @@ CHECK_SOURCES = {
     "Circolare 2009 C8A.4.2.3): a0* = alpha0 g / (e* FC) >= ag S / q",
     "nonlinear, ground level": "Circolare 2019 C8.7.1, nonlinear kinematic analysis at ground level (the same form "
     "as Circolare 2009 C8A.4.2.3): du* = 0.4 d0* >= SDe(Ts), Ts = 2 pi sqrt(ds* / as*), ds* = 0.4 du*",
-    "linear, at height": "Circolare 2009 C8A.4.2.3 form, kept (NOT the 2019 form): a0* >= Se(T1) psi(Z) gamma / q; "
-    "Circolare 2019 C8.7.1 takes the demand at height from the floor spectra of NTC 2018 7.2.3 / Circolare 2019 "
-    "C7.2.3, not implemented here",
+    "linear, at height": "Circolare 2019 C8.7.1.2.1.7 on C8.7.1.2.1.5, linear kinematic analysis at height: "
+    "ag,SLV = q ag,SLD, ag,SLD the ag at which the floor's demand SeZ(T0, 5 %) (Eqs C7.2.5-C7.2.10; the floor's peak "
+    "a_Z at T0 = 0, Eqs C8.7.1.8 and C7.2.8) reaches a0* = alpha0 g / (e* FC) (Eq C8.7.1.9): a0* >= SeZ(T0) / q",
+    "nonlinear, at height": "Circolare 2019 C8.7.1.2.1.8, nonlinear kinematic analysis at height: d_SLV = 0.4 d0* "
+    "(C8.7.1.2.1.6) >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2), not below SeZ(T1, xi) b^2 T1^2 / (4 pi^2) for T_SLV > b T1 "
+    "(Eq C8.7.1.12), T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) (Eq C8.7.1.10), SeZ of Eqs C7.2.5-C7.2.10",
+    "linear, at height (Circolare 2009)": "Circolare 2009 C8A.4.2.3 form, asked for with --height-check circolare2009 "
+    "(superseded: Circolare 2019 C8.7.1 takes the demand at height from the floor spectra of C7.2.3, the default): "
+    "a0* >= Se(T1) psi(Z) gamma / q",
 }
 
 VERIFIED, NOT_VERIFIED, NOT_APPLICABLE = "verified", "not verified", "not applicable"
@@ -141,6 +160,8 @@ class Check:
         Why it does not apply (else empty).
     source
         Clause and equations.
+    demand_text
+        How the demand is made, in words and numbers (for the text; empty: from ``terms``).
     """
 
     name: str
@@ -154,6 +175,7 @@ class Check:
     ag_capacity_m_s2: float = math.nan
     reason: str = ""
     source: str = CLAUSE
+    demand_text: str = ""
 
     @property
     def applies(self) -> bool:
@@ -257,25 +279,97 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
                 )
             )
         return checks
+    if position.method == "circolare2009":
+        return [_height_check_2009(kin, site, position, q)]
+    return height_checks_2019(kin, site, position, q)
+
+
+def _height_check_2009(kin: KinematicQuantities, site: AnySite, position: Position, q: float) -> Check:
+    """The superseded linear check at height of Circolare 2009 C8A.4.2.3 (module docstring)."""
+    ag, S, a0 = site.ag_m_s2, site.S, kin.a0_star_m_s2
     T1 = position.period_s
     se_t1 = float(site.spectrum.psa([T1])[0])
     psi, gamma = position.psi, position.gamma
     demand = se_t1 * psi * gamma / q
-    checks.append(
-        _check(
-            "linear, at height",
-            "a0*",
-            "a0* >= Se(T1) psi(Z) gamma / q",
-            demand,
-            a0,
-            "m/s^2",
-            terms={"Se_T1_m_s2": se_t1, "T1_s": T1, "psi": psi, "gamma": gamma, "q": q, "ag_m_s2": ag, "S": S},
-            ag_capacity_m_s2=ag * a0 / demand,
-            source=f"{CHECK_SOURCES['linear, at height']}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g} ({Q_CLAUSE}); "
-            f"T1: {position.period_source}; Se from {site.spectrum_clause}",
-        )
+    name = "linear, at height (Circolare 2009)"
+    return _check(
+        name,
+        "a0*",
+        "a0* >= Se(T1) psi(Z) gamma / q",
+        demand,
+        a0,
+        "m/s^2",
+        terms={"Se_T1_m_s2": se_t1, "T1_s": T1, "psi": psi, "gamma": gamma, "q": q, "ag_m_s2": ag, "S": S},
+        ag_capacity_m_s2=ag * a0 / demand,
+        source=f"{CHECK_SOURCES[name]}; psi(Z) = Z/H, gamma = 3N/(2N+1), q = {q:g} ({Q_CLAUSE}); "
+        f"T1: {position.period_source}; Se from {site.spectrum_clause}",
+        demand_text=f"Se(T1) psi gamma / q = {se_t1:.4g} x {psi:.4g} x {gamma:.4g} / {q:g} = {demand:.4g} m/s^2 "
+        f"(T1 = {T1:.3g} s)",
     )
-    return checks
+
+
+def height_checks_2019(kin: KinematicQuantities, site: AnySite, position: Position, q: float = Q_FACTOR) -> list[Check]:
+    """The linear and nonlinear checks of a mechanism at height by Circolare 2019 C8.7.1 on the
+    floor spectrum of C7.2.3 (module docstring)."""
+    ag, a0 = site.ag_m_s2, kin.a0_star_m_s2
+    floor = position.floor(site.spectrum)
+    common = {"T1_s": floor.T1_s, "psi": floor.psi1, "gamma": floor.gamma1, "xi1": floor.building_damping}
+    where = (
+        f"T1: {position.period_source}; xi1 = {100 * floor.building_damping:g} %; psi(Z) = Z/H, gamma = 3N/(2N+1) "
+        f"(Eq C7.2.10); Se from {site.spectrum_clause.split(';')[0]}"
+    )
+    T0 = position.T0_s
+    sez_t0 = float(floor.psa([T0], SLD_DAMPING)[0])
+    name = "linear, at height"
+    linear = _check(
+        name,
+        "a0*",
+        "a0* >= SeZ(T0) / q",
+        sez_t0 / q,
+        a0,
+        "m/s^2",
+        terms={**common, "a_Z_m_s2": floor.peak_m_s2, "T0_s": T0, "SeZ_T0_m_s2": sez_t0, "q": q, "ag_m_s2": ag},
+        ag_capacity_m_s2=ag * a0 * q / sez_t0,
+        source=f"{CHECK_SOURCES[name]}; q = {q:g}; T0 = {T0:g} s; {where}",
+        demand_text=f"SeZ(T0 = {T0:g} s, 5 %) / q = {sez_t0:.4g} / {q:g} = {sez_t0 / q:.4g} m/s^2 (the floor's peak "
+        f"a_Z = {floor.peak_m_s2:.4g} m/s^2, T1 = {floor.T1_s:.3g} s)",
+    )
+    name, inequality = "nonlinear, at height", "d_SLV >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2)"
+    curve = kin.spectral()
+    if kin.du_star_m is None or curve is None:
+        return [
+            linear,
+            _not_applicable(name, "d_SLV", inequality, "m", f"no capacity curve to alpha = 0 ({kin.nonlinear_note})"),
+        ]
+    d_slv = kin.du_star_m
+    a_slv = float(np.interp(d_slv, curve[0], curve[1]))
+    if a_slv <= 0.0:
+        return [linear, _not_applicable(name, "d_SLV", inequality, "m", "the capacity curve has no a > 0 at d_SLV")]
+    T_slv = secant_period(d_slv, a_slv)
+    if T_slv > 4.0:
+        return [
+            linear,
+            _not_applicable(name, "d_SLV", inequality, "m", f"T_SLV = {T_slv:.3g} s is beyond the spectrum's 4 s"),
+        ]
+    xi = position.xi_slv
+    demand, bound = displacement_demand(floor, T_slv, xi)
+    sez = float(floor.psa([T_slv], xi)[0])
+    floor_words = "" if math.isnan(bound) else f", not below SeZ(T1) (b T1 / 2 pi)^2 = {bound:.4g} m"
+    nonlinear = _check(
+        name,
+        "d_SLV",
+        inequality,
+        demand,
+        d_slv,
+        "m",
+        terms={**common, "a_SLV_m_s2": a_slv, "T_SLV_s": T_slv, "xi": xi, "SeZ_TSLV_m_s2": sez, "bound_m": bound},
+        ag_capacity_m_s2=ag * d_slv / demand,
+        source=f"{CHECK_SOURCES[name]}; xi = {100 * xi:g} %; {where}",
+        demand_text=f"SeZ(T_SLV = {T_slv:.4g} s, {100 * xi:g} %) (T_SLV / 2 pi)^2 = {sez:.4g} x "
+        f"{(T_slv / (2 * math.pi)) ** 2:.4g} = {float(floor.sde([T_slv], xi)[0]):.4g} m{floor_words} "
+        f"(a(d_SLV) = {a_slv:.4g} m/s^2)",
+    )
+    return [linear, nonlinear]
 
 
 def checks_not_made(
@@ -294,11 +388,18 @@ def checks_not_made(
         Whether the masonry's compressive strength was taken at the hinges (``--fm``).
     """
     out = []
-    if position.at_height:
+    if position.at_height and position.method == "circolare2009":
         out.append(
-            "not made: the nonlinear check at height (Circolare 2009 C8A.4.2.3 with the floor's displacement "
-            "spectrum; Circolare 2019 C8.7.1 with the floor spectra of C7.2.3): the floor's response is not "
-            "modelled; only the linear check at height (2009 form) is made"
+            "not made: the nonlinear check at height: the Circolare 2009 form asked for (--height-check "
+            "circolare2009) has its linear check only here; the default, Circolare 2019 C8.7.1 with the floor "
+            "spectra of C7.2.3, makes both"
+        )
+    elif position.at_height:
+        out.append(
+            "not made: the floor spectrum's higher modes and the building's own nonlinearity beyond T1 and xi1: the "
+            "floor spectrum is the first mode's (Circolare 2019 C7.2.3: sufficient for local mechanisms in "
+            "multi-storey buildings); give T1 and xi1 of the damaged building (--t1, --building-damping-pct) where "
+            "it yields at the site's shaking (C7.2.3, C8.7.1.2.1.8)"
         )
     if kin is not None and kin.nonlinear_note and "slides" in kin.nonlinear_note:
         out.append(

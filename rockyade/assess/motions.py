@@ -7,7 +7,7 @@ by its settings and number, so that a task pickles small and the record is read 
 cache where the run happens). **A load factor multiplies the record's accelerations as
 read** (after the conversion of the file's units to m/s^2; nothing else is done to them).
 
-* :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt`` and ``.dat`` file of a folder,
+* :func:`records_in_folder`: every ``.at2``, ``.csv``, ``.txt``, ``.dat`` and ``.asc`` (ESM) file of a folder,
   sorted by name (the same accelerogram twice, e.g. an ``.AT2`` and its ``.csv``, is refused;
   a link to a record file is followed and counted; a link to anything else, and a
   subfolder (real or linked: records are read from the folder itself only), refused rather
@@ -19,6 +19,7 @@ read** (after the conversion of the file's units to m/s^2; nothing else is done 
 from __future__ import annotations
 
 import dataclasses
+import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -30,12 +31,13 @@ import numpy as np
 from rockyade.assess.measures import Measure
 from rockyade.errors import InputError
 from rockyade.motion.records import Record, normalise_units, read_record
+from rockyade.motion.selection_set import is_selection, read_selection
 from rockyade.motion.spec import MotionSpec
 from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
 from rockyade.motion.types import RecordMotion, SyntheticMotion
 
 #: File names a records folder is read for (case-insensitive suffixes).
-RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".dat")
+RECORD_SUFFIXES = (".at2", ".csv", ".txt", ".dat", ".asc")
 #: Records of a set, at most.
 MAX_RECORDS = 1000
 #: Records of a synthetic suite, at most (generation takes about a second each).
@@ -56,11 +58,20 @@ class RecordFiles:
         The folder as the user gave it (a link stays a link), for people (:meth:`describe`);
         None: the first file's folder. Not part of what the records are (not compared, not in
         :meth:`to_dict`).
+    scale_factors
+        Each record's factor when the folder is a selection (``rockyade motion select``): the
+        records are read scaled by them, and lambda = 1 is the selection's own scaling to the
+        site's spectrum; None: the records as read.
+    selection
+        What the selection says of itself (:meth:`rockyade.motion.selection_set.SelectionFiles.summary`),
+        or None.
     """
 
     files: tuple[str, ...]
     units: str | None = None
     folder: str | None = field(default=None, compare=False)
+    scale_factors: tuple[float, ...] | None = None
+    selection: dict[str, Any] | None = field(default=None, compare=False)
 
     @property
     def count(self) -> int:
@@ -71,22 +82,69 @@ class RecordFiles:
         """Record i (0-based) by its file name."""
         return Path(self.files[i]).name
 
+    def scale(self, i: int) -> float:
+        """Record i's scale factor (1 outside a selection)."""
+        return 1.0 if self.scale_factors is None else float(self.scale_factors[i])
+
     def record(self, i: int) -> Record:
-        """Record i as read (m/s^2)."""
-        return read_record(self.files[i], None, self.units)
+        """Record i as read (m/s^2), times its selection's factor."""
+        record = read_record(self.files[i], None, self.units)
+        if self.scale_factors is None:
+            return record
+        return record.with_accel(record.accel_m_s2 * self.scale(i), f"scaled by {self.scale(i):.8g} (selection)")
 
     def motion(self, i: int, load_factor: float) -> MotionSpec:
-        """The scene's ``[motion]``: record i times ``load_factor``."""
-        return RecordMotion(self.files[i], None, self.units, None, False, None, None, float(load_factor))
+        """The scene's ``[motion]``: record i times its selection's factor times ``load_factor``."""
+        factor = float(load_factor) * self.scale(i)
+        return RecordMotion(self.files[i], None, self.units, None, False, None, None, factor)
 
     def describe(self) -> str:
         """One line."""
         folder = self.folder if self.folder is not None else Path(self.files[0]).parent if self.files else Path(".")
-        return f"{self.count} record file{'' if self.count == 1 else 's'} of {folder}"
+        text = f"{self.count} record file{'' if self.count == 1 else 's'} of {folder}"
+        if self.selection is None:
+            return text
+        s = self.selection
+        verdict = "compatible" if s.get("compatible") else "NOT compatible"
+        dev, period = s.get("worst_deviation"), s.get("worst_deviation_period_s")
+        worst = f"worst deviation {100 * dev:+.1f} % at {period:.3g} s" if dev is not None and period else ""
+        few = (
+            "; fewer than 7 records: NTC 2018 7.3.5 takes the most unfavourable record's effects, not the mean"
+            if self.count < 7
+            else ""
+        )
+        return (
+            f"{text}: the selection {s['selection']} (rockyade motion select), each scaled by its factor, {verdict} "
+            f"with the site's spectrum (NTC 2018 3.2.3.6; {worst}); lambda = 1 is its scaling{few}"
+        )
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
-        return {"kind": "records", "files": list(self.files), "units": self.units}
+        out: dict[str, Any] = {"kind": "records", "files": list(self.files), "units": self.units}
+        if self.scale_factors is not None:
+            out["scale_factors"] = list(self.scale_factors)
+            out["selection"] = self.selection
+        return out
+
+    def check_site(self, site_dict: dict[str, Any]) -> None:
+        """Refuse a selection made for another site than ``site_dict`` (a site's ``to_dict``): its
+        factors scale the records to that site's spectrum. Nothing to check outside a selection."""
+        if self.selection is None:
+            return
+        made = self.selection.get("site") or {}
+        keys = (
+            *("spectrum_code", "ag_m_s2", "F0", "TC_star_s", "soil", "topography", "topography_height_ratio"),
+            *("spectrum_type", "ground", "importance_factor"),
+        )
+        differ = [k for k in keys if (k in made or k in site_dict) and not _same(made.get(k), site_dict.get(k))]
+        if differ:
+            k = differ[0]
+            raise InputError(
+                "--records",
+                f"the selection {self.selection['selection']} was made for another site ({k} = {made.get(k)!r} there, "
+                f"{site_dict.get(k)!r} here): its factors scale the records to that site's spectrum; select again "
+                "with this site's options",
+            )
 
 
 @dataclass(frozen=True)
@@ -156,6 +214,8 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
     path = Path(folder)
     if not path.is_dir():
         raise InputError(field, f"{path} is not a folder of record files")
+    if is_selection(path):
+        return selection_records(path, units, field)
     files = record_files(path, field)
     if not files:
         raise InputError(field, f"no record file ({', '.join(RECORD_SUFFIXES)}) in {path}")
@@ -167,6 +227,33 @@ def records_in_folder(folder: str | Path, units: str | None = None, field: str =
     read = [records.record(i) for i in range(records.count)]
     _refuse_duplicates(read, [f.name for f in files], field)
     return records
+
+
+def selection_records(folder: Path, units: str | None = None, field: str = "--records") -> RecordFiles:
+    """The records of a selection folder (``rockyade motion select``), checked
+    (:func:`rockyade.motion.selection_set.read_selection`) and read once now.
+
+    Raises
+    ------
+    InputError
+        ``units`` given (a selection's records name theirs as read when selected), or a damaged selection.
+    """
+    if units is not None:
+        raise InputError(
+            "--units", "applies to a folder of records, not to a selection (its records were read already)"
+        )
+    chosen = read_selection(folder, field)
+    records = RecordFiles(chosen.files, None, str(folder), chosen.scale_factors, chosen.summary())
+    for i in range(records.count):
+        records.record(i)
+    return records
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Two values of a site's description alike (numbers to 1e-9 relative)."""
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool):
+        return math.isclose(float(a), float(b), rel_tol=1e-9, abs_tol=1e-12)
+    return a == b
 
 
 def record_files(folder: Path, field: str = "--records") -> list[Path]:

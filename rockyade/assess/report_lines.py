@@ -88,7 +88,9 @@ def _check_line(check: Check) -> str:
         return f"  {check.name}: {check.inequality}: not applicable ({check.reason})\n    clause: {check.source}"
     t = check.terms
     q_words = f" (q = {t['q']:g}, {Q_CLAUSE})" if "q" in t else ""
-    if check.quantity == "a0*" and "T1_s" not in t:
+    if check.demand_text:
+        demand = check.demand_text + (q_words if check.quantity == "a0*" else "")
+    elif check.quantity == "a0*" and "T1_s" not in t:
         demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}{q_words}"
     elif check.quantity == "a0*":
         demand = (

@@ -18,9 +18,11 @@ the check a0* >= ag S / q is then alpha0 / (e* FC) >= (ag/g) S / q whatever the 
 
 A mechanism sits at ground level (the default) or at a height Z of a building of height H,
 N storeys and fundamental period T1 (the demand is then the floor's: Circolare 2019
-C8.7.1). Without a given T1 it is the code's simplified estimate T1 = Ct H^(3/4) with
-Ct = 0.05 (EN 1998-1 4.3.3.2.2(3), Eq 4.6, "all other structures", buildings up to 40 m;
-NTC 2008 7.3.3.2, Eq 7.3.5 gives the same C1 = 0.050).
+C8.7.1, with the floor spectrum of C7.2.3, :mod:`rockyade.assess.floor_spectra`; or the
+superseded form of Circolare 2009 C8A.4.2.3 when asked for). Without a given T1 it is the
+code's simplified estimate T1 = Ct H^(3/4) with Ct = 0.05 (EN 1998-1 4.3.3.2.2(3), Eq 4.6,
+"all other structures", buildings up to 40 m; NTC 2008 7.3.3.2, Eq 7.3.5 gives the same
+C1 = 0.050).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ import re
 from dataclasses import dataclass
 from typing import Any
 
+from rockyade.assess.floor_spectra import BUILDING_DAMPING, SLV_DAMPING, FloorSpectrum, check_damping
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.motion.ec8 import EC8_GROUND, ElasticSpectrum
@@ -46,6 +49,11 @@ MAX_T1_FORMULA_HEIGHT_M = 40.0
 #: Largest building height and storey count accepted.
 MAX_BUILDING_HEIGHT_M = 300.0
 MAX_STOREYS = 100
+#: The forms of the check at height: Circolare 2019's floor spectra (the default), or the
+#: superseded Circolare 2009 C8A.4.2.3 form.
+HEIGHT_CHECKS = ("circolare2019", "circolare2009")
+#: Largest mechanism period T0 accepted, s (the spectra are used up to 4 s).
+MAX_MECHANISM_PERIOD_S = 4.0
 
 _ACCEL = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(g|m/s2|m/s\^2|m/s\*\*2)\s*$")
 
@@ -291,21 +299,44 @@ class Position:
         Number of storeys N.
     T1_s
         Fundamental period of the building, s (None: the simplified formula, module docstring).
+    height_check
+        ``circolare2019`` (None: the default) or ``circolare2009`` (:data:`HEIGHT_CHECKS`).
+    building_damping
+        The building's equivalent viscous damping xi1 of the floor spectrum, a ratio (None: 5 %).
+    mechanism_period_s
+        The mechanism's period T0 in the linear check, s (None: 0, a mechanism rigid until it
+        moves, whose demand is the floor's peak acceleration; Circolare 2019 C8.7.1.2.1.5).
+    mechanism_damping
+        The mechanism's equivalent damping in the nonlinear check, a ratio (None: 8 %, Circolare
+        2019 C8.7.1.2.1.8).
     """
 
     z_m: float | None = None
     building_height_m: float | None = None
     storeys: int | None = None
     T1_s: float | None = None
+    height_check: str | None = None
+    building_damping: float | None = None
+    mechanism_period_s: float | None = None
+    mechanism_damping: float | None = None
 
     def __post_init__(self) -> None:
         given = [v is not None for v in (self.z_m, self.building_height_m, self.storeys)]
         if any(given) and not all(given):
             raise InputError("--z", "a mechanism at height needs --z, --building-height and --storeys together")
-        if self.T1_s is not None and self.z_m is None:
-            raise InputError("--t1", "applies to a mechanism at height (with --z, --building-height, --storeys)")
+        height_only = {
+            "--t1": self.T1_s,
+            "--height-check": self.height_check,
+            "--building-damping-pct": self.building_damping,
+            "--mechanism-period": self.mechanism_period_s,
+            "--mechanism-damping-pct": self.mechanism_damping,
+        }
+        for option, value in height_only.items():
+            if value is not None and self.z_m is None:
+                raise InputError(option, "applies to a mechanism at height (with --z, --building-height, --storeys)")
         if self.z_m is None:
             return
+        self._check_floor_options()
         H = self.building_height_m
         if not (isinstance(H, (int, float)) and math.isfinite(H) and 0.0 < H <= MAX_BUILDING_HEIGHT_M):
             raise InputError("--building-height", f"must be in (0, {MAX_BUILDING_HEIGHT_M:g}] m, got {H!r}")
@@ -319,6 +350,58 @@ class Position:
         if t1 is not None and not (isinstance(t1, (int, float)) and math.isfinite(t1) and 0.0 < t1 <= 4.0):
             raise InputError("--t1", f"must be in (0, 4] s (the EC8 spectrum is defined up to 4 s), got {t1!r}")
 
+    def _check_floor_options(self) -> None:
+        """The options of the 2019 check at height, and none of them with the 2009 form."""
+        if self.height_check is not None and self.height_check not in HEIGHT_CHECKS:
+            raise InputError("--height-check", f"must be one of {', '.join(HEIGHT_CHECKS)}, got {self.height_check!r}")
+        floor_only = {
+            "--building-damping-pct": self.building_damping,
+            "--mechanism-period": self.mechanism_period_s,
+            "--mechanism-damping-pct": self.mechanism_damping,
+        }
+        if self.method == "circolare2009":
+            for option, value in floor_only.items():
+                if value is not None:
+                    raise InputError(
+                        option, "is an input of the 2019 floor spectra, not of --height-check circolare2009"
+                    )
+        for option, value in (
+            ("--building-damping-pct", self.building_damping),
+            ("--mechanism-damping-pct", self.mechanism_damping),
+        ):
+            if value is not None:
+                check_damping(value, option)
+        t0 = self.mechanism_period_s
+        if t0 is not None and not (
+            isinstance(t0, (int, float)) and math.isfinite(t0) and 0.0 <= t0 <= MAX_MECHANISM_PERIOD_S
+        ):
+            raise InputError("--mechanism-period", f"must be in [0, {MAX_MECHANISM_PERIOD_S:g}] s, got {t0!r}")
+
+    def floor(self, spectrum: ElasticSpectrum) -> FloorSpectrum:
+        """The floor spectrum at this height over the site's ``spectrum`` (Circolare 2019 C7.2.3,
+        first mode: gamma, psi, T1, xi1 of this position)."""
+        return FloorSpectrum(spectrum, self.period_s, self.gamma, self.psi, self.xi1)
+
+    @property
+    def method(self) -> str:
+        """The form of the check at height: ``circolare2019`` unless ``circolare2009`` was asked for."""
+        return self.height_check or HEIGHT_CHECKS[0]
+
+    @property
+    def xi1(self) -> float:
+        """The building's damping of the floor spectrum, a ratio (5 % unless given)."""
+        return BUILDING_DAMPING if self.building_damping is None else float(self.building_damping)
+
+    @property
+    def T0_s(self) -> float:
+        """The mechanism's period in the linear check, s (0 unless given)."""
+        return 0.0 if self.mechanism_period_s is None else float(self.mechanism_period_s)
+
+    @property
+    def xi_slv(self) -> float:
+        """The mechanism's damping in the nonlinear check, a ratio (8 % unless given)."""
+        return SLV_DAMPING if self.mechanism_damping is None else float(self.mechanism_damping)
+
     @property
     def at_height(self) -> bool:
         """True for a mechanism at a height of a building."""
@@ -326,13 +409,14 @@ class Position:
 
     @property
     def psi(self) -> float:
-        """psi(Z) = Z / H (Circolare 2019 C8.7.1)."""
+        """psi(Z) = Z / H (Circolare 2009 C8A.4.2.3; Circolare 2019 C7.2.3: the linear first mode, normalised at
+        the top)."""
         assert self.z_m is not None and self.building_height_m is not None
         return self.z_m / self.building_height_m
 
     @property
     def gamma(self) -> float:
-        """gamma = 3 N / (2 N + 1), the modal participation factor (Circolare 2019 C8.7.1)."""
+        """gamma = 3 N / (2 N + 1), the modal participation factor (Circolare 2019 Eq C7.2.10)."""
         assert self.storeys is not None
         return 3.0 * self.storeys / (2.0 * self.storeys + 1.0)
 
@@ -358,10 +442,16 @@ class Position:
         """One line."""
         if not self.at_height:
             return "at ground level"
+        form = (
+            "Circolare 2009 C8A.4.2.3 form (--height-check circolare2009)"
+            if self.method == "circolare2009"
+            else f"Circolare 2019 floor spectrum, xi1 = {100 * self.xi1:g} %, T0 = {self.T0_s:g} s, mechanism's "
+            f"xi = {100 * self.xi_slv:g} % in the nonlinear check"
+        )
         return (
             f"at Z = {self.z_m:g} m of a {self.building_height_m:g} m building of {self.storeys} storeys "
             f"(psi = Z/H = {self.psi:.4g}, gamma = 3N/(2N+1) = {self.gamma:.4g}, T1 = {self.period_s:.4g} s: "
-            f"{self.period_source})"
+            f"{self.period_source}; {form})"
         )
 
     def to_dict(self) -> dict[str, Any]:
@@ -377,4 +467,14 @@ class Position:
             "gamma": self.gamma,
             "T1_s": self.period_s,
             "T1_source": self.period_source,
+            "height_check": self.method,
+            **(
+                {}
+                if self.method == "circolare2009"
+                else {
+                    "building_damping": self.xi1,
+                    "mechanism_period_s": self.T0_s,
+                    "mechanism_damping_nonlinear": self.xi_slv,
+                }
+            ),
         }

@@ -21,70 +21,32 @@ from rockyade.cli.fragility_options import (
     write_tables,
 )
 from rockyade.cli.resumable import write_partial
+from rockyade.cli.site_options import add_period_option, add_site_options, site_from
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
     from rockyade.assess import DynamicSettings, Position
-    from rockyade.assess.site import AnySite
 
 #: Exit code of a scene that cannot stand (the answer is not a number).
 EXIT_UNSTABLE = 1
 
 
-def _site(args: argparse.Namespace) -> AnySite:
-    """The site: NTC 2018's spectrum unless EC8's is asked for (``--spectrum ec8``, or its own
-    options ``--spectrum-type`` and ``--ground``)."""
-    from rockyade.assess import Site, parse_acceleration
-    from rockyade.assess.site import NtcSite
-    from rockyade.constants import CODE_GRAVITY as G
-
-    ec8_given = [o for o in ("spectrum_type", "ground", "importance") if getattr(args, o) is not None]
-    ntc_given = [
-        o for o in ("f0", "tc_star", "soil", "topography", "topography_height_ratio") if getattr(args, o) is not None
-    ]
-    if args.spectrum is None and ec8_given and ntc_given:
-        raise InputError(
-            "--" + ntc_given[0].replace("_", "-"),
-            f"mixes the NTC 2018 site (--{ntc_given[0].replace('_', '-')}) with an EC8 option "
-            f"(--{ec8_given[0].replace('_', '-')}): give one site, or --spectrum to say which",
-        )
-    spectrum = args.spectrum or ("ec8" if ec8_given else "ntc2018")
-    ag = parse_acceleration(args.ag, "--ag")
-    if spectrum == "ec8":
-        if ntc_given:
-            raise InputError(
-                "--" + ntc_given[0].replace("_", "-"), "is an NTC 2018 site parameter, not with the EC8 spectrum"
-            )
-        for option in ("spectrum_type", "ground"):
-            if getattr(args, option) is None:
-                raise InputError("--" + option.replace("_", "-"), "is required with the EC8 spectrum")
-        return Site(args.spectrum_type, args.ground, ag, 1.0 if args.importance is None else args.importance)
-    if ec8_given:
-        raise InputError(
-            "--" + ec8_given[0].replace("_", "-"),
-            "is an EC8 option, not with the NTC 2018 spectrum (give --spectrum ec8 for EC8's)",
-        )
-    for option in ("f0", "tc_star", "soil"):
-        if getattr(args, option) is None:
-            raise InputError(
-                "--" + option.replace("_", "-"),
-                "is required with the NTC 2018 spectrum (the default with --code ntc2018): the site's ag, F0 and TC* "
-                "(NTC 2018 Allegato A) and its soil category; or give --spectrum ec8 with --spectrum-type and --ground",
-            )
-    return NtcSite(
-        ag / G,
-        args.f0,
-        args.tc_star,
-        args.soil,
-        args.topography or "T1",
-        1.0 if args.topography_height_ratio is None else args.topography_height_ratio,
-    )
-
-
 def _position(args: argparse.Namespace) -> Position:
     from rockyade.assess import Position
 
-    return Position(args.z, args.building_height, args.storeys, args.t1)
+    def ratio(pct: float | None) -> float | None:
+        return None if pct is None else pct / 100.0
+
+    return Position(
+        args.z,
+        args.building_height,
+        args.storeys,
+        args.t1,
+        args.height_check,
+        ratio(args.building_damping_pct),
+        args.mechanism_period,
+        ratio(args.mechanism_damping_pct),
+    )
 
 
 def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
@@ -142,7 +104,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
 
     rule = None if args.friction_rule is None else check_friction_rule(args.friction_rule, "--friction-rule")
     fm = None if args.fm is None else check_fm(args.fm, "--fm")
-    site, position = _site(args), _position(args)
+    site, position = site_from(args), _position(args)
     dynamic = _dynamic(args)
     if dynamic is not None and dynamic.records is None and site.spectrum_code != "ec8":
         from rockyade.assess.assessment import NTC_SUITE_MESSAGE
@@ -306,38 +268,7 @@ def register(sub: Any) -> None:
     )
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     p.add_argument("--code", default="ntc2018", help="the code whose checks are made: ntc2018 (default)")
-    p.add_argument(
-        "--ag",
-        required=True,
-        help="the site's peak ground acceleration on type A ground, with its unit: 0.25g or 2.45m/s2 "
-        "(g: standard gravity, 9.80665 m/s^2, as for records in g and in a0* = alpha0 g / (e* FC)); "
-        "NTC 2018: ag of Allegato A for the limit "
-        "state's return period; EC8: agR",
-    )
-    p.add_argument(
-        "--spectrum",
-        choices=("ntc2018", "ec8"),
-        help="whose elastic spectrum: ntc2018 (the default with --code ntc2018, NTC 2018 3.2.3.2.1) or ec8 "
-        "(EN 1998-1 3.2.2.2; also chosen by giving --spectrum-type and --ground)",
-    )
-    ntc = p.add_argument_group("the NTC 2018 site (3.2.3.2.1; ag, F0, TC* from Allegato A)")
-    ntc.add_argument("--f0", type=float, help="F0, the spectrum's maximum amplification")
-    ntc.add_argument("--tc-star", type=float, metavar="S", help="TC*, s")
-    ntc.add_argument("--soil", help="subsoil category A, B, C, D or E (Tab. 3.2.II; SS and CC of Tab. 3.2.IV)")
-    ntc.add_argument(
-        "--topography", help="topographic category T1, T2, T3 or T4 (Tab. 3.2.III; ST of Tab. 3.2.V; default T1)"
-    )
-    ntc.add_argument(
-        "--topography-height-ratio",
-        type=float,
-        metavar="R",
-        help="the site's height above the base of the relief over the relief's height, in [0, 1]: ST falls "
-        "linearly from Tab. 3.2.V's value at the top (1, the default) to 1 at the base",
-    )
-    ec8 = p.add_argument_group("the EC8 site (EN 1998-1 3.2.2.2)")
-    ec8.add_argument("--spectrum-type", type=int, help="EC8 elastic spectrum type: 1 or 2")
-    ec8.add_argument("--ground", help="EC8 ground type: A, B, C, D or E")
-    ec8.add_argument("--importance", type=float, help="importance factor gamma_I, in [0.5, 2] (default 1)")
+    add_site_options(p)
     p.add_argument(
         "--knowledge-level",
         metavar="LC",
@@ -374,8 +305,34 @@ def register(sub: Any) -> None:
     height.add_argument("--z", type=float, metavar="M", help="height of the mechanism above the foundation, m")
     height.add_argument("--building-height", type=float, metavar="M", help="height H of the building, m")
     height.add_argument("--storeys", type=int, metavar="N", help="storeys N of the building")
+    add_period_option(height, "its floor spectrum's (default Ct H^(3/4), Ct = 0.05)")
     height.add_argument(
-        "--t1", type=float, metavar="S", help="period T1 of the building, s (default Ct H^(3/4), Ct = 0.05)"
+        "--height-check",
+        choices=("circolare2019", "circolare2009"),
+        help="the check at height: circolare2019 (the default: Circolare 2019 C8.7.1 with the floor spectra of "
+        "C7.2.3, linear and nonlinear) or circolare2009 (the superseded Circolare 2009 C8A.4.2.3 form, "
+        "Se(T1) psi gamma / q, linear only)",
+    )
+    height.add_argument(
+        "--building-damping-pct",
+        type=float,
+        metavar="PCT",
+        help="the building's equivalent viscous damping xi1 of the floor spectrum, %% in [2, 30] (default 5; more "
+        "where the building yields at the site's shaking, Circolare 2019 C7.2.3)",
+    )
+    height.add_argument(
+        "--mechanism-period",
+        type=float,
+        metavar="S",
+        help="the mechanism's period T0 in the linear check, s in [0, 4] (default 0: rigid until it moves, the "
+        "demand is the floor's peak acceleration; Circolare 2019 C8.7.1.2.1.5)",
+    )
+    height.add_argument(
+        "--mechanism-damping-pct",
+        type=float,
+        metavar="PCT",
+        help="the mechanism's equivalent damping in the nonlinear check, %% in [2, 30] (default 8, Circolare 2019 "
+        "C8.7.1.2.1.8 for SLV)",
     )
     p.add_argument(
         "--pushover",
@@ -390,7 +347,8 @@ def register(sub: Any) -> None:
         "--records",
         type=Path,
         metavar="DIR",
-        help="your records (a folder of .at2/.csv/.txt/.dat files), each scaled to PGA = ag S at load factor 1 "
+        help="your records (a folder of .at2/.asc/.csv/.txt/.dat files), each scaled to PGA = ag S at load factor 1, "
+        "or a selection written by 'rockyade motion select' for this site (each record scaled by its factor) "
         "(default: a synthetic suite compatible with the site's spectrum)",
     )
     dyn.add_argument(

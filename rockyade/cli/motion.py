@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
+from rockyade.cli.site_options import add_period_option, add_site_options
 from rockyade.errors import InputError
 
 #: Period range of ``motion spectrum``, s.
@@ -21,11 +22,16 @@ def _read(args: argparse.Namespace):
 
 
 def _add_record_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("record", type=Path, help="record file: PEER .AT2, two-column time/acceleration, or one column")
+    p.add_argument(
+        "record",
+        type=Path,
+        help="record file: PEER .AT2, ESM ASCII (.ASC), two-column time/acceleration, or one column",
+    )
     p.add_argument(
         "--format",
-        choices=["at2", "csv", "single"],
-        help="file format (default: from the content: a PEER header is at2, one number a line with --dt is single)",
+        choices=["at2", "csv", "single", "esm"],
+        help="file format (default: from the content: a PEER header is at2, an ESM header (KEY: value lines, "
+        "SAMPLING_INTERVAL_S, NDATA) is esm, one number a line with --dt is single)",
     )
     p.add_argument(
         "--units",
@@ -276,12 +282,158 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0 if report["compatible"] else 1
 
 
+def cmd_select(args: argparse.Namespace) -> int:
+    """Records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)."""
+    import numpy as np
+
+    from rockyade.assess.motions import records_in_folder
+    from rockyade.cli.site_options import site_from
+    from rockyade.motion import selection as sel
+    from rockyade.motion.selection_set import check_out_folder, is_selection
+
+    site = site_from(args)
+    t_range = sel.period_range(args.t1)
+    bounds = sel.check_bounds(args.scale_bounds)
+    if is_selection(args.records):
+        raise InputError(
+            "--records",
+            f"{args.records} is a selection ('motion select' wrote it): give the folder of the records to select from",
+        )
+    if args.out is not None:
+        check_output_dir(args.out, "--out")
+        check_out_folder(args.out, args.records)
+    folder = records_in_folder(args.records, args.units)
+    count = sel.check_count(args.count, folder.count, args.max_response)
+    records = [folder.record(i) for i in range(folder.count)]
+    names = [folder.label(i) for i in range(folder.count)]
+    target = site.spectrum
+    grid = sel.check_grid(target, t_range)
+    shown = np.union1d(np.geomspace(0.04, max(4.0, t_range[1]), 80), grid)
+    spectra = sel.spectra_of(records, shown, names, t_range[1])
+    inside = np.isin(shown, grid)
+    chosen = sel.select(spectra[:, inside], names, target, grid, count, bounds)
+    data = _selection_data(args, site, chosen, records, t_range, bounds, count)
+    if args.json:
+        json_out(data)
+    else:
+        _print_selection(chosen, data)
+    if not chosen.compatible:
+        where = f"; nothing written to {args.out}" if args.out is not None else ""
+        print(f"no set of {count} records of {args.records} is compatible with the site's spectrum{where}")
+        return 1
+    if args.out is not None:
+        _write_selection(args, chosen, folder, records, shown, spectra, target, t_range, data)
+    return 0
+
+
+def _selection_data(args, site, chosen, records, t_range, bounds, count) -> dict[str, Any]:
+    """selection.json's content, and the table's rows (under ``rows``)."""
+    import numpy as np
+
+    from rockyade import __version__
+    from rockyade.constants import STANDARD_GRAVITY
+    from rockyade.motion.selection import BAND_ABOVE, BAND_BELOW, MEAN_RULE_COUNT
+    from rockyade.motion.spectra import response_spectrum
+
+    rows = []
+    for i, name, factor in zip(chosen.indices, chosen.names, chosen.scale_factors, strict=True):
+        record = records[i]
+        row: dict[str, Any] = {"record": name, "scale_factor": float(factor)}
+        row["pga_m_s2"] = factor * record.pga_m_s2
+        row["pga_g"] = row["pga_m_s2"] / STANDARD_GRAVITY
+        if args.t1 is not None:
+            sa = float(response_spectrum(record.accel_m_s2, record.dt_s, np.array([args.t1]), 0.05)[1][0]) * factor
+            row["sa_t1_m_s2"], row["sa_t1_g"] = sa, sa / STANDARD_GRAVITY
+        rows.append(row)
+    dev, period = chosen.worst
+    rule = (
+        "the mean of the records' effects (NTC 2018 7.3.5: 7 records or more)"
+        if count >= MEAN_RULE_COUNT
+        else "the most unfavourable record's effects (NTC 2018 7.3.5: fewer than 7 records; --max-response)"
+    )
+    return {
+        "compatible": chosen.compatible,
+        "summary": chosen.summary(),
+        "worst_deviation": dev,
+        "worst_deviation_period_s": period,
+        "mean_over_target_min": float(chosen.ratio.min()),
+        "mean_over_target_max": float(chosen.ratio.max()),
+        "band_use": chosen.rho,
+        "band": {"below": BAND_BELOW, "above": BAND_ABOVE, "source": "NTC 2018 3.2.3.6"},
+        "period_range_s": list(t_range),
+        "t1_s": args.t1,
+        "periods_checked": len(chosen.periods_s),
+        "count": count,
+        "rule": rule,
+        "scale_bounds": list(bounds),
+        "search": {"sets_ranked": chosen.ranked, "how": chosen.how},
+        "site": site.to_dict(),
+        "records_folder": str(args.records),
+        "records_in_folder": len(records),
+        "records_needed": chosen.estimate or None,
+        "rows": rows,
+        "rockyade_version": __version__,
+    }
+
+
+def _print_selection(chosen, data: dict[str, Any]) -> None:
+    """The set, one record a line, and the verdict."""
+    best = "selected" if chosen.compatible else "the best set found (not compatible)"
+    print(
+        f"{best}: {data['count']} of {data['records_in_folder']} records ({data['search']['how']}, "
+        f"{data['search']['sets_ranked']} sets ranked; scale factors within {data['scale_bounds'][0]:g}-"
+        f"{data['scale_bounds'][1]:g})"
+    )
+    for row in data["rows"]:
+        sa = f", Sa(T1) {row['sa_t1_g']:.4g} g" if "sa_t1_g" in row else ""
+        print(f"  {row['record']}: x {row['scale_factor']:.4g} (PGA {row['pga_g']:.4g} g{sa})")
+    print(chosen.summary())
+    if data["records_needed"]:
+        est = data["records_needed"]
+        needed = est.get("records_needed")
+        head = f"records needed: about {needed}" if needed else "records needed: no estimate"
+        print(f"{head} ({est['why']})")
+
+
+def _write_selection(args, chosen, folder, records, shown, spectra, target, t_range, data) -> None:
+    """The set into --out (rockyade.motion.selection_set)."""
+    import pandas as pd
+
+    from rockyade.figures.record_selection import plot_selection
+    from rockyade.motion.selection import BAND_ABOVE, BAND_BELOW
+    from rockyade.motion.selection_set import write_selection
+
+    sources = [Path(folder.files[i]) for i in chosen.indices]
+    table = pd.DataFrame(data["rows"])
+    meta = {k: v for k, v in data.items() if k != "rows"}
+
+    def draw(path: Path) -> None:
+        scaled = spectra[list(chosen.indices)] * chosen.scale_factors[:, None]
+        title = f"{target.label}; {data['count']} records of {args.records}"
+        plot_selection(
+            shown,
+            target.psa(shown),
+            scaled,
+            list(chosen.names),
+            (BAND_BELOW, BAND_ABOVE),
+            t_range,
+            path,
+            title=title,
+            verdict=chosen.summary(),
+        )
+
+    given = [str(Path(args.records) / source.name) for source in sources]
+    written = write_selection(args.out, sources, table, meta, draw, given)
+    print_wrote(Path(f"{', '.join(written)} in {args.out}"), args.json)
+
+
 def register(sub: Any) -> None:
     """Add ``rockyade motion ...``."""
     motion = sub.add_parser(
         "motion",
-        help="records, response spectra, synthetic EC8 suites",
-        description="Base motions: read records, response spectra, spectrum-compatible suites.",
+        help="records, response spectra, synthetic EC8 suites, records selected to a site",
+        description="Base motions: read records, response spectra, spectrum-compatible suites, records selected "
+        "and scaled to a site's spectrum.",
     )
     msub = motion.add_subparsers(dest="motion_command", required=True, metavar="MOTION_COMMAND")
 
@@ -341,6 +493,47 @@ def register(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--plot", type=Path, help="PNG: target vs mean spectrum with the +/-10%% band")
     p.set_defaults(func=cmd_check)
+
+    p = msub.add_parser(
+        "select",
+        help="records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)",
+        description="Pick from a folder of records (PEER .AT2, ESM .ASC, text) a set of --count records and a "
+        "scale factor for each whose mean 5 % spectrum lies nowhere more than 10 % below the site's elastic "
+        "spectrum nor more than 30 % above it over 0.15-2.0 s (0.15 s-2 T1 when longer), NTC 2018 3.2.3.6. "
+        "Writes selection.csv, spectra.png, selection.json and the chosen records into --out (a set that "
+        "'assess --records' reads); exit 1 with the best deviation reached and an estimate of the records "
+        "needed when no set is compatible. See docs/howto/base-motions.md.",
+    )
+    p.add_argument("--records", type=Path, required=True, metavar="DIR", help="folder of the records to select from")
+    p.add_argument(
+        "--count",
+        type=int,
+        default=7,
+        help="records of the set: at least 7 (the mean response, NTC 2018 7.3.5; default 7), 3 to 6 with "
+        "--max-response",
+    )
+    p.add_argument(
+        "--max-response",
+        action="store_true",
+        help="a set of 3 to 6 records, whose effects are then taken as the most unfavourable record's (NTC 2018 7.3.5)",
+    )
+    p.add_argument(
+        "--scale-bounds",
+        type=float,
+        nargs=2,
+        default=[0.5, 2.0],
+        metavar=("LO", "HI"),
+        help="bounds of each record's scale factor (default 0.5 2)",
+    )
+    p.add_argument(
+        "--units",
+        help="units of the records that do not name theirs: g, m/s2, cm/s2 (as 'assess --records' takes it)",
+    )
+    add_site_options(p)
+    add_period_option(p, "the range checked becomes 0.15 s-2 T1 when 2 T1 > 2 s (T1 <= 2 s)")
+    p.add_argument("--out", type=Path, help="the selection's folder (written only for a compatible set)")
+    p.add_argument("--json", action="store_true", help="print the answer as JSON")
+    p.set_defaults(func=cmd_select)
 
 
 __all__ = ["register"]

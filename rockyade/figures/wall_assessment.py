@@ -164,27 +164,30 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
             )
             ymax = max(ymax, c.demand)
         else:
-            ts = c.terms["Ts_s"]
-            se = c.terms["Se_Ts_m_s2"]
             periods = np.linspace(0.02, 4.0, 400)
-            spectrum = a.site.spectrum.psa(periods)
-            sd = spectrum * (periods / (2 * math.pi)) ** 2
-            ax.plot(sd * 1e3, spectrum, color="0.55", lw=1.0, label="site's elastic spectrum (ADRS)")
+            if "T_SLV_s" in c.terms:  # at height: the floor's spectrum (Circolare 2019 C7.2.3, C8.7.1.12)
+                ts, xi = c.terms["T_SLV_s"], c.terms["xi"]
+                floor = a.position.floor(a.site.spectrum)
+                spectrum, sd = floor.psa(periods, xi), floor.sde(periods, xi)
+                what = f"the floor's spectrum at Z, {100 * xi:g} % (ADRS)"
+                se = c.demand * (2 * math.pi / ts) ** 2
+                label = f"{c.name}: demand at T_SLV = {ts:.2f} s: {c.demand * 1e3:.3g} mm ({c.status})"
+            else:
+                ts, se = c.terms["Ts_s"], c.terms["Se_Ts_m_s2"]
+                spectrum = a.site.spectrum.psa(periods)
+                sd = spectrum * (periods / (2 * math.pi)) ** 2
+                what = "site's elastic spectrum (ADRS)"
+                label = f"{c.name}: demand SDe(Ts = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})"
+            ax.plot(sd * 1e3, spectrum, color="0.55", lw=1.0, label=what)
             ax.plot([0, c.demand * 1e3], [0, se], color="0.55", lw=0.8, ls=":")
-            ax.plot(
-                [c.demand * 1e3],
-                [se],
-                "D",
-                color=colour,
-                ms=6,
-                zorder=6,
-                label=f"{c.name}: demand SDe(Ts = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})",
-            )
+            ax.plot([c.demand * 1e3], [se], "D", color=colour, ms=6, zorder=6, label=label)
             if kin.du_star_m is not None:  # None when the mechanism has no ultimate displacement
                 ax.axvline(
                     kin.du_star_m * 1e3, color=CURVE, ls="--", lw=1.2, label=f"du* = {kin.du_star_m * 1e3:.3g} mm"
                 )
-            if kin.ds_star_m is not None and kin.as_star_m_s2 is not None:
+            if "T_SLV_s" in c.terms and kin.du_star_m is not None:  # the secant point of T_SLV (C8.7.1.10)
+                ax.plot([kin.du_star_m * 1e3], [c.terms["a_SLV_m_s2"]], "s", color=CURVE, ms=4)
+            elif kin.ds_star_m is not None and kin.as_star_m_s2 is not None:
                 ax.plot([kin.ds_star_m * 1e3], [kin.as_star_m_s2], "s", color=CURVE, ms=4)
             ymax = max(ymax, se)
             xmax = max(xmax, c.demand)

@@ -21,6 +21,7 @@
   acceleration (``t_s,accel_m_s2,vel_m_s,disp_m``, as ``rockyade motion synth`` writes).
 * Single-column text: one acceleration per line at a given ``dt_s``; a file given ``dt_s``
   but no format is read as one column when its first data line holds one number.
+* ESM's ASCII records (``KEY: value`` header, then one value a line): :mod:`rockyade.motion.esm`.
 
 Numbers are ASCII decimals, with an optional exponent written E or Fortran's D
 (``1.0D-02``); ``1_0``, non-ASCII digits, ``inf`` and ``nan`` are refused. A UTF-8 byte
@@ -35,6 +36,7 @@ from __future__ import annotations
 
 import math
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import cast
@@ -59,17 +61,10 @@ DT_RANGE_S = (1.0e-5, 1.0)
 MAX_ABS_ACCEL_M_S2 = 1000.0
 UNIT_ALIASES = {
     "g": "g",
-    "m/s2": "m/s2",
-    "m/s^2": "m/s2",
-    "m/s/s": "m/s2",
-    "mps2": "m/s2",
-    "cm/s2": "cm/s2",
-    "cm/s^2": "cm/s2",
-    "cm/s/s": "cm/s2",
-    "cm/sec/sec": "cm/s2",
-    "gal": "cm/s2",
+    **dict.fromkeys(("m/s2", "m/s^2", "m/s/s", "mps2"), "m/s2"),
+    **dict.fromkeys(("cm/s2", "cm/s^2", "cm/s/s", "cm/sec/sec", "gal"), "cm/s2"),
 }
-FORMATS = ("at2", "csv", "single")
+FORMATS = ("at2", "csv", "single", "esm")
 #: Unit names of velocities and displacements (refused with a message saying so).
 VELOCITY_UNITS = ("cm/s", "cm/sec", "m/s", "m/sec", "mm/s", "in/s", "cm", "m", "mm")
 #: How the options that fix a file's reading are spelt in a scene and on the command line.
@@ -281,10 +276,6 @@ def _read_text(path: Path) -> str:
     except UnicodeDecodeError:
         text = data.decode("latin-1")
     return text.replace("\r\n", "\n").replace("\r", "\n")
-
-
-def _read_lines(path: Path) -> list[str]:
-    return _read_text(path).split("\n")
 
 
 def _head_lines(path: Path, count: int = 64) -> list[str]:
@@ -692,13 +683,17 @@ def count_samples(path: str | Path, fmt: str | None = None) -> int:
 def detect_format(path: str | Path, dt_s: float | None = None) -> str:
     """The format of a record file from its content, else its extension.
 
-    ``at2`` for a PEER header (whatever the extension) or a ``.AT2`` file; ``single`` when
-    ``dt_s`` is given and the first data line holds one number; ``csv`` otherwise.
+    ``at2`` for a PEER header (whatever the extension) or a ``.AT2`` file; ``esm`` for an ESM
+    header; ``single`` when ``dt_s`` is given and the first data line holds one number; ``csv`` otherwise.
     """
+    from rockyade.motion.esm import is_esm_header
+
     path = Path(path)
     head = _head_lines(path)
     if path.suffix.lower() == ".at2" or peer_header(head) is not None:
         return "at2"
+    if is_esm_header(head):
+        return "esm"
     if dt_s is not None:
         for line in head:
             body = line.split("#", 1)[0].strip()
@@ -717,7 +712,7 @@ def read_record(
     path
         The file.
     fmt
-        "at2", "csv" (two columns) or "single" (one column, needs ``dt_s``); default from
+        "at2", "csv" (two columns), "single" (one column, needs ``dt_s``) or "esm"; default from
         the content (:func:`detect_format`).
     units
         Units of the values when the file does not name them (default m/s2 for text
@@ -729,8 +724,10 @@ def read_record(
     if fmt is not None and fmt not in FORMATS:
         raise InputError("format", f"must be one of {', '.join(FORMATS)}, got {fmt!r}")
     fmt = fmt or detect_format(path, dt_s)
-    if fmt == "at2":
-        record = read_at2(path, units, dt_s)
+    if fmt in ("at2", "esm"):
+        from rockyade.motion.esm import read_esm
+
+        record = (read_at2 if fmt == "at2" else read_esm)(path, units, dt_s)
     elif fmt == "csv":
         record = read_two_column(path, units, dt_s)
     elif dt_s is None:
@@ -782,8 +779,6 @@ def units_warning(record: Record, given: str | None = None) -> str | None:
 
 def _warn_implausible(record: Record, given: str | None) -> None:
     """Print :func:`units_warning` once per file and process (stderr: the answer on stdout stays clean)."""
-    import sys
-
     message = units_warning(record, given)
     if message is None or record.source in _WARNED:
         return

@@ -28,6 +28,7 @@ The pseudo-spectral acceleration is PSA = w^2 max |u|.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -48,8 +49,10 @@ def default_periods(t_min: float = 0.02, t_max: float = 4.0, n: int = 100) -> ND
     return np.geomspace(t_min, t_max, n)
 
 
+@functools.lru_cache(maxsize=4096)
 def _recurrence(omega: float, damping: float, h: float) -> NDArray[np.float64]:
-    """(Phi, Gamma0, Gamma1) flattened: 4 + 2 + 2 numbers."""
+    """(Phi, Gamma0, Gamma1) flattened: 4 + 2 + 2 numbers (read-only; kept for the next record
+    of the same sampling: a folder's records share their periods and step)."""
     from scipy.linalg import expm
 
     m = np.zeros((4, 4))
@@ -62,7 +65,9 @@ def _recurrence(omega: float, damping: float, h: float) -> NDArray[np.float64]:
     phi = e[:2, :2]
     gamma0 = e[:2, 2]
     gamma1 = e[:2, 3]
-    return np.concatenate([phi.ravel(), gamma0, gamma1])
+    out = np.concatenate([phi.ravel(), gamma0, gamma1])
+    out.setflags(write=False)
+    return out
 
 
 @numba.njit(cache=True)
@@ -177,6 +182,8 @@ def response_spectrum(
     accel = np.concatenate([accel, np.zeros(pad)])
     substeps = np.maximum(1, np.ceil(MIN_STEPS_PER_PERIOD * dt_s / periods)).astype(np.int64)
     omega = 2 * np.pi / periods
-    coeffs = np.array([_recurrence(w, damping, dt_s / m) for w, m in zip(omega, substeps, strict=True)])
+    coeffs = np.array(
+        [_recurrence(float(w), float(damping), float(dt_s / m)) for w, m in zip(omega, substeps, strict=True)]
+    )
     peaks = _peak_response(accel, coeffs, substeps, omega, float(damping), float(dt_s))
     return periods, omega * omega * peaks

@@ -23,7 +23,7 @@ Scene tables (all take ``load_factor``, default 1)::
     [motion]                    # recorded accelerogram
     type = "record"
     file = "records/RSN6.AT2"   # relative to the scene file
-    format = "at2"              # at2 | csv | single (default by extension)
+    format = "at2"              # at2 | csv | single | esm (default by content)
     units = "g"                 # default: the AT2 header; m/s2 for text files
     dt_s = 0.01                 # one-column files (read as such without format); else must match the file
     baseline = false            # zero final velocity and displacement

@@ -50,6 +50,10 @@ the tolerance, pass or fail):
 * ``loaded_pushover``: the reference DEM's pushover onset of that block (levels held 0.4 s
   every 1 % of the closed form from 0.98 of it) within 2 % of the closed form, and the last
   level at which it stood at most the closed form;
+* ``floor_spectrum``: a mechanism at height by Circolare 2019 C8.7.1 on the floor spectrum of
+  C7.2.3 (the tuff wall with its roof at 7 m of a 10 m building, T1 = 0.3 s): the floor's peak,
+  the linear demand, a(d_SLV), T_SLV, the nonlinear demand and its C8.7.1.12 floor, and the code's
+  capacity against the hand calculation of docs/howto/is-this-wall-safe.md (2e-4);
 * ``limit_pushover``: the limit analysis's multiplier against the reference DEM's pushover
   onset (held levels every 1 % of it from 0.98 of it) within 2 %, for a block, a 20-voussoir
   arch, a wall restrained at its top (three hinges) and a running-bond panel that slides on a
@@ -63,7 +67,7 @@ the tolerance, pass or fail):
 
 The checks live by domain: :mod:`rockyade.studies.verify_closed` (no solver),
 :mod:`rockyade.studies.verify_dem`, :mod:`rockyade.studies.verify_pushover`,
-:mod:`rockyade.studies.verify_siconos`; each row holds its tolerance once
+:mod:`rockyade.studies.verify_siconos`, :mod:`rockyade.studies.verify_floor`; each row holds its tolerance once
 (:mod:`rockyade.studies.verify_rows`).
 
 ``kinematic``, ``code``, ``fragility_fit``, ``loaded_block``, ``loaded_classical``, ``code_friction``
@@ -90,6 +94,7 @@ from rockyade.studies.verify_closed import (
     check_loaded_mass,
 )
 from rockyade.studies.verify_dem import check_agreement, check_baseline, check_drums, check_frame, check_pad, check_wall
+from rockyade.studies.verify_floor import check_floor_spectrum
 from rockyade.studies.verify_pushover import check_limit_pushover, check_loaded_pushover
 from rockyade.studies.verify_rows import Row
 from rockyade.studies.verify_siconos import check_siconos
@@ -111,6 +116,7 @@ CHECK_FUNCTIONS: dict[str, Callable[[list[str]], tuple[list[Row], dict[str, Resu
     "crushing": check_crushing,
     "loaded_pushover": check_loaded_pushover,
     "limit_pushover": check_limit_pushover,
+    "floor_spectrum": check_floor_spectrum,
     "siconos": check_siconos,
 }
 

@@ -18,5 +18,6 @@ CHECKS = (
     "crushing",
     "loaded_pushover",
     "limit_pushover",
+    "floor_spectrum",
     "siconos",
 )
