@@ -20,7 +20,7 @@ from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import rest_motion, stack
 
-NTC = ["--ag", "0.2g", "--f0", "2.4", "--tc-star", "0.3", "--soil", "B"]
+NTC = ["--knowledge-level", "LC1", "--ag", "0.2g", "--f0", "2.4", "--tc-star", "0.3", "--soil", "B"]
 HEIGHT = ["--z", "6", "--building-height", "9", "--storeys", "3", "--t1", "0.3"]
 
 
