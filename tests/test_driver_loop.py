@@ -16,29 +16,11 @@ import numpy as np
 import rockyade
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.io import driver_loop, warm_program
-from rockyade.io.warm_program import Program
+
+from .processes import fake_program
 
 PACKAGE = Path(rockyade.__file__).parent
 LOOP = Path(driver_loop.__file__)
-
-#: A driver without an engine: the loop, loaded by path as the real drivers load it.
-FAKE_DRIVER = """
-import json, runpy, sys, types
-import numpy as np
-loop = types.SimpleNamespace(**runpy.run_path(sys.argv[1], run_name="driver_loop"))
-class Recorder:
-    status, stop_time, stop_body, overturn_times, k, start, flushes = "completed", None, None, {}, 2, 0.0, 0
-def run(scene, out, deadline, flush_s):
-    with open(scene) as fh:
-        job = json.load(fh)
-    if job.get("raise"):
-        raise RuntimeError("the scene raised")
-    print("running", job["name"])
-    meta = loop.output_meta(Recorder(), True, steps=7, version="fake 1.0", dt_s=0.1, max_residual=1e-9)
-    loop.write_output(out, np.savez, {"pos": np.zeros((2, 1, 2))}, meta)
-    return "completed"
-loop.exit_now(loop.serve(int(sys.argv[3]), run))
-"""
 
 
 def _imports(path: Path) -> set[str]:
@@ -64,8 +46,7 @@ def _run(tmp_path: Path, job: dict, out: Path) -> tuple[str | None, str]:
     scene = tmp_path / f"{job['name']}.json"
     scene.write_text(json.dumps(job))
     log = tmp_path / f"{job['name']}.log"
-    program = Program([sys.executable, "-c", FAKE_DRIVER, str(LOOP)], {}, "Fake", "--fake-timeout", 30.0)
-    reason = warm_program.run_scene(program, scene, out, log, 60.0, warm=True)
+    reason = warm_program.run_scene(fake_program(), scene, out, log, 60.0, warm=True)
     return reason, log.read_text()
 
 

@@ -46,6 +46,7 @@ import tempfile
 import threading
 import time
 import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -74,6 +75,26 @@ class WorkerLostError(Exception):
     def __init__(self, reason: str, output: str = "") -> None:
         super().__init__(reason)
         self.output = output
+
+
+@contextlib.contextmanager
+def sigint_held_back() -> Iterator[None]:
+    """Hold SIGINT back from this thread while it forks a worker. Between fork and exec the
+    child runs Python (the interpreter's at-fork hooks, the ``preexec_fn``) with this
+    process's Ctrl-C handler, and is still in the terminal's process group: a Ctrl-C then ran
+    that handler in the child, whose exception showed as "Exception ignored in: <bound method
+    Random.seed ...>". The child inherits the blocked signal through exec: the worker, in a
+    session of its own, never takes Ctrl-C (its parent decides). In this process a Ctrl-C
+    meanwhile goes to another thread, or waits for this one to unblock it."""
+    try:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    except (AttributeError, OSError, ValueError):  # no per-thread masks here
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
 def _timeout_reason(timeout: float, label: str, option: str) -> str:
@@ -127,16 +148,17 @@ class Worker:
         self.sock = ours
         self.closed = False
         try:
-            self.proc = subprocess.Popen(
-                [*command, "--serve", str(theirs.fileno())],
-                stdin=subprocess.DEVNULL,
-                stdout=self.startup,
-                stderr=subprocess.STDOUT,
-                env=env,
-                pass_fds=(theirs.fileno(),),
-                start_new_session=True,  # a group of its own: a timeout kills it and its children
-                preexec_fn=child_dies_with_parent(),  # ... and it dies with this thread, even by SIGKILL
-            )
+            with sigint_held_back():
+                self.proc = subprocess.Popen(
+                    [*command, "--serve", str(theirs.fileno())],
+                    stdin=subprocess.DEVNULL,
+                    stdout=self.startup,
+                    stderr=subprocess.STDOUT,
+                    env=env,
+                    pass_fds=(theirs.fileno(),),
+                    start_new_session=True,  # a group of its own: a timeout kills it and its children
+                    preexec_fn=child_dies_with_parent(),  # ... and it dies with this thread, even by SIGKILL
+                )
         except BaseException:
             ours.close()
             self.startup.close()

@@ -33,16 +33,14 @@ from pathlib import Path
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
 from rockyade.dem.result_frames import worker_frame
-from rockyade.dem.worker_backend import (
-    PROBE_ANSWER,
-    Arrays,
-    WorkerBackend,
-    worker_env,
-)
+from rockyade.dem.worker_backend import PROBE_ANSWER, Arrays, WorkerBackend, worker_env
+from rockyade.dem.worker_backend import TIMEOUT_CAP_S as TIMEOUT_CAP_S  # re-exported: the default timeout's cap
+from rockyade.dem.worker_backend import TIMEOUT_STARTUP_S as TIMEOUT_STARTUP_S  # ... and its start-up allowance
 from rockyade.dem.worker_output import WorkerOutput
 from rockyade.errors import InputError
 from rockyade.io import warm_program
 from rockyade.io.atomic import write_json, write_text
+from rockyade.io.warm_program import QUIT_WAIT_S as QUIT_WAIT_S  # re-exported: a worker's quit allowance
 from rockyade.io.warm_program import Program
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta
