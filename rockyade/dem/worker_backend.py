@@ -22,7 +22,8 @@ An engine fills in its names (``solver``, ``label``, ``python_variable``,
 :meth:`~WorkerBackend.program`, :meth:`~WorkerBackend.needs`, :meth:`~WorkerBackend.probe`,
 :meth:`~WorkerBackend.version`, and, where it has them, :meth:`~WorkerBackend.unstable_reason`,
 :meth:`~WorkerBackend.engine_problem`, :meth:`~WorkerBackend.engine_meta` and
-:meth:`~WorkerBackend.rescue` (docs/architecture.md, "How to add a solver").
+:meth:`~WorkerBackend.rescue` with :meth:`~WorkerBackend.rescued_meta` (docs/architecture.md, "How
+to add a solver").
 """
 
 from __future__ import annotations
@@ -32,10 +33,12 @@ import contextlib
 import dataclasses
 import functools
 import json
+import math
 import os
 import subprocess
 import time
 import zipfile
+from collections.abc import Callable
 from pathlib import Path
 from typing import ClassVar
 
@@ -63,6 +66,8 @@ UNREADABLE = (OSError, ValueError, KeyError, zipfile.BadZipFile)
 PROBE_TIMEOUT_S = 120.0
 
 Arrays = dict[str, np.ndarray]
+#: A run's metadata from what its driver said (:meth:`WorkerBackend.run_meta` with the rest bound).
+MetaOf = Callable[[WorkerOutput], dict[str, object]]
 
 
 class WorkerBackend(abc.ABC):
@@ -130,19 +135,16 @@ class WorkerBackend(abc.ABC):
         """The engine's own fields of the Result's metadata."""
         return {}
 
-    def rescue(
-        self,
-        model: DemModel,
-        meta: WorkerOutput,
-        arrays: Arrays,
-        problem: str,
-        total: float,
-        extra: dict[str, object],
-        lowpass: float | None,
-    ) -> Result | None:
-        """A Result to give instead of failing for ``problem`` (YADE: a collapse up to a deep
-        overlap), or None."""
+    def rescue(self, model: DemModel, meta: WorkerOutput, arrays: Arrays, problem: str) -> int | None:
+        """How many samples to keep as a result instead of failing for ``problem`` (YADE: an
+        assembly collapsing up to a deep overlap), or None; :meth:`rescued_meta` then says how
+        the run ended."""
         return None
+
+    def rescued_meta(self, model: DemModel, meta: WorkerOutput, arrays: Arrays, run_meta: MetaOf) -> dict[str, object]:
+        """The metadata of a rescued run, ``arrays`` cut to the samples kept (``run_meta(m)``:
+        :meth:`run_meta` of a run whose driver said ``m``)."""
+        return run_meta(meta)
 
     # ------------------------------------------------------------------ running
 
@@ -273,9 +275,13 @@ class WorkerBackend(abc.ABC):
                 self.solver, model.scene_hash, f"unreadable {self.label} output {out_file.name}: {exc}", **extra
             )
         problem = self.problem(model, meta, arrays)
-        if problem is not None:
-            rescued = self.rescue(model, meta, arrays, problem, total, extra, lowpass)
-            return rescued if rescued is not None else self._partial_failure(model, meta, arrays, problem, total, extra)
+        keep = None if problem is None else self.rescue(model, meta, arrays, problem)
+        if problem is not None and keep is None:
+            return self._partial_failure(model, meta, arrays, problem, total, extra)
+        if keep is not None:
+            arrays = {k: v[:keep] for k, v in arrays.items()}
+            out = self.rescued_meta(model, meta, arrays, lambda m: self.run_meta(model, m, total, extra, arrays))
+            return Result(worker_frame(model, arrays, lowpass), RunMeta.from_dict(out))
         return Result(
             worker_frame(model, arrays, lowpass), RunMeta.from_dict(self.run_meta(model, meta, total, extra, arrays))
         )
@@ -326,6 +332,30 @@ class WorkerBackend(abc.ABC):
         return Result(frame, RunMeta.from_dict(worker_result.failed_partially(out, reason, n)))
 
 
+def body_payload(model: DemModel, i: int) -> dict[str, object]:
+    """What every driver reads of body ``i`` (its payload adds the engine's own keys): its name,
+    whether it is fixed, mass (kg) and centroidal inertia (kg m^2), contact polygon about its
+    centroid (m), start (centroid m, angle rad, velocity m/s, angular velocity rad/s), rest and
+    stop angles (rad; None: it never stops the run) and the point whose acceleration is
+    recorded (m, from the centroid)."""
+    b = model.bodies[i]
+    stop = float(model.stop_angle_rad[i]) if model.stop_angle_rad is not None else 0.5 * math.pi
+    return {
+        "name": b.name,
+        "fixed": bool(b.fixed),
+        "mass_kg": b.mass_kg,
+        "inertia_kgm2": b.inertia_kgm2,
+        "vertices_m": b.contact_vertices_m.tolist(),
+        "centroid0_m": model.pos0_m[i].tolist(),
+        "angle0_rad": float(model.ang0_rad[i]),
+        "rest_angle_rad": b.rest_angle_rad,
+        "stop_angle_rad": stop if math.isfinite(stop) else None,
+        "vel0_m_s": model.vel0_m_s[i].tolist(),
+        "angvel0_rad_s": float(model.angvel0_rad_s[i]),
+        "accel_point_m": list(b.accel_point_m),
+    }
+
+
 def worker_env(**changes: str | None) -> dict[str, str]:
     """A driver's environment: this one, with one OpenMP thread, no display (no GUI), no user
     site-packages, and ``changes`` (None: the variable removed)."""
@@ -368,4 +398,12 @@ def check_python(variable: str, python: str, probe: tuple[str, ...], env: tuple[
 #: What a probe prints when the engine imported.
 PROBE_ANSWER = "rockyade-engine-ok"
 
-__all__ = ["PROBE_ANSWER", "TIMEOUT_CAP_S", "TIMEOUT_STARTUP_S", "WorkerBackend", "check_python", "worker_env"]
+__all__ = [
+    "PROBE_ANSWER",
+    "TIMEOUT_CAP_S",
+    "TIMEOUT_STARTUP_S",
+    "WorkerBackend",
+    "body_payload",
+    "check_python",
+    "worker_env",
+]

@@ -154,33 +154,6 @@ class WorkerOutput:
 #: Keys of the drivers before the one dialect -> today's.
 OLDER_NAMES = {"iterations": "steps", "yade_version": "version", "siconos_version": "version"}
 _FIELDS = frozenset(f.name for f in fields(WorkerOutput))
-_INTEGERS = frozenset(
-    {
-        "n_filled",
-        "steps",
-        "stop_body",
-        "rotation_track_period_steps",
-        "solver_calls",
-        "solver_iterations",
-        "unconverged_steps",
-        "retried_steps",
-        "retried_steps_converged",
-        "fallback_steps",
-        "loose_steps",
-    }
-)
-_FLOATS = frozenset(
-    {
-        "stop_time_s",
-        "wall_time_s",
-        "process_cpu_s",
-        "dt_s",
-        "max_polyhedra_penetration_over_radius",
-        "deep_overlap_time_s",
-        "max_rotation_step_rad",
-        "first_unconverged_s",
-        "max_residual",
-        "max_penetration_m",
-        "max_bullet_overlap_m",
-    }
-)
+#: The fields read as integers and as floats (by their annotations).
+_INTEGERS = frozenset(f.name for f in fields(WorkerOutput) if f.type in ("int", "int | None"))
+_FLOATS = frozenset(f.name for f in fields(WorkerOutput) if f.type in ("float", "float | None"))

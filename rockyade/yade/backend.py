@@ -32,8 +32,7 @@ from pathlib import Path
 
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
-from rockyade.dem.result_frames import worker_frame
-from rockyade.dem.worker_backend import PROBE_ANSWER, Arrays, WorkerBackend, worker_env
+from rockyade.dem.worker_backend import PROBE_ANSWER, Arrays, MetaOf, WorkerBackend, worker_env
 from rockyade.dem.worker_backend import TIMEOUT_CAP_S as TIMEOUT_CAP_S  # re-exported: the default timeout's cap
 from rockyade.dem.worker_backend import TIMEOUT_STARTUP_S as TIMEOUT_STARTUP_S  # ... and its start-up allowance
 from rockyade.dem.worker_output import WorkerOutput
@@ -43,7 +42,6 @@ from rockyade.io.atomic import write_json, write_text
 from rockyade.io.warm_program import QUIT_WAIT_S as QUIT_WAIT_S  # re-exported: a worker's quit allowance
 from rockyade.io.warm_program import Program
 from rockyade.result import Result
-from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.yade.deep_overlap import DEEP_OVERLAP, collapse_before_overlap, collapsed_meta
 from rockyade.yade.payload import scene_payload
@@ -104,23 +102,12 @@ class Yade(WorkerBackend):
             "rotation_track_period_steps": meta.rotation_track_period_steps,
         }
 
-    def rescue(
-        self,
-        model: DemModel,
-        meta: WorkerOutput,
-        arrays: Arrays,
-        problem: str,
-        total: float,
-        extra: dict[str, object],
-        lowpass: float | None,
-    ) -> Result | None:
-        """An assembly collapsing up to a deep overlap: its history to there (:mod:`rockyade.yade.deep_overlap`)."""
-        keep = collapse_before_overlap(model, meta, arrays) if problem == DEEP_OVERLAP else None
-        if keep is None:
-            return None
-        cut = {k: v[:keep] for k, v in arrays.items()}
-        out = collapsed_meta(model, meta, cut, lambda m: self.run_meta(model, m, total, extra, cut))
-        return Result(worker_frame(model, cut, lowpass), RunMeta.from_dict(out))
+    def rescue(self, model: DemModel, meta: WorkerOutput, arrays: Arrays, problem: str) -> int | None:
+        """An assembly collapsing up to a deep overlap: its samples to there (:mod:`rockyade.yade.deep_overlap`)."""
+        return collapse_before_overlap(model, meta, arrays) if problem == DEEP_OVERLAP else None
+
+    def rescued_meta(self, model: DemModel, meta: WorkerOutput, arrays: Arrays, run_meta: MetaOf) -> dict[str, object]:
+        return collapsed_meta(model, meta, arrays, run_meta)
 
 
 YADE = Yade()
