@@ -115,6 +115,9 @@ def test_a_bad_siconos_python_is_refused_naming_the_variable(kind, tmp_path, mon
     err = capsys.readouterr().err
     assert code == 2 and "ROCKYADE_SICONOS_PYTHON" in err and "Traceback" not in err, err
     assert STARTED["Siconos"] == before  # refused before any worker started
+    with pytest.raises(InputError) as refused:  # and by the studies' check before their runs
+        SiconosSolver().check_scene(scene_from_dict(TINY))
+    assert refused.value.field == "ROCKYADE_SICONOS_PYTHON"
 
 
 LONG_RUN = """

@@ -156,6 +156,21 @@ class WorkerBackend(abc.ABC):
             return checked
         return min(TIMEOUT_STARTUP_S + self.seconds_per_body_step * body_steps, TIMEOUT_CAP_S)
 
+    def check_variable(self) -> None:
+        """Refuse a Python named by ``python_variable`` that is not an executable file or cannot
+        import the engine (:func:`check_python`; nothing to check when the variable is unset).
+
+        Raises
+        ------
+        InputError
+            Naming the variable.
+        """
+        if os.environ.get(self.python_variable):
+            program = self.program()
+            check_python(
+                self.python_variable, program.command[0], tuple(self.probe()), tuple(sorted(program.env.items()))
+            )
+
     def check_installed(self) -> None:
         """Refuse a bad Python named by ``python_variable`` and a missing engine (module docstring).
 
@@ -166,9 +181,7 @@ class WorkerBackend(abc.ABC):
         SolverUnavailableError
             The engine is not installed.
         """
-        named = os.environ.get(self.python_variable)
-        if named:
-            check_python(self.python_variable, named, tuple(self.probe()), tuple(sorted(self.program().env.items())))
+        self.check_variable()
         why = self.missing()
         if why is not None:
             raise SolverUnavailableError(why)

@@ -21,7 +21,7 @@ from rockyade.errors import InputError
 from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
 from rockyade.scene import ContactSpec, Scene
-from rockyade.siconos.backend import run_model
+from rockyade.siconos.backend import SICONOS, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
@@ -233,7 +233,8 @@ class SiconosSolver(SolverBase):
 
     def check_scene(self, scene: Scene) -> None:
         """Refuse before any run what :meth:`run` refuses whatever the motion: a target mu the
-        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`).
+        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`), a bad
+        ``ROCKYADE_SICONOS_PYTHON`` (:meth:`rockyade.dem.worker_backend.WorkerBackend.check_variable`).
 
         Raises
         ------
@@ -241,6 +242,7 @@ class SiconosSolver(SolverBase):
             As :meth:`run` would.
         """
         check_target_mu(scene, self.model(scene))
+        SICONOS.check_variable()
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Steps at the Siconos time step, SECONDS_PER_STEP x n ** STEP_EXPONENT each for n

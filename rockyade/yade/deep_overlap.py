@@ -17,6 +17,7 @@ from collections.abc import Callable
 import numpy as np
 
 from rockyade.dem.model import DemModel
+from rockyade.dem.overturn import DROP_FRACTION
 from rockyade.dem.result_frames import energy_gain
 from rockyade.dem.worker_output import WorkerOutput
 
@@ -25,9 +26,6 @@ DEEP_OVERLAP = (
     "a vertex sphere went deeper into a non-rectangular block than its own radius (YADE's sphere-polyhedron "
     "contact then loses its normal): the impact is too hard for these contact spheres"
 )
-#: A block has fallen off when its centroid dropped by more than this fraction of its height
-#: (the collapse table's rule, rockyade.analysis.collapse.DROP_FRACTION).
-DROP_FRACTION = 0.5
 
 
 def collapse_before_overlap(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray]) -> int | None:
@@ -35,7 +33,8 @@ def collapse_before_overlap(model: DemModel, meta: WorkerOutput, arrays: dict[st
 
     The rule (docs/yade.md): at the last sample before the overlap (``deep_overlap_time_s``
     of the driver; the end of the output when an older driver does not say), some moving block
-    has reached its landing angle, dropped by more than DROP_FRACTION of its height, or passed
+    has reached its landing angle, dropped by more than DROP_FRACTION of its height (the
+    collapse table's rule, :data:`rockyade.dem.overturn.DROP_FRACTION`), or passed
     its tipping angle alpha, and the energy has not grown up to then (no blow-up by
     :func:`rockyade.dem.result_frames.energy_gain`).
     """
