@@ -62,8 +62,10 @@ TIMEOUT_STARTUP_S = 60.0
 TIMEOUT_CAP_S = 3600.0
 #: What a worker's output file cannot be read for.
 UNREADABLE = (OSError, ValueError, KeyError, zipfile.BadZipFile)
-#: Seconds a Python named by a variable has to show that it imports its engine.
+#: Seconds a Python named by a variable has to show that it imports its engine ...
 PROBE_TIMEOUT_S = 120.0
+#: ... by printing this.
+PROBE_ANSWER = "rockyade-engine-ok"
 
 Arrays = dict[str, np.ndarray]
 #: A run's metadata from what its driver said (:meth:`WorkerBackend.run_meta` with the rest bound).
@@ -407,9 +409,6 @@ def check_python(variable: str, python: str, probe: tuple[str, ...], env: tuple[
         said = error_line(done.stderr) or f"exit code {done.returncode}, no answer"
         raise InputError(variable, f"must name a Python that imports the engine, got {python!r}: {said}")
 
-
-#: What a probe prints when the engine imported.
-PROBE_ANSWER = "rockyade-engine-ok"
 
 __all__ = [
     "PROBE_ANSWER",
