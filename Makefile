@@ -26,9 +26,9 @@ lint: setup
 	$(BIN)/lint-imports
 	$(BIN)/mypy rockyade
 
-# the inner loop: lint, then every test not marked slow or yade (pyproject's markers), in parallel
+# the inner loop: lint, then every test not marked slow, yade or siconos (pyproject's markers), in parallel
 check: setup lint
-	$(BIN)/python -m pytest -n $(WORKERS) -q -m "not slow and not yade"
+	$(BIN)/python -m pytest -n $(WORKERS) -q -m "not slow and not yade and not siconos"
 
 test: setup lint
 	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15

@@ -26,13 +26,13 @@ from pathlib import Path
 
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.errors import InputError
+from rockyade.io import warm_program
 from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.reference import run_model
 from rockyade.solvers.yade import YadeSolver
 from rockyade.studies.specimen_scenes import block_table
 from rockyade.yade import backend as yade_backend
-from rockyade.yade import warm_worker as yade_worker
 
 BLOCK = block_table("1")  # specimen 1 with its experimental parameters (Tables 1, 3)
 
@@ -148,7 +148,7 @@ def harmonic_scene(amplitude_mm: float, duration: float = 20.0):
 
 def _worker_cpu_s() -> float:
     """CPU time (user + system) of this thread's warm YADE worker so far, s (0 without one)."""
-    box = yade_worker._slot().box
+    box = warm_program.slot(yade_backend.YADE.label).box
     if not box or not box[-1].alive():
         return 0.0
     fields = Path(f"/proc/{box[-1].proc.pid}/stat").read_text().rsplit(")", 1)[1].split()
@@ -191,7 +191,7 @@ def warm_vs_cold(runs: int = 20, duration: float = 20.0) -> dict[str, float]:
             cpu[name] += used
             assert result.ok, result.meta.failure_reason
             results[name].append(result)
-    yade_worker.close_workers()
+    yade_backend.close_workers()
     out: dict[str, float] = {"load_average": max(load, os.getloadavg()[0])}
     for name in solvers:
         startups = sorted(r.meta.startup_time_s for r in results[name][1 if name == "warm" else 0 :])

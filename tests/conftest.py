@@ -68,10 +68,41 @@ def rel(a: float, b: float) -> float:
     return abs(a - b) / abs(b) if b else math.inf
 
 
+#: The engines that run in another Python: each a marker that ``make check`` leaves to ``make test``,
+#: and its name in rockyade's workers (rockyade.io.warm_program.STARTED).
+ENGINE_MARKERS = {"yade": "YADE", "siconos": "Siconos"}
+
+
+@pytest.fixture(scope="module")
+def siconos_present() -> None:
+    """Debian's Siconos installed, or the test skipped (failed where ``ROCKYADE_REQUIRE_SICONOS=1``):
+    a test that uses it runs the real Siconos and is marked ``siconos``."""
+    from .processes import require_siconos
+
+    require_siconos()
+
+
+@pytest.fixture(autouse=True)
+def _engines_run_only_where_marked(request: pytest.FixtureRequest):
+    """The gate's own check: a test that starts a worker of a real engine (YADE, Siconos) in
+    this process is marked with its name, so that ``make check`` never runs one."""
+    from rockyade.io.warm_program import STARTED
+
+    before = dict(STARTED)
+    yield
+    for engine, label in ENGINE_MARKERS.items():
+        if STARTED[label] > before.get(label, 0) and request.node.get_closest_marker(engine) is None:
+            pytest.fail(f"started {label} without the marker {engine!r} (tests/conftest.py)", pytrace=False)
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """A test run with the parameter ``"yade"`` (a solver) runs the real YADE: marked ``yade``,
-    so that ``make check`` (``-m "not slow and not yade"``) leaves it to ``make test``."""
+    """A test that runs a real engine is marked with its name, so that ``make check``
+    (``-m "not slow and not yade and not siconos"``) leaves it to ``make test``: a test run
+    with the parameter ``"yade"`` or ``"siconos"`` (a solver), and a test that uses the
+    fixture ``siconos_present``."""
     for item in items:
         callspec = getattr(item, "callspec", None)
-        if callspec is not None and any(isinstance(v, str) and v == "yade" for v in callspec.params.values()):
-            item.add_marker(pytest.mark.yade)
+        values = [v for v in callspec.params.values() if isinstance(v, str)] if callspec is not None else []
+        for engine in ENGINE_MARKERS:
+            if engine in values or f"{engine}_present" in getattr(item, "fixturenames", ()):
+                item.add_marker(getattr(pytest.mark, engine))

@@ -127,3 +127,36 @@ def sigint_default() -> None:
     it, whatever the test run inherited (a shell starts a background job with SIGINT ignored,
     and a Python started so ignores Ctrl-C)."""
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+#: A worker driver without an engine: the loop (rockyade/io/driver_loop.py, its path the first
+#: argument), loaded by path as the real drivers load it; a job's scene is JSON: ``name`` (printed
+#: to the job's log), ``raise`` (the scene raises), ``sleep_s`` (the scene's run time).
+FAKE_DRIVER = """
+import json, runpy, sys, time, types
+loop = types.SimpleNamespace(**runpy.run_path(sys.argv[1], run_name="driver_loop"))
+class Recorder:
+    status, stop_time, stop_body, overturn_times, k, start, flushes = "completed", None, None, {}, 2, 0.0, 0
+def run(scene, out, deadline, flush_s):
+    with open(scene) as fh:
+        job = json.load(fh)
+    if job.get("raise"):
+        raise RuntimeError("the scene raised")
+    print("running", job["name"])
+    time.sleep(job.get("sleep_s", 0.0))
+    import numpy as np
+    meta = loop.output_meta(Recorder(), True, steps=7, version="fake 1.0", dt_s=0.1, max_residual=1e-9)
+    loop.write_output(out, np.savez, {"pos": np.zeros((2, 1, 2))}, meta)
+    return "completed"
+loop.exit_now(loop.serve(int(sys.argv[3]), run))
+"""
+
+
+def fake_program():
+    """The engine-free driver (FAKE_DRIVER) as rockyade starts a worker's program, named "Fake"."""
+    import sys
+
+    from rockyade.io import driver_loop
+    from rockyade.io.warm_program import Program
+
+    return Program([sys.executable, "-c", FAKE_DRIVER, driver_loop.__file__], {}, "Fake", "--fake-timeout", 30.0)

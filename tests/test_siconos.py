@@ -29,14 +29,12 @@ from rockyade.solvers import make_solver
 from rockyade.solvers.siconos import SiconosSolver
 
 from .conftest import EXAMPLES
-from .processes import listening_of_tree, require_siconos, sigint_default
+from .processes import listening_of_tree, sigint_default
 
 RECORDS = EXAMPLES / "records"
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _siconos_present():
-    require_siconos()
+pytestmark = pytest.mark.usefixtures("siconos_present")  # the real Siconos: marked siconos (conftest)
 
 
 def _block(width: float, height: float, motion: dict, duration: float, sample_dt: float = 0.002):

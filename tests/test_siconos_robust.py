@@ -21,12 +21,7 @@ from rockyade.siconos import backend as siconos_backend
 from rockyade.siconos.payload import scene_payload
 from rockyade.solvers.siconos import SiconosSolver
 
-from .processes import require_siconos
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _siconos_present():
-    require_siconos()
+pytestmark = pytest.mark.usefixtures("siconos_present")  # the real Siconos: marked siconos (conftest)
 
 
 def _wall(duration_s: float) -> dict:

@@ -9,14 +9,7 @@ import pytest
 from rockyade.studies.verification import verify
 from rockyade.studies.verify_siconos import SICONOS_PUSHOVERS
 
-from .processes import require_siconos
-
-pytestmark = pytest.mark.slow
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _siconos_present():
-    require_siconos()
+pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("siconos_present")]
 
 
 def test_siconos_rows_pass_against_closed_forms(tmp_path):

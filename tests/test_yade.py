@@ -540,7 +540,7 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     kept = Result.read(Path("t/long.csv"))
     assert kept.status == "failed" and kept.meta.partial is True and len(kept.frame) > 0
     # the scene was stopped: its warm YADE waits idle for the next one, and quits when asked
-    from rockyade.yade.warm_worker import QUIT_WAIT_S, close_workers
+    from rockyade.yade.backend import QUIT_WAIT_S, close_workers
 
     start = time.monotonic()
     close_workers()

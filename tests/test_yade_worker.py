@@ -1,6 +1,6 @@
-"""YADE kept warm (rockyade.yade.warm_worker), with YADE really running: the same results as one
-process per run, a crash or a timeout costs one scene, no port, nothing left behind, no
-write through a link, a full disk named and cleaned up."""
+"""YADE kept warm (rockyade.io.warm_program, through rockyade.yade.backend), with YADE really
+running: the same results as one process per run, a crash or a timeout costs one scene, no
+port, nothing left behind, no write through a link, a full disk named and cleaned up."""
 
 from __future__ import annotations
 
@@ -24,7 +24,6 @@ from rockyade.runner import Executor, solve_scenes
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.solvers.yade import YadeSolver
 from rockyade.yade import backend as yade_backend
-from rockyade.yade import warm_worker as yade_worker
 
 from .conftest import EXAMPLES
 from .processes import alive, cmdline, descendants, listening_of_tree, require_yade
@@ -143,7 +142,7 @@ def test_a_killed_yade_run_keeps_the_samples_it_flushed(tmp_path, monkeypatch):
     driver runs) after it flushed its samples: the run fails naming the signal, keeps the
     samples of the last flush marked partial, and that flushed file is whole (written to a
     ``.part`` file and renamed: a kill never leaves a truncated output)."""
-    monkeypatch.setattr(yade_worker, "FLUSH_PERIOD_S", 0.3)
+    monkeypatch.setattr(yade_backend, "FLUSH_PERIOD_S", 0.3)
     long = _scene("specimen1_free.toml", 3600.0, sample_dt_s=0.01)
     holder: dict = {}
     thread = threading.Thread(target=lambda: holder.update(r=YadeSolver(workdir=tmp_path, stem="k").run(long)))

@@ -22,7 +22,7 @@ def cmd_yade_script(args: argparse.Namespace) -> int:
     check_output_dir(args.out, "--out")
     paths = write_script(load_scene(args.scene), args.out)
     out = args.out
-    print(f"wrote {paths['script']} and {paths['data']}")
+    print(f"wrote {paths['script']} (and {paths['loop'].name}, which it loads) and {paths['data']}")
     print(f"  batch:        yade -x {out / 'run.py'}")
     print(f"  with the GUI: yade {out / 'run.py'}")
     print(f"  without the launcher (no server): /usr/bin/python3.11 {out / 'run.py'}")

@@ -2,10 +2,13 @@
 :mod:`rockyade.siconos.driver`) writes beside its samples, typed: :class:`WorkerOutput`.
 
 The drivers run in another Python (YADE's, Debian's) and write their metadata as one JSON
-object in the output ``.npz`` (key ``meta``); the backends read it once, here, and decide from
-its attributes whether the samples are a result (complete, stable, converged) and what the
-Result's :class:`rockyade.run_meta.RunMeta` says. A key a driver does not write (an older
-driver, the other solver's) takes its default.
+object in the output ``.npz`` (key ``meta``), in the one dialect of
+:func:`rockyade.io.driver_loop.output_meta` plus each engine's own diagnostics; the backends
+read it once, here, and decide from its attributes whether the samples are a result
+(complete, stable, converged) and what the Result's :class:`rockyade.run_meta.RunMeta` says.
+A key a driver does not write (the other engine's) takes its default; the names an older
+driver wrote (OLDER_NAMES: a ``rockyade yade-script`` folder made before the one dialect) are
+read as today's.
 """
 
 from __future__ import annotations
@@ -43,9 +46,9 @@ class WorkerOutput:
     dt_s
         The time step, s.
     steps
-        Time steps taken (YADE's ``iterations``, Siconos's ``steps``).
+        Time steps taken.
     version
-        The engine's version (YADE's ``yade_version``, Siconos's ``siconos_version``).
+        The engine's version.
     max_polyhedra_penetration_over_radius
         YADE: the deepest vertex sphere in a non-rectangular block over its radius.
     deep_overlap_time_s
@@ -121,14 +124,11 @@ class WorkerOutput:
         ValueError, TypeError
             A value of the wrong kind.
         """
-        values: dict[str, Any] = {k: v for k, v in data.items() if k in _FIELDS and v is not None}
+        named = {OLDER_NAMES.get(k, k): v for k, v in data.items()}
+        values: dict[str, Any] = {k: v for k, v in named.items() if k in _FIELDS and v is not None}
         values["status"] = str(data["status"])
-        for key in ("steps", "iterations"):  # Siconos's name, YADE's
-            if data.get(key) is not None:
-                values["steps"] = int(data[key])
-        for key in ("yade_version", "siconos_version"):
-            if data.get(key) is not None:
-                values["version"] = str(data[key])
+        if "version" in values:
+            values["version"] = str(values["version"])
         for key in _INTEGERS & values.keys():
             values[key] = int(values[key])
         for key in _FLOATS & values.keys():
@@ -151,33 +151,9 @@ class WorkerOutput:
         return cls.from_dict(data)
 
 
+#: Keys of the drivers before the one dialect -> today's.
+OLDER_NAMES = {"iterations": "steps", "yade_version": "version", "siconos_version": "version"}
 _FIELDS = frozenset(f.name for f in fields(WorkerOutput))
-_INTEGERS = frozenset(
-    {
-        "n_filled",
-        "stop_body",
-        "rotation_track_period_steps",
-        "solver_calls",
-        "solver_iterations",
-        "unconverged_steps",
-        "retried_steps",
-        "retried_steps_converged",
-        "fallback_steps",
-        "loose_steps",
-    }
-)
-_FLOATS = frozenset(
-    {
-        "stop_time_s",
-        "wall_time_s",
-        "process_cpu_s",
-        "dt_s",
-        "max_polyhedra_penetration_over_radius",
-        "deep_overlap_time_s",
-        "max_rotation_step_rad",
-        "first_unconverged_s",
-        "max_residual",
-        "max_penetration_m",
-        "max_bullet_overlap_m",
-    }
-)
+#: The fields read as integers and as floats (by their annotations).
+_INTEGERS = frozenset(f.name for f in fields(WorkerOutput) if f.type in ("int", "int | None"))
+_FLOATS = frozenset(f.name for f in fields(WorkerOutput) if f.type in ("float", "float | None"))

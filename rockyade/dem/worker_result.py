@@ -17,6 +17,7 @@ from rockyade.dem.model import DemModel
 from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.dem.result_frames import energy_gain
 from rockyade.dem.worker_output import WorkerOutput
+from rockyade.io.warm_program import error_line
 
 #: The arrays a driver writes beside its metadata (``meta``).
 ARRAYS = ("pos", "ang", "angvel", "vpoint", "state", "fn", "ncont", "slip")
@@ -37,15 +38,12 @@ def read_output(out_file: Path) -> tuple[WorkerOutput, dict[str, np.ndarray]]:
 
 
 def last_error_line(log_file: Path) -> str:
-    """The last error line of a worker's log ("" when it has none: a banner is not a reason)."""
+    """The last error line of a worker's log ("" when it has none: a banner is not a reason;
+    :func:`rockyade.io.warm_program.error_line`)."""
     try:
-        lines = [ln.strip() for ln in log_file.read_text(errors="replace").splitlines() if ln.strip()]
+        return error_line(log_file.read_text(errors="replace"))
     except OSError:
         return ""
-    for line in reversed(lines):
-        if "Error" in line or "Exception" in line:
-            return line
-    return ""
 
 
 def incomplete_output(model: DemModel, meta: WorkerOutput, arrays: dict[str, np.ndarray], label: str) -> str | None:

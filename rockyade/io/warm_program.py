@@ -25,19 +25,20 @@ module knows no program.
   raised fails that scene only; the next starts a fresh worker.
 * **Nothing left behind.** The worker's start-up output goes to an anonymous file.
 
-The protocol the driver speaks: it says ``{"ready": true, "pid": ...}``, then takes jobs
-``{"scene", "out", "deadline", "flush_s"}`` with the log's descriptor, and answers
-``{"ok": true}`` (``"timeout": true`` when stopped at the deadline), ``{"ok": false,
-"errno", "strerror", "path"}`` (its output could not be written) or ``{"ok": false}`` and
-exits (its scene raised); it stops on ``{"quit": true}``.
+The protocol the driver speaks is its loop's, :mod:`rockyade.io.driver_loop` (one module for
+every driver): it says ``{"ready": true, "pid": ...}``, then takes jobs ``{"scene", "out",
+"deadline", "flush_s"}`` with the log's descriptor, and answers ``{"ok": true}``
+(``"timeout": true`` when stopped at the deadline), ``{"ok": false, "errno", "strerror",
+"path"}`` (its output could not be written) or ``{"ok": false}`` and exits (its scene
+raised); it stops on ``{"quit": true}``.
 """
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import json
 import os
-import shutil
 import signal
 import socket
 import subprocess
@@ -45,18 +46,18 @@ import tempfile
 import threading
 import time
 import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
 
 from rockyade.errors import InputError, os_error_message
 from rockyade.io.atomic import create_temporary, file_mode
+from rockyade.io.driver_loop import MESSAGE_BYTES
 from rockyade.io.parent_death import child_dies_with_parent
 
 #: Seconds a worker has to stop after ``quit`` before it is killed.
 QUIT_WAIT_S = 5.0
-#: Largest message either side sends, bytes.
-MESSAGE_BYTES = 1 << 16
 #: Seconds after a scene's deadline before its worker is killed: the driver stops the scene at
 #: the deadline itself (at its next sample) and writes what it recorded in this time.
 STOP_GRACE_S = 10.0
@@ -76,11 +77,31 @@ class WorkerLostError(Exception):
         self.output = output
 
 
-def _timeout_reason(timeout: float, label: str = "YADE", option: str = "--yade-timeout") -> str:
+@contextlib.contextmanager
+def sigint_held_back() -> Iterator[None]:
+    """Hold SIGINT back from this thread while it forks a worker. Between fork and exec the
+    child runs Python (the interpreter's at-fork hooks, the ``preexec_fn``) with this
+    process's Ctrl-C handler, and is still in the terminal's process group: a Ctrl-C then ran
+    that handler in the child, whose exception showed as "Exception ignored in: <bound method
+    Random.seed ...>". The child inherits the blocked signal through exec: the worker, in a
+    session of its own, never takes Ctrl-C (its parent decides). In this process a Ctrl-C
+    meanwhile goes to another thread, or waits for this one to unblock it."""
+    try:
+        previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    except (AttributeError, OSError, ValueError):  # no per-thread masks here
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _timeout_reason(timeout: float, label: str, option: str) -> str:
     return f"timeout: {label} did not finish within {timeout:.6g} s and was stopped (raise it with {option})"
 
 
-def _last_error_line(text: str) -> str:
+def error_line(text: str) -> str:
     """The last line that names an error ("" when there is none: a banner is not a reason)."""
     for line in reversed([ln.strip() for ln in text.splitlines() if ln.strip()]):
         if "Error" in line or "Exception" in line:
@@ -116,8 +137,8 @@ class Worker:
         env: dict[str, str],
         deadline: float,
         timeout: float,
-        label: str = "YADE",
-        timeout_option: str = "--yade-timeout",
+        label: str,
+        timeout_option: str,
     ) -> None:
         self.label, self.timeout_option = label, timeout_option
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
@@ -127,16 +148,17 @@ class Worker:
         self.sock = ours
         self.closed = False
         try:
-            self.proc = subprocess.Popen(
-                [*command, "--serve", str(theirs.fileno())],
-                stdin=subprocess.DEVNULL,
-                stdout=self.startup,
-                stderr=subprocess.STDOUT,
-                env=env,
-                pass_fds=(theirs.fileno(),),
-                start_new_session=True,  # a group of its own: a timeout kills it and its children
-                preexec_fn=child_dies_with_parent(),  # ... and it dies with this thread, even by SIGKILL
-            )
+            with sigint_held_back():
+                self.proc = subprocess.Popen(
+                    [*command, "--serve", str(theirs.fileno())],
+                    stdin=subprocess.DEVNULL,
+                    stdout=self.startup,
+                    stderr=subprocess.STDOUT,
+                    env=env,
+                    pass_fds=(theirs.fileno(),),
+                    start_new_session=True,  # a group of its own: a timeout kills it and its children
+                    preexec_fn=child_dies_with_parent(),  # ... and it dies with this thread, even by SIGKILL
+                )
         except BaseException:
             ours.close()
             self.startup.close()
@@ -144,6 +166,7 @@ class Worker:
         finally:
             theirs.close()
         _WORKERS.add(self)
+        STARTED[label] += 1
         try:
             hello = self._receive(deadline, timeout)
         except WorkerLostError:
@@ -183,7 +206,7 @@ class Worker:
         code = self.kill()
         output = self.startup_text()
         self.forget()
-        detail = _last_error_line(output)
+        detail = error_line(output)
         reason = reason.replace("{code}", str(code))
         if detail and not reason.startswith("timeout"):
             reason += f": {detail}"
@@ -295,6 +318,8 @@ class Worker:
 
 _WORKERS: weakref.WeakSet[Worker] = weakref.WeakSet()
 _LOCAL = threading.local()
+#: Workers this process started, by program (what ran here: the test suite's gate reads it).
+STARTED: collections.Counter[str] = collections.Counter()
 
 
 class _Slot:
@@ -446,32 +471,6 @@ def _copy(text: str, fd: int) -> None:
             os.write(fd, text.encode())
 
 
-def keep_run_files(directory: Path, work: str, name: str, tag: str, ok: bool, into: Path | None = None) -> Path:
-    """Give a run's files (``<work><tag>.json``, ``.npz``, ``.log`` in ``directory``) their kept
-    names in ``into`` (default ``directory``): ``<name><tag>.*``, unless the run failed (not
-    ``ok``) and ``<name><tag>.npz`` there is an earlier run's output: then
-    ``<name>_failed<tag>.*`` beside it, so that a failed run never replaces or deletes the
-    files of an earlier one (whose result's ``log_path`` names its own log). Shared by the
-    backends that run in a worker (YADE: ``tag`` ".yade"; Siconos: ".siconos").
-
-    Returns
-    -------
-    Path
-        Where the log went (the Result's ``log_path``).
-    """
-    into = directory if into is None else into
-    final = name
-    if not ok and (into / f"{name}{tag}.npz").exists():
-        final = f"{name}_failed"
-    for suffix in (".json", ".npz", ".log"):
-        src = directory / f"{work}{tag}{suffix}"
-        if src.exists():
-            shutil.move(src, into / f"{final}{tag}{suffix}")  # across file systems too (a temporary folder)
-        elif suffix != ".log":  # no output of this run: none of an earlier run's stays beside its log
-            (into / f"{final}{tag}{suffix}").unlink(missing_ok=True)
-    return into / f"{final}{tag}.log"
-
-
 #: The longest timeout a user may give a run, s (30 days).
 MAX_TIMEOUT_S = 30 * 86400.0
 
@@ -498,12 +497,13 @@ def check_timeout(timeout_s: float | None, field: str = "timeout_s") -> float | 
 
 __all__ = [
     "MAX_TIMEOUT_S",
+    "STARTED",
     "Program",
     "Worker",
     "WorkerLostError",
     "check_timeout",
     "close_workers",
-    "keep_run_files",
+    "error_line",
     "run_scene",
     "slot",
 ]

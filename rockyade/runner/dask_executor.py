@@ -11,6 +11,7 @@ from __future__ import annotations
 import queue
 import re
 import threading
+import time
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 
@@ -45,7 +46,7 @@ def run_dask_in_process(batch: Batch[Job, Value], workers: int) -> None:
     unfinished = object()
 
     def guarded(i: int) -> Any:
-        if batch.stop.event.is_set():
+        if batch.stop.requested:
             return unfinished
         batch.started.add(i)
         return i, call(batch.fn, batch.jobs[i], batch.failed)
@@ -139,6 +140,6 @@ def run_dask_remote(batch: Batch[Job, Value], scheduler: str, timeout_s: float) 
                 client.cancel([f for f in futures if not f.done()])
                 break
             if not ready:
-                batch.stop.event.wait(0.1)
+                time.sleep(0.1)
     finally:
         client.close()

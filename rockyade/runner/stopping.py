@@ -1,8 +1,17 @@
-"""Ctrl-C during a run of many: the first stops dispatching, the second stops the running runs."""
+"""Ctrl-C during a run of many: the first stops dispatching, the second stops the running runs.
+
+The handler only counts and says so: it raises nothing, sets no event and takes no lock (a
+``threading.Event`` set from a handler deadlocks when the main thread was inside that event's
+lock), and its message never raises either (a write to stderr interrupted by the signal is a
+reentrant call: the line then goes to the descriptor directly). The run loops read the count
+at their own safe points. A worker process forked while Ctrl-C is pressed never runs this
+handler: the thread that forks it holds SIGINT back (:mod:`rockyade.io.warm_program`).
+"""
 
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -24,7 +33,6 @@ class StopRequest:
 
     def __init__(self, raise_on_second: bool = False) -> None:
         self.count = 0
-        self.event = threading.Event()
         self.raise_on_second = raise_on_second
         self._previous: Any = None
         self._installed = False
@@ -40,11 +48,10 @@ class StopRequest:
         return self.count >= 2
 
     def _handler(self, signum: int, frame: Any) -> None:
-        # never raises: an exception raised here would surface at an arbitrary point of the
-        # main thread (inside a C call it reads as "SystemError: ... returned a result with
-        # an exception set"); the run loops read the count at their own safe points
+        # never raises (module docstring): an exception raised here would surface at an arbitrary
+        # point of the main thread (inside a C call it reads as "SystemError: ... returned a
+        # result with an exception set"); the run loops read the count at their own safe points
         self.count += 1
-        self.event.set()
         if self.count == 1:
             say("Ctrl-C: no new run starts; waiting for the running runs to finish (Ctrl-C again stops them now)")
         elif self.count == 2:
@@ -72,7 +79,13 @@ class StopRequest:
 
 
 def say(message: str) -> None:
-    """A line on stderr, on a line of its own (below a progress bar); never raises."""
-    with contextlib.suppress(OSError, ValueError):
-        sys.stderr.write(f"\n{message}\n")
+    """A line on stderr, on a line of its own (below a progress bar); never raises: where
+    ``sys.stderr`` cannot take it (closed, or busy in the very write a signal interrupted),
+    it goes to descriptor 2 as it is."""
+    line = f"\n{message}\n"
+    try:
+        sys.stderr.write(line)
         sys.stderr.flush()
+    except (OSError, ValueError, RuntimeError):  # RuntimeError: a reentrant call inside the writer
+        with contextlib.suppress(OSError):
+            os.write(2, line.encode(errors="replace"))

@@ -82,7 +82,7 @@ def bound(name: str) -> Bound:
 
 
 def check_block_ranges(block: object, spec: object, field_prefix: str, source: str | None) -> None:
-    """Ranges that depend on the block's geometry: extent, given inertia, p override.
+    """Ranges that depend on the block's geometry: extent, mass from a density, given inertia, p override.
 
     Parameters
     ----------
@@ -107,6 +107,14 @@ def check_block_ranges(block: object, spec: object, field_prefix: str, source: s
             )
     cx, cy = block.centroid_m  # type: ignore[attr-defined]
     mass = block.mass_kg  # type: ignore[attr-defined]
+    bound = BOUNDS["mass_kg"]
+    if getattr(spec, "density_kg_m3", None) is not None and not bound.lo <= mass <= bound.hi:
+        raise InputError(  # the mass's range, however it is given
+            f"{field_prefix}density_kg_m3",
+            f"gives the block a mass of {mass:.4g} kg (density x area x thickness), outside mass_kg's range "
+            f"[{bound.lo:g}, {bound.hi:g}] kg",
+            source,
+        )
     r_max2 = float(np.max((verts[:, 0] - cx) ** 2 + (verts[:, 1] - cy) ** 2))
     inertia = getattr(spec, "inertia_kgm2", None)
     if inertia is not None:

@@ -5,15 +5,12 @@ Usage::
     python3 driver.py --serve FD              # how rockyade runs it: many scenes
     python3 driver.py SCENE.json RESULT.npz   # one scene
 
-``--serve FD``: a Siconos worker (:mod:`rockyade.io.warm_program` starts it). FD is its end of a
-socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
-then takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
-descriptor of the job's log file (SCM_RIGHTS) onto which its stdout and stderr go while the
-job runs, and answers each with ``{"ok": ...}`` (``"timeout": true`` when the scene was
-stopped at its deadline, a ``time.monotonic()`` value, with its samples written; every
-``flush_s`` seconds the samples so far are written, ``complete: false``, so that a worker
-killed from outside leaves them). After a job that raised it answers and exits (code 1).
-It stops on ``{"quit": true}`` or when its end of the socket closes.
+``--serve FD``: a Siconos worker (:mod:`rockyade.io.warm_program` starts it) running the loop
+every driver shares (:mod:`rockyade.io.driver_loop`, loaded by its path: this Python cannot
+import rockyade): one scene after the other, the samples so far written every ``flush_s``
+seconds (``complete: false``) so that a worker killed from outside leaves them. The output
+is that module's one dialect (:func:`rockyade.io.driver_loop.output_meta`) with Siconos's
+own diagnostics.
 
 Runs inside Debian's /usr/bin/python3 and imports only the standard library, numpy and
 Siconos (``python3-siconos``). The scene is data prepared by rockyade
@@ -52,14 +49,14 @@ Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, 
 solver").
 """
 
-import contextlib
 import json
 import math
 import os
-import socket
+import runpy
 import sys
 import time
 import traceback
+import types
 
 import numpy as np
 
@@ -107,27 +104,14 @@ HOLD_GROWTH = 8
 SLIP_RATIO = 0.999
 
 
-class OutputError(Exception):
-    """The output could not be written (its partial file is removed)."""
-
-    def __init__(self, path, exc):
-        super().__init__(f"cannot write {path}: {exc.strerror or exc}")
-        self.path = path
-        self.errno = exc.errno
-        self.strerror = exc.strerror or str(exc)
-
-
-def _write_replacing(path, write):
-    """``write(tmp)`` to ``path + ".part"``, then rename it onto ``path``; on failure the
-    partial file is removed and OutputError names ``path``."""
-    tmp = path + ".part"
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise OutputError(path, exc) from None
+#: The loop and output writing every driver shares (``rockyade/io/driver_loop.py``, run from its
+#: path: this Python cannot import rockyade).
+LOOP = types.SimpleNamespace(
+    **runpy.run_path(
+        os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "io", "driver_loop.py"),
+        run_name="driver_loop",
+    )
+)
 
 
 def _siconos():
@@ -751,33 +735,26 @@ class Recorder:
     def write(self, complete):
         n = self.k
         stepper = self.built["stepper"]
-        meta = {
-            "status": self.status if complete or self.status == "timeout" else "running",
-            "stop_time_s": self.stop_time,
-            "overturn_times_s": {str(i): t for i, t in self.overturn_times.items()},
-            "stop_body": self.stop_body,
-            "n_filled": n,
-            "steps": self.steps,
-            "wall_time_s": time.perf_counter() - self.start,
-            "siconos_version": self.S["version"],
-            "dt_s": self.scene["dt_s"],
-            "solver_calls": self.solver_calls,
-            "solver_iterations": self.iterations,
-            "unconverged_steps": self.unconverged,
-            "first_unconverged_s": self.first_unconverged_s,
-            "max_residual": self.max_residual,
-            "failure_reason": self.failure_reason,
-            "retried_steps": stepper.retries,
-            "retried_steps_converged": stepper.retried_ok,
-            "fallback_steps": stepper.fallback_steps,
-            "loose_steps": stepper.loose,
-            "friction_solvers": stepper.names,
-            "max_penetration_m": self.max_penetration,
-            "max_bullet_overlap_m": self.max_overlap,
-            "complete": complete,
-            "flushes": self.flushes,
-            "process_cpu_s": time.process_time(),
-        }
+        meta = LOOP.output_meta(
+            self,
+            complete,
+            steps=self.steps,
+            version=self.S["version"],
+            dt_s=self.scene["dt_s"],
+            solver_calls=self.solver_calls,
+            solver_iterations=self.iterations,
+            unconverged_steps=self.unconverged,
+            first_unconverged_s=self.first_unconverged_s,
+            max_residual=self.max_residual,
+            failure_reason=self.failure_reason,
+            retried_steps=stepper.retries,
+            retried_steps_converged=stepper.retried_ok,
+            fallback_steps=stepper.fallback_steps,
+            loose_steps=stepper.loose,
+            friction_solvers=stepper.names,
+            max_penetration_m=self.max_penetration,
+            max_bullet_overlap_m=self.max_overlap,
+        )
         arrays = {
             "pos": self.pos[:n],
             "ang": self.ang[:n],
@@ -788,14 +765,7 @@ class Recorder:
             "ncont": self.ncont[:n],
             "slip": self.slip[:n],
         }
-
-        def write(tmp):
-            with open(tmp, "wb") as fh:
-                np.savez(fh, **arrays, meta=np.array(json.dumps(meta)))
-                fh.flush()
-                os.fsync(fh.fileno())
-
-        _write_replacing(self.out_path, write)
+        LOOP.write_output(self.out_path, np.savez, arrays, meta)
 
 
 #: Steps whose base forces are computed at a time (base_force_steps).
@@ -886,71 +856,23 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     return rec.status
 
 
-def _send(sock, message):
-    sock.send(json.dumps(message).encode())
-
-
 def serve(fd):
-    """Run scenes as they come on socket ``fd`` (module docstring); return the exit code."""
-    sock = socket.socket(fileno=fd)
-    keep_out, keep_err = os.dup(1), os.dup(2)
+    """Run scenes as they come on socket ``fd`` (the loop of ``driver_loop``); return the exit code."""
     _siconos()  # loaded before saying ready: a missing Siconos fails the start, not a scene
-    _send(sock, {"ready": True, "pid": os.getpid()})
-    while True:
-        try:
-            data, fds, _flags, _addr = socket.recv_fds(sock, 1 << 16, 1)
-        except OSError:
-            return 0
-        if not data:
-            for extra in fds:
-                os.close(extra)
-            return 0
-        job = json.loads(data)
-        if job.get("quit"):
-            return 0
-        sys.stdout.flush()
-        sys.stderr.flush()
-        for log in fds:
-            os.dup2(log, 1)
-            os.dup2(log, 2)
-            os.close(log)
-        reply = {"ok": True}
-        try:
-            status = main(job["scene"], job["out"], deadline=job.get("deadline"), flush_s=job.get("flush_s"))
-            if status == "timeout":
-                reply["timeout"] = True
-        except OutputError as exc:
-            reply = {"ok": False, "path": exc.path, "errno": exc.errno, "strerror": exc.strerror}
-        except Exception as exc:  # reported, then this worker ends
-            traceback.print_exc()
-            reply = {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os.dup2(keep_out, 1)
-        os.dup2(keep_err, 2)
-        if not reply["ok"] and "errno" not in reply:
-            _send(sock, reply)
-            return 1
-        _send(sock, reply)
-
-
-def _exit(code):
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
+    return LOOP.serve(fd, main)
 
 
 if __name__ == "__main__":
     try:
         args = sys.argv[1:]
         if args and args[0] == "--serve":
-            _exit(serve(int(args[1])))
+            LOOP.exit_now(serve(int(args[1])))
         elif len(args) >= 2:
             print(main(args[0], args[1]))
         else:
             print(__doc__)
-            _exit(2)
+            LOOP.exit_now(2)
     except Exception:
         traceback.print_exc()
-        _exit(1)
-    _exit(0)
+        LOOP.exit_now(1)
+    LOOP.exit_now(0)

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rockyade.dem.model import DemModel
+from rockyade.dem.worker_backend import body_payload
 
 FORMAT = "rockyade-siconos-scene-1"
 #: Bullet keeps a contact point while the gap is below this fraction of the smallest block size.
@@ -171,7 +172,6 @@ def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
     """
     groups, laws = contact_laws(model)
     radius = disk_radius(model)
-    stop = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(len(model.bodies), 0.5 * math.pi)
     bodies = []
     for i, b in enumerate(model.bodies):
         load = None
@@ -182,21 +182,10 @@ def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
                 load = {"force_N": f, "arm_Nm": arm}
         bodies.append(
             {
-                "name": b.name,
-                "fixed": bool(b.fixed),
-                "mass_kg": b.mass_kg,
-                "inertia_kgm2": b.inertia_kgm2,
-                "vertices_m": b.contact_vertices_m.tolist(),
+                **body_payload(model, i),
                 "disk_centres_m": disk_centres(b.contact_vertices_m, radius).tolist(),
                 "hull_group": groups[i][0],
                 "disk_group": groups[i][1],
-                "centroid0_m": model.pos0_m[i].tolist(),
-                "angle0_rad": float(model.ang0_rad[i]),
-                "rest_angle_rad": b.rest_angle_rad,
-                "stop_angle_rad": float(stop[i]) if np.isfinite(stop[i]) else None,
-                "vel0_m_s": model.vel0_m_s[i].tolist(),
-                "angvel0_rad_s": float(model.angvel0_rad_s[i]),
-                "accel_point_m": list(b.accel_point_m),
                 "load": load,
             }
         )

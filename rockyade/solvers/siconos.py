@@ -18,9 +18,10 @@ from typing import Any, ClassVar
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
 from rockyade.errors import InputError
+from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
-from rockyade.scene import Scene
-from rockyade.siconos.backend import check_timeout, run_model
+from rockyade.scene import ContactSpec, Scene
+from rockyade.siconos.backend import SICONOS, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import Numerics
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
@@ -75,6 +76,21 @@ def _check_folder(value: Any, field: str) -> str | None:
     if value is not None and not isinstance(value, (str, Path)):
         raise InputError(field, f"must be a folder path, got {value!r}")
     return None if value is None else str(value)
+
+
+#: The stiffness of the joints of Siconos's DEM model, N/m: the model builder wants one; Siconos's
+#: contacts are rigid and never read it.
+UNUSED_STIFFNESS_N_PER_M = 1.0
+
+
+def rigid_scene(scene: Scene) -> Scene:
+    """``scene`` with only what Siconos's contacts take from its contact settings: the friction
+    angles (``[contact]``'s and those of ``[[joints]]``), and an explicit joint (stiffness
+    UNUSED_STIFFNESS_N_PER_M, no damping) for the model builder."""
+    c = scene.contact
+    contact = ContactSpec(K_N_per_m=UNUSED_STIFFNESS_N_PER_M, beta_s=0.0, friction_angle_deg=c.friction_angle_deg)
+    joints = [replace(j, values=tuple((k, v) for k, v in j.values if k == "friction_angle_deg")) for j in scene.joints]
+    return replace(scene, contact=contact, joints=tuple(j for j in joints if j.values))
 
 
 @dataclass(frozen=True)
@@ -163,12 +179,13 @@ class SiconosSolver(SolverBase):
         object.__setattr__(self, "failed_dir", _check_folder(self.failed_dir, "failed_dir"))
 
     def model(self, scene: Scene) -> DemModel:
-        """The scene's blocks, motion and start as the DEMs build them (a matched calibration's
-        damping search is skipped: Siconos has no damping; the penalty springs' settlement
-        check is not made: its contacts are rigid)."""
-        if scene.contact.calibration == "matched":
-            scene = replace(scene, contact=replace(scene.contact, calibration="paper"))
-        return calibrated_model(scene, rigid_contacts=True)
+        """The scene's blocks, motion, loads and start as the DEMs build them, and its friction
+        (:func:`rigid_scene`): none of the DEMs' contact calibration runs (the paper's Eqs 10-15,
+        the matched damping search), nor its checks (Eq 13's range, the penalty springs'
+        settlement, the DEM time step's stability), since Siconos's contacts are rigid. The
+        model keeps the scene's own hash."""
+        model = calibrated_model(rigid_scene(scene), rigid_contacts=True)
+        return replace(model, scene_hash=scene.scene_hash)
 
     def numerics(self, model: DemModel) -> tuple[Numerics, dict[str, object]]:
         """The time step and solver settings for ``model``, and how the step was chosen."""
@@ -216,7 +233,8 @@ class SiconosSolver(SolverBase):
 
     def check_scene(self, scene: Scene) -> None:
         """Refuse before any run what :meth:`run` refuses whatever the motion: a target mu the
-        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`).
+        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`), a bad
+        ``ROCKYADE_SICONOS_PYTHON`` (:meth:`rockyade.dem.worker_backend.WorkerBackend.check_variable`).
 
         Raises
         ------
@@ -224,6 +242,7 @@ class SiconosSolver(SolverBase):
             As :meth:`run` would.
         """
         check_target_mu(scene, self.model(scene))
+        SICONOS.check_variable()
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
         """Steps at the Siconos time step, SECONDS_PER_STEP x n ** STEP_EXPONENT each for n

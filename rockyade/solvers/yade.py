@@ -2,10 +2,10 @@
 
 The model is the reference DEM's (:mod:`rockyade.dem.model`, matched calibration
 included), written as data and run by YADE's own Python in a process of its own, kept warm
-for the next run (:mod:`rockyade.yade.warm_worker`): no listening socket, one OpenMP thread, a
-timeout per run, its log kept beside its output. A failure
-of any kind (exit code, timeout, exception inside YADE, non-finite state, partial output)
-is a Result with status ``failed``, the reason and the log path.
+for the next run (:class:`rockyade.dem.worker_backend.WorkerBackend`): no listening socket,
+one OpenMP thread, a timeout per run, its log kept beside its output. A failure of any kind
+(exit code, timeout, exception inside YADE, non-finite state, partial output) is a Result
+with status ``failed``, the reason and the log path.
 """
 
 from __future__ import annotations
@@ -15,11 +15,12 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from rockyade.errors import InputError
+from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
-from rockyade.yade.backend import check_timeout, run_model, yade_model
+from rockyade.yade.backend import run_model, yade_model
 
 
 def _check_folder(value: Any, field: str) -> str | None:
@@ -45,9 +46,9 @@ class YadeSolver(SolverBase):
         body-step, at most one hour; :func:`rockyade.yade.backend.default_timeout`).
     workdir
         Where YADE's files are kept: ``<stem>.yade.json`` (the scene data),
-        ``<stem>.yade.npz`` (its output) and ``<stem>.yade.log``. Default: a temporary
-        folder, removed after a successful run and kept (its log path in the Result)
-        after a failed one.
+        ``<stem>.yade.npz`` (its output) and ``<stem>.yade.log``. Default: a private
+        temporary folder, removed after a successful run and kept (its log path in the
+        Result) after a failed one (:mod:`rockyade.io.run_files`).
     stem
         File stem of those files (default: ``<scene hash>_yade``).
     warm

@@ -8,16 +8,13 @@ Usage::
     yade run.py                                        # scene.json beside run.py, writes
                                                        # result.npz and result.csv there
 
-``--serve FD``: a YADE worker (:mod:`rockyade.yade.warm_worker` starts it). FD is its end of a
-socket pair (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true}``,
-then takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
-descriptor of the job's log file (SCM_RIGHTS) onto which its stdout and stderr go while the
-job runs, and answers each with ``{"ok": ...}`` (``"timeout": true`` when the scene was
-stopped at its deadline, a ``time.monotonic()`` value, with its samples written; every
-``flush_s`` seconds of a run the samples so far are written, ``complete: false``, so that a
-worker killed from outside leaves them). Between jobs it resets YADE (:func:`reset`). After a job that raised
-it answers and exits (code 1): a fresh worker takes the next scene. It stops on
-``{"quit": true}`` or when its end of the socket closes.
+``--serve FD``: a YADE worker (:mod:`rockyade.io.warm_program` starts it) running the loop
+every driver shares (:mod:`rockyade.io.driver_loop`, loaded by its path: this Python cannot
+import rockyade; a yade-script folder carries a copy beside ``run.py``): one scene after the
+other, the samples so far written every ``flush_s`` seconds (``complete: false``) so that a
+worker killed from outside leaves them, and YADE reset between scenes (:func:`reset`). The
+output is that module's one dialect (:func:`rockyade.io.driver_loop.output_meta`) with YADE's
+own diagnostics.
 
 YADE makes a folder ``/tmp/yade-`` plus six random characters when it is imported (a fixed /tmp, whatever
 TMPDIR says) and removes it only at its own exit, which the driver never reaches (it leaves
@@ -82,10 +79,11 @@ import contextlib
 import json
 import math
 import os
-import socket
+import runpy
 import sys
 import time
 import traceback
+import types
 from typing import Any
 
 YADE_PY = os.environ.get("ROCKYADE_YADE_PY", "/usr/lib/x86_64-linux-gnu/yade-double/py")
@@ -114,6 +112,18 @@ from yade import (  # noqa: E402
     utils,
 )
 
+
+def _driver_loop():
+    """The loop and output writing every driver shares (``rockyade/io/driver_loop.py``, run from
+    its path: this Python cannot import rockyade); beside this script in a yade-script folder."""
+    here = os.path.dirname(os.path.abspath(sys.argv[0] if __name__ == "__main__" else __file__))
+    beside = os.path.join(here, "driver_loop.py")
+    path = beside if os.path.isfile(beside) else os.path.join(here, os.pardir, "io", "driver_loop.py")
+    return types.SimpleNamespace(**runpy.run_path(path, run_name="driver_loop"))
+
+
+LOOP = _driver_loop()
+
 SCENE_FORMAT = "rockyade-yade-scene-2"
 BASE_HALF_SIZE = 50.0
 HELPER_DENSITY = 1.0e15
@@ -137,29 +147,6 @@ def _remove_yade_temp_folder():
     with contextlib.suppress(OSError):
         os.rmdir(folder)  # only an empty folder, never a link
     return folder
-
-
-class OutputError(Exception):
-    """The output could not be written (its partial file is removed)."""
-
-    def __init__(self, path, exc):
-        super().__init__(f"cannot write {path}: {exc.strerror or exc}")
-        self.path = path
-        self.errno = exc.errno
-        self.strerror = exc.strerror or str(exc)
-
-
-def _write_replacing(path, write):
-    """``write(tmp)`` to ``path + ".part"``, then rename it onto ``path``; on failure the
-    partial file is removed and OutputError names ``path``."""
-    tmp = path + ".part"
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except OSError as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise OutputError(path, exc) from None
 
 
 def _material(values, density):
@@ -656,36 +643,20 @@ class Recorder:
         """The samples so far to ``out_path`` (replacing it as one step: a kill leaves the
         previous file); ``complete`` False: a flush while running, or a run stopped at its
         deadline."""
-        n = self.k
-        meta = {
-            "status": self.status if complete or self.status == "timeout" else "running",
-            "stop_time_s": self.stop_time,
-            "overturn_times_s": {str(i): t for i, t in self.overturn_times.items()},
-            "stop_body": self.stop_body,
-            "n_filled": n,
-            "iterations": O.iter,
-            "wall_time_s": time.perf_counter() - self.start,
-            "recorder_time_s": self.own_time,
-            "build_time_s": self.scene.get("_build_time_s"),
-            "yade_version": __import__("yade.config", fromlist=["version"]).version,
-            "dt_s": O.dt,
-            "max_polyhedra_penetration_over_radius": self.max_depth_ratio,
-            "deep_overlap_time_s": self.deep_overlap_time,
-            "max_rotation_step_rad": self.max_rotation_step,
-            "rotation_track_period_steps": self.track_period,
-            "complete": complete,
-            "flushes": self.flushes,
-            "process_cpu_s": time.process_time(),
-        }
-        arrays = self.arrays(n)
-
-        def write(tmp):
-            with open(tmp, "wb") as fh:
-                np.savez(fh, **arrays, meta=np.array(json.dumps(meta)))
-                fh.flush()
-                os.fsync(fh.fileno())
-
-        _write_replacing(self.out_path, write)
+        meta = LOOP.output_meta(
+            self,
+            complete,
+            steps=O.iter,
+            version=__import__("yade.config", fromlist=["version"]).version,
+            dt_s=O.dt,
+            recorder_time_s=self.own_time,
+            build_time_s=self.scene.get("_build_time_s"),
+            max_polyhedra_penetration_over_radius=self.max_depth_ratio,
+            deep_overlap_time_s=self.deep_overlap_time,
+            max_rotation_step_rad=self.max_rotation_step,
+            rotation_track_period_steps=self.track_period,
+        )
+        LOOP.write_output(self.out_path, np.savez, self.arrays(self.k), meta)
 
     def write_csv(self, n):
         """A plain table for hand work: t, and per block x, y (centroid) and theta (from rest)."""
@@ -699,10 +670,10 @@ class Recorder:
         cols = [t]
         for i in range(len(names)):
             cols += [arrays["pos"][:, i, 0], arrays["pos"][:, i, 1], arrays["ang"][:, i] - rest[i]]
-        _write_replacing(
+        LOOP.write_replacing(
             self.csv_path,
-            lambda tmp: np.savetxt(
-                tmp, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g"
+            lambda fh: np.savetxt(
+                fh, np.column_stack(cols), delimiter=",", header=",".join(header), comments="", fmt="%.10g"
             ),
         )
 
@@ -789,52 +760,14 @@ def reset():
     globals()["rockyade_record"] = None
 
 
-def _send(sock, message):
-    sock.send(json.dumps(message).encode())
-
-
 def serve(fd):
-    """Run scenes as they come on socket ``fd`` (module docstring); return the exit code."""
-    sock = socket.socket(fileno=fd)
-    keep_out, keep_err = os.dup(1), os.dup(2)
-    _send(sock, {"ready": True, "pid": os.getpid(), "yade_temp_folder": YADE_TEMP_FOLDER})
-    while True:
-        try:
-            data, fds, _flags, _addr = socket.recv_fds(sock, 1 << 16, 1)
-        except OSError:
-            return 0
-        if not data:  # the other end closed: rockyade is gone or done
-            for extra in fds:
-                os.close(extra)
-            return 0
-        job = json.loads(data)
-        if job.get("quit"):
-            return 0
-        sys.stdout.flush()
-        sys.stderr.flush()
-        for log in fds:
-            os.dup2(log, 1)
-            os.dup2(log, 2)
-            os.close(log)
-        reply: dict[str, Any] = {"ok": True}
-        try:
-            status = main(job["scene"], job["out"], deadline=job.get("deadline"), flush_s=job.get("flush_s"))
-            if status == "timeout":  # stopped at its deadline, its samples written
-                reply["timeout"] = True
-        except OutputError as exc:
-            reply = {"ok": False, "path": exc.path, "errno": exc.errno, "strerror": exc.strerror}
-        except Exception as exc:  # reported, then this worker ends
-            traceback.print_exc()
-            reply = {"ok": False, "error": f"{type(exc).__name__}: {exc}"}
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os.dup2(keep_out, 1)
-        os.dup2(keep_err, 2)
-        if not reply["ok"] and "errno" not in reply:
-            _send(sock, reply)
-            return 1  # a scene that raised: a fresh worker takes the next
-        reset()
-        _send(sock, reply)
+    """Run scenes as they come on socket ``fd`` (the loop of ``driver_loop``, resetting YADE
+    between scenes); return the exit code."""
+
+    def run(scene, out, deadline, flush_s):
+        return main(scene, out, deadline=deadline, flush_s=flush_s)
+
+    return LOOP.serve(fd, run, hello={"yade_temp_folder": YADE_TEMP_FOLDER}, after_job=reset)
 
 
 def _interactive_launcher():
@@ -842,14 +775,6 @@ def _interactive_launcher():
     runtime = sys.modules.get("yade.runtime")
     opts = getattr(runtime, "opts", None)
     return opts is not None and not getattr(opts, "exitAfter", True)
-
-
-def _exit(code):
-    """Leave at once: YADE's simulation thread, cancelled by the interpreter's normal exit,
-    sometimes aborts the process ("exception not rethrown") after the output is written."""
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code)
 
 
 YADE_TEMP_FOLDER = None
@@ -861,7 +786,7 @@ if __name__ == "__main__":
     try:
         args = sys.argv[1:]
         if args and args[0] == "--serve":
-            _exit(serve(int(args[1])))
+            LOOP.exit_now(serve(int(args[1])))
         elif args and args[0] == "--describe":
             main(args[1], None, describe=True)
         elif len(args) >= 2:
@@ -877,7 +802,7 @@ if __name__ == "__main__":
     except Exception:
         traceback.print_exc()
         if not launcher:
-            _exit(1)
+            LOOP.exit_now(1)
         raise
     if not launcher:
-        _exit(0)
+        LOOP.exit_now(0)

@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from rockyade.dem.model import DemModel
+from rockyade.dem.worker_backend import body_payload
 from rockyade.errors import InputError
 from rockyade.yade.contact_plan import BASE_BIT, plan_contacts
 
@@ -119,29 +120,17 @@ def scene_payload(model: DemModel) -> dict[str, object]:
         )
     loads = equivalent_loads(model)
     bodies = []
-    stop = model.stop_angle_rad if model.stop_angle_rad is not None else np.full(len(model.bodies), 0.5 * math.pi)
     for i, b in enumerate(model.bodies):
         size = float(np.max(np.ptp(b.contact_vertices_m, axis=0)))
         bodies.append(
             {
-                "name": b.name,
-                "fixed": bool(b.fixed),
-                "mass_kg": b.mass_kg,
-                "inertia_kgm2": b.inertia_kgm2,
-                "vertices_m": b.contact_vertices_m.tolist(),
+                **body_payload(model, i),
                 "sphere_centers_m": plan.centers_m[i].tolist(),
                 "sphere_copies": [[list(c) for c in vertex] for vertex in plan.copies[i]],
                 "prism_mask": plan.prism_mask(i),
                 "prism_box": rectangle(b.contact_vertices_m),
                 "sphere_radius_m": float(radii[i]),
                 "prism_half_thickness_m": max(PRISM_HALF_THICKNESS_FRACTION * size, 5 * float(radii[i])),
-                "centroid0_m": model.pos0_m[i].tolist(),
-                "angle0_rad": float(model.ang0_rad[i]),
-                "rest_angle_rad": b.rest_angle_rad,
-                "stop_angle_rad": float(stop[i]) if np.isfinite(stop[i]) else None,
-                "vel0_m_s": model.vel0_m_s[i].tolist(),
-                "angvel0_rad_s": float(model.angvel0_rad_s[i]),
-                "accel_point_m": list(b.accel_point_m),
                 "load": loads[i],
             }
         )
