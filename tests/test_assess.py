@@ -250,8 +250,12 @@ def test_pgv_of_a_sine_is_its_closed_form():
 
 
 def test_a_records_folder_refuses_the_same_record_twice_and_an_empty_folder(tmp_path, two_records):
+    twins = tmp_path / "twins"
+    twins.mkdir()
+    shutil.copy(EXAMPLES / "records" / "ec8_type2_D_record21.AT2", twins)
+    shutil.copy(EXAMPLES / "records_csv" / "ec8_type2_D_record21.csv", twins)
     with pytest.raises(InputError) as info:
-        records_in_folder(EXAMPLES / "records")  # record 21 as .AT2 and as .csv
+        records_in_folder(twins)  # record 21 as .AT2 and as .csv
     assert "same accelerogram" in info.value.message
     with pytest.raises(InputError):
         records_in_folder(tmp_path / "nowhere")
