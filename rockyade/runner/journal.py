@@ -209,7 +209,7 @@ def claim(
     Parameters
     ----------
     folder
-        The runs' folder (made if missing).
+        The runs' folder (named in errors).
     identity
         What decides the study's runs (JSON-ready).
     resume
@@ -239,7 +239,7 @@ def claim(
                 f"{folder} holds the runs of another study or of other options ({why}); "
                 "run the command as it was run, or without --resume to start again",
             )
-    folder.mkdir(parents=True, exist_ok=True)
+    path.parent.mkdir(parents=True, exist_ok=True)  # the runs' folder is made when a run ends
     write_json(path, ident)
     return ident
 
