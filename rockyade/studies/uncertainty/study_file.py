@@ -6,8 +6,8 @@ uncertain, under a suite of records.
 The classical parameters are drawn from distributions (:mod:`rockyade.studies.sampling`:
 normal, lognormal or uniform per parameter, or the joint normal of an identification) by
 Latin hypercube with an explicit seed; records bring the record-to-record variation. Each
-(sample, record, load factor, solver) is one run of the batch engine
-(:func:`rockyade.batch.run_study_tasks`, local processes or Dask). The report gives,
+(sample, record, load factor, solver) is one run of the study
+(:func:`rockyade.batch.run_study`, local processes or Dask). The report gives,
 per solver and load factor, the probability of overturning and of exceeding theta/alpha
 levels with 95 % Wilson bands, lognormal fragility curves against intensity measures
 (:mod:`rockyade.motion.intensity`), and, when every sample runs every record, the spread
