@@ -281,3 +281,40 @@ def test_a_bad_count_or_a_negative_value_is_refused_naming_its_option(argv, opti
     err = capsys.readouterr().err
     assert code == 2 and option in err and words in err and "expected one argument" not in err, err
     assert not (inputs / "out").exists()
+
+
+def test_a_ctrl_c_between_two_rounds_of_stripes_stops_the_fragility(inputs, monkeypatch):
+    """The stripes extended round by round share one stop request: a Ctrl-C as the first round's
+    last run ends (delivered as the signal handler does) starts no second round; the analysis
+    stops with the rows of the first (their partial summary is the command's to write)."""
+    import signal
+
+    import rockyade.assess.fragility_analysis as fa
+    from rockyade.assess import fragility_plan, parse_measure, records_in_folder
+    from rockyade.assess.stripes import StripesInterruptedError
+    from rockyade.runner import Executor
+    from rockyade.scene import load_scene
+
+    plan = fragility_plan(
+        load_scene(inputs / "wall.toml"),
+        records_in_folder(inputs / "records"),
+        parse_measure("pga"),
+        "housner",
+        levels=[0.05, 0.1],  # nothing moves: the levels are extended upwards
+        extend=True,
+        executor=Executor("threads", 1),
+        progress=False,
+    )
+    real = fa.run_stripes
+    rounds: list[int] = []
+
+    def ctrl_c_at_the_end(*args, **kwargs):
+        rows = real(*args, **kwargs)
+        rounds.append(len(rows))
+        kwargs["stop"]._handler(signal.SIGINT, None)
+        return rows
+
+    monkeypatch.setattr(fa, "run_stripes", ctrl_c_at_the_end)
+    with pytest.raises(StripesInterruptedError) as info:
+        fa.run_fragility(plan, Executor("threads", 1), progress=False)
+    assert rounds == [4] and len(info.value.rows) == 4 and info.value.plan is plan
