@@ -8,9 +8,10 @@ from pathlib import Path
 from setuptools import find_namespace_packages, setup
 
 EXAMPLES = Path(__file__).resolve().parent / "examples"
-example_packages = ["rockyade.examples"] + sorted(
-    f"rockyade.examples.{p.name}" for p in EXAMPLES.iterdir() if p.is_dir() and not p.name.startswith((".", "__"))
-)
+example_packages = [
+    "rockyade.examples",
+    *sorted(f"rockyade.examples.{p.name}" for p in EXAMPLES.iterdir() if p.is_dir() and not p.name.startswith((".", "__"))),
+]
 
 setup(
     packages=[*find_namespace_packages(include=["rockyade*"]), *example_packages],

@@ -25,7 +25,7 @@ from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
 from rockyade.studies import fragility_study, overturning
 from rockyade.studies.specimen_scenes import block_table
-from rockyade.studies.uncertainty_study import build_tasks, draw_samples, run_uncertainty, uncertainty_study_from_dict
+from rockyade.studies.uncertainty import build_tasks, draw_samples, run_uncertainty, uncertainty_study_from_dict
 
 RECORDS = tuple(range(1, 6))
 LOAD_FACTORS = (0.4, 0.8, 1.2, 1.6)

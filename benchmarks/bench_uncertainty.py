@@ -34,7 +34,7 @@ from rockyade.figures.canvas import file_figure, save_figure
 from rockyade.identification.fit import identify, synthetic_measurement
 from rockyade.io.atomic import atomic_open, write_json
 from rockyade.probability.fragility_curves import Fragility
-from rockyade.studies.uncertainty_study import run_uncertainty, uncertainty_study_from_dict
+from rockyade.studies.uncertainty import run_uncertainty, uncertainty_study_from_dict
 
 SENSITIVITY_LOAD_FACTORS = [0.4, 0.6, 0.8, 1.0, 1.2, 1.4]
 CONVERGENCE_LOAD_FACTORS = [round(0.1 * k, 1) for k in range(2, 16)]

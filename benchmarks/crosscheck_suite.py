@@ -10,7 +10,7 @@ Scenes and record sets:
 * ``wall`` and ``arch``: the 5-course wall and the semicircular arch of ``examples/assemblies``
   over 10 records (DEMs only: Housner is for one block).
 
-Each scene runs ``rockyade crosscheck``'s study (:mod:`rockyade.studies.crosscheck_study`) into
+Each scene runs ``rockyade crosscheck``'s study (:mod:`rockyade.studies.crosscheck`) into
 ``<out>/<suite>/<scene>/`` (resumable: ``--resume``), and the pairs of every scene are
 gathered in ``<out>/<suite>/summary.csv`` and ``summary.md``: per scene and pair of solvers
 the median ratio of collapse intensities and its 95 % interval at each time-step factor, and
@@ -38,7 +38,7 @@ from rockyade.assess import ec8_suite, paper_suite_set, parse_measure
 from rockyade.constants import G
 from rockyade.runner import Executor
 from rockyade.scene import load_scene, scene_from_dict
-from rockyade.studies.crosscheck_study import crosscheck_plan, run_crosscheck
+from rockyade.studies.crosscheck import crosscheck_plan, run_crosscheck
 from rockyade.studies.specimen_scenes import biblock_blocks, block_table, scene_dict
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"

@@ -24,7 +24,7 @@ from rockyade.calibration.model_stage import calibrated_model
 from rockyade.constants import G
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.studies.crosscheck_study import crosscheck_plan, run_crosscheck
+from rockyade.studies.crosscheck import crosscheck_plan, run_crosscheck
 from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 #: Specimen 3's contact stiffness in the matched calibration, N/m.

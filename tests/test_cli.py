@@ -373,7 +373,7 @@ def test_one_dt_factor_range_everywhere(capsys):
     from rockyade.errors import InputError
     from rockyade.solvers import make_solver
     from rockyade.solvers.base import DT_FACTOR_MIN
-    from rockyade.studies.crosscheck_study import check_dt_factors
+    from rockyade.studies.crosscheck import check_dt_factors
 
     from .conftest import ROOT
 

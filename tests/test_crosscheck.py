@@ -154,7 +154,7 @@ def small_plan(records: Path, dt_factors=(1.0, 0.5)):
     from rockyade.assess import parse_measure, records_in_folder
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck_study import crosscheck_plan
+    from rockyade.studies.crosscheck import crosscheck_plan
 
     return crosscheck_plan(
         load_scene(EXAMPLES / "specimen1_record.toml"),
@@ -172,7 +172,7 @@ def small_plan(records: Path, dt_factors=(1.0, 0.5)):
 
 def run(plan, out: Path, resume: bool = False):
     from rockyade.runner import Executor
-    from rockyade.studies.crosscheck_study import run_crosscheck
+    from rockyade.studies.crosscheck import run_crosscheck
 
     return run_crosscheck(plan, out, Executor("threads", 1), resume=resume, progress=False, say=lambda _s: None)
 
@@ -196,7 +196,7 @@ def complete(plan, tmp_path_factory):
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
     assert summary.partial is False and summary.verdicts
-    from rockyade.studies.crosscheck_study import RESULT_FILES, journal_dir
+    from rockyade.studies.crosscheck import RESULT_FILES, journal_dir
 
     for name in RESULT_FILES:
         assert (out / name).is_file(), name
@@ -245,11 +245,11 @@ def test_small_real_crosscheck(complete, plan):
 
 
 def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
-    import rockyade.studies.crosscheck_study as cc
+    import rockyade.studies.crosscheck as cc
 
     reference_out, _ = complete
     total = len(pd.read_csv(reference_out / "runs.csv"))
-    real = cc.run_study_tasks
+    real = cc.search.run_study
     calls = {"n": 0}
 
     def stop_at_the_third_round(*args, **kwargs):
@@ -258,7 +258,7 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
             raise BatchInterruptedError(0, len(args[0]), None)
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(cc, "run_study_tasks", stop_at_the_third_round)
+    monkeypatch.setattr(cc.search, "run_study", stop_at_the_third_round)
     out = tmp_path / "out"
     with pytest.raises(BatchInterruptedError):
         run(plan, out)
@@ -272,15 +272,15 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
         meta = json.loads(path.read_text())
         assert meta["dt_factor"] == float(path.parent.parent.name.removeprefix("dt")) and meta["dt_s"] > 0
     assert set(pd.read_csv(reference_out / "runs.csv").dt_factor) == {1.0, 0.5}
-    monkeypatch.setattr(cc, "run_study_tasks", real)
+    monkeypatch.setattr(cc.search, "run_study", real)
     written: list[str] = []
-    real_write = cc.run_study_tasks
+    real_write = cc.search.run_study
 
     def watch(tasks, *args, **kwargs):  # every run the resumed study makes
         written.extend(str(t.scene_hash) + repr(t.solver) for t in tasks)
         return real_write(tasks, *args, **kwargs)
 
-    monkeypatch.setattr(cc, "run_study_tasks", watch)
+    monkeypatch.setattr(cc.search, "run_study", watch)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
     assert data["runs_reused"] == len(first)
@@ -291,9 +291,9 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
 
 def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypatch):
     """A process killed mid-study (no summary written): the runs on disk are all it left."""
-    import rockyade.studies.crosscheck_study as cc
+    import rockyade.studies.crosscheck as cc
 
-    real = cc.run_study_tasks
+    real = cc.search.run_study
     calls = {"n": 0}
 
     def killed(*args, **kwargs):
@@ -302,13 +302,13 @@ def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypat
             raise SystemExit(137)  # stands for SIGKILL: nothing after this line runs
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(cc, "run_study_tasks", killed)
+    monkeypatch.setattr(cc.search, "run_study", killed)
     out = tmp_path / "out"
     with pytest.raises(SystemExit):
         run(plan, out)
     assert not (cc.journal_dir(out) / "crosscheck.json").exists() and not (out / "crosscheck.json").exists()
     done = len(list(cc.journal_dir(out).rglob("runs/*.json")))
-    monkeypatch.setattr(cc, "run_study_tasks", real)
+    monkeypatch.setattr(cc.search, "run_study", real)
     run(plan, out, resume=True)
     data = json.loads((out / "crosscheck.json").read_text())
     assert data["runs_reused"] == done > 0
@@ -317,7 +317,7 @@ def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypat
 def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp_path, monkeypatch):
     import shutil
 
-    import rockyade.studies.crosscheck_study as cc
+    import rockyade.studies.crosscheck as cc
 
     out = tmp_path / "out"
     shutil.copytree(complete[0], out)
@@ -325,7 +325,7 @@ def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp
     other_records = write_records(tmp_path / "one", count=1)
     other = small_plan(other_records, dt_factors=(1.0,))
     # a study that crashes part-way leaves the complete earlier set as it was
-    real = cc.run_study_tasks
+    real = cc.search.run_study
     calls = {"n": 0}
 
     def crash(*args, **kwargs):
@@ -334,11 +334,11 @@ def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp
             raise OSError(28, "No space left on device")
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(cc, "run_study_tasks", crash)
+    monkeypatch.setattr(cc.search, "run_study", crash)
     with pytest.raises(OSError):
         run(other, out)
     assert (out / "crosscheck.json").read_bytes() == before
-    monkeypatch.setattr(cc, "run_study_tasks", real)
+    monkeypatch.setattr(cc.search, "run_study", real)
     with pytest.raises(InputError, match="--resume"):  # a resume of another study is refused
         run(small_plan(other_records, dt_factors=(1.0, 0.5)), out, resume=True)
     run(other, out)  # without --resume: the unfinished study is discarded, the new set replaces the old
@@ -419,7 +419,7 @@ def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_pa
 
 
 def test_out_that_is_a_link_or_a_file_is_refused(tmp_path):
-    from rockyade.studies.crosscheck_study import check_out, journal_dir
+    from rockyade.studies.crosscheck import check_out, journal_dir
 
     mine = tmp_path / "mine"
     mine.mkdir()
@@ -440,7 +440,7 @@ from pathlib import Path
 from rockyade.assess import parse_measure, records_in_folder
 from rockyade.runner import Executor
 from rockyade.scene import load_scene
-from rockyade.studies.crosscheck_study import Study, crosscheck_plan
+from rockyade.studies.crosscheck import Study, crosscheck_plan
 from rockyade.kernel.runs import simulate_runs
 from rockyade.kernel.single import simulate_single
 plan = crosscheck_plan(load_scene(Path(sys.argv[1])), records_in_folder(sys.argv[2]), parse_measure("pga"),
@@ -469,7 +469,7 @@ def test_warm_up_loads_the_kernels_the_workers_run(records, tmp_path):
 
 
 def test_cost_line_counts_the_start_up(plan):
-    from rockyade.studies.crosscheck_study import ROUND_OVERHEAD_S
+    from rockyade.studies.crosscheck import ROUND_OVERHEAD_S
 
     line = plan.cost_line(2)
     assert "start-up" in line and f"{plan.rounds()} rounds" in line
@@ -687,7 +687,7 @@ def test_real_records_housner_and_the_reference_dem_agree_on_a_slender_block(tmp
     from rockyade.assess import parse_measure, records_in_folder
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck_study import crosscheck_plan
+    from rockyade.studies.crosscheck import crosscheck_plan
 
     folder = tmp_path / "peer"
     folder.mkdir()
@@ -830,8 +830,8 @@ def test_runs_that_failed_are_said_and_a_pair_whose_solver_always_failed_says_so
     """Outcomes where the reference DEM failed every run: the pair's verdict says so with the
     reason (not "inconclusive"), its searches say "every run failed" (not "no runs") and
     index.md counts the failures per solver with their first reasons."""
-    from rockyade.studies.crosscheck_report import index_text, summarise
-    from rockyade.studies.crosscheck_study import Outcomes
+    from rockyade.studies.crosscheck import Outcomes
+    from rockyade.studies.crosscheck.reporting import index_text, summarise
 
     outcomes = Outcomes()
     low, high = plan.scan_si[0], plan.scan_si[1]
@@ -928,8 +928,8 @@ def test_below_min_records_no_interval_is_shown_anywhere_and_digits_follow_the_r
     the fragility rows say why they have no numbers; a 10 % resolution gives 2 decimals."""
     from rockyade.analysis.crosscheck_statistics import MIN_RECORDS, ratio_decimals
     from rockyade.figures.paired_ratios import PairedRatios
-    from rockyade.studies.crosscheck_report import index_text, summarise
-    from rockyade.studies.crosscheck_study import Outcomes
+    from rockyade.studies.crosscheck import Outcomes
+    from rockyade.studies.crosscheck.reporting import index_text, summarise
 
     assert plan.motions.count < MIN_RECORDS and plan.resolution == 0.1
     assert (ratio_decimals(0.01), ratio_decimals(0.1), ratio_decimals(0.5)) == (3, 2, 1)
@@ -964,7 +964,7 @@ def test_default_levels_start_at_the_alpha_the_solvers_run(records):
     from rockyade.constants import CODE_GRAVITY, G
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck_study import classical_static, crosscheck_plan
+    from rockyade.studies.crosscheck import classical_static, crosscheck_plan
 
     scene = load_scene(EXAMPLES / "specimen1_record.toml")
     assert scene.blocks[0].classical().alpha_rad == 0.235
@@ -981,3 +981,119 @@ def test_default_levels_start_at_the_alpha_the_solvers_run(records):
     assert cc.scan_si[0] / CODE_GRAVITY == pytest.approx(0.2395, abs=1e-4)
     assert "classical alpha = 0.235 rad" in cc.stripes.levels_source
     assert classical_static(load_scene(EXAMPLES / "biblock_free.toml")) is None
+
+
+# ---------------------------------------------------------------------- Ctrl-C, a full disk, failed runs
+
+
+@pytest.fixture(scope="module")
+def one_record_plan(tmp_path_factory):
+    """One record, the solvers' own time step, a coarse bisection: a few rounds of a few runs."""
+    return small_plan(write_records(tmp_path_factory.mktemp("one") / "records", count=1), dt_factors=(1.0,))
+
+
+def test_a_ctrl_c_at_a_rounds_end_is_kept_for_the_next_round(one_record_plan, tmp_path, monkeypatch):
+    """A single Ctrl-C after the last run of round 1 finished (delivered through the study's stop
+    request, as the signal handler does): no round 2 starts; exit 130 with the partial summary and
+    the --resume hint (it used to say "no new run starts", run rounds 2-6 and exit 0)."""
+    import signal
+
+    import rockyade.studies.crosscheck as cc
+
+    real = cc.search.run_study
+    rounds: list[int] = []
+
+    def ctrl_c_at_the_end(tasks, *args, **kwargs):
+        runs = real(tasks, *args, **kwargs)
+        rounds.append(len(tasks))
+        kwargs["stop"]._handler(signal.SIGINT, None)  # the first Ctrl-C, the round's runs all finished
+        return runs
+
+    monkeypatch.setattr(cc.search, "run_study", ctrl_c_at_the_end)
+    out = tmp_path / "out"
+    with pytest.raises(BatchInterruptedError) as info:
+        run(one_record_plan, out)
+    assert len(rounds) == 1 and info.value.resume_option == "--resume" and "--resume" in str(info.value)
+    assert "PARTIAL" in (out / "partial" / "index.md").read_text() and not (out / "crosscheck.json").exists()
+    assert json.loads((out / "partial" / "crosscheck.json").read_text())["partial"] is True
+    monkeypatch.setattr(cc.search, "run_study", real)
+    summary = run(one_record_plan, out, resume=True)
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert summary.partial is False and data["runs_reused"] == rounds[0] and not (out / "partial").exists()
+
+
+def test_a_ctrl_c_while_the_set_is_written_leaves_the_previous_set_and_a_partial_summary(
+    one_record_plan, tmp_path, monkeypatch
+):
+    import rockyade.studies.crosscheck as cc
+
+    out = tmp_path / "out"
+    run(one_record_plan, out)
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+    real = cc.search.write_summary
+
+    def ctrl_c_in_the_set(plan, summary, folder, *args, **kwargs):
+        if folder.name.startswith(".set."):
+            raise KeyboardInterrupt
+        return real(plan, summary, folder, *args, **kwargs)
+
+    monkeypatch.setattr(cc.search, "write_summary", ctrl_c_in_the_set)
+    with pytest.raises(BatchInterruptedError, match="--resume"):
+        run(one_record_plan, out)
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+    assert "PARTIAL" in (out / "partial" / "index.md").read_text() and not list(out.glob(".set.*"))
+
+
+def test_a_full_disk_while_the_set_is_written_names_the_file(one_record_plan, tmp_path, monkeypatch):
+    import errno
+    import os
+
+    from rockyade.errors import os_error_message
+
+    real = os.fsync
+
+    def full_in_the_set(fd: int) -> None:
+        if "/.set." in os.readlink(f"/proc/self/fd/{fd}"):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(fd)
+
+    out = tmp_path / "out"
+    monkeypatch.setattr(os, "fsync", full_in_the_set)
+    with pytest.raises(OSError) as info:
+        run(one_record_plan, out)
+    said = os_error_message(info.value)
+    assert "disk full" in said and said.startswith(str(out / "")) and Path(info.value.filename).name in RESULT_NAMES
+    assert not list(out.glob(".set.*")) and (out / "partial" / "study.json").is_file()  # --resume writes it
+
+
+RESULT_NAMES = (".names", "collapse_intensities.csv", "pairs.csv", "runs.csv", "crosscheck.json", "crosscheck.png",
+                "index.md")  # fmt: skip
+
+
+def test_failed_runs_are_run_again_on_resume_and_their_searches_go_on(one_record_plan, tmp_path, monkeypatch):
+    """Runs that failed (a worker killed, say) end their searches at their bracket so far; the set
+    says so and keeps the journal, and --resume runs them again and finishes the searches (it used
+    to say "nothing is unfinished", the coarse bracket kept)."""
+    import rockyade.batch.running as running
+
+    real = running.answered_row
+    failing = {"n": 0}
+
+    def some_fail(task, result, row):
+        if task.solver.name == "reference" and failing["n"] < 2:
+            failing["n"] += 1
+            return row.failed("the worker process died (killed, or out of memory)")
+        return real(task, result, row)
+
+    monkeypatch.setattr(running, "answered_row", some_fail)
+    out = tmp_path / "out"
+    first = run(one_record_plan, out)
+    assert failing["n"] == 2 and first.runs["collapsed"].isna().sum() == 2
+    assert (out / "crosscheck.json").is_file() and (out / "partial" / "study.json").is_file()
+    monkeypatch.setattr(running, "answered_row", real)
+    again = run(one_record_plan, out, resume=True)
+    assert again.runs["collapsed"].notna().all() and not (out / "partial").exists()
+    data = json.loads((out / "crosscheck.json").read_text())
+    assert data["runs_made"] >= 2 and data["runs_reused"] == len(first.runs) - 2
+    clean = run(one_record_plan, tmp_path / "clean")  # the searches as if nothing had failed
+    pd.testing.assert_frame_equal(again.collapse, clean.collapse)

@@ -305,7 +305,7 @@ def test_shipped_study_comment_points_at_the_readme_identified_file(tmp_path, mo
     repository folder); a missing file is reported under the study's field, not ``from``."""
     import re
 
-    from rockyade.studies.uncertainty_study import load_uncertainty_study
+    from rockyade.studies.uncertainty import load_uncertainty_study
 
     shipped = EXAMPLES / "studies" / "uncertainty_specimen1.toml"
     line = re.search(r"^#\s+(identified = \"[^\"]+\")", shipped.read_text(), re.M).group(1)

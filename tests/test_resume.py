@@ -261,7 +261,10 @@ def test_an_error_after_the_checks_leaves_no_empty_out_folder(tmp_path, wall, re
 
 
 def test_an_interrupt_before_any_run_leaves_no_empty_out_folder(tmp_path):
-    from rockyade.cli.resumable import study_output
+    from rockyade.runner.study_folder import StudyFolder, StudySet
+
+    def study_output(out, ident, resume, names, last):
+        return StudyFolder(out, StudySet(ident["command"], names, last), ident, resume)
 
     out = tmp_path / "new"
     with pytest.raises(KeyboardInterrupt), study_output(out, {"command": "x"}, False, ("a.json",), "a.json"):

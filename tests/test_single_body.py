@@ -73,8 +73,8 @@ def test_a_group_gives_the_rows_of_runs_one_at_a_time(tmp_path):
     b = expand([("s1", base)], grid, ["reference"], save_history=False)
     assert not a[0].solver.record_energy  # no history, no energy terms
     assert len({job_key(t) for t in b}) == 1 and job_key(b[0]) is not None
-    one = pd.DataFrame([run_task(t, output(tmp_path / "a")) for t in a]).drop(columns="elapsed_s")
-    grouped = pd.DataFrame(run_job(tuple(b), output(tmp_path / "b"))).drop(columns="elapsed_s")
+    one = pd.DataFrame([run_task(t, output(tmp_path / "a")).summary() for t in a]).drop(columns="elapsed_s")
+    grouped = pd.DataFrame([r.summary() for r in run_job(tuple(b), output(tmp_path / "b"))]).drop(columns="elapsed_s")
     assert set(one.status) == {"completed", "overturned"}
     pd.testing.assert_frame_equal(comparable(one), comparable(grouped))
     assert (tmp_path / "b" / "runs" / f"{b[0].scene_hash}_reference.json").is_file()  # resume reads it

@@ -1,12 +1,14 @@
 """Stripes run in groups (rockyade.assess.stripes.run_stripe_job: a GroupSolver steps runs of
-one block together) give the rows of the runs one at a time (run_stripe_task), for Housner and
-the reference DEM, on the paper study's stripes (the load factors exactly as asked)."""
+one block together, grouped by the one key of every study, rockyade.batch.running.job_key) give
+the rows of the runs one at a time (run_stripe_task), for Housner and the reference DEM, on the
+paper study's stripes (the load factors exactly as asked)."""
 
 from __future__ import annotations
 
 import pytest
 
-from rockyade.assess.stripes import run_stripe_job, run_stripe_task, stripe_group
+from rockyade.assess.stripes import run_stripe_job, run_stripe_task
+from rockyade.batch.running import job_key as stripe_group
 from rockyade.studies import fragility_study
 
 

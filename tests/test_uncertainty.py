@@ -15,7 +15,7 @@ from rockyade.errors import InputError
 from rockyade.probability.exceedance import level_column
 from rockyade.probability.fragility_curves import wilson_interval
 from rockyade.studies.sampling import Marginal, draw_parameters, joint_from_identified
-from rockyade.studies.uncertainty_study import run_uncertainty, uncertainty_study_from_dict
+from rockyade.studies.uncertainty import run_uncertainty, uncertainty_study_from_dict
 from tests.conftest import EXAMPLES
 
 
@@ -170,7 +170,7 @@ def test_study_from_an_identified_file(tmp_path):
 def test_bad_studies_name_the_field(change, field):
     with pytest.raises(InputError) as err:
         study = uncertainty_study_from_dict(_study(**change))
-        from rockyade.studies.uncertainty_study import draw_samples
+        from rockyade.studies.uncertainty import draw_samples
 
         draw_samples(study)
     assert err.value.field == field
@@ -251,7 +251,7 @@ def test_a_samples_scenes_are_the_scenes_read_whole(tmp_path):
     import copy
 
     from rockyade.scene import scene_from_dict
-    from rockyade.studies.uncertainty_study import build_tasks, draw_samples
+    from rockyade.studies.uncertainty import build_tasks, draw_samples
 
     study = uncertainty_study_from_dict(_study(samples=2))
     samples = draw_samples(study)

@@ -21,7 +21,7 @@ by run (docs/verification.md):
   step; a difference between solvers smaller than a solver's own change with dt says
   nothing (:func:`pair_verdict`).
 
-Everything here is arithmetic on outcomes: no solver runs (the study, :mod:`rockyade.studies.crosscheck_study`).
+Everything here is arithmetic on outcomes: no solver runs (the study, :mod:`rockyade.studies.crosscheck`).
 """
 
 from __future__ import annotations

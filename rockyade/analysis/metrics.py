@@ -6,16 +6,17 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.analysis.collapse_verdict import collapse_verdict
 from rockyade.blocks.classical import ClassicalParameters
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.constants import G
 from rockyade.result import Result
-from rockyade.run_meta import RunMeta
+from rockyade.runner.rows import Cell, Verdict
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
 
@@ -24,7 +25,11 @@ if TYPE_CHECKING:
 
 
 def run_metrics(
-    scene: Scene, result: Result, n_impacts: int = MU_EFF_IMPACTS, report: pd.DataFrame | None = None
+    scene: Scene,
+    result: Result,
+    n_impacts: int = MU_EFF_IMPACTS,
+    report: pd.DataFrame | None = None,
+    verdict: Verdict | None = None,
 ) -> dict[str, dict[str, float]]:
     """Per-block summary of a run: peaks, max |theta|, effective mu, overturn.
 
@@ -38,6 +43,9 @@ def run_metrics(
         Impacts used for the effective restitution (free rocking).
     report
         The run's :func:`rockyade.analysis.collapse.collapse_report`, when the caller has it.
+    verdict
+        The run's :func:`rockyade.analysis.collapse_verdict.collapse_verdict`, when the caller
+        has it.
 
     Returns
     -------
@@ -45,26 +53,22 @@ def run_metrics(
         block name -> ``max_abs_theta_rad``, ``max_theta_over_alpha``, ``n_peaks``,
         ``first_peak_rad``, ``mu_eff`` (free rocking only; NaN otherwise or without two
         peaks), ``residual_theta_rad``,
-        ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool: in an assembly,
-        it fell by the collapse table's rule, :mod:`rockyade.analysis.collapse`).
+        ``uplift_time_s`` (first |theta| > 1e-4 alpha), ``overturned`` (bool: it fell, by the
+        one rule of :mod:`rockyade.analysis.collapse_verdict`).
     """
     out: dict[str, dict[str, float]] = {}
     t = result.t
     free = scene.motion.type == "free"
-    fell: dict[str, bool] = {}
-    if scene.positioned and result.ok:
-        if report is None:
-            from rockyade.analysis.collapse import collapse_report
-
-            report = collapse_report(scene, result)
-        fell = dict(zip(report["block"], report["fell"], strict=True))
+    fell: tuple[str, ...] = ()
+    if result.ok:
+        fell = (verdict or collapse_verdict(scene, result, report=report)).fallen
     classical = loaded_classical(scene, G)
     for spec in scene.blocks:
         if spec.fixed:
             continue
         cp = classical[spec.name]
         theta = result.series("theta_rad", spec.name)
-        overturned = fell[spec.name] if spec.name in fell else block_overturned(result.meta, spec.name)
+        overturned = spec.name in fell
         values = theta_metrics(t, theta, cp.alpha_rad, cp)
         out[spec.name] = block_summary(values, t, theta, cp.alpha_rad, free, overturned, n_impacts, cp)
     return out
@@ -110,8 +114,7 @@ def block_summary(
     free
         Free rocking (``mu_eff`` is computed for it only).
     overturned
-        Whether the block overturned (:func:`block_overturned`, or the collapse table's rule in
-        an assembly).
+        Whether the block fell (:func:`rockyade.analysis.collapse_verdict.collapse_verdict`).
     n_impacts
         Impacts used for the effective restitution.
     classical
@@ -128,13 +131,6 @@ def block_summary(
         "overturned": overturned,
     }
     return {k: values[k] for k in SUMMARY_KEYS}
-
-
-def block_overturned(meta: RunMeta, block: str) -> bool:
-    """Whether ``block`` overturned in a run with metadata ``meta`` (the solvers'
-    ``overturned_block``, the first to fall, and ``overturn_times_s``, every block that fell;
-    :mod:`rockyade.dem.overturn`)."""
-    return meta.overturned_block == block or block in (meta.overturn_times_s or {})
 
 
 def uplift_threshold_rad(alpha_rad: float) -> float:
@@ -225,7 +221,9 @@ def assembly_metrics(scene: Scene, result: Result, report: pd.DataFrame | None =
     }
 
 
-def summary_metrics(scene: Scene, result: Result) -> dict[str, Any]:
+def summary_metrics(
+    scene: Scene, result: Result, report: pd.DataFrame | None = None, verdict: Verdict | None = None
+) -> dict[str, Cell]:
     """The metrics of a run as one flat summary row (a batch summary's, after its status
     columns): the assembly's (:func:`assembly_metrics`, positioned scenes), each block's
     (:func:`run_metrics`; prefixed with the block's name unless the scene has one block;
@@ -239,13 +237,19 @@ def summary_metrics(scene: Scene, result: Result) -> dict[str, Any]:
         The Scene that produced ``result``.
     result
         The run's Result (completed or overturned).
+    report, verdict
+        The run's collapse table and verdict, when the caller has them (computed once).
     """
-    row: dict[str, Any] = {}
+    row: dict[str, Cell] = {}
+    if report is None and scene.positioned and len(scene.blocks) > 1:
+        from rockyade.analysis.collapse import collapse_report
+
+        report = collapse_report(scene, result)
     if scene.positioned:
-        row.update(assembly_metrics(scene, result))
+        row.update(assembly_metrics(scene, result, report))
     if not scene.positioned or len(scene.blocks) <= PER_BLOCK_LIMIT:
         single = len(scene.blocks) == 1
-        for block, values in run_metrics(scene, result).items():
+        for block, values in run_metrics(scene, result, report=report, verdict=verdict).items():
             for key, value in values.items():
                 row[key if single else f"{block}_{key}"] = value
     if len(scene.blocks) == 2:

@@ -62,6 +62,7 @@ from rockyade.io.strict_json import finite_or_null
 from rockyade.limit import LimitResult, limit_analysis
 from rockyade.limit.kinematic import check_fc
 from rockyade.runner import Executor
+from rockyade.runner.study_folder import StudyFolder
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import Solver
@@ -536,11 +537,11 @@ def add_dynamics(
     allow_large: bool = False,
     progress: bool = True,
     on_plan: Any = None,
-    journal: Any = None,
+    folder: StudyFolder | None = None,
 ) -> Assessment:
     """Run the dynamic part of an assessment (module docstring) and attach it; the same
-    assessment back. ``journal``: where each run is written as it ends, and read back on a
-    resume (:func:`rockyade.assess.fragility_analysis.run_fragility`).
+    assessment back. ``folder``: the study folder in whose journal each run is written as it
+    ends, and read back on a resume (:func:`rockyade.assess.fragility_analysis.run_fragility`).
 
     Raises
     ------
@@ -557,7 +558,7 @@ def add_dynamics(
     plan = dynamic_plan(scene, assessment.site, settings, executor, progress)
     if on_plan is not None:
         on_plan(plan)
-    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress, journal=journal)
+    assessment.dynamic = run_fragility(plan, executor, allow_large=allow_large, progress=progress, folder=folder)
     return assessment
 
 

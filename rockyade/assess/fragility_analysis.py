@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -37,6 +37,7 @@ from rockyade.assess.stripes import (
     DEFAULT_SAMPLE_DT_S,
     DEFAULT_TAIL_S,
     StripePlan,
+    StripesInterruptedError,
     check_fallen_blocks,
     collapse_rule,
     record_measures,
@@ -44,14 +45,17 @@ from rockyade.assess.stripes import (
     runs_frame,
 )
 from rockyade.constants import CODE_GRAVITY, G
-from rockyade.errors import BatchInterruptedError, InputError, RockyadeError
+from rockyade.errors import InputError, RockyadeError
 from rockyade.io.strict_json import finite_or_null
 from rockyade.runner import Executor
-from rockyade.runner.journal import Journal
+from rockyade.runner.study_folder import StudyFolder
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
 from rockyade.solvers.base import Solver
 from rockyade.solvers.cost_estimate import duration_text
+
+if TYPE_CHECKING:
+    from rockyade.runner.stopping import StopRequest
 
 #: Default levels as multiples of the static collapse acceleration (module docstring).
 DEFAULT_FACTORS = tuple(float(2.0 ** (k / 2.0)) for k in range(7))
@@ -374,25 +378,30 @@ def run_fragility(
     allow_large: bool = False,
     progress: bool = True,
     on_round: Callable[[str], None] | None = None,
-    journal: Journal | None = None,
+    folder: StudyFolder | None = None,
 ) -> FragilityResult:
     """Run the stripes (extending them as the plan says), fit and return the result.
 
-    With a ``journal`` each run is written there as it ends, and a run it holds from an
-    earlier, interrupted analysis of the same plan is read back rather than run
-    (:func:`rockyade.assess.stripes.run_stripes`).
+    With a ``folder`` (:class:`rockyade.runner.study_folder.StudyFolder`) each run is written to
+    its journal as it ends, and a run it holds from an earlier, interrupted analysis of the
+    same plan is read back rather than run (:func:`rockyade.assess.stripes.run_stripes`). One
+    Ctrl-C stops the analysis, between two rounds of stripes as well as within one.
 
     Raises
     ------
     InputError
         A run above the runner's cost limits (``allow_large`` lifts them).
-    BatchInterruptedError
+    StripesInterruptedError
         Ctrl-C; its ``rows`` are the runs that finished, its ``plan`` this plan.
     """
+    from rockyade.runner.stopping import StopRequest
+
+    executor = executor or Executor("local", 2)
     try:
-        return _run_fragility(plan, executor or Executor("local", 2), allow_large, progress, on_round, journal)
-    except BatchInterruptedError as exc:
-        exc.plan = plan  # type: ignore[attr-defined]  # its rows read with the plan's measure
+        with StopRequest(raise_on_second=executor.in_process) as stop:
+            return _run_fragility(plan, executor, allow_large, progress, on_round, folder, stop)
+    except StripesInterruptedError as exc:
+        exc.plan = plan  # its rows read with the plan's measure
         raise
 
 
@@ -402,11 +411,14 @@ def _run_fragility(
     allow_large: bool,
     progress: bool,
     on_round: Callable[[str], None] | None,
-    journal: Journal | None,
+    folder: StudyFolder | None,
+    stop: StopRequest,
 ) -> FragilityResult:
     m = plan.measure
     levels = list(plan.levels_si)
-    rows = run_stripes(plan.stripes, levels, executor, allow_large=allow_large, progress=progress, journal=journal)
+    rows = run_stripes(
+        plan.stripes, levels, executor, allow_large=allow_large, progress=progress, folder=folder, stop=stop
+    )
     added: list[float] = []
     for _ in range(MAX_EXTRA_LEVELS if plan.extend else 0):
         table = stripe_table(runs_frame(rows, m), m.si_column)
@@ -418,6 +430,8 @@ def _run_fragility(
                 plan.stripes.load_factor(i, new)
         except InputError:
             break  # a record cannot be scaled that far: stop extending (the text says where the curve ends)
+        if stop.requested:  # a Ctrl-C at the end of the last round: no new round starts
+            raise StripesInterruptedError(rows, plan.stripes.motions.count, stop.now)
         if on_round is not None:
             on_round(f"extending the stripes: {m.name} = {m.shown(new):.4g} {m.unit}")
         added.append(new)
@@ -429,8 +443,11 @@ def _run_fragility(
             allow_large=allow_large,
             progress=progress,
             done_rows=rows,
-            journal=journal,
+            folder=folder,
+            stop=stop,
         )
+    if stop.requested:  # a Ctrl-C after the last run finished: the answer is not given as complete
+        raise StripesInterruptedError(rows, 0, stop.now)
     runs = runs_frame(rows, m)
     stripes = stripe_table(runs, m.si_column)
     if m.column != m.si_column:

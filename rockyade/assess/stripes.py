@@ -7,16 +7,14 @@ by the scaled record and its duration by the record's plus a tail of free motion
 default: a block set rocking late in the record still falls or comes to rest), sampled at
 ``sample_dt_s`` (0.01 s by default: collapse is the question, not the history).
 
-Each run is a task of :mod:`rockyade.runner` (cost checked before any run, local processes,
-Ctrl-C, a failed run never stopping the others); what comes back from a worker is one row,
-not the time history. A run **collapses** when
-
-* the scene is a single block: its status is ``overturned`` (the solver's own criterion:
-  Housner's |theta| = pi/2, the DEMs' landing on another face);
-* the scene has several blocks: at least ``fallen_blocks`` of them fell (default 1), as the
-  collapse table of :func:`rockyade.analysis.collapse.collapse_report` says (a block lying
-  on another face, carried down by more than half its height, or left leaning beyond its
-  tipping angle).
+The runs are a study's (:func:`rockyade.batch.study_runs.run_study`: cost checked before any
+run, local processes or Dask, Ctrl-C, a failed run never stopping the others, runs of one block
+stepped together, each run's record in the study's journal as it ends); what comes back from a
+worker is one row, not the time history. A run **collapses** by the one rule of
+:func:`rockyade.analysis.collapse_verdict.collapse_verdict`: a single block overturns (its
+solver's status), or at least ``fallen_blocks`` blocks of several fall (default 1; the collapse
+table's rule: a block lying on another face, carried down by more than half its height, or left
+leaning beyond its tipping angle).
 
 A run's row gives its peak rotation as ``max_theta_over_alpha``, the largest |theta| of its
 blocks over the whole scene's critical angle (:func:`whole_alpha`: atan of the limit-analysis
@@ -31,27 +29,27 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import time
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
-import numpy as np
 import pandas as pd
 
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet, record_summary
-from rockyade.blocks.classical import ClassicalParameters
+from rockyade.batch.running import BatchTask, lean_solver, output, run_job, run_task
+from rockyade.batch.study_runs import StudyInterruptedError, run_study
 from rockyade.constants import G
 from rockyade.errors import BatchInterruptedError, InputError
-from rockyade.result import Result
-from rockyade.runner import Executor, Task, check_costs, run_jobs
-from rockyade.runner.groups import group_jobs
-from rockyade.runner.journal import Journal
-from rockyade.runner.tasks import solve
+from rockyade.runner import Executor, run_jobs
+from rockyade.runner.rows import UNFINISHED, Cells, RunRow
+from rockyade.runner.study_folder import PARTIAL_DIR, StudyFolder
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
-from rockyade.solvers.base import GroupSolver, Solver
+from rockyade.solvers.base import Solver
+
+if TYPE_CHECKING:
+    from rockyade.runner.stopping import StopRequest
 
 #: Free motion after the record, s.
 DEFAULT_TAIL_S = 5.0
@@ -108,8 +106,9 @@ def check_fallen_blocks(scene: Scene, fallen_blocks: int) -> int:
 
 
 @dataclass(frozen=True)
-class StripeTask(Task):
-    """One run of a stripe: a task (:class:`rockyade.runner.Task`) and what names it.
+class StripeTask(BatchTask):
+    """One run of a stripe: a study's task (:class:`rockyade.batch.running.BatchTask`: no
+    history, no metrics, the collapse verdict) and what names it.
 
     Attributes
     ----------
@@ -121,15 +120,14 @@ class StripeTask(Task):
         The stripe's intensity, SI (m/s^2 or m/s).
     load_factor
         lambda on the record's accelerations.
-    fallen_blocks
-        Fallen blocks that make a collapse (several blocks).
+    whole_alpha_rad
+        The whole scene's critical angle (:func:`whole_alpha`), rad.
     """
 
     record_index: int = 0
     record: str = ""
     level_si: float = math.nan
     load_factor: float = math.nan
-    fallen_blocks: int = 1
     whole_alpha_rad: float = math.nan
 
 
@@ -138,7 +136,7 @@ def whole_alpha(scene: Scene) -> float:
     multipliers towards +x and -x (for one block its alpha; for a stack turning about its base
     the whole's alpha, b / h_c = tan alpha); NaN without a mechanism."""
     if single_block(scene):
-        return float(_classical(scene).alpha_rad)
+        return float(loaded_classical(scene, G)[scene.blocks[0].name].alpha_rad)  # the body that rocks
     from rockyade.limit import limit_analysis
 
     lams = []
@@ -152,78 +150,53 @@ def whole_alpha(scene: Scene) -> float:
     return math.atan(min(lams)) if lams else math.nan
 
 
-def _classical(scene: Scene) -> ClassicalParameters:
-    """The single block's classical parameters as it rocks (the masses of its loads in, each side
-    its own alpha: :func:`rockyade.scene.carried.loaded_classical`)."""
-    return loaded_classical(scene, G)[scene.blocks[0].name]
-
-
-def collapse_of(scene: Scene, result: Result, fallen_blocks: int = 1) -> tuple[bool, int, float, float]:
-    """(collapsed, blocks fallen, largest peak |theta| / the block's own alpha, largest peak
-    |theta| in rad) of a run (module docstring); a single block's rotation on each side over
-    that side's alpha (:meth:`rockyade.blocks.classical.ClassicalParameters.theta_over_alpha`)."""
-    if single_block(scene):
-        spec = scene.blocks[0]
-        theta = np.asarray(result.series("theta_rad", spec.name), dtype=float)
-        finite = theta[np.isfinite(theta)]
-        peak = float(np.max(np.abs(finite))) if finite.size else math.nan
-        over = result.status == "overturned"
-        return over, int(over), _classical(scene).theta_over_alpha(theta), peak
-    from rockyade.analysis.collapse import collapse_report
-
-    report = collapse_report(scene, result)
-    fallen = int(report["fell"].sum())
-    ratio = float(np.nanmax(report["max_theta_over_alpha"])) if len(report) else math.nan
-    peak = float(np.nanmax(report["max_abs_theta_rad"])) if len(report) else math.nan
-    return fallen >= fallen_blocks, fallen, ratio, peak
-
-
-def _row(task: StripeTask, status: str, reason: str) -> dict[str, Any]:
+def stripe_row(task: StripeTask, row: RunRow) -> Cells:
+    """A run's row in the stripes' table (:data:`RUN_COLUMNS`): its verdict, its peak rotation
+    over the whole scene's alpha and over each block's own (module docstring)."""
+    verdict = row.verdict if row.answered else None
+    own = verdict.peak_over_own_alpha if verdict is not None else math.nan
+    whole = own  # a single block: each side's rotation over that side's alpha
+    if verdict is not None and not single_block(task.scene) and math.isfinite(task.whole_alpha_rad):
+        whole = verdict.peak_theta_rad / task.whole_alpha_rad
     return {
         "run": task.index,
         "record": task.record,
         "record_index": task.record_index,
         "level_si": task.level_si,
         "load_factor": task.load_factor,
-        "solver": task.solver.name,
-        "status": status,
-        "collapsed": False,
-        "n_fallen": 0,
-        "max_theta_over_alpha": math.nan,
-        "max_theta_over_own_alpha": math.nan,
-        "failure_reason": reason,
-        "wall_time_s": math.nan,
-        "scene_hash": task.scene_hash,
+        "solver": row.solver,
+        "status": row.status,
+        "collapsed": bool(row.collapsed),
+        "n_fallen": verdict.n_fallen if verdict is not None else 0,
+        "max_theta_over_alpha": whole,
+        "max_theta_over_own_alpha": own,
+        "failure_reason": row.failure_reason,
+        "wall_time_s": row.elapsed_s if row.elapsed_s is not None else math.nan,
+        "scene_hash": row.scene_hash,
     }
 
 
-def run_stripe_task(task: StripeTask) -> dict[str, Any]:
-    """Run one task and reduce it to its row (what travels back from a worker). Never raises:
-    a failed run is a row with status ``failed`` and the reason."""
-    start = time.perf_counter()
-    result = solve(task)
-    row = _row(task, result.status, str(result.meta.failure_reason or ""))
-    row["wall_time_s"] = time.perf_counter() - start
-    if result.ok:
-        try:
-            collapsed, fallen, ratio, peak = collapse_of(task.scene, result, task.fallen_blocks)
-        except Exception as exc:  # an analysis that fails is this run's failure, not the batch's
-            row.update(status="failed", failure_reason=f"collapse analysis: {type(exc).__name__}: {exc}")
-        else:
-            single = single_block(task.scene) or not math.isfinite(task.whole_alpha_rad)
-            whole = ratio if single else peak / task.whole_alpha_rad
-            row.update(
-                collapsed=bool(collapsed),
-                n_fallen=fallen,
-                max_theta_over_alpha=whole,
-                max_theta_over_own_alpha=ratio,
-            )
-    return row
+def run_stripe_task(task: StripeTask) -> Cells:
+    """Run one task alone (:func:`rockyade.batch.running.run_task`) and give its stripe row.
+    Never raises: a failed run is a row with status ``failed`` and the reason."""
+    return stripe_row(task, run_task(task))
 
 
-def failed_row(task: StripeTask, reason: str) -> dict[str, Any]:
-    """The row of a run whose worker gave nothing back (it died)."""
-    return _row(task, "failed", reason)
+def run_stripe_job(job: tuple[StripeTask, ...]) -> list[Cells]:
+    """The stripe rows of a job of runs that share a structure
+    (:func:`rockyade.batch.running.run_job`: the solver steps them together, the rows of the
+    runs one at a time)."""
+    return [stripe_row(task, row) for task, row in zip(job, run_job(job), strict=True)]
+
+
+class StripesInterruptedError(BatchInterruptedError):
+    """Ctrl-C stopped the stripes: ``rows``, the stripe rows of the runs that finished (those
+    of earlier rounds first), for the partial summary; ``plan``, the fragility plan when known."""
+
+    def __init__(self, rows: list[Cells], unfinished: int, hard: bool) -> None:
+        super().__init__(len(rows), unfinished, None, hard)
+        self.rows = rows
+        self.plan: object | None = None
 
 
 @dataclass(frozen=True)
@@ -297,17 +270,20 @@ class StripePlan:
         for level in levels_si:
             for i in range(self.motions.count):
                 lf = self.load_factor(i, level)
+                scene = self.scene_for(i, lf)
                 out.append(
                     StripeTask(
                         first_index + len(out),
-                        self.solver,
-                        self.scene_for(i, lf),
+                        lean_solver(self.solver, scene),
+                        scene,
                         {"record": self.motions.label(i), **self.level_labels(level)},
+                        save_history=False,
+                        metrics=False,
+                        fallen_blocks=self.fallen_blocks,
                         record_index=i,
                         record=self.motions.label(i),
                         level_si=float(level),
                         load_factor=lf,
-                        fallen_blocks=self.fallen_blocks,
                         whole_alpha_rad=self.whole_alpha_rad,
                     )
                 )
@@ -345,11 +321,6 @@ def record_measures(
     return pd.DataFrame(outcome.in_order())
 
 
-def run_name(task: StripeTask) -> str:
-    """A run's name in a journal: its scene's hash and its solver."""
-    return f"{task.scene_hash}_{task.solver.name}"
-
-
 def run_stripes(
     plan: StripePlan,
     levels_si: Sequence[float],
@@ -358,110 +329,47 @@ def run_stripes(
     first_index: int = 0,
     allow_large: bool = False,
     progress: bool = True,
-    done_rows: Sequence[dict[str, Any]] = (),
-    journal: Journal | None = None,
-) -> list[dict[str, Any]]:
-    """Run every record at every level; the rows in task order.
+    done_rows: Sequence[Cells] = (),
+    folder: StudyFolder | None = None,
+    stop: StopRequest | None = None,
+) -> list[Cells]:
+    """Run every record at every level (:func:`rockyade.batch.study_runs.run_study`); the
+    stripe rows in task order.
 
-    With a ``journal`` (:class:`rockyade.runner.journal.Journal`) a run finished earlier is
-    not run again (its row is read back) and each run's row is written there as it ends.
+    With a ``folder`` (:class:`rockyade.runner.study_folder.StudyFolder`) each run's record is
+    written in its journal as the run ends, and a run finished earlier is read back rather than
+    run again.
 
     Raises
     ------
     InputError
         A run above the runner's cost limits (``allow_large`` lifts them), a load factor
         out of range.
-    BatchInterruptedError
+    StripesInterruptedError
         Ctrl-C (``done_rows`` and what finished are in its ``rows``).
     """
     tasks = plan.tasks(levels_si, first_index)
-    earlier: dict[int, dict[str, Any]] = {}
-    if journal is not None:
-        for task in tasks:
-            row = journal.done(run_name(task), task.scene_hash)
-            if row is not None:
-                earlier[task.index] = {**row, "run": task.index}
-    todo = [t for t in tasks if t.index not in earlier]
-    check_costs(todo, allow_large)
-    jobs = group_jobs(todo, stripe_group, max(1, min(MAX_RUNS_PER_JOB, -(-len(todo) // (4 * executor.workers)))))
-
-    def on_done(_i: int, job_rows: list[dict[str, Any]]) -> None:
-        if journal is not None:
-            for row in job_rows:
-                task = tasks[row["run"] - first_index]
-                journal.record(run_name(task), {"status": row["status"], "scene_hash": task.scene_hash, "summary": row})
-
-    outcome = run_jobs(
-        jobs,
-        run_stripe_job,
-        executor=executor,
-        failed=lambda job, reason: [failed_row(task, reason) for task in job],
-        on_done=on_done,
-        progress=progress,
-        desc="runs",
-        skipped=len(earlier),
-    )
-    by_index = {**earlier, **{row["run"]: row for job_rows in outcome.values.values() for row in job_rows}}
-    rows = [by_index[k] for k in sorted(by_index)]
-    if outcome.unfinished:
-        stopped = sum(len(jobs[i]) for i in outcome.unfinished)
-        error = BatchInterruptedError(len(done_rows) + len(rows), stopped, None, outcome.hard)
-        error.rows = [*done_rows, *rows]  # type: ignore[attr-defined]
-        raise error
-    return rows
-
-
-#: Most runs of one group in one job (groups are cut so that every worker gets jobs).
-MAX_RUNS_PER_JOB = 64
-
-
-def stripe_group(task: StripeTask) -> str | None:
-    """The group of a run (:func:`rockyade.runner.groups.group_jobs`): runs of one block whose
-    solver steps scenes of one structure together (:class:`rockyade.solvers.base.GroupSolver`,
-    its ``group_key``: the same block, another record or load factor) go to one job; None: it
-    runs alone."""
-    solver = task.solver
-    if not single_block(task.scene) or not isinstance(solver, GroupSolver):
-        return None
-    key = solver.group_key(task.scene)
-    return None if key is None else f"{solver!r}|{key}"
-
-
-def run_stripe_job(job: tuple[StripeTask, ...]) -> list[dict[str, Any]]:
-    """The rows of a job of :func:`stripe_group`'s group (or of one task). Never raises: should
-    the group fail as a whole, its runs are run one by one (:func:`run_stripe_task`).
-
-    A group's runs are the solver's own runs stepped together (the same results, bit for bit,
-    as one at a time: :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`); a run
-    collapses when its status is ``overturned``, and its peak |theta| is that of its sampled
-    rotation, over the block's alpha."""
-    if len(job) == 1:
-        return [run_stripe_task(job[0])]
-    from rockyade.analysis.metrics import uplift_threshold_rad
-
-    start = time.perf_counter()
-    solver = job[0].solver
-    assert isinstance(solver, GroupSolver)  # stripe_group groups only these
-    cp = _classical(job[0].scene)
-    alpha = cp.alpha_rad
+    files = None
+    if folder is not None:  # the records go in the journal: rows and verdicts, no solver's files
+        files = output(folder.out, folder.writing_token(), PARTIAL_DIR, lean=True)
     try:
-        runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
-    except Exception:  # a run of its own says what went wrong
-        return [run_stripe_task(task) for task in job]
-    elapsed = (time.perf_counter() - start) / len(job)
-    rows = []
-    for task, one in zip(job, runs, strict=True):
-        row = _row(task, one.status, str(one.meta.failure_reason or ""))
-        row["wall_time_s"] = elapsed
-        if one.status != "failed":
-            over = one.status == "overturned"
-            ratio = cp.theta_over_alpha(one.theta_rad)
-            row.update(collapsed=over, n_fallen=int(over), max_theta_over_alpha=ratio, max_theta_over_own_alpha=ratio)
-        rows.append(row)
-    return rows
+        runs = run_study(
+            tasks,
+            executor=executor,
+            journal=folder.journal if folder is not None else None,
+            files=files,
+            allow_large=allow_large,
+            progress=progress,
+            stop=stop,
+            tell_failures=False,
+        )
+    except StudyInterruptedError as exc:
+        finished = [stripe_row(t, r) for t, r in zip(tasks, exc.runs.rows, strict=True) if r.status != UNFINISHED]
+        raise StripesInterruptedError([*done_rows, *finished], exc.runs.unfinished, exc.runs.hard) from None
+    return [stripe_row(task, row) for task, row in zip(tasks, runs.rows, strict=True)]
 
 
-def runs_frame(rows: Sequence[dict[str, Any]], measure: Measure) -> pd.DataFrame:
+def runs_frame(rows: Sequence[Cells], measure: Measure) -> pd.DataFrame:
     """The runs as a table: :data:`RUN_COLUMNS` and the level in the measure's unit."""
     frame = pd.DataFrame(list(rows), columns=list(RUN_COLUMNS))
     if measure.column != measure.si_column:  # pgv: m/s both ways

@@ -1,14 +1,18 @@
-"""Batches: a study file's grid of scenes x solvers, run on the runner, one summary row per run.
+"""Batches, and the one way every study runs its runs.
 
-Three rooms, one idea each:
+Four rooms, one idea each:
 
 * :mod:`rockyade.batch.study`: the study file (its grammar and errors) and a
   :class:`~rockyade.batch.study.Study`: the base scenes read once, the grid, its points made
   one at a time;
-* :mod:`rockyade.batch.running`: a study's tasks, what one run does, handing them to
-  :mod:`rockyade.runner` (costs, executors, Ctrl-C, the output's lock);
-* :mod:`rockyade.batch.summary`: the summary rows, the rows of runs finished earlier
-  (resume, :mod:`rockyade.runner.journal`) and ``summary.csv``.
+* :mod:`rockyade.batch.running`: a study's tasks and what one run (or one job of runs that
+  share a structure) does: solve, the collapse verdict and the metrics the study asks for, its
+  record and files; its row (:class:`rockyade.runner.rows.RunRow`);
+* :mod:`rockyade.batch.study_runs`: :func:`~rockyade.batch.study_runs.run_study`, the one
+  entry point of every study's runs (resume from the journal, costs, groups, the runner,
+  Ctrl-C);
+* :mod:`rockyade.batch.summary`: the summary rows and ``summary.csv``, and the batch itself
+  (:func:`~rockyade.batch.summary.run_study_tasks`).
 
 ::
 
@@ -18,15 +22,18 @@ Three rooms, one idea each:
     summary = run_study_tasks(study_tasks(study), "reports/sweep", workers=2)
 """
 
-from rockyade.batch.running import BatchTask, batch_task, expand, run_study_tasks, study_tasks
+from rockyade.batch.running import BatchTask, batch_task, expand, study_tasks
 from rockyade.batch.study import MAX_RUNS, MAX_RUNS_ALLOWED, Study, load_study, make_study
-from rockyade.batch.summary import comparable, failures, run_name
+from rockyade.batch.study_runs import StudyInterruptedError, StudyRuns, run_scenes, run_study
+from rockyade.batch.summary import comparable, failures, run_name, run_study_tasks
 
 __all__ = [
     "MAX_RUNS",
     "MAX_RUNS_ALLOWED",
     "BatchTask",
     "Study",
+    "StudyInterruptedError",
+    "StudyRuns",
     "batch_task",
     "comparable",
     "expand",
@@ -34,6 +41,8 @@ __all__ = [
     "load_study",
     "make_study",
     "run_name",
+    "run_scenes",
+    "run_study",
     "run_study_tasks",
     "study_tasks",
 ]

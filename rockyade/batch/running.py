@@ -1,132 +1,142 @@
-"""Running a batch: a study's tasks, what one run does (solve, metrics, write its files),
-and handing them to the runner (:mod:`rockyade.runner`).
+"""One run of a study, and one job of runs: what a worker does with a task (solve, the collapse
+verdict and the metrics the study asks for, the files it keeps) and the row it gives back
+(:class:`rockyade.runner.rows.RunRow`).
 
-Each run is named ``<scene hash>_<solver>``; ``runs/<name>.json`` (metadata and the summary
-row) is written for every run, ``runs/<name>.csv`` with the time history when asked; a solver
-that keeps files of its own keeps them in ``runs/<solver>/`` (YADE: its scene data and log).
-A run's JSON is its record in the journal of finished runs that every study command shares
-(:mod:`rockyade.runner.journal`): written atomically and fsynced, file and folder, as the run
-ends (a killed batch, or a power cut, leaves whole records or none).
+Every study runs its tasks through here (:func:`rockyade.batch.study_runs.run_study`):
+``batch``, ``uncertainty`` and the pattern map ask for the summary metrics (and keep the time
+history when the study file says so); ``fragility``, ``assess`` and ``crosscheck`` ask for the
+collapse verdict only.
 
-A failed run never stops the batch: its row says why (a full disk too: the run fails with
-that reason and the batch goes on). ``resume`` skips runs whose JSON says they completed
-(or overturned) for the same scene hash and re-runs failed ones.
+A run of a study with a folder (:class:`Output`) writes its record there as it ends, where it
+runs (:mod:`rockyade.runner.journal`: ``runs/<name>.json``, its metadata, row and verdict,
+atomically, fsynced and sealed): ``resume`` reads it back. A run whose time history is kept
+writes it as ``<name>.csv`` beside it (the JSON, last, marks the pair complete); a solver that
+keeps files of its own keeps them in ``runs/<solver>/`` (YADE: its scene data and log). The
+folder and the study's lock on it go to the runs once, beside the tasks (:class:`Output`).
 
-The runs go through :mod:`rockyade.runner`: costs checked before any run (``allow_large``
-lifts the limits), local processes or Dask, Ctrl-C, worker lifetime. One batch at a time
-may write an output directory (a lock); what a killed batch left (temporary files, a result
-between its two renames) is settled when the next one starts. After Ctrl-C ``summary.csv``
-is written with what finished, the unfinished runs listed with status ``unfinished``, and
-:class:`~rockyade.errors.BatchInterruptedError` is raised.
-
-The output folder and the batch's lock on it go to the runs once, beside the tasks
-(:class:`Output`), not in every task.
+Runs that share a structure (no history kept, a solver that runs scenes of one structure
+together: :class:`rockyade.solvers.base.GroupSolver`) go to one job (:func:`job_key`), which
+the solver answers at once, with the rows of the runs one at a time.
 """
 
 from __future__ import annotations
 
 import contextlib
-import functools
 import time
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Hashable, Iterable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from rockyade.batch.study import Study, make_study
-from rockyade.batch.summary import (
-    UNFINISHED,
-    completed_row,
-    duplicate_row,
-    failure_line,
-    placeholder_row,
-    status_row,
-    summary_frame,
-    task_run_name,
-    write_failure_row,
-    write_summary,
-)
-from rockyade.errors import BatchInterruptedError
-from rockyade.io.atomic import remove_stale_temporaries
-from rockyade.io.folders import output_folder
-from rockyade.io.locking import lock_token, output_lock, writing_for
-from rockyade.runner import Executor, Task, check_costs, run_jobs, solve
-from rockyade.runner.executor import SCHEDULER_TIMEOUT_S
-from rockyade.runner.groups import group_jobs
-from rockyade.runner.journal import claim, marked_record, write_run
+from rockyade.constants import G
+from rockyade.errors import os_error_message
+from rockyade.io.locking import writing_for
+from rockyade.result import Result
+from rockyade.runner import Task, solve
+from rockyade.runner.journal import marked_record, write_run
+from rockyade.runner.rows import Cell, RunRow, Verdict
 from rockyade.scene import Scene
+from rockyade.scene.carried import loaded_classical
 from rockyade.solvers import as_solver
-from rockyade.solvers.base import GroupSolver, Solver
+from rockyade.solvers.base import GroupRun, GroupSolver, Solver
 
-#: Most runs of one group in one job (groups are cut so that every worker gets jobs).
-MAX_RUNS_PER_JOB = 64
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass(frozen=True)
 class BatchTask(Task):
-    """One run of a batch: a task (:class:`rockyade.runner.Task`) and whether its time
-    history is kept.
+    """One run of a study: a task (:class:`rockyade.runner.Task`) and what the study keeps of it.
 
     Attributes
     ----------
     save_history
         Write the time history as well as the metadata.
+    metrics
+        The summary metrics (:func:`rockyade.analysis.metrics.summary_metrics`) in its row.
+    fallen_blocks
+        The collapse verdict in its row, a collapse being this many fallen blocks
+        (:func:`rockyade.analysis.collapse_verdict.collapse_verdict`); None: no verdict.
+    keep_result
+        Its Result comes back in its row (:attr:`rockyade.runner.rows.RunRow.result`): a study
+        that reads the whole run.
     """
 
     save_history: bool = True
+    metrics: bool = True
+    fallen_blocks: int | None = None
+    keep_result: bool = False
 
 
 @dataclass(frozen=True)
 class Output:
-    """Where a batch's runs write, given to every run once.
+    """Where a study's runs keep their files, given to every run once.
 
     Attributes
     ----------
     out_dir
-        The batch's folder (absolute: a worker elsewhere, a Dask worker in another folder,
-        writes where the batch reads); the runs go in ``runs/``.
+        The study's folder (absolute: a worker elsewhere, a Dask worker in another folder,
+        writes where the study reads).
     lock_token
-        The token of the batch's lock on ``out_dir`` ("" when the caller holds none): the run
-        writes there on the batch's behalf (:func:`rockyade.io.locking.writing_for`),
+        The token of the study's lock on ``out_dir`` ("" when the caller holds none): the run
+        writes there on the study's behalf (:func:`rockyade.io.locking.writing_for`),
         wherever it runs.
+    runs_dir
+        The runs' folder in ``out_dir`` (their records, histories and files).
+    solver_files
+        The solvers keep their own files there (YADE's scene data and log).
+    record_meta
+        A run's record holds its metadata (the Result's) beside its row; False: its row and
+        verdict only (a journal that goes once the study is complete).
     """
 
     out_dir: str
     lock_token: str = ""
+    runs_dir: str = "runs"
+    solver_files: bool = True
+    record_meta: bool = True
 
     @property
     def runs(self) -> Path:
         """The runs' folder."""
-        return Path(self.out_dir) / "runs"
+        return Path(self.out_dir) / self.runs_dir
 
-    def writing(self) -> contextlib.AbstractContextManager[Any]:
-        """Write under the batch's lock (nothing to do without a token)."""
+    def writing(self) -> contextlib.AbstractContextManager[object]:
+        """Write under the study's lock (nothing to do without a token)."""
         return writing_for(self.out_dir, self.lock_token) if self.lock_token else contextlib.nullcontext()
 
 
-def output(out_dir: str | Path, lock_token: str = "") -> Output:
-    """The :class:`Output` of ``out_dir``, made absolute here, on the client."""
-    return Output(str(Path(out_dir).absolute()), lock_token)
+def output(out_dir: str | Path, lock_token: str = "", runs_dir: str = "runs", lean: bool = False) -> Output:
+    """The :class:`Output` of ``out_dir``, made absolute here, on the client (``lean``: no
+    solver's own files, records without the metadata)."""
+    return Output(str(Path(out_dir).absolute()), lock_token, runs_dir, not lean, not lean)
 
 
 def batch_task(
-    index: int, solver: Solver | str, scene: Scene, labels: Mapping[str, Any], save_history: bool = True
+    index: int,
+    solver: Solver | str,
+    scene: Scene,
+    labels: Mapping[str, Cell],
+    save_history: bool = True,
+    *,
+    metrics: bool = True,
+    fallen_blocks: int | None = None,
 ) -> BatchTask:
-    """A batch run. Without the history, the solver records only what the summary reads
+    """A study's run. Without the history, the solver records only what the row reads
     (:func:`lean_solver`)."""
     solver = as_solver(solver)
     if not save_history:
         solver = lean_solver(solver, scene)
-    return BatchTask(index, solver, scene, dict(labels), save_history)
+    return BatchTask(index, solver, scene, dict(labels), save_history, metrics, fallen_blocks)
 
 
 def lean_solver(solver: Solver, scene: Scene) -> Solver:
     """The solver of a run whose history is not kept: without energy terms, and for a column
-    without contact states (the summary reads neither; an assembly's collapse metrics read
-    the contacts' slipping)."""
+    without contact states (the row reads neither; an assembly's collapse reads the contacts'
+    slipping)."""
     changes = {}
     if getattr(solver, "record_energy", False):
         changes["record_energy"] = False
@@ -136,7 +146,7 @@ def lean_solver(solver: Solver, scene: Scene) -> Solver:
 
 
 def study_tasks(study: Study) -> Iterator[BatchTask]:
-    """The tasks of a study, made as they are asked for: every grid point x solver."""
+    """The tasks of a study file, made as they are asked for: every grid point x solver."""
     index = 0
     for point in study.points():
         for solver in study.solvers:
@@ -145,8 +155,8 @@ def study_tasks(study: Study) -> Iterator[BatchTask]:
 
 
 def expand(
-    bases: list[tuple[str, dict[str, Any]]],
-    grid: Mapping[str, list[Any]],
+    bases: list[tuple[str, dict[str, object]]],
+    grid: Mapping[str, list[object]],
     solvers: Iterable[Solver | str],
     *,
     save_history: bool = True,
@@ -169,252 +179,156 @@ def expand(
 # ---------------------------------------------------------------------- one run
 
 
-def run_task(task: BatchTask, out: Output) -> dict[str, Any]:
-    """Run one task: solve, metrics, write its files in ``out``; its summary row. Never
-    raises: failures become rows."""
-    with out.writing():
-        return _run_task(task, out)
-
-
 def keeping_files(task: BatchTask, out: Output) -> BatchTask:
     """The task with its solver keeping its own files (if any) in ``runs/<solver>/`` of ``out``."""
     solver = task.solver.keeping_files(out.runs / task.solver.name)
     return task if solver is task.solver else replace(task, solver=solver)
 
 
-def _run_task(task: BatchTask, out: Output) -> dict[str, Any]:
-    from rockyade.analysis.metrics import summary_metrics
+def run_task(task: BatchTask, out: Output | None = None) -> RunRow:
+    """Run one task: solve, its verdict and metrics, its files in ``out``; its row. Never
+    raises: a failure is a row with status ``failed`` and the reason."""
+    with out.writing() if out is not None else contextlib.nullcontext():
+        return _run_task(task, out)
 
+
+def _run_task(task: BatchTask, out: Output | None) -> RunRow:
     start = time.perf_counter()
-    runs = out.runs
-    runs.mkdir(parents=True, exist_ok=True)
-    name = task_run_name(task)
-    result = solve(keeping_files(task, out))
-    row = status_row(task, result.meta)
-    if result.ok:
-        row.update(summary_metrics(task.scene, result))
-    row["elapsed_s"] = time.perf_counter() - start
+    if out is not None:
+        out.runs.mkdir(parents=True, exist_ok=True)
+        if out.solver_files:
+            task = keeping_files(task, out)
+    result = solve(task)
+    row = answered_row(task, result, RunRow.of(task, result.meta))
+    row = replace(row, elapsed_s=time.perf_counter() - start, result=result if task.keep_result else None)
+    return row if out is None else recorded(row, out, result if task.save_history else None)
+
+
+def recorded(row: RunRow, out: Output, result: Result | None = None) -> RunRow:
+    """``row`` with its record written in ``out``'s runs (with ``result``, when it answered:
+    the time history beside it, the record last); a full disk fails the run, saying why (no
+    file of it left half-written), and the study goes on."""
     try:
-        if task.save_history and result.ok:
-            result.write(runs / f"{name}.csv", marked_record({"summary": row}))  # the JSON, last, marks it complete
+        if result is not None and row.answered:
+            result.write(out.runs / f"{row.name}.csv", marked_record(record_of(row)))
         else:
-            write_run(runs, name, {**result.meta.to_dict(), "summary": row})
-    except OSError as exc:  # a full disk: this run fails with the reason, the batch goes on
-        row = write_failure_row(task, row, exc)
-    return row
+            write_run(out.runs, row.name, record_of(row, out.record_meta))
+    except OSError as exc:
+        return replace(row.failed(f"cannot write the result: {os_error_message(exc)}"), recorded=True)
+    return replace(row, recorded=True)
+
+
+def answered_row(task: BatchTask, result: Result | GroupRun, row: RunRow) -> RunRow:
+    """``row`` with the verdict and the metrics the task asks for, when the run answered (an
+    analysis that fails is this run's failure, not the study's)."""
+    if not row.answered or not (task.metrics or task.fallen_blocks is not None):
+        return row
+    from rockyade.analysis.collapse_verdict import collapse_verdict
+
+    scene = task.scene
+    try:
+        report = _report(task, result)
+        verdict = collapse_verdict(scene, result, task.fallen_blocks or 1, report)
+        metrics: dict[str, Cell] = {}
+        if task.metrics:
+            metrics = _metrics(task, result, report, verdict)
+    except Exception as exc:
+        return row.failed(f"analysis of the run: {type(exc).__name__}: {exc}")
+    return replace(row, verdict=verdict if task.fallen_blocks is not None else None, metrics=metrics)
+
+
+def _report(task: BatchTask, result: Result | GroupRun) -> pd.DataFrame | None:
+    """The collapse table of a run of several blocks (shared by its verdict and metrics)."""
+    if len(task.scene.blocks) == 1 or isinstance(result, GroupRun):
+        return None
+    from rockyade.analysis.collapse import collapse_report
+
+    return collapse_report(task.scene, result)
+
+
+def _metrics(
+    task: BatchTask, result: Result | GroupRun, report: pd.DataFrame | None, verdict: Verdict
+) -> dict[str, Cell]:
+    from rockyade.analysis.metrics import block_summary, summary_metrics
+
+    if not isinstance(result, GroupRun):
+        return summary_metrics(task.scene, result, report, verdict)
+    spec = task.scene.blocks[0]
+    cp = loaded_classical(task.scene, G)[spec.name]  # the body that rocks: each side its own alpha
+    t = np.arange(result.theta_rad.size) * result.sample_dt_s
+    free = task.scene.motion.type == "free"
+    fell = spec.name in verdict.fallen
+    return dict(block_summary(result.metrics, t, result.theta_rad, cp.alpha_rad, free, fell, classical=cp))
+
+
+def record_of(row: RunRow, meta: bool = True) -> dict[str, object]:
+    """A run's record in its study's journal (:mod:`rockyade.runner.journal`): its metadata
+    (``meta``), status, scene hash, row and verdict."""
+    record: dict[str, object] = dict(row.meta.to_dict()) if meta and row.meta is not None else {}
+    record.update(status=row.status, scene_hash=row.scene_hash, summary=row.summary())
+    if row.verdict is not None:
+        record["verdict"] = row.verdict.to_dict()
+    return record
 
 
 # ---------------------------------------------------------------------- runs in groups
 
 
-def job_key(task: BatchTask) -> Any:
+def job_key(task: BatchTask) -> Hashable | None:
     """The group of a task (:func:`rockyade.runner.groups.group_jobs`): runs without history
-    whose solver runs scenes of one structure together (``group_key``); None: it runs alone."""
-    if task.save_history or not isinstance(task.solver, GroupSolver):
+    whose solver runs scenes of one structure together (its ``group_key``: the same block,
+    another record or load factor); None: it runs alone."""
+    solver = task.solver
+    if task.save_history or task.keep_result or not isinstance(solver, GroupSolver):
         return None
-    k = task.solver.group_key(task.scene)
-    return None if k is None else (repr(task.solver), k)
+    key = solver.group_key(task.scene)
+    return None if key is None else (repr(solver), key)
 
 
-def run_job(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
-    """Run a job of :func:`job_key`'s group (or one task); its summary rows. Never raises:
-    should the group fail as a whole, its runs are run one by one."""
+def run_job(job: tuple[BatchTask, ...], out: Output | None = None) -> list[RunRow]:
+    """The rows of a job of :func:`job_key`'s group (or of one task). Never raises: should
+    the group fail as a whole, its runs are run one by one.
+
+    A group's runs are the solver's own runs stepped together (the same results, bit for bit,
+    as one at a time: :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`)."""
     if len(job) == 1:
         return [run_task(job[0], out)]
-    with out.writing():
+    with out.writing() if out is not None else contextlib.nullcontext():
         return _run_group(job, out)
 
 
-def _run_group(job: tuple[BatchTask, ...], out: Output) -> list[dict[str, Any]]:
-    from rockyade.analysis.metrics import block_overturned, block_summary, uplift_threshold_rad
-    from rockyade.constants import G
-    from rockyade.scene.carried import loaded_classical
+def _run_group(job: tuple[BatchTask, ...], out: Output | None) -> list[RunRow]:
+    from rockyade.analysis.metrics import uplift_threshold_rad
 
     start = time.perf_counter()
-    first = job[0]
-    spec = first.scene.blocks[0]
-    cp = loaded_classical(first.scene, G)[spec.name]  # the body that rocks: each side its own alpha
-    alpha = cp.alpha_rad
-    solver = first.solver
+    solver = job[0].solver
     assert isinstance(solver, GroupSolver)  # job_key groups only these
+    alpha = loaded_classical(job[0].scene, G)[job[0].scene.blocks[0].name].alpha_rad
     try:
         runs = solver.run_group([t.scene for t in job], uplift_threshold_rad(alpha))
     except Exception:  # a run of its own says what went wrong
         return [_run_task(task, out) for task in job]
     elapsed = (time.perf_counter() - start) / len(job)
-    folder = out.runs
-    folder.mkdir(parents=True, exist_ok=True)
-    free = first.scene.motion.type == "free"
-    rows = []
-    for task, one in zip(job, runs, strict=True):
-        row = status_row(task, one.meta)
-        if one.status != "failed":
-            t = np.arange(one.theta_rad.size) * one.sample_dt_s
-            overturned = block_overturned(one.meta, spec.name)
-            row.update(block_summary(one.metrics, t, one.theta_rad, alpha, free, overturned, classical=cp))
-        row["elapsed_s"] = elapsed
-        try:
-            write_run(folder, row["run"], {**one.meta.to_dict(), "summary": row})
-        except OSError as exc:
-            row = write_failure_row(task, row, exc)
-        rows.append(row)
-    return rows
-
-
-# ---------------------------------------------------------------------- the batch
-
-
-def run_study_tasks(
-    tasks: Iterable[BatchTask],
-    out_dir: str | Path,
-    *,
-    executor: str | Executor = "local",
-    workers: int = 2,
-    scheduler: str | None = None,
-    resume: bool = False,
-    progress: bool = True,
-    desc: str = "runs",
-    allow_large: bool = False,
-    scheduler_timeout_s: float = SCHEDULER_TIMEOUT_S,
-    group_runs: bool = True,
-    identity: Mapping[str, Any] | None = None,
-    resume_option: str | None = "--resume",
-) -> pd.DataFrame:
-    """Run tasks and write the summary in ``out_dir``; return it (sorted by task order).
-
-    Parameters
-    ----------
-    tasks
-        The runs (:func:`study_tasks`, :func:`expand`, :func:`batch_task`).
-    out_dir
-        The batch's folder (made if missing; locked while the batch runs).
-    executor
-        "local" (worker processes), "dask" (``scheduler`` address, or Dask's threaded
-        scheduler in this process) or "threads" (this process), with ``workers``,
-        ``scheduler`` and ``scheduler_timeout_s``; or a :class:`rockyade.runner.Executor`
-        holding them all.
-    resume
-        Skip runs already completed for the same scene hash; re-run failed ones.
-    allow_large
-        Run even if a run's cost estimate is above the limits of :mod:`rockyade.runner.cost_limits`.
-    resume_option
-        The caller's option that resumes, named after Ctrl-C (None: it cannot resume).
-    identity
-        What study this is (:func:`rockyade.runner.journal.claim`: ``study.json`` in ``out_dir``);
-        ``resume`` over the runs of another is refused. None: not checked.
-    group_runs
-        Run the runs that share a structure together (:func:`job_key`, :func:`run_job`; the
-        same rows); False: one run per job (benchmarks compare the two).
-
-    Raises
-    ------
-    InputError
-        Bad settings, a run above the cost limits, an output another batch is writing,
-        ``resume`` over the runs of another study (``identity``).
-    BatchInterruptedError
-        After Ctrl-C, once the summary of what finished is written.
-    """
-    how = executor if isinstance(executor, Executor) else Executor(executor, workers, scheduler, scheduler_timeout_s)
-    task_list = list(tasks)  # scenes built (a bad grid point refused) before the folder is touched
-    folder = Path(out_dir)
-    with output_folder(folder), output_lock(folder, "out"):  # an error before any run leaves no empty folder
-        out = output(folder, lock_token(folder))
-        _settle(out.runs)
-        if identity is not None:
-            claim(folder, identity, resume)
-        return _run_locked(task_list, out, how, resume, progress, desc, allow_large, group_runs, resume_option)
-
-
-def _settle(runs: Path) -> None:
-    """What a killed batch left: finish or drop half-replaced results, remove temporary files."""
-    from rockyade.result import settle_results
-
-    remove_stale_temporaries(runs.parent)
-    if runs.is_dir():
-        settle_results(runs)
-
-
-def _run_locked(
-    tasks: list[BatchTask],
-    out: Output,
-    how: Executor,
-    resume: bool,
-    progress: bool,
-    desc: str,
-    allow_large: bool,
-    group_runs: bool,
-    resume_option: str | None,
-) -> pd.DataFrame:
-    first, duplicates = _distinct(tasks)
-    rows: list[dict[str, Any]] = []
-    todo = []
-    for task in first:
-        done = completed_row(task, out.runs) if resume else None
-        if done is not None:
-            rows.append(done)
-        else:
-            todo.append(task)
-    check_costs(todo, allow_large)
-    key = job_key if group_runs else (lambda _task: None)
-    n_grouped = sum(key(t) is not None for t in todo)
-    jobs = group_jobs(todo, key, min(MAX_RUNS_PER_JOB, max(1, -(-n_grouped // (4 * how.workers)))))
-    outcome = run_jobs(
-        jobs,
-        functools.partial(run_job, out=out),
-        executor=how,
-        failed=lambda job, reason: [placeholder_row(task, "failed", reason) for task in job],
-        on_done=lambda _i, job_rows: rows.extend(job_rows),
-        describe_failure=lambda job_rows: "\n".join(filter(None, map(failure_line, job_rows))) or None,
-        progress=progress,
-        desc=desc,
-        skipped=len(rows),
-    )
-    for i in outcome.unfinished:
-        reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"
-        rows.extend(placeholder_row(task, UNFINISHED, reason) for task in jobs[i])
-    by_index = {row["index"]: row for row in rows}
-    for task, original in duplicates:
-        rows.append(duplicate_row(task, by_index[original.index]))
-    summary = summary_frame(rows, list(tasks[0].labels) if tasks else [])
-    folder = Path(out.out_dir)
-    write_summary(summary, folder)
-    if outcome.stopped:
-        if outcome.hard:
-            _settle(out.runs)
-        stopped = {task.index for i in outcome.unfinished for task in jobs[i]}
-        unfinished = len(stopped) + sum(1 for _task, original in duplicates if original.index in stopped)
-        raise BatchInterruptedError(
-            len(tasks) - unfinished, unfinished, str(folder / "summary.csv"), outcome.hard, resume_option
-        )
-    return summary
-
-
-def _distinct(tasks: list[BatchTask]) -> tuple[list[BatchTask], list[tuple[BatchTask, BatchTask]]]:
-    """The tasks run (the first of each run name: the same scene hash and solver) and the
-    duplicates, each with the task it repeats (run once: two tasks would write one file)."""
-    first: dict[str, BatchTask] = {}
-    duplicates = []
-    for task in tasks:
-        name = task_run_name(task)
-        if name in first:
-            duplicates.append((task, first[name]))
-        else:
-            first[name] = task
-    return list(first.values()), duplicates
+    rows = [answered_row(task, one, RunRow.of(task, one.meta, elapsed)) for task, one in zip(job, runs, strict=True)]
+    if out is None:
+        return rows
+    out.runs.mkdir(parents=True, exist_ok=True)
+    return [recorded(row, out) for row in rows]
 
 
 __all__ = [
-    "MAX_RUNS_PER_JOB",
     "BatchTask",
     "Output",
+    "answered_row",
     "batch_task",
     "expand",
     "job_key",
     "keeping_files",
     "lean_solver",
     "output",
+    "record_of",
+    "recorded",
     "run_job",
-    "run_study_tasks",
     "run_task",
     "study_tasks",
 ]

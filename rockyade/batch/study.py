@@ -32,6 +32,7 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.io.fields import TableReader
 from rockyade.motion.types import RecordMotion
+from rockyade.runner.tasks import Cell
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver, make_solvers, solver_names
 from rockyade.solvers.base import Solver
@@ -83,7 +84,7 @@ class GridPoint:
         The validated scene, its record file named by an absolute path.
     """
 
-    labels: dict[str, Any]
+    labels: dict[str, Cell]
     scene: Scene
 
 
@@ -114,8 +115,8 @@ class Study:
     """
 
     name: str
-    bases: tuple[tuple[str, dict[str, Any]], ...]
-    grid: Mapping[str, list[Any]]
+    bases: tuple[tuple[str, dict[str, object]], ...]
+    grid: Mapping[str, list[object]]
     solvers: tuple[Solver, ...]
     save_histories: bool = True
     source: str | None = None
@@ -169,8 +170,8 @@ class Study:
 
 
 def make_study(
-    bases: list[tuple[str, dict[str, Any]]],
-    grid: Mapping[str, list[Any]],
+    bases: list[tuple[str, dict[str, object]]],
+    grid: Mapping[str, list[object]],
     solvers: Iterable[Solver | str],
     *,
     name: str = "study",
@@ -204,7 +205,7 @@ def make_study(
 
 def load_study(
     path: str | Path,
-    options: Mapping[str, Any] | None = None,
+    options: Mapping[str, object] | None = None,
     fields: Mapping[str, str] | None = None,
     allow_large: bool = False,
 ) -> Study:
@@ -305,14 +306,14 @@ def check_run_count(count: int, allow_large: bool = False, source: str | None = 
         )
 
 
-def _scene_dict(path: Path) -> dict[str, Any]:
+def _scene_dict(path: Path) -> dict[str, object]:
     """A base scene file, read and validated, in the scene format's canonical form."""
     from rockyade.scene import load_scene
 
     return load_scene(path).to_dict()
 
 
-def _set_path(d: dict[str, Any], dotted: str, value: Any, source: str | None) -> None:
+def _set_path(d: dict[str, object], dotted: str, value: object, source: str | None) -> None:
     """Set ``d``'s value at ``dotted`` (a list's items by number), dropping its alternatives."""
     parts = dotted.split(".")
     target: Any = d
@@ -345,7 +346,7 @@ def _check_alternatives(keys: Iterable[str], source: str | None) -> None:
         seen[(table, leaf)] = key
 
 
-def _valid_scene(d: dict[str, Any], source: str | None, base_dir: Path | None) -> Scene | None:
+def _valid_scene(d: dict[str, object], source: str | None, base_dir: Path | None) -> Scene | None:
     """The scene of ``d``, or None if it is not valid as it is (a grid point may complete it)."""
     from rockyade.scene import scene_from_dict
 
@@ -355,7 +356,7 @@ def _valid_scene(d: dict[str, Any], source: str | None, base_dir: Path | None) -
         return None
 
 
-def _grid_scene(d: dict[str, Any], base_scene: Scene | None, source: str | None, base_dir: Path | None) -> Scene:
+def _grid_scene(d: dict[str, object], base_scene: Scene | None, source: str | None, base_dir: Path | None) -> Scene:
     """The scene of a grid point ``d``: ``scene_from_dict(d)``. With ``base_scene`` (the valid
     base scene of a grid over the motion only) the same Scene, read at a third of the cost:
     only the motion is read, and checked with the rest (:meth:`rockyade.scene.Scene.with_changes`);
@@ -381,7 +382,7 @@ def _absolute_files(scene: Scene) -> Scene:
     return replace(scene, motion=replace(motion, file=str(Path(motion.file).resolve())))
 
 
-def _label(value: Any) -> Any:
+def _label(value: object) -> Cell:
     """A grid value as a summary cell: a table or list as JSON."""
     return value if isinstance(value, (int, float, str, bool)) else json.dumps(value, sort_keys=True)
 

@@ -4,13 +4,13 @@ them (docs/howto/is-this-wall-safe.md)."""
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
+    accept_negative_values,
     add_run_options,
     count_and_seed,
     executor_from,
@@ -20,12 +20,14 @@ from rockyade.cli.fragility_options import (
     solver_from,
     write_tables,
 )
-from rockyade.cli.resumable import write_partial
 from rockyade.cli.site_options import add_period_option, add_site_options, site_from
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
+    from collections.abc import Callable
+
     from rockyade.assess import DynamicSettings, Position
+    from rockyade.runner.study_folder import StudyFolder
 
 #: Exit code of a scene that cannot stand (the answer is not a number).
 EXIT_UNSTABLE = 1
@@ -85,15 +87,18 @@ def cmd_assess(args: argparse.Namespace) -> int:
     from rockyade.assess import assess
     from rockyade.assess.code import check_code, confidence_factor
     from rockyade.assess.report_lines import assessment_lines
-    from rockyade.cli.resumable import file_digest, finish, identity, study_output
+    from rockyade.assess.stripes import StripesInterruptedError
+    from rockyade.cli.resumable import file_digest, identity
     from rockyade.errors import BatchInterruptedError
     from rockyade.limit.crushing import check_fm
     from rockyade.limit.rigid_blocks import check_friction_angle
+    from rockyade.runner.study_folder import ASSESS, StudyFolder, check_out
     from rockyade.scene import load_scene
 
     check_code(args.code)
     if args.out is not None:
         check_output_dir(args.out, "--out")
+        check_out(args.out, ASSESS, resume_field="--resume" if args.resume else None)  # before any work
     elif args.resume:
         raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
     fc, fc_source = confidence_factor(args.knowledge_level, args.fc)
@@ -129,21 +134,20 @@ def cmd_assess(args: argparse.Namespace) -> int:
     )
     if not args.json:
         print("\n".join(assessment_lines(result, str(args.scene))), flush=True)
-    data: dict[str, Any]
+    data: dict[str, object]
     if dynamic is not None and args.out is not None:
-        with study_output(
-            args.out, identity("assess", args, file_digest(args.scene)), args.resume, ASSESS_SET, ASSESS_LAST
-        ) as output:
+        ident = identity("assess", args, file_digest(args.scene))
+        with StudyFolder(args.out, ASSESS, ident, args.resume, say=_say(args)) as folder:
             try:
-                _dynamics(args, result, scene, dynamic, executor, output.journal)
-            except BatchInterruptedError as exc:
-                _interrupted(args, result, exc, output)
-                raise type(exc)(exc.finished, exc.unfinished, exc.summary_path, exc.hard) from None
-            if output.journal.resumed and not args.json:
-                print(f"resumed: {output.journal.resumed} run(s) read back from {output.partial}, not run again")
+                _dynamics(args, result, scene, dynamic, executor, folder)
+            except StripesInterruptedError as exc:
+                path = _interrupted(args, result, exc, folder)
+                raise BatchInterruptedError(exc.finished, exc.unfinished, path, exc.hard) from None
+            if folder.journal.resumed and not args.json:
+                print(f"resumed: {folder.journal.resumed} run(s) read back from {folder.journal_dir}, not run again")
             data = _finish(args, result, scene)
-            _write(args, result, data)
-            finish(output)
+            _write(folder, args, result, data)
+            folder.finish(result.dynamic.failed if result.dynamic is not None else 0)
         return 0
     if dynamic is not None:
         try:
@@ -151,23 +155,26 @@ def cmd_assess(args: argparse.Namespace) -> int:
         except BatchInterruptedError as exc:
             if args.json:  # the static answer, kept
                 json_out({**_static_data(args, result), "partial": True})
-            raise type(exc)(exc.finished, exc.unfinished, None, exc.hard, "--out DIR (then --resume)") from None
+            raise BatchInterruptedError(
+                exc.finished, exc.unfinished, None, exc.hard, "--out DIR (then --resume)"
+            ) from None
     data = _finish(args, result, scene)
     if args.out is not None:
-        with study_output(
-            args.out, identity("assess", args, file_digest(args.scene)), False, ASSESS_SET, ASSESS_LAST
-        ) as output:
-            _write(args, result, data)
-            finish(output)
+        ident = identity("assess", args, file_digest(args.scene))
+        with StudyFolder(args.out, ASSESS, ident, False, say=_say(args)) as folder:
+            _write(folder, args, result, data)
+            folder.finish()
     return 0
 
 
-#: The files of an assessment's result set, and the one that marks it complete (last in).
-ASSESS_SET = ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json")
-ASSESS_LAST = "assess.json"
+def _say(args: argparse.Namespace) -> Callable[[str], None]:
+    """Where the output folder's notes go: the text, or nowhere beside the JSON."""
+    return (lambda _line: None) if args.json else print
 
 
-def _dynamics(args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, journal: Any) -> None:
+def _dynamics(
+    args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, folder: StudyFolder | None
+) -> None:
     from rockyade.assess.assessment import add_dynamics
 
     def on_plan(plan: Any) -> None:
@@ -183,38 +190,35 @@ def _dynamics(args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, e
         allow_large=args.allow_large,
         progress=not args.quiet,
         on_plan=on_plan,
-        journal=journal,
+        folder=folder,
     )
 
 
-def _static_data(args: argparse.Namespace, result: Any) -> dict[str, Any]:
-    data: dict[str, Any] = result.to_dict()
+def _static_data(args: argparse.Namespace, result: Any) -> dict[str, object]:
+    data: dict[str, object] = result.to_dict()
     data["scene"] = str(args.scene)
     return data
 
 
-def _interrupted(args: argparse.Namespace, result: Any, exc: Any, output: Any) -> None:
+def _interrupted(args: argparse.Namespace, result: Any, exc: Any, folder: StudyFolder) -> str:
     """After Ctrl-C: the static answer (``partial/assess.json``, marked partial) and the runs
-    that finished (``partial/runs.csv``), for ``--resume`` to go on from."""
+    that finished (``partial/runs.csv``), for ``--resume`` to go on from; what the message names."""
     from rockyade.assess.stripes import runs_frame
     from rockyade.io.atomic import write_json
 
-    data = {
-        **_static_data(args, result),
-        "partial": True,
-        "dynamic_interrupted": {"finished": exc.finished, "unfinished": exc.unfinished},
-    }
-    write_json(output.partial / "assess.json", data)
-    rows = getattr(exc, "rows", [])
+    progress = {"finished": exc.finished, "unfinished": exc.unfinished}
+    data = {**_static_data(args, result), "partial": True, "dynamic_interrupted": progress}
+    write_json(folder.partial / "assess.json", data)
+    path = str(folder.partial / "assess.json")
     plan = getattr(exc, "plan", None)
-    exc.summary_path = str(output.partial / "assess.json")
-    if rows and plan is not None:  # the message names the runs' list (the static answer is beside it)
-        exc.summary_path = str(write_partial(output, runs_frame(rows, plan.measure), data["dynamic_interrupted"]))
+    if exc.rows and plan is not None:  # the message names the runs' list (the static answer is beside it)
+        path = str(folder.write_partial(runs_frame(exc.rows, plan.measure), progress))
     if args.json:
         json_out(data)
+    return path
 
 
-def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, Any]:
+def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, object]:
     """The pushover, the dynamics' text, the JSON."""
     from rockyade.assess.report_lines import dynamic_lines
 
@@ -233,14 +237,13 @@ def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, Any]
     return data
 
 
-def _write(args: argparse.Namespace, result: Any, data: dict[str, Any]) -> None:
+def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dict[str, object]) -> None:
     """The result set, replaced as a whole (:mod:`rockyade.io.resultset`)."""
     from rockyade.figures.wall_assessment import draw_assessment
     from rockyade.io.atomic import write_json
-    from rockyade.io.resultset import replacing_set
 
     out: Path = args.out
-    with replacing_set(out, ASSESS_SET, ASSESS_LAST) as stage:
+    with folder.replacing() as stage:
         written = []
         if result.dynamic is not None:
             written += write_tables(stage, result.dynamic)
@@ -359,6 +362,6 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, help="write assess.json, assess.png and the runs' CSVs in this directory")
     p.add_argument("--json", action="store_true", help="print the answer as JSON")
     add_run_options(p, f"records of the site's synthetic suite (default {DEFAULT_COUNT})")
-    # "-x" is a value of --direction, not an option
-    p._negative_number_matcher = re.compile(r"^-x$|^-\d+$|^-\d*\.\d+$")
+    # "-x" is a value of --direction, not an option; nor is a negative number (refused by its option)
+    accept_negative_values(p, also="-x$")
     p.set_defaults(func=cmd_assess)

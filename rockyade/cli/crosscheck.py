@@ -10,6 +10,7 @@ from typing import Any
 
 from rockyade.cli.common import add_allow_large, check_output_dir
 from rockyade.cli.fragility_options import add_record_source
+from rockyade.cli.resumable import add_executor_options
 from rockyade.errors import InputError
 
 
@@ -22,13 +23,12 @@ def _fraction(text: str, option: str) -> float:
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
     """Plan (cost line), run the rounds, write the set and swap it in; exit 1 when a run failed."""
-    from rockyade.assess import parse_measure, records_in_folder
-    from rockyade.assess.motions import MotionSet
+    from rockyade.assess import parse_measure
     from rockyade.cli.common import solver_options
-    from rockyade.cli.fragility_options import float_list, refuse_suite_options_with_records, suite_from
+    from rockyade.cli.fragility_options import float_list, motions_from
     from rockyade.runner import Executor
     from rockyade.scene import load_scene
-    from rockyade.studies.crosscheck_study import (
+    from rockyade.studies.crosscheck import (
         check_dt_factors,
         check_out,
         crosscheck_plan,
@@ -37,7 +37,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     )
 
     check_output_dir(args.out, "--out")
-    check_out(args.out)
+    check_out(args.out, args.resume)
     names = parse_solvers(args.solvers)
     measure = parse_measure(args.intensity)
     levels = float_list(args.levels, "--levels") if args.levels else None
@@ -51,16 +51,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     options, _flags = solver_options(args)
     if "timeout_s" in options and "yade" not in names:
         raise InputError("--yade-timeout", "applies to the yade solver; this cross-check does not run it")
-    if args.records is not None:
-        for option in ("spectrum_type", "ground", "ag"):
-            if getattr(args, option) is not None:
-                raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8, not to --records")
-        refuse_suite_options_with_records(args)
-        motions: MotionSet = records_in_folder(args.records, args.units)
-    else:
-        if args.units is not None:
-            raise InputError("--units", "applies to --records")
-        motions = suite_from(args)
+    motions = motions_from(args)
     scene = load_scene(args.scene)
     record_executor = how if how.kind == "local" else Executor("local", args.workers)
     plan = crosscheck_plan(
@@ -150,15 +141,7 @@ def register(sub: Any) -> None:
         help="time-step factors in [0.001, 1], the first 1 (default 1,0.5: the convergence check)",
     )
     p.add_argument("--out", type=Path, required=True, help="output directory (replaced as a whole when done)")
-    p.add_argument("--resume", action="store_true", help="finish an interrupted cross-check without repeating a run")
-    p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
-    p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or Dask")
-    p.add_argument(
-        "--scheduler", help="Dask scheduler address (default: Dask's threaded scheduler in this process; no port opens)"
-    )
-    p.add_argument(
-        "--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)"
-    )
+    add_executor_options(p, "finish an interrupted cross-check without repeating a run (failed runs run again)")
     p.add_argument(
         "--fallen-blocks",
         type=int,

@@ -14,50 +14,35 @@ from rockyade.cli.fragility_options import (
     add_run_options,
     executor_from,
     float_list,
+    motions_from,
     print_plan,
-    refuse_suite_options_with_records,
     solver_from,
-    suite_from,
     write_tables,
 )
-from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
-    from rockyade.assess.motions import MotionSet
-
-
-#: The files of a fragility result set, and the one that marks it complete (last in).
-FRAGILITY_SET = ("runs.csv", "stripes.csv", "records.csv", "fragility.png", "fragility.json")
-FRAGILITY_LAST = "fragility.json"
+    pass
 
 
 def cmd_fragility(args: argparse.Namespace) -> int:
     """Run the stripes, fit the curve, write the CSVs, JSON and figure (a set replaced as a
     whole); Ctrl-C writes a partial summary that ``--resume`` goes on from."""
-    from rockyade.assess import fragility_plan, parse_measure, records_in_folder, run_fragility
+    from rockyade.assess import fragility_plan, parse_measure, run_fragility
     from rockyade.assess.report_lines import fit_lines
-    from rockyade.assess.stripes import runs_frame
-    from rockyade.cli.resumable import file_digest, finish, identity, study_output, write_partial
+    from rockyade.assess.stripes import StripesInterruptedError, runs_frame
+    from rockyade.cli.resumable import file_digest, identity
     from rockyade.errors import BatchInterruptedError
     from rockyade.io.atomic import write_json
-    from rockyade.io.resultset import replacing_set
+    from rockyade.runner.study_folder import FRAGILITY, StudyFolder, check_out
     from rockyade.scene import load_scene
 
     check_output_dir(args.out, "--out")
+    check_out(args.out, FRAGILITY, resume_field="--resume" if args.resume else None)  # before the plan
     measure = parse_measure(args.intensity)
     levels = float_list(args.levels, "--levels") if args.levels else None
     executor = executor_from(args)
     solver = solver_from(args)
-    if args.records is not None:
-        for option in ("spectrum_type", "ground", "ag"):
-            if getattr(args, option) is not None:
-                raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8, not to --records")
-        refuse_suite_options_with_records(args)
-        motions: MotionSet = records_in_folder(args.records, args.units)
-    else:
-        if args.units is not None:
-            raise InputError("--units", "applies to --records")
-        motions = suite_from(args)
+    motions = motions_from(args)
     scene = load_scene(args.scene)
     # every check (the levels' load factors included) before --out is made
     plan = fragility_plan(
@@ -74,34 +59,26 @@ def cmd_fragility(args: argparse.Namespace) -> int:
         progress=not args.quiet,
     )
     ident = identity("fragility", args, file_digest(args.scene))
-    with study_output(args.out, ident, args.resume, FRAGILITY_SET, FRAGILITY_LAST) as output:
+    with StudyFolder(args.out, FRAGILITY, ident, args.resume, say=print) as folder:
         print(f"fragility of {args.scene}")
         print_plan(plan, args.workers)
         try:
             result = run_fragility(
-                plan,
-                executor,
-                allow_large=args.allow_large,
-                progress=not args.quiet,
-                on_round=print,
-                journal=output.journal,
+                plan, executor, allow_large=args.allow_large, progress=not args.quiet, on_round=print, folder=folder
             )
-        except BatchInterruptedError as exc:
-            rows = getattr(exc, "rows", [])
-            if rows:
-                exc.summary_path = str(
-                    write_partial(
-                        output, runs_frame(rows, plan.measure), {"finished": exc.finished, "unfinished": exc.unfinished}
-                    )
-                )
-            raise type(exc)(exc.finished, exc.unfinished, exc.summary_path, exc.hard) from None
-        if output.journal.resumed:
-            print(f"resumed: {output.journal.resumed} run(s) read back from {output.partial}, not run again")
+        except StripesInterruptedError as exc:
+            path = None
+            if exc.rows:
+                progress = {"finished": exc.finished, "unfinished": exc.unfinished}
+                path = str(folder.write_partial(runs_frame(exc.rows, plan.measure), progress))
+            raise BatchInterruptedError(exc.finished, exc.unfinished, path, exc.hard) from None
+        if folder.journal.resumed:
+            print(f"resumed: {folder.journal.resumed} run(s) read back from {folder.journal_dir}, not run again")
         for line in fit_lines(result):
             print(line)
         from rockyade.figures.wall_assessment import draw_fragility
 
-        with replacing_set(args.out, FRAGILITY_SET, FRAGILITY_LAST) as stage:
+        with folder.replacing() as stage:
             written = write_tables(stage, result)
             data = result.to_dict()
             data["scene"] = str(args.scene)
@@ -109,7 +86,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
             written.append("fragility.png")
             write_json(stage / "fragility.json", data)
             written.append("fragility.json")
-        finish(output)
+        folder.finish(result.failed)
     print(f"wrote {', '.join(written)} in {args.out}")
     return 1 if result.failed else 0
 

@@ -4,6 +4,7 @@ workers, records, collapse, sampling), the synthetic suite, the plan's printout 
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -13,6 +14,7 @@ from rockyade.errors import InputError
 if TYPE_CHECKING:  # the parser stays fast: these are imported when a command runs
     from rockyade.assess import SyntheticSuite
     from rockyade.assess.fragility_analysis import FragilityPlan, FragilityResult
+    from rockyade.assess.motions import MotionSet
     from rockyade.runner import Executor
     from rockyade.solvers.base import Solver
 
@@ -59,7 +61,7 @@ def suite_from(args: argparse.Namespace) -> SyntheticSuite:
                 raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8 (the paper's suite is fixed)")
         if args.seed is not None:
             raise InputError("--seed", "applies to --suite ec8 (the paper's suite has its own)")
-        return paper_suite_set(args.count or 30)
+        return paper_suite_set(30 if args.count is None else args.count)  # --count 0 is refused, not 30
     missing = [o for o in ("spectrum_type", "ground", "ag") if getattr(args, o) is None]
     if missing:
         flags = ", ".join("--" + o.replace("_", "-") for o in missing)
@@ -68,6 +70,22 @@ def suite_from(args: argparse.Namespace) -> SyntheticSuite:
         )
     ag = parse_acceleration(args.ag, "--ag")
     return ec8_suite(args.spectrum_type, args.ground, ag, *count_and_seed(args))
+
+
+def motions_from(args: argparse.Namespace) -> MotionSet:
+    """The record set of ``--records DIR`` (with ``--units``) or ``--suite`` (its own options),
+    each option refused where it does not apply."""
+    from rockyade.assess import records_in_folder
+
+    if args.records is not None:
+        for option in ("spectrum_type", "ground", "ag"):
+            if getattr(args, option) is not None:
+                raise InputError("--" + option.replace("_", "-"), "applies to --suite ec8, not to --records")
+        refuse_suite_options_with_records(args)
+        return records_in_folder(args.records, args.units)
+    if args.units is not None:
+        raise InputError("--units", "applies to --records")
+    return suite_from(args)
 
 
 def count_and_seed(args: argparse.Namespace) -> tuple[int, int]:
@@ -83,9 +101,23 @@ def refuse_suite_options_with_records(args: argparse.Namespace) -> None:
             raise InputError("--" + option, "applies to a synthetic suite, not to --records")
 
 
+#: What argparse takes for a value, not an option, when it starts with "-": a negative number
+#: however written (``-0.3,0.6`` for ``--levels``, ``-0.25g`` for ``--ag``), so that the option's
+#: own check names it and its range rather than argparse's "expected one argument".
+NEGATIVE_VALUE = r"-\.?\d"
+
+
+def accept_negative_values(p: argparse.ArgumentParser, also: str = "") -> None:
+    """Let ``p`` take values that start with a minus sign and a digit (:data:`NEGATIVE_VALUE`),
+    and ``also`` (a regular expression of other such values, e.g. ``-x``)."""
+    pattern = f"^(?:{NEGATIVE_VALUE}" + (f"|{also}" if also else "") + ")"
+    p._negative_number_matcher = re.compile(pattern)  # argparse's own hook for values like "-1"
+
+
 def add_record_source(p: argparse.ArgumentParser) -> None:
     """The record set of a study of many records: ``--records DIR`` or ``--suite``, with the EC8
     suite's ``--spectrum-type``, ``--ground`` and ``--ag``."""
+    accept_negative_values(p)
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--records", type=Path, metavar="DIR", help="a folder of record files (.at2, .csv, .txt, .dat)")
     source.add_argument(

@@ -1,38 +1,27 @@
-"""What every command that runs many runs shares: ``--executor``/``--scheduler`` (as
-``batch`` takes them), ``--resume``, the journal of finished runs in ``--out``, the partial
-summary after Ctrl-C, and the result set replaced as a whole.
-
-``--out DIR`` of such a command holds its result set (replaced as a whole:
-:mod:`rockyade.io.resultset`) and, while a study is unfinished, ``DIR/partial/``: the
-journal (:class:`rockyade.runner.journal.Journal`, one durable record per finished run and
-``study.json``) and, after Ctrl-C, the partial summary (``runs.csv`` and ``partial.json``,
-marked ``"partial": true``). ``--resume`` reads the journal back; a complete set removes it.
+"""What every command that runs many runs shares on the command line: ``--executor``,
+``--scheduler`` and ``--workers`` (as ``batch`` takes them), ``--resume``, and the study's
+identity (what decides its runs). The output folder's life (lock, journal, partial summary, the
+set replaced as a whole) is :class:`rockyade.runner.study_folder.StudyFolder`'s.
 """
 
 from __future__ import annotations
 
 import argparse
-import contextlib
 import hashlib
-import json
-from collections.abc import Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:
     from rockyade.runner import Executor
-    from rockyade.runner.journal import Journal
-
-#: The journal and partial summary's folder in ``--out``.
-PARTIAL_DIR = "partial"
+    from rockyade.runner.tasks import Cell
 
 
-def add_executor_options(p: argparse.ArgumentParser) -> None:
-    """``--workers``, ``--executor``, ``--scheduler``, ``--scheduler-timeout`` and ``--resume``,
-    as ``batch`` takes them."""
+def add_executor_options(p: argparse.ArgumentParser, resume_help: str | None = None) -> None:
+    """``--workers``, ``--executor``, ``--scheduler``, ``--scheduler-timeout`` and ``--resume``
+    (``resume_help``: what it does for this command), the same for every study command."""
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument(
         "--executor",
@@ -51,7 +40,8 @@ def add_executor_options(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--resume",
         action="store_true",
-        help="keep the runs an interrupted run of the same command left in --out (partial/) and run only the others",
+        help=resume_help
+        or "keep the runs an interrupted run of the same command left in --out (partial/) and run only the others",
     )
 
 
@@ -67,9 +57,11 @@ def executor_from(args: argparse.Namespace) -> Executor:
         raise InputError(flag.get(exc.field, "--executor"), exc.message) from None
 
 
-def identity(command: str, args: argparse.Namespace, scene_hash: str, ignore: Sequence[str] = ()) -> dict[str, Any]:
+def identity(command: str, args: argparse.Namespace, scene_hash: str, ignore: Sequence[str] = ()) -> dict[str, object]:
     """What decides a command's runs: its name, the scene's hash and every option but those
-    that only say where or how it runs (``--out``, ``--resume``, the executor, progress)."""
+    that only say where or how it runs (``--out``, ``--resume``, the executor, progress). A
+    path is the file or folder it names (resolved): the same records given by a relative or an
+    absolute path are the same study."""
     skip = {
         "out",
         "resume",
@@ -88,9 +80,9 @@ def identity(command: str, args: argparse.Namespace, scene_hash: str, ignore: Se
     return {"command": command, "scene_hash": scene_hash, "options": options}
 
 
-def _plain(value: Any) -> Any:
+def _plain(value: object) -> Cell:
     if isinstance(value, Path):
-        return str(value)
+        return str(value.resolve())
     if value is None or isinstance(value, (bool, int, float, str)):
         return value
     return repr(value)
@@ -101,75 +93,4 @@ def file_digest(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
 
 
-@dataclass
-class StudyOutput:
-    """An output folder of a study while it runs (module docstring)."""
-
-    out: Path
-    journal: Journal
-    created: bool
-
-    @property
-    def partial(self) -> Path:
-        """The journal's folder."""
-        return self.journal.folder
-
-
-@contextlib.contextmanager
-def study_output(
-    out: Path, ident: Mapping[str, Any], resume: bool, names: Sequence[str], last: str
-) -> Iterator[StudyOutput]:
-    """Make ``out`` (after every check: the caller validated its input), lock it, settle what
-    a killed run left, open its journal. On an error or Ctrl-C that leaves no finished run, a
-    folder made here is removed again (no empty ``--out``).
-
-    Raises
-    ------
-    InputError
-        Another process writes ``out``; ``resume`` over another study's journal.
-    """
-    from rockyade.io.folders import output_folder
-    from rockyade.io.locking import output_lock
-    from rockyade.io.resultset import settle
-    from rockyade.runner.journal import Journal
-
-    with output_folder(out) as created, output_lock(out, "--out"):
-        settle(out, names, last)
-        journal = Journal(out / PARTIAL_DIR, ident, resume)
-        ok = False
-        try:
-            yield StudyOutput(out, journal, created)
-            ok = True
-        finally:
-            if not ok:
-                journal.remove_if_empty()
-
-
-def write_partial(output: StudyOutput, frame: Any, summary: Mapping[str, Any]) -> Path:
-    """The partial summary after Ctrl-C: ``partial/runs.csv`` (what finished) and
-    ``partial/partial.json`` (``"partial": true`` and ``summary``); the CSV's path."""
-    from rockyade.io.atomic import atomic_open, write_json
-
-    path = output.partial / "runs.csv"
-    with atomic_open(path) as fh:
-        frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
-    write_json(output.partial / "partial.json", {"partial": True, **json.loads(json.dumps(dict(summary), default=str))})
-    return path
-
-
-def finish(output: StudyOutput) -> None:
-    """The set is complete: the journal goes."""
-    output.journal.clear()
-
-
-__all__ = [
-    "PARTIAL_DIR",
-    "StudyOutput",
-    "add_executor_options",
-    "executor_from",
-    "file_digest",
-    "finish",
-    "identity",
-    "study_output",
-    "write_partial",
-]
+__all__ = ["add_executor_options", "executor_from", "file_digest", "identity"]

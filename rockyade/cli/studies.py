@@ -16,6 +16,7 @@ from rockyade.cli.common import (
     solvers_from_args,
     total_time,
 )
+from rockyade.cli.resumable import add_executor_options
 from rockyade.errors import InputError
 
 
@@ -134,6 +135,9 @@ def cmd_batch(args: argparse.Namespace) -> int:
     check_output_dir(args.out, "out")
     from rockyade.batch import failures, load_study, run_study_tasks, study_tasks
     from rockyade.runner import Executor
+    from rockyade.runner.study_folder import BATCH, check_out
+
+    check_out(args.out, BATCH, resume_field="--resume" if args.resume else None)  # before the study is read
 
     how = Executor(args.executor, args.workers, args.scheduler, args.scheduler_timeout)  # checked before any work
     study = load_study(args.study, *solver_options(args), allow_large=args.allow_large)
@@ -198,20 +202,7 @@ def register(sub: Any) -> None:
     )
     p.add_argument("study", type=Path, help="study file (.toml)")
     p.add_argument("--out", type=Path, required=True, help="output directory")
-    p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
-    p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or a Dask cluster")
-    p.add_argument(
-        "--scheduler",
-        help="Dask scheduler address, e.g. tls://host:8786 (default: Dask's threaded scheduler in this "
-        "process; no port opens). See docs/batches.md for TLS",
-    )
-    p.add_argument(
-        "--scheduler-timeout",
-        type=float,
-        default=10.0,
-        help="seconds to wait for the scheduler to answer (default 10)",
-    )
-    p.add_argument("--resume", action="store_true", help="skip runs already completed; re-run failed ones")
+    add_executor_options(p, "skip runs already completed; re-run failed ones")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_yade_timeout(p)
     add_allow_large(p)

@@ -10,9 +10,11 @@ from typing import Any
 def cmd_uncertainty(args: argparse.Namespace) -> int:
     """Run an uncertainty study and print its probabilities and fragility fits."""
     from rockyade.cli.common import check_output_dir
-    from rockyade.studies.uncertainty_study import load_uncertainty_study, run_uncertainty
+    from rockyade.runner.study_folder import UNCERTAINTY, check_out
+    from rockyade.studies.uncertainty import load_uncertainty_study, run_uncertainty
 
     check_output_dir(args.out, "--out")
+    check_out(args.out, UNCERTAINTY, resume_field="--resume" if args.resume else None)  # before reading it
     study = load_uncertainty_study(args.study)
     if args.samples is not None or args.seed is not None:
         if args.samples is not None and args.samples < 1:
@@ -83,6 +85,8 @@ def _measure_text(value: float, measure: str, unit: str) -> str:
 
 def register(sub: Any) -> None:
     """Add ``rockyade uncertainty``."""
+    from rockyade.cli.resumable import add_executor_options
+
     p = sub.add_parser(
         "uncertainty",
         help="probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)",
@@ -96,19 +100,7 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--samples", type=int, help="override the number of parameter samples")
     p.add_argument("--seed", type=int, help="override the seed of the Latin hypercube")
-    p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
-    p.add_argument("--executor", choices=["local", "dask"], default="local", help="local processes or a Dask cluster")
-    p.add_argument(
-        "--scheduler",
-        help="Dask scheduler address, e.g. tls://host:8786 (default: Dask's threaded scheduler in this "
-        "process; no port opens). See docs/batches.md",
-    )
-    p.add_argument(
-        "--scheduler-timeout", type=float, default=10.0, help="seconds to wait for the scheduler (default 10)"
-    )
-    p.add_argument(
-        "--resume", action="store_true", help="skip runs already completed by an interrupted run of the same study"
-    )
+    add_executor_options(p, "skip runs already completed by an interrupted run of the same study")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument(
         "--accel-units",

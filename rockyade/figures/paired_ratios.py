@@ -79,7 +79,7 @@ class PairedRatios:
 
     @classmethod
     def from_pairs(cls, pairs: pd.DataFrame, measure: str = "pga", tolerance: float = 0.05) -> PairedRatios:
-        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck_report.summarise`); with a
+        """The display of ``pairs.csv`` (:func:`rockyade.studies.crosscheck.reporting.summarise`); with a
         ``scene`` column (several cross-checks in one table), each label starts with it.
 
         Raises

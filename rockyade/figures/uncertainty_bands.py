@@ -42,7 +42,7 @@ def plot_uncertainty(
     Parameters
     ----------
     study, probabilities, runs, fragility, spread
-        The study and its tables (:func:`rockyade.studies.uncertainty_study.run_uncertainty`).
+        The study and its tables (:func:`rockyade.studies.uncertainty.run_uncertainty`).
     path
         PNG to write (atomically); None writes nothing.
     n_bins

@@ -63,15 +63,27 @@ from __future__ import annotations
 import functools
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
 
+from rockyade.housner.equation import (
+    I_AL,
+    I_AR,
+    I_G,
+    I_LAL,
+    I_LAR,
+    I_LBL,
+    I_LBR,
+    I_LOADED,
+    I_MULR,
+    I_MURL,
+    I_PL,
+    I_PR,
+    theta_dd,
+)
+from rockyade.housner.sdof import HousnerModel
 from rockyade.motion.ground import GroundMotion, ground_acceleration
-
-if TYPE_CHECKING:
-    from rockyade.housner.sdof import HousnerModel
 
 #: A block is declared at rest when an impact leaves it an energy that would lift it by
 #: less than REST_FRACTION * alpha.
@@ -85,39 +97,21 @@ _STATUS_NAMES = ("completed", "overturned")
 
 # ------------------------------------------------------------------ numba kernel
 
-_AL, _AR, _PL2G, _PR2G, _MULR, _MURL, _G, _PL, _PR, _LAL, _LBL, _LAR, _LBR, _LOADED = range(14)
-
-
-@numba.njit(cache=True)
-def _theta_dd(side, theta, ah, av, prm):
-    """theta'' of Eq 1, with the point loads' moment when there are some (module docstring)."""
-    if side > 0:
-        a = prm[_AL] - theta
-        acc = -(prm[_G] + av) * math.sin(a) + ah * math.cos(a)
-        if prm[_LOADED] != 0.0:
-            acc += (prm[_G] + av) / prm[_G] * (prm[_LAL] * math.cos(theta) - prm[_LBL] * math.sin(theta))
-        return prm[_PL2G] * acc
-    a = prm[_AR] + theta
-    acc = (prm[_G] + av) * math.sin(a) + ah * math.cos(a)
-    if prm[_LOADED] != 0.0:
-        acc += (prm[_G] + av) / prm[_G] * (prm[_LAR] * math.cos(theta) - prm[_LBR] * math.sin(theta))
-    return prm[_PR2G] * acc
-
 
 @numba.njit(cache=True)
 def _rk4(t, th, om, h, side, prm, mt, mah, mav):
     """One classical Runge-Kutta step of size h; returns (theta, omega)."""
     ah, av, j = ground_acceleration(t, mt, mah, mav, 0)
     k1t = om
-    k1w = _theta_dd(side, th, ah, av, prm)
+    k1w = theta_dd(side, th, ah, av, prm)
     ah, av, j = ground_acceleration(t + 0.5 * h, mt, mah, mav, j)
     k2t = om + 0.5 * h * k1w
-    k2w = _theta_dd(side, th + 0.5 * h * k1t, ah, av, prm)
+    k2w = theta_dd(side, th + 0.5 * h * k1t, ah, av, prm)
     k3t = om + 0.5 * h * k2w
-    k3w = _theta_dd(side, th + 0.5 * h * k2t, ah, av, prm)
+    k3w = theta_dd(side, th + 0.5 * h * k2t, ah, av, prm)
     ah, av, _ = ground_acceleration(t + h, mt, mah, mav, j)
     k4t = om + h * k3w
-    k4w = _theta_dd(side, th + h * k3t, ah, av, prm)
+    k4w = theta_dd(side, th + h * k3t, ah, av, prm)
     return (
         th + h / 6.0 * (k1t + 2.0 * k2t + 2.0 * k3t + k4t),
         om + h / 6.0 * (k1w + 2.0 * k2w + 2.0 * k3w + k4w),
@@ -198,10 +192,10 @@ def _uplift(t0, t_end, mt, mah, mav, prm):
     n = mt.size
     if n < 2 or t0 >= mt[n - 1]:
         return -1.0, 0
-    g = prm[_G]
+    g = prm[I_G]
     # uplift multipliers (module docstring): tan(alpha) without loads
-    tan_l = math.tan(prm[_AL]) - prm[_LAL] / (g * math.cos(prm[_AL]))
-    tan_r = math.tan(prm[_AR]) + prm[_LAR] / (g * math.cos(prm[_AR]))
+    tan_l = math.tan(prm[I_AL]) - prm[I_LAL] / (g * math.cos(prm[I_AL]))
+    tan_r = math.tan(prm[I_AR]) + prm[I_LAR] / (g * math.cos(prm[I_AR]))
     ah, av, _ = ground_acceleration(t0, mt, mah, mav, 0)
     fp = ah - (g + av) * tan_l
     fm = -ah - (g + av) * tan_r
@@ -248,7 +242,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
     status = 0
     t_over = -1.0
     t_alpha = -1.0
-    alpha_min = min(prm[_AL], prm[_AR])
+    alpha_min = min(prm[I_AL], prm[I_AR])
     n_motion = mt.size
     t = 0.0
     th = theta0
@@ -262,7 +256,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         omega_s[0] = om
         side0 = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
         ah, av, _ = ground_acceleration(0.0, mt, mah, mav, 0)
-        acc_s[0] = _theta_dd(side0, th, ah, av, prm)
+        acc_s[0] = theta_dd(side0, th, ah, av, prm)
         k = 1
     while t < duration:
         if resting:
@@ -282,7 +276,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
             side = side_up
         elif th != 0.0 or om != 0.0:
             side = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
-        alpha_side = prm[_AL] if side > 0 else prm[_AR]
+        alpha_side = prm[I_AL] if side > 0 else prm[I_AR]
         # step end: no longer than h_max, aligned with the next base-motion sample
         h = h_max
         if n_motion >= 2 and t < mt[n_motion - 1]:
@@ -332,7 +326,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
             theta_s[k] = thk
             omega_s[k] = omk
             ah, av, _ = ground_acceleration(tk, mt, mah, mav, 0)
-            acc_s[k] = _theta_dd(side, thk, ah, av, prm)
+            acc_s[k] = theta_dd(side, thk, ah, av, prm)
             k += 1
         if event == 0:
             t, th, om = t + h, th1, om1
@@ -343,7 +337,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
             status = 1
             t_over = t
             break
-        mu = prm[_MULR] if side > 0 else prm[_MURL]
+        mu = prm[I_MULR] if side > 0 else prm[I_MURL]
         om_after = mu * om_e
         if counts[0] < max_events:
             impacts[counts[0], 0] = t
@@ -353,20 +347,24 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         th = 0.0
         om = om_after
         new_side = -side
-        p_new = prm[_PL] if new_side > 0 else prm[_PR]
-        a_new = prm[_AL] if new_side > 0 else prm[_AR]
+        p_new = prm[I_PL] if new_side > 0 else prm[I_PR]
+        a_new = prm[I_AL] if new_side > 0 else prm[I_AR]
         lift = 0.5 * om_after * om_after / (p_new * p_new)
         eps_rest = rest_lift * alpha_min
         barrier = math.cos(a_new - eps_rest) - math.cos(a_new)
-        if prm[_LOADED] != 0.0:
-            la = prm[_LAL] if new_side > 0 else prm[_LAR]
-            lb = prm[_LBL] if new_side > 0 else prm[_LBR]
-            barrier += (-new_side * la * math.sin(eps_rest) + lb * (1.0 - math.cos(eps_rest))) / prm[_G]
+        if prm[I_LOADED] != 0.0:
+            la = prm[I_LAL] if new_side > 0 else prm[I_LAR]
+            lb = prm[I_LBL] if new_side > 0 else prm[I_LBR]
+            barrier += (-new_side * la * math.sin(eps_rest) + lb * (1.0 - math.cos(eps_rest))) / prm[I_G]
         if lift < barrier:
             om = 0.0
             resting = True
     return theta_s, omega_s, acc_s, impacts, peaks, uplifts, counts, status, t_over, t_alpha, k
 
+
+#: The compiled functions of a run (numba's cache holds them once a run compiled them:
+#: :meth:`rockyade.solvers.housner.HousnerSolver.compiled_cached`).
+KERNELS = (_integrate,)
 
 # ------------------------------------------------------------------ Python API
 
@@ -435,7 +433,7 @@ def solve(
     step_s
         Largest Runge-Kutta step, s (default 1 / (400 p)).
     """
-    prm = model._params()
+    prm = model.params()
     if step_s is None:
         step_s = 1.0 / (STEPS_PER_RADIAN * max(model.p_left, model.p_right))
     if motion is None and model.loaded:
@@ -487,6 +485,4 @@ def solve(
 @functools.cache
 def warm_up() -> None:
     """Load the compiled kernel once per process, so that wall times measure the solve."""
-    from rockyade.housner.sdof import HousnerModel
-
     solve(HousnerModel.symmetric(0.2, 3.0, 0.9), GroundMotion(np.array([0.0, 0.1]), np.zeros(2)), 0.01, 0.01)

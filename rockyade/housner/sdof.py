@@ -11,7 +11,7 @@ import numpy as np
 
 from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
-from rockyade.housner.integrator import _theta_dd
+from rockyade.housner.equation import theta_dd
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical, residual_force
 
@@ -68,7 +68,7 @@ class HousnerModel:
 
     def acceleration(self, side: int, theta: float, ah: float = 0.0, av: float = 0.0) -> float:
         """theta'' on ``side`` (+1 left pivot, -1 right pivot), rad/s^2."""
-        return _theta_dd(side, theta, ah, av, self._params())
+        return theta_dd(side, theta, ah, av, self.params())
 
     def energy(self, side: int, theta: float, omega: float) -> float:
         """Energy in units of M g R of the active side (R its pivot-to-centroid distance):
@@ -98,7 +98,9 @@ class HousnerModel:
         loads = -(a / self.g) * math.sin(theta) + (b / self.g) * (1.0 - math.cos(theta))
         return 0.5 * omega * omega / (p * p) + math.cos(alpha - abs(theta)) - math.cos(alpha) + loads
 
-    def _params(self) -> np.ndarray:
+    def params(self) -> np.ndarray:
+        """The model as the array :func:`rockyade.housner.equation.theta_dd` takes (its order:
+        :data:`rockyade.housner.equation.PARAMS`)."""
         return np.array(
             [
                 self.alpha_left,

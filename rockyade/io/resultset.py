@@ -24,10 +24,11 @@ mix that looks complete.
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import secrets
 import shutil
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 
 from rockyade.io.atomic import fsync_dir
@@ -62,9 +63,9 @@ def replacing_set(folder: str | os.PathLike[str], names: Sequence[str], last: st
         written = sorted(p.name for p in stage.iterdir())
         if last not in written:
             raise ValueError(f"the new set has no {last}")
-        (stage / NAMES_FILE).write_text("\n".join(written) + "\n")
+        _named(functools.partial((stage / NAMES_FILE).write_text, "\n".join(written) + "\n"), stage / NAMES_FILE)
         for name in written:
-            _fsync(stage / name)
+            _named(functools.partial(_fsync, stage / name), stage / name)
         fsync_dir(stage)
         os.rename(stage, folder / COMMIT_DIR)  # the commit point
         fsync_dir(folder)
@@ -114,6 +115,16 @@ def _finish(folder: Path, names: Sequence[str], last: str) -> None:
         os.replace(commit / last, folder / last)
     fsync_dir(folder)
     shutil.rmtree(commit, ignore_errors=True)
+
+
+def _named(step: Callable[[], object], path: Path) -> None:
+    """Do ``step``; an OSError that names no file (a full disk's) names ``path``."""
+    try:
+        step()
+    except OSError as exc:
+        if exc.filename is None:
+            exc.filename = str(path)
+        raise
 
 
 def _fsync(path: Path) -> None:

@@ -4,7 +4,7 @@ classical parameters alone cause.
 
 Input: one row per run with ``solver``, ``load_factor``, ``status`` (completed, overturned,
 failed), ``max_theta_over_alpha`` and, for the spread, ``sample``, ``nominal`` and
-``record`` (the runs table of :mod:`rockyade.studies.uncertainty_study`). Failed runs are
+``record`` (the runs table of :mod:`rockyade.studies.uncertainty`). Failed runs are
 counted and left out of every probability. An overturned run exceeds every level.
 """
 

@@ -11,9 +11,14 @@
   many scenes, Results in order;
 * worker processes ignore Ctrl-C, lead their own process group and die with this process
   however it dies (:mod:`rockyade.runner.workers`); no executor opens a port unless given a
-  Dask scheduler's address.
+  Dask scheduler's address;
+* :class:`~rockyade.runner.rows.RunRow`: the one typed row of a study's run;
+  :mod:`rockyade.runner.journal`: the journal of finished runs (sealed records, the study's
+  identity); :class:`~rockyade.runner.study_folder.StudyFolder`: a study's output folder and its
+  whole life (refusals, lock, settle, journal, partial summary, the set swapped in).
 
-Batches (:mod:`rockyade.batch`) and the studies run on it::
+Every study runs its runs through :func:`rockyade.batch.run_study` (above the analysis, which
+gives each run its verdict and metrics); a script runs scenes with :func:`solve_scenes`::
 
     from rockyade.runner import Executor, solve_scenes
 

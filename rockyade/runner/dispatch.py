@@ -15,6 +15,7 @@ over many scenes, Results back in order.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
@@ -78,6 +79,7 @@ def run_jobs(
     progress: bool = False,
     desc: str = "runs",
     skipped: int = 0,
+    stop: StopRequest | None = None,
 ) -> Outcome[Value]:
     """Run ``fn(job)`` for every job on ``executor`` (module docstring).
 
@@ -96,6 +98,9 @@ def run_jobs(
         Show a progress bar named ``desc``.
     skipped
         Jobs done before (a resumed batch): counted on the bar as already finished.
+    stop
+        The stop request (Ctrl-C) of a study of several rounds, entered by the caller (None:
+        this call installs its own): a Ctrl-C between two rounds stays requested for the next.
     """
     jobs = list(jobs)
     values: dict[int, Value] = {}
@@ -113,7 +118,9 @@ def run_jobs(
             bar.write(line)
 
     stopped_now = False
-    with StopRequest(raise_on_second=executor.in_process) as stop:
+    with contextlib.ExitStack() as stack:
+        if stop is None:
+            stop = stack.enter_context(StopRequest(raise_on_second=executor.in_process))
         try:
             executor.run(jobs, fn, done, failed, stop, started)
         except KeyboardInterrupt:
@@ -127,7 +134,7 @@ def run_jobs(
         values=values,
         unfinished=unfinished,
         started=frozenset(started),
-        stopped=stop.requested and bool(unfinished),  # a Ctrl-C after the last job changes nothing
+        stopped=stop.requested and bool(unfinished),  # a Ctrl-C after the last job changes nothing here
         hard=stop.now or stopped_now,
     )
 

@@ -8,13 +8,22 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
 
 from rockyade.errors import RockyadeError
 from rockyade.result import Result, failed_result
 from rockyade.runner.cost_limits import cost_refusal
 from rockyade.scene import Scene
 from rockyade.solvers.base import Solver
+
+#: A value of a table a study writes (a task's label, a cell of a run's row): strict JSON's
+#: scalars (NaN and infinity written as null).
+Cell = float | int | str | bool | None
+
+
+def run_name(scene_hash: str, solver: str) -> str:
+    """A run's name, ``<scene hash>_<solver>``: its file stem in a study's folder, and what a
+    resumed study finds it by (every study names its runs so)."""
+    return f"{scene_hash}_{solver}"
 
 
 @dataclass(frozen=True)
@@ -38,11 +47,16 @@ class Task:
     index: int
     solver: Solver
     scene: Scene
-    labels: Mapping[str, Any] = field(default_factory=dict)
+    labels: Mapping[str, Cell] = field(default_factory=dict)
     scene_hash: str = field(init=False, default="")
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "scene_hash", self.scene.scene_hash)
+
+    @property
+    def name(self) -> str:
+        """The run's name (:func:`run_name`): its file stem in a study's folder."""
+        return run_name(self.scene_hash, self.solver.name)
 
     def describe(self) -> str:
         """``run 3 (base = s, motion.record = 2)``: the run as named in errors."""

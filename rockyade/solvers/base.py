@@ -268,6 +268,12 @@ class SolverBase:
         """Itself: this solver keeps no files."""
         return self
 
+    def compiled_cached(self, scene: Scene) -> bool:
+        """Whether the compiled code this solver runs ``scene`` with is in numba's on-disk cache
+        (:func:`rockyade.solvers.cost_estimate.numba_cached`): else the first run in a process
+        compiles it. True for a solver that compiles nothing here."""
+        return True
+
     def check_scene(self, scene: Scene) -> None:
         """Refuse, before anything runs, a scene that :meth:`run` would refuse with an
         InputError whatever its motion (e.g. a target the solver cannot reach); nothing here:

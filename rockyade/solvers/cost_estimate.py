@@ -177,3 +177,18 @@ def sample_cost(scene: Scene, solver: str) -> CostEstimate:
 def estimate_dict(estimate: CostEstimate) -> dict[str, Any]:
     """The estimate as a JSON-ready dictionary."""
     return dataclasses.asdict(estimate)
+
+
+def numba_cached(*kernels: object) -> bool:
+    """Whether numba's on-disk cache holds every one of ``kernels`` (compiled functions): else
+    the first run in a process compiles them (a minute of CPU). Read from numba's index of each
+    function's cache, empty when missing or of another source (stale); should numba's internals
+    move, the cache is taken to be there (the smaller estimate)."""
+    for kernel in kernels:
+        try:
+            cache: Any = getattr(kernel, "_cache", None)
+            if not cache._cache_file._load_index():
+                return False
+        except Exception:
+            return True
+    return True

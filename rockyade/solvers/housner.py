@@ -18,7 +18,7 @@ from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.errors import InputError
 from rockyade.housner.history import housner_frame
-from rockyade.housner.integrator import REST_FRACTION, STEPS_PER_RADIAN, Trajectory, solve, warm_up
+from rockyade.housner.integrator import KERNELS, REST_FRACTION, STEPS_PER_RADIAN, Trajectory, solve, warm_up
 from rockyade.housner.sdof import HousnerModel, housner_model
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
@@ -26,7 +26,7 @@ from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage
-from rockyade.solvers.cost_estimate import CostEstimate, sample_cost
+from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,10 @@ class HousnerSolver(SolverBase):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
+
+    def compiled_cached(self, scene: Scene) -> bool:
+        """Whether numba's cache holds the integrator (:data:`rockyade.housner.integrator.KERNELS`)."""
+        return numba_cached(*KERNELS)
 
     def _step_s(self, model: HousnerModel) -> float:
         """The largest Runge-Kutta step, s: ``dt_factor`` / (``STEPS_PER_RADIAN`` p)."""

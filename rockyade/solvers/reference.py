@@ -42,13 +42,13 @@ from rockyade.dem.overturn import CRITERION, body_falls, run_outcome
 from rockyade.dem.result_frames import dem_frame, energy_gain, load_work
 from rockyade.kernel import simulation as kernel
 from rockyade.kernel.runs import simulate_runs
-from rockyade.kernel.single import single_body
+from rockyade.kernel.single import simulate_single, single_body
 from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, classical_meta, motion_coverage
-from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
+from rockyade.solvers.cost_estimate import CostEstimate, dem_cost, numba_cached
 
 _STATUS_NAMES = {
     kernel.STATUS_COMPLETED: "completed",
@@ -86,6 +86,12 @@ class ReferenceSolver(SolverBase):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
+
+    def compiled_cached(self, scene: Scene) -> bool:
+        """Whether numba's cache holds the kernels ``scene``'s runs take: for one block the
+        grouped and single-body paths, for several the general loop."""
+        single = len(scene.blocks) == 1
+        return numba_cached(*((simulate_runs, simulate_single) if single else (kernel.simulate,)))
 
     def run(self, scene: Scene) -> Result:
         """Run a scene with the reference DEM.

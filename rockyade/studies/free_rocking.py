@@ -13,13 +13,14 @@ import math
 import pandas as pd
 
 from rockyade import paper
+from rockyade.batch import run_scenes
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.errors import CalibrationError
 from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
 from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.result import Result
-from rockyade.runner import Executor, solve_scenes
+from rockyade.runner import Executor
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
@@ -58,11 +59,11 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     if use_yade:
         solvers["yade"] = (YadeSolver(), "free rocking: YADE")
     for name, (solver, desc) in solvers.items():
-        for c, r in zip(runnable, solve_scenes(solver, scenes, executor=on, progress=True, desc=desc), strict=True):
+        for c, r in zip(runnable, run_scenes(solver, scenes, executor=on, desc=desc), strict=True):
             c[name] = r
     keys = [(key, params) for key in paper.ALL_SPECIMENS for params in PARAMETER_SETS]
     exact_scenes = [_free_scene(key, params) for key, params in keys]
-    found = solve_scenes(HousnerSolver(), exact_scenes, executor=on, progress=True, desc="free rocking: Housner")
+    found = run_scenes(HousnerSolver(), exact_scenes, executor=on, desc="free rocking: Housner")
     exact = dict(zip(keys, found, strict=True))
     _record_runs(report, exact, cases, use_yade)
     table = pd.DataFrame(_exact_rows(exact) + _dem_rows(cases, exact, use_yade))

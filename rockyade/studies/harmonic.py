@@ -15,12 +15,13 @@ import numpy as np
 import pandas as pd
 
 from rockyade.analysis.patterns import classify_result
+from rockyade.batch import run_scenes
 from rockyade.constants import G
 from rockyade.dem.statics import column_uplift
 from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay, Span
 from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.motion.analytic import Harmonic
-from rockyade.runner import Executor, solve_scenes
+from rockyade.runner import Executor
 from rockyade.scene import scene_from_dict
 from rockyade.solvers.housner import HousnerSolver
 from rockyade.solvers.reference import ReferenceSolver
@@ -57,7 +58,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
     for solver, who in solvers:
         chosen = [c for c in cases if solver.name in c["solvers"]]
         scenes = [c["scene"] for c in chosen]
-        found = solve_scenes(solver, scenes, executor=on, progress=True, desc=f"harmonic: {who}")
+        found = run_scenes(solver, scenes, executor=on, desc=f"harmonic: {who}")
         for c, r in zip(chosen, found, strict=True):
             c["results"][solver.name] = r
     rows = []

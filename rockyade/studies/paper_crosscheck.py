@@ -2,7 +2,7 @@
 
 The four specimens (experimental alpha, p, mu; matched calibration) over the paper's suite
 (30 records) with Housner and the reference DEM, each at its own time step and at half of
-it: per specimen a ``rockyade crosscheck`` (:mod:`rockyade.studies.crosscheck_study`) into
+it: per specimen a ``rockyade crosscheck`` (:mod:`rockyade.studies.crosscheck`) into
 ``crosscheck/specimen<k>/``. YADE and Siconos against the reference DEM on a subset
 (:data:`SUBSET_SPECIMEN`, the first :data:`SUBSET_RECORDS` records, the solvers' own steps:
 ``crosscheck/specimen1_yade/`` and ``crosscheck/specimen1_siconos/``, the latter with the paper's
@@ -24,7 +24,7 @@ from rockyade.analysis.crosscheck_statistics import MIN_RECORDS
 from rockyade.assess import paper_suite_set, parse_measure
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
-from rockyade.studies.crosscheck_study import Summary, crosscheck_plan, run_crosscheck
+from rockyade.studies.crosscheck import Summary, crosscheck_plan, run_crosscheck
 from rockyade.studies.report import Report
 from rockyade.studies.specimen_scenes import block_table, scene_dict
 

@@ -11,10 +11,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from rockyade.batch import run_scenes
 from rockyade.figures.solver_panels import Curve, Panel, SolverPanelsDisplay
 from rockyade.figures.styles import SOLVER_LABELS
 from rockyade.result import Result
-from rockyade.runner import Executor, solve_scenes
+from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.solvers.base import Solver
 from rockyade.solvers.housner import HousnerSolver
@@ -50,7 +51,7 @@ def run(report: Report, workers: int = 2, use_yade: bool = True) -> pd.DataFrame
         solvers.append((YadeSolver(), "YADE"))
     on = Executor("threads", workers)
     for solver, who in solvers:
-        found = solve_scenes(solver, scenes, executor=on, progress=True, desc=f"random: {who}")
+        found = run_scenes(solver, scenes, executor=on, desc=f"random: {who}")
         for case, r in zip(cases, found, strict=True):
             case[4][solver.name] = r
     for key, record, factor, scene, results in cases:

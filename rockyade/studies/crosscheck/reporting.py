@@ -1,4 +1,4 @@
-"""The summary of a cross-check (:mod:`rockyade.studies.crosscheck_study`): collapse intensities,
+"""The summary of a cross-check (:mod:`rockyade.studies.crosscheck`): collapse intensities,
 paired ratios with their bootstrap intervals, the convergence in the time step, the verdict
 agreement and the fragility per solver, from the runs' outcomes
 (:mod:`rockyade.analysis.crosscheck_statistics`); ``index.md`` in words and numbers; the set's files.
@@ -10,7 +10,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -32,9 +32,8 @@ from rockyade.analysis.crosscheck_statistics import (
 )
 from rockyade.assess.stripes import collapse_rule
 from rockyade.io.atomic import atomic_open, write_json, write_text
-
-if TYPE_CHECKING:
-    from rockyade.studies.crosscheck_study import CrosscheckPlan, Outcomes
+from rockyade.runner.rows import Cells
+from rockyade.studies.crosscheck.plan import CrosscheckPlan, Outcomes
 
 
 @dataclass(frozen=True)
@@ -44,7 +43,7 @@ class Summary:
     collapse: pd.DataFrame
     pairs: pd.DataFrame
     runs: pd.DataFrame
-    fragility: list[dict[str, Any]]
+    fragility: list[dict[str, object]]
     verdicts: list[str]
     partial: bool
 
@@ -122,8 +121,9 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
             same, n = verdict_agreement(scan_verdicts(solver, f), scan_verdicts(solver, plan.dt_factors[0]))
             if f == finest:
                 dt_change[solver] = abs(ratio.median - 1.0) if math.isfinite(ratio.median) else math.nan
-            row = _pair_row("dt", solver, solver, f, plan.dt_factors[0], without_interval(ratio), same, n, "", "")
-            pair_rows.append(row)
+            pair_rows.append(
+                _pair_row("dt", solver, solver, f, plan.dt_factors[0], without_interval(ratio), same, n, "", "")
+            )
     failures = failed_runs(runs)
     verdicts = []
     for f in plan.dt_factors:
@@ -233,7 +233,7 @@ def _pair_row(
     n: int,
     verdict: str,
     sentence: str,
-) -> dict[str, Any]:
+) -> Cells:
     return {
         "kind": kind,
         "solver_a": a,
@@ -252,13 +252,13 @@ def _pair_row(
     }
 
 
-def _fragility(plan: CrosscheckPlan, runs: pd.DataFrame) -> list[dict[str, Any]]:
+def _fragility(plan: CrosscheckPlan, runs: pd.DataFrame) -> list[dict[str, object]]:
     """Per solver and dt factor, the lognormal fragility of its runs (scan and bisection)
     with its bootstrap intervals (:func:`rockyade.assess.stripe_fit.fit_stripes`)."""
     from rockyade.assess.stripe_fit import fit_stripes
 
     m = plan.measure
-    out: list[dict[str, Any]] = []
+    out: list[dict[str, object]] = []
     if runs.empty:
         return out
     for (solver, f), group in runs.groupby(["solver", "dt_factor"], sort=False):
@@ -291,6 +291,18 @@ def _interval_text(r: Any, decimals: int) -> str:
     if 0 < r.records < MIN_RECORDS:
         return too_few_note(int(r.records))
     return f"{r.records} records"
+
+
+def _number(value: object) -> float:
+    """A number of a fit's dictionary (NaN: none)."""
+    return float(value) if isinstance(value, (int, float)) else math.nan
+
+
+def _bounds(value: object) -> tuple[float, float]:
+    """An interval of a fit's dictionary (NaN, NaN: none)."""
+    if isinstance(value, (list, tuple)) and len(value) == 2:
+        return _number(value[0]), _number(value[1])
+    return math.nan, math.nan
 
 
 def _fmt(v: float, digits: int = 4) -> str:
@@ -383,11 +395,11 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
             why = str(fr.get("status") or "not fitted").replace("|", "/")
             lines.append(f"| {fr['solver']} | {fr['dt_factor']:g} | {why} | - | - | - |")
             continue
-        mi = fr.get(f"median_interval_{m.unit.replace('/', '_')}", [math.nan, math.nan])
-        bi = fr.get("beta_interval", [math.nan, math.nan])
+        mi = _bounds(fr.get(f"median_interval_{m.unit.replace('/', '_')}"))
+        bi = _bounds(fr.get("beta_interval"))
         lines.append(
-            f"| {fr['solver']} | {fr['dt_factor']:g} | {_fmt(fr.get(key, math.nan))} | {_fmt(mi[0])}-{_fmt(mi[1])} | "
-            f"{_fmt(fr.get('beta', math.nan), 3)} | {_fmt(bi[0], 3)}-{_fmt(bi[1], 3)} |"
+            f"| {fr['solver']} | {fr['dt_factor']:g} | {_fmt(median)} | {_fmt(mi[0])}-{_fmt(mi[1])} | "
+            f"{_fmt(_number(fr.get('beta')), 3)} | {_fmt(bi[0], 3)}-{_fmt(bi[1], 3)} |"
         )
     c = summary.collapse
     if not c.empty:
@@ -425,7 +437,7 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
 
 
 def write_summary(
-    plan: CrosscheckPlan, summary: Summary, folder: Path, seconds: float, extra: Mapping[str, Any]
+    plan: CrosscheckPlan, summary: Summary, folder: Path, seconds: float, extra: Mapping[str, object]
 ) -> None:
     """The set's files in ``folder`` (the JSON last: it says whether the set is complete)."""
     from rockyade.io.strict_json import finite_or_null
