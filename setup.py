@@ -10,7 +10,9 @@ from setuptools import find_namespace_packages, setup
 EXAMPLES = Path(__file__).resolve().parent / "examples"
 example_packages = [
     "rockyade.examples",
-    *sorted(f"rockyade.examples.{p.name}" for p in EXAMPLES.iterdir() if p.is_dir() and not p.name.startswith((".", "__"))),
+    *sorted(
+        f"rockyade.examples.{p.name}" for p in EXAMPLES.iterdir() if p.is_dir() and not p.name.startswith((".", "__"))
+    ),
 ]
 
 setup(

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from rockyade.motion.ec8 import ElasticSpectrum
-from rockyade.motion.records import MAX_ABS_ACCEL_M_S2
+from rockyade.motion.record_text import MAX_ABS_ACCEL_M_S2
 from rockyade.motion.synthetic import (
     CacheDamagedError,
     Envelope,

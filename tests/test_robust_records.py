@@ -206,7 +206,7 @@ def test_a_velocity_record_in_a_scene_is_refused_in_one_line(tmp_path, capsys):
 
 def test_velocity_units_are_named_as_such():
     from rockyade.errors import InputError
-    from rockyade.motion.records import normalise_units
+    from rockyade.motion.record_text import normalise_units
 
     for units in ("cm/s", "CM/SEC", "m/s", "cm"):
         with pytest.raises(InputError, match="velocity unit: a record must hold accelerations"):

@@ -30,7 +30,8 @@ import numpy as np
 
 from rockyade.assess.measures import Measure
 from rockyade.errors import InputError
-from rockyade.motion.records import Record, normalise_units, read_record
+from rockyade.motion.record_text import Record, normalise_units
+from rockyade.motion.records import read_record
 from rockyade.motion.selection_set import is_selection, read_selection
 from rockyade.motion.spec import MotionSpec
 from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record

@@ -37,19 +37,19 @@ from pathlib import Path
 import numpy as np
 
 from rockyade.errors import InputError
-from rockyade.motion.records import (
+from rockyade.motion.record_text import (
     DT_RANGE_S,
     MAX_RECORD_SAMPLES,
     Record,
     RecordError,
-    _accel,
-    _check_dt,
-    _check_not_cut,
-    _number,
-    _read_text,
-    _resolve_units,
+    accel_si,
+    check_dt,
+    check_not_cut,
     normalise_units,
+    number_at,
     parse_number,
+    read_text,
+    resolve_units,
 )
 
 #: A header line: an upper-case key (letters, digits, ``_ / ^ . -``), a colon, its value.
@@ -127,7 +127,7 @@ def _units(path: Path, header: dict[str, tuple[str, int]], given: str | None) ->
         unit = normalise_units(text, "UNITS")
     except InputError as exc:
         raise RecordError(path, line, f"UNITS: {exc.message}") from None
-    return _resolve_units(path, line, unit, given)
+    return resolve_units(path, line, unit, given)
 
 
 def _quantity(path: Path, header: dict[str, tuple[str, int]]) -> None:
@@ -190,12 +190,12 @@ def read_esm(path: str | Path, units: str | None = None, dt_s: float | None = No
         NDATA, a value that is not a number, or a header that disagrees with the data.
     """
     path = Path(path)
-    lines = _read_text(path).split("\n")
+    lines = read_text(path).split("\n")
     header, first = _header(path, lines)
     _quantity(path, header)
     n, dt = _sampling(path, header)
     unit = _units(path, header, units)
-    _check_dt(path, header["SAMPLING_INTERVAL_S"][1], dt, dt_s, "SAMPLING_INTERVAL_S says")
+    check_dt(path, header["SAMPLING_INTERVAL_S"][1], dt, dt_s, "SAMPLING_INTERVAL_S says")
     values: list[float] = []
     tokens: list[tuple[str, int]] = []
     for lineno, line in enumerate(lines[first:], start=first + 1):
@@ -207,14 +207,14 @@ def read_esm(path: str | Path, units: str | None = None, dt_s: float | None = No
                     f"NDATA = {n} in the header but the file holds more values (value {n + 1} is on line {lineno}): "
                     "the header and the data disagree",
                 )
-            values.append(_number(path, lineno, token))
+            values.append(number_at(path, lineno, token))
             tokens.append((token, lineno))
     if len(values) < n:
         raise RecordError(
             path, len(lines), f"NDATA = {n} in the header but the file holds {len(values)} values: truncated?"
         )
-    _check_not_cut(path, tokens, True)
-    accel = _accel(path, values, unit)
+    check_not_cut(path, tokens, True)
+    accel = accel_si(path, values, unit)
     _check_header_against_data(path, header, n, dt, accel)
     event = header.get("EVENT_ID", header.get("EVENT_NAME", ("", 0)))[0]
     station = ".".join(header.get(k, ("", 0))[0] for k in ("NETWORK", "STATION_CODE"))

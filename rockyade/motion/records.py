@@ -37,190 +37,34 @@ from __future__ import annotations
 import math
 import re
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import cast
 
 import numpy as np
 
 from rockyade.constants import STANDARD_GRAVITY
 from rockyade.errors import InputError
 from rockyade.motion.peer import PeerHeader, peer_header
+from rockyade.motion.record_text import (
+    DT_RANGE_S,
+    MAX_RECORD_SAMPLES,
+    NUMBER_PATTERN,
+    UNITS,
+    Record,
+    RecordError,
+    accel_si,
+    check_dt,
+    check_not_cut,
+    number_at,
+    parse_number,
+    read_text,
+    resolve_units,
+)
 from rockyade.motion.text_columns import DECIMAL_COMMA, split_columns, with_point
 
-#: factor to m/s^2 per unit name (a record "in g" means standard gravity)
-UNITS = {"g": STANDARD_GRAVITY, "m/s2": 1.0, "cm/s2": 0.01}
-
-#: Most samples a record may hold (a day at 100 Hz is 8.6 million).
-MAX_RECORD_SAMPLES = 10_000_000
-#: Largest record file read, bytes.
-MAX_RECORD_BYTES = 512 * 1024 * 1024
-#: Sampling interval range of a record, s.
-DT_RANGE_S = (1.0e-5, 1.0)
-#: Largest |acceleration| accepted, m/s^2 (about 100 g; the strongest records reach 4 g).
-MAX_ABS_ACCEL_M_S2 = 1000.0
-UNIT_ALIASES = {
-    "g": "g",
-    **dict.fromkeys(("m/s2", "m/s^2", "m/s/s", "mps2"), "m/s2"),
-    **dict.fromkeys(("cm/s2", "cm/s^2", "cm/s/s", "cm/sec/sec", "gal"), "cm/s2"),
-}
 FORMATS = ("at2", "csv", "single", "esm")
-#: Unit names of velocities and displacements (refused with a message saying so).
-VELOCITY_UNITS = ("cm/s", "cm/sec", "m/s", "m/sec", "mm/s", "in/s", "cm", "m", "mm")
 #: How the options that fix a file's reading are spelt in a scene and on the command line.
 SINGLE_HINT = 'format = "single" and its sampling interval dt_s (rockyade motion: --format single --dt)'
 TWO_COLUMN_HINT = 'format = "csv" (or no format) and no dt_s (rockyade motion: --format csv)'
-
-
-class RecordError(InputError):
-    """A record file that cannot be read: names the file and the line."""
-
-    def __init__(self, path: str | Path, line: int | None, message: str) -> None:
-        where = f"line {line}" if line is not None else "record"
-        super().__init__(where, message, str(path))
-        self.path = str(path)
-        self.line = line
-
-
-def normalise_units(units: str, source: str = "units") -> str:
-    """Canonical unit name (g, m/s2, cm/s2) or InputError."""
-    key = units.strip().lower().replace(" ", "")
-    if key in VELOCITY_UNITS:
-        raise InputError(source, f"{units!r} is a velocity unit: a record must hold accelerations, in g, m/s2 or cm/s2")
-    if key not in UNIT_ALIASES:
-        raise InputError(
-            source, f"must be one of g, m/s2, cm/s2 (aliases: {', '.join(sorted(UNIT_ALIASES))}), got {units!r}"
-        )
-    return UNIT_ALIASES[key]
-
-
-@dataclass(frozen=True)
-class Record:
-    """An accelerogram in SI units.
-
-    Attributes
-    ----------
-    t_s
-        Sample times, s, from 0 (uniform for AT2 and single-column files).
-    accel_m_s2
-        Acceleration, m/s^2.
-    units_in_file
-        Units the file used (g, m/s2, cm/s2).
-    source
-        File path or description.
-    title
-        Header text (event, station) when the file has one.
-    """
-
-    t_s: np.ndarray
-    accel_m_s2: np.ndarray
-    units_in_file: str
-    source: str
-    title: str = ""
-    extra: dict[str, object] = field(default_factory=dict)
-
-    @property
-    def npts(self) -> int:
-        """Number of samples."""
-        return int(self.accel_m_s2.size)
-
-    @property
-    def dt_s(self) -> float:
-        """Sampling interval, s (the mean one for non-uniform files)."""
-        return float((self.t_s[-1] - self.t_s[0]) / (self.npts - 1))
-
-    @property
-    def uniform(self) -> bool:
-        """True when the samples are equally spaced."""
-        d = np.diff(self.t_s)
-        return bool(np.allclose(d, d[0], rtol=1e-6, atol=0))
-
-    @property
-    def duration_s(self) -> float:
-        """Time of the last sample, s."""
-        return float(self.t_s[-1])
-
-    @property
-    def pga_m_s2(self) -> float:
-        """Peak absolute acceleration, m/s^2."""
-        return float(np.max(np.abs(self.accel_m_s2)))
-
-    @property
-    def pga_time_s(self) -> float:
-        """Time of the peak absolute acceleration, s."""
-        return float(self.t_s[int(np.argmax(np.abs(self.accel_m_s2)))])
-
-    def with_accel(self, accel: np.ndarray, note: str) -> Record:
-        """A copy with other acceleration samples (processing history in ``extra``)."""
-        done = cast("list[str]", self.extra.get("processing", []))  # only this method writes it: a list
-        history = [*done, note]
-        return Record(
-            self.t_s,
-            np.asarray(accel, dtype=float),
-            self.units_in_file,
-            self.source,
-            self.title,
-            {**self.extra, "processing": history},
-        )
-
-
-_NUMBER = r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eEdD][-+]?[0-9]+)?"
-_NUMBER_RE = re.compile(rf"^{_NUMBER}$", re.ASCII)
-
-
-def parse_number(token: str) -> float | None:
-    """A decimal number as written in records (exponent E or D), or None if not one.
-
-    Only ASCII digits; no ``_``, no ``inf``/``nan``. A value beyond the float range gives
-    ``inf`` (the callers refuse it).
-    """
-    if not _NUMBER_RE.match(token):
-        return None
-    return float(token.replace("D", "E").replace("d", "e"))
-
-
-def _signature(token: str) -> tuple[bool, int, int]:
-    """How a number is written: (has an exponent, digits after the point, exponent digits)."""
-    mantissa, mark, exponent = token.upper().replace("D", "E").partition("E")
-    return (bool(mark), len(mantissa.partition(".")[2]), len(exponent.lstrip("+-")))
-
-
-def _check_not_cut(path: Path, tokens: list[tuple[str, int]], last_in_file: bool) -> None:
-    """Refuse a last value that is cut short: every other value is written one way, it another.
-
-    ``tokens`` are the (text, line) of the values of one column, in order;
-    ``last_in_file``: no value follows the last of them. Only a column written in a fixed
-    format (every other value with an exponent, or with 3 decimals or more, alike) says how
-    the last value should look; a free-format column is left alone.
-    """
-    if not last_in_file or len(tokens) < 2:
-        return
-    last, line = tokens[-1]
-    others = [_signature(t) for t, _ in tokens[:-1]]
-    if len({(exp, frac) for exp, frac, _ in others}) != 1:
-        return  # free format: the values vary anyway
-    has_exp, frac, _ = others[0]
-    fixed = has_exp if len(others) == 1 else (has_exp or frac >= 3)
-    if not fixed:
-        return
-    min_exp_digits = min(2, *(d for _, _, d in others))  # exponents are written with 2 digits or more
-    mine = _signature(last)
-    if mine[0] != has_exp or mine[1] != frac or mine[2] < min_exp_digits:
-        raise RecordError(
-            path,
-            line,
-            f"the last value {last!r} is written differently from every other value (e.g. "
-            f"{tokens[0][0]!r}): the file looks truncated inside it",
-        )
-
-
-def _number(path: Path, lineno: int, token: str, what: str = "value") -> float:
-    value = parse_number(token)
-    if value is None:
-        raise RecordError(path, lineno, f"not a number: {token!r}")
-    if not math.isfinite(value):
-        raise RecordError(path, lineno, f"{what} {token!r} is beyond the floating-point range")
-    return value
 
 
 def _parse_at2_sampling(line: str, path: Path, lineno: int) -> tuple[int, float]:
@@ -235,7 +79,7 @@ def _parse_at2_sampling(line: str, path: Path, lineno: int) -> tuple[int, float]
             raise RecordError(path, lineno, "header has NPTS= but no DT=")
         npts_text, dt_text = m_n.group(1), m_dt.group(1)
     else:
-        numbers = re.findall(_NUMBER, upper, re.ASCII)
+        numbers = re.findall(NUMBER_PATTERN, upper, re.ASCII)
         if len(numbers) < 2:
             raise RecordError(path, lineno, f"expected 'NPTS=..., DT=... SEC' or 'NPTS DT', got {line.strip()!r}")
         npts_text, dt_text = numbers[0], numbers[1]
@@ -262,20 +106,6 @@ def _at2_units(line: str) -> str | None:
     if re.search(r"\bUNITS\s+OF\s+G\b|\bIN\s+G\b|\(G\)|\bG\s*$", upper):
         return "g"
     return None
-
-
-def _read_text(path: Path) -> str:
-    if not path.is_file():
-        raise RecordError(path, None, "file not found")
-    size = path.stat().st_size
-    if size > MAX_RECORD_BYTES:
-        raise RecordError(path, None, f"the file has {size} bytes, more than the {MAX_RECORD_BYTES} a record may have")
-    data = path.read_bytes()
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError:
-        text = data.decode("latin-1")
-    return text.replace("\r\n", "\n").replace("\r", "\n")
 
 
 def _head_lines(path: Path, count: int = 64) -> list[str]:
@@ -307,68 +137,6 @@ def _refuse_other_quantities(path: Path, lines: list[str], fmt: str) -> PeerHead
     return header
 
 
-def _resolve_units(path: Path, line: int | None, in_file: str | None, given: str | None) -> str:
-    """The units to use: the file's; ``given`` must agree with them (or stand in for none)."""
-    wanted = normalise_units(given) if given else None
-    if in_file is not None and wanted is not None and wanted != in_file:
-        raise RecordError(
-            path,
-            line,
-            f"the file says its values are in {in_file} but units = {wanted} was given: "
-            "drop the units option (the file's units are used) or fix the file",
-        )
-    return in_file or wanted or ""
-
-
-def _check_dt(path: Path, line: int | None, dt_file: float, dt_given: float | None, where: str) -> None:
-    """Refuse a ``dt_s`` that disagrees with the file's own sampling (relative 1e-6)."""
-    if dt_given is not None and not math.isclose(dt_given, dt_file, rel_tol=1e-6):
-        raise RecordError(
-            path,
-            line,
-            f"{where} {dt_file:g} s but dt_s = {dt_given:g} s was given: drop dt_s (the file's sampling is "
-            "used) or fix the file",
-        )
-
-
-def _accel(path: Path, values: list[float], unit: str) -> np.ndarray:
-    a = np.asarray(values, dtype=float) * UNITS[unit]
-    if not np.all(np.isfinite(a)):
-        raise RecordError(path, None, "contains NaN or infinite values")
-    worst = int(np.argmax(np.abs(a)))
-    if abs(a[worst]) > MAX_ABS_ACCEL_M_S2:
-        raise RecordError(
-            path,
-            None,
-            f"sample {worst + 1} is {a[worst]:.4g} m/s^2, beyond +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2: "
-            f"wrong units ({unit})?",
-        )
-    return a
-
-
-def record_problem(t_s: np.ndarray, accel_m_s2: np.ndarray) -> str | None:
-    """What keeps samples from being a record, or None: the bounds every record passes,
-    whether read from a file or taken from the synthetic-record cache.
-
-    1-D float arrays of the same length, 2 to :data:`MAX_RECORD_SAMPLES` samples, times from 0
-    strictly increasing, finite accelerations within +/- :data:`MAX_ABS_ACCEL_M_S2` m/s^2.
-    """
-    if not all(isinstance(x, np.ndarray) and x.dtype == np.float64 and x.ndim == 1 for x in (t_s, accel_m_s2)):
-        return "times and accelerations must be 1-D float64 arrays"
-    if t_s.shape != accel_m_s2.shape:
-        return f"{t_s.size} times but {accel_m_s2.size} accelerations"
-    if not 2 <= t_s.size <= MAX_RECORD_SAMPLES:
-        return f"{t_s.size} samples, not in [2, {MAX_RECORD_SAMPLES}]"
-    if not (np.all(np.isfinite(t_s)) and t_s[0] == 0.0 and np.all(np.diff(t_s) > 0)):
-        return "times must start at 0 and increase strictly"
-    if not np.all(np.isfinite(accel_m_s2)):
-        return "contains NaN or infinite values"
-    worst = int(np.argmax(np.abs(accel_m_s2)))
-    if abs(accel_m_s2[worst]) > MAX_ABS_ACCEL_M_S2:
-        return f"sample {worst + 1} is {accel_m_s2[worst]:.4g} m/s^2, beyond +/-{MAX_ABS_ACCEL_M_S2:g} m/s^2"
-    return None
-
-
 def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = None) -> Record:
     """Read a PEER NGA AT2 file (see module docstring).
 
@@ -383,13 +151,13 @@ def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = No
         Optional sampling interval, s: refused unless it equals the header's DT.
     """
     path = Path(path)
-    text = _read_text(path)
+    text = read_text(path)
     lines = text.split("\n")
     _refuse_other_quantities(path, lines, "at2")
     if len(lines) < 5:
         raise RecordError(path, len(lines), "an AT2 file needs 4 header lines and data")
     npts, dt = _parse_at2_sampling(lines[3], path, 4)
-    file_units = _resolve_units(path, 3, _at2_units(lines[2]), units)
+    file_units = resolve_units(path, 3, _at2_units(lines[2]), units)
     if not file_units:
         raise RecordError(
             path,
@@ -397,7 +165,7 @@ def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = No
             f"cannot tell the units from {lines[2].strip()!r}: give them with --units g, m/s2 or cm/s2 (a scene: "
             'units = "g" in its [motion])',
         )
-    _check_dt(path, 4, dt, dt_s, "the header says DT =")
+    check_dt(path, 4, dt, dt_s, "the header says DT =")
     tokens: list[tuple[str, int]] = []
     values: list[float] = []
     extra = 0  # values after the NPTS-th
@@ -411,7 +179,7 @@ def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = No
             continue
         take = parts[: npts - len(values)]
         for token in take:
-            values.append(_number(path, lineno, token))
+            values.append(number_at(path, lineno, token))
             tokens.append((token, lineno))
         if len(take) < len(parts):
             first_extra_line = lineno
@@ -427,8 +195,8 @@ def read_at2(path: str | Path, units: str | None = None, dt_s: float | None = No
             f"NPTS = {npts} in the header but the file holds {npts + extra} values (value {npts + 1} is on line "
             f"{first_extra_line}): the header and the data disagree; fix NPTS or remove the extra values",
         )
-    _check_not_cut(path, tokens, True)
-    accel = _accel(path, values, file_units)
+    check_not_cut(path, tokens, True)
+    accel = accel_si(path, values, file_units)
     title = lines[1].strip()
     return Record(np.arange(npts) * dt, accel, file_units, str(path), title, {"format": "at2", "dt_file_s": dt})
 
@@ -516,7 +284,7 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
         Optional sampling interval, s: refused unless the times are spaced by it.
     """
     path = Path(path)
-    lines = _read_text(path).split("\n")
+    lines = read_text(path).split("\n")
     _refuse_other_quantities(path, lines, "csv")
     times: list[float] = []
     accel: list[float] = []
@@ -557,15 +325,15 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
             before = f"where the lines before hold {width}"
             raise RecordError(path, lineno, f"holds {len(columns)} values ({body!r}) {before}")
         seen_data = True
-        times.append(_number(path, lineno, columns[0], "time"))
-        accel.append(_number(path, lineno, columns[1]))
+        times.append(number_at(path, lineno, columns[0], "time"))
+        accel.append(number_at(path, lineno, columns[1]))
         column.append((columns[1], lineno))
     if len(times) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
     if len(times) > MAX_RECORD_SAMPLES:
         raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
-    _check_not_cut(path, column, True)
-    unit = _resolve_units(path, header_line, header_unit, units) or "m/s2"
+    check_not_cut(path, column, True)
+    unit = resolve_units(path, header_line, header_unit, units) or "m/s2"
     t = np.asarray(times)
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if bad.size:
@@ -579,8 +347,8 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
     if dt_s is not None:
         steps = np.diff(t)
         worst = int(np.argmax(np.abs(steps - dt_s)))
-        _check_dt(path, column[worst + 1][1], float(steps[worst]), dt_s, "the time column steps by")
-    a = _accel(path, accel, unit)
+        check_dt(path, column[worst + 1][1], float(steps[worst]), dt_s, "the time column steps by")
+    a = accel_si(path, accel, unit)
     return Record(t - t[0], a, unit, str(path), "", {"format": "csv"})
 
 
@@ -628,7 +396,7 @@ def read_single_column(path: str | Path, dt_s: float, units: str | None = None) 
         raise RecordError(path, None, f"dt must be > 0 s, got {dt_s!r}")
     if not DT_RANGE_S[0] <= dt_s <= DT_RANGE_S[1]:
         raise RecordError(path, None, f"dt must be in [{DT_RANGE_S[0]:g}, {DT_RANGE_S[1]:g}] s, got {dt_s!r}")
-    lines = _read_text(path).split("\n")
+    lines = read_text(path).split("\n")
     _refuse_other_quantities(path, lines, "single")
     values: list[float] = []
     column: list[tuple[str, int]] = []
@@ -652,15 +420,15 @@ def read_single_column(path: str | Path, dt_s: float, units: str | None = None) 
                     f"holds {len(columns)} numbers ({body!r}); a one-column file holds one acceleration per line: "
                     f"for time and acceleration columns use {TWO_COLUMN_HINT}",
                 )
-        values.append(_number(path, lineno, token))
+        values.append(number_at(path, lineno, token))
         column.append((token, lineno))
     if len(values) < 2:
         raise RecordError(path, None, "fewer than 2 samples")
     if len(values) > MAX_RECORD_SAMPLES:
         raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
-    _check_not_cut(path, column, True)
-    unit = _resolve_units(path, header_line, header_unit, units) or "m/s2"
-    a = _accel(path, values, unit)
+    check_not_cut(path, column, True)
+    unit = resolve_units(path, header_line, header_unit, units) or "m/s2"
+    a = accel_si(path, values, unit)
     return Record(np.arange(a.size) * dt_s, a, unit, str(path), "", {"format": "single"})
 
 

@@ -24,7 +24,7 @@ A cache file is trusted only as far as it checks out (:func:`load_cached_record`
 file (never through a link) of at most :data:`MAX_CACHE_BYTES`, an ``.npz`` of exactly the
 arrays written, float64 samples of the suite's length and sampling, the SHA-256 of its
 content as written, the suite's key and the record's index in its metadata, and the bounds
-every read record passes (:func:`rockyade.motion.records.record_problem`). Anything else (a
+every read record passes (:func:`rockyade.motion.record_text.record_problem`). Anything else (a
 truncated, emptied, rescaled or replaced file) is regenerated and rewritten atomically (two
 processes doing so at once each rename a complete file into place); a cache that cannot be
 written (a folder that is a file, a read-only disk) gives the generated record with one
@@ -53,7 +53,7 @@ from rockyade.errors import InputError
 from rockyade.io.atomic import atomic_open
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.processing import baseline_correct, integrate
-from rockyade.motion.records import Record, RecordError, record_problem
+from rockyade.motion.record_text import Record, RecordError, record_problem
 from rockyade.motion.spectra import response_spectrum
 
 GENERATOR_VERSION = 2

@@ -53,15 +53,8 @@ from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.ground import GroundMotion
 from rockyade.motion.processing import bandpass, baseline_correct, scale_to_pga
 from rockyade.motion.quasistatic import GravityRamp, Pushover
-from rockyade.motion.records import (
-    DT_RANGE_S,
-    FORMATS,
-    MAX_ABS_ACCEL_M_S2,
-    Record,
-    count_samples,
-    normalise_units,
-    read_record,
-)
+from rockyade.motion.record_text import DT_RANGE_S, MAX_ABS_ACCEL_M_S2, Record, normalise_units
+from rockyade.motion.records import FORMATS, count_samples, read_record
 from rockyade.motion.spec import MAX_START_S, MOTION_TYPES, MotionSpec
 from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
 
