@@ -186,6 +186,7 @@ def _meta(
                 "exceeded_time_s": dict(zip(("base", "seat"), traj.friction_exceeded_s, strict=True)),
                 "max_impulse_ratio": dict(zip(("base", "seat"), traj.impulse_ratio_max, strict=True)),
             },
+            "pivot_tension_time_s": dict(zip(("base", "seat"), traj.pivot_tension_s, strict=True)),
             "onset_multiplier": model.onset_multiplier,
             "uplift_multipliers": model.uplift_multipliers(),
             "model_notes": list(model.notes),

@@ -282,7 +282,7 @@ def _centroid_velocities(th1, phi, w1, wphi, sb, ss, prm):
 
 
 @numba.njit(cache=True)
-def _post_impact(th1, phi, w1, wphi, sb, ss, nb_, ns_, prm):
+def post_impact(th1, phi, w1, wphi, sb, ss, nb_, ns_, prm):
     """Velocities (theta_1', phi') just after an impact, in the mode (nb_, ns_) after it:
     the angular momentum of the upper block about its seat pivot (when the seat is open after
     the impact) and of the stack about its base pivot (when the base is open) are conserved
@@ -343,7 +343,7 @@ def impact(th1, phi, w1, wphi, sb, ss, joint, prm):
                     continue
             elif ss != 0 and cs != ss:
                 continue
-            nw1, nwphi = _post_impact(th1, phi, w1, wphi, sb, ss, cb, cs, prm)
+            nw1, nwphi = post_impact(th1, phi, w1, wphi, sb, ss, cb, cs, prm)
             v1x, v1y, v2x, v2y = _centroid_velocities(th1, phi, nw1, nwphi, cb, cs, prm)
             loads = joint_loads(
                 th1,
@@ -423,4 +423,5 @@ __all__ = [
     "joint_loads",
     "kinematics",
     "parameter_count",
+    "post_impact",
 ]

@@ -45,6 +45,7 @@ from rockyade.twoblock.dynamics import (
     choose_mode,
     contact_state,
     impact,
+    post_impact,
 )
 
 #: A joint is closed after an impact that leaves it too little energy to lift by REST_FRACTION x alpha.
@@ -136,8 +137,8 @@ def _value(kind, t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav):
     if kind == _SEAT_R:
         return loads[7] / prm[MOMENT_SCALE]
     if kind == _N_BASE:
-        return loads[0] / prm[WEIGHT]
-    return loads[4] / prm[WEIGHT]
+        return 1.0 if abs(th1) > prm[ALPHA_BASE] else loads[0] / prm[WEIGHT]
+    return 1.0 if abs(phi) > prm[ALPHA_SEAT] else loads[4] / prm[WEIGHT]
 
 
 @numba.njit(cache=True)
@@ -255,15 +256,18 @@ def _lift_too_small(joint, w_rel, prm, rest_fraction):
 
 
 @numba.njit(cache=True)
-def _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed):
+def _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed, tension):
     """Track |T| / N of each joint in contact: the largest, and when it first exceeded the
-    joint's friction coefficient."""
+    joint's friction coefficient; and when a pivot first pulled (N < 0, held as Housner's
+    pivot is: only past the joint's alpha, where the block falls either way)."""
     ah, av, _ = ground_acceleration(t, mt, mah, mav, 0)
     loads = contact_state(th1, phi, w1, wp, sb, ss, ah, av, prm)
     for k in range(2):
         n = loads[0] if k == 0 else loads[4]
         tt = loads[1] if k == 0 else loads[5]
         if n <= 0.0:
+            if n < -ADMISSIBLE_TOL * prm[WEIGHT] and tension[k] < 0.0:
+                tension[k] = t
             continue
         r = abs(tt) / n
         if r > fmax[k]:
@@ -290,6 +294,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
     counts = np.zeros(5, dtype=np.int64)  # impacts, peaks, uplifts, mode changes, inadmissible impacts
     fmax = np.zeros(2)
     fexceed = np.full(2, -1.0)
+    tension = np.full(2, -1.0)
     imp_ratio = np.zeros(2)
     status = 0
     fail_code = 0
@@ -397,7 +402,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
         if event < 0:
             th1, phi, w1, wp = s1
             t = t + h
-            _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed)
+            _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed, tension)
             continue
         th1, phi, w1, wp = _rk4(t, th1, phi, w1, wp, tau_end, sb, ss, prm, mt, mah, mav)
         t = t_stop
@@ -422,10 +427,13 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
                 counts[4] += 1
             if ratio > imp_ratio[joint]:
                 imp_ratio[joint] = ratio
+            # a joint left too little to lift closes: the impact's outcome with it closed
             if nsb != 0 and th1 == 0.0 and _lift_too_small(0, nw1, prm, rest_fraction):
-                nsb, nw1 = 0, 0.0
+                nsb = 0
+                nw1, nwp = post_impact(th1, phi, w1, wp, sb, ss, nsb, nss, prm)
             if nss != 0 and phi == 0.0 and _lift_too_small(1, nwp, prm, rest_fraction):
-                nss, nwp = 0, 0.0
+                nss = 0
+                nw1, nwp = post_impact(th1, phi, w1, wp, sb, ss, nsb, nss, prm)
             sb, ss, w1, wp = nsb, nss, nw1, nwp
             if counts[0] < cap:
                 row = impacts[counts[0]]
@@ -476,6 +484,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
         fmax,
         fexceed,
         imp_ratio,
+        tension,
         status,
         fail_code,
         t_end_run,

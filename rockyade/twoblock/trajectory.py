@@ -60,6 +60,10 @@ class TwoBlockTrajectory:
         When |T| / N first exceeded each joint's friction coefficient (None: never).
     impulse_ratio_max
         Largest tangential over normal impulse at a landing corner, per joint.
+    pivot_tension_s
+        When each joint's pivot first pulled (N < 0) while the joint was past its alpha
+        (held, as in Housner's model: the block falls either way), s; None: never. Within
+        alpha a pulling pivot ends the run as failed.
     status
         "completed", "overturned" or "failed".
     end_time_s
@@ -85,6 +89,7 @@ class TwoBlockTrajectory:
     friction_max: tuple[float, float]
     friction_exceeded_s: tuple[float | None, float | None]
     impulse_ratio_max: tuple[float, float]
+    pivot_tension_s: tuple[float | None, float | None]
     status: str
     end_time_s: float | None
     overturned_block: int | None
@@ -181,8 +186,8 @@ def solve(
         integ.REST_FRACTION,
         integ.MAX_RECORDED_EVENTS,
     )
-    samples, modes, impacts, peaks, uplifts, changes, counts, fmax, fexceed, imp_ratio = out[:10]
-    status, fail_code, t_end, over_block, n_filled = out[10:]
+    samples, modes, impacts, peaks, uplifts, changes, counts, fmax, fexceed, imp_ratio, tension = out[:11]
+    status, fail_code, t_end, over_block, n_filled = out[11:]
     status = int(status)
     n_keep = int(n_filled) if status != 0 else n_samples
     cap = integ.MAX_RECORDED_EVENTS
@@ -201,6 +206,7 @@ def solve(
         friction_max=(float(fmax[0]), float(fmax[1])),
         friction_exceeded_s=tuple(float(x) if x >= 0 else None for x in fexceed),  # type: ignore[arg-type]
         impulse_ratio_max=(float(imp_ratio[0]), float(imp_ratio[1])),
+        pivot_tension_s=tuple(float(x) if x >= 0 else None for x in tension),  # type: ignore[arg-type]
         status=_STATUS_NAMES[status],
         end_time_s=float(t_end) if status != 0 else None,
         overturned_block=int(over_block) if status == 1 else None,
