@@ -316,3 +316,54 @@ def test_cli_runs_the_bi_block_and_refuses_a_single_block_with_exit_2(tmp_path):
     assert bad.returncode == 2
     assert "two stacked blocks" in bad.stderr and "Traceback" not in bad.stderr
     assert not (tmp_path / "x.csv").exists()
+
+
+# ---------------------------------------------------------------------- check 5
+
+
+@pytest.mark.parametrize(("freq", "amp", "pattern"), [(2.0, 2.0, "rest"), (4.0, 4.0, "4"), (5.0, 5.0, "2")])
+def test_pattern_map_cells_by_the_exact_solver_beside_the_dem(freq, amp, pattern):
+    """Check 5, cell by cell: three cells of the paper's pattern map (experimental parameters, the
+    study's scene) give the exact solver the DEM's dominant pattern: rest below the uplift, the
+    upper block alone (4), both blocks in opposite ways (2, the paper's pattern at 5 Hz, 5 mm)."""
+    from rockyade.analysis.patterns import classify_result
+    from rockyade.motion.analytic import Harmonic
+    from rockyade.studies.pattern_map import CYCLES
+    from rockyade.studies.specimen_scenes import biblock_blocks, scene_dict
+
+    end = Harmonic(1.0, freq, CYCLES, 2).phases_s["end_s"]
+    motion = {"type": "harmonic", "amplitude_mm": amp, "frequency_hz": freq, "cycles": CYCLES}
+    scene = scene_from_dict(scene_dict(biblock_blocks(), motion, end + 1.0, 0.002, "paper"))
+    patterns = {name: classify_result(scene, run(scene, name)).dominant for name in ("twoblock", "reference")}
+    assert patterns == {"twoblock": pattern, "reference": pattern}
+
+
+def test_pattern_map_figure_has_a_panel_per_solver(tmp_path):
+    """The study's figure: the DEM's panel and the exact solver's, each with the paper's regions."""
+    import pandas as pd
+
+    from rockyade.studies import pattern_map
+    from rockyade.studies.report import Report
+
+    cells = pd.DataFrame(
+        {
+            "frequency_hz": [4.0, 5.0, 7.0],
+            "amplitude_mm": [4.0, 5.0, 8.0],
+            "pattern_dem": ["4", "2", "1"],
+            "pattern_exact": ["4", "2", "2"],
+        }
+    )
+    cells["pattern_paper"] = [
+        pattern_map.paper_pattern(f, a) for f, a in zip(cells.frequency_hz, cells.amplitude_mm, strict=False)
+    ]
+    for key in ("dem", "exact"):
+        cells[f"agree_{key}"] = [
+            None if p is None else p == d for p, d in zip(cells.pattern_paper, cells[f"pattern_{key}"], strict=False)
+        ]
+    report = Report(tmp_path)
+    report.section("Patterns")
+    fig = pattern_map.draw_figure(report, cells, pattern_map.agreement(cells, "dem")).figure_
+    titles = [ax.get_title() for ax in fig.axes]
+    assert any("reference DEM" in t for t in titles) and any("exact two-block solver" in t for t in titles)
+    assert (tmp_path / "pattern_map.png").stat().st_size > 0
+    assert "exact two-block solver: pattern 2 2 of 2 cells" in report.sections[-1][1][-1]

@@ -180,25 +180,36 @@ def contact_state(th1, phi, w1, wphi, sb, ss, ah, av, prm):
 
 
 @numba.njit(cache=True)
-def _violation(sb, ss, loads, open_b, open_s, rate_b, rate_s, force_scale, moment_scale, rate_scale):
+def _violation(sb, ss, loads, open_b, open_s, rate_b, rate_s, force_scale, moment_scale, rate_scale, held_b, held_s):
     """Worst normalised violation of the conditions of mode (sb, ss): closed joints keep their
-    resultant on the contact, open pivots press (N >= 0), and a joint that opens now turns the
-    way it opens (``rate``: its relative acceleration, or velocity after an impact)."""
+    resultant on the contact, open pivots press (N >= 0; not asked of a pivot ``held`` past its
+    alpha, where the block falls either way and the pivot is held as Housner's is), and a joint
+    that opens now turns the way it opens (``rate``: its relative acceleration, or velocity
+    after an impact)."""
     nb, _tb, mbl, mbr, ns, _ts, msl, msr = loads
     worst = 0.0
     if sb == 0:
         worst = max(worst, -mbl / moment_scale, -mbr / moment_scale)
     else:
-        worst = max(worst, -nb / force_scale)
+        if not held_b:
+            worst = max(worst, -nb / force_scale)
         if open_b:
             worst = max(worst, -sb * rate_b / rate_scale)
     if ss == 0:
         worst = max(worst, -msl / moment_scale, -msr / moment_scale)
     else:
-        worst = max(worst, -ns / force_scale)
+        if not held_s:
+            worst = max(worst, -ns / force_scale)
         if open_s:
             worst = max(worst, -ss * rate_s / rate_scale)
     return worst
+
+
+@numba.njit(cache=True)
+def held(th1, phi, prm):
+    """Whether each joint is past its alpha (base: |theta_1|, seat: |phi|), where a pulling
+    pivot is held (the integrator's flight test and :func:`choose_mode` skip it)."""
+    return abs(th1) > prm[ALPHA_BASE], abs(phi) > prm[ALPHA_SEAT]
 
 
 @numba.njit(cache=True)
@@ -219,6 +230,7 @@ def choose_mode(th1, phi, w1, wphi, sb, ss, ah, av, prm, free_b, free_s, exclude
     force_scale = prm[WEIGHT]
     moment_scale = prm[MOMENT_SCALE]
     rate_scale = g * prm[WEIGHT] / prm[MOMENT_SCALE]  # g / height
+    hb, hs = held(th1, phi, prm)
     for cb in range(-1, 2):
         if not free_b and cb != sb:
             continue
@@ -247,6 +259,8 @@ def choose_mode(th1, phi, w1, wphi, sb, ss, ah, av, prm, free_b, free_s, exclude
                 force_scale,
                 moment_scale,
                 rate_scale,
+                hb,
+                hs,
             )
             n_open = (1 if (free_b and cb != 0) else 0) + (1 if (free_s and cs != 0) else 0)
             ok = v <= ADMISSIBLE_TOL
@@ -330,6 +344,7 @@ def impact(th1, phi, w1, wphi, sb, ss, joint, prm):
     moment_scale = force_scale * height
     best_v = math.inf
     best_n = 3
+    hb, hs = held(th1, phi, prm)
     out_b, out_s, out_w1, out_wphi, ratio = sb, ss, w1, wphi, 0.0
     for cb in range(-1, 2):
         if joint == 0:
@@ -364,7 +379,7 @@ def impact(th1, phi, w1, wphi, sb, ss, joint, prm):
             )
             opens_b = cb != 0 and (joint == 0 or sb == 0)
             opens_s = cs != 0 and (joint == 1 or ss == 0)
-            v = _violation(cb, cs, loads, opens_b, opens_s, nw1, nwphi, force_scale, moment_scale, scale_w)
+            v = _violation(cb, cs, loads, opens_b, opens_s, nw1, nwphi, force_scale, moment_scale, scale_w, hb, hs)
             n_open = (1 if opens_b else 0) + (1 if opens_s else 0)
             ok = v <= ADMISSIBLE_TOL
             best_ok = best_v <= ADMISSIBLE_TOL

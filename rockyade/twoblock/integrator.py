@@ -44,6 +44,7 @@ from rockyade.twoblock.dynamics import (
     at_rest_margins,
     choose_mode,
     contact_state,
+    held,
     impact,
     post_impact,
 )
@@ -136,9 +137,10 @@ def _value(kind, t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav):
         return loads[6] / prm[MOMENT_SCALE]
     if kind == _SEAT_R:
         return loads[7] / prm[MOMENT_SCALE]
+    hb, hs = held(th1, phi, prm)
     if kind == _N_BASE:
-        return 1.0 if abs(th1) > prm[ALPHA_BASE] else loads[0] / prm[WEIGHT]
-    return 1.0 if abs(phi) > prm[ALPHA_SEAT] else loads[4] / prm[WEIGHT]
+        return 1.0 if hb else loads[0] / prm[WEIGHT]
+    return 1.0 if hs else loads[4] / prm[WEIGHT]
 
 
 @numba.njit(cache=True)
