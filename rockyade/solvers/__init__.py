@@ -5,7 +5,8 @@
 rigid-polygon DEM, numba), ``yade`` (:class:`~rockyade.solvers.yade.YadeSolver`, YADE
 in batch mode), ``siconos`` (:class:`~rockyade.solvers.siconos.SiconosSolver`,
 nonsmooth contact dynamics in Debian's Siconos) and ``twoblock``
-(:class:`~rockyade.solvers.twoblock.TwoBlockSolver`, the exact solution of two stacked blocks). Each is a :class:`~rockyade.solvers.base.Solver`: ``run(scene)``,
+(:class:`~rockyade.solvers.twoblock.TwoBlockSolver`, the exact solution of two stacked
+blocks). Each is a :class:`~rockyade.solvers.base.Solver`: ``run(scene)``,
 ``estimate_cost(scene)`` and its options as fields. Solvers never import each other; this
 registry is the only place that knows them all, and it hands back instances::
 

@@ -207,9 +207,12 @@ def _violation(sb, ss, loads, open_b, open_s, rate_b, rate_s, force_scale, momen
 
 @numba.njit(cache=True)
 def held(th1, phi, prm):
-    """Whether each joint is past its alpha (base: |theta_1|, seat: |phi|), where a pulling
-    pivot is held (the integrator's flight test and :func:`choose_mode` skip it)."""
-    return abs(th1) > prm[ALPHA_BASE], abs(phi) > prm[ALPHA_SEAT]
+    """Whether each joint's pivot is held when it pulls (the integrator's flight test and
+    :func:`choose_mode` skip it): past the joint's alpha (base: |theta_1|, seat: |phi|), or,
+    for the seat, while the lower block is past its own (the stack is falling; the upper block
+    goes with it). There the block falls either way, and its pivot is held as Housner's is."""
+    base = abs(th1) > prm[ALPHA_BASE]
+    return base, base or abs(phi) > prm[ALPHA_SEAT]
 
 
 @numba.njit(cache=True)

@@ -5,7 +5,9 @@ from __future__ import annotations
 
 import functools
 import math
+import sys
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -215,10 +217,24 @@ def solve(
     )
 
 
+def _compiled_cached() -> bool:
+    """True when numba's on-disk cache holds the integrator (next to the module, where numba
+    puts it when that folder is writable)."""
+    return any((Path(integ.__file__).parent / "__pycache__").glob("integrator.integrate-*.nbi"))
+
+
 @functools.cache
 def warm_up() -> None:
-    """Load the compiled kernel once per process, so that wall times measure the solve."""
+    """Load the compiled kernel once per process, so that wall times measure the solve (the
+    first run after an installation compiles it: a note says so)."""
     from rockyade.twoblock.model import TwoBlockModel
+
+    if not _compiled_cached():
+        print(
+            "rockyade: compiling the two-block solver (numba, once per installation: about a minute) ...",
+            file=sys.stderr,
+            flush=True,
+        )
 
     model = TwoBlockModel(
         names=("lower", "upper"),
