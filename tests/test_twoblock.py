@@ -367,3 +367,12 @@ def test_pattern_map_figure_has_a_panel_per_solver(tmp_path):
     assert any("reference DEM" in t for t in titles) and any("exact two-block solver" in t for t in titles)
     assert (tmp_path / "pattern_map.png").stat().st_size > 0
     assert "exact two-block solver: pattern 2 2 of 2 cells" in report.sections[-1][1][-1]
+
+
+def test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling():
+    """``benchmarks/bench_twoblock.py --quick`` runs both solvers on the record and prints the
+    sampling check: the same impact times at 0.01 s and 0.001 s (no speed is asserted)."""
+    bench = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_twoblock.py"
+    proc = subprocess.run([sys.executable, str(bench), "--quick"], capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert "runs/s" in proc.stdout and "largest difference 0 s" in proc.stdout

@@ -144,6 +144,29 @@ def _value(kind, t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav):
 
 
 @numba.njit(cache=True)
+def _all_values(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, out):
+    """Every event function of :func:`_value` at one state, into ``out`` (one evaluation of the
+    contact forces for all); returns those forces (:func:`rockyade.twoblock.dynamics.joint_loads`)."""
+    ah, av, _ = ground_acceleration(t, mt, mah, mav, 0)
+    loads = contact_state(th1, phi, w1, wp, sb, ss, ah, av, prm)
+    hb, hs = held(th1, phi, prm)
+    out[_IMPACT_BASE] = sb * th1
+    out[_IMPACT_SEAT] = ss * phi
+    out[_OVER_LOWER] = abs(th1) - 0.5 * math.pi
+    out[_OVER_UPPER] = max(abs(th1 + phi), abs(phi)) - 0.5 * math.pi
+    out[_BASE_L] = loads[2] / prm[MOMENT_SCALE]
+    out[_BASE_R] = loads[3] / prm[MOMENT_SCALE]
+    out[_SEAT_L] = loads[6] / prm[MOMENT_SCALE]
+    out[_SEAT_R] = loads[7] / prm[MOMENT_SCALE]
+    out[_N_BASE] = 1.0 if hb else loads[0] / prm[WEIGHT]
+    out[_N_SEAT] = 1.0 if hs else loads[4] / prm[WEIGHT]
+    out[_PEAK_LOWER] = w1
+    out[_PEAK_UPPER] = w1 + wp
+    out[_TURN_SEAT] = wp
+    return loads
+
+
+@numba.njit(cache=True)
 def _before(kind, f, f0):
     """True while the event has not happened: an angle above 0 (impact), below pi/2
     (overturn), a margin or normal force not below -ADMISSIBLE_TOL, or a velocity keeping
@@ -258,12 +281,11 @@ def _lift_too_small(joint, w_rel, prm, rest_fraction):
 
 
 @numba.njit(cache=True)
-def _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed, tension):
-    """Track |T| / N of each joint in contact: the largest, and when it first exceeded the
-    joint's friction coefficient; and when a pivot first pulled (N < 0, held as Housner's
-    pivot is: only past the joint's alpha, where the block falls either way)."""
-    ah, av, _ = ground_acceleration(t, mt, mah, mav, 0)
-    loads = contact_state(th1, phi, w1, wp, sb, ss, ah, av, prm)
+def _friction(t, loads, prm, fmax, fexceed, tension):
+    """Track |T| / N of each joint in contact (``loads``: :func:`rockyade.twoblock.dynamics.joint_loads`):
+    the largest, and when it first exceeded the joint's friction coefficient; and when a pivot
+    first pulled (N < 0, held as Housner's pivot is: only where the block falls either way,
+    :func:`rockyade.twoblock.dynamics.held`)."""
     for k in range(2):
         n = loads[0] if k == 0 else loads[4]
         tt = loads[1] if k == 0 else loads[5]
@@ -309,6 +331,9 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
     resting = sb == 0 and ss == 0
     stuck = 0
     t_last = -1.0
+    vals0 = np.zeros(_N_KINDS)
+    vals1 = np.zeros(_N_KINDS)
+    fresh = False  # vals0 holds the event functions at (t, state)
     if not resting:
         ah, av, _ = ground_acceleration(0.0, mt, mah, mav, 0)
         dd1, ddp = accelerations(th1, phi, w1, wp, sb, ss, ah, av, prm)
@@ -361,15 +386,15 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
             h = duration - t
         if h <= 0.0:
             break
+        if not fresh:
+            _all_values(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, vals0)
+            fresh = True
         s1 = _rk4(t, th1, phi, w1, wp, h, sb, ss, prm, mt, mah, mav)
+        loads1 = _all_values(t + h, s1[0], s1[1], s1[2], s1[3], sb, ss, prm, mt, mah, mav, vals1)
         tau_end = h
         event = -1
         for kind in range(_PEAK_LOWER):
-            if not _active(kind, sb, ss):
-                continue
-            f0 = _value(kind, t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav)
-            f1 = _value(kind, t + h, s1[0], s1[1], s1[2], s1[3], sb, ss, prm, mt, mah, mav)
-            if _before(kind, f1, f0):
+            if not _active(kind, sb, ss) or _before(kind, vals1[kind], vals0[kind]):
                 continue
             tau = _first_root(kind, t, th1, phi, w1, wp, h, sb, ss, prm, mt, mah, mav)
             if tau >= 0.0 and (tau < tau_end or (tau == tau_end and event < 0)):
@@ -378,8 +403,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
         for kind in (_PEAK_LOWER, _PEAK_UPPER):
             if not _active(kind, sb, ss):
                 continue
-            f0 = _value(kind, t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav)
-            f1 = _value(kind, t + h, s1[0], s1[1], s1[2], s1[3], sb, ss, prm, mt, mah, mav)
+            f0, f1 = vals0[kind], vals1[kind]
             if f0 * f1 < 0.0 or (event >= 0 and f0 != 0.0):
                 tau = _first_root(kind, t, th1, phi, w1, wp, tau_end, sb, ss, prm, mt, mah, mav)
                 if tau > 0.0 and tau < tau_end:
@@ -404,8 +428,10 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
         if event < 0:
             th1, phi, w1, wp = s1
             t = t + h
-            _friction(t, th1, phi, w1, wp, sb, ss, prm, mt, mah, mav, fmax, fexceed, tension)
+            _friction(t, loads1, prm, fmax, fexceed, tension)
+            vals0, vals1 = vals1, vals0
             continue
+        fresh = False
         th1, phi, w1, wp = _rk4(t, th1, phi, w1, wp, tau_end, sb, ss, prm, mt, mah, mav)
         t = t_stop
         if event in (_OVER_LOWER, _OVER_UPPER):
