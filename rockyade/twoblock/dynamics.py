@@ -10,7 +10,7 @@ a = R(theta_1) r_1, c = R(theta_1) s, d = R(theta_2) r_2 (R the rotation):
 
     G_1 = O + a,    G_2 = O + c + d.
 
-Lagrange's equations of the chain (Psycharis 1990, Eqs 3-4, in this notation):
+Lagrange's equations of the chain (the two-block equations of Psycharis 1990, in this notation):
 
     M11 theta_1'' + M12 theta_2'' = Q1 + m_2 (c x d) theta_2'^2
     M12 theta_1'' + M22 theta_2'' = Q2 - m_2 (c x d) theta_1'^2
