@@ -5,7 +5,7 @@ scene out. Its modes, impacts and refusals are in ``docs/twoblock.md``."""
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import ClassVar
 
 from rockyade import __version__
@@ -23,6 +23,10 @@ from rockyade.twoblock.trajectory import max_step
 
 #: A scene's mu within this relative distance of the model's own counts as reached.
 MU_RTOL = 0.01
+#: Wall time per Runge-Kutta step, s, events included (cost estimate): the bi-block under a
+#: 25 s record, 445-829 impacts, 4.7 us a step on the loaded 2-core machine
+#: (``benchmarks/bench_twoblock.py``).
+SECONDS_PER_STEP = 5e-6
 #: How the run decides an overturn (the Result's ``overturn_criterion``).
 OVERTURN_CRITERION = (
     "|theta| of either block or the upper block's rotation on its seat reached pi/2 (the run stops there, "
@@ -102,8 +106,20 @@ class TwoBlockSolver(SolverBase):
         return Result(frame, _meta(scene, model, motion, traj, wall, self.dt_factor))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """One step per output sample (:func:`rockyade.solvers.cost_estimate.sample_cost`)."""
-        return sample_cost(scene, self.name)
+        """The output of :func:`rockyade.solvers.cost_estimate.sample_cost` (the time history of
+        both blocks), and the Runge-Kutta steps at the largest step, SECONDS_PER_STEP each.
+
+        Raises
+        ------
+        InputError
+            A scene the solver cannot treat.
+        """
+        step = max_step(self.model(scene), self.dt_factor)
+        steps = scene.duration_s / step
+        cost = sample_cost(scene, self.name)
+        return replace(
+            cost, integration_steps=steps, time_step_s=step, wall_time_s=cost.wall_time_s + steps * SECONDS_PER_STEP
+        )
 
 
 def _check_mu(scene: Scene, model: TwoBlockModel) -> dict[str, object]:
