@@ -29,7 +29,7 @@ import math
 import numba
 import numpy as np
 
-from rockyade.motion.ground import ground_acceleration
+from rockyade.motion.ground import aligned_step, ground_acceleration
 from rockyade.twoblock.dynamics import (
     ADMISSIBLE_TOL,
     ALPHA_BASE,
@@ -324,7 +324,6 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
     fail_code = 0
     t_end_run = -1.0
     over_block = -1
-    n_motion = mt.size
     t = 0.0
     k = 0
     eps = 1e-9 * dt_sample
@@ -372,18 +371,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
                 changes[counts[3], 0], changes[counts[3], 1], changes[counts[3], 2] = t, sb, ss
             counts[3] += 1
             resting = False
-        # step end: no longer than h_max, aligned with the next base-motion sample
-        h = h_max
-        if n_motion >= 2 and t < mt[n_motion - 1]:
-            j = np.searchsorted(mt, t, side="right")
-            if j < n_motion:
-                gap = mt[j] - t
-                if gap < h:
-                    h = gap
-                elif gap < h * 1.1:
-                    h = 0.5 * gap
-        if t + h > duration:
-            h = duration - t
+        h = aligned_step(t, h_max, duration, mt)  # no longer than h_max, ending on a motion sample
         if h <= 0.0:
             break
         if not fresh:
