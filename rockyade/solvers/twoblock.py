@@ -17,8 +17,8 @@ from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase, check_dt_factor
 from rockyade.solvers.cost_estimate import CostEstimate, sample_cost
 from rockyade.twoblock import TwoBlockModel, TwoBlockTrajectory, solve, two_block_model, warm_up
-from rockyade.twoblock.history import two_block_frame
-from rockyade.twoblock.integrator import REST_FRACTION
+from rockyade.twoblock.event_driven import REST_FRACTION
+from rockyade.twoblock.time_history import two_block_frame
 from rockyade.twoblock.trajectory import max_step
 
 #: A scene's mu within this relative distance of the model's own counts as reached.
@@ -84,7 +84,7 @@ class TwoBlockSolver(SolverBase):
         Raises
         ------
         InputError
-            A scene the solver cannot treat (module docstring of :mod:`rockyade.twoblock.model`).
+            A scene the solver cannot treat (module docstring of :mod:`rockyade.twoblock.stack`).
         """
         model = self.model(scene)
         motion = scene.motion.ground_motion(scene.duration_s)

@@ -42,7 +42,7 @@ import numba
 
 from rockyade.motion.ground import ground_acceleration
 
-# the parameter vector (rockyade.twoblock.model.TwoBlockModel.params)
+# the parameter vector (rockyade.twoblock.stack.TwoBlockModel.params)
 (
     M1,
     I1,

@@ -1,5 +1,5 @@
 """A run of the two-block stack from Python: the start (a released block, or rest), the
-compiled integration (:mod:`rockyade.twoblock.integrator`), and what it found."""
+compiled integration (:mod:`rockyade.twoblock.event_driven`), and what it found."""
 
 from __future__ import annotations
 
@@ -12,9 +12,9 @@ from pathlib import Path
 import numpy as np
 
 from rockyade.motion.ground import GroundMotion
-from rockyade.twoblock import integrator as integ
+from rockyade.twoblock import event_driven as integ
 from rockyade.twoblock.dynamics import ADMISSIBLE_TOL, choose_mode, ground
-from rockyade.twoblock.model import TwoBlockModel
+from rockyade.twoblock.stack import TwoBlockModel
 
 _STATUS_NAMES = ("completed", "overturned", "failed")
 #: Why a run failed, by the integrator's failure code.
@@ -220,14 +220,14 @@ def solve(
 def _compiled_cached() -> bool:
     """True when numba's on-disk cache holds the integrator (next to the module, where numba
     puts it when that folder is writable)."""
-    return any((Path(integ.__file__).parent / "__pycache__").glob("integrator.integrate-*.nbi"))
+    return any((Path(integ.__file__).parent / "__pycache__").glob("event_driven.integrate-*.nbi"))
 
 
 @functools.cache
 def warm_up() -> None:
     """Load the compiled kernel once per process, so that wall times measure the solve (the
     first run after an installation compiles it: a note says so)."""
-    from rockyade.twoblock.model import TwoBlockModel
+    from rockyade.twoblock.stack import TwoBlockModel
 
     if not _compiled_cached():
         print(

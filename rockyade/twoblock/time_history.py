@@ -10,7 +10,7 @@ import pandas as pd
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import column
 from rockyade.scene import Scene
-from rockyade.twoblock.model import TwoBlockModel
+from rockyade.twoblock.stack import TwoBlockModel
 from rockyade.twoblock.trajectory import TwoBlockTrajectory
 
 
