@@ -22,7 +22,7 @@ from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
-from rockyade.siconos.payload import Numerics
+from rockyade.siconos.payload import INTEGRATORS, Numerics
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
@@ -71,6 +71,16 @@ def _check_restitution(value: Any, field: str) -> float:
     return e
 
 
+def _check_integrator(value: Any, field: str) -> str:
+    if value not in INTEGRATORS:
+        raise InputError(field, f"must be one of {', '.join(INTEGRATORS)}, got {value!r}")
+    return str(value)
+
+
+def _check_optional_tol(value: Any, field: str) -> float | None:
+    return None if value is None else _check_tol(value, field)
+
+
 def _check_folder(value: Any, field: str) -> str | None:
     if value is not None and not isinstance(value, (str, Path)):
         raise InputError(field, f"must be a folder path, got {value!r}")
@@ -99,9 +109,15 @@ class SiconosSolver(SolverBase):
     restitution
         Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
         restitution, Housner's Eq 4).
+    integrator
+        How each step's one-step problem is built and solved: "numerics" (the default:
+        assembled with numpy, solved by Siconos's numerics, Lemke for a few contacts,
+        Gauss-Seidel warm-started for more: :mod:`rockyade.siconos.moreau_jean`) or "kernel"
+        (Siconos's TimeStepping, the nonsmooth Newton then NSGS and ADMM: the path before).
     solver_tol, solver_max_iter
-        Tolerance and iteration cap of the friction-contact solvers (the nonsmooth Newton,
-        then NSGS and ADMM on a step it fails; the Newton stops at 100 iterations at most).
+        Tolerance and iteration cap of the friction-contact solvers (default tolerance:
+        DEFAULT_TOL of the integrator; Lemke's pivoting has none; on the kernel path the
+        Newton stops at 100 iterations at most).
     newton_max_iter
         Newton iterations per step on the nonlinear kinematics (1: linearised once).
     workdir
@@ -121,7 +137,8 @@ class SiconosSolver(SolverBase):
         "dt_s": _check_dt,
         "dt_factor": check_dt_factor,
         "restitution": _check_restitution,
-        "solver_tol": _check_tol,
+        "integrator": _check_integrator,
+        "solver_tol": _check_optional_tol,
         "solver_max_iter": _check_count(1, 100_000),
         "newton_max_iter": _check_count(1, 100),
         "workdir": _check_folder,
@@ -139,8 +156,13 @@ class SiconosSolver(SolverBase):
     warm: bool = True
     dt_s: float | None = None
     dt_factor: float = 1.0
+    #: The friction-contact solvers' default tolerance per integrator (relative; docs/siconos.md,
+    #: "The tolerance": chosen by what halving it changes).
+    DEFAULT_TOL: ClassVar[dict[str, float]] = {"numerics": 1e-6, "kernel": 1e-8}
+
     restitution: float = 0.0
-    solver_tol: float = 1e-8
+    integrator: str = "numerics"
+    solver_tol: float | None = None
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
     workdir: str | None = None
@@ -153,6 +175,7 @@ class SiconosSolver(SolverBase):
             "dt_s",
             "dt_factor",
             "restitution",
+            "integrator",
             "solver_tol",
             "solver_max_iter",
             "newton_max_iter",
@@ -178,7 +201,8 @@ class SiconosSolver(SolverBase):
             dt_s=dt,
             steps_per_sample=steps,
             restitution=self.restitution,
-            solver_tol=self.solver_tol,
+            integrator=self.integrator,
+            solver_tol=self.solver_tol if self.solver_tol is not None else self.DEFAULT_TOL[self.integrator],
             solver_max_iter=self.solver_max_iter,
             newton_max_iter=self.newton_max_iter,
         )
@@ -188,6 +212,7 @@ class SiconosSolver(SolverBase):
             if self.dt_s is not None
             else "default (1e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
             "dt_base_s": base,
+            "integrator": self.integrator,
         }
         return numerics, how
 

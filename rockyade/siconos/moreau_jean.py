@@ -1,0 +1,561 @@
+"""The Moreau-Jean step of a scene, assembled with numpy and solved by Siconos's numerics.
+
+Runs inside Debian's Python, imported by the Siconos driver (:mod:`rockyade.siconos.driver`,
+which passes it Siconos's ``numerics`` module): it imports only numpy (and scipy, whose
+sparse matrices are how Siconos's Python takes a sparse one). It is Siconos's own time
+stepping, Moreau-Jean's theta-method with Newton's impact law and Coulomb friction, written
+out so that the one-step problem is built once per step with numpy instead of by Siconos's
+kernel from one Python-visible object per contact (docs/siconos.md, "The one-step problem").
+
+Per step k (step h, theta = 1/2):
+
+* the contact pairs' geometry at q_k, all pairs at once (:class:`PairTable`): the gap g,
+  the normal and tangent, and the rows H_n, H_t of the contact Jacobian (the velocity of the
+  vertex relative to the other body's material point at it, along n and t);
+* the active set, Siconos's rule (``MoreauJeanOSI::addInteractionInIndexSet``):
+  g + h/2 (H_n v_k) <= its activation threshold;
+* the free velocity v_free = v_k + h M^-1 F_theta, F_theta = theta F(t_k+1) + (1 - theta) F(t_k)
+  (gravity, the base's inertial force -m a_g(t), point loads at q_k);
+* the one-step problem of the active contacts, Siconos's ``FrictionContactProblem``:
+  u = W r + q with W = H M^-1 H^T (the Delassus operator) and q = H v_free + (e H_n v_k, 0),
+  r the impulses, Coulomb's cone |r_t| <= mu r_n, u_n >= 0 complementary to r_n;
+* v_k+1 = v_free + M^-1 H^T r, q_k+1 = q_k + h ((1 - theta) v_k + theta v_k+1).
+
+The problem is solved by Siconos: a few contacts (``DIRECT_CONTACTS``) as FrictionContact(2)
+by Lemke's pivoting method (``fc2d_lexicolemke``; its Gauss-Seidel from zero when Lemke's
+residual is above the tolerance), more as FrictionContact(3) whose
+out-of-plane row is decoupled (W's third diagonal entry 1, q's 0: its impulse stays 0, so
+the iterates are FrictionContact(2)'s, measured) by Gauss-Seidel on a sparse matrix
+(``fc3d_nsgs``) warm-started from the last step's impulses of the same pairs, and by the
+proximal-point method (``fc3d_proximal``: a regularised Newton) when Gauss-Seidel stops
+above the tolerance. Why FrictionContact(3) there: Siconos 4.4's 2-D Gauss-Seidel takes
+only a sparse-block matrix, whose conversion cost more than the solve, and its sweeps were
+2.2x slower than the 3-D one's on a sparse matrix (docs/siconos.md).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+#: Up to this many active contacts the problem is FrictionContact(2), dense, solved by Lemke.
+DIRECT_CONTACTS = 16
+#: Up to this many pairs a step is computed pair by pair in Python floats, beyond it with
+#: numpy over all pairs at once (numpy's per-call overhead dominates a block's or a bi-block's
+#: step: measured).
+SCALAR_PAIRS = 16
+#: A contact is active while g + h/2 u_n is at most this fraction of the smallest block
+#: dimension (Siconos's constraint activation threshold; 0 there): a contact at rest whose
+#: gap drifts by rounding stays active instead of opening and letting its block drop.
+ACTIVATION_FRACTION = 1e-5
+#: The proximal-point fallback's iteration cap.
+PROX_MAX_ITER = 200
+
+
+class PairTable:
+    """The contact pairs of a scene as arrays, and their geometry at a state (numpy).
+
+    Parameters
+    ----------
+    bodies
+        The scene's bodies (``vertices_m`` in the body frame, ``fixed``).
+    pairs
+        The vertex-to-edge pairs (:func:`rockyade.siconos.driver.contact_pairs`): ``a`` the
+        vertex's body, ``v`` its index, ``b`` the edge's body (-1: the ground), and for a
+        block's edge ``e0``, ``n`` (outward normal), ``L`` in that block's frame; ``mu``.
+    twin
+        For each pair the index of an earlier pair at the same point (coinciding corners), or
+        -1 (:func:`rockyade.siconos.driver.twins`): while the earlier one is on its edge the
+        later one is open.
+    edge_slack, deep_fraction
+        A pair is open when its vertex has left its edge by ``edge_slack`` of the edge's
+        length, or lies deeper behind it than ``deep_fraction`` of the smaller block's
+        smallest dimension.
+    """
+
+    def __init__(
+        self,
+        bodies: list[dict[str, Any]],
+        pairs: list[dict[str, Any]],
+        twin: np.ndarray,
+        edge_slack: float,
+        deep_fraction: float,
+    ) -> None:
+        nb = len(bodies)
+        m = len(pairs)
+        local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
+        size = [float(np.min(np.ptp(v, axis=0))) for v in local]
+        self.pairs = pairs
+        self.a = np.array([p["a"] for p in pairs], dtype=int)
+        self.b = np.array([p["b"] if p["b"] >= 0 else nb for p in pairs], dtype=int)
+        self.ground = np.array([p["b"] < 0 for p in pairs], dtype=bool)
+        self.vloc = np.array([local[p["a"]][p["v"]] for p in pairs], dtype=float).reshape(m, 2)
+        self.e0 = np.array([p["e0"] if p["b"] >= 0 else (0.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
+        self.nl = np.array([p["n"] if p["b"] >= 0 else (0.0, 1.0) for p in pairs], dtype=float).reshape(m, 2)
+        length = np.array([p["L"] if p["b"] >= 0 else math.inf for p in pairs], dtype=float)
+        self.lo = -edge_slack * np.where(self.ground, 0.0, length)
+        self.lo[self.ground] = -math.inf
+        self.hi = np.where(self.ground, math.inf, length * (1.0 + edge_slack))
+        self.deep = -np.array(
+            [deep_fraction * min(size[p["a"]], size[p["b"]] if p["b"] >= 0 else size[p["a"]]) for p in pairs]
+        )
+        self.mu = np.array([p["mu"] for p in pairs], dtype=float)
+        self.twin = np.asarray(twin, dtype=int)
+        self.has_twin = np.flatnonzero(self.twin >= 0)
+        self.twin_of = self.twin[self.has_twin]
+        self.size = min(size)
+        self.lists = (
+            self.a.tolist(),
+            self.b.tolist(),
+            self.vloc.tolist(),
+            self.nl.tolist(),
+            self.e0.tolist(),
+            self.lo.tolist(),
+            self.hi.tolist(),
+            self.deep.tolist(),
+            self.twin.tolist(),
+        )
+
+    def geometry(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The pairs at positions ``q`` ((nb + 1, 3): x, y, theta per body, the ground last).
+
+        Returns
+        -------
+        gap
+            (m,) the vertex's distance from the edge's line along its normal, m.
+        closed
+            (m,) the pair is a contact: its vertex on its edge, not too deep, not a twin's
+            shadow.
+        H
+            (m, 2, 2, 3) the contact Jacobian: [pair, side (a: the vertex's body, b: the
+            edge's), row (normal, tangent), dof (x, y, theta)]; u = H_a v_a + H_b v_b.
+        """
+        qa, qb = q[self.a], q[self.b]
+        ca, sa = np.cos(qa[:, 2]), np.sin(qa[:, 2])
+        cb, sb = np.cos(qb[:, 2]), np.sin(qb[:, 2])
+        vx, vy = self.vloc[:, 0], self.vloc[:, 1]
+        rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
+        px, py = qa[:, 0] + rax, qa[:, 1] + ray
+        nx = cb * self.nl[:, 0] - sb * self.nl[:, 1]
+        ny = sb * self.nl[:, 0] + cb * self.nl[:, 1]
+        ex, ey = self.e0[:, 0], self.e0[:, 1]
+        rbx, rby = px - qb[:, 0], py - qb[:, 1]
+        dx, dy = rbx - (cb * ex - sb * ey), rby - (sb * ex + cb * ey)
+        gap = dx * nx + dy * ny
+        along = dy * nx - dx * ny  # tangent t = (-n_y, n_x)
+        closed = (along >= self.lo) & (along <= self.hi) & (gap >= self.deep)
+        if len(self.has_twin):
+            closed[self.has_twin] &= ~closed[self.twin_of]
+        H = np.empty((len(gap), 2, 2, 3))
+        H[:, 0, 0, 0], H[:, 0, 0, 1], H[:, 0, 0, 2] = nx, ny, ny * rax - nx * ray
+        H[:, 0, 1, 0], H[:, 0, 1, 1], H[:, 0, 1, 2] = -ny, nx, nx * rax + ny * ray
+        H[:, 1, 0, 0], H[:, 1, 0, 1], H[:, 1, 0, 2] = -nx, -ny, nx * rby - ny * rbx
+        H[:, 1, 1, 0], H[:, 1, 1, 1], H[:, 1, 1, 2] = ny, -nx, -nx * rbx - ny * rby
+        return gap, closed, H
+
+
+def delassus_blocks(
+    m: int, contacts: np.ndarray, dofs: np.ndarray, rows: np.ndarray, minv: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The non-zero 2x2 blocks of W = H M^-1 H^T for ``m`` contacts.
+
+    Parameters
+    ----------
+    contacts, dofs, rows
+        One entry per (contact, moving body) incidence: the contact's index, the body's
+        index among the moving bodies, and the contact's (2, 3) Jacobian rows on that body.
+    minv
+        (moving bodies, 3) the inverse mass matrix's diagonal (1/m, 1/m, 1/I), 1/kg, 1/(kg m^2).
+
+    Returns
+    -------
+    block_row, block_col, blocks
+        The blocks (n, 2, 2) and their block indices, each block once, sorted by column then row.
+    """
+    order = np.argsort(dofs, kind="stable")
+    c, d, Jr = contacts[order], dofs[order], rows[order]
+    counts = np.bincount(d)
+    group = counts[d]
+    start = (np.cumsum(counts) - counts)[d]
+    x = np.repeat(np.arange(len(d)), group)
+    y = np.arange(len(x)) - np.repeat(np.cumsum(group) - group, group) + np.repeat(start, group)
+    products = np.einsum("pik,pjk->pij", (Jr * minv[d][:, None, :])[x], Jr[y]).reshape(-1, 4)
+    keys, where = np.unique(c[y] * m + c[x], return_inverse=True)
+    blocks = np.empty((len(keys), 4))
+    for j in range(4):  # the sum of the products of the same block (np.add.at is slower)
+        blocks[:, j] = np.bincount(where, weights=products[:, j], minlength=len(keys))
+    return keys % m, keys // m, blocks.reshape(-1, 2, 2)
+
+
+def sparse_fc3(m: int, block_row: np.ndarray, block_col: np.ndarray, blocks: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The CSC arrays (data, indices, indptr) of the 3m x 3m FrictionContact(3) matrix whose 2x2
+    in-plane blocks are ``blocks`` (sorted by column then row) and whose out-of-plane rows are
+    decoupled (diagonal 1)."""
+    per_col = np.bincount(block_col, minlength=m)
+    counts = np.empty(3 * m, dtype=np.int64)
+    counts[0::3] = 2 * per_col
+    counts[1::3] = 2 * per_col
+    counts[2::3] = 1
+    indptr = np.zeros(3 * m + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    indices = np.empty(int(indptr[-1]), dtype=np.int64)
+    data = np.empty(int(indptr[-1]))
+    rank = np.arange(len(block_row)) - (np.cumsum(per_col) - per_col)[block_col]
+    for k in (0, 1):
+        at = indptr[3 * block_col + k] + 2 * rank
+        indices[at] = 3 * block_row
+        indices[at + 1] = 3 * block_row + 1
+        data[at] = blocks[:, 0, k]
+        data[at + 1] = blocks[:, 1, k]
+    third = indptr[3 * np.arange(m) + 2]
+    indices[third] = 3 * np.arange(m) + 2
+    data[third] = 1.0
+    return data, indices, indptr
+
+
+class MoreauJean:
+    """A scene stepped by Moreau-Jean with its one-step problem solved by Siconos (module docstring).
+
+    Parameters
+    ----------
+    scene
+        The payload (:mod:`rockyade.siconos.payload`): bodies, time step, theta, restitution,
+        solver tolerance and iteration cap.
+    table
+        The contact pairs (:class:`PairTable`).
+    sn
+        Siconos's ``numerics`` module.
+    forces
+        A callable giving the base's force per unit mass (a_x, a_y), m/s^2, at the start and
+        the end of step k: ``forces(k) -> ((ax0, ay0), (ax1, ay1))``.
+    """
+
+    def __init__(self, scene: dict[str, Any], table: PairTable, sn: Any, forces: Any) -> None:
+        bodies = scene["bodies"]
+        nb = len(bodies)
+        self.scene, self.table, self.sn, self.forces = scene, table, sn, forces
+        self.h = float(scene["dt_s"])
+        self.theta = float(scene["theta"])
+        self.e = float(scene["restitution"])
+        self.q = np.zeros((nb + 1, 3))
+        self.v = np.zeros((nb + 1, 3))
+        for i, b in enumerate(bodies):
+            self.q[i] = (b["centroid0_m"][0], b["centroid0_m"][1], b["angle0_rad"])
+            self.v[i] = (b["vel0_m_s"][0], b["vel0_m_s"][1], b["angvel0_rad_s"])
+        self.moving = np.array([not b["fixed"] for b in bodies] + [False])
+        self.mass = np.array([float(b["mass_kg"]) for b in bodies] + [0.0])[self.moving]
+        self.minv = np.array(
+            [[1.0 / b["mass_kg"], 1.0 / b["mass_kg"], 1.0 / b["inertia_kgm2"]] for b in bodies if not b["fixed"]]
+        )
+        self.dof = np.full(nb + 1, -1)
+        self.dof[self.moving] = np.arange(int(self.moving.sum()))
+        self.dof_a, self.dof_b = self.dof[table.a], self.dof[table.b]
+        self.loads = [(int(self.dof[i]), b["load"]) for i, b in enumerate(bodies) if not b["fixed"] and b.get("load")]
+        self.threshold = ACTIVATION_FRACTION * table.size
+        self.tol = float(scene["solver_tol"])
+        self.max_iter = int(scene["solver_max_iter"])
+        self.impulse = np.zeros((len(table.pairs), 2))  # the last step's (r_n, r_t) per pair, N s
+        self.loaded: list[tuple[int, float, float, float]] = []  # the last step's (pair, r_n, r_t, gap)
+        self.scalar = len(table.pairs) <= SCALAR_PAIRS
+        self._qs, self._vs = self.q.tolist(), self.v.tolist()  # the scalar path's state
+        self.moving_ids = np.flatnonzero(self.moving).tolist()
+        self.minv_list = self.minv.ravel().tolist()
+        self.minv_flat = self.minv.ravel()
+        self.mass_list = self.mass.tolist()
+        self.mu_list = table.mu.tolist()
+        self.dof_list = self.dof.tolist()
+        self._options: dict[str, Any] = {}
+        self._sparse: Any = None
+        # diagnostics (the driver's Recorder reads them)
+        self.calls = self.iterations = self.unconverged = self.fallbacks = 0
+        self.residual = 0.0  # of the last call
+        self.max_residual = 0.0
+        self.names = ["fc2d_lemke", "fc2d_nsgs", "fc3d_nsgs", "fc3d_prox"]
+
+    def describe(self) -> str:
+        """The one-step problem and its solvers, in words (the Result's ``one_step_problem``)."""
+        return (
+            f"Moreau-Jean assembled with numpy (theta {self.theta:g}, activation threshold {self.threshold:.3g} m); "
+            f"up to {DIRECT_CONTACTS} active contacts FrictionContact(2) by Lemke (then Gauss-Seidel), "
+            "more FrictionContact(3) with the out-of-plane row decoupled by Gauss-Seidel warm-started from the "
+            "last step's impulses (then the proximal point method)"
+        )
+
+    def options(self, name: str) -> Any:
+        """Siconos's solver options of ``name`` (created once, tolerance and cap set)."""
+        so = self._options.get(name)
+        if so is None:
+            sn = self.sn
+            ids = {
+                "lemke": sn.SICONOS_FRICTION_2D_LEMKE,
+                "nsgs2": sn.SICONOS_FRICTION_2D_NSGS,
+                "nsgs": sn.SICONOS_FRICTION_3D_NSGS,
+                "prox": sn.SICONOS_FRICTION_3D_PROX,
+            }
+            so = self._options[name] = sn.SolverOptions(ids[name])
+            # Lemke's cap is on its pivots
+            so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = (
+                min(self.max_iter, PROX_MAX_ITER) if name == "prox" else self.max_iter
+            )
+            so.dparam[sn.SICONOS_DPARAM_TOL] = self.tol
+        return so
+
+    def force(self, k: int) -> np.ndarray:
+        """(moving, 3) F_theta of step k: gravity and the base's inertial force, theta-weighted
+        between the step's ends, and the point loads at q_k, N and N m."""
+        (ax0, ay0), (ax1, ay1) = self.forces(k)
+        th = self.theta
+        ax, ay = (1.0 - th) * ax0 + th * ax1, (1.0 - th) * ay0 + th * ay1
+        F = np.zeros((len(self.mass), 3))
+        F[:, 0] = self.mass * ax
+        F[:, 1] = self.mass * ay
+        for d, load in self.loads:
+            phi = float(self.q[self.moving][d, 2])
+            fx, fy = load["force_N"]
+            m0, qarm = load["arm_Nm"]
+            F[d] += (fx, fy, math.cos(phi) * m0 - math.sin(phi) * qarm)
+        return F
+
+    def step(self, k: int) -> bool:
+        """Take step ``k``; True when it had active contacts."""
+        if self.scalar:
+            return self._step_scalar(k)
+        h, th, mv = self.h, self.theta, self.moving
+        t = self.table
+        gap, closed, H = t.geometry(self.q)
+        va, vb = self.v[t.a], self.v[t.b]
+        un = np.einsum("kj,kj->k", H[:, 0, 0], va) + np.einsum("kj,kj->k", H[:, 1, 0], vb)
+        active = np.flatnonzero(closed & (gap + 0.5 * h * un <= self.threshold))
+        v_free = self.v.copy()
+        v_free[mv] += h * self.minv * self.force(k)
+        impulse = np.zeros_like(self.impulse)
+        if len(active):
+            Ha = H[active]
+            q = np.einsum("kij,kj->ki", Ha[:, 0], v_free[t.a[active]]) + np.einsum(
+                "kij,kj->ki", Ha[:, 1], v_free[t.b[active]]
+            )
+            q[:, 0] += self.e * un[active]
+            r = self.solve(active, Ha, q)
+            impulse[active] = r
+            # H^T r summed per body (np.add.at is slower than bincount)
+            to = np.concatenate([t.a[active], t.b[active]])
+            each = np.concatenate([np.einsum("kij,ki->kj", Ha[:, 0], r), np.einsum("kij,ki->kj", Ha[:, 1], r)])
+            push = np.stack([np.bincount(to, weights=each[:, j], minlength=len(self.v)) for j in range(3)], axis=1)
+            v_free[mv] += self.minv * push[mv]
+        self.q[mv] += h * ((1.0 - th) * self.v[mv] + th * v_free[mv])
+        self.v = v_free
+        self.impulse = impulse
+        self.loaded = list(
+            zip(
+                active.tolist(),
+                impulse[active, 0].tolist(),
+                impulse[active, 1].tolist(),
+                gap[active].tolist(),
+                strict=True,
+            )
+        )
+        return bool(len(active))
+
+    def _step_scalar(self, k: int) -> bool:
+        """:meth:`step` for a few pairs: the geometry and the update pair by pair in Python
+        floats, the problem dense with numpy (numpy's per-call overhead dominates a few pairs)."""
+        h, th = self.h, self.theta
+        a_of, b_of, vloc, nl, e0, lo, hi, deep, twin = self.table.lists
+        qs, vs = self._qs, self._vs
+        trig = [(math.cos(p[2]), math.sin(p[2])) for p in qs]
+        dof = self.dof_list
+        nd = len(self.minv_flat)
+        inside = [False] * len(a_of)
+        found = []
+        rows = []
+        bounce = []
+        limit = self.threshold
+        for i in range(len(a_of)):
+            a, b = a_of[i], b_of[i]
+            ca, sa = trig[a]
+            cb, sb = trig[b]
+            vx, vy = vloc[i]
+            rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
+            n0, n1 = nl[i]
+            nx, ny = cb * n0 - sb * n1, sb * n0 + cb * n1
+            ex, ey = e0[i]
+            qa, qb = qs[a], qs[b]
+            rbx, rby = qa[0] + rax - qb[0], qa[1] + ray - qb[1]
+            dx, dy = rbx - (cb * ex - sb * ey), rby - (sb * ex + cb * ey)
+            gap = dx * nx + dy * ny
+            along = dy * nx - dx * ny
+            inside[i] = ok = lo[i] <= along <= hi[i] and gap >= deep[i]
+            if not ok or (twin[i] >= 0 and inside[twin[i]]):
+                continue
+            va, vb = vs[a], vs[b]
+            ra, rb = ny * rax - nx * ray, nx * rby - ny * rbx
+            un = nx * (va[0] - vb[0]) + ny * (va[1] - vb[1]) + ra * va[2] + rb * vb[2]
+            if gap + 0.5 * h * un > limit:
+                continue
+            row_n, row_t = [0.0] * nd, [0.0] * nd
+            da, db = dof[a], dof[b]
+            if da >= 0:
+                row_n[3 * da : 3 * da + 3] = nx, ny, ra
+                row_t[3 * da : 3 * da + 3] = -ny, nx, nx * rax + ny * ray
+            if db >= 0:
+                row_n[3 * db : 3 * db + 3] = -nx, -ny, rb
+                row_t[3 * db : 3 * db + 3] = ny, -nx, -nx * rbx - ny * rby
+            rows.append(row_n)
+            rows.append(row_t)
+            bounce.append(self.e * un)
+            bounce.append(0.0)
+            found.append((i, gap))
+        v0 = [x for body in self.moving_ids for x in vs[body]]
+        F = self.force_list(k)
+        minv = self.minv_list
+        v_new = [v + h * w * f for v, w, f in zip(v0, minv, F, strict=True)]
+        self.loaded = []
+        if found:
+            m = len(found)
+            H = np.array(rows)
+            HM = H * self.minv_flat
+            r = self._direct_dense(m, HM @ H.T, H @ v_new + bounce, [self.mu_list[i] for i, _ in found])
+            push = (r @ HM).tolist()
+            v_new = [v + p for v, p in zip(v_new, push, strict=True)]
+            rl = r.tolist()
+            self.loaded = [(i, rl[2 * j], rl[2 * j + 1], gap) for j, (i, gap) in enumerate(found)]
+        for j, body in enumerate(self.moving_ids):
+            qb, vb = qs[body], vs[body]
+            for c in range(3):
+                old, new = v0[3 * j + c], v_new[3 * j + c]
+                qb[c] += h * ((1.0 - th) * old + th * new)
+                vb[c] = new
+        return bool(found)
+
+    def force_list(self, k: int) -> list[float]:
+        """:meth:`force` as a flat list of floats (the scalar path)."""
+        (ax0, ay0), (ax1, ay1) = self.forces(k)
+        th = self.theta
+        ax, ay = (1.0 - th) * ax0 + th * ax1, (1.0 - th) * ay0 + th * ay1
+        F = [c for m in self.mass_list for c in (m * ax, m * ay, 0.0)]
+        for d, load in self.loads:
+            phi = self._qs[self.moving_ids[d]][2]
+            fx, fy = load["force_N"]
+            m0, qarm = load["arm_Nm"]
+            F[3 * d] += fx
+            F[3 * d + 1] += fy
+            F[3 * d + 2] += math.cos(phi) * m0 - math.sin(phi) * qarm
+        return F
+
+    def runaway(self, max_speed: float, max_spin: float) -> tuple[int, float, float] | None:
+        """The first body whose state is not finite or whose speed (m/s) or spin (rad/s) is
+        beyond the bounds: (index, speed, spin), or None."""
+        if self.scalar:
+            for i in self.moving_ids:
+                (x, y, p), (vx, vy, w) = self._qs[i], self._vs[i]
+                speed = math.hypot(vx, vy)
+                if not (speed <= max_speed and abs(w) <= max_spin and math.isfinite(x + y + p)):
+                    return i, speed, abs(w)
+            return None
+        v = self.v[:-1]
+        speeds = np.hypot(v[:, 0], v[:, 1])
+        ok = np.isfinite(self.q[:-1]).all(axis=1) & (speeds <= max_speed) & (np.abs(v[:, 2]) <= max_spin)
+        if ok[self.moving[:-1]].all():
+            return None
+        i = int(np.flatnonzero(~ok & self.moving[:-1])[0])
+        return i, float(speeds[i]), float(abs(v[i, 2]))
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        """(nb, 3) positions (x, y, theta) and (nb, 3) velocities of the bodies, m, rad, m/s, rad/s."""
+        if self.scalar:
+            return np.array(self._qs[:-1]), np.array(self._vs[:-1])
+        return self.q[:-1], self.v[:-1]
+
+    def solve(self, active: np.ndarray, Ha: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """The impulses (m, 2) of the active contacts (module docstring)."""
+        m = len(active)
+        da, db = self.dof_a[active], self.dof_b[active]
+        on_a, on_b = np.flatnonzero(da >= 0), np.flatnonzero(db >= 0)
+        rows, cols, blocks = delassus_blocks(
+            m,
+            np.concatenate([on_a, on_b]),
+            np.concatenate([da[on_a], db[on_b]]),
+            np.concatenate([Ha[on_a, 0], Ha[on_b, 1]]),
+            self.minv,
+        )
+        mu = self.table.mu[active]
+        if m <= DIRECT_CONTACTS:
+            return self._direct(m, rows, cols, blocks, q, mu)
+        return self._iterative(m, rows, cols, blocks, q, mu, self.impulse[active])
+
+    def _direct(self, m, rows, cols, blocks, q, mu) -> np.ndarray:
+        W = np.zeros((m, 2, m, 2))
+        W[rows, :, cols, :] = blocks
+        return self._direct_dense(m, W.reshape(2 * m, 2 * m), q.ravel(), mu).reshape(m, 2)
+
+    def _direct_dense(self, m, W, q, mu) -> np.ndarray:
+        """The impulses (2m,) of the dense FrictionContact(2) problem (W, q, mu): Lemke's
+        solution when its residual (Siconos's ``fc2d_compute_error``, which Lemke leaves in
+        the options) is within the tolerance, else Siconos's Gauss-Seidel from zero.
+
+        Siconos 4.4's ``fc2d_lexicolemke`` reports success whatever its residual (it compares
+        the residual with the iteration cap, ``iparam[0]``, instead of the tolerance); on the
+        degenerate problems of redundant contacts it can stop on a wrong solution (measured:
+        residual 9e-3 on a 4-block stack at rest), hence the check here."""
+        sn = self.sn
+        self.calls += 1
+        problem = sn.FrictionContactProblem(2, W, q, mu)
+        fell_back = False
+        for name in ("lemke", "nsgs2"):
+            so = self.options(name)
+            r = np.zeros(2 * m)
+            sn.fc2d_driver(problem, r, np.zeros(2 * m), so)
+            residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+            self.iterations += max(1, int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
+            if residual <= self.tol and np.all(np.isfinite(r)):
+                break
+            fell_back = True
+        else:
+            self.unconverged += 1
+        if fell_back:
+            self.fallbacks += 1
+        self.residual = residual
+        self.max_residual = max(self.max_residual, residual)
+        return r
+
+    def _iterative(self, m, rows, cols, blocks, q, mu, start) -> np.ndarray:
+        sn = self.sn
+        if self._sparse is None:
+            try:
+                import scipy.sparse
+            except ImportError:
+                raise ImportError(
+                    "Siconos's Python takes a sparse matrix as a scipy one: apt-get install python3-scipy"
+                ) from None
+            self._sparse = scipy.sparse
+        self.calls += 1
+        data, indices, indptr = sparse_fc3(m, rows, cols, blocks)
+        W = self._sparse.csc_matrix((data, indices, indptr), shape=(3 * m, 3 * m))
+        W.indices, W.indptr = indices, indptr  # scipy narrows them to int32; Siconos takes int64
+        q3 = np.zeros((m, 3))
+        q3[:, :2] = q
+        problem = sn.FrictionContactProblem(3, W, q3.ravel(), mu)
+        r3 = np.zeros((m, 3))
+        r3[:, :2] = start
+        r = r3.ravel().copy()
+        so = self.options("nsgs")
+        info = sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
+        iterations = int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
+        residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        if info != 0 or not np.all(np.isfinite(r)):
+            self.fallbacks += 1
+            r2 = r3.ravel().copy()
+            prox = self.options("prox")
+            info2 = sn.fc3d_driver(problem, r2, np.zeros(3 * m), prox)
+            res2 = float(prox.dparam[sn.SICONOS_DPARAM_RESIDU])
+            iterations += int(prox.iparam[sn.SICONOS_IPARAM_ITER_DONE])
+            if np.all(np.isfinite(r2)) and (info2 == 0 or not res2 > residual):
+                r, info, residual = r2, info2, res2
+        self.iterations += iterations
+        self.residual = residual
+        self.max_residual = max(self.max_residual, residual)
+        if info != 0:
+            self.unconverged += 1
+        return r.reshape(m, 3)[:, :2]
