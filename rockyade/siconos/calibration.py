@@ -42,7 +42,7 @@ from rockyade.scene import Scene
 #: A target mu within this relative distance of the model's own counts as reached.
 MU_RTOL = 0.01
 #: Default time step: this fraction of 1/p of the fastest moving block ...
-DT_P_FRACTION = 1.0e-3
+DT_P_FRACTION = 4.0e-3
 #: ... within these bounds, s.
 DT_MIN_S = 2.0e-5
 DT_MAX_S = 1.0e-3

@@ -22,15 +22,16 @@ Per step k (step h, theta = 1/2):
 * v_k+1 = v_free + M^-1 H^T r, q_k+1 = q_k + h ((1 - theta) v_k + theta v_k+1).
 
 The problem is solved by Siconos: a few contacts (``DIRECT_CONTACTS``) as FrictionContact(2)
-by Lemke's pivoting method (``fc2d_lexicolemke``; its Gauss-Seidel from zero when Lemke's
-residual is above the tolerance), more as FrictionContact(3) whose
-out-of-plane row is decoupled (W's third diagonal entry 1, q's 0: its impulse stays 0, so
+by Lemke's pivoting method (``fc2d_lexicolemke``); more as FrictionContact(3) whose
+out-of-plane row is decoupled (W's third diagonal entry 1, q's 0: its impulse stays 0, and
 the iterates are FrictionContact(2)'s, measured) by Gauss-Seidel on a sparse matrix
-(``fc3d_nsgs``) warm-started from the last step's impulses of the same pairs, and by the
-proximal-point method (``fc3d_proximal``: a regularised Newton) when Gauss-Seidel stops
-above the tolerance. Why FrictionContact(3) there: Siconos 4.4's 2-D Gauss-Seidel takes
-only a sparse-block matrix, whose conversion cost more than the solve, and its sweeps were
-2.2x slower than the 3-D one's on a sparse matrix (docs/siconos.md).
+(``fc3d_nsgs``, each contact's local problem by a projection on its cone) warm-started from
+the last step's impulses of the same pairs. A solution whose residual is above the tolerance
+is taken again by the proximal point method (``fc3d_proximal``: a regularised nonsmooth
+Newton, which the singular W of redundant contacts does not stop); after Gauss-Seidel fails,
+the proximal method goes first for 1, then 8, 64, ... solves (HOLD_GROWTH). Why
+FrictionContact(3) for many contacts: Siconos 4.4's 2-D Gauss-Seidel takes only a
+sparse-block matrix, whose conversion cost as much as the solve (docs/siconos.md).
 """
 
 from __future__ import annotations
@@ -50,8 +51,18 @@ SCALAR_PAIRS = 16
 #: dimension (Siconos's constraint activation threshold; 0 there): a contact at rest whose
 #: gap drifts by rounding stays active instead of opening and letting its block drop.
 ACTIVATION_FRACTION = 1e-5
-#: The proximal-point fallback's iteration cap.
+#: Gauss-Seidel's local solver (each contact's problem with the others' impulses fixed): a
+#: projection on the friction cone, Siconos's cheapest; its default, a local nonsmooth Newton,
+#: cost 29x more a step on a moving arch for the same solution (docs/siconos.md).
+NSGS_LOCAL_SOLVER = "SICONOS_FRICTION_3D_ONECONTACT_ProjectionOnCone"
+#: Gauss-Seidel's iteration cap (the proximal point method takes a step it fails: on the
+#: t/R 0.08 arch collapsing, 7.0 s with 200 against 16.6 s with 1,000, the same motion).
+NSGS_MAX_ITER = 200
+#: The proximal point method's iteration cap.
 PROX_MAX_ITER = 200
+#: After Gauss-Seidel fails, the proximal method goes first for 1 solve, then HOLD_GROWTH
+#: times longer at each new failure (a collapsing arch fails it at every step).
+HOLD_GROWTH = 8
 
 
 class PairTable:
@@ -267,20 +278,22 @@ class MoreauJean:
         self.mu_list = table.mu.tolist()
         self.dof_list = self.dof.tolist()
         self._options: dict[str, Any] = {}
+        self.prox_until = 0  # the proximal method goes first until this solver call
+        self.hold = 1
         self._sparse: Any = None
-        # diagnostics (the driver's Recorder reads them)
+        # diagnostics (the driver's Recorder reads them); fallbacks: the proximal method's calls
         self.calls = self.iterations = self.unconverged = self.fallbacks = 0
         self.residual = 0.0  # of the last call
         self.max_residual = 0.0
-        self.names = ["fc2d_lemke", "fc2d_nsgs", "fc3d_nsgs", "fc3d_prox"]
+        self.names = ["fc2d_lemke", "fc3d_nsgs", "fc3d_prox"]
 
     def describe(self) -> str:
         """The one-step problem and its solvers, in words (the Result's ``one_step_problem``)."""
         return (
             f"Moreau-Jean assembled with numpy (theta {self.theta:g}, activation threshold {self.threshold:.3g} m); "
-            f"up to {DIRECT_CONTACTS} active contacts FrictionContact(2) by Lemke (then Gauss-Seidel), "
+            f"up to {DIRECT_CONTACTS} active contacts FrictionContact(2) by Lemke, "
             "more FrictionContact(3) with the out-of-plane row decoupled by Gauss-Seidel warm-started from the "
-            "last step's impulses (then the proximal point method)"
+            "last step's impulses; the proximal point method where they end above the tolerance"
         )
 
     def options(self, name: str) -> Any:
@@ -290,11 +303,12 @@ class MoreauJean:
             sn = self.sn
             ids = {
                 "lemke": sn.SICONOS_FRICTION_2D_LEMKE,
-                "nsgs2": sn.SICONOS_FRICTION_2D_NSGS,
                 "nsgs": sn.SICONOS_FRICTION_3D_NSGS,
                 "prox": sn.SICONOS_FRICTION_3D_PROX,
             }
             so = self._options[name] = sn.SolverOptions(ids[name])
+            if name == "nsgs":  # each contact's local problem by one projection on its cone
+                sn.solver_options_update_internal(so, 0, getattr(sn, NSGS_LOCAL_SOLVER))
             # Lemke's cap is on its pivots
             so.iparam[sn.SICONOS_IPARAM_MAX_ITER] = (
                 min(self.max_iter, PROX_MAX_ITER) if name == "prox" else self.max_iter
@@ -493,7 +507,7 @@ class MoreauJean:
     def _direct_dense(self, m, W, q, mu) -> np.ndarray:
         """The impulses (2m,) of the dense FrictionContact(2) problem (W, q, mu): Lemke's
         solution when its residual (Siconos's ``fc2d_compute_error``, which Lemke leaves in
-        the options) is within the tolerance, else Siconos's Gauss-Seidel from zero.
+        the options) is within the tolerance, else the proximal point method's.
 
         Siconos 4.4's ``fc2d_lexicolemke`` reports success whatever its residual (it compares
         the residual with the iteration cap, ``iparam[0]``, instead of the tolerance); on the
@@ -501,26 +515,55 @@ class MoreauJean:
         residual 9e-3 on a 4-block stack at rest), hence the check here."""
         sn = self.sn
         self.calls += 1
-        problem = sn.FrictionContactProblem(2, W, q, mu)
-        fell_back = False
-        for name in ("lemke", "nsgs2"):
-            so = self.options(name)
-            r = np.zeros(2 * m)
-            sn.fc2d_driver(problem, r, np.zeros(2 * m), so)
-            residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
-            self.iterations += max(1, int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
-            if residual <= self.tol and np.all(np.isfinite(r)):
-                break
-            fell_back = True
-        else:
-            self.unconverged += 1
-        if fell_back:
-            self.fallbacks += 1
-        self.residual = residual
-        self.max_residual = max(self.max_residual, residual)
+        so = self.options("lemke")
+        r = np.zeros(2 * m)
+        sn.fc2d_driver(sn.FrictionContactProblem(2, W, q, mu), r, np.zeros(2 * m), so)
+        residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        self.iterations += max(1, int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
+        if not (residual <= self.tol and np.all(np.isfinite(r))):
+            W3 = np.zeros((m, 3, m, 3))
+            W3[:, :2, :, :2] = np.asarray(W).reshape(m, 2, m, 2)
+            W3[np.arange(m), 2, np.arange(m), 2] = 1.0
+            r, residual = self._prox(
+                m, W3.reshape(3 * m, 3 * m), np.asarray(q).reshape(m, 2), mu, None, r.reshape(m, 2), residual
+            )
+            r = r.ravel()
+        self._count(residual)
         return r
 
+    def _prox(self, m, W, q, mu, problem, start, residual) -> tuple[np.ndarray, float]:
+        """The proximal point method from ``start`` (m, 2) on the FrictionContact(3) problem
+        (W 3m x 3m, q (m, 2), mu; ``problem`` when built): its impulses (m, 2) and residual,
+        or ``start`` and ``residual`` when it does no better."""
+        sn = self.sn
+        self.fallbacks += 1
+        if problem is None:
+            q3 = np.zeros((m, 3))
+            q3[:, :2] = q
+            problem = sn.FrictionContactProblem(3, W, q3.ravel(), mu)
+        r3 = np.zeros((m, 3))
+        r3[:, :2] = np.where(np.isfinite(start), start, 0.0)
+        r = r3.ravel()
+        so = self.options("prox")
+        sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
+        self.iterations += int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
+        got = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        if np.all(np.isfinite(r)) and not got > residual:
+            return r.reshape(m, 3)[:, :2], got
+        return start, residual
+
+    def _count(self, residual: float) -> None:
+        """The last solve's residual in the diagnostics; above the tolerance it is unconverged."""
+        self.residual = residual
+        self.max_residual = max(self.max_residual, residual)
+        if not residual <= self.tol:
+            self.unconverged += 1
+
     def _iterative(self, m, rows, cols, blocks, q, mu, start) -> np.ndarray:
+        """The impulses (m, 2) by Gauss-Seidel on the sparse FrictionContact(3) problem from
+        ``start`` (the last step's impulses of the same pairs), and by the proximal point
+        method where Gauss-Seidel ends above the tolerance (first, for a while, after it did:
+        HOLD_GROWTH)."""
         sn = self.sn
         if self._sparse is None:
             try:
@@ -537,25 +580,24 @@ class MoreauJean:
         q3 = np.zeros((m, 3))
         q3[:, :2] = q
         problem = sn.FrictionContactProblem(3, W, q3.ravel(), mu)
+        out, residual = start, math.inf
+        if self.calls < self.prox_until:  # Gauss-Seidel failed lately: the proximal method first
+            out, residual = self._prox(m, W, q, mu, problem, start, residual)
+            if residual <= self.tol:
+                self._count(residual)
+                return out
         r3 = np.zeros((m, 3))
-        r3[:, :2] = start
-        r = r3.ravel().copy()
+        r3[:, :2] = out
+        r = r3.ravel()
         so = self.options("nsgs")
-        info = sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
-        iterations = int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
-        residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
-        if info != 0 or not np.all(np.isfinite(r)):
-            self.fallbacks += 1
-            r2 = r3.ravel().copy()
-            prox = self.options("prox")
-            info2 = sn.fc3d_driver(problem, r2, np.zeros(3 * m), prox)
-            res2 = float(prox.dparam[sn.SICONOS_DPARAM_RESIDU])
-            iterations += int(prox.iparam[sn.SICONOS_IPARAM_ITER_DONE])
-            if np.all(np.isfinite(r2)) and (info2 == 0 or not res2 > residual):
-                r, info, residual = r2, info2, res2
-        self.iterations += iterations
-        self.residual = residual
-        self.max_residual = max(self.max_residual, residual)
-        if info != 0:
-            self.unconverged += 1
-        return r.reshape(m, 3)[:, :2]
+        sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
+        self.iterations += int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
+        got = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        if np.all(np.isfinite(r)) and not got > residual:
+            out, residual = r.reshape(m, 3)[:, :2], got
+        if not residual <= self.tol and self.calls >= self.prox_until:
+            out, residual = self._prox(m, W, q, mu, problem, out, residual)
+            self.prox_until = self.calls + self.hold
+            self.hold *= HOLD_GROWTH
+        self._count(residual)
+        return out

@@ -21,7 +21,7 @@ from rockyade.errors import InputError
 from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.siconos.backend import check_timeout, run_model
-from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
+from rockyade.siconos.calibration import DT_MAX_S, DT_MIN_S, DT_P_FRACTION, check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import INTEGRATORS, Numerics
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
@@ -100,7 +100,7 @@ class SiconosSolver(SolverBase):
         Run in a Siconos process kept warm between runs (one per thread; the default), or
         in a process of its own (False): the same result; warm saves the start-up.
     dt_s
-        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 1e-3 / p of
+        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 4e-3 / p of
         the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
         interval.
     dt_factor
@@ -158,7 +158,7 @@ class SiconosSolver(SolverBase):
     dt_factor: float = 1.0
     #: The friction-contact solvers' default tolerance per integrator (relative; docs/siconos.md,
     #: "The tolerance": chosen by what halving it changes).
-    DEFAULT_TOL: ClassVar[dict[str, float]] = {"numerics": 1e-6, "kernel": 1e-8}
+    DEFAULT_TOL: ClassVar[dict[str, float]] = {"numerics": 1e-4, "kernel": 1e-8}
 
     restitution: float = 0.0
     integrator: str = "numerics"
@@ -210,7 +210,7 @@ class SiconosSolver(SolverBase):
             "dt_factor": self.dt_factor,
             "dt_source": "user"
             if self.dt_s is not None
-            else "default (1e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
+            else f"default ({DT_P_FRACTION:g} / p of the fastest block, in [{DT_MIN_S:g}, {DT_MAX_S:g}] s)",
             "dt_base_s": base,
             "integrator": self.integrator,
         }
