@@ -315,7 +315,8 @@ def convergence(size: Size) -> None:
         intensity, runs = collapse_intensity(solver, size)
         rows[label] = [peak, fall_s, intensity]
         print(
-            f"  {label:14s} wall top course {1e3 * peak:.4g} mm (dt {wall_result.meta.dt_s:.3g} s, {wall_result.status}); "
+            f"  {label:14s} wall top course {1e3 * peak:.4g} mm "
+            f"(dt {wall_result.meta.dt_s:.3g} s, {wall_result.status}); "
             f"t/R 0.08 arch falls at {fall_s:.4g} s ({fall.meta.overturned_block}); t/R 0.15 arch collapses from "
             f"{intensity:.4g} g ({runs} runs); {time.perf_counter() - start:.0f} s"
         )
