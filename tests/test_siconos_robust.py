@@ -73,8 +73,8 @@ def test_a_33_block_wall_stands_at_rest(integrator):
         assert meta.extra["retried_steps"] >= 1 and meta.extra["fallback_steps"] >= 1
         assert list(meta.extra["friction_solvers"]) == ["nsn", "nsgs", "admm"]
     else:
-        assert meta.extra["solver_calls"] == 30 and meta.extra["max_solver_residual"] <= 1e-6
-        assert list(meta.extra["friction_solvers"]) == ["fc2d_lemke", "fc2d_nsgs", "fc3d_nsgs", "fc3d_prox"]
+        assert meta.extra["solver_calls"] == 30 and meta.extra["max_solver_residual"] <= meta.extra["solver_tol"]
+        assert list(meta.extra["friction_solvers"]) == ["fc2d_lemke", "fc3d_nsgs", "fc3d_prox"]
 
 
 def test_an_arch_below_its_minimum_thickness_collapses_and_is_reported_overturned():

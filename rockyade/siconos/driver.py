@@ -15,37 +15,41 @@ stopped at its deadline, a ``time.monotonic()`` value, with its samples written;
 killed from outside leaves them). After a job that raised it answers and exits (code 1).
 It stops on ``{"quit": true}`` or when its end of the socket closes.
 
-Runs inside Debian's /usr/bin/python3 and imports only the standard library, numpy and
-Siconos (``python3-siconos``). The scene is data prepared by rockyade
+Runs inside Debian's /usr/bin/python3 and imports only the standard library, numpy,
+Siconos (``python3-siconos``) and, from its own folder, :mod:`rockyade.siconos.moreau_jean`
+(which takes scipy's sparse matrices to Siconos). The scene is data prepared by rockyade
 (``rockyade.siconos.payload``): the blocks' contact polygons (the DEMs' own: base corners at
 the equivalent base b_eq), masses and inertias (I_O = M g R / p^2), the ground acceleration
-samples, the loads and the time step.
+samples, the loads, the time step and ``integrator``, which chooses the engine:
 
-The model (nonsmooth contact dynamics, Moreau-Jean time stepping):
-
-* each moving block is a ``RigidBody2dDS`` (x, y, theta); a fixed block and the ground are
-  static (they move with the base: not at all in the base frame);
-* contacts are rockyade's own vertex-to-edge pairs, found once from the starting geometry
-  (``contact_pairs``: the reference DEM's), each a ``LagrangianLinearTIR`` whose C and e
-  are set before every step from the bodies' positions (``Contacts``: numpy over all
-  pairs, plain floats for a few), with ``NewtonImpactFrictionNSL(e, 0, mu, 3)``; of two
-  pairs at coinciding corners only one is active at a time (their rows would make the
-  one-step problem singular);
-* the one-step problem is ``FrictionContact(3)`` solved by the nonsmooth Newton
-  (Alart-Curnier); a step it fails (Siconos raises, the residual stays above the
-  tolerance, the state runs away) is taken again from the state before it by NSGS, then
-  ADMM (``Stepper``: both tolerate the redundant contacts of walls and arches); a step
-  none can take ends the run ``failed`` with the reason and the samples so far;
-* ``MoreauJeanOSI(theta)``; the ground motion enters in the base frame as an inertial
-  force -m a_g(t) on every moving block (exact for a rigid base: the base frame translates
-  without rotating), with the vertical -m (g + a_v(t)), both evaluated at the middle of each
-  step (t_k + dt/2) and set with ``setFExtPtr`` before the step; a point load is a constant
-  force at its point of the block, its torque cos(phi) M0 - sin(phi) Q at world angle phi;
-* every ``steps_per_sample`` steps the state is recorded with, per vertex, the normal force
-  (reaction impulse / dt) and whether the contact slips (|tangential| >= SLIP_RATIO x mu x
-  normal); per step the numerics solver's iterations and residual are counted (a step whose
-  residual stays above the tolerance is "unconverged"); at every sample the deepest
-  penetration (-gap) of the contacts.
+* contacts are rockyade's own vertex-to-edge pairs (``contact_pairs``: the reference DEM's),
+  found once from the starting geometry; a corner lifted at the start pairs with the seat it
+  will land on (``pair_reach_fraction``); of two pairs at coinciding corners only one is
+  active at a time (``twins``: their rows are equal);
+* ``numerics`` (the default, :class:`NumericsEngine`): every vertex of a moving block is also
+  paired with the ground (a block that starts above it, or falls, lands); Moreau-Jean's
+  one-step problem is assembled with numpy and solved by Siconos's numerics
+  (:mod:`rockyade.siconos.moreau_jean`: Lemke for a few contacts, Gauss-Seidel warm-started
+  for many, the proximal point method where they stop above the tolerance); the base force
+  theta-weighted between each step's ends;
+* ``kernel`` (:class:`KernelEngine`, the path before): each moving block a
+  ``RigidBody2dDS``, each pair a ``LagrangianLinearTIR`` whose C and e are set before every
+  step (``Contacts``) with ``NewtonImpactFrictionNSL(e, 0, mu, 3)``, ``MoreauJeanOSI(theta)``
+  and ``TimeStepping``; the one-step problem ``FrictionContact(3)`` by the nonsmooth Newton,
+  a step it fails taken again by NSGS, then ADMM (``Stepper``); the base force at the middle
+  of each step, set with ``setFExtPtr``;
+* either way the ground motion enters in the base frame as an inertial force -m a_g(t) on
+  every moving block (exact for a rigid base: the base frame translates without rotating),
+  with the vertical -m (g + a_v(t)); a point load is a constant force at its point of the
+  block, its torque cos(phi) M0 - sin(phi) Q at world angle phi; a step no solver can take, or
+  that leaves a body non-finite or running away, ends the run ``failed`` with the reason and
+  the samples so far;
+* every ``steps_per_sample`` steps the state is recorded (:class:`Recorder`) with, per vertex,
+  the normal force (reaction impulse / dt) and whether the contact slips (|tangential| >=
+  SLIP_RATIO x mu x normal); per step the solver's iterations and residual are counted (a
+  step left above the tolerance is "unconverged"); at every sample the deepest penetration
+  of a vertex below the ground: beyond ``max_penetration_m`` the run fails (the block went
+  through the ground).
 
 Same role as :mod:`rockyade.yade.driver`: each package of an engine that runs in another
 Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
@@ -270,34 +274,17 @@ class Contacts:
         bodies = scene["bodies"]
         nb = len(bodies)
         m = len(pairs)
-        local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
-        size = [float(np.min(np.ptp(v, axis=0))) for v in local]
         self.q = np.zeros((nb + 1, 3))  # the bodies' (x, y, theta); row nb: the ground
         for i, b in enumerate(bodies):
             self.q[i] = (b["centroid0_m"][0], b["centroid0_m"][1], b["angle0_rad"])
         self.moving_ids = [i for i, ds in enumerate(ds_of) if ds is not None]
-        self.a = np.array([p["a"] for p in pairs], dtype=int)
-        self.b = np.array([p["b"] if p["b"] >= 0 else nb for p in pairs], dtype=int)
-        self.ground = np.array([p["b"] < 0 for p in pairs], dtype=bool)
-        self.vloc = np.array([local[p["a"]][p["v"]] for p in pairs]).reshape(m, 2)
-        self.e0 = np.array([p["e0"] if p["b"] >= 0 else (0.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.t = np.array([p["t"] if p["b"] >= 0 else (1.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.n = np.array([p["n"] if p["b"] >= 0 else (0.0, 1.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.length = np.array([p["L"] if p["b"] >= 0 else math.inf for p in pairs], dtype=float)
-        self.slack = EDGE_SLACK * np.where(self.ground, 0.0, self.length)
-        self.deep = np.array(
-            [DEEP_FRACTION * min(size[p["a"]], size[p["b"]] if p["b"] >= 0 else size[p["a"]]) for p in pairs]
-        )
-        movable = np.array([ds is not None for ds in ds_of] + [False])
-        self.mov_a = movable[self.a].astype(float)
-        self.mov_b = movable[self.b].astype(float)
         self.twin = twins(scene, pairs)
+        # the pairs' geometry: the numerics path's (its gap, open rule and Jacobian rows)
+        self.table = _sibling("moreau_jean").PairTable(bodies, pairs, self.twin, EDGE_SLACK, DEEP_FRACTION)
+        movable = np.array([ds is not None for ds in ds_of] + [False])
+        self.mov_a = movable[self.table.a].astype(float)
+        self.mov_b = movable[self.table.b].astype(float)
         self.inside = np.zeros(m, dtype=bool)
-        self.a_list, self.b_list = self.a.tolist(), self.b.tolist()
-        self.vloc_list, self.n_list, self.e0_list = self.vloc.tolist(), self.n.tolist(), self.e0.tolist()
-        self.slack_list, self.length_list = self.slack.tolist(), self.length.tolist()
-        self.deep_list = (-self.deep).tolist()
-        self.ground_list, self.twin_list = self.ground.tolist(), self.twin.tolist()
         self.mova_list, self.movb_list = self.mov_a.tolist(), self.mov_b.tolist()
         self.inters, self.views, self.cols = [], [], []
         laws = {}
@@ -340,39 +327,17 @@ class Contacts:
         return qf
 
     def geometry(self):
-        """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs)."""
-        q = self.q
-        qa, qb = q[self.a], q[self.b]
-        ca, sa = np.cos(qa[:, 2]), np.sin(qa[:, 2])
-        cb, sb = np.cos(qb[:, 2]), np.sin(qb[:, 2])
-        vx, vy = self.vloc[:, 0], self.vloc[:, 1]
-        rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
-        px, py = qa[:, 0] + rax, qa[:, 1] + ray
-        nx = cb * self.n[:, 0] - sb * self.n[:, 1]
-        ny = sb * self.n[:, 0] + cb * self.n[:, 1]
-        tx, ty = -ny, nx
-        ex, ey = self.e0[:, 0], self.e0[:, 1]
-        dx = px - (qb[:, 0] + cb * ex - sb * ey)
-        dy = py - (qb[:, 1] + sb * ex + cb * ey)
-        gap = dx * nx + dy * ny
-        sp = dx * tx + dy * ty
-        inside = self.ground | ((sp >= -self.slack) & (sp <= self.length + self.slack))
-        inside &= gap >= -self.deep
-        self.inside[:] = inside
-        has = self.twin >= 0
-        shadowed = np.zeros_like(inside)
-        shadowed[has] = inside[self.twin[has]]
-        closed = inside & ~shadowed
-        rbx, rby = px - qb[:, 0], py - qb[:, 1]
+        """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs:
+        the pair table's geometry, with the twist row and the moving sides only)."""
+        q, t = self.q, self.table
+        gap, closed, H = t.geometry(q)
         J = self.jac
-        ma, mb = self.mov_a, self.mov_b
-        J[:, 0, 0], J[:, 0, 1], J[:, 0, 2] = nx * ma, ny * ma, (ny * rax - nx * ray) * ma
-        J[:, 1, 0], J[:, 1, 1], J[:, 1, 2] = tx * ma, ty * ma, (ty * rax - tx * ray) * ma
-        J[:, 2, 2] = TWIST_ARM * ma
-        J[:, 0, 3], J[:, 0, 4], J[:, 0, 5] = -nx * mb, -ny * mb, -(ny * rbx - nx * rby) * mb
-        J[:, 1, 3], J[:, 1, 4], J[:, 1, 5] = -tx * mb, -ty * mb, -(ty * rbx - tx * rby) * mb
-        J[:, 2, 5] = -TWIST_ARM * mb
-        cq = np.einsum("kij,kj->ki", J[:, :, :3], qa) + np.einsum("kij,kj->ki", J[:, :, 3:], qb)
+        ma, mb = self.mov_a[:, None, None], self.mov_b[:, None, None]
+        J[:, :2, :3] = H[:, 0] * ma
+        J[:, :2, 3:] = H[:, 1] * mb
+        J[:, 2, 2] = TWIST_ARM * self.mov_a
+        J[:, 2, 5] = -TWIST_ARM * self.mov_b
+        cq = np.einsum("kij,kj->ki", J[:, :, :3], q[t.a]) + np.einsum("kij,kj->ki", J[:, :, 3:], q[t.b])
         self.off[:] = -cq
         self.off[:, 0] += np.where(closed, gap - GAP_OFFSET_M, 1.0)
         self.gaps[:] = np.where(closed, gap, math.inf)
@@ -382,27 +347,27 @@ class Contacts:
         floats: faster than numpy's per-call overhead for the few pairs of a block or a small
         stack (SCALAR_PAIRS). Writes each pair's C and e directly (not ``jac`` and ``off``)."""
         q, gaps, inside_flags = self.read_state_floats(), self.gaps, self.inside
+        a_of, b_of, vloc, nl, e0, lo, hi, deep, twin_of = self.table.lists
         gap_list = [0.0] * len(self.pairs)
         for k in range(len(self.pairs)):
-            a, b = self.a_list[k], self.b_list[k]
+            a, b = a_of[k], b_of[k]
             xa, ya, pa = q[a]
             xb, yb, pb = q[b]
             ca, sa = math.cos(pa), math.sin(pa)
-            vx, vy = self.vloc_list[k]
+            vx, vy = vloc[k]
             rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
             px, py = xa + rax, ya + ray
             cb, sb = math.cos(pb), math.sin(pb)
-            n0, n1 = self.n_list[k]
+            n0, n1 = nl[k]
             nx, ny = cb * n0 - sb * n1, sb * n0 + cb * n1
             tx, ty = -ny, nx
-            ex, ey = self.e0_list[k]
+            ex, ey = e0[k]
             dx, dy = px - (xb + cb * ex - sb * ey), py - (yb + sb * ex + cb * ey)
             gap = dx * nx + dy * ny
             sp = dx * tx + dy * ty
-            slack, length = self.slack_list[k], self.length_list[k]
-            inside = (self.ground_list[k] or -slack <= sp <= length + slack) and gap >= self.deep_list[k]
+            inside = lo[k] <= sp <= hi[k] and gap >= deep[k]
             inside_flags[k] = inside
-            twin = self.twin_list[k]
+            twin = twin_of[k]
             closed = inside and not (twin >= 0 and inside_flags[twin])
             rbx, rby = px - xb, py - yb
             ma, mb = self.mova_list[k], self.movb_list[k]

@@ -43,6 +43,9 @@ import numpy as np
 
 #: Up to this many active contacts the problem is FrictionContact(2), dense, solved by Lemke.
 DIRECT_CONTACTS = 16
+#: Up to this many active contacts Lemke is the last resort after Gauss-Seidel and the
+#: proximal method (its cost grows as the cube of the contacts).
+LEMKE_CONTACTS = 120
 #: Up to this many pairs a step is computed pair by pair in Python floats, beyond it with
 #: numpy over all pairs at once (numpy's per-call overhead dominates a block's or a bi-block's
 #: step: measured).
@@ -60,6 +63,11 @@ NSGS_LOCAL_SOLVER = "SICONOS_FRICTION_3D_ONECONTACT_ProjectionOnCone"
 NSGS_MAX_ITER = 200
 #: The proximal point method's iteration cap.
 PROX_MAX_ITER = 200
+#: A solution whose largest impulse exceeds this many times the moving bodies' momentum scale
+#: (their mass x (the largest free speed + g dt)) is refused: on the singular W of redundant
+#: contacts the proximal method once returned impulses of 1e16 N s in W's null space, within
+#: its relative tolerance, whose rounding then threw a voussoir at 5e14 m/s.
+IMPULSE_FACTOR = 1e3
 #: After Gauss-Seidel fails, the proximal method goes first for 1 solve, then HOLD_GROWTH
 #: times longer at each new failure (a collapsing arch fails it at every step).
 HOLD_GROWTH = 8
@@ -167,10 +175,82 @@ class PairTable:
         return gap, closed, H
 
 
+class DelassusPattern:
+    """Where the blocks of W = H M^-1 H^T of an active set are, and how they are summed: found
+    once and kept while the active set stays (most steps), so that a step computes only the
+    values.
+
+    Parameters
+    ----------
+    m
+        The active contacts.
+    contacts, dofs
+        One entry per (contact, moving body) incidence: the contact's index among the active
+        ones and the body's index among the moving bodies.
+    """
+
+    def __init__(self, m: int, contacts: np.ndarray, dofs: np.ndarray) -> None:
+        self.m = m
+        self.order = np.argsort(dofs, kind="stable")
+        c, d = contacts[self.order], dofs[self.order]
+        self.dofs = d
+        counts = np.bincount(d)
+        group = counts[d]
+        start = (np.cumsum(counts) - counts)[d]
+        # every pair (x, y) of incidences on the same body: a product J_x M^-1 J_y^T
+        self.x = np.repeat(np.arange(len(d)), group)
+        self.y = np.arange(len(self.x)) - np.repeat(np.cumsum(group) - group, group) + np.repeat(start, group)
+        keys, where = np.unique(c[self.y] * m + c[self.x], return_inverse=True)
+        self.perm = np.argsort(where, kind="stable")  # the products of one block together
+        self.starts = np.flatnonzero(np.r_[True, np.diff(where[self.perm]) != 0])
+        self.block_row, self.block_col = keys % m, keys // m
+        self._fc3: tuple[np.ndarray, ...] | None = None
+
+    def blocks(self, rows: np.ndarray, minv: np.ndarray) -> np.ndarray:
+        """(n, 2, 2) the blocks, sorted by column then row, from the incidences' (2, 3) Jacobian
+        rows and the moving bodies' inverse mass diagonals (1/m, 1/m, 1/I)."""
+        Jr = rows[self.order]
+        a, b = (Jr * minv[self.dofs][:, None, :])[self.x], Jr[self.y]
+        products = np.empty((len(a), 4))
+        for i in range(2):  # written out: 6x faster than einsum on a wall's 4,600 products
+            for j in range(2):
+                products[:, 2 * i + j] = a[:, i, 0] * b[:, j, 0] + a[:, i, 1] * b[:, j, 1] + a[:, i, 2] * b[:, j, 2]
+        return np.add.reduceat(products[self.perm], self.starts, axis=0).reshape(-1, 2, 2)
+
+    def fc3(self, blocks: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The CSC arrays (data, indices, indptr) of the 3m x 3m FrictionContact(3) matrix with
+        these in-plane ``blocks`` and its out-of-plane rows decoupled (diagonal 1)."""
+        if self._fc3 is None:
+            m, block_row, block_col = self.m, self.block_row, self.block_col
+            per_col = np.bincount(block_col, minlength=m)
+            counts = np.empty(3 * m, dtype=np.int64)
+            counts[0::3] = 2 * per_col
+            counts[1::3] = 2 * per_col
+            counts[2::3] = 1
+            indptr = np.zeros(3 * m + 1, dtype=np.int64)
+            np.cumsum(counts, out=indptr[1:])
+            indices = np.empty(int(indptr[-1]), dtype=np.int64)
+            at = np.empty((len(block_row), 2, 2), dtype=np.int64)  # where each block entry goes
+            rank = np.arange(len(block_row)) - (np.cumsum(per_col) - per_col)[block_col]
+            for k in (0, 1):
+                first = indptr[3 * block_col + k] + 2 * rank
+                indices[first] = 3 * block_row
+                indices[first + 1] = 3 * block_row + 1
+                at[:, 0, k], at[:, 1, k] = first, first + 1
+            third = indptr[3 * np.arange(m) + 2]
+            indices[third] = 3 * np.arange(m) + 2
+            self._fc3 = (indices, indptr, at, third)
+        indices, indptr, at, third = self._fc3
+        data = np.empty(len(indices))
+        data[at] = blocks
+        data[third] = 1.0
+        return data, indices, indptr
+
+
 def delassus_blocks(
     m: int, contacts: np.ndarray, dofs: np.ndarray, rows: np.ndarray, minv: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The non-zero 2x2 blocks of W = H M^-1 H^T for ``m`` contacts.
+    """The non-zero 2x2 blocks of W = H M^-1 H^T for ``m`` contacts (:class:`DelassusPattern`).
 
     Parameters
     ----------
@@ -185,45 +265,17 @@ def delassus_blocks(
     block_row, block_col, blocks
         The blocks (n, 2, 2) and their block indices, each block once, sorted by column then row.
     """
-    order = np.argsort(dofs, kind="stable")
-    c, d, Jr = contacts[order], dofs[order], rows[order]
-    counts = np.bincount(d)
-    group = counts[d]
-    start = (np.cumsum(counts) - counts)[d]
-    x = np.repeat(np.arange(len(d)), group)
-    y = np.arange(len(x)) - np.repeat(np.cumsum(group) - group, group) + np.repeat(start, group)
-    products = np.einsum("pik,pjk->pij", (Jr * minv[d][:, None, :])[x], Jr[y]).reshape(-1, 4)
-    keys, where = np.unique(c[y] * m + c[x], return_inverse=True)
-    blocks = np.empty((len(keys), 4))
-    for j in range(4):  # the sum of the products of the same block (np.add.at is slower)
-        blocks[:, j] = np.bincount(where, weights=products[:, j], minlength=len(keys))
-    return keys % m, keys // m, blocks.reshape(-1, 2, 2)
+    pattern = DelassusPattern(m, contacts, dofs)
+    return pattern.block_row, pattern.block_col, pattern.blocks(rows, minv)
 
 
 def sparse_fc3(m: int, block_row: np.ndarray, block_col: np.ndarray, blocks: np.ndarray) -> tuple[np.ndarray, ...]:
     """The CSC arrays (data, indices, indptr) of the 3m x 3m FrictionContact(3) matrix whose 2x2
     in-plane blocks are ``blocks`` (sorted by column then row) and whose out-of-plane rows are
-    decoupled (diagonal 1)."""
-    per_col = np.bincount(block_col, minlength=m)
-    counts = np.empty(3 * m, dtype=np.int64)
-    counts[0::3] = 2 * per_col
-    counts[1::3] = 2 * per_col
-    counts[2::3] = 1
-    indptr = np.zeros(3 * m + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    indices = np.empty(int(indptr[-1]), dtype=np.int64)
-    data = np.empty(int(indptr[-1]))
-    rank = np.arange(len(block_row)) - (np.cumsum(per_col) - per_col)[block_col]
-    for k in (0, 1):
-        at = indptr[3 * block_col + k] + 2 * rank
-        indices[at] = 3 * block_row
-        indices[at + 1] = 3 * block_row + 1
-        data[at] = blocks[:, 0, k]
-        data[at + 1] = blocks[:, 1, k]
-    third = indptr[3 * np.arange(m) + 2]
-    indices[third] = 3 * np.arange(m) + 2
-    data[third] = 1.0
-    return data, indices, indptr
+    decoupled (diagonal 1): :meth:`DelassusPattern.fc3` for a pattern of these blocks."""
+    pattern = DelassusPattern.__new__(DelassusPattern)
+    pattern.m, pattern.block_row, pattern.block_col, pattern._fc3 = m, block_row, block_col, None
+    return pattern.fc3(blocks)
 
 
 class MoreauJean:
@@ -265,6 +317,9 @@ class MoreauJean:
         self.dof_a, self.dof_b = self.dof[table.a], self.dof[table.b]
         self.loads = [(int(self.dof[i]), b["load"]) for i, b in enumerate(bodies) if not b["fixed"] and b.get("load")]
         self.threshold = ACTIVATION_FRACTION * table.size
+        self.total_mass = float(self.mass.sum())
+        self.g = float(scene["g"])
+        self.impulse_limit = math.inf  # set each step (IMPULSE_FACTOR)
         self.tol = float(scene["solver_tol"])
         self.max_iter = int(scene["solver_max_iter"])
         self.impulse = np.zeros((len(table.pairs), 2))  # the last step's (r_n, r_t) per pair, N s
@@ -278,6 +333,7 @@ class MoreauJean:
         self.mu_list = table.mu.tolist()
         self.dof_list = self.dof.tolist()
         self._options: dict[str, Any] = {}
+        self._pattern: tuple[bytes, DelassusPattern, np.ndarray, np.ndarray] | None = None
         self.prox_until = 0  # the proximal method goes first until this solver call
         self.hold = 1
         self._sparse: Any = None
@@ -344,6 +400,7 @@ class MoreauJean:
         active = np.flatnonzero(closed & (gap + 0.5 * h * un <= self.threshold))
         v_free = self.v.copy()
         v_free[mv] += h * self.minv * self.force(k)
+        self.impulse_limit = IMPULSE_FACTOR * self.total_mass * (float(np.max(np.abs(v_free))) + self.g * h)
         impulse = np.zeros_like(self.impulse)
         if len(active):
             Ha = H[active]
@@ -425,6 +482,7 @@ class MoreauJean:
         F = self.force_list(k)
         minv = self.minv_list
         v_new = [v + h * w * f for v, w, f in zip(v0, minv, F, strict=True)]
+        self.impulse_limit = IMPULSE_FACTOR * self.total_mass * (max(map(abs, v_new)) + self.g * h)
         self.loaded = []
         if found:
             m = len(found)
@@ -485,29 +543,26 @@ class MoreauJean:
     def solve(self, active: np.ndarray, Ha: np.ndarray, q: np.ndarray) -> np.ndarray:
         """The impulses (m, 2) of the active contacts (module docstring)."""
         m = len(active)
-        da, db = self.dof_a[active], self.dof_b[active]
-        on_a, on_b = np.flatnonzero(da >= 0), np.flatnonzero(db >= 0)
-        rows, cols, blocks = delassus_blocks(
-            m,
-            np.concatenate([on_a, on_b]),
-            np.concatenate([da[on_a], db[on_b]]),
-            np.concatenate([Ha[on_a, 0], Ha[on_b, 1]]),
-            self.minv,
-        )
+        key = active.tobytes()
+        if self._pattern is None or self._pattern[0] != key:
+            da, db = self.dof_a[active], self.dof_b[active]
+            on_a, on_b = np.flatnonzero(da >= 0), np.flatnonzero(db >= 0)
+            pattern = DelassusPattern(m, np.concatenate([on_a, on_b]), np.concatenate([da[on_a], db[on_b]]))
+            self._pattern = (key, pattern, on_a, on_b)
+        _, pattern, on_a, on_b = self._pattern
+        blocks = pattern.blocks(np.concatenate([Ha[on_a, 0], Ha[on_b, 1]]), self.minv)
         mu = self.table.mu[active]
         if m <= DIRECT_CONTACTS:
-            return self._direct(m, rows, cols, blocks, q, mu)
-        return self._iterative(m, rows, cols, blocks, q, mu, self.impulse[active])
-
-    def _direct(self, m, rows, cols, blocks, q, mu) -> np.ndarray:
-        W = np.zeros((m, 2, m, 2))
-        W[rows, :, cols, :] = blocks
-        return self._direct_dense(m, W.reshape(2 * m, 2 * m), q.ravel(), mu).reshape(m, 2)
+            W = np.zeros((m, 2, m, 2))
+            W[pattern.block_row, :, pattern.block_col, :] = blocks
+            return self._direct_dense(m, W.reshape(2 * m, 2 * m), q.ravel(), mu).reshape(m, 2)
+        return self._iterative(m, pattern, blocks, q, mu, self.impulse[active])
 
     def _direct_dense(self, m, W, q, mu) -> np.ndarray:
         """The impulses (2m,) of the dense FrictionContact(2) problem (W, q, mu): Lemke's
         solution when its residual (Siconos's ``fc2d_compute_error``, which Lemke leaves in
-        the options) is within the tolerance, else the proximal point method's.
+        the options) is within the tolerance, else Gauss-Seidel's, else the proximal point
+        method's (on the problem as FrictionContact(3), its out-of-plane row decoupled).
 
         Siconos 4.4's ``fc2d_lexicolemke`` reports success whatever its residual (it compares
         the residual with the iteration cap, ``iparam[0]``, instead of the tolerance); on the
@@ -518,37 +573,40 @@ class MoreauJean:
         so = self.options("lemke")
         r = np.zeros(2 * m)
         sn.fc2d_driver(sn.FrictionContactProblem(2, W, q, mu), r, np.zeros(2 * m), so)
-        residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
         self.iterations += max(1, int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE]))
-        if not (residual <= self.tol and np.all(np.isfinite(r))):
+        residual = float(so.dparam[sn.SICONOS_DPARAM_RESIDU]) if self._sane(r) else math.inf
+        out = r.reshape(m, 2)
+        if not residual <= self.tol:
             W3 = np.zeros((m, 3, m, 3))
             W3[:, :2, :, :2] = np.asarray(W).reshape(m, 2, m, 2)
             W3[np.arange(m), 2, np.arange(m), 2] = 1.0
-            r, residual = self._prox(
-                m, W3.reshape(3 * m, 3 * m), np.asarray(q).reshape(m, 2), mu, None, r.reshape(m, 2), residual
-            )
-            r = r.ravel()
-        self._count(residual)
-        return r
-
-    def _prox(self, m, W, q, mu, problem, start, residual) -> tuple[np.ndarray, float]:
-        """The proximal point method from ``start`` (m, 2) on the FrictionContact(3) problem
-        (W 3m x 3m, q (m, 2), mu; ``problem`` when built): its impulses (m, 2) and residual,
-        or ``start`` and ``residual`` when it does no better."""
-        sn = self.sn
-        self.fallbacks += 1
-        if problem is None:
             q3 = np.zeros((m, 3))
-            q3[:, :2] = q
-            problem = sn.FrictionContactProblem(3, W, q3.ravel(), mu)
+            q3[:, :2] = np.asarray(q).reshape(m, 2)
+            problem = sn.FrictionContactProblem(3, W3.reshape(3 * m, 3 * m), q3.ravel(), mu)
+            self.fallbacks += 1
+            for name in ("nsgs", "prox"):
+                out, residual = self._fc3(name, problem, m, out, residual)
+                if residual <= self.tol:
+                    break
+        self._count(residual)
+        return out.ravel()
+
+    def _sane(self, r: np.ndarray) -> bool:
+        """Finite impulses within IMPULSE_FACTOR of the step's momentum scale."""
+        return bool(np.all(np.isfinite(r))) and not float(np.max(np.abs(r), initial=0.0)) > self.impulse_limit
+
+    def _fc3(self, name, problem, m, start, residual) -> tuple[np.ndarray, float]:
+        """Siconos's 3-D solver ``name`` on ``problem`` from ``start`` (m, 2; out of plane 0):
+        its impulses (m, 2) and residual, or ``start`` and ``residual`` when it does no better."""
+        sn = self.sn
         r3 = np.zeros((m, 3))
         r3[:, :2] = np.where(np.isfinite(start), start, 0.0)
         r = r3.ravel()
-        so = self.options("prox")
+        so = self.options(name)
         sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
         self.iterations += int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
         got = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
-        if np.all(np.isfinite(r)) and not got > residual:
+        if self._sane(r) and not got > residual:
             return r.reshape(m, 3)[:, :2], got
         return start, residual
 
@@ -559,11 +617,11 @@ class MoreauJean:
         if not residual <= self.tol:
             self.unconverged += 1
 
-    def _iterative(self, m, rows, cols, blocks, q, mu, start) -> np.ndarray:
+    def _iterative(self, m, pattern, blocks, q, mu, start) -> np.ndarray:
         """The impulses (m, 2) by Gauss-Seidel on the sparse FrictionContact(3) problem from
-        ``start`` (the last step's impulses of the same pairs), and by the proximal point
-        method where Gauss-Seidel ends above the tolerance (first, for a while, after it did:
-        HOLD_GROWTH)."""
+        ``start`` (the last step's impulses of the same pairs), by the proximal point method
+        where Gauss-Seidel ends above the tolerance (first, for a while, after it did:
+        HOLD_GROWTH), and by Lemke where both do (up to LEMKE_CONTACTS)."""
         sn = self.sn
         if self._sparse is None:
             try:
@@ -574,7 +632,7 @@ class MoreauJean:
                 ) from None
             self._sparse = scipy.sparse
         self.calls += 1
-        data, indices, indptr = sparse_fc3(m, rows, cols, blocks)
+        data, indices, indptr = pattern.fc3(blocks)
         W = self._sparse.csc_matrix((data, indices, indptr), shape=(3 * m, 3 * m))
         W.indices, W.indptr = indices, indptr  # scipy narrows them to int32; Siconos takes int64
         q3 = np.zeros((m, 3))
@@ -582,22 +640,28 @@ class MoreauJean:
         problem = sn.FrictionContactProblem(3, W, q3.ravel(), mu)
         out, residual = start, math.inf
         if self.calls < self.prox_until:  # Gauss-Seidel failed lately: the proximal method first
-            out, residual = self._prox(m, W, q, mu, problem, start, residual)
+            self.fallbacks += 1
+            out, residual = self._fc3("prox", problem, m, start, residual)
             if residual <= self.tol:
                 self._count(residual)
                 return out
-        r3 = np.zeros((m, 3))
-        r3[:, :2] = out
-        r = r3.ravel()
-        so = self.options("nsgs")
-        sn.fc3d_driver(problem, r, np.zeros(3 * m), so)
-        self.iterations += int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
-        got = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
-        if np.all(np.isfinite(r)) and not got > residual:
-            out, residual = r.reshape(m, 3)[:, :2], got
+        out, residual = self._fc3("nsgs", problem, m, out, residual)
         if not residual <= self.tol and self.calls >= self.prox_until:
-            out, residual = self._prox(m, W, q, mu, problem, out, residual)
+            self.fallbacks += 1
+            out, residual = self._fc3("prox", problem, m, out, residual)
             self.prox_until = self.calls + self.hold
             self.hold *= HOLD_GROWTH
+        if not residual <= self.tol and m <= LEMKE_CONTACTS:  # the last resort: pivoting
+            W2 = np.zeros((m, 2, m, 2))
+            W2[pattern.block_row, :, pattern.block_col, :] = blocks
+            so = self.options("lemke")
+            r = np.zeros(2 * m)
+            sn.fc2d_driver(
+                sn.FrictionContactProblem(2, W2.reshape(2 * m, 2 * m), q.ravel(), mu), r, np.zeros(2 * m), so
+            )
+            self.iterations += int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
+            got = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+            if self._sane(r) and got < residual:
+                out, residual = r.reshape(m, 2), got
         self._count(residual)
         return out
