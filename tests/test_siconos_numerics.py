@@ -20,6 +20,7 @@ import pytest
 from rockyade.blocks.restitution import find_peaks, restitution_per_impact
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.scene.generators import rest_motion, stack
+from rockyade.scene.generators.arches import arch
 from rockyade.siconos import backend as siconos_backend
 from rockyade.siconos.calibration import default_dt
 from rockyade.siconos.payload import PENETRATION_FRACTION, scene_payload
@@ -135,14 +136,22 @@ def test_the_numerics_path_agrees_with_the_kernel_and_is_closer_to_housner():
 
 
 def test_the_default_step_is_the_fraction_of_one_over_p_and_its_bounds():
-    """4e-3 / p of the fastest moving block, at most 1e-3 s: specimen 1 (p 2.2 rad/s) gets the
-    cap, the wall's half units (p 7.2 rad/s) 5.6e-4 s."""
+    """4e-3 / p of the fastest moving block, at most 5e-4 s: specimen 1 (p 3.84 rad/s), the
+    bi-block (5.0) and the wall (its half units' 7.21: 5.5e-4 s) get the cap, the 20
+    voussoirs of a semicircular arch at t/R 0.08 (9.6) 4.2e-4 s."""
     solver = SiconosSolver()
-    one = solver.model(load_scene(EXAMPLES / "specimen1_free.toml"))
-    assert default_dt(one) == pytest.approx(1e-3)
-    wall = solver.model(load_scene(EXAMPLES / "assemblies" / "wall_5_courses.toml"))
-    p = max(b.p_rad_s for b in wall.bodies if not b.fixed)
-    assert default_dt(wall) == pytest.approx(4e-3 / p) and 4e-4 < default_dt(wall) < 7e-4
+    scenes = [load_scene(EXAMPLES / name) for name in ("specimen1_free.toml", "biblock_free.toml")]
+    scenes.append(load_scene(EXAMPLES / "assemblies" / "wall_5_courses.toml"))
+    scenes.append(
+        scene_from_dict(arch(span_m=1.92, ring_depth_m=0.08, voussoirs=20, pier_width_m=0.16, pier_height_m=0.5))
+    )
+    steps = []
+    for scene in scenes:
+        model = solver.model(scene)
+        p = max(b.p_rad_s for b in model.bodies if not b.fixed)
+        assert default_dt(model) == pytest.approx(min(4e-3 / p, 5e-4))
+        steps.append(default_dt(model))
+    assert steps[:3] == [5e-4] * 3 and 4.0e-4 < steps[3] < 4.4e-4, steps
 
 
 SCRIPT = """
