@@ -175,6 +175,12 @@ def disk_centres(vertices: np.ndarray, radius: float) -> np.ndarray:
     return out
 
 
+def penetration_bound(model: DemModel) -> float:
+    """The depth below the ground beyond which a run fails, m: PENETRATION_FRACTION of the
+    smallest block dimension."""
+    return PENETRATION_FRACTION * min(float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies)
+
+
 def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
     """The model as the JSON data the Siconos driver reads.
 
@@ -229,8 +235,7 @@ def scene_payload(model: DemModel, numerics: Numerics) -> dict[str, object]:
         "stop_on_overturn": bool(model.stop_on_overturn),
         "restitution": numerics.restitution,
         "integrator": numerics.integrator,
-        "max_penetration_m": PENETRATION_FRACTION
-        * min(float(np.min(np.ptp(b.contact_vertices_m, axis=0))) for b in model.bodies),
+        "max_penetration_m": penetration_bound(model),
         "theta": THETA,
         "friction_solver": numerics.friction_solver,
         "fallback_solvers": list(numerics.fallback_solvers),

@@ -22,7 +22,7 @@ from rockyade.result import Result
 from rockyade.scene import Scene
 from rockyade.siconos.backend import check_timeout, run_model
 from rockyade.siconos.calibration import DT_MAX_S, DT_MIN_S, DT_P_FRACTION, check_target_mu, default_dt, steps_for
-from rockyade.siconos.payload import INTEGRATORS, Numerics
+from rockyade.siconos.payload import INTEGRATORS, Numerics, penetration_bound
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
@@ -143,14 +143,20 @@ class SiconosSolver(SolverBase):
         "newton_max_iter": _check_count(1, 100),
         "workdir": _check_folder,
     }
-    #: Siconos's time per step of one moving block, s, and how it grows with n moving blocks:
-    #: SECONDS_PER_STEP x n ** STEP_EXPONENT (cost estimate). Measured on the 2-core machine
-    #: (docs/siconos.md, benchmarks/bench_siconos.py): one block 55-75 us a step; the 13-block
-    #: arch at rest 86 ms; the 20-voussoir arch collapsing 50 ms; the 33-block wall 98 ms at
-    #: rest and 1.3 s under a pulse (NSGS's iterations on the hyperstatic joints): n ** 2.5
-    #: gives 36, 107 and 380 ms for these, within a factor of 4 of each.
-    SECONDS_PER_STEP: ClassVar[float] = 6e-5
-    STEP_EXPONENT: ClassVar[float] = 2.5
+    #: Siconos's time per step, s: STEP_S + BODY_STEP_S x n for n moving blocks (cost estimate),
+    #: the numerics path at its default tolerance. Measured with benchmarks/bench_siconos.py's
+    #: scenes beside warm YADE on the loaded 2-core machine (load 14-17, where YADE took 3.2-4.5
+    #: times its own estimate), scaled by that factor (4): a block 0.45 ms a step measured (30 s
+    #: record), the bi-block 0.59 ms (25 s record), the 20-voussoir arch 4.6 ms at rest and
+    #: 11.7 ms under a pulse, the 32-block wall 8.6-13.0 ms under pulses (docs/siconos.md, "Cost").
+    STEP_S: ClassVar[float] = 3e-5
+    BODY_STEP_S: ClassVar[float] = 8.5e-5
+    #: The kernel path's (``integrator = "kernel"``): KERNEL_STEP_S x n ** KERNEL_EXPONENT, measured
+    #: before (one block 55-75 us a step; the 13-block arch at rest 86 ms; the 20-voussoir arch
+    #: collapsing 50 ms; the 33-block wall 98 ms at rest and 1.3 s under a pulse: within a factor
+    #: of 4 of each).
+    KERNEL_STEP_S: ClassVar[float] = 6e-5
+    KERNEL_EXPONENT: ClassVar[float] = 2.5
 
     timeout_s: float | None = None
     warm: bool = True
@@ -213,6 +219,7 @@ class SiconosSolver(SolverBase):
             else f"default ({DT_P_FRACTION:g} / p of the fastest block, in [{DT_MIN_S:g}, {DT_MAX_S:g}] s)",
             "dt_base_s": base,
             "integrator": self.integrator,
+            "penetration_bound_m": penetration_bound(model),
         }
         return numerics, how
 
@@ -251,13 +258,20 @@ class SiconosSolver(SolverBase):
         check_target_mu(scene, self.model(scene))
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Steps at the Siconos time step, SECONDS_PER_STEP x n ** STEP_EXPONENT each for n
-        moving blocks (the one-step problem's assembly and solution grow faster than n)."""
+        """Steps at the Siconos time step, STEP_S + BODY_STEP_S x n each for n moving blocks
+        (the pairs' geometry and the one-step problem's assembly grow with the blocks, and
+        Gauss-Seidel's sweeps with the contacts; its iterations, warm-started, stayed at
+        11-67 a step on the arch and the wall); on the kernel path KERNEL_STEP_S x
+        n ** KERNEL_EXPONENT (its one-step problem, assembled by Siconos's kernel, and the
+        nonsmooth Newton's failures on redundant contacts grow faster than n)."""
         model = self.model(scene)
         numerics, _ = self.numerics(model)
         moving = max(1, len(model.moving))
         steps = float(scene.n_samples - 1) * numerics.steps_per_sample
-        per_step = self.SECONDS_PER_STEP * moving**self.STEP_EXPONENT
+        if self.integrator == "kernel":
+            per_step = self.KERNEL_STEP_S * moving**self.KERNEL_EXPONENT
+        else:
+            per_step = self.STEP_S + self.BODY_STEP_S * moving
         return stepped_cost(scene, self.name, steps * moving, numerics.dt_s, steps * per_step)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:
