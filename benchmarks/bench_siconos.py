@@ -210,12 +210,21 @@ def wall_costs(size: Size, record: bool) -> None:
         print(describe(f"Siconos, {scene.duration_s:g} s record", seconds, result) + f" ({seconds / 60:.1f} min)")
 
 
+#: YADE's joint stiffness for the t/R 0.08 arch, Pa/m: the generator's 1e10 lets its thin
+#: piers' joints settle more than the DEMs' check allows (it asks for 1.04e10); Siconos has none.
+THIN_ARCH_JKN_PA_PER_M = 2e10
+
+
 def arch_costs(size: Size) -> None:
     """The arch at rest at t/R 0.15 (stands) and 0.08 (collapses), YADE and Siconos."""
     print(f"arch of {size.voussoirs} voussoirs on fixed piers, {size.arch_s:g} s at rest ({load()})")
     yade = warm_yade(size)
     for t_over_r in (0.15, 0.08):
         scene = arch_scene(size, t_over_r)
+        if t_over_r < 0.1:
+            data = scene.to_dict()
+            data["contact"]["jkn_Pa_per_m"] = THIN_ARCH_JKN_PA_PER_M
+            scene = scene_from_dict(data)
         yade_s, result = timed(yade, scene)
         print(describe(f"t/R {t_over_r:g}: YADE (warm)", yade_s, result))
         seconds, result = timed(make_solver("siconos", timeout_s=3600.0), scene)
