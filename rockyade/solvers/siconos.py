@@ -163,7 +163,7 @@ class SiconosSolver(SolverBase):
     dt_s: float | None = None
     dt_factor: float = 1.0
     #: The friction-contact solvers' default tolerance per integrator (relative; docs/siconos.md,
-    #: "The tolerance": chosen by what halving it changes).
+    #: "The time step and the tolerance": chosen by what halving it changes).
     DEFAULT_TOL: ClassVar[dict[str, float]] = {"numerics": 1e-4, "kernel": 1e-8}
 
     restitution: float = 0.0

@@ -22,7 +22,7 @@ from rockyade.studies.verify_rows import Row, absolute, relative
 #: panel are not: their blocks meet corner to corner (each such corner is two vertex-to-edge
 #: pairs at one point with one normal); the driver's twin pairs and fallback solvers run them,
 #: but too slowly for a check (the panel's pushover did not finish in 500 s, the arch's went
-#: unstable at 0.185 s at a 1 ms step): docs/siconos.md, Limits.
+#: unstable at 0.185 s at a 1 ms step): docs/siconos.md, History (the kernel path).
 SICONOS_PUSHOVERS = ("block", "restrained wall")
 
 #: The stack at rest's tolerances: rigid contacts leave no settlement, so any movement is
