@@ -15,6 +15,8 @@ the ratios measured in the same run, not seconds):
   shipped EC8 record at 0.3 g, 25 s simulated, beside YADE.
 * ``block``: specimen 1's geometry, 30 s under the EC8 record at 0.15 g and 0.3 g (rounds in
   alternation, median ratio to YADE).
+* ``costs``: each of these scenes' measured time against ``estimate_cost``, Siconos's and
+  YADE's (YADE's ratio says how loaded the machine is).
 * ``convergence``: Siconos at its default step and tolerance, at half the step and at half the
   tolerance: the wall's top-course peak displacement under a 0.8 g pulse (it slides), the t/R
   0.08 arch's collapse time (sampled every 2 ms), and the t/R 0.15 arch's collapse intensity
@@ -23,8 +25,8 @@ the ratios measured in the same run, not seconds):
 ``--quick`` runs every part on small scenes and short durations (a test runs it in seconds);
 its numbers check the script, not the targets.
 
-Run: ``python benchmarks/bench_siconos.py [wall] [arch] [biblock] [block] [convergence]
-[--record] [--quick] [--repeat=N]`` (no part: wall, arch, biblock, convergence).
+Run: ``python benchmarks/bench_siconos.py [wall] [arch] [biblock] [block] [costs]
+[convergence] [--record] [--quick] [--repeat=N]`` (no part: wall, arch, biblock, convergence).
 """
 
 from __future__ import annotations
@@ -276,6 +278,33 @@ def block_costs(size: Size, repeat: int) -> None:
             )
 
 
+def estimate_costs(size: Size) -> None:
+    """Each scene's measured time against ``estimate_cost``, Siconos's and YADE's (YADE's
+    measured-to-estimate factor says how loaded the machine is)."""
+    scenes = {
+        f"single block, record at 0.3 g, {size.block_s:g} s": block_scene(size.block_s, 0.3),
+        f"bi-block, record at 0.3 g, {size.record_s:g} s": biblock_scene(size),
+        f"arch t/R 0.15 at rest, {size.arch_s:g} s": arch_scene(size, 0.15),
+        f"arch t/R 0.15, 0.2 g pulse, {size.pulse_s:g} s": arch_scene(
+            size, 0.15, pulse_motion(amplitude_g=0.2, period_s=0.5), size.pulse_s
+        ),
+        f"wall, 0.3 g pulse, {size.wall_s:g} s": wall_scene(size),
+        f"wall, 0.8 g pulse, {2.5 * size.wall_s:g} s": wall_scene(size, 0.8, 2.5 * size.wall_s),
+    }
+    print(f"measured against estimate_cost ({load()})")
+    yade = warm_yade(size)
+    siconos = make_solver("siconos", timeout_s=3600.0)
+    for label, scene in scenes.items():
+        yade_s, _ = timed(yade, scene)
+        seconds, result = timed(siconos, scene)
+        estimate = siconos.estimate_cost(scene).wall_time_s
+        yade_estimate = yade.estimate_cost(scene).wall_time_s
+        print(
+            f"  {label:36s} Siconos {seconds:7.2f} s, estimate {estimate:7.3g} s ({seconds / estimate:4.1f}x); "
+            f"YADE {yade_s:7.2f} s, estimate {yade_estimate:7.3g} s ({yade_s / yade_estimate:4.1f}x); {result.status}"
+        )
+
+
 def collapses(solver: Any, size: Size, amplitude_g: float) -> bool:
     result = solver.run(arch_scene(size, 0.15, pulse_motion(amplitude_g=amplitude_g, period_s=0.5), size.pulse_s))
     if result.status == "failed":
@@ -340,7 +369,7 @@ def convergence(size: Size) -> None:
         )
 
 
-PARTS = ("wall", "arch", "biblock", "block", "convergence")
+PARTS = ("wall", "arch", "biblock", "block", "costs", "convergence")
 
 
 def main(argv: list[str]) -> None:
@@ -358,6 +387,8 @@ def main(argv: list[str]) -> None:
         biblock_costs(size)
     if "block" in parts:
         block_costs(size, repeat)
+    if "costs" in parts:
+        estimate_costs(size)
     if "convergence" in parts:
         convergence(size)
 
