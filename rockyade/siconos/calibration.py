@@ -46,7 +46,7 @@ from rockyade.scene import Scene
 MU_RTOL = 0.01
 #: Default time step: this fraction of 1/p of the fastest moving block (1e-3 before the
 #: measurements: the wall's blocks, p 7.2 rad/s, got 1.33e-4 s) ...
-DT_P_FRACTION = 4.0e-3
+DT_P_FRACTION = 3.0e-3
 #: ... within these bounds, s (at most 5e-4 s: a single block's per-impact restitution
 #: scatters by 1.1 % at 1e-3 s, 0.7 % at 5e-4 s, 0.3 % at 2.5e-4 s around Eq 4).
 DT_MIN_S = 2.0e-5

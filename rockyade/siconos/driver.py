@@ -280,7 +280,7 @@ class Contacts:
         self.moving_ids = [i for i, ds in enumerate(ds_of) if ds is not None]
         self.twin = twins(scene, pairs)
         # the pairs' geometry: the numerics path's (its gap, open rule and Jacobian rows)
-        self.table = _sibling("moreau_jean").PairTable(bodies, pairs, self.twin, EDGE_SLACK, DEEP_FRACTION)
+        self.table = _sibling("pair_table").PairTable(bodies, pairs, self.twin, EDGE_SLACK, DEEP_FRACTION)
         movable = np.array([ds is not None for ds in ds_of] + [False])
         self.mov_a = movable[self.table.a].astype(float)
         self.mov_b = movable[self.table.b].astype(float)
@@ -935,11 +935,10 @@ class NumericsEngine:
     ground (:func:`contact_pairs` with ``ground_all``)."""
 
     def __init__(self, scene, S):
-        mj = _sibling("moreau_jean")
         self.scene = scene
         pairs = contact_pairs(scene, ground_all=True)
-        table = mj.PairTable(scene["bodies"], pairs, twins(scene, pairs), EDGE_SLACK, DEEP_FRACTION)
-        self.mj = mj.MoreauJean(scene, table, S["sn"], StepForces(scene))
+        table = _sibling("pair_table").PairTable(scene["bodies"], pairs, twins(scene, pairs), EDGE_SLACK, DEEP_FRACTION)
+        self.mj = _sibling("moreau_jean").MoreauJean(scene, table, S["sn"], StepForces(scene))
         self.pairs = pairs
         self._calls = self._iterations = self._unconverged = 0
 

@@ -100,8 +100,8 @@ class SiconosSolver(SolverBase):
         Run in a Siconos process kept warm between runs (one per thread; the default), or
         in a process of its own (False): the same result; warm saves the start-up.
     dt_s
-        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 4e-3 / p of
-        the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
+        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 3e-3 / p of
+        the fastest moving block within [2e-5, 5e-4] s), rounded down to divide the sample
         interval.
     dt_factor
         Multiplies the time step, in [0.001, 1] (1: the step as chosen; 0.5: halved, for

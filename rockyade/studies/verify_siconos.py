@@ -32,7 +32,7 @@ REST_ROTATION_RAD, REST_MOVEMENT_M = 1e-6, 1e-6
 
 def quasistatic_siconos() -> Solver:
     """Siconos for the rows without impacts (the stack at rest): a step of 1 ms (its contacts
-    are rigid, so no stiffness limits the step; the default, 4e-3 / p within 5e-4 s, is made for
+    are rigid, so no stiffness limits the step; the default, 3e-3 / p within 5e-4 s, is made for
     impacts)."""
     return make_solver("siconos", dt_s=1e-3)
 
