@@ -144,11 +144,12 @@ class SiconosSolver(SolverBase):
         "workdir": _check_folder,
     }
     #: Siconos's time per step, s: STEP_S + BODY_STEP_S x n for n moving blocks (cost estimate),
-    #: the numerics path at its default tolerance. Measured with benchmarks/bench_siconos.py's
-    #: scenes beside warm YADE on the loaded 2-core machine (load 14-17, where YADE took 3.2-4.5
-    #: times its own estimate), scaled by that factor (4): a block 0.45 ms a step measured (30 s
-    #: record), the bi-block 0.59 ms (25 s record), the 20-voussoir arch 4.6 ms at rest and
-    #: 11.7 ms under a pulse, the 32-block wall 8.6-13.0 ms under pulses (docs/siconos.md, "Cost").
+    #: the numerics path at its default step and tolerance. Measured with benchmarks/
+    #: bench_siconos.py's scenes beside warm YADE on the loaded 2-core machine (load 12-15, where
+    #: YADE took 3.0-10.6 times its own estimate), divided by about that factor (4): a block
+    #: 0.25 ms a step (30 s record), the bi-block 0.36 ms (25 s record), the 20-voussoir arch
+    #: 5.2 ms at rest and 14 ms under a pulse, the 32-block wall 8.3-16.7 ms under a record and
+    #: pulses (docs/siconos.md, "Cost beside YADE").
     STEP_S: ClassVar[float] = 3e-5
     BODY_STEP_S: ClassVar[float] = 8.5e-5
     #: The kernel path's (``integrator = "kernel"``): KERNEL_STEP_S x n ** KERNEL_EXPONENT, measured
