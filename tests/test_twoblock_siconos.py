@@ -43,11 +43,9 @@ def test_first_impact_within_one_percent_of_siconos_and_the_later_rocking_close(
     exact = run(scene, "twoblock")
     siconos = make_solver("siconos", restitution=0.0).run(scene)
     assert exact.status == "completed" and siconos.ok, siconos.meta.failure_reason
-    if siconos.series("y_m", "upper").min() < -1e-3:  # rocking only ever lifts the centroid
-        pytest.xfail(
-            "Siconos's driver pairs a vertex with an edge only when it starts within 7.5 mm of it: the upper "
-            "block's lifted corner has no contact and falls through the lower block (fixed on the siconos branch)"
-        )
+    # rocking only ever lifts the centroid (y_m: its rise from the start): the lifted corner pairs
+    # with its seat and lands on it (before, it fell through the lower block)
+    assert siconos.series("y_m", "upper").min() > -1e-3, "the upper block fell into the lower"
     t_exact = np.array([row[0] for row in exact.meta.extra["impacts"] if row[1] == 1])
     t_sic = _zero_crossings(siconos.t, siconos.series("theta_rad", "upper"))
     assert t_exact[0] == pytest.approx(0.2705, abs=1e-3)
