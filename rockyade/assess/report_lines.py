@@ -195,6 +195,7 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         lines.append(
             f"  nonlinear: d0* = {kin.d0_star_m:.4g} m, du* = 0.4 d0* = {kin.du_star_m:.4g} m, ds* = "
             f"{kin.ds_star_m:.4g} m, as* = {kin.as_star_m_s2:.4g} m/s^2, Ts = 2 pi sqrt(ds*/as*) = {kin.Ts_s:.4g} s"
+            + ("" if a.position.method == "circolare2009" else " (the 2009 form's period; the 2019 checks take T_SLV)")
         )
     else:
         lines.append(f"  nonlinear: none ({kin.nonlinear_note})")

@@ -42,7 +42,7 @@ def _position(args: argparse.Namespace) -> Position:
         args.building_height,
         args.storeys,
         args.t1,
-        args.height_check,
+        args.code_form,
         ratio(args.building_damping_pct),
         args.mechanism_period,
         ratio(args.mechanism_damping_pct),
@@ -306,12 +306,15 @@ def register(sub: Any) -> None:
     height.add_argument("--building-height", type=float, metavar="M", help="height H of the building, m")
     height.add_argument("--storeys", type=int, metavar="N", help="storeys N of the building")
     add_period_option(height, "its floor spectrum's (default Ct H^(3/4), Ct = 0.05)")
-    height.add_argument(
+    p.add_argument(
+        "--code-form",
         "--height-check",
+        dest="code_form",
         choices=("circolare2019", "circolare2009"),
-        help="the check at height: circolare2019 (the default: Circolare 2019 C8.7.1 with the floor spectra of "
-        "C7.2.3, linear and nonlinear) or circolare2009 (the superseded Circolare 2009 C8A.4.2.3 form, "
-        "Se(T1) psi gamma / q, linear only)",
+        help="the form of the checks, at ground level and at height: circolare2019 (the default: Circolare 2019 "
+        "C8.7.1.2.1, the nonlinear check at T_SLV with the mechanism's damping, at height on the floor spectra of "
+        "C7.2.3) or circolare2009 (the superseded Circolare 2009 C8A.4.2.3 form: at ground level the nonlinear check "
+        "at Ts and 5 %%, at height Se(T1) psi gamma / q, linear only); --height-check is its former name",
     )
     height.add_argument(
         "--building-damping-pct",
@@ -327,12 +330,12 @@ def register(sub: Any) -> None:
         help="the mechanism's period T0 in the linear check, s in [0, 4] (default 0: rigid until it moves, the "
         "demand is the floor's peak acceleration; Circolare 2019 C8.7.1.2.1.5)",
     )
-    height.add_argument(
+    p.add_argument(
         "--mechanism-damping-pct",
         type=float,
         metavar="PCT",
-        help="the mechanism's equivalent damping in the nonlinear check, %% in [2, 30] (default 8, Circolare 2019 "
-        "C8.7.1.2.1.8 for SLV)",
+        help="the mechanism's equivalent damping in the nonlinear check of the 2019 form, at ground level and at "
+        "height, %% in [2, 30] (default 8, Circolare 2019 C8.7.1.2.1.8 for SLV)",
     )
     p.add_argument(
         "--pushover",
