@@ -173,7 +173,8 @@ class Check:
     source
         Clause and equations.
     demand_text
-        How the demand is made, in words and numbers (for the text; empty: from ``terms``).
+        How the demand is made, in words and numbers (the text's and the report's; empty where the
+        check does not apply).
     """
 
     name: str
@@ -215,6 +216,7 @@ class Check:
             "ag_capacity_g": self.ag_capacity_m_s2 / G,
             "reason": self.reason,
             "source": self.source,
+            "demand_text": self.demand_text,
         }
 
 
@@ -259,6 +261,7 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
                 ag_capacity_m_s2=ag * a0 / demand,
                 source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g} ({Q_CLAUSE}); "
                 f"S from {site.spectrum_clause.split(';')[0]}",
+                demand_text=f"ag S / q = {ag:.4g} x {S:g} / {q:g} = {demand:.4g} m/s^2",
             )
         )
         if position.method == "circolare2009":

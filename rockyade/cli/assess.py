@@ -4,6 +4,7 @@ them (docs/howto/is-this-wall-safe.md)."""
 from __future__ import annotations
 
 import argparse
+import functools
 import re
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -80,8 +81,9 @@ def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
     return DynamicSettings(**settings)
 
 
-def cmd_assess(args: argparse.Namespace) -> int:
-    """The checks, the dynamics, the text (or JSON), and with --out the files."""
+def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None = None) -> int:
+    """The checks, the dynamics, the text (or JSON), with --out the files, with --report the page
+    (``parser``: the command's, which tells the options given from rockyade's defaults)."""
     from rockyade.assess import assess
     from rockyade.assess.code import check_code, confidence_factor
     from rockyade.assess.report_lines import assessment_lines
@@ -94,8 +96,11 @@ def cmd_assess(args: argparse.Namespace) -> int:
     check_code(args.code)
     if args.out is not None:
         check_output_dir(args.out, "--out")
+        check_assess_folder(args.out)
     elif args.resume:
         raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
+    if args.report is not None:
+        _check_report_option(args)
     fc, fc_source = confidence_factor(args.knowledge_level, args.fc)
     friction = None
     if args.friction_angle_deg is not None:
@@ -144,6 +149,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
             data = _finish(args, result, scene)
             _write(args, result, data)
             finish(output)
+        _report(args, parser, result, data)
         return 0
     if dynamic is not None:
         try:
@@ -159,12 +165,59 @@ def cmd_assess(args: argparse.Namespace) -> int:
         ) as output:
             _write(args, result, data)
             finish(output)
+    _report(args, parser, result, data)
     return 0
 
 
 #: The files of an assessment's result set, and the one that marks it complete (last in).
 ASSESS_SET = ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json")
 ASSESS_LAST = "assess.json"
+#: What an assessment's --out may hold besides its set: the journal of an unfinished run, the lock.
+ASSESS_BOOKKEEPING = ("partial", ".rockyade.lock")
+
+
+def check_assess_folder(out: Path) -> None:
+    """Refuse an --out that holds files that are not an assessment's (another command's set, ...):
+    its set would be mixed with them (InputError naming --out)."""
+    if not out.is_dir():
+        return
+    others = sorted(
+        p.name
+        for p in out.iterdir()
+        if p.name not in ASSESS_SET and p.name not in ASSESS_BOOKKEEPING and not p.name.startswith(".")
+    )
+    if others:
+        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
+        raise InputError(
+            "--out",
+            f"{out} holds files that are not an assessment's ({shown}): give an empty folder, or one a previous "
+            "'assess --out' wrote (its set is then replaced as a whole)",
+        )
+
+
+def _check_report_option(args: argparse.Namespace) -> None:
+    """--report: a folder that is not --out and holds nothing but a previous report (before any work)."""
+    from rockyade.studies.assess_report import check_report_folder
+
+    check_output_dir(args.report, "--report")
+    if args.out is not None and Path(args.report).resolve() == Path(args.out).resolve():
+        raise InputError("--report", "must be another folder than --out (the report is a set of its own)")
+    check_report_folder(args.report)
+
+
+def _report(
+    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Any, data: dict[str, Any]
+) -> None:
+    """With --report: the page, written from ``data`` (what assess.json holds) as a set of its own."""
+    if args.report is None:
+        return
+    from rockyade.cli.assess_options import options_defaulted, options_given
+    from rockyade.studies.assess_report import provenance, write_report
+
+    solver = result.dynamic.plan.stripes.solver.name if result.dynamic is not None else None
+    prov = provenance(args.scene, options_given(args, parser), options_defaulted(args, parser, result), solver)
+    written = write_report(args.report, result, data, prov)
+    print_wrote(Path(f"{', '.join(written)} in {args.report}"), args.json)
 
 
 def _dynamics(args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, journal: Any) -> None:
@@ -360,8 +413,15 @@ def register(sub: Any) -> None:
         "default 0.35, 0.5, 0.71, 1, 1.41, 2, 2.83, extended to bracket the median)",
     )
     p.add_argument("--out", type=Path, help="write assess.json, assess.png and the runs' CSVs in this directory")
+    p.add_argument(
+        "--report",
+        type=Path,
+        metavar="DIR",
+        help="write the assessment's page in this directory: report.html (self-contained, the figures embedded) and "
+        "its Markdown twin report.md with the figures as PNG files beside it, from the numbers of assess.json",
+    )
     p.add_argument("--json", action="store_true", help="print the answer as JSON")
     add_run_options(p, f"records of the site's synthetic suite (default {DEFAULT_COUNT})")
     # "-x" is a value of --direction, not an option
     p._negative_number_matcher = re.compile(r"^-x$|^-\d+$|^-\d*\.\d+$")
-    p.set_defaults(func=cmd_assess)
+    p.set_defaults(func=functools.partial(cmd_assess, parser=p))

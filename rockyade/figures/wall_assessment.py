@@ -209,7 +209,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
     return fig, ax
 
 
-def _marks(a: Assessment) -> list[tuple[float, str, str, str]]:
+def assessment_marks(a: Assessment) -> list[tuple[float, str, str, str]]:
     """The code's demand and capacity on the fragility's axis (ag, SI)."""
     marks = [(a.site.ag_m_s2, f"the site's ag = {a.site.ag_m_s2 / G:.3g} g (the code's demand)", DEMAND, "-")]
     styles = iter(("--", "-.", ":"))
@@ -246,7 +246,7 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
     fig, axes = new_figure(path, 1, panels, figsize=(6.4 * panels, 6.2), layout="constrained", squeeze=False)
     plot_capacity(a, axes[0, 0])
     if a.dynamic is not None:
-        plot_fragility(a.dynamic, axes[0, 1], marks=_marks(a))
+        plot_fragility(a.dynamic, axes[0, 1], marks=assessment_marks(a))
         ratio = a.median_over_code
         axes[0, 1].set_title(
             f"dynamics: {a.dynamic.plan.stripes.solver.name}, {a.dynamic.plan.stripes.motions.count} records"
