@@ -19,6 +19,7 @@ import pytest
 
 from rockyade.assess.report_model import lookup
 from rockyade.cli import main
+from rockyade.motion.selection_set import sha256
 from rockyade.studies import assess_report
 
 from .conftest import EXAMPLES
@@ -108,7 +109,7 @@ def test_the_page_holds_inputs_clauses_checks_not_made_dynamics_and_version(repo
     assert "<script" not in html and "<link" not in html and "http://" not in html and "https://" not in html
     assert "Content-Security-Policy" in html and "default-src 'none'" in html
     # the inputs and their sources: the scene's SHA-256, the options given, the defaults named as such
-    sha = assess_report.file_sha256(Path(WALL))
+    sha = sha256(Path(WALL))
     assert sha in html and "--knowledge-level" in html and "LC1" in html
     assert "rockyade&#x27;s default" in html and "--mechanism-damping-pct" in html
     # every check's clause and formula, and every check not made with its reason

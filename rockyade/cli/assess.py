@@ -172,20 +172,18 @@ def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None 
 #: The files of an assessment's result set, and the one that marks it complete (last in).
 ASSESS_SET = ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json")
 ASSESS_LAST = "assess.json"
-#: What an assessment's --out may hold besides its set: the journal of an unfinished run, the lock.
-ASSESS_BOOKKEEPING = ("partial", ".rockyade.lock")
+#: What an assessment's --out may hold besides its set: the journal of an unfinished run.
+ASSESS_BOOKKEEPING = ("partial",)
 
 
 def check_assess_folder(out: Path) -> None:
     """Refuse an --out that holds files that are not an assessment's (another command's set, ...):
     its set would be mixed with them (InputError naming --out)."""
+    from rockyade.io.folders import other_files
+
     if not out.is_dir():
         return
-    others = sorted(
-        p.name
-        for p in out.iterdir()
-        if p.name not in ASSESS_SET and p.name not in ASSESS_BOOKKEEPING and not p.name.startswith(".")
-    )
+    others = other_files(out, (*ASSESS_SET, *ASSESS_BOOKKEEPING))
     if others:
         shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
         raise InputError(

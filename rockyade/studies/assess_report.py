@@ -16,7 +16,6 @@ anything is drawn.
 from __future__ import annotations
 
 import datetime as dt
-import hashlib
 import importlib.metadata
 import platform
 import shlex
@@ -41,14 +40,14 @@ from rockyade.assess.report_model import (
 from rockyade.assess.report_page import report_page
 from rockyade.assess.report_render import render_html, render_markdown
 from rockyade.errors import InputError
+from rockyade.io.folders import other_files
+from rockyade.motion.selection_set import sha256
 
 REPORT_HTML = "report.html"
 REPORT_MD = "report.md"
 #: The set's files; ``report.html``, written last, marks it complete.
 REPORT_SET = (*FIGURES, REPORT_MD, REPORT_HTML)
 REPORT_LAST = REPORT_HTML
-#: What a report folder may hold besides its set: the lock and hidden files (a set being swapped in).
-BOOKKEEPING = (".rockyade.lock",)
 
 
 def check_report_folder(folder: Path, option: str = "--report") -> None:
@@ -65,11 +64,7 @@ def check_report_folder(folder: Path, option: str = "--report") -> None:
         raise InputError(option, f"{folder} is a file; give a folder")
     if not folder.is_dir():
         return
-    others = sorted(
-        p.name
-        for p in folder.iterdir()
-        if p.name not in REPORT_SET and p.name not in BOOKKEEPING and not p.name.startswith(".")
-    )
+    others = other_files(folder, REPORT_SET)
     links = sorted(p.name for p in folder.iterdir() if p.name in REPORT_SET and p.is_symlink())
     if others or links:
         shown = ", ".join((others + links)[:5]) + (" ..." if len(others + links) > 5 else "")
@@ -78,15 +73,6 @@ def check_report_folder(folder: Path, option: str = "--report") -> None:
             f"{folder} holds files that are not an assessment report's ({shown}): give an empty folder, or one a "
             "previous 'assess --report' wrote (its report is then replaced as a whole)",
         )
-
-
-def file_sha256(path: Path) -> str:
-    """A file's SHA-256, hex."""
-    digest = hashlib.sha256()
-    with path.open("rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def _package(name: str) -> str:
@@ -150,7 +136,7 @@ def provenance(
     when = (now or dt.datetime.now(dt.UTC)).replace(microsecond=0).isoformat()
     return Provenance(
         str(scene),
-        file_sha256(scene),
+        sha256(scene),
         shlex.join(words),
         tuple(given),
         tuple(defaults),
@@ -275,7 +261,6 @@ __all__ = [
     "REPORT_MD",
     "REPORT_SET",
     "check_report_folder",
-    "file_sha256",
     "provenance",
     "versions",
     "write_report",
