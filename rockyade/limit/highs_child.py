@@ -49,7 +49,9 @@ KILL_MARGIN_S = 30.0
 #: Seconds between the parent's looks at the child.
 POLL_S = 0.2
 
-_IPM_ROW = re.compile(r"^\s*(\d+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)\s+\S+\s*$")
+_NUMBER = r"[-+]?\d+\.?\d*(?:e[-+]?\d+)?"
+#: HiPO's iteration row: iteration, primal and dual objectives, infeasibilities, relative gap, time.
+_IPM_ROW = re.compile(rf"^\s*(\d+)\s+{_NUMBER}\s+{_NUMBER}\s+{_NUMBER}\s+{_NUMBER}\s+({_NUMBER})\s+{_NUMBER}\s*$")
 _SIMPLEX_ROW = re.compile(r"^\s*(\d+)\s+(\S+)\s+(Ph1|Pr|Du)")
 
 
@@ -65,7 +67,7 @@ def last_iteration(log: Path) -> str:
     for line in reversed(lines):
         ipm = _IPM_ROW.match(line)
         if ipm is not None:
-            return f"interior point iteration {ipm.group(1)}, relative gap {float(ipm.group(6)):.1e}"
+            return f"interior point iteration {ipm.group(1)}, relative gap {float(ipm.group(2)):.1e}"
         simplex = _SIMPLEX_ROW.match(line)
         if simplex is not None:
             return f"simplex iteration {simplex.group(1)}"

@@ -217,9 +217,10 @@ _SOLVER_OF = {"highs-ds": "simplex", "highs-ipm": "ipx", "highs-hipo": "hipo"}
 #: Below, the dual simplex is as fast and keeps its vertex (the mechanism of the tests' walls, to the bit).
 HIPO_COLUMNS = 4000
 #: Columns from which a programme is solved in a child process (Ctrl-C ends it at once, progress every
-#: 10 s: :mod:`rockyade.limit.highs_child`): about 850 blocks of running bond, a second or more of HiGHS
-#: against the child's start (about 1 s of CPU). Smaller programmes run here.
-CHILD_COLUMNS = 10000
+#: 10 s: :mod:`rockyade.limit.highs_child`): about 1,700 blocks of running bond, 2.5 s of HiPO's CPU or
+#: more, against the child's start (about 1 s of CPU). Smaller programmes run here: a Ctrl-C waits for
+#: the programme under way (HiGHS does not return to Python before), a second or two.
+CHILD_COLUMNS = 20000
 
 
 class TimeLimitError(SolverFailedError):
