@@ -337,7 +337,7 @@ def register(sub: Any) -> None:
     )
     joints = p.add_mutually_exclusive_group()
     joints.add_argument(
-        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 90)"
+        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 89.9]"
     )
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
     p.add_argument(
