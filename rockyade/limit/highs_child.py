@@ -8,8 +8,10 @@ in short steps, so that
 
 * Ctrl-C (KeyboardInterrupt) in the parent kills the child (SIGKILL), waits for it to be gone and
   raises on: nothing is left running;
-* the child dies with its parent however the parent dies (:mod:`rockyade.io.parent_death`), and
-  ignores a Ctrl-C of its own (the terminal sends it to both: the parent decides);
+* the child dies with its parent however the parent dies (:mod:`rockyade.io.parent_death`, asked
+  for by the child itself: no Python runs between fork and exec, where it could deadlock on a
+  lock another thread held), and ignores a Ctrl-C of its own (the terminal sends it to both: the
+  parent decides);
 * ``on_progress`` is called every ``progress_every_s`` seconds with the time so far and HiGHS's
   latest iteration (from its log);
 * the time limit is HiGHS's own, with a margin after which the parent kills the child itself.
@@ -17,7 +19,7 @@ in short steps, so that
 The programme goes to the child as a ``numpy`` archive (no pickle) in a private temporary
 folder, and the answer comes back the same way; the folder is removed afterwards.
 
-Run by the parent as ``python -m rockyade.limit.highs_child FOLDER SOLVER TIME_LIMIT``.
+Run by the parent as ``python -m rockyade.limit.highs_child FOLDER SOLVER TIME_LIMIT PARENT_PID``.
 """
 
 from __future__ import annotations
@@ -39,7 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from rockyade.errors import SolverFailedError
-from rockyade.io.parent_death import child_dies_with_parent
+from rockyade.io.parent_death import die_with_parent
 from rockyade.limit.highs import Programme, ProgrammeOutcome, check_solver, solve_programme
 
 #: Seconds between progress calls (the CLI prints a line at each).
@@ -133,11 +135,10 @@ def solve_in_child(
         limit = "none" if time_limit_s is None else repr(float(time_limit_s))
         with open(folder / "stderr.txt", "wb") as err, open(folder / "highs.log", "wb") as log:
             proc = subprocess.Popen(
-                [sys.executable, "-m", "rockyade.limit.highs_child", str(folder), solver, limit],
+                [sys.executable, "-m", "rockyade.limit.highs_child", str(folder), solver, limit, str(os.getpid())],
                 stdin=subprocess.DEVNULL,
                 stdout=log,
                 stderr=err,
-                preexec_fn=child_dies_with_parent(),
                 start_new_session=True,  # a Ctrl-C at the terminal reaches the parent only
             )
         start = time.perf_counter()
@@ -181,6 +182,7 @@ def _line_buffered_stdout() -> None:
 def _child_main(argv: list[str]) -> int:
     """The child: read the programme, solve it, write the outcome."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent decides on Ctrl-C, and kills this process
+    die_with_parent(int(argv[3]))
     _line_buffered_stdout()
     folder, solver, limit = Path(argv[0]), argv[1], argv[2]
     with np.load(folder / "programme.npz", allow_pickle=False) as arrays:
