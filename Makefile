@@ -31,7 +31,7 @@ check: setup lint
 	$(BIN)/python -m pytest -n $(WORKERS) -q -m "not slow and not yade and not siconos"
 
 test: setup lint
-	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
+	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 ROCKYADE_REQUIRE_CHROMIUM=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
 
 run: setup
 	$(BIN)/rockyade paper --out $(OUT) --workers $(WORKERS)

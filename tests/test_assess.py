@@ -141,18 +141,31 @@ def test_the_checks_of_a_free_standing_wall_match_the_hand_calculation():
     assert linear.demand == pytest.approx(ag * S / q) and linear.demand == pytest.approx(1.4715)
     assert linear.capacity == pytest.approx(a0) and linear.status == NOT_VERIFIED
     assert linear.ag_capacity_m_s2 == pytest.approx(a0 * q / S)  # 0.1235 g
-    # nonlinear: d0* = b; du* = 0.4 b; Ts from the capacity curve at ds* = 0.4 du* (statics of a
-    # block turned by theta: alpha = tan(atan(b / h_c) - theta), test_limit_kinematic checks it)
+    # nonlinear, Circolare 2019 C8.7.1.2.1.8: d_SLV = 0.4 d0* = 0.4 b; on the capacity curve there the block has
+    # turned by theta with R sin(a) - R sin(a - theta) = d_SLV (R, a: its centroid's radius and angle from the toe),
+    # where alpha = tan(a - theta) (test_limit_kinematic checks the curve)
     assert kin.du_star_m == pytest.approx(0.4 * b, rel=1e-6)
-    ts = kin.Ts_s
-    assert 0.5 < ts < 2.0  # between TC and TD: Se = 2.5 ag S TC / T
-    se = 2.5 * ag * S * 0.5 / ts
-    sde = se * (ts / (2 * math.pi)) ** 2
-    assert nonlinear.demand == pytest.approx(sde, rel=1e-12)
+    R = math.hypot(b, 1.25)
+    alpha = math.tan(math.asin((b - 0.4 * b) / R))
+    a_slv = alpha * CODE_GRAVITY / fc  # e* = 1
+    t_slv = 1.68 * math.pi * math.sqrt(0.4 * b / a_slv)  # Eq C8.7.1.10: 1.79 s
+    assert nonlinear.terms["a_SLV_m_s2"] == pytest.approx(a_slv, rel=1e-4)
+    assert nonlinear.terms["T_SLV_s"] == pytest.approx(t_slv, rel=1e-4)
+    assert 0.5 < t_slv < 2.0  # between TC and TD: Se = 2.5 ag S eta TC / T, eta(8 %) = sqrt(10 / 13)
+    sde = 2.5 * ag * S * math.sqrt(10 / 13) * 0.5 / t_slv * (t_slv / (2 * math.pi)) ** 2
+    assert nonlinear.demand == pytest.approx(sde, rel=1e-4)
     assert nonlinear.capacity == pytest.approx(0.4 * b, rel=1e-6)
     assert nonlinear.status == NOT_VERIFIED
-    assert nonlinear.ag_capacity_m_s2 == pytest.approx(ag * 0.4 * b / sde, rel=1e-6)
+    assert nonlinear.ag_capacity_m_s2 == pytest.approx(ag * 0.4 * b / sde, rel=1e-4)
     assert verdict([linear, nonlinear]) == NOT_VERIFIED
+    # the superseded Circolare 2009 form, by name: du* against SDe(Ts) at 5 %, Ts at ds* = 0.4 du*
+    _, form_2009 = code_checks(kin, site, Position(code_form="circolare2009"))
+    ts = kin.Ts_s
+    assert 0.5 < ts < 2.0
+    sde_2009 = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2
+    assert form_2009.name == "nonlinear, ground level (Circolare 2009)"
+    assert form_2009.demand == pytest.approx(sde_2009, rel=1e-12) and form_2009.status == NOT_VERIFIED
+    assert form_2009.ag_capacity_m_s2 == pytest.approx(ag * 0.4 * b / sde_2009, rel=1e-6)
     # the same wall on a site a fifth as strong: the linear check holds
     weak = code_checks(kin, Site(1, "B", 0.05 * G), Position())
     assert weak[0].status == VERIFIED and verdict(weak) == VERIFIED
@@ -162,7 +175,7 @@ def test_a_mechanism_at_height_takes_the_floor_demand_and_the_simplified_period(
     """The superseded Circolare 2009 form, asked for by name (the 2019 form: tests/test_floor_spectra.py)."""
     kin = limit_analysis(wall_scene(), fc=1.35).kinematic
     site = Site(1, "B", 0.25 * G)
-    pos = Position(6.0, 9.0, 3, height_check="circolare2009")
+    pos = Position(6.0, 9.0, 3, code_form="circolare2009")
     assert pos.period_s == pytest.approx(0.05 * 9.0**0.75)  # 0.26 s: on the plateau TB-TC
     assert "Eq 4.6" in pos.period_source
     [check] = code_checks(kin, site, pos)
@@ -170,7 +183,7 @@ def test_a_mechanism_at_height_takes_the_floor_demand_and_the_simplified_period(
     assert check.terms["Se_T1_m_s2"] == pytest.approx(plateau)
     assert check.demand == pytest.approx(plateau * (6.0 / 9.0) * (9.0 / 7.0) / 2.0)
     assert check.ag_capacity_m_s2 == pytest.approx(site.ag_m_s2 * kin.a0_star_m_s2 / check.demand)
-    given = code_checks(kin, site, Position(6.0, 9.0, 3, T1_s=1.0, height_check="circolare2009"))[0]
+    given = code_checks(kin, site, Position(6.0, 9.0, 3, T1_s=1.0, code_form="circolare2009"))[0]
     assert given.terms["Se_T1_m_s2"] == pytest.approx(2.5 * 0.25 * G * 1.2 * 0.5 / 1.0)
 
 

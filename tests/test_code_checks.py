@@ -88,8 +88,11 @@ def test_every_check_names_its_clause_and_formula():
     assert "NTC 2018 3.2.3.2.1" in ground[0].source and "Eq 3.2.12" in ground[1].source
     linear, nonlinear = height  # Circolare 2019 C8.7.1 on the floor spectra of C7.2.3
     assert "C8.7.1.2.1.7" in linear.source and "Eq C8.7.1.12" in nonlinear.source
-    [form_2009] = code_checks(kin, site, Position(6.0, 9.0, 3, height_check="circolare2009"))
+    [form_2009] = code_checks(kin, site, Position(6.0, 9.0, 3, code_form="circolare2009"))
     assert form_2009.source.startswith(CHECK_SOURCES[form_2009.name]) and "superseded" in form_2009.source
+    ground_2009 = code_checks(kin, site, Position(code_form="circolare2009"))[1]
+    assert ground_2009.name == "nonlinear, ground level (Circolare 2009)" and "superseded" in ground_2009.source
+    assert "C8.7.1.2.1.8" in ground[1].source and "Eq C8.7.1.10" in ground[1].source
     ec8 = code_checks(kin, Site(1, "B", 0.25 * G), Position())
     assert "EN 1998-1" in ec8[1].source
 

@@ -2,17 +2,18 @@
 "Exception ignored in: <bound method Random.seed ...> SystemError: <built-in function
 isinstance> returned a result with an exception set").
 
-A worker is forked with a ``preexec_fn``, so its child runs Python between fork and exec (the
+A worker was forked with a ``preexec_fn``, so its child ran Python between fork and exec (the
 interpreter's at-fork hooks, such as random's reseeding, then the ``preexec_fn``), still in
-the terminal's process group and with this process's Ctrl-C handler. On a loaded machine that
-stretch lasts, and a Ctrl-C landing in it ran the handler in the child. The thread that forks
-now holds SIGINT back, so that only rockyade's process takes a Ctrl-C, once.
+the terminal's process group and with this process's Ctrl-C handler: a Ctrl-C landing there
+ran the handler in the child. Python between fork and exec could also deadlock the child (a
+lock another thread held at the fork), and the thread that started it then waited forever
+(CI: 20 batches on threads never ended). Now no Python runs in the child before exec (the
+driver asks for ``PR_SET_PDEATHSIG`` itself), and the thread that forks holds SIGINT back.
 
-Here every child is held 0.2 s between fork and exec (an at-fork hook that sleeps: what a
-loaded machine does by chance), with a busy loop beside, and each of 20 batches on the Dask
-executor and on threads is pressed twice within that stretch. (Two presses that come before
-the main thread runs the handler count as one, Python's own signal handling: such a batch
-is stopped once, not twice.)"""
+Here each of 20 batches on the Dask executor and on threads is pressed twice while its first
+worker starts, with a busy loop beside (a loaded machine). (Two presses that come before the
+main thread runs the handler count as one, Python's own signal handling: such a batch is
+stopped once, not twice.)"""
 
 from __future__ import annotations
 
@@ -26,9 +27,9 @@ import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 
-#: 20 batches of runs that each start a worker of the engine-free driver; a thread presses
-#: Ctrl-C (SIGINT to the process group, as a terminal does) twice while the first workers
-#: are between fork and exec.
+#: 20 batches of runs that each start a worker of the engine-free driver; each batch's first
+#: run presses Ctrl-C (SIGINT to the process group, as a terminal does) twice, 0.08 s apart,
+#: as it starts its worker.
 BATCHES = """
 import functools, json, os, signal, sys, threading, time, tempfile
 from pathlib import Path
@@ -38,20 +39,15 @@ from tests.processes import fake_program
 
 folder = Path(tempfile.mkdtemp())
 presses = []
-trial = -1
-forking = threading.local()
 
 def press_twice():
-    \"\"\"At a trial's first fork (its child now held): Ctrl-C, and again 0.08 s later.\"\"\"
-    if not presses and getattr(forking, "trial", None) == trial:  # not a late fork of a stopped batch
-        presses.append(threading.Timer(0.08, os.killpg, (0, signal.SIGINT)))
-        os.killpg(0, signal.SIGINT)
-        presses[0].start()
-
-os.register_at_fork(after_in_child=lambda: time.sleep(0.2), after_in_parent=press_twice)
+    presses.append(threading.Timer(0.08, os.killpg, (0, signal.SIGINT)))
+    os.killpg(0, signal.SIGINT)
+    presses[0].start()
 
 def job(i, of_trial):
-    forking.trial = of_trial
+    if i == 0:
+        press_twice()
     scene = folder / f"{of_trial}-{i}.json"
     scene.write_text(json.dumps({"name": str(i), "sleep_s": 0.1}))
     out, log = scene.with_suffix(".npz"), scene.with_suffix(".log")
@@ -65,9 +61,40 @@ for trial in range(20):
     hard += outcome.hard
 for thread in threading.enumerate():  # the runs abandoned after each second Ctrl-C
     if thread is not threading.main_thread() and not thread.daemon:
-        thread.join(120)
+        thread.join(60)
 print("hard", hard, flush=True)
 """
+
+#: A worker started from a process with threads: an at-fork hook that would run in the child
+#: (as it did with a ``preexec_fn``) leaves a file.
+NO_PYTHON_IN_CHILD = """
+import json, os, sys, threading, tempfile
+from pathlib import Path
+from rockyade.io import warm_program
+from tests.processes import fake_program
+
+folder = Path(sys.argv[1])
+os.register_at_fork(after_in_child=lambda: (folder / f"child-ran-python-{os.getpid()}").touch())
+threading.Thread(target=lambda: None).start()
+scene = folder / "scene.json"
+scene.write_text(json.dumps({"name": "0", "sleep_s": 0.0}))
+reason = warm_program.run_scene(fake_program(), scene, folder / "out.npz", folder / "run.log", 60.0, warm=False)
+print("reason", reason, flush=True)
+"""
+
+
+def test_no_python_runs_in_a_worker_between_fork_and_exec(tmp_path):
+    done = subprocess.run(
+        [sys.executable, "-c", NO_PYTHON_IN_CHILD, str(tmp_path)],
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert done.returncode == 0 and done.stdout.strip() == "reason None", (done.stdout, done.stderr)
+    assert (tmp_path / "out.npz").is_file()
+    assert not list(tmp_path.glob("child-ran-python-*")), "Python ran in the worker before exec"
 
 
 @pytest.mark.parametrize("executor", ["dask", "threads"])

@@ -117,15 +117,15 @@ def test_a_mechanism_with_a_period_takes_the_floor_spectrum_there():
 def test_the_2009_form_is_kept_by_name_and_says_so():
     kin = limit_analysis(block(), fc=1.35).kinematic
     site = Site(1, "B", 0.25 * G)
-    pos = Position(6.0, 9.0, 3, T1_s=0.3, height_check="circolare2009")
+    pos = Position(6.0, 9.0, 3, T1_s=0.3, code_form="circolare2009")
     [check] = code_checks(kin, site, pos)
     plateau = 2.5 * 0.25 * G * 1.2
     assert check.name == "linear, at height (Circolare 2009)"
     assert check.demand == pytest.approx(plateau * (6 / 9) * (9 / 7) / 2.0, rel=1e-12)
-    assert "superseded" in check.source and "--height-check circolare2009" in check.source
+    assert "superseded" in check.source and "--code-form circolare2009" in check.source
     notes = checks_not_made(kin, pos)
     assert any("nonlinear check at height" in n and "circolare2009" in n for n in notes)
-    assert pos.to_dict()["height_check"] == "circolare2009"
+    assert pos.to_dict()["code_form"] == "circolare2009"
 
 
 def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, capsys):
@@ -135,6 +135,9 @@ def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, ca
     assert "linear, at height: a0* = " in text and "SeZ(T0 = 0 s, 5 %) / q" in text
     assert "nonlinear, at height: d_SLV = " in text and "SeZ(T_SLV = " in text
     assert "Circolare 2019 floor spectrum, xi1 = 5 %" in text
+    assert main(["assess", str(scene), *NTC, "--static-only", *HEIGHT, "--code-form", "circolare2009"]) == 0
+    assert "Se(T1) psi gamma / q" in capsys.readouterr().out
+    # the option's former name still works
     assert main(["assess", str(scene), *NTC, "--static-only", *HEIGHT, "--height-check", "circolare2009"]) == 0
     assert "Se(T1) psi gamma / q" in capsys.readouterr().out
 
@@ -145,7 +148,8 @@ def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, ca
         (["--building-damping-pct", "50"], "--building-damping-pct"),
         (["--mechanism-damping-pct", "1"], "--mechanism-damping-pct"),
         (["--mechanism-period", "-1"], "--mechanism-period"),
-        (["--height-check", "circolare2009", "--mechanism-damping-pct", "8"], "--mechanism-damping-pct"),
+        (["--code-form", "circolare2009", "--mechanism-damping-pct", "8"], "--mechanism-damping-pct"),
+        (["--code-form", "circolare2009", "--building-damping-pct", "8"], "--building-damping-pct"),
     ],
 )
 def test_bad_floor_options_are_refused_naming_them(tmp_path, capsys, extra, option):
@@ -157,8 +161,17 @@ def test_bad_floor_options_are_refused_naming_them(tmp_path, capsys, extra, opti
 def test_floor_options_apply_at_height_only():
     with pytest.raises(Exception, match="--building-damping-pct"):
         Position(building_damping=0.05)
-    with pytest.raises(Exception, match="--height-check"):
-        Position(height_check="circolare2019")
+    with pytest.raises(Exception, match="--mechanism-period"):
+        Position(mechanism_period_s=0.2)
+    with pytest.raises(Exception, match="--t1"):
+        Position(T1_s=0.3)
+    # the form of the checks and the mechanism's damping apply at ground level too
+    assert Position(code_form="circolare2009").method == "circolare2009"
+    assert Position(mechanism_damping=0.10).xi_slv == 0.10
+    with pytest.raises(Exception, match="--code-form"):
+        Position(code_form="circolare2013")
+    with pytest.raises(Exception, match="--mechanism-damping-pct"):
+        Position(code_form="circolare2009", mechanism_damping=0.08)
 
 
 def test_the_ntc_site_reaches_the_floor_spectrum_through_its_own_spectrum():
@@ -174,6 +187,7 @@ def test_the_verify_row_of_the_worked_example_passes(tmp_path):
     from rockyade.studies.verification import verify
 
     table = verify(tmp_path, ["floor_spectrum"], ["reference"])
-    assert len(table) == 7 and set(table["check"]) == {"floor_spectrum"}
+    # seven at height, three at ground level (the 2019 form, its ag, the 2009 form)
+    assert len(table) == 10 and set(table["check"]) == {"floor_spectrum"}
     assert table["passed"].all(), table[~table["passed"]].to_string()
     assert table["difference"].abs().max() < 1e-3

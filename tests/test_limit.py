@@ -264,7 +264,7 @@ def test_bad_direction_and_friction_are_refused():
     with pytest.raises(InputError, match="direction"):
         limit_analysis(scene, direction="x")
     for bad in (90.0, -1.0, math.inf):
-        with pytest.raises(InputError, match=r"friction_angle_deg.*\[0, 90\)"):
+        with pytest.raises(InputError, match=r"friction_angle_deg.*\[0, 89.9\]"):
             limit_analysis(scene, friction_angle_deg=bad)
 
 

@@ -101,7 +101,7 @@ def test_an_assembly_that_cannot_stand_exits_1(capsys, tmp_path):
 @pytest.mark.parametrize(
     ("extra", "message"),
     [
-        (["--friction-angle-deg", "95"], "--friction-angle-deg: must be in [0, 90) degrees"),
+        (["--friction-angle-deg", "95"], "--friction-angle-deg: must be in [0, 89.9] degrees"),
         (["--friction-angle-deg", "nan"], "--friction-angle-deg: must be"),
         (["--fc", "0.5"], "--fc: must be in [1, 10]"),
         (["--plot", "mechanism.txt"], "--plot: must be a .png file"),

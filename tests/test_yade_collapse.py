@@ -73,6 +73,7 @@ def test_a_failed_yade_run_keeps_its_samples_marked_partial(tmp_path):
     parsed.write(runs / f"{name}.csv", {"summary": {"status": "failed"}})
 
     task = SimpleNamespace(
+        name=name,
         scene_hash=model.scene_hash,
         index=0,
         labels={},

@@ -6,10 +6,16 @@ here the demand of the site (:mod:`rockyade.assess.site`: NTC 2018's elastic spe
 clause and formula (:data:`CHECK_SOURCES`):
 
 * linear kinematic analysis, a mechanism at ground level: a0* >= ag S / q (Circolare 2019
-  C8.7.1, the same form as Circolare 2009 C8A.4.2.3);
-* nonlinear kinematic analysis, a mechanism at ground level: du* >= SDe(Ts), with the
-  elastic displacement spectrum SDe(T) = Se(T) (T / 2 pi)^2 (NTC 2018 3.2.3.2.3 Eq 3.2.12;
-  EN 1998-1 3.2.2.2 Eq 3.7), for Ts up to 4 s;
+  C8.7.1.2.1.7, the same form as Circolare 2009 C8A.4.2.3);
+* nonlinear kinematic analysis, a mechanism at ground level (Circolare 2019 C8.7.1.2.1.8):
+  d_SLV = 0.4 d0* (C8.7.1.2.1.6, the du* of the capacity curve) >= SDe(T_SLV, xi), the elastic
+  displacement spectrum SDe(T) = Se(T, xi) (T / 2 pi)^2 (NTC 2018 3.2.3.2.3 Eq 3.2.12; EN 1998-1
+  3.2.2.2 Eq 3.7) at the secant period T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) (Eq C8.7.1.10) and
+  the mechanism's damping xi = 8 % (C8.7.1.2.1.8; Se scaled by eta(xi) = sqrt(10 / (5 + xi)),
+  NTC 2018 Eq 3.2.4), for T_SLV up to 4 s. The clause takes the largest spectral displacement
+  over [T0, T_SLV]; the code's spectra do not decrease with T, so that is SDe(T_SLV).
+  Or, asked for by name (``circolare2009``), the superseded form of Circolare 2009 C8A.4.2.3:
+  du* >= SDe(Ts) at 5 %, Ts = 2 pi sqrt(ds* / as*), ds* = 0.4 du*;
 * a mechanism at height Z of a building of height H, N storeys and period T1, by Circolare 2019
   C8.7.1 with the floor spectrum SeZ of C7.2.3 (:mod:`rockyade.assess.floor_spectra`; first
   mode, psi(Z) = Z / H, gamma = 3 N / (2 N + 1), the building's damping xi1):
@@ -18,10 +24,9 @@ clause and formula (:data:`CHECK_SOURCES`):
     demand at the mechanism's period T0 and 5 % damping, SeZ(T0) (= a_Z, the floor's peak, at
     T0 = 0, a mechanism rigid until it moves: Eqs C8.7.1.8 and C7.2.8; Eqs C8.7.1.9 and C7.2.5
     for T0 > 0), reaches a0*: the check a0* >= SeZ(T0) / q;
-  - nonlinear (C8.7.1.2.1.8): d_SLV = 0.4 d0* (C8.7.1.2.1.6, the du* of the ground's check)
-    >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2) (Eq C8.7.1.12, not below SeZ(T1, xi) b^2 T1^2 / (4 pi^2)
-    when T_SLV > b T1), with T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) on the capacity curve
-    (Eq C8.7.1.10) and the mechanism's damping xi = 8 %;
+  - nonlinear (C8.7.1.2.1.8): d_SLV = 0.4 d0* >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2) (Eq C8.7.1.12,
+    not below SeZ(T1, xi) b^2 T1^2 / (4 pi^2) when T_SLV > b T1), with T_SLV of Eq C8.7.1.10 and
+    the mechanism's damping xi = 8 %;
 
   or, asked for by name (``circolare2009``), the superseded form of Circolare 2009 C8A.4.2.3:
   a0* >= Se(T1) psi(Z) gamma / q (linear only).
@@ -38,6 +43,7 @@ go into the output's notes).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -49,6 +55,7 @@ from rockyade.assess.site import AnySite, Position
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.limit.kinematic import KinematicQuantities
+from rockyade.motion.ec8 import damping_correction
 
 #: Codes whose checks are implemented.
 CODES = ("ntc2018",)
@@ -103,17 +110,22 @@ def confidence_factor(level: str | None, fc: float | None) -> tuple[float, str]:
 CLAUSE = "NTC 2018 8.7.1, Circolare 2019 C8.7.1 (kinematic analysis of local mechanisms)"
 #: Each check's clause and formula (the check's ``source``).
 CHECK_SOURCES = {
-    "linear, ground level": "Circolare 2019 C8.7.1, linear kinematic analysis at ground level (the same form as "
+    "linear, ground level": "Circolare 2019 C8.7.1.2.1.7, linear kinematic analysis at ground level (the same form as "
     "Circolare 2009 C8A.4.2.3): a0* = alpha0 g / (e* FC) >= ag S / q",
-    "nonlinear, ground level": "Circolare 2019 C8.7.1, nonlinear kinematic analysis at ground level (the same form "
-    "as Circolare 2009 C8A.4.2.3): du* = 0.4 d0* >= SDe(Ts), Ts = 2 pi sqrt(ds* / as*), ds* = 0.4 du*",
+    "nonlinear, ground level": "Circolare 2019 C8.7.1.2.1.8, nonlinear kinematic analysis at ground level: d_SLV = "
+    "0.4 d0* (C8.7.1.2.1.6) >= SDe(T_SLV) = Se(T_SLV, xi) T_SLV^2 / (4 pi^2), the elastic displacement spectrum "
+    "at the mechanism's damping xi (the largest over [T0, T_SLV]: the code's spectrum does not decrease with T), "
+    "T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) (Eq C8.7.1.10)",
+    "nonlinear, ground level (Circolare 2009)": "Circolare 2009 C8A.4.2.3 form, asked for with --code-form "
+    "circolare2009 (superseded: Circolare 2019 C8.7.1.2.1.8 takes the displacement spectrum at T_SLV with the "
+    "mechanism's damping, the default): du* = 0.4 d0* >= SDe(Ts), Ts = 2 pi sqrt(ds* / as*), ds* = 0.4 du*, 5 %",
     "linear, at height": "Circolare 2019 C8.7.1.2.1.7 on C8.7.1.2.1.5, linear kinematic analysis at height: "
     "ag,SLV = q ag,SLD, ag,SLD the ag at which the floor's demand SeZ(T0, 5 %) (Eqs C7.2.5-C7.2.10; the floor's peak "
     "a_Z at T0 = 0, Eqs C8.7.1.8 and C7.2.8) reaches a0* = alpha0 g / (e* FC) (Eq C8.7.1.9): a0* >= SeZ(T0) / q",
     "nonlinear, at height": "Circolare 2019 C8.7.1.2.1.8, nonlinear kinematic analysis at height: d_SLV = 0.4 d0* "
     "(C8.7.1.2.1.6) >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2), not below SeZ(T1, xi) b^2 T1^2 / (4 pi^2) for T_SLV > b T1 "
     "(Eq C8.7.1.12), T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) (Eq C8.7.1.10), SeZ of Eqs C7.2.5-C7.2.10",
-    "linear, at height (Circolare 2009)": "Circolare 2009 C8A.4.2.3 form, asked for with --height-check circolare2009 "
+    "linear, at height (Circolare 2009)": "Circolare 2009 C8A.4.2.3 form, asked for with --code-form circolare2009 "
     "(superseded: Circolare 2019 C8.7.1 takes the demand at height from the floor spectra of C7.2.3, the default): "
     "a0* >= Se(T1) psi(Z) gamma / q",
 }
@@ -161,7 +173,8 @@ class Check:
     source
         Clause and equations.
     demand_text
-        How the demand is made, in words and numbers (for the text; empty: from ``terms``).
+        How the demand is made, in words and numbers (the text's and the report's; empty where the
+        check does not apply).
     """
 
     name: str
@@ -203,6 +216,7 @@ class Check:
             "ag_capacity_g": self.ag_capacity_m_s2 / G,
             "reason": self.reason,
             "source": self.source,
+            "demand_text": self.demand_text,
         }
 
 
@@ -247,41 +261,95 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
                 ag_capacity_m_s2=ag * a0 / demand,
                 source=f"{CHECK_SOURCES['linear, ground level']}; q = {q:g} ({Q_CLAUSE}); "
                 f"S from {site.spectrum_clause.split(';')[0]}",
+                demand_text=f"ag S / q = {ag:.4g} x {S:g} / {q:g} = {demand:.4g} m/s^2",
             )
         )
-        name, inequality = "nonlinear, ground level", "du* >= SDe(Ts)"
-        if kin.du_star_m is None or kin.Ts_s is None:
-            checks.append(
-                _not_applicable(name, "du*", inequality, "m", f"no capacity curve to alpha = 0 ({kin.nonlinear_note})")
-            )
-        elif kin.Ts_s > 4.0:
-            checks.append(
-                _not_applicable(name, "du*", inequality, "m", f"Ts = {kin.Ts_s:.3g} s is beyond the spectrum's 4 s")
-            )
+        if position.method == "circolare2009":
+            checks.append(_ground_nonlinear_2009(kin, site))
         else:
-            sde = displacement_spectrum(site, kin.Ts_s)
-            checks.append(
-                _check(
-                    name,
-                    "du*",
-                    inequality,
-                    sde,
-                    kin.du_star_m,
-                    "m",
-                    terms={
-                        "Ts_s": kin.Ts_s,
-                        "Se_Ts_m_s2": float(site.spectrum.psa([kin.Ts_s])[0]),
-                        "ag_m_s2": ag,
-                        "S": S,
-                    },
-                    ag_capacity_m_s2=ag * kin.du_star_m / sde,
-                    source=f"{CHECK_SOURCES[name]}; {site.spectrum_clause}",
-                )
-            )
+            checks.append(_ground_nonlinear_2019(kin, site, position.xi_slv))
         return checks
     if position.method == "circolare2009":
         return [_height_check_2009(kin, site, position, q)]
     return height_checks_2019(kin, site, position, q)
+
+
+def _ground_nonlinear_2009(kin: KinematicQuantities, site: AnySite) -> Check:
+    """The superseded nonlinear check at ground level of Circolare 2009 C8A.4.2.3 (module docstring)."""
+    ag, S = site.ag_m_s2, site.S
+    name, inequality = "nonlinear, ground level (Circolare 2009)", "du* >= SDe(Ts)"
+    if kin.du_star_m is None or kin.Ts_s is None:
+        return _not_applicable(name, "du*", inequality, "m", f"no capacity curve to alpha = 0 ({kin.nonlinear_note})")
+    if kin.Ts_s > 4.0:
+        return _not_applicable(name, "du*", inequality, "m", f"Ts = {kin.Ts_s:.3g} s is beyond the spectrum's 4 s")
+    sde = displacement_spectrum(site, kin.Ts_s)
+    se = float(site.spectrum.psa([kin.Ts_s])[0])
+    return _check(
+        name,
+        "du*",
+        inequality,
+        sde,
+        kin.du_star_m,
+        "m",
+        terms={"Ts_s": kin.Ts_s, "Se_Ts_m_s2": se, "ag_m_s2": ag, "S": S},
+        ag_capacity_m_s2=ag * kin.du_star_m / sde,
+        source=f"{CHECK_SOURCES[name]}; {site.spectrum_clause}",
+        demand_text=f"SDe(Ts = {kin.Ts_s:.4g} s, 5 %) = Se (Ts / 2 pi)^2 = {se:.4g} x "
+        f"{(kin.Ts_s / (2 * math.pi)) ** 2:.4g} = {sde:.4g} m",
+    )
+
+
+def _slv_point(kin: KinematicQuantities) -> tuple[float, float, float] | str:
+    """(d_SLV, a(d_SLV), T_SLV) on the capacity curve (Circolare 2019 C8.7.1.2.1.6, Eq C8.7.1.10), or
+    why there is none (a reason for a check not made)."""
+    curve = kin.spectral()
+    if kin.du_star_m is None or curve is None:
+        return f"no capacity curve to alpha = 0 ({kin.nonlinear_note})"
+    d_slv = kin.du_star_m
+    a_slv = float(np.interp(d_slv, curve[0], curve[1]))
+    if a_slv <= 0.0:
+        return "the capacity curve has no a > 0 at d_SLV"
+    T_slv = secant_period(d_slv, a_slv)
+    if T_slv > 4.0:
+        return f"T_SLV = {T_slv:.3g} s is beyond the spectrum's 4 s"
+    return d_slv, a_slv, T_slv
+
+
+def _ground_nonlinear_2019(kin: KinematicQuantities, site: AnySite, xi: float) -> Check:
+    """The nonlinear check at ground level of Circolare 2019 C8.7.1.2.1.8 (module docstring): d_SLV against the
+    site's elastic displacement spectrum at T_SLV and the mechanism's damping ``xi``."""
+    ag, S = site.ag_m_s2, site.S
+    name, inequality = "nonlinear, ground level", "d_SLV >= SDe(T_SLV, xi)"
+    point = _slv_point(kin)
+    if isinstance(point, str):
+        return _not_applicable(name, "d_SLV", inequality, "m", point)
+    d_slv, a_slv, T_slv = point
+    damped = dataclasses.replace(site.spectrum, damping=xi)
+    se = float(damped.psa([T_slv])[0])
+    factor = (T_slv / (2.0 * math.pi)) ** 2
+    sde = se * factor
+    return _check(
+        name,
+        "d_SLV",
+        inequality,
+        sde,
+        d_slv,
+        "m",
+        terms={
+            "T_SLV_s": T_slv,
+            "a_SLV_m_s2": a_slv,
+            "xi": xi,
+            "eta": damping_correction(xi),
+            "Se_TSLV_m_s2": se,
+            "ag_m_s2": ag,
+            "S": S,
+        },
+        ag_capacity_m_s2=ag * d_slv / sde,
+        source=f"{CHECK_SOURCES[name]}; xi = {100 * xi:g} % (C8.7.1.2.1.8), eta(xi) = sqrt(10 / (5 + xi)) >= 0.55 "
+        f"(NTC 2018 Eq 3.2.4; EN 1998-1 Eq 3.6); {site.spectrum_clause}",
+        demand_text=f"SDe(T_SLV = {T_slv:.4g} s, {100 * xi:g} %) = Se (T_SLV / 2 pi)^2 = {se:.4g} x {factor:.4g} = "
+        f"{sde:.4g} m (a(d_SLV) = {a_slv:.4g} m/s^2, eta = {damping_correction(xi):.4g})",
+    )
 
 
 def _height_check_2009(kin: KinematicQuantities, site: AnySite, position: Position, q: float) -> Check:
@@ -335,22 +403,10 @@ def height_checks_2019(kin: KinematicQuantities, site: AnySite, position: Positi
         f"a_Z = {floor.peak_m_s2:.4g} m/s^2, T1 = {floor.T1_s:.3g} s)",
     )
     name, inequality = "nonlinear, at height", "d_SLV >= SeZ(T_SLV, xi) T_SLV^2 / (4 pi^2)"
-    curve = kin.spectral()
-    if kin.du_star_m is None or curve is None:
-        return [
-            linear,
-            _not_applicable(name, "d_SLV", inequality, "m", f"no capacity curve to alpha = 0 ({kin.nonlinear_note})"),
-        ]
-    d_slv = kin.du_star_m
-    a_slv = float(np.interp(d_slv, curve[0], curve[1]))
-    if a_slv <= 0.0:
-        return [linear, _not_applicable(name, "d_SLV", inequality, "m", "the capacity curve has no a > 0 at d_SLV")]
-    T_slv = secant_period(d_slv, a_slv)
-    if T_slv > 4.0:
-        return [
-            linear,
-            _not_applicable(name, "d_SLV", inequality, "m", f"T_SLV = {T_slv:.3g} s is beyond the spectrum's 4 s"),
-        ]
+    point = _slv_point(kin)
+    if isinstance(point, str):
+        return [linear, _not_applicable(name, "d_SLV", inequality, "m", point)]
+    d_slv, a_slv, T_slv = point
     xi = position.xi_slv
     demand, bound = displacement_demand(floor, T_slv, xi)
     sez = float(floor.psa([T_slv], xi)[0])
@@ -390,7 +446,7 @@ def checks_not_made(
     out = []
     if position.at_height and position.method == "circolare2009":
         out.append(
-            "not made: the nonlinear check at height: the Circolare 2009 form asked for (--height-check "
+            "not made: the nonlinear check at height: the Circolare 2009 form asked for (--code-form "
             "circolare2009) has its linear check only here; the default, Circolare 2019 C8.7.1 with the floor "
             "spectra of C7.2.3, makes both"
         )

@@ -88,17 +88,7 @@ def _check_line(check: Check) -> str:
         return f"  {check.name}: {check.inequality}: not applicable ({check.reason})\n    clause: {check.source}"
     t = check.terms
     q_words = f" (q = {t['q']:g}, {Q_CLAUSE})" if "q" in t else ""
-    if check.demand_text:
-        demand = check.demand_text + (q_words if check.quantity == "a0*" else "")
-    elif check.quantity == "a0*" and "T1_s" not in t:
-        demand = f"ag S / q = {t['ag_m_s2']:.4g} x {t['S']:g} / {t['q']:g} = {check.demand:.4g} {unit}{q_words}"
-    elif check.quantity == "a0*":
-        demand = (
-            f"Se(T1) psi gamma / q = {t['Se_T1_m_s2']:.4g} x {t['psi']:.4g} x {t['gamma']:.4g} / {t['q']:g} = "
-            f"{check.demand:.4g} {unit} (T1 = {t['T1_s']:.3g} s){q_words}"
-        )
-    else:
-        demand = f"SDe(Ts = {t['Ts_s']:.4g} s) = Se (Ts / 2 pi)^2 = {check.demand:.4g} {unit}"
+    demand = check.demand_text + (q_words if check.quantity == "a0*" else "")
     word = "verified" if check.status == VERIFIED else "NOT VERIFIED"
     return (
         f"  {check.name}: {check.quantity} = {check.capacity:.4g} {unit} against {demand}: {word} "
@@ -195,6 +185,7 @@ def assessment_lines(a: Assessment, source: str) -> list[str]:
         lines.append(
             f"  nonlinear: d0* = {kin.d0_star_m:.4g} m, du* = 0.4 d0* = {kin.du_star_m:.4g} m, ds* = "
             f"{kin.ds_star_m:.4g} m, as* = {kin.as_star_m_s2:.4g} m/s^2, Ts = 2 pi sqrt(ds*/as*) = {kin.Ts_s:.4g} s"
+            + ("" if a.position.method == "circolare2009" else " (the 2009 form's period; the 2019 checks take T_SLV)")
         )
     else:
         lines.append(f"  nonlinear: none ({kin.nonlinear_note})")

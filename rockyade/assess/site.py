@@ -18,8 +18,9 @@ the check a0* >= ag S / q is then alpha0 / (e* FC) >= (ag/g) S / q whatever the 
 
 A mechanism sits at ground level (the default) or at a height Z of a building of height H,
 N storeys and fundamental period T1 (the demand is then the floor's: Circolare 2019
-C8.7.1, with the floor spectrum of C7.2.3, :mod:`rockyade.assess.floor_spectra`; or the
-superseded form of Circolare 2009 C8A.4.2.3 when asked for). Without a given T1 it is the
+C8.7.1, with the floor spectrum of C7.2.3, :mod:`rockyade.assess.floor_spectra`). The checks
+take the form of Circolare 2019 C8.7.1.2.1 at ground level and at height (the default), or
+the superseded form of Circolare 2009 C8A.4.2.3 when asked for by name (``code_form``). Without a given T1 it is the
 code's simplified estimate T1 = Ct H^(3/4) with Ct = 0.05 (EN 1998-1 4.3.3.2.2(3), Eq 4.6,
 "all other structures", buildings up to 40 m; NTC 2008 7.3.3.2, Eq 7.3.5 gives the same
 C1 = 0.050).
@@ -49,9 +50,9 @@ MAX_T1_FORMULA_HEIGHT_M = 40.0
 #: Largest building height and storey count accepted.
 MAX_BUILDING_HEIGHT_M = 300.0
 MAX_STOREYS = 100
-#: The forms of the check at height: Circolare 2019's floor spectra (the default), or the
-#: superseded Circolare 2009 C8A.4.2.3 form.
-HEIGHT_CHECKS = ("circolare2019", "circolare2009")
+#: The forms of the checks: Circolare 2019 C8.7.1.2.1 (the default; at height on the floor
+#: spectra of C7.2.3), or the superseded Circolare 2009 C8A.4.2.3 form, asked for by name.
+CODE_FORMS = ("circolare2019", "circolare2009")
 #: Largest mechanism period T0 accepted, s (the spectra are used up to 4 s).
 MAX_MECHANISM_PERIOD_S = 4.0
 
@@ -299,23 +300,24 @@ class Position:
         Number of storeys N.
     T1_s
         Fundamental period of the building, s (None: the simplified formula, module docstring).
-    height_check
-        ``circolare2019`` (None: the default) or ``circolare2009`` (:data:`HEIGHT_CHECKS`).
+    code_form
+        ``circolare2019`` (None: the default) or ``circolare2009`` (:data:`CODE_FORMS`), at ground
+        level and at height.
     building_damping
         The building's equivalent viscous damping xi1 of the floor spectrum, a ratio (None: 5 %).
     mechanism_period_s
         The mechanism's period T0 in the linear check, s (None: 0, a mechanism rigid until it
         moves, whose demand is the floor's peak acceleration; Circolare 2019 C8.7.1.2.1.5).
     mechanism_damping
-        The mechanism's equivalent damping in the nonlinear check, a ratio (None: 8 %, Circolare
-        2019 C8.7.1.2.1.8).
+        The mechanism's equivalent damping in the nonlinear check of the 2019 form, at ground level
+        and at height, a ratio (None: 8 %, Circolare 2019 C8.7.1.2.1.8).
     """
 
     z_m: float | None = None
     building_height_m: float | None = None
     storeys: int | None = None
     T1_s: float | None = None
-    height_check: str | None = None
+    code_form: str | None = None
     building_damping: float | None = None
     mechanism_period_s: float | None = None
     mechanism_damping: float | None = None
@@ -326,17 +328,15 @@ class Position:
             raise InputError("--z", "a mechanism at height needs --z, --building-height and --storeys together")
         height_only = {
             "--t1": self.T1_s,
-            "--height-check": self.height_check,
             "--building-damping-pct": self.building_damping,
             "--mechanism-period": self.mechanism_period_s,
-            "--mechanism-damping-pct": self.mechanism_damping,
         }
         for option, value in height_only.items():
             if value is not None and self.z_m is None:
                 raise InputError(option, "applies to a mechanism at height (with --z, --building-height, --storeys)")
+        self._check_form_options()
         if self.z_m is None:
             return
-        self._check_floor_options()
         H = self.building_height_m
         if not (isinstance(H, (int, float)) and math.isfinite(H) and 0.0 < H <= MAX_BUILDING_HEIGHT_M):
             raise InputError("--building-height", f"must be in (0, {MAX_BUILDING_HEIGHT_M:g}] m, got {H!r}")
@@ -350,21 +350,19 @@ class Position:
         if t1 is not None and not (isinstance(t1, (int, float)) and math.isfinite(t1) and 0.0 < t1 <= 4.0):
             raise InputError("--t1", f"must be in (0, 4] s (the EC8 spectrum is defined up to 4 s), got {t1!r}")
 
-    def _check_floor_options(self) -> None:
-        """The options of the 2019 check at height, and none of them with the 2009 form."""
-        if self.height_check is not None and self.height_check not in HEIGHT_CHECKS:
-            raise InputError("--height-check", f"must be one of {', '.join(HEIGHT_CHECKS)}, got {self.height_check!r}")
-        floor_only = {
+    def _check_form_options(self) -> None:
+        """The form of the checks, the options of the 2019 form, and none of them with the 2009 form."""
+        if self.code_form is not None and self.code_form not in CODE_FORMS:
+            raise InputError("--code-form", f"must be one of {', '.join(CODE_FORMS)}, got {self.code_form!r}")
+        form_2019_only = {
             "--building-damping-pct": self.building_damping,
             "--mechanism-period": self.mechanism_period_s,
             "--mechanism-damping-pct": self.mechanism_damping,
         }
         if self.method == "circolare2009":
-            for option, value in floor_only.items():
+            for option, value in form_2019_only.items():
                 if value is not None:
-                    raise InputError(
-                        option, "is an input of the 2019 floor spectra, not of --height-check circolare2009"
-                    )
+                    raise InputError(option, "is an input of the Circolare 2019 form, not of --code-form circolare2009")
         for option, value in (
             ("--building-damping-pct", self.building_damping),
             ("--mechanism-damping-pct", self.mechanism_damping),
@@ -384,8 +382,8 @@ class Position:
 
     @property
     def method(self) -> str:
-        """The form of the check at height: ``circolare2019`` unless ``circolare2009`` was asked for."""
-        return self.height_check or HEIGHT_CHECKS[0]
+        """The form of the checks: ``circolare2019`` unless ``circolare2009`` was asked for."""
+        return self.code_form or CODE_FORMS[0]
 
     @property
     def xi1(self) -> float:
@@ -441,9 +439,14 @@ class Position:
     def describe(self) -> str:
         """One line."""
         if not self.at_height:
-            return "at ground level"
+            form = (
+                "Circolare 2009 C8A.4.2.3 form (--code-form circolare2009)"
+                if self.method == "circolare2009"
+                else f"Circolare 2019 C8.7.1.2.1 form, mechanism's xi = {100 * self.xi_slv:g} % in the nonlinear check"
+            )
+            return f"at ground level ({form})"
         form = (
-            "Circolare 2009 C8A.4.2.3 form (--height-check circolare2009)"
+            "Circolare 2009 C8A.4.2.3 form (--code-form circolare2009)"
             if self.method == "circolare2009"
             else f"Circolare 2019 floor spectrum, xi1 = {100 * self.xi1:g} %, T0 = {self.T0_s:g} s, mechanism's "
             f"xi = {100 * self.xi_slv:g} % in the nonlinear check"
@@ -456,8 +459,9 @@ class Position:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready."""
+        damping = {} if self.method == "circolare2009" else {"mechanism_damping_nonlinear": self.xi_slv}
         if not self.at_height:
-            return {"at": "ground level"}
+            return {"at": "ground level", "code_form": self.method, **damping}
         return {
             "at": "height",
             "z_m": self.z_m,
@@ -467,14 +471,10 @@ class Position:
             "gamma": self.gamma,
             "T1_s": self.period_s,
             "T1_source": self.period_source,
-            "height_check": self.method,
+            "code_form": self.method,
             **(
                 {}
                 if self.method == "circolare2009"
-                else {
-                    "building_damping": self.xi1,
-                    "mechanism_period_s": self.T0_s,
-                    "mechanism_damping_nonlinear": self.xi_slv,
-                }
+                else {"building_damping": self.xi1, "mechanism_period_s": self.T0_s, **damping}
             ),
         }

@@ -4,6 +4,7 @@ them (docs/howto/is-this-wall-safe.md)."""
 from __future__ import annotations
 
 import argparse
+import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -44,7 +45,7 @@ def _position(args: argparse.Namespace) -> Position:
         args.building_height,
         args.storeys,
         args.t1,
-        args.height_check,
+        args.code_form,
         ratio(args.building_damping_pct),
         args.mechanism_period,
         ratio(args.mechanism_damping_pct),
@@ -82,8 +83,9 @@ def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
     return DynamicSettings(**settings)
 
 
-def cmd_assess(args: argparse.Namespace) -> int:
-    """The checks, the dynamics, the text (or JSON), and with --out the files."""
+def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None = None) -> int:
+    """The checks, the dynamics, the text (or JSON), with --out the files, with --report the page
+    (``parser``: the command's, which tells the options given from rockyade's defaults)."""
     from rockyade.assess import assess
     from rockyade.assess.code import check_code, confidence_factor
     from rockyade.assess.report_lines import assessment_lines
@@ -99,8 +101,11 @@ def cmd_assess(args: argparse.Namespace) -> int:
     if args.out is not None:
         check_output_dir(args.out, "--out")
         check_out(args.out, ASSESS, resume_field="--resume" if args.resume else None)  # before any work
+        check_assess_folder(args.out)
     elif args.resume:
         raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
+    if args.report is not None:
+        _check_report_option(args)
     fc, fc_source = confidence_factor(args.knowledge_level, args.fc)
     friction = None
     if args.friction_angle_deg is not None:
@@ -148,6 +153,7 @@ def cmd_assess(args: argparse.Namespace) -> int:
             data = _finish(args, result, scene)
             _write(folder, args, result, data)
             folder.finish(result.dynamic.failed if result.dynamic is not None else 0)
+        _report(args, parser, result, data)
         return 0
     if dynamic is not None:
         try:
@@ -164,12 +170,56 @@ def cmd_assess(args: argparse.Namespace) -> int:
         with StudyFolder(args.out, ASSESS, ident, False, say=_say(args)) as folder:
             _write(folder, args, result, data)
             folder.finish()
+    _report(args, parser, result, data)
     return 0
 
 
 def _say(args: argparse.Namespace) -> Callable[[str], None]:
     """Where the output folder's notes go: the text, or nowhere beside the JSON."""
     return (lambda _line: None) if args.json else print
+
+
+def check_assess_folder(out: Path) -> None:
+    """Refuse an --out that holds files that are not an assessment's (another command's set, ...):
+    its set would be mixed with them (InputError naming --out)."""
+    from rockyade.io.folders import other_files
+    from rockyade.runner.study_folder import ASSESS, PARTIAL_DIR
+
+    if not out.is_dir():
+        return
+    others = other_files(out, (*ASSESS.names, PARTIAL_DIR))  # besides its set: an unfinished run's journal
+    if others:
+        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
+        raise InputError(
+            "--out",
+            f"{out} holds files that are not an assessment's ({shown}): give an empty folder, or one a previous "
+            "'assess --out' wrote (its set is then replaced as a whole)",
+        )
+
+
+def _check_report_option(args: argparse.Namespace) -> None:
+    """--report: a folder that is not --out and holds nothing but a previous report (before any work)."""
+    from rockyade.studies.assess_report import check_report_folder
+
+    check_output_dir(args.report, "--report")
+    if args.out is not None and Path(args.report).resolve() == Path(args.out).resolve():
+        raise InputError("--report", "must be another folder than --out (the report is a set of its own)")
+    check_report_folder(args.report)
+
+
+def _report(
+    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Any, data: dict[str, Any]
+) -> None:
+    """With --report: the page, written from ``data`` (what assess.json holds) as a set of its own."""
+    if args.report is None:
+        return
+    from rockyade.cli.assess_options import options_defaulted, options_given
+    from rockyade.studies.assess_report import provenance, write_report
+
+    solver = result.dynamic.plan.stripes.solver.name if result.dynamic is not None else None
+    prov = provenance(args.scene, options_given(args, parser), options_defaulted(args, parser, result), solver)
+    written = write_report(args.report, result, data, prov)
+    print_wrote(Path(f"{', '.join(written)} in {args.report}"), args.json)
 
 
 def _dynamics(
@@ -287,7 +337,7 @@ def register(sub: Any) -> None:
     )
     joints = p.add_mutually_exclusive_group()
     joints.add_argument(
-        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 90)"
+        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 89.9]"
     )
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
     p.add_argument(
@@ -309,12 +359,15 @@ def register(sub: Any) -> None:
     height.add_argument("--building-height", type=float, metavar="M", help="height H of the building, m")
     height.add_argument("--storeys", type=int, metavar="N", help="storeys N of the building")
     add_period_option(height, "its floor spectrum's (default Ct H^(3/4), Ct = 0.05)")
-    height.add_argument(
+    p.add_argument(
+        "--code-form",
         "--height-check",
+        dest="code_form",
         choices=("circolare2019", "circolare2009"),
-        help="the check at height: circolare2019 (the default: Circolare 2019 C8.7.1 with the floor spectra of "
-        "C7.2.3, linear and nonlinear) or circolare2009 (the superseded Circolare 2009 C8A.4.2.3 form, "
-        "Se(T1) psi gamma / q, linear only)",
+        help="the form of the checks, at ground level and at height: circolare2019 (the default: Circolare 2019 "
+        "C8.7.1.2.1, the nonlinear check at T_SLV with the mechanism's damping, at height on the floor spectra of "
+        "C7.2.3) or circolare2009 (the superseded Circolare 2009 C8A.4.2.3 form: at ground level the nonlinear check "
+        "at Ts and 5 %%, at height Se(T1) psi gamma / q, linear only); --height-check is its former name",
     )
     height.add_argument(
         "--building-damping-pct",
@@ -330,12 +383,12 @@ def register(sub: Any) -> None:
         help="the mechanism's period T0 in the linear check, s in [0, 4] (default 0: rigid until it moves, the "
         "demand is the floor's peak acceleration; Circolare 2019 C8.7.1.2.1.5)",
     )
-    height.add_argument(
+    p.add_argument(
         "--mechanism-damping-pct",
         type=float,
         metavar="PCT",
-        help="the mechanism's equivalent damping in the nonlinear check, %% in [2, 30] (default 8, Circolare 2019 "
-        "C8.7.1.2.1.8 for SLV)",
+        help="the mechanism's equivalent damping in the nonlinear check of the 2019 form, at ground level and at "
+        "height, %% in [2, 30] (default 8, Circolare 2019 C8.7.1.2.1.8 for SLV)",
     )
     p.add_argument(
         "--pushover",
@@ -360,8 +413,15 @@ def register(sub: Any) -> None:
         "default 0.35, 0.5, 0.71, 1, 1.41, 2, 2.83, extended to bracket the median)",
     )
     p.add_argument("--out", type=Path, help="write assess.json, assess.png and the runs' CSVs in this directory")
+    p.add_argument(
+        "--report",
+        type=Path,
+        metavar="DIR",
+        help="write the assessment's page in this directory: report.html (self-contained, the figures embedded) and "
+        "its Markdown twin report.md with the figures as PNG files beside it, from the numbers of assess.json",
+    )
     p.add_argument("--json", action="store_true", help="print the answer as JSON")
     add_run_options(p, f"records of the site's synthetic suite (default {DEFAULT_COUNT})")
     # "-x" is a value of --direction, not an option; nor is a negative number (refused by its option)
     accept_negative_values(p, also="-x$")
-    p.set_defaults(func=cmd_assess)
+    p.set_defaults(func=functools.partial(cmd_assess, parser=p))

@@ -15,7 +15,7 @@ if TYPE_CHECKING:
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
-SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade", "siconos")
+SOLVER_NAMES: tuple[str, ...] = ("housner", "reference", "yade", "siconos", "twoblock")
 
 
 def json_out(data: object) -> None:

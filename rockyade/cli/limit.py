@@ -7,6 +7,7 @@ import argparse
 import math
 import re
 import sys
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +17,10 @@ from rockyade.errors import InputError, RockyadeError
 #: The coulomb rule's progress: first after this many seconds, then at most every PROGRESS_EVERY_S.
 PROGRESS_AFTER_S = 2.0
 PROGRESS_EVERY_S = 5.0
+#: Without --time-limit the programmes stop after the larger of TIME_LIMIT_MIN_S and TIME_LIMIT_FACTOR
+#: times the estimate (analysis_cost.py): an analysis far slower than its estimate does not run on unseen.
+TIME_LIMIT_MIN_S = 300.0
+TIME_LIMIT_FACTOR = 4.0
 #: Exit codes: 0 collapse (or no mechanism), 1 unstable under gravity or the coulomb rule's iteration
 #: not converged; bad input exits 2.
 EXIT_UNSTABLE = 1
@@ -71,7 +76,23 @@ def cmd_limit(args: argparse.Namespace) -> int:
     if fm is not None:
         extra += "; the hinges moved by crushing: a programme per iteration to a fixed point (a few)"
     _say(f"cost: {cost.describe()}{extra}")
-    check_limit_cost(cost, allow_large=args.allow_large)
+    if coulomb_check and any(itf.friction_angle_deg for itf in model.interfaces):
+        # the coulomb pass runs where the mechanism slides with friction, as on every running-bond wall
+        # measured: the check counts it (an analysis refused up front rather than stopped at its time limit)
+        cost = replace(
+            cost, programmes=cost.programmes + estimate_limit_cost(model, "coulomb", max_iterations).programmes
+        )
+    check_limit_cost(cost, allow_large=args.allow_large, time_limit_s=time_limit)
+    expected = cost.expected_time_s
+    if time_limit is None:
+        time_limit = min(max(TIME_LIMIT_MIN_S, TIME_LIMIT_FACTOR * expected), 1.0e6)
+        bound = (
+            f"time limit {time_limit:.0f} s (the larger of {TIME_LIMIT_MIN_S:.0f} s and {TIME_LIMIT_FACTOR:g} times "
+            "the estimate; --time-limit S to change it)"
+        )
+    else:
+        bound = f"time limit {time_limit:g} s (--time-limit)"
+    _say(f"solving: {bound}; Ctrl-C stops it")
     progress = _Progress(max_iterations) if rule == "coulomb" or coulomb_check else None
     try:
         result = limit_analysis(
@@ -84,9 +105,11 @@ def cmd_limit(args: argparse.Namespace) -> int:
             on_iteration=progress,
             coulomb_check=coulomb_check,
             fm_MPa=fm,
+            on_progress=_solving(expected),
         )
     except TimeLimitError as exc:
-        raise LimitTimeLimitError(f"error: {exc} (--time-limit {time_limit:g}): no answer") from None
+        given = "--time-limit" if args.time_limit is not None else "the default time limit; --time-limit S for more"
+        raise LimitTimeLimitError(f"error: {exc} ({given}): no answer") from None
     if args.json:
         data = result.to_dict()
         data["scene"] = str(args.scene)
@@ -109,6 +132,16 @@ class LimitTimeLimitError(RockyadeError):
 def _say(message: str) -> None:
     """A line on stderr (stdout keeps the answer, and --json's JSON clean)."""
     print(f"rockyade limit: {message}", file=sys.stderr, flush=True)
+
+
+def _solving(expected_s: float):
+    """Progress within a large programme (every 10 s, :mod:`rockyade.limit.highs_child`) on stderr."""
+
+    def say(seconds: float, iteration: str) -> None:
+        where = f", {iteration}" if iteration else ""
+        _say(f"solving: {seconds:.0f} s{where} (expected about {max(expected_s, 1.0):.0f} s)")
+
+    return say
 
 
 class _Progress:
@@ -147,7 +180,7 @@ def register(sub: Any) -> None:
         "--friction-angle-deg",
         type=float,
         metavar="DEG",
-        help="friction angle of every joint, degrees in [0, 90) (default: each joint's from the scene)",
+        help="friction angle of every joint, degrees in [0, 89.9] (default: each joint's from the scene)",
     )
     joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
     p.add_argument(
@@ -177,7 +210,8 @@ def register(sub: Any) -> None:
         type=float,
         metavar="S",
         help="stop the programmes after S seconds of wall time (HiGHS's time limit; exit 1 without an answer, "
-        "or the coulomb rule not converged); default none",
+        "or the coulomb rule not converged), in (0, 1e6]; it bounds the expected time checked against the limits "
+        f"too; default: the larger of {TIME_LIMIT_MIN_S:.0f} s and {TIME_LIMIT_FACTOR:g} times the estimate",
     )
     add_allow_large(p)
     p.add_argument("--fc", type=float, default=1.35, help="the code's confidence factor FC, in [1, 10] (default 1.35)")

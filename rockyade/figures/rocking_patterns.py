@@ -1,6 +1,6 @@
 """The bi-block's map of rocking patterns over base-motion frequency and amplitude: a display.
 
-:class:`PatternMapDisplay` takes the cells a study computed (the DEM's dominant pattern per
+:class:`PatternMapDisplay` takes the cells a study computed (a solver's dominant pattern per
 frequency and amplitude, the paper's reported pattern where it reports one) and draws them,
 following scikit-learn's displays: :meth:`PatternMapDisplay.plot` draws into given Axes or a
 new figure and keeps ``figure_`` and ``ax_``.
@@ -44,16 +44,19 @@ PATTERN_NAMES = {
 
 @dataclass
 class PatternMapDisplay:
-    """The dominant rocking pattern per cell (colour: the DEM) with the paper's reported
-    regions outlined (solid where the DEM agrees, dashed where not).
+    """The dominant rocking pattern per cell (colour: a solver's) with the paper's reported
+    regions outlined (solid where the solver agrees, dashed where not).
 
     Parameters
     ----------
     cells
-        One row per cell: ``frequency_hz``, ``amplitude_mm``, ``pattern_dem`` (a key of
-        :data:`COLOURS`), ``pattern_paper`` (NaN where the paper reports none) and ``agree``.
+        One row per cell: ``frequency_hz``, ``amplitude_mm``, ``pattern_dem`` (the solver's
+        pattern, a key of :data:`COLOURS`), ``pattern_paper`` (NaN where the paper reports none)
+        and ``agree``.
     frequencies_hz, amplitudes_mm
         The grid's frequencies (Hz, x) and table displacement amplitudes (mm, y).
+    solver_label
+        The solver whose patterns colour the cells, in words (the title).
 
     Attributes
     ----------
@@ -64,6 +67,7 @@ class PatternMapDisplay:
     cells: pd.DataFrame
     frequencies_hz: Sequence[float]
     amplitudes_mm: Sequence[float]
+    solver_label: str = "reference DEM"
     figure_: Figure | None = field(default=None, init=False)
     ax_: Axes | None = field(default=None, init=False)
 
@@ -121,10 +125,12 @@ class PatternMapDisplay:
         labels = [PATTERN_NAMES[p] for p in shown] + [
             "paper's region of pattern 2 (opposite ways)",
             "paper's region of pattern 3 (one body)",
-            "dashed outline: the DEM disagrees",
+            "dashed outline: the solver disagrees",
         ]
-        ax.legend(handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, title="cell colour: DEM")
-        ax.set_title("Bi-block: dominant rocking pattern (reference DEM) and the paper's regions")
+        ax.legend(
+            handles, labels, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8, title="cell colour: the solver"
+        )
+        ax.set_title(f"Bi-block: dominant rocking pattern ({self.solver_label}) and the paper's regions")
         if path is not None:
             save_figure(fig, path)
         self.figure_, self.ax_ = fig, ax

@@ -6,9 +6,10 @@ curve with the demand beside the fragility in ag).
   collapse at each stripe (points, 95 % Wilson bars), the lognormal fit (solid over the
   tested levels, dotted beyond), its 90 % bootstrap band, the median marked;
 * :func:`plot_capacity`: the code's capacity curve a*(d*) of the equivalent system, a0*,
-  du* and the secant of Ts, the linear demand (ag S / q, or the floor's at height) and the
-  nonlinear one: the site's elastic spectrum in acceleration-displacement form
-  (Se(T) against SDe(T)) and its point at Ts;
+  du* and the secant point of T_SLV (of Ts in the 2009 form), the linear demand (ag S / q, or
+  the floor's at height) and the nonlinear one: the site's elastic spectrum (the floor's at
+  height) at the check's damping in acceleration-displacement form (Se(T) against SDe(T)) and
+  its point at T_SLV (Ts);
 * with ``--pushover``, the reference DEM's pushover curve at the mechanism's control point
   in the same a*-d* coordinates over the code's curve;
 * :func:`draw_fragility` and :func:`draw_assessment` write them as PNG files.
@@ -16,6 +17,7 @@ curve with the demand beside the fragility in ag).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from pathlib import Path
 from typing import Any
@@ -165,18 +167,24 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
             ymax = max(ymax, c.demand)
         else:
             periods = np.linspace(0.02, 4.0, 400)
-            if "T_SLV_s" in c.terms:  # at height: the floor's spectrum (Circolare 2019 C7.2.3, C8.7.1.12)
+            if "T_SLV_s" in c.terms and a.position.at_height:  # the floor's spectrum (Circolare 2019 C7.2.3)
                 ts, xi = c.terms["T_SLV_s"], c.terms["xi"]
                 floor = a.position.floor(a.site.spectrum)
                 spectrum, sd = floor.psa(periods, xi), floor.sde(periods, xi)
                 what = f"the floor's spectrum at Z, {100 * xi:g} % (ADRS)"
                 se = c.demand * (2 * math.pi / ts) ** 2
                 label = f"{c.name}: demand at T_SLV = {ts:.2f} s: {c.demand * 1e3:.3g} mm ({c.status})"
+            elif "T_SLV_s" in c.terms:  # at ground level, 2019: the site's spectrum at the mechanism's damping
+                ts, xi, se = c.terms["T_SLV_s"], c.terms["xi"], c.terms["Se_TSLV_m_s2"]
+                spectrum = dataclasses.replace(a.site.spectrum, damping=xi).psa(periods)
+                sd = spectrum * (periods / (2 * math.pi)) ** 2
+                what = f"site's elastic spectrum at {100 * xi:g} % (ADRS)"
+                label = f"{c.name}: demand SDe(T_SLV = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})"
             else:
                 ts, se = c.terms["Ts_s"], c.terms["Se_Ts_m_s2"]
                 spectrum = a.site.spectrum.psa(periods)
                 sd = spectrum * (periods / (2 * math.pi)) ** 2
-                what = "site's elastic spectrum (ADRS)"
+                what = "site's elastic spectrum, 5 % (ADRS)"
                 label = f"{c.name}: demand SDe(Ts = {ts:.2f} s) = {c.demand * 1e3:.3g} mm ({c.status})"
             ax.plot(sd * 1e3, spectrum, color="0.55", lw=1.0, label=what)
             ax.plot([0, c.demand * 1e3], [0, se], color="0.55", lw=0.8, ls=":")
@@ -201,7 +209,7 @@ def plot_capacity(a: Assessment, ax: Axes | None = None) -> tuple[Any, Axes]:
     return fig, ax
 
 
-def _marks(a: Assessment) -> list[tuple[float, str, str, str]]:
+def assessment_marks(a: Assessment) -> list[tuple[float, str, str, str]]:
     """The code's demand and capacity on the fragility's axis (ag, SI)."""
     marks = [(a.site.ag_m_s2, f"the site's ag = {a.site.ag_m_s2 / G:.3g} g (the code's demand)", DEMAND, "-")]
     styles = iter(("--", "-.", ":"))
@@ -238,7 +246,7 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
     fig, axes = new_figure(path, 1, panels, figsize=(6.4 * panels, 6.2), layout="constrained", squeeze=False)
     plot_capacity(a, axes[0, 0])
     if a.dynamic is not None:
-        plot_fragility(a.dynamic, axes[0, 1], marks=_marks(a))
+        plot_fragility(a.dynamic, axes[0, 1], marks=assessment_marks(a))
         ratio = a.median_over_code
         axes[0, 1].set_title(
             f"dynamics: {a.dynamic.plan.stripes.solver.name}, {a.dynamic.plan.stripes.motions.count} records"

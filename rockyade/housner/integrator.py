@@ -83,7 +83,7 @@ from rockyade.housner.equation import (
     theta_dd,
 )
 from rockyade.housner.sdof import HousnerModel
-from rockyade.motion.ground import GroundMotion, ground_acceleration
+from rockyade.motion.ground import GroundMotion, aligned_step, ground_acceleration
 
 #: A block is declared at rest when an impact leaves it an energy that would lift it by
 #: less than REST_FRACTION * alpha.
@@ -243,7 +243,6 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
     t_over = -1.0
     t_alpha = -1.0
     alpha_min = min(prm[I_AL], prm[I_AR])
-    n_motion = mt.size
     t = 0.0
     th = theta0
     om = omega0
@@ -277,18 +276,7 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         elif th != 0.0 or om != 0.0:
             side = 1 if (th > 0.0 or (th == 0.0 and om > 0.0)) else -1
         alpha_side = prm[I_AL] if side > 0 else prm[I_AR]
-        # step end: no longer than h_max, aligned with the next base-motion sample
-        h = h_max
-        if n_motion >= 2 and t < mt[n_motion - 1]:
-            j = np.searchsorted(mt, t, side="right")
-            if j < n_motion:
-                gap = mt[j] - t
-                if gap < h:
-                    h = gap
-                elif gap < h * 1.1:
-                    h = 0.5 * gap
-        if t + h > duration:
-            h = duration - t
+        h = aligned_step(t, h_max, duration, mt)  # no longer than h_max, ending on a motion sample
         if h <= 0.0:
             break
         th1, om1 = _rk4(t, th, om, h, side, prm, mt, mah, mav)

@@ -6,6 +6,13 @@ inside the installed package (``rockyade/io/driver_loop.py``, found from the dri
 folder; beside ``run.py`` in a ``rockyade yade-script`` folder), so it imports nothing but
 the standard library. The other side of the protocol is :mod:`rockyade.io.warm_program`.
 
+**Dies with its parent** (:func:`die_with_parent`): first thing in :func:`serve`, the worker asks
+the kernel to SIGKILL it when the thread that started it ends (Linux ``prctl(PR_SET_PDEATHSIG)``),
+and leaves at once if that process (``ROCKYADE_WORKER_PARENT``) is already gone. It is done here,
+after exec, not in a ``preexec_fn``: Python code between fork and exec in a process with
+threads can deadlock the child before exec (a lock another thread held at the fork), and the
+thread that started it then waits for it forever.
+
 **The loop** (:func:`serve`, ``--serve FD``): FD is the worker's end of a socket pair
 (AF_UNIX, SOCK_SEQPACKET: no address, no port). It says ``{"ready": true, "pid": ...}``, then
 takes jobs ``{"scene": path, "out": path, "deadline": t, "flush_s": s}``, each with the
@@ -27,8 +34,10 @@ written to ``<path>.part`` and renamed onto ``path``: a kill leaves the previous
 """
 
 import contextlib
+import ctypes
 import json
 import os
+import signal
 import socket
 import sys
 import time
@@ -38,6 +47,12 @@ from typing import IO, Any, NoReturn
 
 #: Largest message either side sends, bytes.
 MESSAGE_BYTES = 1 << 16
+
+#: The environment variable naming the process that started this worker (its pid).
+PARENT_VARIABLE = "ROCKYADE_WORKER_PARENT"
+
+#: ``prctl``'s option that names the signal sent when the parent thread ends (linux/prctl.h).
+PR_SET_PDEATHSIG = 1
 
 
 class OutputError(Exception):
@@ -97,6 +112,19 @@ def write_output(path: str, savez: Callable[..., None], arrays: dict[str, Any], 
     write_replacing(path, lambda fh: savez(fh, **arrays, meta=json.dumps(meta)))
 
 
+def die_with_parent() -> None:
+    """Ask the kernel to SIGKILL this process when the thread that started it ends, however it
+    ends; leave at once (exit 1) if the process named by ``ROCKYADE_WORKER_PARENT`` is no longer
+    our parent (it died before the request took effect). Where ``prctl`` is missing (not
+    Linux) only the check remains; the parent's own clean-up (it kills the worker's process
+    group) does the rest."""
+    with contextlib.suppress(OSError, AttributeError):
+        ctypes.CDLL(None, use_errno=True).prctl(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    parent = os.environ.get(PARENT_VARIABLE, "")
+    if parent.isdigit() and os.getppid() != int(parent):
+        os._exit(1)
+
+
 def _send(sock: socket.socket, message: dict[str, Any]) -> None:
     sock.send(json.dumps(message).encode())
 
@@ -118,6 +146,7 @@ def serve(
     after_job
         Called after each job the worker survives, before it answers (YADE's reset).
     """
+    die_with_parent()
     sock = socket.socket(fileno=fd)
     keep_out, keep_err = os.dup(1), os.dup(2)
     _send(sock, {"ready": True, "pid": os.getpid(), **(hello or {})})

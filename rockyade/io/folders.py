@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import os
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 #: What a command leaves in a folder it has not written a result to yet: its lock, and the
@@ -54,4 +54,12 @@ def remove_if_unused(folder: Path) -> bool:
     return True
 
 
-__all__ = ["BOOKKEEPING", "output_folder", "remove_if_unused"]
+def other_files(folder: Path, names: Iterable[str]) -> list[str]:
+    """The entries of ``folder`` (an existing directory) that are not ``names`` of a command's set
+    nor bookkeeping: neither :data:`BOOKKEEPING` nor hidden (a set being swapped in); sorted. What a
+    command refuses to write its set beside (it would be mixed with another's)."""
+    known = set(names) | set(BOOKKEEPING)
+    return sorted(p.name for p in folder.iterdir() if p.name not in known and not p.name.startswith("."))
+
+
+__all__ = ["BOOKKEEPING", "other_files", "output_folder", "remove_if_unused"]

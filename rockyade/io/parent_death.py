@@ -1,9 +1,11 @@
 """Child processes that never outlive their parent (Linux ``prctl(PR_SET_PDEATHSIG)``).
 
-A batch worker and a YADE process each ask the kernel to SIGKILL them when the process
-that started them dies, however it dies (SIGKILL included, where no clean-up code runs).
+A forked batch worker (:mod:`rockyade.runner.workers`) asks the kernel to SIGKILL it when the
+process that started it dies, however it dies (SIGKILL included, where no clean-up code runs).
 Where ``prctl`` is missing (not Linux) :func:`die_with_parent` does nothing and the callers'
-own clean-up (killing process groups, timeouts) is what remains.
+own clean-up (killing process groups, timeouts) is what remains. The workers of another
+program (YADE, Siconos) ask for the same in their own driver,
+:func:`rockyade.io.driver_loop.die_with_parent`.
 """
 
 from __future__ import annotations
@@ -28,8 +30,7 @@ def _load_prctl() -> Callable[..., int] | None:
         return None
 
 
-#: Loaded once, in the parent: a ``preexec_fn`` runs between fork and exec, where loading a
-#: library is not safe.
+#: Loaded once, in the parent, before any worker is forked.
 _PRCTL = _load_prctl()
 
 
@@ -41,13 +42,3 @@ def die_with_parent(parent_pid: int) -> None:
             _PRCTL(PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
     if os.getppid() != parent_pid:
         os._exit(1)
-
-
-def child_dies_with_parent() -> Callable[[], None]:
-    """A ``preexec_fn`` for :class:`subprocess.Popen`: the child is killed with this process.
-
-    Note that the kernel sends the signal when the *thread* that forked the child ends; the
-    callers wait for their child in the thread that started it.
-    """
-    parent = os.getpid()
-    return lambda: die_with_parent(parent)

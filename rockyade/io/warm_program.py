@@ -12,10 +12,12 @@ module knows no program.
   here as :mod:`rockyade.io.atomic` opens files (a new file under a random name, never
   through a link), and renamed onto the job's log when the job ends.
 * **Dies with its parent.** Its own session (a timeout kills its group) and
-  ``PR_SET_PDEATHSIG`` (:mod:`rockyade.io.parent_death`): the kernel kills it when the thread
-  that started it ends, however the process ends. Each thread therefore keeps its own
-  worker per program (:func:`run_scene`); a thread that ends closes them; a forked child
-  forgets its parent's.
+  ``PR_SET_PDEATHSIG``, which the driver asks for itself
+  (:func:`rockyade.io.driver_loop.die_with_parent`): the kernel kills it when the thread
+  that started it ends, however the process ends. No Python runs between fork and exec
+  (no ``preexec_fn``): there it could deadlock on a lock another thread held at the fork.
+  Each thread therefore keeps its own worker per program (:func:`run_scene`); a thread
+  that ends closes them; a forked child forgets its parent's.
 * **Timeout per scene.** Each scene has its own wall-clock limit (counting a worker's
   start when one is needed). The driver stops the scene at that deadline itself and writes
   the samples it has (the worker goes on to the next scene); a worker that has not answered
@@ -53,8 +55,7 @@ from typing import IO, Any
 
 from rockyade.errors import InputError, os_error_message
 from rockyade.io.atomic import create_temporary, file_mode
-from rockyade.io.driver_loop import MESSAGE_BYTES
-from rockyade.io.parent_death import child_dies_with_parent
+from rockyade.io.driver_loop import MESSAGE_BYTES, PARENT_VARIABLE
 
 #: Seconds a worker has to stop after ``quit`` before it is killed.
 QUIT_WAIT_S = 5.0
@@ -79,13 +80,12 @@ class WorkerLostError(Exception):
 
 @contextlib.contextmanager
 def sigint_held_back() -> Iterator[None]:
-    """Hold SIGINT back from this thread while it forks a worker. Between fork and exec the
-    child runs Python (the interpreter's at-fork hooks, the ``preexec_fn``) with this
-    process's Ctrl-C handler, and is still in the terminal's process group: a Ctrl-C then ran
-    that handler in the child, whose exception showed as "Exception ignored in: <bound method
-    Random.seed ...>". The child inherits the blocked signal through exec: the worker, in a
-    session of its own, never takes Ctrl-C (its parent decides). In this process a Ctrl-C
-    meanwhile goes to another thread, or waits for this one to unblock it."""
+    """Hold SIGINT back from this thread while it forks a worker. The worker inherits the
+    blocked signal through exec: in a session of its own, it never takes Ctrl-C (its parent
+    decides). In this process a Ctrl-C meanwhile goes to another thread, or waits for this one
+    to unblock it. (Before, the child ran Python between fork and exec, a ``preexec_fn``,
+    where a Ctrl-C ran this process's handler in the child: "Exception ignored in: <bound
+    method Random.seed ...>". No Python runs there now.)"""
     try:
         previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     except (AttributeError, OSError, ValueError):  # no per-thread masks here
@@ -154,10 +154,9 @@ class Worker:
                     stdin=subprocess.DEVNULL,
                     stdout=self.startup,
                     stderr=subprocess.STDOUT,
-                    env=env,
+                    env={**env, PARENT_VARIABLE: str(os.getpid())},
                     pass_fds=(theirs.fileno(),),
                     start_new_session=True,  # a group of its own: a timeout kills it and its children
-                    preexec_fn=child_dies_with_parent(),  # ... and it dies with this thread, even by SIGKILL
                 )
         except BaseException:
             ours.close()

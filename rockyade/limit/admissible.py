@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import heapq
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -68,16 +69,21 @@ def _way_words(model: RigidBlockModel, corner: Corner, way: int) -> str:
 
 
 def solve_admissible(
-    model: RigidBlockModel, direction: str = "+x", method: str = "highs", time_limit_s: float | None = None
+    model: RigidBlockModel,
+    direction: str = "+x",
+    method: str = "highs",
+    time_limit_s: float | None = None,
+    on_progress: Callable[[float, str], None] | None = None,
 ) -> tuple[LPSolution, RigidBlockModel]:
     """The programme's solution with every corner of ``model.corners`` held in one of its ways, the
     lowest (module docstring), and the model solved (those contacts among its interfaces, the
     choice said in its notes). Without such corners: :func:`~rockyade.limit.lp.solve_equilibrium`.
     ``time_limit_s`` bounds the programmes' time together, s (None: no limit; past it
-    :class:`~rockyade.limit.lp.TimeLimitError`).
+    :class:`~rockyade.limit.lp.TimeLimitError`); ``on_progress`` as
+    :func:`~rockyade.limit.lp.solve_equilibrium`'s.
     """
     if not model.corners:
-        return solve_equilibrium(model, direction, method, time_limit_s=time_limit_s), model
+        return solve_equilibrium(model, direction, method, time_limit_s=time_limit_s, on_progress=on_progress), model
     count = 0
     order = 0
     heap: list[tuple[float, int, dict[int, int]]] = [(-math.inf, order, {})]
@@ -93,7 +99,7 @@ def solve_admissible(
                 f"the search over {len(model.corners)} corner contacts needed more than {MAX_PROGRAMMES} programmes"
             )
         left = None if time_limit_s is None else time_limit_s - spent  # the programmes' time so far
-        sol = solve_equilibrium(_with(model, choice), direction, method, time_limit_s=left)
+        sol = solve_equilibrium(_with(model, choice), direction, method, time_limit_s=left, on_progress=on_progress)
         count += 1
         spent += sol.solve_time_s
         open_corners = [c for c in range(len(model.corners)) if c not in choice]
@@ -129,7 +135,7 @@ def solve_admissible(
     sol, choice = best
     solved = _with(model, choice)
     if sol.status == "collapse":
-        sol = solve_equilibrium(solved, direction, method)  # forces for every contact of the model solved
+        sol = solve_equilibrium(solved, direction, method, on_progress=on_progress)  # forces for every contact
         spent += sol.solve_time_s
         count += 1
     words = "; ".join(_way_words(model, model.corners[c], w) for c, w in sorted(choice.items()))

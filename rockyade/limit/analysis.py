@@ -284,6 +284,7 @@ def limit_analysis(
     on_iteration: Callable[[int, float, float], None] | None = None,
     coulomb_check: bool = False,
     fm_MPa: float | None = None,
+    on_progress: Callable[[float, str], None] | None = None,
 ) -> LimitResult:
     """The collapse multiplier, mechanism and kinematic quantities of a scene.
 
@@ -297,7 +298,7 @@ def limit_analysis(
     loads
         External loads (forces without mass), :class:`PointLoad`.
     friction_angle_deg
-        Friction angle of every joint, degrees in [0, 90); None: the scene's.
+        Friction angle of every joint, degrees in [0, 89.9] (rigid_blocks.MAX_FRICTION_ANGLE_DEG); None: the scene's.
     sliding
         False: no joint slides (the multiplier of pure rocking mechanisms).
     fc
@@ -326,6 +327,9 @@ def limit_analysis(
         The masonry's compressive strength, MPa in (0, 1e9]: the hinges move into the joints by the
         stress block's resultant, iterated with the programme's normal forces to a fixed point
         (:mod:`rockyade.limit.crushing`); None: rigid blocks (hinges at the joints' edges).
+    on_progress
+        Progress within a large programme, solved in a child process: called every 10 s with (seconds,
+        HiGHS's latest iteration in words) (:func:`rockyade.limit.lp.solve_equilibrium`).
     """
     if direction not in DIRECTIONS:
         raise InputError("direction", f"must be +x or -x, got {direction!r}")
@@ -345,7 +349,9 @@ def limit_analysis(
         model = scene
     else:
         model = rigid_block_model(scene, loads=loads, friction_angle_deg=friction_angle_deg, sliding=sliding)
-    options: dict[str, Any] = dict(fc=fc, max_iterations=max_iterations, on_iteration=on_iteration)
+    options: dict[str, Any] = dict(
+        fc=fc, max_iterations=max_iterations, on_iteration=on_iteration, on_progress=on_progress
+    )
     if fm_MPa is not None:
         start = time.perf_counter()
         _, crushed_model, crushing = iterate_crushing(
@@ -360,7 +366,7 @@ def limit_analysis(
         result = replace(result, crushing=crushing)
     else:
         result = _limit_analysis(
-            model, direction, fc, nonlinear, friction_rule, max_iterations, time_limit_s, on_iteration
+            model, direction, fc, nonlinear, friction_rule, max_iterations, time_limit_s, on_iteration, on_progress
         )
     if coulomb_check and friction_rule == "associated" and slides_with_friction(result.model, result.mechanism):
         assert result.load_multiplier is not None  # a mechanism comes with its multiplier
@@ -397,6 +403,7 @@ def _limit_analysis(
     max_iterations: int,
     time_limit_s: float | None,
     on_iteration: Callable[[int, float, float], None] | None,
+    on_progress: Callable[[float, str], None] | None = None,
 ) -> LimitResult:
     """:func:`limit_analysis` of a model with its joints as they are (checked arguments)."""
     angles = {itf.friction_angle_deg for itf in model.interfaces}
@@ -407,7 +414,7 @@ def _limit_analysis(
     else:
         phi = "scene"
     t0 = time.perf_counter()
-    sol, model = solve_admissible(model, direction, time_limit_s=time_limit_s)
+    sol, model = solve_admissible(model, direction, time_limit_s=time_limit_s, on_progress=on_progress)
     rule = friction_rule
     if sol.status != "collapse":
         return LimitResult(sol.status, None, direction, model, None, None, None, None, phi, sol.solve_time_s, rule)
@@ -415,7 +422,12 @@ def _limit_analysis(
     if friction_rule == "coulomb" and phi is not None:
         left = None if time_limit_s is None else time_limit_s - (time.perf_counter() - t0)
         iterated = solve_coulomb(
-            model, sol, max_iterations=max_iterations, time_limit_s=left, on_iteration=on_iteration
+            model,
+            sol,
+            max_iterations=max_iterations,
+            time_limit_s=left,
+            on_iteration=on_iteration,
+            on_progress=on_progress,
         )
         iterations, sol = iterated.iterations, iterated.solution
         if not iterated.converged:

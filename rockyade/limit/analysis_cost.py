@@ -2,18 +2,21 @@
 
 The rigid-block model is built first (linear in the blocks: about 1 ms of CPU per block, the
 contacts at rest included); its size then sets the programme's: 3 rows per moving block, 4
-columns per joint and one for lambda (:mod:`rockyade.limit.lp`). The estimate of one programme
-is set by the running-bond walls that ``rockyade build wall`` makes: 2.5 s of CPU for the 999-block
-wall's programme (69,687 nonzeros, interior point method), more than 60 s for the 3,015-block wall's
-(212,000 nonzeros, dual simplex, unfinished on a loaded machine); quadratic in the nonzeros, an
-upper-side guess beyond:
+columns per joint and one for lambda (:mod:`rockyade.limit.lp`). One programme's time follows the
+method :func:`rockyade.limit.lp.choose_solver` takes, each fitted on the running-bond walls that
+``rockyade build wall`` makes (CPU seconds; docs/limit.md, "Cost"):
 
-    seconds ~ SECONDS_PER_NONZERO x nonzeros ** NONZERO_EXPONENT,
-    bytes   ~ BASE_MEMORY_BYTES + BYTES_PER_NONZERO x nonzeros,
+* the dual simplex (below ``HIPO_COLUMNS`` columns): quadratic in the nonzeros,
+  seconds ~ SECONDS_PER_NONZERO x nonzeros ** NONZERO_EXPONENT (0.29 s at 305 blocks);
+* HiPO (from ``HIPO_COLUMNS``): seconds ~ HIPO_SECONDS_PER_NONZERO x nonzeros ** 1.5 (1.0, 5.8 and
+  34 s at 999, 3,025 and 10,050 blocks), plus ``CHILD_START_S`` where the programme runs in a child
+  process (from ``CHILD_COLUMNS`` columns);
 
-an order of magnitude, as the runs' estimates (:mod:`rockyade.solvers.cost_estimate`). The coulomb rule
-solves one programme per iteration after the associated one: most converge within
-:data:`TYPICAL_ITERATIONS`, and ``--max-iterations`` bounds them.
+memory ~ BASE_MEMORY_BYTES + BYTES_PER_NONZERO x nonzeros (262 MB at most in one process for the
+10,050-block wall), an order of magnitude, as the runs' estimates
+(:mod:`rockyade.solvers.cost_estimate`). The coulomb rule solves one programme per iteration after
+the associated one: most converge within :data:`TYPICAL_ITERATIONS`, and ``--max-iterations``
+bounds them.
 
 :data:`LIMITS` are the documented limits (docs/limit.md); above one, ``rockyade limit`` refuses
 the analysis unless ``--allow-large`` is given.
@@ -26,14 +29,21 @@ from dataclasses import dataclass
 from typing import Any
 
 from rockyade.errors import InputError, at_least, at_most
+from rockyade.limit.lp import CHILD_COLUMNS, choose_solver
 from rockyade.limit.rigid_blocks import RigidBlockModel
 
-#: The fit of one programme's CPU time, s (module docstring).
+#: The fit of one programme's CPU time by the dual simplex (below HIPO_COLUMNS columns), s.
 SECONDS_PER_NONZERO = 5.0e-10
 NONZERO_EXPONENT = 2.0
+#: The fit of one programme's CPU time by HiPO (from HIPO_COLUMNS columns), s: 1.0, 5.8 and 34 s of
+#: CPU at 70,083, 216,265 and 725,250 nonzeros (running-bond walls of 999, 3,025 and 10,050 blocks).
+HIPO_SECONDS_PER_NONZERO = 5.4e-8
+HIPO_NONZERO_EXPONENT = 1.5
+#: A programme solved in a child process (from CHILD_COLUMNS columns) pays the child's start, s of CPU.
+CHILD_START_S = 1.0
 #: Memory: the interpreter with numpy and scipy, and per nonzero of the programme, bytes.
 BASE_MEMORY_BYTES = 150.0e6
-BYTES_PER_NONZERO = 1500.0
+BYTES_PER_NONZERO = 200.0
 #: Iterations of the coulomb rule assumed by the expected time (the walls measured took 10 to 40).
 TYPICAL_ITERATIONS = 30
 #: Documented limits (docs/limit.md); ``--allow-large`` lifts them.
@@ -159,7 +169,7 @@ def estimate_limit_cost(
     iterated = friction_rule == "coulomb" and sliding
     programmes = 1 + (min(max_iterations, TYPICAL_ITERATIONS) if iterated else 0)
     max_programmes = 1 + (max_iterations if iterated else 0)
-    seconds = SECONDS_PER_NONZERO * max(nonzeros, 1) ** NONZERO_EXPONENT
+    seconds = programme_seconds(variables, nonzeros)
     memory = BASE_MEMORY_BYTES + BYTES_PER_NONZERO * nonzeros
     return LimitCost(
         model.n_blocks,
@@ -176,22 +186,43 @@ def estimate_limit_cost(
     )
 
 
+def programme_seconds(variables: int, nonzeros: int) -> float:
+    """One programme's expected time, s: the fit of the method :func:`rockyade.limit.lp.choose_solver`
+    takes for it (module docstring), with the child process's start where it runs in one."""
+    if choose_solver("highs", variables) == "hipo":
+        seconds = HIPO_SECONDS_PER_NONZERO * max(nonzeros, 1) ** HIPO_NONZERO_EXPONENT
+    else:
+        seconds = SECONDS_PER_NONZERO * max(nonzeros, 1) ** NONZERO_EXPONENT
+    return seconds + (CHILD_START_S if variables >= CHILD_COLUMNS else 0.0)
+
+
 _WHAT = {
     "expected_time_s": ("seconds of programmes", "--friction-rule associated (one programme), a smaller model"),
     "memory_bytes": ("bytes of memory", "a smaller model (fewer blocks)"),
 }
 
 
-def check_limit_cost(cost: LimitCost, allow_large: bool = False, limits: dict[str, float] | None = None) -> None:
+def check_limit_cost(
+    cost: LimitCost,
+    allow_large: bool = False,
+    limits: dict[str, float] | None = None,
+    time_limit_s: float | None = None,
+) -> None:
     """Refuse (InputError naming ``--allow-large``) an analysis whose estimate is above ``limits``
-    (default :data:`LIMITS`), unless ``allow_large``."""
+    (default :data:`LIMITS`), unless ``allow_large``. ``time_limit_s`` (``--time-limit``) bounds the
+    programmes' time: an analysis whose time limit is within the limit is not refused for its
+    expected time, whatever the estimate."""
     if allow_large:
         return
     limits = LIMITS if limits is None else limits
     for name, limit in limits.items():
         value = getattr(cost, name)
+        if name == "expected_time_s" and time_limit_s is not None and time_limit_s <= limit:
+            continue  # the user's bound holds: the programmes stop at time_limit_s
         if math.isfinite(value) and value > limit:
             what, remedy = _WHAT[name]
+            if name == "expected_time_s":
+                remedy += f", --time-limit S with S <= {limit:g} (it stops the programmes then)"
             raise InputError(
                 "--allow-large",
                 f"the limit analysis needs {at_least(value)} {what}, above the limit {at_most(limit)} "

@@ -107,6 +107,7 @@ def solve_coulomb(
     max_iterations: int = MAX_ITERATIONS,
     time_limit_s: float | None = None,
     on_iteration: Callable[[int, float, float], None] | None = None,
+    on_progress: Callable[[float, str], None] | None = None,
 ) -> CoulombSolution:
     """The non-associated (non-dilatant Coulomb) collapse by the iteration of the module docstring.
 
@@ -125,6 +126,8 @@ def solve_coulomb(
         iteration stops, not converged, and its reason says so.
     on_iteration
         Called after every programme with (iteration, lambda, seconds since the call): progress.
+    on_progress
+        Passed to :func:`~rockyade.limit.lp.solve_equilibrium` (progress within one large programme).
 
     Convergence, relaxation and what "converged" means: module docstring.
     """
@@ -146,7 +149,9 @@ def solve_coulomb(
         try:
             if left is not None and left <= 0.0:
                 raise TimeLimitError("no time left")
-            sol = solve_equilibrium(model, start.direction, method, friction_capacity_N=mu * n_bar, time_limit_s=left)
+            sol = solve_equilibrium(
+                model, start.direction, method, mu * n_bar, time_limit_s=left, on_progress=on_progress
+            )
         except TimeLimitError:
             reason = f"the time limit of {time_limit_s:g} s was reached after {k - 1} iterations"
             return CoulombSolution(sol, k - 1, False, tuple(history), elapsed + time.perf_counter() - t0, reason)

@@ -36,14 +36,16 @@ every contact force does none (:mod:`rockyade.limit.mechanism`).
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
-from scipy.optimize import linprog
 
 from rockyade.errors import InputError, SolverFailedError
+from rockyade.limit.highs import Programme, solve_programme
+from rockyade.limit.highs_child import solve_in_child
 from rockyade.limit.rigid_blocks import RigidBlockModel
 
 #: The multiplier is first sought below this (a horizontal acceleration of 1,000 g); a
@@ -203,17 +205,22 @@ def equilibrium_system(model: RigidBlockModel, direction: str, non_dilatant: boo
     return A, b, lam_col, free.copy(), row_of, (w_ref, l_ref)
 
 
-#: HiGHS's methods as scipy names them; "highs" is rockyade's choice (:func:`highs_method`).
-METHODS = ("highs", "highs-ds", "highs-ipm")
-#: Columns between which "highs" takes the interior point method rather than the dual simplex: on a
-#: running-bond wall of 999 blocks (11,485 columns) the interior point method (with its crossover to a
-#: vertex) takes 2.4 to 2.9 s of CPU against the dual simplex's 11 to 12.5 s, the same multiplier to 5e-7
-#: and a vertex mechanism as well; below IPM_COLUMNS both are fast and the dual simplex keeps its
-#: bit-for-bit answers; on the 3,015-block wall (35,329 columns) the crossover ends "imprecise" and
-#: HiGHS's simplex clean-up from its basis took longer than the dual simplex alone (160 s of CPU
-#: against 60 s, both unfinished on a loaded machine), so above IPM_MAX_COLUMNS the dual simplex stays.
-IPM_COLUMNS = 4000
-IPM_MAX_COLUMNS = 20000
+#: The methods of :func:`solve_equilibrium`: "highs" is rockyade's choice (:func:`choose_solver`),
+#: "highs-ds" HiGHS's dual simplex, "highs-ipm" its interior point method IPX with the crossover to a
+#: vertex, "highs-hipo" its interior point method HiPO without crossover (:mod:`rockyade.limit.highs`).
+METHODS = ("highs", "highs-ds", "highs-ipm", "highs-hipo")
+_SOLVER_OF = {"highs-ds": "simplex", "highs-ipm": "ipx", "highs-hipo": "hipo"}
+#: Columns from which "highs" takes HiPO rather than the dual simplex. Measured on running-bond walls of
+#: ``rockyade build wall`` (CPU s, a loaded 2-core machine; docs/limit.md, "Cost"): 999 blocks (11,625
+#: columns) dual simplex 6.6, IPX with crossover 3.1, HiPO 1.0; 3,025 blocks (35,661 columns) dual
+#: simplex unfinished at 130, IPX without crossover 37, HiPO 5.8; 10,050 blocks (119,401 columns) HiPO 34.
+#: Below, the dual simplex is as fast and keeps its vertex (the mechanism of the tests' walls, to the bit).
+HIPO_COLUMNS = 4000
+#: Columns from which a programme is solved in a child process (Ctrl-C ends it at once, progress every
+#: 10 s: :mod:`rockyade.limit.highs_child`): about 1,700 blocks of running bond, 2.5 s of HiPO's CPU or
+#: more, against the child's start (about 1 s of CPU). Smaller programmes run here: a Ctrl-C waits for
+#: the programme under way (HiGHS does not return to Python before), a second or two.
+CHILD_COLUMNS = 20000
 
 
 class TimeLimitError(SolverFailedError):
@@ -221,12 +228,22 @@ class TimeLimitError(SolverFailedError):
 
 
 def highs_method(method: str, n_columns: int) -> str:
-    """The HiGHS method scipy runs for ``method`` on a programme of ``n_columns`` columns: "highs"
-    is the interior point method from :data:`IPM_COLUMNS` to :data:`IPM_MAX_COLUMNS` columns, where
-    it was measured faster, and the dual simplex elsewhere."""
+    """The method scipy's ``linprog`` runs for ``method`` (the callers that use ``linprog``:
+    :mod:`rockyade.limit.standing`, :func:`rockyade.limit.coulomb.certified`): "highs" is the
+    interior point method with crossover from 4,000 to 20,000 columns and the dual simplex elsewhere."""
     if method != "highs":
         return method
-    return "highs-ipm" if IPM_COLUMNS < n_columns <= IPM_MAX_COLUMNS else "highs-ds"
+    return "highs-ipm" if 4000 < n_columns <= 20000 else "highs-ds"
+
+
+def choose_solver(method: str, n_columns: int) -> str:
+    """HiGHS's solver (:data:`rockyade.limit.highs.SOLVERS`) for ``method`` on ``n_columns`` columns:
+    "highs" is HiPO from :data:`HIPO_COLUMNS` columns and the dual simplex below."""
+    if method not in METHODS:
+        raise InputError("method", f"must be one of {', '.join(METHODS)}, got {method!r}")
+    if method == "highs":
+        return "hipo" if n_columns >= HIPO_COLUMNS else "simplex"
+    return _SOLVER_OF[method]
 
 
 def time_options(time_limit_s: float | None) -> dict[str, float]:
@@ -236,12 +253,42 @@ def time_options(time_limit_s: float | None) -> dict[str, float]:
     return {"time_limit": max(float(time_limit_s), 1.0e-3)}
 
 
+def _programme(A, b, lam_col: int, lower, upper, chained: bool) -> Programme:
+    """maximise lambda, A x = b, as HiGHS's :class:`Programme`. ``chained``: lambda's column, the one
+    dense column (every moving block's x row), becomes one lambda_i per block with lambda_i = lambda_(i+1)
+    (rows of two entries): the normal equations of an interior point method stay sparse (HiPO's
+    factorisation of the 10,050-block wall: 34 s of CPU against 79 s with the dense column). Lambda is
+    then column ``lam_col`` still, the first lambda_i; the extra rows follow the equilibrium rows."""
+    n_rows = A.shape[0]
+    if not chained:
+        c = np.zeros(A.shape[1])
+        c[lam_col] = -1.0
+        return Programme(c, sp.csc_matrix(A), b, b, lower, upper)
+    g = A[:, lam_col].tocoo()
+    blocks = np.arange(g.nnz)
+    lam_cols = sp.csc_matrix((g.data, (g.row, blocks)), shape=(n_rows, g.nnz))
+    ones = np.ones(g.nnz - 1)
+    chain = sp.coo_matrix(
+        (np.concatenate([ones, -ones]), (np.tile(np.arange(g.nnz - 1), 2), np.concatenate([blocks[:-1], blocks[1:]]))),
+        shape=(g.nnz - 1, g.nnz),
+    )
+    matrix = sp.vstack([sp.hstack([A[:, :lam_col], lam_cols]), sp.hstack([sp.csc_matrix((g.nnz - 1, lam_col)), chain])])
+    matrix = matrix.tocsc()
+    c = np.zeros(lam_col + g.nnz)
+    c[lam_col] = -1.0
+    rhs = np.concatenate([b, np.zeros(g.nnz - 1)])
+    lo = np.concatenate([lower[:lam_col], np.full(g.nnz, lower[lam_col])])
+    up = np.concatenate([upper[:lam_col], np.full(g.nnz, upper[lam_col])])
+    return Programme(c, matrix, rhs, rhs, lo, up)
+
+
 def solve_equilibrium(
     model: RigidBlockModel,
     direction: str = "+x",
     method: str = "highs",
     friction_capacity_N: NDArray[np.float64] | None = None,
     time_limit_s: float | None = None,
+    on_progress: Callable[[float, str], None] | None = None,
 ) -> LPSolution:
     """Maximise lambda subject to every moving block's equilibrium (module docstring).
 
@@ -252,8 +299,10 @@ def solve_equilibrium(
     direction
         "+x" or "-x": the sense of the horizontal force lambda m g.
     method
-        HiGHS's method, one of :data:`METHODS` (the interior point method runs a crossover, so
-        its answer is a vertex as the simplex's: same multiplier, same kind of mechanism).
+        HiGHS's method, one of :data:`METHODS`: the simplex and IPX with its crossover give a vertex
+        (the mechanism is a vertex of the kinematic programme); HiPO a point inside the optimal face,
+        the same multiplier to its tolerance (where several mechanisms share it, a blend of them,
+        each as admissible).
     friction_capacity_N
         (n_interfaces, 2) fixed friction capacities c >= 0 at the interface ends, N: with them every
         joint with friction carries |t| <= c whatever its normal force (a non-dilatant, Tresca-like
@@ -261,15 +310,15 @@ def solve_equilibrium(
         |t| <= tan(phi) n with its associated flow.
     time_limit_s
         Wall time HiGHS may take, s (None: no limit); past it :class:`TimeLimitError`.
+    on_progress
+        A programme solved in a child process (from :data:`CHILD_COLUMNS` columns) calls it every 10 s
+        with (seconds so far, HiGHS's latest iteration in words).
     """
-    if method not in METHODS:
-        raise InputError("method", f"must be one of {', '.join(METHODS)}, got {method!r}")
     non_dilatant = friction_capacity_N is not None
     A, b, lam_col, free, row_of, (w_ref, l_ref) = equilibrium_system(model, direction, non_dilatant)
     geo = interface_arrays(model)
     n_cols = lam_col + 1
-    c = np.zeros(n_cols)
-    c[lam_col] = -1.0
+    solver = choose_solver(method, n_cols)
     lower = np.where(np.append(free, False), -np.inf, 0.0)
     upper_t = np.full(n_cols, np.inf)
     if friction_capacity_N is not None:
@@ -286,15 +335,12 @@ def solve_equilibrium(
         upper = upper_t.copy()
         upper[lam_col] = np.inf if cap is None else cap
         left = None if time_limit_s is None else time_limit_s - (time.perf_counter() - t0)
-        res = linprog(
-            c,
-            A_eq=A,
-            b_eq=b,
-            bounds=np.column_stack([lower, upper]),
-            method=highs_method(method, n_cols),
-            options=time_options(left),
-        )
-        if res.status != 0 or cap is None or res.x[lam_col] < 0.999 * cap:
+        programme = _programme(A, b, lam_col, lower, upper, chained=solver == "hipo")
+        if n_cols >= CHILD_COLUMNS:
+            res = solve_in_child(programme, solver, left, on_progress)
+        else:
+            res = solve_programme(programme, solver, left)
+        if res.status != 0 or cap is None or res.x is None or res.x[lam_col] < 0.999 * cap:
             break
     elapsed = time.perf_counter() - t0
     assert res is not None  # the loop above runs at least once
@@ -307,15 +353,15 @@ def solve_equilibrium(
         return LPSolution("unstable", None, direction, None, None, None, elapsed, res.message, friction_capacity_N)
     if res.status == 3:
         return LPSolution("no_mechanism", None, direction, None, None, None, elapsed, res.message, friction_capacity_N)
-    if res.status != 0:
+    if res.status != 0 or res.x is None or res.marginals is None:
         raise SolverFailedError(f"HiGHS could not solve the equilibrium programme: {res.message}")
-    x = res.x
+    x = res.x[: lam_col + 1]
     forces = x[:lam_col].reshape(len(model.interfaces), 2, 2) * w_ref  # (interface, end, column)
     cone = (geo.has_friction & (not non_dilatant))[:, None]  # (f1, f2) columns; else (N, T)
     mu = np.tan(np.radians(np.where(geo.has_friction, geo.friction_deg, 0.0)))[:, None]
     normal = np.where(cone, forces[:, :, 0] + forces[:, :, 1], forces[:, :, 0])
     tangential = np.where(cone, mu * (forces[:, :, 0] - forces[:, :, 1]), forces[:, :, 1])
-    y = -np.asarray(res.eqlin.marginals)  # d(lambda)/d(b): the virtual velocities, scaled
+    y = -res.marginals[: A.shape[0]]  # d(lambda)/d(b): the virtual velocities, scaled
     velocities = np.zeros((model.n_blocks, 3))
     r = row_of[model.moving]
     velocities[model.moving] = np.column_stack([y[r], y[r + 1], y[r + 2] / l_ref])

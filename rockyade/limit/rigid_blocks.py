@@ -285,12 +285,25 @@ def _left_out(scene) -> tuple[str, ...]:
     return tuple(notes)
 
 
+#: The largest friction angle of the programme, degrees. Its cone columns are n +- tan(phi) t
+#: (:mod:`rockyade.limit.lp`): they lose digits as tan(phi)^2 (HiGHS's answer on the 5-course example
+#: wall: the mechanism's closing residual 1.8e-11 at 89.9 deg, 7.5e-9 at 89.99, 4.6e-7 at 89.999, near
+#: the mechanism's tolerance 1e-6; at 89.9999 lambda is off by 1.5e-6 and HiPO fails). tan(89.9 deg) = 573
+#: is friction no joint has; a joint that does not slide is --no-sliding (sliding=False).
+MAX_FRICTION_ANGLE_DEG = 89.9
+_WHY_MAX = (
+    "the programme's cone columns n +- tan(phi) t lose digits as tan(phi)^2 above it (tan(89.9 deg) = 573); "
+    "for joints that do not slide, --no-sliding"
+)
+
+
 def check_friction_angle(value: float, field: str = "friction_angle_deg") -> float:
-    """A friction angle in [0, 90) degrees, else InputError naming ``field``."""
+    """A friction angle in [0, :data:`MAX_FRICTION_ANGLE_DEG`] degrees, else InputError naming ``field``."""
+    top = f"{MAX_FRICTION_ANGLE_DEG:g}"
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(field, f"must be a number of degrees in [0, 90), got {value!r}")
-    if not 0.0 <= value < 90.0:
-        raise InputError(field, f"must be in [0, 90) degrees, got {value:g}")
+        raise InputError(field, f"must be a number of degrees in [0, {top}], got {value!r}")
+    if not 0.0 <= value <= MAX_FRICTION_ANGLE_DEG:
+        raise InputError(field, f"must be in [0, {top}] degrees, got {value:g}: {_WHY_MAX}")
     return float(value)
 
 
@@ -446,6 +459,9 @@ def rigid_block_model(
             phi = friction_angle_deg
         else:
             phi = _friction_of(scene, a, b, default)
+        if sliding and phi is not None and phi > MAX_FRICTION_ANGLE_DEG:
+            field = f"the joint {names[a]}-{BASE if b < 0 else names[b]}'s friction_angle_deg (scene)"
+            check_friction_angle(phi, field)
         interfaces.append(Interface(a, b, np.asarray(c.ends_m, dtype=float), normal, phi if sliding else None, c.kind))
     corners = []
     for pc in _point_contacts(placed, polygons, fixed, rest):

@@ -57,6 +57,35 @@ def ground_acceleration(t: float, t_s, ah, av, hint: int) -> tuple[float, float,
     return ah[j] + w * (ah[j + 1] - ah[j]), av[j] + w * (av[j + 1] - av[j]), j
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def aligned_step(t: float, h_max: float, duration: float, t_s) -> float:
+    """The next step of an integrator at ``t``: at most ``h_max``, ending on the next base-motion
+    sample when that is nearer (halving the gap when it is only a little longer than ``h_max``,
+    so that no sliver of a step is left before the sample), and not past ``duration``; <= 0:
+    the end (Housner's and the two-block integrators, whose forcing is then smooth within a step).
+
+    Parameters
+    ----------
+    t, h_max, duration
+        Time, the largest step and the end time, s.
+    t_s
+        (n,) the base motion's sample times, s.
+    """
+    h = h_max
+    n = t_s.size
+    if n >= 2 and t < t_s[n - 1]:
+        j = np.searchsorted(t_s, t, side="right")
+        if j < n:
+            gap = t_s[j] - t
+            if gap < h:
+                h = gap
+            elif gap < h * 1.1:
+                h = 0.5 * gap
+    if t + h > duration:
+        h = duration - t
+    return h
+
+
 @dataclass(frozen=True, init=False)
 class GroundMotion:
     """Horizontal (and optional vertical) base acceleration, linear between samples.

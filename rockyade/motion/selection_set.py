@@ -38,8 +38,6 @@ SPECTRA_PNG = "spectra.png"
 #: The set's fixed files; the JSON, last, marks it complete.
 FIXED_FILES = (SELECTION_CSV, SPECTRA_PNG, SELECTION_JSON)
 COMMAND = "rockyade motion select"
-#: Files a folder may hold beside a set (bookkeeping): the lock, hidden files.
-_BOOKKEEPING = (".rockyade.lock",)
 
 
 def sha256(path: Path) -> str:
@@ -79,12 +77,9 @@ def check_out_folder(out: Path, records_folder: Path) -> None:
         raise InputError("--out", "is the records' folder: give another folder for the selection")
     if not out.is_dir():
         return
-    ours = set(FIXED_FILES) | set(_previous_records(out))
-    others = sorted(
-        p.name
-        for p in out.iterdir()
-        if p.name not in ours and p.name not in _BOOKKEEPING and not p.name.startswith(".")
-    )
+    from rockyade.io.folders import other_files
+
+    others = other_files(out, (*FIXED_FILES, *_previous_records(out)))
     if others:
         shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
         raise InputError(

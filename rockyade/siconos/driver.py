@@ -12,37 +12,41 @@ seconds (``complete: false``) so that a worker killed from outside leaves them. 
 is that module's one dialect (:func:`rockyade.io.driver_loop.output_meta`) with Siconos's
 own diagnostics.
 
-Runs inside Debian's /usr/bin/python3 and imports only the standard library, numpy and
-Siconos (``python3-siconos``). The scene is data prepared by rockyade
+Runs inside Debian's /usr/bin/python3 and imports only the standard library, numpy,
+Siconos (``python3-siconos``) and, from its own folder, :mod:`rockyade.siconos.moreau_jean`
+(which takes scipy's sparse matrices to Siconos). The scene is data prepared by rockyade
 (``rockyade.siconos.payload``): the blocks' contact polygons (the DEMs' own: base corners at
 the equivalent base b_eq), masses and inertias (I_O = M g R / p^2), the ground acceleration
-samples, the loads and the time step.
+samples, the loads, the time step and ``integrator``, which chooses the engine:
 
-The model (nonsmooth contact dynamics, Moreau-Jean time stepping):
-
-* each moving block is a ``RigidBody2dDS`` (x, y, theta); a fixed block and the ground are
-  static (they move with the base: not at all in the base frame);
-* contacts are rockyade's own vertex-to-edge pairs, found once from the starting geometry
-  (``contact_pairs``: the reference DEM's), each a ``LagrangianLinearTIR`` whose C and e
-  are set before every step from the bodies' positions (``Contacts``: numpy over all
-  pairs, plain floats for a few), with ``NewtonImpactFrictionNSL(e, 0, mu, 3)``; of two
-  pairs at coinciding corners only one is active at a time (their rows would make the
-  one-step problem singular);
-* the one-step problem is ``FrictionContact(3)`` solved by the nonsmooth Newton
-  (Alart-Curnier); a step it fails (Siconos raises, the residual stays above the
-  tolerance, the state runs away) is taken again from the state before it by NSGS, then
-  ADMM (``Stepper``: both tolerate the redundant contacts of walls and arches); a step
-  none can take ends the run ``failed`` with the reason and the samples so far;
-* ``MoreauJeanOSI(theta)``; the ground motion enters in the base frame as an inertial
-  force -m a_g(t) on every moving block (exact for a rigid base: the base frame translates
-  without rotating), with the vertical -m (g + a_v(t)), both evaluated at the middle of each
-  step (t_k + dt/2) and set with ``setFExtPtr`` before the step; a point load is a constant
-  force at its point of the block, its torque cos(phi) M0 - sin(phi) Q at world angle phi;
-* every ``steps_per_sample`` steps the state is recorded with, per vertex, the normal force
-  (reaction impulse / dt) and whether the contact slips (|tangential| >= SLIP_RATIO x mu x
-  normal); per step the numerics solver's iterations and residual are counted (a step whose
-  residual stays above the tolerance is "unconverged"); at every sample the deepest
-  penetration (-gap) of the contacts.
+* contacts are rockyade's own vertex-to-edge pairs (``contact_pairs``: the reference DEM's),
+  found once from the starting geometry; a corner lifted at the start pairs with the seat it
+  will land on (``pair_reach_fraction``); of two pairs at coinciding corners only one is
+  active at a time (``twins``: their rows are equal);
+* ``numerics`` (the default, :class:`NumericsEngine`): every vertex of a moving block is also
+  paired with the ground (a block that starts above it, or falls, lands); Moreau-Jean's
+  one-step problem is assembled with numpy and solved by Siconos's numerics
+  (:mod:`rockyade.siconos.moreau_jean`: Lemke for a few contacts, Gauss-Seidel warm-started
+  for many, the proximal point method where they stop above the tolerance); the base force
+  theta-weighted between each step's ends;
+* ``kernel`` (:class:`KernelEngine`, the path before): each moving block a
+  ``RigidBody2dDS``, each pair a ``LagrangianLinearTIR`` whose C and e are set before every
+  step (``Contacts``) with ``NewtonImpactFrictionNSL(e, 0, mu, 3)``, ``MoreauJeanOSI(theta)``
+  and ``TimeStepping``; the one-step problem ``FrictionContact(3)`` by the nonsmooth Newton,
+  a step it fails taken again by NSGS, then ADMM (``Stepper``); the base force at the middle
+  of each step, set with ``setFExtPtr``;
+* either way the ground motion enters in the base frame as an inertial force -m a_g(t) on
+  every moving block (exact for a rigid base: the base frame translates without rotating),
+  with the vertical -m (g + a_v(t)); a point load is a constant force at its point of the
+  block, its torque cos(phi) M0 - sin(phi) Q at world angle phi; a step no solver can take, or
+  that leaves a body non-finite or running away, ends the run ``failed`` with the reason and
+  the samples so far;
+* every ``steps_per_sample`` steps the state is recorded (:class:`Recorder`) with, per vertex,
+  the normal force (reaction impulse / dt) and whether the contact slips (|tangential| >=
+  SLIP_RATIO x mu x normal); per step the solver's iterations and residual are counted (a
+  step left above the tolerance is "unconverged"); at every sample the deepest penetration
+  of a vertex below the ground: beyond ``max_penetration_m`` the run fails (the block went
+  through the ground).
 
 Same role as :mod:`rockyade.yade.driver`: each package of an engine that runs in another
 Python has a ``payload``, a ``driver`` and a ``backend`` (docs/architecture.md, "How to add a
@@ -84,6 +88,11 @@ DEEP_FRACTION = 0.25
 #: Up to this many pairs the contact geometry is computed pair by pair in Python floats,
 #: beyond it with numpy over all pairs at once (numpy's per-call overhead: measured).
 SCALAR_PAIRS = 12
+#: A vertex pairs with another block's edge only when its block lies on the edge's outer
+#: side: neither of the vertex's own edges dips into the inner side by more than this cosine
+#: (30 deg: a block tilted at the start, its lifted corner still over the seat it will land
+#: on; a block beside another, whose corner touches the other's bottom edge's end, dips 90 deg).
+SIDE_COS = 0.5
 #: Two pairs of the same two bodies are twins when their vertices start this close, as a
 #: fraction of the smallest block dimension (coinciding corners).
 TWIN_FRACTION = 1e-6
@@ -148,17 +157,23 @@ def _rot(angle):
     return np.array([[c, -s], [s, c]])
 
 
-def contact_pairs(scene):
+def contact_pairs(scene, ground_all=False):
     """The vertex-to-edge contact pairs of a scene, found once from the starting geometry.
 
     Returns a list of dicts: ``a`` (the body of the vertex), ``v`` (its index), ``b`` (the
     body of the edge, -1 for the ground), and for a block's edge its start point ``e0``,
     unit direction ``t`` and outward normal ``n`` in that block's frame and its length ``L``;
-    ``mu`` the pair's friction coefficient. A vertex pairs with the ground when it starts
-    below ``ground_pair_fraction`` of its block's height, and with another block's edge when
-    it is within ``pair_gap_fraction`` of the smaller block's smallest dimension of the edge,
-    its foot within the edge by as much, and its own block lies on the edge's outer side
-    (both of its edges leave the vertex on that side): the reference DEM's contacts.
+    ``mu`` the pair's friction coefficient. A vertex of a moving block pairs with the ground
+    when it starts below ``ground_pair_fraction`` of its block's height, or always with
+    ``ground_all`` (the numerics path: a block that starts above the ground, or a voussoir
+    that falls, lands on it; whether the pair is a contact is decided every step by its
+    gap); a vertex pairs with another block's edge when it lies at most
+    ``pair_gap_fraction`` of the smaller block's smallest dimension inside the edge's line
+    and at most ``pair_reach_fraction`` of the smaller block's largest dimension outside it
+    (a corner lifted at the start, as a free-rocking block's, pairs with the seat it will land
+    on), its foot within the edge up to ``pair_gap_fraction``, and its own block lies on the
+    edge's outer side (neither of its edges dips into the inner side by more than SIDE_COS):
+    the reference DEM's contacts.
     """
     bodies = scene["bodies"]
     mu = {}
@@ -167,21 +182,28 @@ def contact_pairs(scene):
         mu[(int(f["b"]), int(f["a"]))] = float(f["mu"])
     local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
     size = [float(np.min(np.ptp(v, axis=0))) for v in local]
+    span = [float(np.max(np.ptp(v, axis=0))) for v in local]
     world = [
         np.asarray(b["centroid0_m"], dtype=float) + local[i] @ _rot(b["angle0_rad"]).T for i, b in enumerate(bodies)
     ]
+    centre = [w.mean(axis=0) for w in world]
+    radius = [float(np.max(np.hypot(*(w - c).T))) for w, c in zip(world, centre, strict=True)]
     pairs = []
     for a, ba in enumerate(bodies):
         va = world[a]
         na = len(va)
         low = float(np.min(va[:, 1]))
         for k in range(na):
-            if not ba["fixed"] and va[k, 1] - low <= scene["ground_pair_fraction"] * np.ptp(va[:, 1]) and low < size[a]:
+            low_enough = va[k, 1] - low <= scene["ground_pair_fraction"] * np.ptp(va[:, 1]) and low < size[a]
+            if not ba["fixed"] and (ground_all or low_enough):
                 pairs.append({"a": a, "v": k, "b": -1, "mu": mu[(a, -1)]})
         for b, bb in enumerate(bodies):
             if b == a or (ba["fixed"] and bb["fixed"]) or (a, b) not in mu:
                 continue
             tol = scene["pair_gap_fraction"] * min(size[a], size[b])
+            reach = max(tol, scene.get("pair_reach_fraction", 0.0) * min(span[a], span[b]))
+            if float(np.hypot(*(centre[a] - centre[b]))) > radius[a] + radius[b] + reach:
+                continue  # too far apart for any pair
             vb = world[b]
             nv = len(vb)
             rb = _rot(-bb["angle0_rad"])
@@ -193,10 +215,10 @@ def contact_pairs(scene):
                 for k in range(na):
                     p = va[k]
                     g, sp = float((p - p0) @ n), float((p - p0) @ t)
-                    if not (-tol <= g <= tol and -tol <= sp <= length + tol):
+                    if not (-tol <= g <= reach and -tol <= sp <= length + tol):
                         continue
                     side = [va[k - 1] - p, va[(k + 1) % na] - p]
-                    if any(float(d @ n) < -1e-9 * length for d in side):
+                    if any(float(d @ n) < -SIDE_COS * float(np.hypot(*d)) - 1e-9 * length for d in side):
                         continue
                     pairs.append(
                         {
@@ -236,34 +258,17 @@ class Contacts:
         bodies = scene["bodies"]
         nb = len(bodies)
         m = len(pairs)
-        local = [np.asarray(b["vertices_m"], dtype=float) for b in bodies]
-        size = [float(np.min(np.ptp(v, axis=0))) for v in local]
         self.q = np.zeros((nb + 1, 3))  # the bodies' (x, y, theta); row nb: the ground
         for i, b in enumerate(bodies):
             self.q[i] = (b["centroid0_m"][0], b["centroid0_m"][1], b["angle0_rad"])
         self.moving_ids = [i for i, ds in enumerate(ds_of) if ds is not None]
-        self.a = np.array([p["a"] for p in pairs], dtype=int)
-        self.b = np.array([p["b"] if p["b"] >= 0 else nb for p in pairs], dtype=int)
-        self.ground = np.array([p["b"] < 0 for p in pairs], dtype=bool)
-        self.vloc = np.array([local[p["a"]][p["v"]] for p in pairs]).reshape(m, 2)
-        self.e0 = np.array([p["e0"] if p["b"] >= 0 else (0.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.t = np.array([p["t"] if p["b"] >= 0 else (1.0, 0.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.n = np.array([p["n"] if p["b"] >= 0 else (0.0, 1.0) for p in pairs], dtype=float).reshape(m, 2)
-        self.length = np.array([p["L"] if p["b"] >= 0 else math.inf for p in pairs], dtype=float)
-        self.slack = EDGE_SLACK * np.where(self.ground, 0.0, self.length)
-        self.deep = np.array(
-            [DEEP_FRACTION * min(size[p["a"]], size[p["b"]] if p["b"] >= 0 else size[p["a"]]) for p in pairs]
-        )
-        movable = np.array([ds is not None for ds in ds_of] + [False])
-        self.mov_a = movable[self.a].astype(float)
-        self.mov_b = movable[self.b].astype(float)
         self.twin = twins(scene, pairs)
+        # the pairs' geometry: the numerics path's (its gap, open rule and Jacobian rows)
+        self.table = _sibling("pair_table").PairTable(bodies, pairs, self.twin, EDGE_SLACK, DEEP_FRACTION)
+        movable = np.array([ds is not None for ds in ds_of] + [False])
+        self.mov_a = movable[self.table.a].astype(float)
+        self.mov_b = movable[self.table.b].astype(float)
         self.inside = np.zeros(m, dtype=bool)
-        self.a_list, self.b_list = self.a.tolist(), self.b.tolist()
-        self.vloc_list, self.n_list, self.e0_list = self.vloc.tolist(), self.n.tolist(), self.e0.tolist()
-        self.slack_list, self.length_list = self.slack.tolist(), self.length.tolist()
-        self.deep_list = (-self.deep).tolist()
-        self.ground_list, self.twin_list = self.ground.tolist(), self.twin.tolist()
         self.mova_list, self.movb_list = self.mov_a.tolist(), self.mov_b.tolist()
         self.inters, self.views, self.cols = [], [], []
         laws = {}
@@ -306,39 +311,17 @@ class Contacts:
         return qf
 
     def geometry(self):
-        """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs)."""
-        q = self.q
-        qa, qb = q[self.a], q[self.b]
-        ca, sa = np.cos(qa[:, 2]), np.sin(qa[:, 2])
-        cb, sb = np.cos(qb[:, 2]), np.sin(qb[:, 2])
-        vx, vy = self.vloc[:, 0], self.vloc[:, 1]
-        rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
-        px, py = qa[:, 0] + rax, qa[:, 1] + ray
-        nx = cb * self.n[:, 0] - sb * self.n[:, 1]
-        ny = sb * self.n[:, 0] + cb * self.n[:, 1]
-        tx, ty = -ny, nx
-        ex, ey = self.e0[:, 0], self.e0[:, 1]
-        dx = px - (qb[:, 0] + cb * ex - sb * ey)
-        dy = py - (qb[:, 1] + sb * ex + cb * ey)
-        gap = dx * nx + dy * ny
-        sp = dx * tx + dy * ty
-        inside = self.ground | ((sp >= -self.slack) & (sp <= self.length + self.slack))
-        inside &= gap >= -self.deep
-        self.inside[:] = inside
-        has = self.twin >= 0
-        shadowed = np.zeros_like(inside)
-        shadowed[has] = inside[self.twin[has]]
-        closed = inside & ~shadowed
-        rbx, rby = px - qb[:, 0], py - qb[:, 1]
+        """Gaps, open flags, Jacobians and offsets of every pair at ``self.q`` (numpy, all pairs:
+        the pair table's geometry, with the twist row and the moving sides only)."""
+        q, t = self.q, self.table
+        gap, closed, H = t.geometry(q)
         J = self.jac
-        ma, mb = self.mov_a, self.mov_b
-        J[:, 0, 0], J[:, 0, 1], J[:, 0, 2] = nx * ma, ny * ma, (ny * rax - nx * ray) * ma
-        J[:, 1, 0], J[:, 1, 1], J[:, 1, 2] = tx * ma, ty * ma, (ty * rax - tx * ray) * ma
-        J[:, 2, 2] = TWIST_ARM * ma
-        J[:, 0, 3], J[:, 0, 4], J[:, 0, 5] = -nx * mb, -ny * mb, -(ny * rbx - nx * rby) * mb
-        J[:, 1, 3], J[:, 1, 4], J[:, 1, 5] = -tx * mb, -ty * mb, -(ty * rbx - tx * rby) * mb
-        J[:, 2, 5] = -TWIST_ARM * mb
-        cq = np.einsum("kij,kj->ki", J[:, :, :3], qa) + np.einsum("kij,kj->ki", J[:, :, 3:], qb)
+        ma, mb = self.mov_a[:, None, None], self.mov_b[:, None, None]
+        J[:, :2, :3] = H[:, 0] * ma
+        J[:, :2, 3:] = H[:, 1] * mb
+        J[:, 2, 2] = TWIST_ARM * self.mov_a
+        J[:, 2, 5] = -TWIST_ARM * self.mov_b
+        cq = np.einsum("kij,kj->ki", J[:, :, :3], q[t.a]) + np.einsum("kij,kj->ki", J[:, :, 3:], q[t.b])
         self.off[:] = -cq
         self.off[:, 0] += np.where(closed, gap - GAP_OFFSET_M, 1.0)
         self.gaps[:] = np.where(closed, gap, math.inf)
@@ -348,27 +331,27 @@ class Contacts:
         floats: faster than numpy's per-call overhead for the few pairs of a block or a small
         stack (SCALAR_PAIRS). Writes each pair's C and e directly (not ``jac`` and ``off``)."""
         q, gaps, inside_flags = self.read_state_floats(), self.gaps, self.inside
+        a_of, b_of, vloc, nl, e0, lo, hi, deep, twin_of = self.table.lists
         gap_list = [0.0] * len(self.pairs)
         for k in range(len(self.pairs)):
-            a, b = self.a_list[k], self.b_list[k]
+            a, b = a_of[k], b_of[k]
             xa, ya, pa = q[a]
             xb, yb, pb = q[b]
             ca, sa = math.cos(pa), math.sin(pa)
-            vx, vy = self.vloc_list[k]
+            vx, vy = vloc[k]
             rax, ray = ca * vx - sa * vy, sa * vx + ca * vy
             px, py = xa + rax, ya + ray
             cb, sb = math.cos(pb), math.sin(pb)
-            n0, n1 = self.n_list[k]
+            n0, n1 = nl[k]
             nx, ny = cb * n0 - sb * n1, sb * n0 + cb * n1
             tx, ty = -ny, nx
-            ex, ey = self.e0_list[k]
+            ex, ey = e0[k]
             dx, dy = px - (xb + cb * ex - sb * ey), py - (yb + sb * ex + cb * ey)
             gap = dx * nx + dy * ny
             sp = dx * tx + dy * ty
-            slack, length = self.slack_list[k], self.length_list[k]
-            inside = (self.ground_list[k] or -slack <= sp <= length + slack) and gap >= self.deep_list[k]
+            inside = lo[k] <= sp <= hi[k] and gap >= deep[k]
             inside_flags[k] = inside
-            twin = self.twin_list[k]
+            twin = twin_of[k]
             closed = inside and not (twin >= 0 and inside_flags[twin])
             rbx, rby = px - xb, py - yb
             ma, mb = self.mova_list[k], self.movb_list[k]
@@ -606,11 +589,16 @@ class Stepper:
 
 
 class Recorder:
-    """The samples of a run, its diagnostics and its output file (module docstring)."""
+    """The samples of a run, its diagnostics and its output file (module docstring).
 
-    def __init__(self, scene, built, S, out_path):
-        self.scene, self.built, self.S, self.out_path = scene, built, S, out_path
-        self.sn = S["sn"]
+    It reads the state and the contacts' impulses from the run's engine (:class:`KernelEngine`
+    or :class:`NumericsEngine`): ``state()`` gives the bodies' (x, y, theta) and velocities,
+    ``contact_impulses()`` each loaded pair's impulses and gap, ``solve_report()`` the last
+    step's iterations, residual and whether it converged.
+    """
+
+    def __init__(self, scene, engine, S, out_path):
+        self.scene, self.engine, self.S, self.out_path = scene, engine, S, out_path
         nb = len(scene["bodies"])
         self.nb = nb
         self.ns = scene["n_samples"]
@@ -629,7 +617,8 @@ class Recorder:
         self.failure_reason = None
         self.overturn_times = {}
         self.max_penetration = 0.0  # of a vertex below the ground, m (geometric)
-        self.max_overlap = 0.0  # Bullet's -gap, m (a disk's includes about 0.44 of its radius)
+        self.penetration_bound = scene.get("max_penetration_m")  # beyond it the run fails, m
+        self.max_overlap = 0.0  # the deepest vertex-to-edge overlap of a loaded pair, m
         self.iterations = 0
         self.solver_calls = 0
         self.unconverged = 0
@@ -644,15 +633,15 @@ class Recorder:
         k = self.k
         if k >= self.ns:
             return False
+        q, v = self.engine.state()
+        deepest = None
         for i, b in enumerate(self.scene["bodies"]):
-            ds = self.built["bodies"][i]
-            if ds is None:
+            if b["fixed"]:
                 self.pos[k, i] = b["centroid0_m"]
                 self.ang[k, i] = b["angle0_rad"]
                 continue
-            q, v = ds.q(), ds.velocity()
-            x, y, phi = float(q[0]), float(q[1]), float(q[2])
-            vx, vy, w = float(v[0]), float(v[1]), float(v[2])
+            x, y, phi = (float(c) for c in q[i])
+            vx, vy, w = (float(c) for c in v[i])
             if not (math.isfinite(x) and math.isfinite(y) and math.isfinite(phi) and math.isfinite(w)):
                 return self._fail(t, i, "non-finite state")
             if math.hypot(vx, vy) > MAX_SPEED_M_S or abs(w) > MAX_SPIN_RAD_S:
@@ -667,6 +656,7 @@ class Recorder:
             low = min(y + s * vxb + c * vyb for vxb, vyb in self.verts[i])
             if -low > self.max_penetration:
                 self.max_penetration = -low
+                deepest = i
             stop = b["stop_angle_rad"]
             if stop is not None and abs(phi - b["rest_angle_rad"]) >= stop and i not in self.overturn_times:
                 self.overturn_times[i] = t
@@ -674,6 +664,14 @@ class Recorder:
                     self.status, self.stop_time, self.stop_body = "overturned", t, i
         self._contacts(k)
         self.k = k + 1
+        bound = self.penetration_bound
+        if deepest is not None and bound is not None and self.max_penetration > bound:
+            self._fail(
+                t,
+                deepest,
+                f"a vertex {self.max_penetration:.3g} m below the ground, beyond the bound of {bound:.3g} m "
+                "(the block went through the ground)",
+            )
         return self.status == "completed"
 
     def _fail(self, t, i, why):
@@ -683,20 +681,16 @@ class Recorder:
 
     def _contacts(self, k):
         """Normal force and state per vertex, contact points and slip per block (module docstring)."""
-        contacts = self.built["contacts"]
         dt = self.scene["dt_s"]
         points = {}
-        for pair, inter, gap in zip(contacts.pairs, contacts.inters, contacts.gaps, strict=True):
-            if not math.isfinite(gap):
-                continue
-            lam = inter.lambda_(1)
-            rn = float(lam[0]) / dt
+        for pair, lam_n, lam_t, gap in self.engine.contact_impulses():
+            rn = lam_n / dt
             if rn <= 0.0:
                 continue
             if -gap > self.max_overlap:
                 self.max_overlap = -gap
             body, v, other = pair["a"], pair["v"], pair["b"]
-            slips = abs(float(lam[1])) >= SLIP_RATIO * pair["mu"] * float(lam[0])
+            slips = abs(lam_t) >= SLIP_RATIO * pair["mu"] * lam_n
             self.fn[k, body, v] += rn
             if slips:
                 self.state[k, body, v] = 2
@@ -720,21 +714,19 @@ class Recorder:
         """The numerics solver's iterations and residual after a step (when it ran)."""
         if not had_contacts:
             return
-        sn, so = self.sn, self.built["stepper"].so
-        it = int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE])
-        res = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        it, res, converged = self.engine.solve_report()
         self.solver_calls += 1
         self.iterations += it
         if res > self.max_residual:
             self.max_residual = res
-        if res > ACCEPT_FACTOR * self.scene["solver_tol"] or not math.isfinite(res):
+        if not converged:
             self.unconverged += 1
             if self.first_unconverged_s is None:
                 self.first_unconverged_s = t
 
     def write(self, complete):
         n = self.k
-        stepper = self.built["stepper"]
+        stepper = self.engine.diagnostics()
         meta = LOOP.output_meta(
             self,
             complete,
@@ -747,11 +739,14 @@ class Recorder:
             first_unconverged_s=self.first_unconverged_s,
             max_residual=self.max_residual,
             failure_reason=self.failure_reason,
-            retried_steps=stepper.retries,
-            retried_steps_converged=stepper.retried_ok,
-            fallback_steps=stepper.fallback_steps,
-            loose_steps=stepper.loose,
-            friction_solvers=stepper.names,
+            retried_steps=stepper["retried_steps"],
+            retried_steps_converged=stepper["retried_steps_converged"],
+            fallback_steps=stepper["fallback_steps"],
+            loose_steps=stepper["loose_steps"],
+            friction_solvers=stepper["friction_solvers"],
+            integrator=self.scene.get("integrator", "kernel"),
+            one_step_problem=stepper["one_step_problem"],
+            penetration_bound_m=self.penetration_bound,
             max_penetration_m=self.max_penetration,
             max_bullet_overlap_m=self.max_overlap,
         )
@@ -772,13 +767,13 @@ class Recorder:
 FORCE_CHUNK = 4096
 
 
-def base_forces(scene, start=0, stop=None):
-    """(stop - start, 2) the inertial force per unit mass at the middle of steps ``start`` to
-    ``stop`` (default: the last), m/s^2: (-a_h, -(g + a_v)), the samples linear between, zero
-    outside the record."""
+def base_forces(scene, start=0, stop=None, offset=0.5):
+    """(stop - start, 2) the inertial force per unit mass at ``offset`` of steps ``start`` to
+    ``stop`` (default: the last; offset 0.5: their middle, 0: their start), m/s^2:
+    (-a_h, -(g + a_v)), the samples linear between, zero outside the record."""
     dt, g = scene["dt_s"], scene["g"]
     stop = scene["n_steps"] if stop is None else stop
-    t = (np.arange(start, stop) + 0.5) * dt
+    t = (np.arange(start, stop) + offset) * dt
     n = len(t)
     out = np.zeros((n, 2))
     out[:, 1] = -g
@@ -797,6 +792,176 @@ def base_force_steps(scene):
         yield from base_forces(scene, start, min(start + FORCE_CHUNK, scene["n_steps"])).tolist()
 
 
+class StepForces:
+    """The base's force per unit mass at the start and the end of each step, m/s^2
+    (:func:`base_forces` at the steps' boundaries, FORCE_CHUNK steps at a time): ``self(k)``
+    gives ((a_x, a_y) at t_k, (a_x, a_y) at t_k+1), steps taken in order."""
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.start = 0
+        self.values = base_forces(scene, 0, min(FORCE_CHUNK, scene["n_steps"]) + 1, offset=0.0).tolist()
+
+    def __call__(self, k):
+        i = k - self.start
+        if i + 1 >= len(self.values):
+            self.start = k
+            stop = min(k + FORCE_CHUNK, self.scene["n_steps"]) + 1
+            self.values = base_forces(self.scene, k, stop, offset=0.0).tolist()
+            i = 0
+        return self.values[i], self.values[i + 1]
+
+
+class KernelEngine:
+    """The scene in Siconos's kernel (``integrator = "kernel"``, the path before the numerics
+    one): one ``RigidBody2dDS`` per moving block, one interaction per pair, ``TimeStepping``
+    with ``MoreauJeanOSI`` and ``FrictionContact(3)`` (:func:`build`, :class:`Stepper`). The
+    base force is set at the middle of each step with ``setFExtPtr``."""
+
+    def __init__(self, scene, S):
+        self.scene = scene
+        self.built = build(scene, S)
+        self.sn = S["sn"]
+        self.moving = [
+            (ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
+            for i, ds in enumerate(self.built["bodies"])
+            if ds is not None
+        ]
+        self.forces = base_force_steps(scene)
+        self.stepper = self.built["stepper"]
+        self.contacts = self.built["contacts"]
+        nb = len(scene["bodies"])
+        self.q0 = np.array([[*b["centroid0_m"], b["angle0_rad"]] for b in scene["bodies"]]).reshape(nb, 3)
+
+    def step(self, index):
+        """Take step ``index``; True when it had contacts (StepError when none could take it)."""
+        ax, ay = next(self.forces)
+        for ds, m, load in self.moving:
+            if load is None:
+                ds.setFExtPtr([m * ax, m * ay, 0.0])
+            else:
+                phi = float(ds.q()[2])
+                fx, fy = load["force_N"]
+                m0, q = load["arm_Nm"]
+                ds.setFExtPtr([m * ax + fx, m * ay + fy, math.cos(phi) * m0 - math.sin(phi) * q])
+        self.contacts.update()
+        return self.stepper.step(index)
+
+    def advance(self):
+        """After the step's sample: Siconos's next step (its memories swapped)."""
+        self.built["sim"].nextStep()
+
+    def state(self):
+        """(nb, 3) positions (x, y, theta) and (nb, 3) velocities; a fixed body at its start."""
+        q, v = self.q0.copy(), np.zeros_like(self.q0)
+        for i, ds in enumerate(self.built["bodies"]):
+            if ds is not None:
+                q[i] = ds.q()
+                v[i] = ds.velocity()
+        return q, v
+
+    def contact_impulses(self):
+        """(pair, normal impulse, tangential impulse, gap) of every closed pair, N s and m."""
+        for pair, inter, gap in zip(self.contacts.pairs, self.contacts.inters, self.contacts.gaps, strict=True):
+            if math.isfinite(gap):
+                lam = inter.lambda_(1)
+                yield pair, float(lam[0]), float(lam[1]), gap
+
+    def solve_report(self):
+        """The last step's solver iterations, residual, and whether it is within ACCEPT_FACTOR
+        x the tolerance."""
+        so, sn = self.stepper.so, self.sn
+        res = float(so.dparam[sn.SICONOS_DPARAM_RESIDU])
+        ok = res <= ACCEPT_FACTOR * self.scene["solver_tol"] and math.isfinite(res)
+        return int(so.iparam[sn.SICONOS_IPARAM_ITER_DONE]), res, ok
+
+    def diagnostics(self):
+        st = self.stepper
+        return {
+            "retried_steps": st.retries,
+            "retried_steps_converged": st.retried_ok,
+            "fallback_steps": st.fallback_steps,
+            "loose_steps": st.loose,
+            "friction_solvers": st.names,
+            "one_step_problem": "FrictionContact(3) assembled by Siconos's kernel (TimeStepping)",
+        }
+
+
+def _sibling(name):
+    """A module of the driver's own folder (Debian's Python runs the driver as a script, so its
+    folder is on ``sys.path``; the modules there import nothing from rockyade)."""
+    import importlib
+
+    folder = os.path.dirname(os.path.abspath(__file__))
+    if folder not in sys.path:
+        sys.path.insert(0, folder)
+    return importlib.import_module(name)
+
+
+class NumericsEngine:
+    """The scene stepped by Moreau-Jean with the one-step problem assembled with numpy and
+    solved by Siconos's numerics (``integrator = "numerics"``, the default:
+    :mod:`rockyade.siconos.moreau_jean`). Every vertex of a moving block is paired with the
+    ground (:func:`contact_pairs` with ``ground_all``)."""
+
+    def __init__(self, scene, S):
+        self.scene = scene
+        pairs = contact_pairs(scene, ground_all=True)
+        table = _sibling("pair_table").PairTable(scene["bodies"], pairs, twins(scene, pairs), EDGE_SLACK, DEEP_FRACTION)
+        self.mj = _sibling("moreau_jean").MoreauJean(scene, table, S["sn"], StepForces(scene))
+        self.pairs = pairs
+        self._calls = self._iterations = self._unconverged = 0
+
+    def step(self, index):
+        """Take step ``index``; True when it had active contacts."""
+        mj = self.mj
+        self._calls, self._iterations, self._unconverged = mj.calls, mj.iterations, mj.unconverged
+        had = mj.step(index)
+        bad = mj.runaway(MAX_SPEED_M_S, MAX_SPIN_RAD_S)
+        if bad is not None:
+            i, speed, spin = bad
+            t = (index + 1) * self.scene["dt_s"]
+            raise StepError(
+                f"the step to t = {t:.6g} s left body {i} with a non-finite state or a runaway speed "
+                f"(|v| = {speed:.3g} m/s, |omega| = {spin:.3g} rad/s; limits {MAX_SPEED_M_S:g} m/s, "
+                f"{MAX_SPIN_RAD_S:g} rad/s)"
+            )
+        return had
+
+    def advance(self):
+        """Nothing to do after the step's sample."""
+
+    def state(self):
+        """(nb, 3) positions (x, y, theta) and (nb, 3) velocities."""
+        return self.mj.state()
+
+    def contact_impulses(self):
+        """(pair, normal impulse, tangential impulse, gap) of every active pair, N s and m."""
+        for k, rn, rt, gap in self.mj.loaded:
+            yield self.pairs[k], rn, rt, gap
+
+    def solve_report(self):
+        """The last step's solver iterations, residual, and whether its solver converged."""
+        mj = self.mj
+        return mj.iterations - self._iterations, mj.residual, mj.unconverged == self._unconverged
+
+    def diagnostics(self):
+        mj = self.mj
+        return {
+            "retried_steps": mj.fallbacks,
+            "retried_steps_converged": mj.fallbacks - mj.unconverged,
+            "fallback_steps": mj.fallbacks,
+            "loose_steps": 0,
+            "friction_solvers": list(mj.names),
+            "one_step_problem": mj.describe(),
+        }
+
+
+def engine(scene, S):
+    """The run's engine: :class:`NumericsEngine` (the default) or :class:`KernelEngine`."""
+    return KernelEngine(scene, S) if scene.get("integrator", "kernel") == "kernel" else NumericsEngine(scene, S)
+
+
 def main(scene_path, out_path, deadline=None, flush_s=None):
     """Run one scene: read the payload, build, step to the end or the stop rule, write the
     samples to ``out_path`` (``.npz``). Returns the run's status."""
@@ -805,34 +970,17 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
     if scene.get("format") != SCENE_FORMAT:
         raise ValueError(f"scene format {scene.get('format')!r}, expected {SCENE_FORMAT!r}")
     S = _siconos()
-    built = build(scene, S)
-    rec = Recorder(scene, built, S, out_path)
-    moving = [
-        (ds, float(scene["bodies"][i]["mass_kg"]), scene["bodies"][i].get("load"))
-        for i, ds in enumerate(built["bodies"])
-        if ds is not None
-    ]
-    forces = base_force_steps(scene)
+    run = engine(scene, S)
+    rec = Recorder(scene, run, S, out_path)
     dt, sps, n_steps = scene["dt_s"], scene["steps_per_sample"], scene["n_steps"]
     deadline = math.inf if deadline is None else float(deadline)
     flush_s = math.inf if flush_s is None else float(flush_s)
     next_flush = time.monotonic() + flush_s
-    sim, stepper, contacts = built["sim"], built["stepper"], built["contacts"]
     go = rec.record(0.0)
     step = 0
     while go and step < n_steps:
-        ax, ay = next(forces)
-        for ds, m, load in moving:
-            if load is None:
-                ds.setFExtPtr([m * ax, m * ay, 0.0])
-            else:
-                phi = float(ds.q()[2])
-                fx, fy = load["force_N"]
-                m0, q = load["arm_Nm"]
-                ds.setFExtPtr([m * ax + fx, m * ay + fy, math.cos(phi) * m0 - math.sin(phi) * q])
-        contacts.update()
         try:
-            had = stepper.step(step)
+            had = run.step(step)
         except StepError as exc:
             rec.status, rec.stop_time, rec.failure_reason = "failed", step * dt, str(exc)
             break
@@ -851,7 +999,7 @@ def main(scene_path, out_path, deadline=None, flush_s=None):
                     rec.write(complete=False)
                     rec.flushes += 1
                     next_flush = time.monotonic() + flush_s
-        sim.nextStep()
+        run.advance()
     rec.write(complete=rec.status != "timeout")
     return rec.status
 

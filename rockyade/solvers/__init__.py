@@ -3,8 +3,10 @@
 ``housner`` (:class:`~rockyade.solvers.housner.HousnerSolver`, exact classical SDOF),
 ``reference`` (:class:`~rockyade.solvers.reference.ReferenceSolver`, standalone
 rigid-polygon DEM, numba), ``yade`` (:class:`~rockyade.solvers.yade.YadeSolver`, YADE
-in batch mode) and ``siconos`` (:class:`~rockyade.solvers.siconos.SiconosSolver`,
-nonsmooth contact dynamics in Debian's Siconos). Each is a :class:`~rockyade.solvers.base.Solver`: ``run(scene)``,
+in batch mode), ``siconos`` (:class:`~rockyade.solvers.siconos.SiconosSolver`,
+nonsmooth contact dynamics in Debian's Siconos) and ``twoblock``
+(:class:`~rockyade.solvers.twoblock.TwoBlockSolver`, the exact solution of two stacked
+blocks). Each is a :class:`~rockyade.solvers.base.Solver`: ``run(scene)``,
 ``estimate_cost(scene)`` and its options as fields. Solvers never import each other; this
 registry is the only place that knows them all, and it hands back instances::
 
@@ -31,6 +33,7 @@ SOLVER_CLASSES = {
     "reference": ("rockyade.solvers.reference", "ReferenceSolver"),
     "yade": ("rockyade.solvers.yade", "YadeSolver"),
     "siconos": ("rockyade.solvers.siconos", "SiconosSolver"),
+    "twoblock": ("rockyade.solvers.twoblock", "TwoBlockSolver"),
 }
 
 

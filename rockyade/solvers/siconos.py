@@ -22,8 +22,8 @@ from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
 from rockyade.scene import ContactSpec, Scene
 from rockyade.siconos.backend import SICONOS, run_model
-from rockyade.siconos.calibration import check_target_mu, default_dt, steps_for
-from rockyade.siconos.payload import Numerics
+from rockyade.siconos.calibration import DT_MAX_S, DT_MIN_S, DT_P_FRACTION, check_target_mu, default_dt, steps_for
+from rockyade.siconos.payload import INTEGRATORS, Numerics, penetration_bound
 from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
@@ -72,6 +72,16 @@ def _check_restitution(value: Any, field: str) -> float:
     return e
 
 
+def _check_integrator(value: Any, field: str) -> str:
+    if value not in INTEGRATORS:
+        raise InputError(field, f"must be one of {', '.join(INTEGRATORS)}, got {value!r}")
+    return str(value)
+
+
+def _check_optional_tol(value: Any, field: str) -> float | None:
+    return None if value is None else _check_tol(value, field)
+
+
 def _check_folder(value: Any, field: str) -> str | None:
     if value is not None and not isinstance(value, (str, Path)):
         raise InputError(field, f"must be a folder path, got {value!r}")
@@ -106,8 +116,8 @@ class SiconosSolver(SolverBase):
         Run in a Siconos process kept warm between runs (one per thread; the default), or
         in a process of its own (False): the same result; warm saves the start-up.
     dt_s
-        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 1e-3 / p of
-        the fastest moving block within [2e-5, 1e-3] s), rounded down to divide the sample
+        Time step, s (default: :func:`rockyade.siconos.calibration.default_dt`, 3e-3 / p of
+        the fastest moving block within [2e-5, 5e-4] s), rounded down to divide the sample
         interval.
     dt_factor
         Multiplies the time step, in [0.001, 1] (1: the step as chosen; 0.5: halved, for
@@ -115,9 +125,15 @@ class SiconosSolver(SolverBase):
     restitution
         Newton restitution e at every contact, in [0, 1] (default 0: the geometry's own
         restitution, Housner's Eq 4).
+    integrator
+        How each step's one-step problem is built and solved: "numerics" (the default:
+        assembled with numpy, solved by Siconos's numerics, Lemke for a few contacts,
+        Gauss-Seidel warm-started for more: :mod:`rockyade.siconos.moreau_jean`) or "kernel"
+        (Siconos's TimeStepping, the nonsmooth Newton then NSGS and ADMM: the path before).
     solver_tol, solver_max_iter
-        Tolerance and iteration cap of the friction-contact solvers (the nonsmooth Newton,
-        then NSGS and ADMM on a step it fails; the Newton stops at 100 iterations at most).
+        Tolerance and iteration cap of the friction-contact solvers (default tolerance:
+        DEFAULT_TOL of the integrator; Lemke's pivoting has none; on the kernel path the
+        Newton stops at 100 iterations at most).
     newton_max_iter
         Newton iterations per step on the nonlinear kinematics (1: linearised once).
     workdir
@@ -137,26 +153,39 @@ class SiconosSolver(SolverBase):
         "dt_s": _check_dt,
         "dt_factor": check_dt_factor,
         "restitution": _check_restitution,
-        "solver_tol": _check_tol,
+        "integrator": _check_integrator,
+        "solver_tol": _check_optional_tol,
         "solver_max_iter": _check_count(1, 100_000),
         "newton_max_iter": _check_count(1, 100),
         "workdir": _check_folder,
     }
-    #: Siconos's time per step of one moving block, s, and how it grows with n moving blocks:
-    #: SECONDS_PER_STEP x n ** STEP_EXPONENT (cost estimate). Measured on the 2-core machine
-    #: (docs/siconos.md, benchmarks/bench_siconos.py): one block 55-75 us a step; the 13-block
-    #: arch at rest 86 ms; the 20-voussoir arch collapsing 50 ms; the 33-block wall 98 ms at
-    #: rest and 1.3 s under a pulse (NSGS's iterations on the hyperstatic joints): n ** 2.5
-    #: gives 36, 107 and 380 ms for these, within a factor of 4 of each.
-    SECONDS_PER_STEP: ClassVar[float] = 6e-5
-    STEP_EXPONENT: ClassVar[float] = 2.5
+    #: Siconos's time per step, s: STEP_S + BODY_STEP_S x n for n moving blocks (cost estimate),
+    #: the numerics path at its default step and tolerance. Measured with benchmarks/
+    #: bench_siconos.py's scenes beside warm YADE on the loaded 2-core machine (load 12-15, where
+    #: YADE took 3.0-10.6 times its own estimate), divided by about that factor (4): a block
+    #: 0.25 ms a step (30 s record), the bi-block 0.36 ms (25 s record), the 20-voussoir arch
+    #: 5.2 ms at rest and 14 ms under a pulse, the 32-block wall 8.3-16.7 ms under a record and
+    #: pulses (docs/siconos.md, "Cost beside YADE").
+    STEP_S: ClassVar[float] = 3e-5
+    BODY_STEP_S: ClassVar[float] = 8.5e-5
+    #: The kernel path's (``integrator = "kernel"``): KERNEL_STEP_S x n ** KERNEL_EXPONENT, measured
+    #: before (one block 55-75 us a step; the 13-block arch at rest 86 ms; the 20-voussoir arch
+    #: collapsing 50 ms; the 33-block wall 98 ms at rest and 1.3 s under a pulse: within a factor
+    #: of 4 of each).
+    KERNEL_STEP_S: ClassVar[float] = 6e-5
+    KERNEL_EXPONENT: ClassVar[float] = 2.5
 
     timeout_s: float | None = None
     warm: bool = True
     dt_s: float | None = None
     dt_factor: float = 1.0
+    #: The friction-contact solvers' default tolerance per integrator (relative; docs/siconos.md,
+    #: "The time step and the tolerance": chosen by what halving it changes).
+    DEFAULT_TOL: ClassVar[dict[str, float]] = {"numerics": 1e-4, "kernel": 1e-8}
+
     restitution: float = 0.0
-    solver_tol: float = 1e-8
+    integrator: str = "numerics"
+    solver_tol: float | None = None
     solver_max_iter: int = 1000
     newton_max_iter: int = 1
     workdir: str | None = None
@@ -169,6 +198,7 @@ class SiconosSolver(SolverBase):
             "dt_s",
             "dt_factor",
             "restitution",
+            "integrator",
             "solver_tol",
             "solver_max_iter",
             "newton_max_iter",
@@ -195,7 +225,8 @@ class SiconosSolver(SolverBase):
             dt_s=dt,
             steps_per_sample=steps,
             restitution=self.restitution,
-            solver_tol=self.solver_tol,
+            integrator=self.integrator,
+            solver_tol=self.solver_tol if self.solver_tol is not None else self.DEFAULT_TOL[self.integrator],
             solver_max_iter=self.solver_max_iter,
             newton_max_iter=self.newton_max_iter,
         )
@@ -203,8 +234,10 @@ class SiconosSolver(SolverBase):
             "dt_factor": self.dt_factor,
             "dt_source": "user"
             if self.dt_s is not None
-            else "default (1e-3 / p of the fastest block, in [2e-5, 1e-3] s)",
+            else f"default ({DT_P_FRACTION:g} / p of the fastest block, in [{DT_MIN_S:g}, {DT_MAX_S:g}] s)",
             "dt_base_s": base,
+            "integrator": self.integrator,
+            "penetration_bound_m": penetration_bound(model),
         }
         return numerics, how
 
@@ -245,13 +278,20 @@ class SiconosSolver(SolverBase):
         SICONOS.check_variable()
 
     def estimate_cost(self, scene: Scene) -> CostEstimate:
-        """Steps at the Siconos time step, SECONDS_PER_STEP x n ** STEP_EXPONENT each for n
-        moving blocks (the one-step problem's assembly and solution grow faster than n)."""
+        """Steps at the Siconos time step, STEP_S + BODY_STEP_S x n each for n moving blocks
+        (the pairs' geometry and the one-step problem's assembly grow with the blocks, and
+        Gauss-Seidel's sweeps with the contacts; its iterations, warm-started, stayed at
+        11-67 a step on the arch and the wall); on the kernel path KERNEL_STEP_S x
+        n ** KERNEL_EXPONENT (its one-step problem, assembled by Siconos's kernel, and the
+        nonsmooth Newton's failures on redundant contacts grow faster than n)."""
         model = self.model(scene)
         numerics, _ = self.numerics(model)
         moving = max(1, len(model.moving))
         steps = float(scene.n_samples - 1) * numerics.steps_per_sample
-        per_step = self.SECONDS_PER_STEP * moving**self.STEP_EXPONENT
+        if self.integrator == "kernel":
+            per_step = self.KERNEL_STEP_S * moving**self.KERNEL_EXPONENT
+        else:
+            per_step = self.STEP_S + self.BODY_STEP_S * moving
         return stepped_cost(scene, self.name, steps * moving, numerics.dt_s, steps * per_step)
 
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> SiconosSolver:

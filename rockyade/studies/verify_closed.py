@@ -182,10 +182,16 @@ def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     kin = _kinematic(limit_analysis(_block_scene(0.25, 2.5), fc=1.35))
     ag, S, q = 0.25 * CODE_GRAVITY, 1.2, 2.0  # ag in g and a0* with standard gravity (docs/conventions.md)
     linear, nonlinear = code_checks(kin, Site(1, "B", ag), Position())
+    _, nonlinear_2009 = code_checks(kin, Site(1, "B", ag), Position(code_form="circolare2009"))
     a0 = 0.1 * CODE_GRAVITY / 1.35
     ts = known(kin.Ts_s, "Ts")
     du = known(kin.du_star_m, "du*")
     sde = 2.5 * ag * S * 0.5 / ts * (ts / (2 * math.pi)) ** 2  # TC < Ts < TD
+    # Circolare 2019 C8.7.1.2.1.8: at d_SLV = du* = 0.05 m the block has turned until its centroid, R = 1.25623 m
+    # from the toe, is 0.125 - 0.05 m from the toe's vertical: alpha = tan(asin(0.075 / R)); T_SLV (Eq C8.7.1.10)
+    a_slv = math.tan(math.asin((0.125 - 0.05) / math.hypot(0.125, 1.25))) * CODE_GRAVITY / 1.35
+    t_slv = 1.68 * math.pi * math.sqrt(0.05 / a_slv)
+    sde_slv = 2.5 * ag * S * math.sqrt(10 / 13) * 0.5 / t_slv * (t_slv / (2 * math.pi)) ** 2  # eta(8 %), TC < T < TD
     src = "hand calculation (docs/limit.md)"
     rows = [
         Row(
@@ -215,12 +221,39 @@ def check_code(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
             src,
             relative(1e-12),
         ),
-        Row("code", "assess", "du* = 0.4 b (m)", du, 0.05, src, relative(1e-6)),
+        Row("code", "assess", "du* = d_SLV = 0.4 b (m)", du, 0.05, src, relative(1e-6)),
         Row(
             "code",
             "assess",
-            "nonlinear demand SDe(Ts) = 2.5 ag S TC / Ts (Ts / 2 pi)^2 (m)",
+            "a(d_SLV) = tan(asin(0.075 / R)) g / FC (m/s^2)",
+            nonlinear.terms["a_SLV_m_s2"],
+            a_slv,
+            src,
+            relative(1e-4),
+        ),
+        Row(
+            "code",
+            "assess",
+            "T_SLV = 1.68 pi sqrt(d_SLV / a(d_SLV)) (s)",
+            nonlinear.terms["T_SLV_s"],
+            t_slv,
+            src,
+            relative(1e-4),
+        ),
+        Row(
+            "code",
+            "assess",
+            "nonlinear demand (Circolare 2019) SDe(T_SLV, 8 %) = 2.5 ag S eta TC / T (T / 2 pi)^2 (m)",
             nonlinear.demand,
+            sde_slv,
+            src,
+            relative(1e-4),
+        ),
+        Row(
+            "code",
+            "assess",
+            "nonlinear demand (Circolare 2009 form) SDe(Ts) = 2.5 ag S TC / Ts (Ts / 2 pi)^2 (m)",
+            nonlinear_2009.demand,
             sde,
             src,
             relative(1e-12),

@@ -22,7 +22,7 @@ from rockyade.studies.verify_rows import Row, absolute, relative
 #: panel are not: their blocks meet corner to corner (each such corner is two vertex-to-edge
 #: pairs at one point with one normal); the driver's twin pairs and fallback solvers run them,
 #: but too slowly for a check (the panel's pushover did not finish in 500 s, the arch's went
-#: unstable at 0.185 s at a 1 ms step): docs/siconos.md, Limits.
+#: unstable at 0.185 s at a 1 ms step): docs/siconos.md, History (the kernel path).
 SICONOS_PUSHOVERS = ("block", "restrained wall")
 
 #: The stack at rest's tolerances: rigid contacts leave no settlement, so any movement is
@@ -32,7 +32,8 @@ REST_ROTATION_RAD, REST_MOVEMENT_M = 1e-6, 1e-6
 
 def quasistatic_siconos() -> Solver:
     """Siconos for the rows without impacts (the stack at rest): a step of 1 ms (its contacts
-    are rigid, so no stiffness limits the step; the default, 1e-3 / p, is made for impacts)."""
+    are rigid, so no stiffness limits the step; the default, 3e-3 / p within 5e-4 s, is made for
+    impacts)."""
     return make_solver("siconos", dt_s=1e-3)
 
 
