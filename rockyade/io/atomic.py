@@ -127,6 +127,12 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", durable: bool = T
     dest = Path(path)
     with staged_file(dest, mode, durable) as (fh, tmp):
         yield fh
+    _rename_into_place(tmp, dest, durable)
+
+
+def _rename_into_place(tmp: Path, dest: Path, durable: bool) -> None:
+    """Rename the complete temporary ``tmp`` onto ``dest`` (and make it durable); on failure
+    remove ``tmp``."""
     try:
         os.replace(tmp, dest)
     except BaseException:
@@ -158,13 +164,11 @@ def atomic_path(path: str | os.PathLike[str], durable: bool = True) -> Iterator[
                 os.fsync(fd)
         finally:
             os.close(fd)
-        os.replace(tmp, dest)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
         raise
-    if durable:
-        fsync_dir(dest.parent)
+    _rename_into_place(tmp, dest, durable)
 
 
 def fsync_dir(directory: str | os.PathLike[str]) -> None:
