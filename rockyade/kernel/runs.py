@@ -4,9 +4,9 @@ block, joint, time step and length) and differ in their base motion.
 :func:`simulate_runs` steps them together: chunks of up to :data:`CHUNK_RUNS` runs, in
 parallel over numba's threads (``prange``), each chunk advanced step by step with the inner
 loop over its runs (:func:`step_runs`: the runs' state held by field), and a run that ends
-drops out of its chunk. Each run's step is that of the single-body loop
-(:func:`rockyade.kernel.single.run_body`): both call the one step of a body of :mod:`.body_step`,
-so the results are the same bits as one run at a time (:func:`simulate_runs_each`, which runs
+drops out of its chunk. Each run's arithmetic is that of
+the single-body loop (:func:`rockyade.kernel.single.run_body`), both from :mod:`.step`, so
+the results are the same bits as one run at a time (:func:`simulate_runs_each`, which runs
 each by ``run_body``; ``tests/test_runs_batched.py``). The summary's metrics are computed
 in the kernel from each run's samples:
 
@@ -28,9 +28,20 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.kernel.body_step import end_step, motion_interval, step_body
-from rockyade.kernel.integration import STATUS_COMPLETED
-from rockyade.kernel.single import lone_body, run_body, start_of
+from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
+from rockyade.kernel.single import run_body
+from rockyade.kernel.step import (
+    base_point,
+    beyond_stop_angle,
+    blown_up,
+    damping,
+    drifted,
+    fraction,
+    kicked,
+    lerp,
+    world_x,
+    world_y,
+)
 
 
 class RunsOutput(NamedTuple):
@@ -47,51 +58,6 @@ class RunsOutput(NamedTuple):
     max_abs_theta_time: NDArray[np.float64]  #: (R,) its (first) sample time, s
     residual_theta: NDArray[np.float64]  #: (R,) theta of the last sample, rad
     uplift_time: NDArray[np.float64]  #: (R,) first sample time with |theta| > the threshold, s
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def new_runs_output(n_runs: int, n_samples: int) -> RunsOutput:
-    """A :class:`RunsOutput` of ``n_runs`` runs that have not started: completed, not stopped, no
-    sample written, never overturned, NaN samples and metrics."""
-    return RunsOutput(
-        np.full(n_runs, STATUS_COMPLETED, dtype=np.int64),
-        np.full(n_runs, -1.0),
-        np.zeros(n_runs, dtype=np.int64),
-        np.full(n_runs, np.nan),
-        np.full((n_runs, n_samples, 2), np.nan),
-        np.full((n_runs, n_samples), np.nan),
-        np.full((n_runs, n_samples), np.nan),
-        np.full(n_runs, np.nan),
-        np.full(n_runs, np.nan),
-        np.full(n_runs, np.nan),
-        np.full(n_runs, np.nan),
-    )
-
-
-@numba.njit(cache=True, nogil=True)
-def summarise(
-    n_filled, ang, peak, peak_t, residual, uplift, r: int, rest: float, uplift_rad: float, sample_dt: float
-) -> None:
-    """The summary's metrics of run ``r`` from its samples (module docstring; theta = angle -
-    ``rest``, rad; ``uplift_rad`` the lift-off threshold, rad; ``sample_dt`` s): row ``r`` of
-    :class:`RunsOutput`'s ``max_abs_theta``, ``max_abs_theta_time``, ``residual_theta`` and
-    ``uplift_time`` (``peak``, ``peak_t``, ``residual``, ``uplift``) written.
-
-    Compiled on its own (not inlined) and given the arrays, not the :class:`RunsOutput`: numba
-    (0.68) dropped stores in a ``prange`` loop made through the tuple's fields
-    (``out.n_filled[r] = ...``) or by this function inlined there (the metrics stayed NaN)."""
-    nf = n_filled[r]
-    best = -1.0
-    for k in range(nf):
-        th = ang[r, k] - rest
-        if abs(th) > best:
-            best = abs(th)
-            peak_t[r] = k * sample_dt
-        if abs(th) > uplift_rad and np.isnan(uplift[r]):
-            uplift[r] = k * sample_dt
-    if nf > 0:
-        peak[r] = best
-        residual[r] = ang[r, nf - 1] - rest
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
@@ -119,61 +85,153 @@ def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, 
     """
     n_runs = starts.size - 1
     maxv = bodies.verts.shape[1]
+    nv = bodies.nverts[0]
     n_samples = settings.n_steps // settings.steps_per_sample + 1
-    out = new_runs_output(n_runs, n_samples)
-    status, t_stop, n_filled, overturn_t = out.status, out.t_stop, out.n_filled, out.overturn_time
-    pos, ang, angvel = out.pos, out.ang, out.angvel
-    peak, peak_t, residual, uplift = out.max_abs_theta, out.max_abs_theta_time, out.residual_theta, out.uplift_time
+    j = joints.base_joint[0]
+    rest = bodies.rest_ang[0]
+    status = np.zeros(n_runs, dtype=np.int64)
+    t_stop = np.zeros(n_runs)
+    n_filled = np.zeros(n_runs, dtype=np.int64)
+    overturn_t = np.zeros(n_runs)
+    pos = np.full((n_runs, n_samples, 2), np.nan)
+    ang = np.full((n_runs, n_samples), np.nan)
+    angvel = np.full((n_runs, n_samples), np.nan)
+    peak = np.full(n_runs, np.nan)
+    peak_t = np.full(n_runs, np.nan)
+    residual = np.full(n_runs, np.nan)
+    uplift = np.full(n_runs, np.nan)
     for r in numba.prange(n_runs):
         a, b = starts[r], starts[r + 1]
+        vpoint = np.empty((n_samples, 2))
+        ncont = np.empty(n_samples, dtype=np.int32)
+        slip = np.empty(n_samples, dtype=np.bool_)
+        states = np.zeros((n_samples if settings.record_corners else 1, maxv), dtype=np.int8)
         st, ts, nf, ot = run_body(
-            lone_body(bodies, joints, bodies.verts[0]),
-            settings,
+            bodies.verts[0],
+            nv,
+            bodies.mass[0],
+            bodies.inertia[0],
+            joints.kn[j],
+            joints.ks[j],
+            joints.cn[j],
+            joints.cs[j],
+            joints.tanphi[j],
+            rest,
+            bodies.stop_angle[0],
+            bodies.accel_points[0, 0],
+            bodies.accel_points[0, 1],
+            settings.g,
+            settings.dt,
+            settings.n_steps,
+            settings.steps_per_sample,
+            settings.mass_damping,
+            settings.stop_on_overturn,
+            settings.record_corners,
             mt[a:b],
             mah[a:b],
             mav[a:b],
-            start_of(initial),
-            np.zeros((1, maxv)),
+            initial.pos[0, 0],
+            initial.pos[0, 1],
+            initial.ang[0],
+            initial.vel[0, 0],
+            initial.vel[0, 1],
+            initial.angvel[0],
+            np.zeros(maxv),
             np.zeros(maxv, dtype=np.int8),
             pos[r],
             ang[r],
             angvel[r],
-            np.empty((n_samples, 2)),
-            np.empty(n_samples, dtype=np.int32),
-            np.empty(n_samples, dtype=np.bool_),
-            np.zeros((n_samples if settings.record_corners else 1, maxv), dtype=np.int8),
+            vpoint,
+            ncont,
+            slip,
+            states,
         )
         status[r], t_stop[r], n_filled[r], overturn_t[r] = st, ts, nf, ot
-        summarise(n_filled, ang, peak, peak_t, residual, uplift, r, bodies.rest_ang[0], uplift_rad, sample_dt)
-    return out
+        # the summary's metrics from this run's samples (theta = angle - rest angle)
+        best = -1.0
+        for k in range(nf):
+            th = ang[r, k] - rest
+            if abs(th) > best:
+                best = abs(th)
+                peak_t[r] = k * sample_dt
+            if abs(th) > uplift_rad and np.isnan(uplift[r]):
+                uplift[r] = k * sample_dt
+        if nf > 0:
+            peak[r] = best
+            residual[r] = ang[r, nf - 1] - rest
+    return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _segment(seg, i: int, h: int, mt, mah, mav) -> None:
+    """Slot ``i`` of ``seg`` takes the motion's interval from sample ``h`` to ``h`` + 1."""
+    seg[0, i] = mt[h]
+    seg[1, i] = mt[h + 1]
+    seg[2, i] = mah[h]
+    seg[3, i] = mah[h + 1]
+    seg[4, i] = mav[h]
+    seg[5, i] = mav[h + 1]
 
 
 @numba.njit(cache=True, nogil=True)
-def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out: RunsOutput) -> None:
+def step_runs(
+    lo: int,
+    hi: int,
+    verts,
+    nv: int,
+    mass: float,
+    inertia: float,
+    kn: float,
+    ks: float,
+    cn: float,
+    cs: float,
+    tanphi: float,
+    rest_ang: float,
+    stop_angle: float,
+    g: float,
+    dt: float,
+    n_steps: int,
+    sps: int,
+    mass_damping: float,
+    stop_on_overturn: bool,
+    mt,
+    mah,
+    mav,
+    starts,
+    x0: float,
+    y0: float,
+    ang0: float,
+    vx0: float,
+    vy0: float,
+    w0: float,
+    status,
+    t_stop,
+    n_filled,
+    overturn_t,
+    pos,
+    ang_s,
+    angvel_s,
+) -> None:
     """Step runs ``lo`` to ``hi`` - 1 together (module docstring): each step, the inner loop goes
     over the runs still going (their state held by field, one array each, by slot), each run's
-    step that of :func:`rockyade.kernel.single.run_body` (the one step of
-    :func:`rockyade.kernel.body_step.step_body` and :func:`~rockyade.kernel.body_step.end_step`, so
-    the same doubles; the samples' extras that the runs do not keep left out); a run that ends
-    drops out of the active set, which is compacted at once.
+    arithmetic that of :func:`rockyade.kernel.single.run_body` (operation for operation, so the
+    same doubles; the samples' extras that the runs do not keep left out); a run that ends drops
+    out of the active set, which is compacted at once.
 
     Parameters
     ----------
     lo, hi
         The runs stepped by this call.
-    one, settings
-        The body and its base joint (:class:`rockyade.kernel.body_step.OneBody`) and the
-        :class:`rockyade.kernel.state.Settings` (SI units).
+    verts, nv, mass, inertia, kn, ks, cn, cs, tanphi, rest_ang, stop_angle, g, dt, n_steps, sps, mass_damping,
+    stop_on_overturn
+        As :func:`rockyade.kernel.single.run_body` (SI units).
     mt, mah, mav, starts
         The runs' base motions one after the other (s, m/s^2, m/s^2) and where each starts.
-    start
-        The shared initial state (m, rad, m/s, rad/s): :func:`rockyade.kernel.single.start_of`.
-    out
-        :class:`RunsOutput`, rows ``lo`` to ``hi`` - 1 written.
+    x0, y0, ang0, vx0, vy0, w0
+        The shared initial state (m, rad, m/s, rad/s).
+    status, t_stop, n_filled, overturn_t, pos, ang_s, angvel_s
+        :class:`RunsOutput`'s arrays, rows ``lo`` to ``hi`` - 1 written.
     """
-    nv = one.nv
-    dt, n_steps, sps = settings.dt, settings.n_steps, settings.steps_per_sample
-    x0, y0, ang0, vx0, vy0, w0 = start
     n = hi - lo
     # the state of the runs still going, by slot (slot i holds run run_of[i])
     run_of = np.arange(lo, hi)
@@ -184,7 +242,6 @@ def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out:
     vy = np.full(n, vy0)
     w = np.full(n, w0)
     shear = np.zeros((n, nv))
-    no_states = np.zeros(1, dtype=np.int8)
     hint = np.zeros(n, dtype=np.int64)
     first = np.empty(n, dtype=np.int64)
     t_last = np.empty(n)
@@ -192,7 +249,7 @@ def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out:
     # each run's motion: its first and last sample, and the interval the time is in
     t_first = np.zeros(n)
     a_last = np.zeros((2, n))
-    seg = np.zeros((7, n))  # the interval (body_step.Interval), by field
+    seg = np.zeros((6, n))  # t, t', a_h, a_h', a_v, a_v' at the interval's ends
     for i in range(n):
         a, b = starts[lo + i], starts[lo + i + 1]
         first[i] = a
@@ -201,7 +258,7 @@ def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out:
             t_first[i] = mt[a]
             a_last[0, i] = mah[b - 1]
             a_last[1, i] = mav[b - 1]
-            _store(seg, i, motion_interval(mt, mah, mav, a))
+            _segment(seg, i, a, mt, mah, mav)
     done = np.zeros(n, dtype=np.bool_)
     n_act = n
     for step in range(n_steps + 1):
@@ -212,58 +269,80 @@ def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out:
         k = step // sps
         n_done = 0
         for i in range(n_act):
+            # the base acceleration (run_body's lookup, this run's motion)
+            ah = 0.0
+            av = 0.0
+            if t < t_last[i] and t >= t_first[i]:
+                if t >= seg[1, i]:  # the next interval (rare: a record's samples are many steps apart)
+                    a = first[i]
+                    h = hint[i]
+                    while t >= mt[a + h + 1]:
+                        h += 1
+                    hint[i] = h
+                    _segment(seg, i, a + h, mt, mah, mav)
+                u = fraction(t, seg[0, i], seg[1, i] - seg[0, i])
+                ah = lerp(u, seg[2, i], seg[3, i] - seg[2, i])
+                av = lerp(u, seg[4, i], seg[5, i] - seg[4, i])
+            elif t == t_last[i]:
+                ah = a_last[0, i]
+                av = a_last[1, i]
             xi, yi, angi, vxi, vyi, wi = x[i], y[i], ang[i], vx[i], vy[i], w[i]
-            interval = (seg[0, i], seg[1, i], seg[2, i], seg[3, i], seg[4, i], seg[5, i], seg[6, i])
-            _, _, vx_new, vy_new, w_new, _, _, h, interval, moved = step_body(
-                t,
-                mt,
-                mah,
-                mav,
-                first[i],
-                t_first[i],
-                t_last[i],
-                a_last[0, i],
-                a_last[1, i],
-                hint[i],
-                interval,
-                one,
-                settings.g,
-                dt,
-                settings.mass_damping,
-                xi,
-                yi,
-                angi,
-                vxi,
-                vyi,
-                wi,
-                shear,
-                i,
-                False,
-                no_states,
-                False,
-            )
-            if moved:
-                hint[i] = h
-                _store(seg, i, interval)
+            c = math.cos(angi)
+            s = math.sin(angi)
+            fx = -mass * ah
+            fy = -mass * (g + av)
+            tz = 0.0
+            for v in range(nv):
+                py = world_y(yi, c, s, verts[v, 0], verts[v, 1])
+                if -py < 0.0:
+                    if shear[i, v] != 0.0:
+                        shear[i, v] = 0.0
+                    continue
+                px = world_x(xi, c, s, verts[v, 0], verts[v, 1])
+                cfx, cfy, ctz, _fn, _spring, s_new, _visc, _state, _slip = base_point(
+                    px, py, xi, yi, vxi, vyi, wi, shear[i, v], kn, ks, cn, cs, tanphi, dt
+                )
+                shear[i, v] = s_new
+                fx += cfx
+                fy += cfy
+                tz += ctz
+            # kick
+            w_prev = wi
+            if mass_damping > 0.0:
+                fdx, fdy, tdz = damping(mass, inertia, mass_damping, vxi, vyi, wi)
+                fx += fdx
+                fy += fdy
+                tz += tdz
+            vxi = kicked(vxi, fx, mass, dt)
+            vyi = kicked(vyi, fy, mass, dt)
+            wi = kicked(wi, tz, inertia, dt)
             if sampling:
                 r = run_of[i]
-                out.pos[r, k, 0] = xi
-                out.pos[r, k, 1] = yi
-                out.ang[r, k] = angi
-                out.angvel[r, k] = 0.5 * (w_new + wi)
-                out.n_filled[r] = k + 1
+                pos[r, k, 0] = xi
+                pos[r, k, 1] = yi
+                ang_s[r, k] = angi
+                angvel_s[r, k] = 0.5 * (wi + w_prev)
+                n_filled[r] = k + 1
             if step == n_steps:
                 done[i] = True
                 n_done += 1
                 continue
-            xi, yi, angi, st, ot_i = end_step(
-                step, xi, yi, angi, vx_new, vy_new, w_new, dt, one, settings.stop_on_overturn, ot[i]
-            )
-            x[i], y[i], ang[i], vx[i], vy[i], w[i], ot[i] = xi, yi, angi, vx_new, vy_new, w_new, ot_i
+            # drift, then the blow-up and overturn checks
+            xi = drifted(xi, vxi, dt)
+            yi = drifted(yi, vyi, dt)
+            angi = drifted(angi, wi, dt)
+            x[i], y[i], ang[i], vx[i], vy[i], w[i] = xi, yi, angi, vxi, vyi, wi
+            st = STATUS_COMPLETED
+            if blown_up(vxi, vyi, wi):
+                st = STATUS_FAILED
+            elif beyond_stop_angle(angi, rest_ang, stop_angle) and math.isnan(ot[i]):
+                ot[i] = (step + 1) * dt
+                if stop_on_overturn:
+                    st = STATUS_OVERTURNED
             if st != STATUS_COMPLETED:
                 r = run_of[i]
-                out.status[r] = st
-                out.t_stop[r] = (step + 1) * dt
+                status[r] = st
+                t_stop[r] = (step + 1) * dt
                 done[i] = True
                 n_done += 1
         if n_done:
@@ -271,27 +350,20 @@ def step_runs(lo: int, hi: int, one, settings, mt, mah, mav, starts, start, out:
             keep = 0
             for i in range(n_act):
                 if done[i]:
-                    out.overturn_time[run_of[i]] = ot[i]
+                    overturn_t[run_of[i]] = ot[i]
                     continue
                 if keep != i:
                     run_of[keep], x[keep], y[keep], ang[keep] = run_of[i], x[i], y[i], ang[i]
                     vx[keep], vy[keep], w[keep], hint[keep] = vx[i], vy[i], w[i], hint[i]
                     first[keep], t_first[keep], t_last[keep], ot[keep] = first[i], t_first[i], t_last[i], ot[i]
                     a_last[0, keep], a_last[1, keep] = a_last[0, i], a_last[1, i]
-                    for f in range(7):
+                    for f in range(6):
                         seg[f, keep] = seg[f, i]
                     for v in range(nv):
                         shear[keep, v] = shear[i, v]
                 done[keep] = False
                 keep += 1
             n_act = keep
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _store(seg, i: int, interval) -> None:
-    """Slot ``i`` of ``seg`` takes an interval (:data:`rockyade.kernel.body_step.Interval`)."""
-    for f in range(7):
-        seg[f, i] = interval[f]
 
 
 #: Runs stepped together by one call of :func:`step_runs` at most (a chunk: their state stays
@@ -303,23 +375,98 @@ CHUNK_RUNS = 16
 def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
     """Run R motions on one body, stepped together (module docstring): the runs are cut into
     chunks of at most :data:`CHUNK_RUNS` runs, in parallel over numba's threads, and each chunk is stepped by
-    :func:`step_runs`; the same results, bit for bit, as :func:`simulate_runs_each`, which
-    takes the same arguments (``record_corners`` off here) and returns the same
-    :class:`RunsOutput`."""
+    :func:`step_runs`; the same results, bit for bit, as :func:`simulate_runs_each`.
+
+    Parameters
+    ----------
+    bodies, joints, settings, initial
+        The records of :func:`rockyade.kernel.state.pack` for the shared structure (one
+        moving body, ``record_energy`` and ``record_corners`` off).
+    mt, mah, mav
+        The runs' base motions one after the other: s, m/s^2, m/s^2.
+    starts
+        (R + 1,) where each run's motion starts in them (the last: their length).
+    uplift_rad
+        |theta| above which the block has lifted off, rad.
+    sample_dt
+        Time between samples, s.
+
+    Returns
+    -------
+    RunsOutput
+    """
     n_runs = starts.size - 1
     nv = bodies.nverts[0]
     n_samples = settings.n_steps // settings.steps_per_sample + 1
-    out = new_runs_output(n_runs, n_samples)
-    # the polygon's vertices, contiguous: stepped by every run of a chunk
-    verts = np.ascontiguousarray(bodies.verts[0, :nv])
+    j = joints.base_joint[0]
+    rest = bodies.rest_ang[0]
+    status = np.full(n_runs, STATUS_COMPLETED, dtype=np.int64)
+    t_stop = np.full(n_runs, -1.0)
+    n_filled = np.zeros(n_runs, dtype=np.int64)
+    overturn_t = np.full(n_runs, np.nan)
+    pos = np.full((n_runs, n_samples, 2), np.nan)
+    ang = np.full((n_runs, n_samples), np.nan)
+    angvel = np.full((n_runs, n_samples), np.nan)
+    peak = np.full(n_runs, np.nan)
+    peak_t = np.full(n_runs, np.nan)
+    residual = np.full(n_runs, np.nan)
+    uplift = np.full(n_runs, np.nan)
     n_chunks = (n_runs + CHUNK_RUNS - 1) // CHUNK_RUNS
+    verts = np.ascontiguousarray(bodies.verts[0, :nv])
     for c in numba.prange(n_chunks):
         lo = c * n_runs // n_chunks
         hi = (c + 1) * n_runs // n_chunks
         if hi > lo:
-            step_runs(lo, hi, lone_body(bodies, joints, verts), settings, mt, mah, mav, starts, start_of(initial), out)
-    n_filled, ang = out.n_filled, out.ang
-    peak, peak_t, residual, uplift = out.max_abs_theta, out.max_abs_theta_time, out.residual_theta, out.uplift_time
+            step_runs(
+                lo,
+                hi,
+                verts,
+                nv,
+                bodies.mass[0],
+                bodies.inertia[0],
+                joints.kn[j],
+                joints.ks[j],
+                joints.cn[j],
+                joints.cs[j],
+                joints.tanphi[j],
+                rest,
+                bodies.stop_angle[0],
+                settings.g,
+                settings.dt,
+                settings.n_steps,
+                settings.steps_per_sample,
+                settings.mass_damping,
+                settings.stop_on_overturn,
+                mt,
+                mah,
+                mav,
+                starts,
+                initial.pos[0, 0],
+                initial.pos[0, 1],
+                initial.ang[0],
+                initial.vel[0, 0],
+                initial.vel[0, 1],
+                initial.angvel[0],
+                status,
+                t_stop,
+                n_filled,
+                overturn_t,
+                pos,
+                ang,
+                angvel,
+            )
     for r in numba.prange(n_runs):
-        summarise(n_filled, ang, peak, peak_t, residual, uplift, r, bodies.rest_ang[0], uplift_rad, sample_dt)
-    return out
+        # the summary's metrics from this run's samples (theta = angle - rest angle)
+        nf = n_filled[r]
+        best = -1.0
+        for k in range(nf):
+            th = ang[r, k] - rest
+            if abs(th) > best:
+                best = abs(th)
+                peak_t[r] = k * sample_dt
+            if abs(th) > uplift_rad and np.isnan(uplift[r]):
+                uplift[r] = k * sample_dt
+        if nf > 0:
+            peak[r] = best
+            residual[r] = ang[r, nf - 1] - rest
+    return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)
