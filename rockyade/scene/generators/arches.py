@@ -179,10 +179,5 @@ def arch(
     for k, quad in enumerate(voussoir_quads(span, depth, n, offset, num(ph)), start=1):
         verts, position, rotation = frame_of(quad)
         blocks.append(polygon_block(f"v{k:0{width_n}d}", verts, position, rotation, t, density))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else udec_contact(depth, density),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    contact_table = contact if contact is not None else udec_contact(depth, density)
+    return scene_table(blocks, contact=contact_table, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)

@@ -28,7 +28,6 @@ from rockyade.scene.generators.scene_tables import (
     digits,
     exact,
     num,
-    paper_contact,
     rect_block,
     scene_table,
 )
@@ -152,13 +151,7 @@ def stack(
     for i in range(n):
         blocks.append(_block(f"b{i + 1:0{width_n}d}", widths[i], tops[i], heights[i], y, thickness, density, layout))
         y += heights[i]
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 def round_drum_mass_inertia(diameter_m: float, height_m: float, density_kg_m3: float) -> tuple[float, float]:
@@ -245,13 +238,7 @@ def column(
     if capital_width_m is not None and capital_height_m is not None:
         cw, ch = exact(capital_width_m), exact(capital_height_m)
         blocks.append(_block("capital", cw, cw, ch, n * h, t, density, layout))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 #: The former name of :func:`column` (kept: scripts call it).

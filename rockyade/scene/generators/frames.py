@@ -27,7 +27,6 @@ from rockyade.scene.generators.scene_tables import (
     check_density,
     exact,
     num,
-    paper_contact,
     rect_block,
     scene_table,
 )
@@ -114,13 +113,7 @@ def frame(
         rect_block("column_right", bw, bh, half, Fraction(0), t, density),
         rect_block("beam", beam_length, beam_h, Fraction(0), bh, t, beam_density),
     ]
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 #: The former name of :func:`frame` (kept: scripts call it).

@@ -273,13 +273,15 @@ def default_duration_s(motion: Mapping[str, Any] | None, base_dir: str | Path | 
 def scene_table(
     blocks: list[dict[str, Any]],
     *,
-    contact: Mapping[str, Any],
+    contact: Mapping[str, Any] | None,
     motion: Mapping[str, Any] | None,
     duration_s: float | None,
     sample_dt_s: float,
     joints: list[dict[str, Any]] | None = None,
 ) -> dict[str, Any]:
     """The scene dictionary (keys in the order a reader expects them in the file).
+
+    ``contact`` None: the paper's calibration (:func:`paper_contact`).
 
     ``duration_s`` None: :func:`default_duration_s` of the motion (a record's length plus a
     tail of free rocking, relative paths from the current folder).
@@ -292,7 +294,7 @@ def scene_table(
     data: dict[str, Any] = {
         "duration_s": float(duration_s),
         "sample_dt_s": float(sample_dt_s),
-        "contact": dict(contact),
+        "contact": dict(contact if contact is not None else paper_contact()),
         "motion": dict(motion if motion is not None else DEFAULT_PULSE),
         "blocks": blocks,
     }

@@ -58,7 +58,6 @@ from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.overburden import add_overburden
 from rockyade.scene.generators.scene_tables import (
     exact,
-    paper_contact,
     rect_block,
     scene_table,
 )
@@ -183,7 +182,7 @@ def wall_section(
         ]
     data = scene_table(
         [*blocks, *fixed],
-        contact=contact if contact is not None else paper_contact(),
+        contact=contact,
         motion=motion,
         duration_s=duration_s,
         sample_dt_s=sample_dt_s,

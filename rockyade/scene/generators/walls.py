@@ -277,10 +277,5 @@ def wall(
             blocks.append(rect_block(name, x1 - x0, y1 - y0, (x0 + x1) / 2, y0, thickness, density))
     for k, (x0, x1, y0, y1) in lintels:
         blocks.append(rect_block(f"lintel{k + 1}", x1 - x0, y1 - y0, (x0 + x1) / 2, y0, thickness, density))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else udec_contact(float(height), density),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    contact_table = contact if contact is not None else udec_contact(float(height), density)
+    return scene_table(blocks, contact=contact_table, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
