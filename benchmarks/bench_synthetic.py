@@ -6,7 +6,8 @@ import os
 import tempfile
 import time
 
-from rockyade.motion.synthetic import compatibility_report, generate_suite, paper_suite
+from rockyade.motion.suite_cache import generate_suite
+from rockyade.motion.synthetic import compatibility_report, paper_suite
 
 
 def main() -> None:

@@ -165,7 +165,7 @@ def overhead_target(repeat: int) -> None:
         nonlocal n
         n += 1
         tasks = fragility_study.tasks(
-            out / f"o{n}", specimens=("2",), records=range(1, 11), load_factors=(0.3,), solvers=("reference",)
+            specimens=("2",), records=range(1, 11), load_factors=(0.3,), solvers=("reference",)
         )
         return tasks, output(out / f"o{n}")
 
@@ -211,7 +211,7 @@ def batch_target() -> None:
     figures, per_cpu, verdicts = {}, {}, {}
     for name, workers, grouped in (("per-run", 1, False), ("grouped", 1, True), ("grouped", 2, True)):
         folder = out / f"{name}{workers}"
-        tasks = fragility_study.tasks(folder, load_factors=(0.2, 0.4, 0.6, 0.8), solvers=("reference",))
+        tasks = fragility_study.tasks(load_factors=(0.2, 0.4, 0.6, 0.8), solvers=("reference",))
         start, cpu = time.perf_counter(), cpu_now()
         summary = run_study_tasks(tasks, folder, workers=workers, progress=False, group_runs=grouped)
         wall, cpu = time.perf_counter() - start, cpu_now() - cpu

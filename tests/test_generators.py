@@ -503,7 +503,7 @@ def test_build_writes_scenes_that_load_from_another_folder(tmp_path, monkeypatch
         (["frame", "--motion", "free"], "--free-block: is required"),
         (["frame", "--motion", "record", "--record", "nowhere.at2"], "--record: file not found"),
         (["stack", "--blocks", "3"], "--blocks: a linear taper needs"),
-        (["wall", "--contact", "udec", "--jkn-pa-per-m", "0"], "--jkn-pa-per-m: must be > 0"),
+        (["wall", "--contact", "udec", "--jkn-pa-per-m", "0"], "--jkn-pa-per-m: must be in [1, 1e+15] Pa/m, got 0"),
         # a wall its default joints cannot carry: run would refuse it, so build does, before writing
         (["wall", "--courses", "12", "--jkn-pa-per-m", "1e9"], "--jkn-pa-per-m: K = "),
     ],

@@ -20,13 +20,13 @@ from rockyade.motion.ec8 import ElasticSpectrum, damping_correction
 from rockyade.motion.processing import bandpass, baseline_correct, integrate, scale_to_pga
 from rockyade.motion.records import RecordError, read_at2, read_record, read_single_column, read_two_column
 from rockyade.motion.spectra import response_spectrum
+from rockyade.motion.suite_cache import suite_record
 from rockyade.motion.synthetic import (
     Envelope,
     SuiteSpec,
     compatibility_report,
     generate_record,
     paper_suite,
-    suite_record,
 )
 from rockyade.scene import scene_from_dict
 

@@ -18,16 +18,14 @@ import pytest
 
 from rockyade.motion.ec8 import ElasticSpectrum
 from rockyade.motion.record_text import MAX_ABS_ACCEL_M_S2
-from rockyade.motion.synthetic import (
+from rockyade.motion.suite_cache import (
     CacheDamagedError,
-    Envelope,
-    SuiteSpec,
     _digest,
     cache_path,
-    generate_record,
     load_cached_record,
     suite_record,
 )
+from rockyade.motion.synthetic import Envelope, SuiteSpec, generate_record
 
 #: A quick suite: 2.5 s records, two spectral corrections at most.
 SPEC = SuiteSpec(
@@ -141,9 +139,9 @@ def test_a_symlink_in_place_of_the_file_is_replaced_not_followed(cache, generate
 
 @pytest.mark.parametrize("which", ["suite folder", "cache root"])
 def test_a_cache_folder_that_is_a_file_gives_the_record_and_one_warning(cache, generated, which, monkeypatch, capsys):
-    from rockyade.motion import synthetic
+    from rockyade.motion import suite_cache
 
-    monkeypatch.setattr(synthetic, "_WARNED", set())
+    monkeypatch.setattr(suite_cache, "_WARNED", set())
     blocked = cache.parent if which == "suite folder" else cache.parent.parent.parent
     shutil.rmtree(blocked)
     blocked.write_text("a file where a folder should be")
@@ -159,11 +157,11 @@ def test_a_folder_in_place_of_a_cache_file_is_named_and_the_record_generated(cac
     """A folder where a record's cache file should be: the record is generated, one note
     names the file (it used to end with 'rockyade: error: 14: Is a directory', naming a file
     descriptor), one warning says the cache cannot be written there, whatever the reads."""
-    from rockyade.motion import synthetic
+    from rockyade.motion import suite_cache
 
-    monkeypatch.setattr(synthetic, "_WARNED", set())
-    monkeypatch.setattr(synthetic, "_NOTED", set())
-    monkeypatch.setattr(synthetic, "_HELD", type(synthetic._HELD)())
+    monkeypatch.setattr(suite_cache, "_WARNED", set())
+    monkeypatch.setattr(suite_cache, "_NOTED", set())
+    monkeypatch.setattr(suite_cache, "_HELD", type(suite_cache._HELD)())
     cache.unlink()
     cache.mkdir()
     for _ in range(3):
@@ -181,7 +179,7 @@ def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated)
     folder.mkdir()
     code = textwrap.dedent(
         """
-        from rockyade.motion.synthetic import suite_record
+        from rockyade.motion.suite_cache import suite_record
         from tests.test_robust_cache import SPEC
         print(repr(float(suite_record(SPEC, 1).accel_m_s2.sum())))
         """
@@ -215,7 +213,7 @@ def test_two_processes_regenerating_at_once_both_get_the_record(cache, generated
     cache.write_bytes(b"")  # damaged: both processes regenerate it and rename a file into place
     code = textwrap.dedent(
         """
-        from rockyade.motion.synthetic import suite_record
+        from rockyade.motion.suite_cache import suite_record
         from tests.test_robust_cache import SPEC
         print(suite_record(SPEC, 1).accel_m_s2.tobytes().hex()[:64])
         """

@@ -140,3 +140,22 @@ def test_stale_temporaries_are_removed_without_following_links(tmp_path):
     removed = atomic.remove_stale_temporaries(tmp_path)
     assert sorted(p.name for p in removed) == [".old.csv.def.tmp", ".r.csv.abc.tmp"]
     assert victim.read_text() == "precious\n" and (tmp_path / ".dir.tmp").is_dir()
+
+
+def test_a_path_for_a_writer_that_opens_the_file_itself_is_renamed_only_when_complete(tmp_path):
+    """atomic_path (the animations' writers open the file and take its format from the suffix):
+    the temporary file ends in the destination's suffix and is renamed onto it when the block
+    ends; a failed writer leaves the previous file and no temporary; a stale one is cleared."""
+    dest = tmp_path / "run.gif"
+    dest.write_text("previous")
+    with atomic.atomic_path(dest) as tmp:
+        assert tmp.parent == tmp_path and tmp.name.startswith(".run.gif.") and tmp.suffix == ".gif"
+        assert not tmp.is_symlink() and tmp.read_bytes() == b""
+        tmp.write_text("new")
+    assert dest.read_text() == "new" and not tmp.exists()
+    with pytest.raises(RuntimeError), atomic.atomic_path(dest) as tmp:
+        tmp.write_text("half")
+        raise RuntimeError("the writer failed")
+    assert dest.read_text() == "new" and not tmp.exists()
+    (tmp_path / ".run.gif.abc.tmp.gif").write_text("killed")
+    assert [p.name for p in atomic.remove_stale_temporaries(tmp_path)] == [".run.gif.abc.tmp.gif"]

@@ -34,7 +34,8 @@ from rockyade.motion.record_text import Record, normalise_units
 from rockyade.motion.records import read_record
 from rockyade.motion.selection_set import is_selection, read_selection
 from rockyade.motion.spec import MotionSpec
-from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
+from rockyade.motion.suite_cache import suite_record
+from rockyade.motion.synthetic import SuiteSpec, paper_suite
 from rockyade.motion.types import RecordMotion, SyntheticMotion
 
 #: File names a records folder is read for (case-insensitive suffixes).

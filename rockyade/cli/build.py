@@ -3,44 +3,27 @@
 Also the snapshot and animation options that ``rockyade run`` shares with ``draw``
 (:func:`add_snapshot_options`, :func:`write_run_drawings`).
 
-Option defaults are written here as literals (importing the generators would load numpy
-and slow down ``rockyade --help``); tests check that they equal the Python defaults.
+The options of ``build KIND`` are made from the generators' table of parameters
+(:mod:`rockyade.scene.generator_options`: name, unit, default, range, help; numpy-free, so that
+``rockyade --help`` stays quick), and every number given is checked against its range there
+before anything is built.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import os
 import re
 import shlex
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from rockyade.cli.common import check_output_file
 from rockyade.cli.drawings import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import ALIASES, COMMON, COMMON_PARAMS, KINDS, OVERBURDEN, Param, options
 
-
-@dataclass(frozen=True)
-class Opt:
-    """One generator option: flag (``--unit-length-m``), default, help; ``dest`` is the
-    generator's parameter name."""
-
-    flag: str
-    default: Any
-    help: str
-    type: Any = float
-    choices: tuple[str, ...] | None = None
-    metavar: str | None = None
-    append: bool = False
-    aliases: tuple[str, ...] = ()
-
-    @property
-    def dest(self) -> str:
-        """The argparse destination of the option (its name without dashes, '-' as '_')."""
-        return self.flag[2:].replace("-", "_")
+__all__ = ["COMMON", "COMMON_PARAMS", "KINDS", "OVERBURDEN", "add_snapshot_options", "register", "write_run_drawings"]
 
 
 def _floats(text: str) -> list[float]:
@@ -54,303 +37,17 @@ def _floats(text: str) -> list[float]:
     return values
 
 
-#: Column-like kinds (column, stack) write an assembly or a column scene.
-LAYOUT_OPT = Opt(
-    "--layout",
-    "positioned",
-    "positioned: an assembly; column: a column scene (no positions)",
-    str,
-    ("positioned", "column"),
-)
-
-KINDS: dict[str, tuple[str, list[Opt]]] = {
-    "wall": (
-        "a dry masonry wall in running or stack bond, with openings (in-plane section)",
-        [
-            Opt("--courses", 5, "number of courses", int),
-            Opt("--units-per-course", 6, "whole units per course", int),
-            Opt("--unit-length-m", 0.4, "unit length along the wall, m"),
-            Opt("--unit-height-m", 0.2, "unit height, m"),
-            Opt("--unit-thickness-m", 0.2, "unit thickness out of plane, m"),
-            Opt(
-                "--bond", "running", "running: half units at both ends of courses 2, 4, ...", str, ("running", "stack")
-            ),
-            Opt(
-                "--opening",
-                None,
-                "an opening X,Y,WIDTH,HEIGHT in m (x from the wall's left end, y from the base); repeat for several",
-                _floats,
-                metavar="X,Y,W,H",
-                append=True,
-            ),
-            Opt("--lintel", "block", "a lintel block over each opening, or none", str, ("block", "none")),
-            Opt("--lintel-height-m", None, "lintel height, m (default: one unit height)"),
-            Opt("--lintel-bearing-m", None, "lintel bearing each side of the opening, m (default: half a unit)"),
-            Opt(
-                "--min-piece-m",
-                None,
-                "cut pieces smaller than this are left out, m (default: a quarter of the smaller unit dimension)",
-            ),
-        ],
-    ),
-    "column": (
-        "a column of equal drums (round by default), optionally with a capital (abacus) block on top",
-        [
-            Opt("--drums", 8, "number of drums", int),
-            Opt("--diameter-m", 0.3, "drum width in the plane of rocking, m"),
-            Opt("--drum-height-m", 0.5, "height of each drum, m"),
-            Opt("--thickness-m", None, "out-of-plane thickness, m (default: the diameter)"),
-            Opt("--capital-width-m", None, "width of a capital block on top, m (with --capital-height-m)"),
-            Opt("--capital-height-m", None, "height of the capital block, m"),
-            Opt(
-                "--section",
-                "round",
-                "round: cylinders (mass rho pi D^2/4 h and inertia m (3 r^2 + h^2)/12 written per drum); "
-                "square: prisms D x thickness",
-                str,
-                ("round", "square"),
-            ),
-            LAYOUT_OPT,
-        ],
-    ),
-    "arch": (
-        "a semicircular or pointed arch of n voussoirs on two piers",
-        [
-            Opt("--span-m", 2.0, "clear span between the springings, m"),
-            Opt("--ring-depth-m", 0.3, "ring depth (extrados minus intrados radius), m"),
-            Opt("--thickness-m", 0.5, "out-of-plane thickness, m"),
-            Opt("--voussoirs", 11, "number of voussoirs (2-201)", int),
-            Opt("--shape", "semicircular", "arch shape", str, ("semicircular", "pointed")),
-            Opt(
-                "--centre-offset-m",
-                None,
-                "pointed arch: distance of each half's centre from the midspan, m "
-                "(default: span/2, the equilateral arch)",
-            ),
-            Opt("--pier-width-m", 0.6, "pier width, m"),
-            Opt("--pier-height-m", 1.0, "pier height, m (0: the arch springs from the base)"),
-            Opt("--piers", "blocks", "blocks (free) or fixed abutments", str, ("blocks", "fixed")),
-        ],
-    ),
-    "frame": (
-        "the rocking frame of Makris & Vassiliou (2013): two free columns and a free cap beam",
-        [
-            Opt("--column-width-m", 0.25, "column width 2b, m"),
-            Opt("--column-height-m", 1.5, "column height 2h, m"),
-            Opt("--span-m", 1.5, "distance between the column axes, m"),
-            Opt("--beam-height-m", 0.25, "beam depth, m"),
-            Opt("--beam-overhang-m", 0.0, "beam length past each column's outer face, m"),
-            Opt("--thickness-m", 0.25, "out-of-plane thickness, m"),
-            Opt("--beam-density-kg-m3", None, "beam density, kg/m^3 (default: --density-kg-m3)"),
-            Opt("--gamma", None, "instead of a beam density: beam mass / both columns' mass"),
-        ],
-    ),
-    "stack": (
-        "a stack of blocks of given sizes (a tapered column)",
-        [
-            Opt(
-                "--widths-m",
-                None,
-                "widths bottom to top, m, comma-separated (or --blocks with "
-                "--bottom-width-m and --top-width-m; default 0.4,0.35,0.3,0.25)",
-                _floats,
-                metavar="W1,W2,...",
-            ),
-            Opt(
-                "--heights-m",
-                [0.6],
-                "heights bottom to top, m, comma-separated, or one for all",
-                _floats,
-                metavar="H1,H2,...",
-            ),
-            Opt("--blocks", None, "number of blocks of a linear taper", int),
-            Opt("--bottom-width-m", None, "width at the bottom of a linear taper, m"),
-            Opt("--top-width-m", None, "width at the top of a linear taper, m"),
-            Opt("--thickness-m", 0.4, "out-of-plane thickness, m"),
-            Opt(
-                "--taper",
-                "steps",
-                "steps: rectangles; continuous: trapezoids with straight sides",
-                str,
-                ("steps", "continuous"),
-            ),
-            LAYOUT_OPT,
-        ],
-    ),
-    "wall-section": (
-        "a wall's section out of its plane: height, thickness (through the section) and length (along the wall), "
-        "courses, a top free, restrained beside one face or both or under a floor, with or without a gap, "
-        "an overburden",
-        [
-            Opt("--height-m", 3.0, "the wall's height, m"),
-            Opt("--thickness-m", 0.3, "the wall's thickness, through the section (the scene's width_m), m"),
-            Opt("--length-m", 1.0, "the wall's length along its plane (the blocks' thickness_m), m"),
-            Opt("--courses", 1, "courses (1: one block), equal unless --split", int),
-            Opt(
-                "--split",
-                None,
-                "2 courses: height of the joint between them / the wall's height, in (0, 1) "
-                "(the two-block wall of the paper's Fig. 2c; default: equal courses)",
-            ),
-            Opt(
-                "--top",
-                "free",
-                "free; restrained (a fixed block beside each face, with a gap > 0); restrained-far or "
-                "restrained-near (one face, x > 0 or x < 0; a zero gap gives the three-hinge mechanism); floor (a "
-                "fixed slab over the top, the gap above it)",
-                str,
-                ("free", "restrained", "restrained-far", "restrained-near", "floor"),
-            ),
-            Opt(
-                "--gap-m",
-                0.0,
-                "restrained, floor: gap between the wall and its restraint (one the wall cannot close "
-                "before it overturns is refused), m",
-            ),
-            Opt("--restraint-height-m", 0.3, "restrained, floor: depth of the restraints (the slab), m"),
-            Opt(
-                "--restraint-width-m",
-                0.3,
-                "restrained, floor: width of the restraints (the slab's reach past the far face), m",
-            ),
-            Opt(
-                "--restraint-friction-deg",
-                0.0,
-                "restrained, floor: friction of the wall-restraint joints, deg (0: none)",
-            ),
-            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
-            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
-        ],
-    ),
-    "restrained-wall": (
-        "a wall restrained at its top (out-of-plane section, the paper's Fig. 2; an alias of wall-section)",
-        [
-            Opt("--wall-height-m", 3.0, "wall height, m (or --height-m, as wall-section)", aliases=("--height-m",)),
-            Opt(
-                "--wall-thickness-m",
-                0.3,
-                "wall thickness (the section's width), m (or --thickness-m)",
-                aliases=("--thickness-m",),
-            ),
-            Opt(
-                "--wall-length-m",
-                1.0,
-                "wall length along its plane (the blocks' out-of-plane thickness), m (or --length-m)",
-                aliases=("--length-m",),
-            ),
-            Opt("--blocks", 2, "1 or 2 wall blocks", int),
-            Opt("--split", 0.5, "two blocks: lower block height / wall height"),
-            Opt(
-                "--restraint",
-                "side",
-                "side: a fixed block against the far face at the top; floor: a fixed slab on the wall's top",
-                str,
-                ("side", "floor"),
-            ),
-            Opt("--restraint-width-m", 0.3, "restraint width (floor: reach past the far face), m"),
-            Opt("--restraint-height-m", 0.3, "restraint height (floor: slab depth), m"),
-            Opt("--gap-m", 0.0, "gap between the wall and the restraint, m"),
-            Opt(
-                "--restraint-friction-deg",
-                0.0,
-                "friction angle of the wall-restraint joint, deg (default 0: a frictionless restraint, which the "
-                "three-hinge mechanism of Fig. 2 needs, as wall-section's)",
-            ),
-        ],
-    ),
-}
-
-#: Kinds that are aliases of another, with how their options map onto it (said in their --help).
-ALIASES = {
-    "restrained-wall": "It is an alias of `rockyade build wall-section` under its former option names: "
-    "--wall-height-m, --wall-thickness-m, --wall-length-m are --height-m, --thickness-m, --length-m; --blocks "
-    "(1 or 2) is --courses; --split is --split; --restraint side is --top restrained-far, --restraint floor is "
-    "--top floor; the other options are the same, with the same defaults. The blocks carry wall-section's names "
-    "(w01, w02; restraint_far or floor).",
-}
-
-#: Options every kind takes (density, time, motion, contact); not generator parameters
-#: except density, duration and sample interval.
-COMMON: list[Opt] = [
-    Opt("--density-kg-m3", 2400.0, "density of the blocks, kg/m^3"),
-    Opt(
-        "--duration-s",
-        None,
-        "simulated time, s (default: with --motion record, the record's length plus 5 s of free rocking; else 3)",
-    ),
-    Opt("--sample-dt-s", 0.002, "output sampling interval, s"),
-    Opt(
-        "--motion",
-        "pulse",
-        "base motion: a pulse, a record file, free rocking of one block, rest (a drop test), gravity-ramp "
-        "(the static check) or pushover (towards +x, lambda rising at 0.05 g/s)",
-        str,
-        ("pulse", "record", "free", "rest", "gravity-ramp", "pushover"),
-    ),
-    Opt("--pulse-shape", "sine", "pulse shape", str, ("sine", "cosine", "ricker")),
-    Opt("--amplitude-g", 0.3, "pulse amplitude, g"),
-    Opt("--period-s", 0.5, "pulse period, s"),
-    Opt("--cycles", 1, "pulse cycles", int),
-    Opt(
-        "--record",
-        None,
-        "record file (AT2, CSV or one column) for --motion record; written relative to the scene file",
-        str,
-        metavar="FILE",
-    ),
-    Opt("--load-factor", 1.0, "multiplies the record's accelerations as read (its samples as in the file)"),
-    Opt("--theta0-rad", 0.05, "free rocking: initial tilt, rad"),
-    Opt("--free-block", None, "free rocking: the block tilted (with what rests on it)", str, metavar="NAME"),
-    Opt(
-        "--contact",
-        "auto",
-        "joints: auto (udec for walls and arches, paper otherwise), paper or matched "
-        "(the paper's calibration, slender blocks), udec (stiffness per unit area)",
-        str,
-        ("auto", "paper", "matched", "udec"),
-    ),
-    Opt("--jkn-pa-per-m", 1.0e10, "udec: normal (and shear) joint stiffness per unit area, Pa/m"),
-    Opt("--damping-ratio", 0.05, "udec: fraction of critical damping of a unit on its bed joint (sets beta_s)"),
-    Opt("--friction-angle-deg", 30.0, "joint friction angle, deg"),
-]
-
-#: Overburden options by kind (not generator parameters: :func:`rockyade.scene.generators.overburden.
-#: add_overburden` adds them as [[loads]] to the generated scene): kind -> (overburden kind, options).
-OVERBURDEN: dict[str, tuple[str, list[Opt]]] = {
-    "wall": ("line", [Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top course, N/m")]),
-    "restrained-wall": (
-        "section",
-        [
-            Opt("--overburden-n-per-m", 0.0, "vertical load per metre of wall on its top, N/m"),
-            Opt("--overburden-eccentricity-m", 0.0, "its distance from the wall's axis, m (> 0 towards +x)"),
-        ],
-    ),
-    "column": (
-        "point",
-        [
-            Opt("--top-load-n", 0.0, "vertical load on the top block, N"),
-            Opt("--top-load-eccentricity-m", 0.0, "its distance from the top block's axis, m (> 0 towards +x)"),
-        ],
-    ),
-}
-OVERBURDEN["stack"] = OVERBURDEN["column"]
-
-#: Generator parameters among the common options.
-COMMON_PARAMS = ("density_kg_m3", "duration_s", "sample_dt_s")
 UDEC_KINDS = ("wall", "arch")
+#: Placeholders of options by unit (others: N for counts, X for numbers).
+UNIT_METAVARS = {"kg/m^3": "KG/M3", "Pa/m": "PA/M", "N/m": "N/M", "N": "NEWTONS"}
 
 
-#: Short metavars from the unit at the end of an option's name.
-UNIT_METAVARS = {"-m": "M", "-s": "S", "-kg-m3": "KG/M3", "-pa-per-m": "PA/M", "-deg": "DEG", "-rad": "RAD"}
-
-
-def _metavar(opt: Opt) -> str | None:
-    if opt.metavar or opt.choices:
-        return opt.metavar
-    for suffix, metavar in sorted(UNIT_METAVARS.items(), key=lambda item: -len(item[0])):
-        if opt.flag.endswith(suffix):
-            return metavar
-    return "N" if opt.type is int else "X"
+def _metavar(p: Param) -> str | None:
+    if p.metavar or p.choices or p.range is None:
+        return p.metavar
+    if p.integer:
+        return "N"
+    return UNIT_METAVARS.get(p.unit, p.unit.upper() or "X")
 
 
 class _DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -366,13 +63,28 @@ class _DefaultsFormatter(argparse.ArgumentDefaultsHelpFormatter):
         return super()._get_help_string(action) or ""
 
 
-def _add(parser: argparse.ArgumentParser | Any, opt: Opt) -> None:
-    kwargs: dict[str, Any] = {"default": opt.default, "help": opt.help, "dest": opt.dest, "metavar": _metavar(opt)}
-    if opt.append:
-        kwargs.update(action="append", type=opt.type)
+def _integer(p: Param) -> Any:
+    """The argparse type of a count: an integer, else the error names its range (``--courses nan``)."""
+
+    def parse(text: str) -> int:
+        try:
+            return int(text)
+        except ValueError:
+            what = p.range.text() if p.range else "an integer"
+            raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
+
+    return parse
+
+
+def _add(parser: argparse.ArgumentParser | Any, p: Param) -> None:
+    """The argparse option of a parameter of the table."""
+    kind = _floats if p.many or p.repeat else str if p.range is None else _integer(p) if p.integer else float
+    kwargs: dict[str, Any] = {"default": p.default, "help": p.help, "dest": p.dest, "metavar": _metavar(p)}
+    if p.repeat:
+        kwargs.update(action="append", type=kind)
     else:
-        kwargs.update(type=opt.type, choices=opt.choices)
-    parser.add_argument(opt.flag, *opt.aliases, **kwargs)
+        kwargs.update(type=kind, choices=p.choices or None)
+    parser.add_argument(p.option, *p.aliases, **kwargs)
 
 
 # ---------------------------------------------------------------------- build
@@ -418,10 +130,6 @@ def _contact_table(args: argparse.Namespace, kind: str, unit_height_m: float) ->
     if choice == "auto":
         choice = "udec" if kind in UDEC_KINDS else "paper"
     if choice == "udec":
-        if not (math.isfinite(args.jkn_pa_per_m) and args.jkn_pa_per_m > 0):
-            raise InputError("--jkn-pa-per-m", f"must be > 0 Pa/m, got {args.jkn_pa_per_m:g}")
-        if not 0.0 <= args.damping_ratio < 1.0:
-            raise InputError("--damping-ratio", f"must be in [0, 1), got {args.damping_ratio:g}")
         return udec_contact(
             unit_height_m, args.density_kg_m3, args.jkn_pa_per_m, args.damping_ratio, args.friction_angle_deg
         )
@@ -435,11 +143,15 @@ _NEEDS = [
 ]
 
 
-def _check_counts_and_pairs(args: argparse.Namespace, kind: str) -> None:
-    """Refuse, before anything is built, a count the generator would divide by (``--courses 0``)
-    and an option that would be silently ignored (an eccentricity without its load)."""
-    if kind == "wall-section" and not 1 <= args.courses <= 200:
-        raise InputError("--courses", f"must be an integer in [1, 200], got {args.courses} (nothing written)")
+def _check_options(args: argparse.Namespace, kind: str) -> None:
+    """Refuse, before anything is built, a number out of its range in the generators' table (a
+    count the generator would divide by, ``--courses 0``; a negative or zero unit height or
+    density, which the joints' damping would take a square root of or divide by; NaN,
+    infinity), naming the option and the range; and an option that would be silently ignored
+    (an eccentricity without its load)."""
+    for p in options(kind):
+        if p.numeric or p.choices:
+            p.check(getattr(args, p.dest), p.option)
     for option, dest, other, other_option in _NEEDS:
         if getattr(args, dest, 0.0) != 0.0 and getattr(args, other, 0.0) == 0.0:
             raise InputError(
@@ -464,7 +176,11 @@ def _unit_height(args: argparse.Namespace, kind: str) -> float:
 
 
 def _generator_kwargs(args: argparse.Namespace, kind: str) -> dict[str, Any]:
-    kwargs = {opt.dest: getattr(args, opt.dest) for opt in KINDS[kind][1]}
+    """The generator's keywords from the options (the overburden's where the generator takes it)."""
+    own = list(KINDS[kind].params)
+    if kind in OVERBURDEN and OVERBURDEN[kind].by_generator:
+        own += OVERBURDEN[kind].params
+    kwargs = {p.dest: getattr(args, p.dest) for p in own}
     kwargs.update({name: getattr(args, name) for name in COMMON_PARAMS})
     if kind == "wall":
         kwargs["openings"] = kwargs.pop("opening") or []
@@ -487,14 +203,19 @@ def _stack_widths(kwargs: dict[str, Any]) -> None:
             raise InputError("--blocks", "a linear taper needs --blocks, --bottom-width-m and --top-width-m")
         kwargs["widths_m"], kwargs["top_width_m"] = tapered_widths(n, bottom, top, kwargs["taper"])
     elif kwargs["widths_m"] is None:
-        kwargs["widths_m"] = [0.4, 0.35, 0.3, 0.25]
+        del kwargs["widths_m"]  # the generator's default
 
 
 def _flag_for(field: str, kind: str) -> str:
-    """The CLI option behind a generator's error field (``openings[1].x_m`` -> ``--opening #2 x_m``)."""
+    """The CLI option behind a generator's or the scene's error field (``openings[1].x_m`` ->
+    ``--opening #2 x_m``; ``motion.amplitude_g`` -> ``--amplitude-g``)."""
     opening = re.fullmatch(r"openings\[(\d+)\](?:\.(\w+))?", field)
     if opening:
         return f"--opening #{int(opening.group(1)) + 1}" + (f" {opening.group(2)}" if opening.group(2) else "")
+    table = re.fullmatch(r"(?:motion|contact)\.(\w+)", field)
+    if table:
+        flag = _flags(kind).get(table.group(1).lower())
+        return flag or {"shape": "--pulse-shape", "beta_s": "--damping-ratio"}.get(table.group(1), field)
     match = re.match(r"[A-Za-z0-9_]+", field)
     base = match.group(0) if match else field
     names = _flags(kind)
@@ -503,8 +224,7 @@ def _flag_for(field: str, kind: str) -> str:
 
 def _flags(kind: str) -> dict[str, str]:
     """Generator parameter name -> CLI flag."""
-    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
-    names = {opt.dest: opt.flag for opt in [*KINDS[kind][1], *extra, *COMMON]}
+    names = {p.dest: p.option for p in options(kind)}
     names.update({"overburden_N_per_m": "--overburden-n-per-m", "overburden_N": "--top-load-n"})
     if kind in ("column", "stack"):
         names["overburden_eccentricity_m"] = "--top-load-eccentricity-m"
@@ -520,18 +240,17 @@ def _cli_words(message: str, kind: str) -> str:
 def _command_line(args: argparse.Namespace, kind: str) -> str:
     """The ``rockyade build`` command that makes this scene (options that differ from their default)."""
     words = ["rockyade", "build", kind]
-    extra = OVERBURDEN[kind][1] if kind in OVERBURDEN else []
-    for opt in [*KINDS[kind][1], *extra, *COMMON]:
-        value = getattr(args, opt.dest)
-        if value == opt.default or value is None:
+    for p in options(kind):
+        value = getattr(args, p.dest)
+        if value == p.default or value is None:
             continue
-        if opt.append:
+        if p.repeat:
             for item in value:
-                words += [opt.flag, ",".join(f"{v:g}" for v in item)]
+                words += [p.option, ",".join(f"{v:g}" for v in item)]
         elif isinstance(value, list):
-            words += [opt.flag, ",".join(f"{v:g}" for v in value)]
+            words += [p.option, ",".join(f"{v:g}" for v in value)]
         else:
-            words += [opt.flag, f"{value:g}" if isinstance(value, float) else str(value)]
+            words += [p.option, f"{value:g}" if isinstance(value, float) else str(value)]
     words += ["--out", Path(args.out).name]
     return shlex.join(words)
 
@@ -553,7 +272,7 @@ def _summary(scene) -> str:
     )
 
 
-def _check_the_dem_takes_it(scene: Any) -> None:
+def _check_the_dem_takes_it(scene: Any, kind: str) -> None:
     """Build the DEM model (joints, statics) before writing: a scene that ``run`` would refuse
     (joints too soft for the wall's weight) is refused here, naming the option to change."""
     if scene.contact.calibration == "matched" and scene.contact.beta_s is None:
@@ -563,17 +282,16 @@ def _check_the_dem_takes_it(scene: Any) -> None:
     try:
         calibrated_model(scene)
     except InputError as exc:
-        flag = {"contact.jkn_Pa_per_m": "--jkn-pa-per-m"}.get(exc.field, exc.field)
-        raise InputError(flag, f"{exc.message} (nothing written)") from None
+        raise InputError(_flag_for(exc.field, kind), f"{exc.message} (nothing written)") from None
 
 
 def _with_overburden(args: argparse.Namespace, kind: str, data: dict[str, Any]) -> dict[str, Any]:
     """The generated scene with the overburden options as [[loads]] (none given: unchanged)."""
-    if kind not in OVERBURDEN:
+    if kind not in OVERBURDEN or OVERBURDEN[kind].by_generator:
         return data
     from rockyade.scene.generators.overburden import add_overburden
 
-    how, _ = OVERBURDEN[kind]
+    how = OVERBURDEN[kind].how
     if how == "point":
         return add_overburden(data, how, force_N=args.top_load_n, eccentricity_m=args.top_load_eccentricity_m)
     return add_overburden(
@@ -599,7 +317,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     check_output_file(out, "--out", (".toml", ".json"))
     if args.draw:
         check_output_file(args.draw, "--draw", ".png")
-    _check_counts_and_pairs(args, kind)
+    _check_options(args, kind)
     kwargs = _generator_kwargs(args, kind)
     kwargs["motion"] = _motion_table(args, out)
     if kwargs["duration_s"] is None:
@@ -612,8 +330,14 @@ def cmd_build(args: argparse.Namespace) -> int:
     except InputError as exc:
         raise InputError(_flag_for(exc.field, kind), _cli_words(exc.message, kind)) from None
     out.parent.mkdir(parents=True, exist_ok=True)  # relative record paths resolve from there
-    scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
-    _check_the_dem_takes_it(scene)
+    try:
+        scene = scene_from_dict(data, source=str(out), base_dir=out.parent)
+    except InputError as exc:
+        flag = _flag_for(exc.field, kind)
+        if flag == exc.field:
+            raise
+        raise InputError(flag, f"{exc.message} (nothing written)") from None
+    _check_the_dem_takes_it(scene, kind)
     floor = {"restrained-wall": ("restraint", "--restraint side"), "wall-section": ("top", "--top restrained-far")}
     if kind in floor and getattr(args, floor[kind][0]) == "floor" and not args.gap_m:
         import sys
@@ -626,7 +350,7 @@ def cmd_build(args: argparse.Namespace) -> int:
     summary = _summary(scene)
     header = "\n".join(
         [
-            f"{KINDS[kind][0][0].upper()}{KINDS[kind][0][1:]}.",
+            f"{KINDS[kind].text[0].upper()}{KINDS[kind].text[1:]}.",
             f"Made by rockyade {__version__}: {_command_line(args, kind)}",
             summary + ".",
             "Positions are base-frame m (docs/assemblies.md); [motion] and [contact] are starting points to edit.",
@@ -697,30 +421,30 @@ def register(sub: Any) -> None:
         "can read and edit. Options are SI, with units in their names.",
     )
     kinds = p.add_subparsers(dest="kind", required=True, metavar="KIND")
-    for kind, (text, options) in KINDS.items():
+    for kind, (text, params) in KINDS.items():
         k = kinds.add_parser(
             kind,
             help=text,
             description=f"Generate {text}." + (f" {ALIASES[kind]}" if kind in ALIASES else ""),
             formatter_class=_DefaultsFormatter,
         )
-        for opt in options:
-            _add(k, opt)
-        if kind in OVERBURDEN or kind == "wall-section":
+        for p in params:
+            _add(k, p)
+        if kind in OVERBURDEN:
             loads = k.add_argument_group("overburden (written as [[loads]], with the mass of its weight by default)")
-            for opt in OVERBURDEN.get(kind, ("", []))[1]:
-                _add(loads, opt)
+            for p in OVERBURDEN[kind].params:
+                _add(loads, p)
             loads.add_argument(
                 "--overburden-mass",
                 choices=("carried", "none"),
                 default="carried",
                 help="carried: the load's mass (its weight / g) shakes with the wall, as the code counts the loads "
                 "a wall carries (Circolare 2019 C8.7.1); none: a force without mass (its horizontal force goes "
-                "elsewhere) (default: carried)",
+                "elsewhere)",
             )
         group = k.add_argument_group("material, time, motion and joints")
-        for opt in COMMON:
-            _add(group, opt)
+        for p in COMMON:
+            _add(group, p)
         k.add_argument("--out", type=Path, required=True, help="scene file to write (.toml or .json)")
         k.add_argument("--draw", type=Path, metavar="PNG", help="also draw the scene (PNG)")
         k.set_defaults(func=cmd_build)

@@ -171,7 +171,8 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from rockyade.io.atomic import atomic_open, write_json
     from rockyade.io.locking import output_lock
     from rockyade.motion.processing import integrate
-    from rockyade.motion.synthetic import compatibility_report, suite_record
+    from rockyade.motion.suite_cache import suite_record
+    from rockyade.motion.synthetic import compatibility_report
 
     if not 1 <= args.count <= 1000:
         raise InputError("count", f"must be in [1, 1000] records, got {args.count}")

@@ -26,7 +26,6 @@ here selects a backend or calls ``plt.show()``. :func:`write_snapshots` writes t
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -34,14 +33,22 @@ from typing import Any
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
-from matplotlib.collections import PolyCollection
 from matplotlib.colors import LinearSegmentedColormap, Normalize
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
-from rockyade.figures.canvas import axes_list, new_figure, save_figure
+from rockyade.figures.block_drawing import (
+    FIGURE_WIDTH_IN,
+    STONE,
+    bounds_of,
+    draw_blocks,
+    draw_rest_outline,
+    figure_for,
+    setup_axes,
+)
+from rockyade.figures.canvas import axes_list, save_figure
+from rockyade.io.atomic import atomic_path
 from rockyade.result import Result, column
 from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
 
@@ -50,13 +57,8 @@ from rockyade.scene.placement import PlacedBlock, placed_blocks, rotation_matrix
 MIN_LABEL_PT = 4.5
 READABLE_LABEL_PT = 6.0
 MAX_LABEL_PT = 10.0
-STONE = "#dccbaa"
-STONE_EDGE = "#4a3f31"
-FIXED = "#b9b9b9"
-FIGURE_WIDTH_IN = 10.0
 #: Colours of moving blocks by |rotation|: stone at rest, dark red at the largest rotation shown.
 ROTATION_CMAP = LinearSegmentedColormap.from_list("stone_to_red", [STONE, "#e8a15c", "#c0392b", "#5e0d0d"])
-MAX_HEIGHT_IN = 8.0
 #: The ``gid`` of the block names drawn (:func:`drawn_names`).
 NAME_GID = "block-name"
 
@@ -109,76 +111,7 @@ def sample_index(result: Result, t_s: float, field: str = "times") -> int:
     return int(np.argmin(np.abs(t - t_s)))
 
 
-# ---------------------------------------------------------------------- drawing pieces
-
-
-def _bounds(polygons: Sequence[np.ndarray]) -> tuple[float, float, float, float]:
-    pts = np.vstack(polygons)
-    x0, y0 = pts.min(axis=0)
-    x1, y1 = pts.max(axis=0)
-    return float(x0), float(x1), min(float(y0), 0.0), float(y1)
-
-
-def _limits(bounds: tuple[float, float, float, float]) -> tuple[tuple[float, float], tuple[float, float], float]:
-    """Axis limits with a margin, and the depth of the hatched ground band, m."""
-    x0, x1, y0, y1 = bounds
-    size = max(x1 - x0, y1 - y0)
-    pad = 0.06 * size
-    ground = 0.04 * size
-    return (x0 - pad, x1 + pad), (min(y0, 0.0) - ground - 0.5 * pad, y1 + pad), ground
-
-
-def _line_width(n_blocks: int) -> float:
-    return float(np.clip(1.2 / math.sqrt(max(n_blocks, 1) / 10.0), 0.25, 1.0))
-
-
-def _draw_ground(ax, xlim: tuple[float, float], depth: float) -> None:
-    ax.add_patch(
-        Rectangle(
-            (xlim[0], -depth),
-            xlim[1] - xlim[0],
-            depth,
-            facecolor="white",
-            edgecolor="0.35",
-            hatch="////",
-            linewidth=0.0,
-            zorder=0,
-        )
-    )
-    ax.plot(xlim, (0.0, 0.0), color="black", linewidth=1.6, zorder=3, solid_capstyle="butt")
-
-
-def _draw_blocks(
-    ax,
-    polygons: Sequence[np.ndarray],
-    fixed: Sequence[bool],
-    facecolors=None,
-    zorder: float = 2.0,
-) -> PolyCollection:
-    """Moving blocks as one collection (returned, for animations) and fixed blocks as another."""
-    lw = _line_width(len(polygons))
-    moving = [p for p, f in zip(polygons, fixed, strict=True) if not f]
-    still = [p for p, f in zip(polygons, fixed, strict=True) if f]
-    coll = PolyCollection(
-        moving,
-        facecolors=STONE if facecolors is None else facecolors,
-        edgecolors=STONE_EDGE,
-        linewidths=lw,
-        zorder=zorder,
-    )
-    ax.add_collection(coll)
-    if still:
-        ax.add_collection(
-            PolyCollection(still, facecolors=FIXED, edgecolors="0.25", linewidths=lw, hatch="///", zorder=zorder)
-        )
-    return coll
-
-
-def _draw_rest_outline(ax, rest: Sequence[np.ndarray]) -> None:
-    """The blocks at rest as thin dashed outlines (behind the moving blocks)."""
-    ax.add_collection(
-        PolyCollection(rest, facecolors="none", edgecolors="0.5", linewidths=0.5, linestyles="--", zorder=1)
-    )
+# ---------------------------------------------------------------------- labels
 
 
 def _points_per_metre(fig, ax) -> float:
@@ -227,53 +160,6 @@ def _label_blocks(fig, ax, placed: Sequence[PlacedBlock]) -> int:
             bbox=dict(facecolor="white", edgecolor="none", alpha=0.8, pad=1.0) if b.fixed else None,
         )
     return skipped
-
-
-def _figure_for(
-    bounds: tuple[float, float, float, float],
-    panels: tuple[int, int] = (1, 1),
-    width_in: float = FIGURE_WIDTH_IN,
-    path: str | Path | None = "file",
-):
-    """A figure whose panels fit the drawing's aspect within ``width_in`` x MAX_HEIGHT_IN:
-    outside pyplot (Agg) when it is for a file (``path`` not None), else pyplot's."""
-    xlim, ylim, _ = _limits(bounds)
-    aspect = (ylim[1] - ylim[0]) / (xlim[1] - xlim[0])
-    rows, cols = panels
-    panel_w = width_in / cols
-    panel_h = panel_w * aspect
-    if panel_h * rows > MAX_HEIGHT_IN:  # tall assemblies: narrower panels rather than a long strip
-        panel_h = MAX_HEIGHT_IN / rows
-        panel_w = max(panel_h / aspect, 1.2)
-    width = max(panel_w * cols + 1.2, 4.5)
-    height = panel_h * rows + 0.35 * rows + 0.8
-    shared = rows * cols > 1
-    return new_figure(
-        None if path is None else Path(str(path)),
-        rows,
-        cols,
-        figsize=(width, height),
-        squeeze=False,
-        sharex=shared,
-        sharey=shared,
-        layout="constrained",
-    )
-
-
-def _setup_axes(ax, bounds) -> float:
-    xlim, ylim, ground = _limits(bounds)
-    ax.set_xlim(*xlim)
-    ax.set_ylim(*ylim)
-    ax.set_aspect("equal", adjustable="box")
-    spec = ax.get_subplotspec()
-    if spec is None or spec.is_last_row():
-        ax.set_xlabel("x (m)")
-    if spec is None or spec.is_first_col():
-        ax.set_ylabel("y (m)")
-    ax.grid(alpha=0.25, linewidth=0.5)
-    ax.set_axisbelow(True)
-    _draw_ground(ax, xlim, ground)
-    return ground
 
 
 def _title(scene, label: str | None) -> str:
@@ -325,15 +211,15 @@ def draw_assembly(
     """
     placed = placed_blocks(scene)
     polygons = [b.vertices_m for b in placed]
-    bounds = _bounds(polygons)
+    bounds = bounds_of(polygons)
     if ax is None:
-        fig, axes = _figure_for(bounds, path=path)
+        fig, axes = figure_for(bounds, path=path)
         ax = axes[0, 0]
     else:
         ax = axes_list(ax, 1)[0]
         fig = ax.figure
-    _setup_axes(ax, bounds)
-    _draw_blocks(ax, polygons, [b.fixed for b in placed])
+    setup_axes(ax, bounds)
+    draw_blocks(ax, polygons, [b.fixed for b in placed])
     skipped = _label_blocks(fig, ax, placed) if labels else 0
     heading = title or _title(scene, None)
     if skipped:
@@ -401,7 +287,7 @@ def draw_snapshots(
     indices = [sample_index(result, float(t)) for t in times_s]
     frames = [moving_polygons(placed, result, i, scale) for i in indices]
     rest = [b.vertices_m for b in placed]
-    bounds = _clip_bounds(_bounds(rest + [p for f in frames for p in f]), _bounds(rest))
+    bounds = _clip_bounds(bounds_of(rest + [p for f in frames for p in f]), bounds_of(rest))
     norm = Normalize(0.0, _rotation_norm(placed, result, indices))
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
@@ -414,7 +300,7 @@ def draw_snapshots(
         aspect = (bounds[1] - bounds[0]) / max(bounds[3] - bounds[2], 1e-9)
         cols = min(n, 3 if aspect < 1.3 else 2 if aspect < 2.6 else 1)
         rows = math.ceil(n / cols)
-        fig, grid = _figure_for(bounds, (rows, cols), width_in=FIGURE_WIDTH_IN + 1.0, path=path)
+        fig, grid = figure_for(bounds, (rows, cols), width_in=FIGURE_WIDTH_IN + 1.0, path=path)
         panels = list(grid.flat)
         for extra in panels[n:]:
             extra.set_visible(False)
@@ -423,10 +309,10 @@ def draw_snapshots(
         panels = axes_list(ax, n)
         fig = panels[0].figure
     for k, panel in enumerate(panels):
-        _setup_axes(panel, bounds)
-        _draw_rest_outline(panel, rest)
+        setup_axes(panel, bounds)
+        draw_rest_outline(panel, rest)
         colours = ROTATION_CMAP(norm(rotations(placed, result, indices[k])[moving_idx]))
-        _draw_blocks(panel, frames[k], fixed, facecolors=colours)
+        draw_blocks(panel, frames[k], fixed, facecolors=colours)
         panel.set_title(f"t = {result.t[indices[k]]:.3f} s", fontsize=10)
     bar = fig.colorbar(ScalarMappable(norm=norm, cmap=ROTATION_CMAP), ax=panels, shrink=0.8, pad=0.02)
     bar.set_label("|rotation from rest| (rad)")
@@ -551,7 +437,7 @@ def animate(
     scene, result
         The scene and its run.
     path
-        .gif or .mp4 to write (next to it, then renamed into place); None writes nothing.
+        .gif or .mp4 to write (atomically: :func:`rockyade.io.atomic.atomic_path`); None writes nothing.
     fps
         Frames per second of the animation.
     speed
@@ -583,19 +469,19 @@ def animate(
     placed = placed_blocks(scene)
     rest = [b.vertices_m for b in placed]
     frames = [moving_polygons(placed, result, i, scale) for i in indices]
-    bounds = _clip_bounds(_bounds(rest + [p for f in frames for p in f]), _bounds(rest))
+    bounds = _clip_bounds(bounds_of(rest + [p for f in frames for p in f]), bounds_of(rest))
     if ax is None:
-        fig, axes = _figure_for(bounds, width_in=8.0, path=path)
+        fig, axes = figure_for(bounds, width_in=8.0, path=path)
         ax = axes[0, 0]
     else:
         ax = axes_list(ax, 1)[0]
         fig = ax.figure
-    _setup_axes(ax, bounds)
-    _draw_rest_outline(ax, rest)
+    setup_axes(ax, bounds)
+    draw_rest_outline(ax, rest)
     fixed = [b.fixed for b in placed]
     moving_idx = [i for i, b in enumerate(placed) if not b.fixed]
     norm = Normalize(0.0, _rotation_norm(placed, result, indices))
-    coll = _draw_blocks(ax, frames[0], fixed)
+    coll = draw_blocks(ax, frames[0], fixed)
     clock = ax.set_title("", fontsize=10)
     note = f" (motion x{scale:g})" if scale != 1.0 else ""
 
@@ -608,13 +494,7 @@ def animate(
     update(0)
     anim = animation.FuncAnimation(fig, update, frames=len(indices), blit=False)
     if path is not None:
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        # writers need a file name: write beside the target, then rename it in place (atomic)
-        tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-        try:
+        # the writers open the file themselves and take its format from its suffix
+        with atomic_path(path) as tmp:
             anim.save(str(tmp), writer=writer, dpi=90)
-            os.replace(tmp, path)
-        finally:
-            tmp.unlink(missing_ok=True)
     return fig, ax, anim

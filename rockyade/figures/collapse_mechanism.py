@@ -23,17 +23,17 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from rockyade.errors import InputError
-from rockyade.figures.assembly import (
+from rockyade.figures.block_drawing import (
     FIGURE_WIDTH_IN,
     FIXED,
     MAX_HEIGHT_IN,
     STONE,
-    _bounds,
-    _draw_blocks,
-    _draw_rest_outline,
-    _figure_for,
-    _limits,
-    _setup_axes,
+    axis_limits,
+    bounds_of,
+    draw_blocks,
+    draw_rest_outline,
+    figure_for,
+    setup_axes,
 )
 from rockyade.figures.canvas import axes_list, new_figure, save_figure
 from rockyade.limit.analysis import LimitResult
@@ -102,7 +102,7 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
     mech = result.mechanism
     rest = list(model.polygons_m)
     moved, scale = displaced_polygons(result)
-    bounds = _bounds(rest + moved)
+    bounds = bounds_of(rest + moved)
     curve = result.kinematic.spectral() if result.kinematic is not None else None
     cax = None
     if ax is not None:
@@ -113,17 +113,17 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
         ax, cax = panels[0], (panels[1] if len(panels) == 2 and curve is not None else None)
         fig = ax.figure
     elif curve is None:
-        fig, axes = _figure_for(bounds, path=path)
+        fig, axes = figure_for(bounds, path=path)
         ax = axes[0, 0]
     else:
         fig, ax, cax = _two_panels(bounds, path)
-    _setup_axes(ax, bounds)
+    setup_axes(ax, bounds)
     fixed = [bool(f) for f in model.fixed]
     colours = []
     if mech is not None:
-        _draw_rest_outline(ax, rest)
+        draw_rest_outline(ax, rest)
         colours = [MOVING if mech.moving[i] else STONE for i in range(model.n_blocks) if not fixed[i]]
-    _draw_blocks(ax, moved, fixed, facecolors=colours or None)
+    draw_blocks(ax, moved, fixed, facecolors=colours or None)
     handles: list[Artist] = []
     if mech is not None:
         vel = mech.velocities
@@ -177,7 +177,7 @@ def draw_mechanism(result: LimitResult, path: str | Path | None = None, title: s
 
 def _two_panels(bounds, path: str | Path | None):
     """A figure with the assembly (left) and the capacity curve (right, narrower)."""
-    xlim, ylim, _ = _limits(bounds)
+    xlim, ylim, _ = axis_limits(bounds)
     aspect = (ylim[1] - ylim[0]) / max(xlim[1] - xlim[0], 1e-9)
     width = FIGURE_WIDTH_IN + 4.0
     # the drawing's width: its share of the figure less its legend and labels (about 2 in), so that the

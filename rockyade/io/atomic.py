@@ -11,6 +11,10 @@ or a link an attacker planted) is never opened, and another random name is tried
 any failure (a full disk, Ctrl-C) the temporary file is removed. A process killed with
 SIGKILL may leave one behind: :func:`remove_stale_temporaries` clears a directory that
 the caller holds the lock of (:mod:`rockyade.io.locking`).
+
+A writer that opens the file itself and picks its format by the file's suffix (matplotlib's
+movie writers) gets a temporary path that ends in the destination's suffix,
+``.<name>.<random>.tmp<suffix>`` (:func:`atomic_path`), renamed in the same way.
 """
 
 from __future__ import annotations
@@ -38,15 +42,15 @@ def _random_part() -> str:
     return secrets.token_hex(8)
 
 
-def create_temporary(dest: Path) -> tuple[int, Path]:
-    """Create ``.<name>.<random>.tmp`` beside ``dest`` exclusively, never through a link.
+def create_temporary(dest: Path, suffix: str = "") -> tuple[int, Path]:
+    """Create ``.<name>.<random>.tmp<suffix>`` beside ``dest`` exclusively, never through a link.
 
     Returns the open descriptor (read-write, mode 0600 until the writer sets its own) and
     the path. A name that exists, whatever it is, is skipped for another random one.
     """
     flags = os.O_RDWR | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC
     for _ in range(TEMP_ATTEMPTS):
-        tmp = dest.parent / f".{dest.name}.{_random_part()}{TEMP_SUFFIX}"
+        tmp = dest.parent / f".{dest.name}.{_random_part()}{TEMP_SUFFIX}{suffix}"
         try:
             return os.open(tmp, flags, 0o600), tmp
         except FileExistsError:
@@ -123,6 +127,12 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", durable: bool = T
     dest = Path(path)
     with staged_file(dest, mode, durable) as (fh, tmp):
         yield fh
+    _rename_into_place(tmp, dest, durable)
+
+
+def _rename_into_place(tmp: Path, dest: Path, durable: bool) -> None:
+    """Rename the complete temporary ``tmp`` onto ``dest`` (and make it durable); on failure
+    remove ``tmp``."""
     try:
         os.replace(tmp, dest)
     except BaseException:
@@ -131,6 +141,34 @@ def atomic_open(path: str | os.PathLike[str], mode: str = "w", durable: bool = T
         raise
     if durable:
         fsync_dir(dest.parent)
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str], durable: bool = True) -> Iterator[Path]:
+    """A temporary path beside ``path``, ending in its suffix, for a writer that opens the file
+    itself and picks the format by the suffix; renamed onto ``path`` when the block ends
+    without an error, removed otherwise (``durable``: see :func:`atomic_open`).
+
+    The file is created empty (exclusively, never through a link) before the writer opens it.
+    """
+    dest = Path(path)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = create_temporary(dest, dest.suffix)
+    os.close(fd)
+    try:
+        yield tmp
+        fd = os.open(tmp, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
+        try:
+            os.fchmod(fd, file_mode())
+            if durable:
+                os.fsync(fd)
+        finally:
+            os.close(fd)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
+    _rename_into_place(tmp, dest, durable)
 
 
 def fsync_dir(directory: str | os.PathLike[str]) -> None:
@@ -149,7 +187,8 @@ def remove_stale_temporaries(directory: str | os.PathLike[str]) -> list[Path]:
     Only call this while holding the directory's lock (no other writer is active there).
     """
     removed = []
-    for path in Path(directory).glob(f".*{TEMP_SUFFIX}"):
+    folder = Path(directory)
+    for path in sorted({*folder.glob(f".*{TEMP_SUFFIX}"), *folder.glob(f".*{TEMP_SUFFIX}.*")}):
         with contextlib.suppress(OSError):  # gone already, or a folder: left alone
             if path.is_symlink() or path.is_file():
                 path.unlink()  # a link is removed itself, never what it points to

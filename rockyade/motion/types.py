@@ -56,7 +56,8 @@ from rockyade.motion.quasistatic import GravityRamp, Pushover
 from rockyade.motion.record_text import DT_RANGE_S, MAX_ABS_ACCEL_M_S2, Record, normalise_units
 from rockyade.motion.records import FORMATS, count_samples, read_record
 from rockyade.motion.spec import MAX_START_S, MOTION_TYPES, MotionSpec
-from rockyade.motion.synthetic import SuiteSpec, paper_suite, suite_record
+from rockyade.motion.suite_cache import suite_record
+from rockyade.motion.synthetic import SuiteSpec, paper_suite
 
 
 def _load_factor(r: TableReader) -> float:

@@ -33,7 +33,8 @@ from rockyade.figures import new_figure, save_figure
 from rockyade.figures.canvas import accel_scale, other_accel_axis
 from rockyade.figures.fragility_panels import FragilityCurve, FragilityDisplay
 from rockyade.figures.styles import SOLVER_LABELS, SOLVER_STYLES
-from rockyade.motion.synthetic import paper_suite, suite_record
+from rockyade.motion.suite_cache import suite_record
+from rockyade.motion.synthetic import paper_suite
 from rockyade.probability.fragility_curves import Fragility, fit_lognormal
 from rockyade.runner import Executor, run_jobs
 from rockyade.scene import scene_from_dict

@@ -35,13 +35,8 @@ from typing import Any
 import numpy as np
 
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.scene_tables import (
-    DEFAULT_DENSITY_KG_M3,
-    DEFAULT_SAMPLE_DT_S,
-    check_choice,
-    check_count,
-    check_density,
-    check_length,
     digits,
     exact,
     num,
@@ -51,8 +46,10 @@ from rockyade.scene.generators.scene_tables import (
     udec_contact,
 )
 
-SHAPES = ("semicircular", "pointed")
-PIERS = ("blocks", "fixed")
+SHAPES = param("arch", "shape").choices
+PIERS = param("arch", "piers").choices
+#: The defaults (the generators' table).
+ARCH = defaults("arch")
 
 Point = tuple[float, float]
 
@@ -112,20 +109,20 @@ def frame_of(quad: list[Point]) -> tuple[list[Point], Point, float]:
 
 
 def arch(
-    span_m: float = 2.0,
-    ring_depth_m: float = 0.3,
-    thickness_m: float = 0.5,
-    voussoirs: int = 11,
-    shape: str = "semicircular",
-    centre_offset_m: float | None = None,
-    pier_width_m: float = 0.6,
-    pier_height_m: float = 1.0,
-    piers: str = "blocks",
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    span_m: float = ARCH.span_m,
+    ring_depth_m: float = ARCH.ring_depth_m,
+    thickness_m: float = ARCH.thickness_m,
+    voussoirs: int = ARCH.voussoirs,
+    shape: str = ARCH.shape,
+    centre_offset_m: float | None = ARCH.centre_offset_m,
+    pier_width_m: float = ARCH.pier_width_m,
+    pier_height_m: float = ARCH.pier_height_m,
+    piers: str = ARCH.piers,
+    density_kg_m3: float = ARCH.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = ARCH.duration_s,
+    sample_dt_s: float = ARCH.sample_dt_s,
 ) -> dict[str, Any]:
     """An arch of ``voussoirs`` voussoirs on two piers as a scene dictionary (module docstring).
 
@@ -151,22 +148,25 @@ def arch(
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is UDEC-style
         (:func:`~rockyade.scene.generators.scene_tables.udec_contact` with the ring depth).
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
-    span = check_length("span_m", span_m)
-    depth = check_length("ring_depth_m", ring_depth_m)
-    t = check_length("thickness_m", thickness_m)
-    n = check_count("voussoirs", voussoirs, 2, 201)
-    shape = check_choice("shape", shape, SHAPES)
+    span = check("arch", "span_m", span_m)
+    depth = check("arch", "ring_depth_m", ring_depth_m)
+    t = check("arch", "thickness_m", thickness_m)
+    n = check("arch", "voussoirs", voussoirs)
+    shape = check("arch", "shape", shape)
     if shape == "semicircular":
         if centre_offset_m not in (None, 0, 0.0):
             raise InputError("centre_offset_m", 'applies to shape = "pointed" only')
         offset = 0.0
     else:
-        offset = span / 2 if centre_offset_m is None else check_length("centre_offset_m", centre_offset_m)
-    pw = exact(check_length("pier_width_m", pier_width_m))
-    ph = exact(check_length("pier_height_m", pier_height_m, zero_ok=True))
-    piers = check_choice("piers", piers, PIERS)
-    density = check_density("density_kg_m3", density_kg_m3)
+        offset = span / 2 if centre_offset_m is None else check("arch", "centre_offset_m", centre_offset_m)
+    pw = exact(check("arch", "pier_width_m", pier_width_m))
+    ph = exact(check("arch", "pier_height_m", pier_height_m))
+    piers = check("arch", "piers", piers)
+    density = check("arch", "density_kg_m3", density_kg_m3)
     if piers == "fixed" and ph == 0:
         raise InputError("piers", '"fixed" needs piers: give pier_height_m > 0')
     blocks: list[dict[str, Any]] = []
@@ -179,10 +179,5 @@ def arch(
     for k, quad in enumerate(voussoir_quads(span, depth, n, offset, num(ph)), start=1):
         verts, position, rotation = frame_of(quad)
         blocks.append(polygon_block(f"v{k:0{width_n}d}", verts, position, rotation, t, density))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else udec_contact(depth, density),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    contact_table = contact if contact is not None else udec_contact(depth, density)
+    return scene_table(blocks, contact=contact_table, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)

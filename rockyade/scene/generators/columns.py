@@ -22,25 +22,22 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import MAX_STACK_BLOCKS, STACK_WIDTHS_M, check, defaults, param
 from rockyade.scene.generators.scene_tables import (
-    DEFAULT_DENSITY_KG_M3,
-    DEFAULT_SAMPLE_DT_S,
-    check_choice,
     check_count,
-    check_density,
-    check_length,
     digits,
     exact,
     num,
-    paper_contact,
     rect_block,
     scene_table,
 )
 
-LAYOUTS = ("positioned", "column")
-TAPERS = ("steps", "continuous")
-SECTIONS = ("round", "square")
-MAX_STACK_BLOCKS = 10_000
+LAYOUTS = param("stack", "layout").choices
+TAPERS = param("stack", "taper").choices
+SECTIONS = param("column", "section").choices
+#: The defaults (the generators' table).
+STACK = defaults("stack")
+COLUMN = defaults("column")
 
 
 def _block(
@@ -71,7 +68,7 @@ def _block(
 
 
 def tapered_widths(
-    blocks: int, bottom_width_m: float, top_width_m: float, taper: str = "steps"
+    blocks: int, bottom_width_m: float, top_width_m: float, taper: str = STACK.taper
 ) -> tuple[list[float], float | None]:
     """Widths for a linearly tapered :func:`stack` of ``blocks`` blocks, m.
 
@@ -82,10 +79,10 @@ def tapered_widths(
         (top block), and None. "continuous": the blocks' bottom widths and the top block's
         top width ``top_width_m``: straight sides from the bottom to the top of the stack.
     """
-    n = check_count("blocks", blocks, 1, MAX_STACK_BLOCKS)
-    lo = exact(check_length("bottom_width_m", bottom_width_m))
-    hi = exact(check_length("top_width_m", top_width_m))
-    taper = check_choice("taper", taper, TAPERS)
+    n = check("stack", "blocks", blocks)
+    lo = exact(check("stack", "bottom_width_m", bottom_width_m))
+    hi = exact(check("stack", "top_width_m", top_width_m))
+    taper = check("stack", "taper", taper)
     if taper == "continuous":
         return [num(lo + (hi - lo) * k / n) for k in range(n)], num(hi)
     if n == 1:
@@ -94,17 +91,17 @@ def tapered_widths(
 
 
 def stack(
-    widths_m: Sequence[float] = (0.4, 0.35, 0.3, 0.25),
-    heights_m: Sequence[float] | float = 0.6,
-    thickness_m: float = 0.4,
-    taper: str = "steps",
-    top_width_m: float | None = None,
-    layout: str = "positioned",
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    widths_m: Sequence[float] = STACK_WIDTHS_M,
+    heights_m: Sequence[float] | float = STACK.heights_m[0],
+    thickness_m: float = STACK.thickness_m,
+    taper: str = STACK.taper,
+    top_width_m: float | None = STACK.top_width_m,
+    layout: str = STACK.layout,
+    density_kg_m3: float = STACK.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = STACK.duration_s,
+    sample_dt_s: float = STACK.sample_dt_s,
 ) -> dict[str, Any]:
     """A stack of blocks of given sizes, bottom to top, centred on x = 0.
 
@@ -126,24 +123,27 @@ def stack(
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for :func:`~rockyade.scene.generators.walls.wall`; the default contact is the
         paper's calibration (slender blocks).
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
     if isinstance(widths_m, str) or not isinstance(widths_m, Sequence) or not widths_m:
         raise InputError("widths_m", "must be a non-empty list of widths in metres")
     n = check_count("widths_m (number of blocks)", len(widths_m), 1, MAX_STACK_BLOCKS)
-    widths = [exact(check_length(f"widths_m[{i}]", w)) for i, w in enumerate(widths_m)]
+    widths = [exact(w) for w in check("stack", "widths_m", list(widths_m))]
     if isinstance(heights_m, (int, float)):
-        heights = [exact(check_length("heights_m", heights_m))] * n
+        heights = [exact(check("stack", "heights_m", heights_m))] * n
     else:
         if len(heights_m) != n:
             raise InputError("heights_m", f"needs one height per block ({n}) or a single height, got {len(heights_m)}")
-        heights = [exact(check_length(f"heights_m[{i}]", h)) for i, h in enumerate(heights_m)]
-    thickness = check_length("thickness_m", thickness_m)
-    taper = check_choice("taper", taper, TAPERS)
-    layout = check_choice("layout", layout, LAYOUTS)
-    density = check_density("density_kg_m3", density_kg_m3)
+        heights = [exact(h) for h in check("stack", "heights_m", list(heights_m))]
+    thickness = check("stack", "thickness_m", thickness_m)
+    taper = check("stack", "taper", taper)
+    layout = check("stack", "layout", layout)
+    density = check("stack", "density_kg_m3", density_kg_m3)
     if taper == "steps" and top_width_m is not None:
         raise InputError("top_width_m", 'applies to taper = "continuous" only')
-    last = widths[-1] if top_width_m is None else exact(check_length("top_width_m", top_width_m))
+    last = widths[-1] if top_width_m is None else exact(check("stack", "top_width_m", top_width_m))
     tops = widths if taper == "steps" else [*widths[1:], last]
     blocks = []
     y = Fraction(0)
@@ -151,13 +151,7 @@ def stack(
     for i in range(n):
         blocks.append(_block(f"b{i + 1:0{width_n}d}", widths[i], tops[i], heights[i], y, thickness, density, layout))
         y += heights[i]
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 def round_drum_mass_inertia(diameter_m: float, height_m: float, density_kg_m3: float) -> tuple[float, float]:
@@ -182,19 +176,19 @@ def round_drum_mass_inertia(diameter_m: float, height_m: float, density_kg_m3: f
 
 
 def column(
-    drums: int = 8,
-    diameter_m: float = 0.3,
-    drum_height_m: float = 0.5,
-    thickness_m: float | None = None,
-    capital_width_m: float | None = None,
-    capital_height_m: float | None = None,
-    section: str = "round",
-    layout: str = "positioned",
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    drums: int = COLUMN.drums,
+    diameter_m: float = COLUMN.diameter_m,
+    drum_height_m: float = COLUMN.drum_height_m,
+    thickness_m: float | None = COLUMN.thickness_m,
+    capital_width_m: float | None = COLUMN.capital_width_m,
+    capital_height_m: float | None = COLUMN.capital_height_m,
+    section: str = COLUMN.section,
+    layout: str = COLUMN.layout,
+    density_kg_m3: float = COLUMN.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = COLUMN.duration_s,
+    sample_dt_s: float = COLUMN.sample_dt_s,
 ) -> dict[str, Any]:
     """A column of ``drums`` equal drums, optionally under a capital (abacus) block.
 
@@ -217,14 +211,19 @@ def column(
         of ``density_kg_m3``. The capital is a square slab either way.
     layout, density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for :func:`stack`.
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
-    n = check_count("drums", drums, 1, MAX_STACK_BLOCKS)
-    d = exact(check_length("diameter_m", diameter_m))
-    h = exact(check_length("drum_height_m", drum_height_m))
-    t = num(d) if thickness_m is None else check_length("thickness_m", thickness_m)
-    layout = check_choice("layout", layout, LAYOUTS)
-    section = check_choice("section", section, SECTIONS)
-    density = check_density("density_kg_m3", density_kg_m3)
+    n = check("column", "drums", drums)
+    d = exact(check("column", "diameter_m", diameter_m))
+    h = exact(check("column", "drum_height_m", drum_height_m))
+    t = num(d) if thickness_m is None else check("column", "thickness_m", thickness_m)
+    layout = check("column", "layout", layout)
+    section = check("column", "section", section)
+    density = check("column", "density_kg_m3", density_kg_m3)
+    capital_width_m = check("column", "capital_width_m", capital_width_m)
+    capital_height_m = check("column", "capital_height_m", capital_height_m)
     if (capital_width_m is None) != (capital_height_m is None):
         missing = "capital_height_m" if capital_height_m is None else "capital_width_m"
         raise InputError(missing, "give both capital_width_m and capital_height_m for a capital, or neither")
@@ -236,17 +235,10 @@ def column(
             del table["density_kg_m3"]
             table["mass_kg"] = mass
             table["inertia_kgm2"] = inertia
-    if capital_width_m is not None:
-        cw = exact(check_length("capital_width_m", capital_width_m))
-        ch = exact(check_length("capital_height_m", capital_height_m))
+    if capital_width_m is not None and capital_height_m is not None:
+        cw, ch = exact(capital_width_m), exact(capital_height_m)
         blocks.append(_block("capital", cw, cw, ch, n * h, t, density, layout))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 #: The former name of :func:`column` (kept: scripts call it).

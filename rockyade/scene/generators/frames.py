@@ -22,18 +22,17 @@ from typing import Any
 from rockyade.blocks.classical import p_rectangle
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import check, defaults
 from rockyade.scene.generators.scene_tables import (
-    DEFAULT_DENSITY_KG_M3,
-    DEFAULT_SAMPLE_DT_S,
     check_density,
-    check_length,
-    check_number,
     exact,
     num,
-    paper_contact,
     rect_block,
     scene_table,
 )
+
+#: The defaults (the generators' table).
+FRAME = defaults("frame")
 
 
 def frame_gamma(scene: Mapping[str, Any]) -> float:
@@ -52,19 +51,19 @@ def frame_frequency(column_width_m: float, column_height_m: float, gamma: float,
 
 
 def frame(
-    column_width_m: float = 0.25,
-    column_height_m: float = 1.5,
-    span_m: float = 1.5,
-    beam_height_m: float = 0.25,
-    beam_overhang_m: float = 0.0,
-    thickness_m: float = 0.25,
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
-    beam_density_kg_m3: float | None = None,
-    gamma: float | None = None,
+    column_width_m: float = FRAME.column_width_m,
+    column_height_m: float = FRAME.column_height_m,
+    span_m: float = FRAME.span_m,
+    beam_height_m: float = FRAME.beam_height_m,
+    beam_overhang_m: float = FRAME.beam_overhang_m,
+    thickness_m: float = FRAME.thickness_m,
+    density_kg_m3: float = FRAME.density_kg_m3,
+    beam_density_kg_m3: float | None = FRAME.beam_density_kg_m3,
+    gamma: float | None = FRAME.gamma,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = FRAME.duration_s,
+    sample_dt_s: float = FRAME.sample_dt_s,
 ) -> dict[str, Any]:
     """The Makris & Vassiliou (2013) rocking frame as a scene dictionary (module docstring).
 
@@ -86,39 +85,35 @@ def frame(
         Instead of a beam density: the mass ratio gamma = beam mass / both columns' mass.
     motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is the paper's calibration.
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
-    bw = exact(check_length("column_width_m", column_width_m))
-    bh = exact(check_length("column_height_m", column_height_m))
-    span = exact(check_length("span_m", span_m))
+    bw = exact(check("frame", "column_width_m", column_width_m))
+    bh = exact(check("frame", "column_height_m", column_height_m))
+    span = exact(check("frame", "span_m", span_m))
     if span <= bw:
         raise InputError("span_m", f"must be > column_width_m ({num(bw):g} m): the columns would overlap")
-    beam_h = exact(check_length("beam_height_m", beam_height_m))
-    overhang = exact(check_length("beam_overhang_m", beam_overhang_m, zero_ok=True))
-    t = check_length("thickness_m", thickness_m)
-    density = check_density("density_kg_m3", density_kg_m3)
+    beam_h = exact(check("frame", "beam_height_m", beam_height_m))
+    overhang = exact(check("frame", "beam_overhang_m", beam_overhang_m))
+    t = check("frame", "thickness_m", thickness_m)
+    density = check("frame", "density_kg_m3", density_kg_m3)
+    ratio = check("frame", "gamma", gamma)
+    beam_density_kg_m3 = check("frame", "beam_density_kg_m3", beam_density_kg_m3)
     beam_length = span + bw + 2 * overhang
-    if gamma is not None:
+    if ratio is not None:
         if beam_density_kg_m3 is not None:
             raise InputError("gamma", "give gamma or beam_density_kg_m3, not both")
-        ratio = check_number("gamma", gamma, 0.0, 100.0, lo_open=True)
         beam_density = check_density("gamma", ratio * 2 * density * num(bw * bh) / num(beam_length * beam_h))
     else:
-        beam_density = check_density(
-            "beam_density_kg_m3", density if beam_density_kg_m3 is None else beam_density_kg_m3
-        )
+        beam_density = density if beam_density_kg_m3 is None else beam_density_kg_m3
     half = span / 2
     blocks = [
         rect_block("column_left", bw, bh, -half, Fraction(0), t, density),
         rect_block("column_right", bw, bh, half, Fraction(0), t, density),
         rect_block("beam", beam_length, beam_h, Fraction(0), bh, t, beam_density),
     ]
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else paper_contact(),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    return scene_table(blocks, contact=contact, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)
 
 
 #: The former name of :func:`frame` (kept: scripts call it).

@@ -19,19 +19,15 @@ force without mass: its horizontal force goes elsewhere).
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import LINE_LOAD, OFFSET, POINT_LOAD
 
 KINDS = ("section", "line", "point")
-#: Largest overburden per metre of wall, N/m (100 MN/m: far above any masonry wall's).
-MAX_N_PER_M = 1.0e8
-#: Largest point overburden, N.
-MAX_N = 1.0e9
 
 
 def _top_blocks(scene) -> list[Any]:
@@ -55,14 +51,6 @@ def _top_face(block) -> tuple[float, float, float]:
 def _load(block: str, point: list[float], force: float, with_mass: bool) -> dict[str, Any]:
     """A vertical [[loads]] entry of ``force`` N downwards, with the mass of its weight or none."""
     return {"block": block, "point_m": point, "force_N": [0.0, -force], "mass_kg": force / G if with_mass else 0.0}
-
-
-def _check(name: str, value: float, bound: float, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise InputError(name, f"must be a finite number of {unit}, got {value!r}")
-    if not 0.0 <= value <= bound:
-        raise InputError(name, f"must be in [0, {bound:g}] {unit} (a downward load), got {value:g}")
-    return float(value)
 
 
 def add_overburden(
@@ -104,10 +92,9 @@ def add_overburden(
 
     if kind not in KINDS:
         raise InputError("overburden", f"kind must be one of {', '.join(KINDS)}, got {kind!r}")
-    q = _check("overburden_N_per_m", force_N_per_m, MAX_N_PER_M, "N/m")
-    n = _check("overburden_N", force_N, MAX_N, "N")
-    if not math.isfinite(eccentricity_m):
-        raise InputError("overburden_eccentricity_m", f"must be a finite length in metres, got {eccentricity_m!r}")
+    q = LINE_LOAD.check("overburden_N_per_m", force_N_per_m)  # the generators' table's ranges: downwards
+    n = POINT_LOAD.check("overburden_N", force_N)
+    eccentricity_m = OFFSET.check("overburden_eccentricity_m", eccentricity_m)
     if (q if kind != "point" else n) == 0.0:
         return dict(scene_dict)
     scene = scene_from_dict(scene_dict)

@@ -27,10 +27,12 @@ from collections.abc import Mapping
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.generators.scene_tables import DEFAULT_DENSITY_KG_M3, DEFAULT_SAMPLE_DT_S, check_choice, check_count
+from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.wall_sections import wall_section
 
-RESTRAINTS = ("side", "floor")
+RESTRAINTS = param("restrained-wall", "restraint").choices
+#: The defaults (the generators' table).
+RESTRAINED = defaults("restrained-wall")
 #: restrained_wall's restraint -> wall_section's top.
 TOP_OF_RESTRAINT = {"side": "restrained-far", "floor": "floor"}
 #: wall_section's parameter names -> restrained_wall's (for error messages).
@@ -44,21 +46,21 @@ FORMER_NAMES = {
 
 
 def restrained_wall(
-    wall_height_m: float = 3.0,
-    wall_thickness_m: float = 0.3,
-    wall_length_m: float = 1.0,
-    blocks: int = 2,
-    split: float = 0.5,
-    restraint: str = "side",
-    restraint_width_m: float = 0.3,
-    restraint_height_m: float = 0.3,
-    gap_m: float = 0.0,
-    restraint_friction_deg: float | None = 0.0,
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    wall_height_m: float = RESTRAINED.wall_height_m,
+    wall_thickness_m: float = RESTRAINED.wall_thickness_m,
+    wall_length_m: float = RESTRAINED.wall_length_m,
+    blocks: int = RESTRAINED.blocks,
+    split: float = RESTRAINED.split,
+    restraint: str = RESTRAINED.restraint,
+    restraint_width_m: float = RESTRAINED.restraint_width_m,
+    restraint_height_m: float = RESTRAINED.restraint_height_m,
+    gap_m: float = RESTRAINED.gap_m,
+    restraint_friction_deg: float | None = RESTRAINED.restraint_friction_deg,
+    density_kg_m3: float = RESTRAINED.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = RESTRAINED.duration_s,
+    sample_dt_s: float = RESTRAINED.sample_dt_s,
 ) -> dict[str, Any]:
     """``wall_section`` under restrained-wall's names (module docstring).
 
@@ -77,8 +79,9 @@ def restrained_wall(
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for :func:`~rockyade.scene.generators.wall_section`.
     """
-    n = check_count("blocks", blocks, 1, 2)
-    kind = check_choice("restraint", restraint, RESTRAINTS)
+    n = check("restrained-wall", "blocks", blocks)
+    kind = check("restrained-wall", "restraint", restraint)
+    split = check("restrained-wall", "split", split) if n == 2 else split
     try:
         return wall_section(
             height_m=wall_height_m,

@@ -1,5 +1,8 @@
 """What every generator shares: exact numbers, parameter checks, block tables, the scene table.
 
+The checks take their ranges from the generators' table of parameters
+(:mod:`rockyade.scene.generator_options`).
+
 Geometry is computed with :class:`fractions.Fraction` from the decimal value of each input
 (``0.1`` is read as 1/10), and converted to the nearest double only when a block table is
 written: a joint's two faces are then the same number, or one rounding apart (< 1e-15 m),
@@ -15,26 +18,34 @@ from pathlib import Path
 from typing import Any
 
 from rockyade.errors import InputError
-from rockyade.scene.bounds import BOUNDS
+from rockyade.scene.generator_options import DENSITY, LENGTH, LENGTH_OR_ZERO, Range, count, defaults
+from rockyade.scene.generator_options import check as check_param
 
-#: Defaults shared by the generators.
-DEFAULT_DENSITY_KG_M3 = 2400.0
+_COMMON = defaults("common")
+#: Defaults shared by the generators (the table's).
+DEFAULT_DENSITY_KG_M3: float = _COMMON.density_kg_m3
 #: Simulated time of a generated scene whose motion has no length of its own to go by, s
 #: (a record's scene lasts the record plus a tail: :func:`default_duration_s`).
 DEFAULT_DURATION_S = 3.0
-DEFAULT_SAMPLE_DT_S = 0.002
+DEFAULT_SAMPLE_DT_S: float = _COMMON.sample_dt_s
 #: The placeholder base motion: a one-sine acceleration pulse (edit it in the scene file).
-DEFAULT_PULSE = {"type": "pulse", "shape": "sine", "amplitude_g": 0.3, "period_s": 0.5, "cycles": 1}
+DEFAULT_PULSE = {
+    "type": "pulse",
+    "shape": _COMMON.pulse_shape,
+    "amplitude_g": _COMMON.amplitude_g,
+    "period_s": _COMMON.period_s,
+    "cycles": _COMMON.cycles,
+}
 #: Header comment of written scenes: how to change the placeholder motion.
 MOTION_NOTE = (
     "[motion] is a placeholder one-sine pulse: edit it (type = pulse | record | synthetic | harmonic | free | rest)"
 )
 #: Joint stiffness per unit area of the UDEC-style default contact, Pa/m (stone or brick
 #: masonry joints are usually modelled with 1e9 to 1e11 Pa/m).
-DEFAULT_JKN_PA_PER_M = 1.0e10
+DEFAULT_JKN_PA_PER_M: float = _COMMON.jkn_pa_per_m
 #: Fraction of critical damping of the default beta_s (see :func:`udec_contact`).
-DEFAULT_JOINT_DAMPING_RATIO = 0.05
-DEFAULT_FRICTION_ANGLE_DEG = 30.0
+DEFAULT_JOINT_DAMPING_RATIO: float = _COMMON.damping_ratio
+DEFAULT_FRICTION_ANGLE_DEG: float = _COMMON.friction_angle_deg
 
 
 def exact(value: float | int | Fraction) -> Fraction:
@@ -65,35 +76,22 @@ def check_number(
     unit: str = "",
 ) -> float:
     """``value`` as a float within [lo, hi] (bounds open as asked), else InputError naming ``name``."""
-    if isinstance(value, bool) or not isinstance(value, (int, float, Fraction)) or not math.isfinite(float(value)):
-        raise InputError(name, f"must be a number, got {value!r}")
-    x = float(value)
-    low_ok = x > lo if lo_open else x >= lo
-    high_ok = x < hi if hi_open else x <= hi
-    if not (low_ok and high_ok):
-        left = "(" if lo_open else "["
-        right = ")" if hi_open else "]"
-        units = f" {unit}" if unit else ""
-        raise InputError(name, f"must be in {left}{lo:g}, {hi:g}{right}{units}, got {x:g}")
-    return x
+    return float(Range(lo, hi, unit, lo_open, hi_open).check(name, value))
 
 
 def check_length(name: str, value: Any, *, zero_ok: bool = False) -> float:
     """A length in (0, the scene's largest length] m ([0, ...] with ``zero_ok``)."""
-    return check_number(name, value, 0.0, BOUNDS["length_m"].hi, lo_open=not zero_ok, unit="m")
+    return float((LENGTH_OR_ZERO if zero_ok else LENGTH).check(name, value))
 
 
 def check_count(name: str, value: Any, lo: int, hi: int) -> int:
     """An integer in [lo, hi]."""
-    if isinstance(value, bool) or not isinstance(value, int) or not lo <= value <= hi:
-        raise InputError(name, f"must be an integer in [{lo}, {hi}], got {value!r}")
-    return value
+    return int(count(lo, hi).check(name, value))
 
 
 def check_density(name: str, value: Any) -> float:
     """A density within the scene's bounds, kg/m^3 (``BOUNDS["density_kg_m3"]``)."""
-    bound = BOUNDS["density_kg_m3"]
-    return check_number(name, value, bound.lo, bound.hi, unit="kg/m^3")
+    return float(DENSITY.check(name, value))
 
 
 def check_choice(name: str, value: Any, choices: Sequence[str]) -> str:
@@ -185,31 +183,39 @@ def udec_contact(
     ``beta_s = 2 zeta / omega`` that gives a unit on its bed joint the fraction ``zeta`` of
     critical damping in vertical vibration, omega = sqrt(jkn / (rho h)) (two points of
     stiffness jkn L t / 2 carrying a mass rho L h t).
+
+    Each argument is checked against its range in the table (InputError naming it).
     """
-    omega = math.sqrt(jkn_Pa_per_m / (density_kg_m3 * unit_height_m))
-    beta = 2.0 * damping_ratio / omega
+    h = check_length("unit_height_m", unit_height_m)
+    rho = check_param("common", "density_kg_m3", density_kg_m3)
+    jkn = check_param("common", "jkn_pa_per_m", jkn_Pa_per_m, "jkn_Pa_per_m")
+    zeta = check_param("common", "damping_ratio", damping_ratio)
+    phi = check_param("common", "friction_angle_deg", friction_angle_deg)
+    omega = math.sqrt(jkn / (rho * h))
+    beta = 2.0 * zeta / omega
     return {
-        "jkn_Pa_per_m": float(jkn_Pa_per_m),
-        "jks_Pa_per_m": float(jkn_Pa_per_m),
+        "jkn_Pa_per_m": float(jkn),
+        "jks_Pa_per_m": float(jkn),
         "beta_s": float(f"{beta:.3g}"),
-        "friction_angle_deg": float(friction_angle_deg),
+        "friction_angle_deg": float(phi),
     }
 
 
 def pulse_motion(amplitude_g: float = 0.3, period_s: float = 0.5, shape: str = "sine", cycles: int = 1) -> dict:
-    """A ``[motion]`` table: an acceleration pulse (see rockyade.motion.types)."""
+    """A ``[motion]`` table: an acceleration pulse (see rockyade.motion.types); the arguments
+    checked against the table."""
     return {
         "type": "pulse",
-        "shape": shape,
-        "amplitude_g": float(amplitude_g),
-        "period_s": float(period_s),
-        "cycles": int(cycles),
+        "shape": check_param("common", "pulse_shape", shape, "shape"),
+        "amplitude_g": check_param("common", "amplitude_g", amplitude_g),
+        "period_s": check_param("common", "period_s", period_s),
+        "cycles": check_param("common", "cycles", cycles),
     }
 
 
 def free_motion(block: str, theta0_rad: float) -> dict:
     """A ``[motion]`` table: free rocking of ``block`` (and what rests on it) from ``theta0_rad``."""
-    return {"type": "free", "theta0_rad": float(theta0_rad), "block": block}
+    return {"type": "free", "theta0_rad": check_param("common", "theta0_rad", theta0_rad), "block": block}
 
 
 def rest_motion() -> dict:
@@ -220,7 +226,7 @@ def rest_motion() -> dict:
 def record_motion(file: str, load_factor: float = 1.0, **options: Any) -> dict:
     """A ``[motion]`` table: a recorded accelerogram (``file`` relative to the scene file)."""
     table = {"type": "record", "file": str(file), **options}
-    if load_factor != 1.0:
+    if check_param("common", "load_factor", load_factor) != 1.0:
         table["load_factor"] = float(load_factor)
     return table
 
@@ -267,7 +273,7 @@ def default_duration_s(motion: Mapping[str, Any] | None, base_dir: str | Path | 
 def scene_table(
     blocks: list[dict[str, Any]],
     *,
-    contact: Mapping[str, Any],
+    contact: Mapping[str, Any] | None,
     motion: Mapping[str, Any] | None,
     duration_s: float | None,
     sample_dt_s: float,
@@ -275,17 +281,20 @@ def scene_table(
 ) -> dict[str, Any]:
     """The scene dictionary (keys in the order a reader expects them in the file).
 
+    ``contact`` None: the paper's calibration (:func:`paper_contact`).
+
     ``duration_s`` None: :func:`default_duration_s` of the motion (a record's length plus a
     tail of free rocking, relative paths from the current folder).
     """
     if duration_s is None:
         duration_s = default_duration_s(motion)
-    check_number("duration_s", duration_s, 0.0, 1.0e5, lo_open=True, unit="s")
+    check_param("common", "duration_s", duration_s)
+    check_param("common", "sample_dt_s", sample_dt_s)
     check_number("sample_dt_s", sample_dt_s, 0.0, duration_s, lo_open=True, unit="s")
     data: dict[str, Any] = {
         "duration_s": float(duration_s),
         "sample_dt_s": float(sample_dt_s),
-        "contact": dict(contact),
+        "contact": dict(contact if contact is not None else paper_contact()),
         "motion": dict(motion if motion is not None else DEFAULT_PULSE),
         "blocks": blocks,
     }

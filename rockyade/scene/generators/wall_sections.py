@@ -54,44 +54,39 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.overburden import add_overburden
 from rockyade.scene.generators.scene_tables import (
-    DEFAULT_DENSITY_KG_M3,
-    DEFAULT_SAMPLE_DT_S,
-    check_choice,
-    check_count,
-    check_density,
-    check_length,
-    check_number,
     exact,
-    paper_contact,
     rect_block,
     scene_table,
 )
 
-TOPS = ("free", "restrained", "restrained-far", "restrained-near", "floor")
+TOPS = param("wall-section", "top").choices
+#: The defaults (the generators' table).
+SECTION = defaults("wall-section")
 #: The fixed blocks of each top, by side.
 SIDES = {"free": (), "restrained": ("near", "far"), "restrained-far": ("far",), "restrained-near": ("near",)}
 
 
 def wall_section(
-    height_m: float = 3.0,
-    thickness_m: float = 0.3,
-    length_m: float = 1.0,
-    courses: int = 1,
-    split: float | None = None,
-    top: str = "free",
-    gap_m: float = 0.0,
-    restraint_height_m: float = 0.3,
-    restraint_width_m: float = 0.3,
-    restraint_friction_deg: float | None = 0.0,
-    overburden_n_per_m: float = 0.0,
-    overburden_eccentricity_m: float = 0.0,
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    height_m: float = SECTION.height_m,
+    thickness_m: float = SECTION.thickness_m,
+    length_m: float = SECTION.length_m,
+    courses: int = SECTION.courses,
+    split: float | None = SECTION.split,
+    top: str = SECTION.top,
+    gap_m: float = SECTION.gap_m,
+    restraint_height_m: float = SECTION.restraint_height_m,
+    restraint_width_m: float = SECTION.restraint_width_m,
+    restraint_friction_deg: float | None = SECTION.restraint_friction_deg,
+    overburden_n_per_m: float = SECTION.overburden_n_per_m,
+    overburden_eccentricity_m: float = SECTION.overburden_eccentricity_m,
+    density_kg_m3: float = SECTION.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = SECTION.duration_s,
+    sample_dt_s: float = SECTION.sample_dt_s,
 ) -> dict[str, Any]:
     """A wall section as a scene dictionary (module docstring).
 
@@ -118,26 +113,29 @@ def wall_section(
         wall's axis, m (> 0 towards +x).
     density_kg_m3, motion, contact, duration_s, sample_dt_s
         As for the other generators; the default contact is the paper's calibration.
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
-    H = exact(check_length("height_m", height_m))
-    T = exact(check_length("thickness_m", thickness_m))
-    length = check_length("length_m", length_m)
-    n = check_count("courses", courses, 1, 200)
-    kind = check_choice("top", top, TOPS)
-    gap = exact(check_length("gap_m", gap_m, zero_ok=True))
-    rh = exact(check_length("restraint_height_m", restraint_height_m))
-    rw = exact(check_length("restraint_width_m", restraint_width_m))
+    H = exact(check("wall-section", "height_m", height_m))
+    T = exact(check("wall-section", "thickness_m", thickness_m))
+    length = check("wall-section", "length_m", length_m)
+    n = check("wall-section", "courses", courses)
+    kind = check("wall-section", "top", top)
+    gap = exact(check("wall-section", "gap_m", gap_m))
+    rh = exact(check("wall-section", "restraint_height_m", restraint_height_m))
+    rw = exact(check("wall-section", "restraint_width_m", restraint_width_m))
     if restraint_friction_deg is not None:
-        check_number("restraint_friction_deg", restraint_friction_deg, 0.0, 90.0, hi_open=True)
-    density = check_density("density_kg_m3", density_kg_m3)
+        check("wall-section", "restraint_friction_deg", restraint_friction_deg)
+    density = check("wall-section", "density_kg_m3", density_kg_m3)
+    split = check("wall-section", "split", split)
     zero = Fraction(0)
     if split is None:
         levels = [H * i / n for i in range(n + 1)]
     else:
         if n != 2:
             raise InputError("split", f"applies to a wall in 2 courses, got {n}")
-        ratio = exact(check_number("split", split, 0.0, 1.0, lo_open=True, hi_open=True))
-        levels = [zero, H * ratio, H]
+        levels = [zero, H * exact(split), H]
     blocks = [
         rect_block(f"w{i + 1:02d}", T, levels[i + 1] - levels[i], zero, levels[i], length, density) for i in range(n)
     ]
@@ -184,10 +182,12 @@ def wall_section(
         ]
     data = scene_table(
         [*blocks, *fixed],
-        contact=contact if contact is not None else paper_contact(),
+        contact=contact,
         motion=motion,
         duration_s=duration_s,
         sample_dt_s=sample_dt_s,
         joints=joints,
     )
-    return add_overburden(data, "section", force_N_per_m=overburden_n_per_m, eccentricity_m=overburden_eccentricity_m)
+    load = check("wall-section", "overburden_n_per_m", overburden_n_per_m)
+    eccentricity = check("wall-section", "overburden_eccentricity_m", overburden_eccentricity_m)
+    return add_overburden(data, "section", force_N_per_m=load, eccentricity_m=eccentricity)

@@ -31,12 +31,8 @@ from fractions import Fraction
 from typing import Any
 
 from rockyade.errors import InputError
+from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.scene_tables import (
-    DEFAULT_DENSITY_KG_M3,
-    DEFAULT_SAMPLE_DT_S,
-    check_choice,
-    check_count,
-    check_density,
     check_length,
     digits,
     exact,
@@ -45,9 +41,11 @@ from rockyade.scene.generators.scene_tables import (
     udec_contact,
 )
 
-BONDS = ("running", "stack")
-LINTELS = ("block", "none")
+BONDS = param("wall", "bond").choices
+LINTELS = param("wall", "lintel").choices
 MAX_WALL_BLOCKS = 100_000
+#: The defaults (the generators' table).
+WALL = defaults("wall")
 
 #: A rectangle (x0, x1, y0, y1), m, exact.
 Rect = tuple[Fraction, Fraction, Fraction, Fraction]
@@ -189,22 +187,22 @@ def wall_pieces(
 
 
 def wall(
-    courses: int = 5,
-    units_per_course: int = 6,
-    unit_length_m: float = 0.4,
-    unit_height_m: float = 0.2,
-    unit_thickness_m: float = 0.2,
-    bond: str = "running",
+    courses: int = WALL.courses,
+    units_per_course: int = WALL.units_per_course,
+    unit_length_m: float = WALL.unit_length_m,
+    unit_height_m: float = WALL.unit_height_m,
+    unit_thickness_m: float = WALL.unit_thickness_m,
+    bond: str = WALL.bond,
     openings: Sequence[Opening | Sequence[float] | Mapping[str, float]] = (),
-    lintel: str = "block",
-    lintel_height_m: float | None = None,
-    lintel_bearing_m: float | None = None,
-    min_piece_m: float | None = None,
-    density_kg_m3: float = DEFAULT_DENSITY_KG_M3,
+    lintel: str = WALL.lintel,
+    lintel_height_m: float | None = WALL.lintel_height_m,
+    lintel_bearing_m: float | None = WALL.lintel_bearing_m,
+    min_piece_m: float | None = WALL.min_piece_m,
+    density_kg_m3: float = WALL.density_kg_m3,
     motion: Mapping[str, Any] | None = None,
     contact: Mapping[str, Any] | None = None,
-    duration_s: float | None = None,
-    sample_dt_s: float = DEFAULT_SAMPLE_DT_S,
+    duration_s: float | None = WALL.duration_s,
+    sample_dt_s: float = WALL.sample_dt_s,
 ) -> dict[str, Any]:
     """A dry masonry wall in running or stack bond, as a scene dictionary (module docstring).
 
@@ -241,28 +239,30 @@ def wall(
     dict
         The scene, ready for :func:`rockyade.scene.scene_from_dict` or
         :func:`rockyade.scene.toml_writer.write_toml`.
+
+    Every argument is checked against its range in the generators' table
+    (:mod:`rockyade.scene.generator_options`).
     """
-    courses = check_count("courses", courses, 1, 1000)
-    units_per_course = check_count("units_per_course", units_per_course, 1, 1000)
+    courses = check("wall", "courses", courses)
+    units_per_course = check("wall", "units_per_course", units_per_course)
     if courses * units_per_course > MAX_WALL_BLOCKS:
         raise InputError("units_per_course", f"courses x units_per_course must be at most {MAX_WALL_BLOCKS}")
-    length = exact(check_length("unit_length_m", unit_length_m))
-    height = exact(check_length("unit_height_m", unit_height_m))
-    thickness = check_length("unit_thickness_m", unit_thickness_m)
-    bond = check_choice("bond", bond, BONDS)
-    lintel = check_choice("lintel", lintel, LINTELS)
-    density = check_density("density_kg_m3", density_kg_m3)
+    length = exact(check("wall", "unit_length_m", unit_length_m))
+    height = exact(check("wall", "unit_height_m", unit_height_m))
+    thickness = check("wall", "unit_thickness_m", unit_thickness_m)
+    bond = check("wall", "bond", bond)
+    lintel = check("wall", "lintel", lintel)
+    density = check("wall", "density_kg_m3", density_kg_m3)
     wall_length, wall_height = units_per_course * length, courses * height
-    min_piece = min(length, height) / 4 if min_piece_m is None else exact(check_length("min_piece_m", min_piece_m))
+    piece = check("wall", "min_piece_m", min_piece_m)  # None for these three: the defaults below
+    lintel_h = check("wall", "lintel_height_m", lintel_height_m)
+    bearing = check("wall", "lintel_bearing_m", lintel_bearing_m)
+    min_piece = min(length, height) / 4 if piece is None else exact(piece)
     holes = _exact_openings(openings, wall_length, wall_height)
     lintels: list[tuple[int, Rect]] = []
     if lintel == "block" and holes:
-        lh = height if lintel_height_m is None else exact(check_length("lintel_height_m", lintel_height_m))
-        lb = (
-            length / 2
-            if lintel_bearing_m is None
-            else exact(check_length("lintel_bearing_m", lintel_bearing_m, zero_ok=True))
-        )
+        lh = height if lintel_h is None else exact(lintel_h)
+        lb = length / 2 if bearing is None else exact(bearing)
         lintels = _lintels(holes, wall_length, wall_height, lh, lb, min_piece)
     pieces = wall_pieces(courses, units_per_course, length, height, bond, holes + [r for _, r in lintels], min_piece)
     if not pieces and not lintels:
@@ -277,10 +277,5 @@ def wall(
             blocks.append(rect_block(name, x1 - x0, y1 - y0, (x0 + x1) / 2, y0, thickness, density))
     for k, (x0, x1, y0, y1) in lintels:
         blocks.append(rect_block(f"lintel{k + 1}", x1 - x0, y1 - y0, (x0 + x1) / 2, y0, thickness, density))
-    return scene_table(
-        blocks,
-        contact=contact if contact is not None else udec_contact(float(height), density),
-        motion=motion,
-        duration_s=duration_s,
-        sample_dt_s=sample_dt_s,
-    )
+    contact_table = contact if contact is not None else udec_contact(float(height), density)
+    return scene_table(blocks, contact=contact_table, motion=motion, duration_s=duration_s, sample_dt_s=sample_dt_s)

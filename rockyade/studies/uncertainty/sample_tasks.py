@@ -117,7 +117,8 @@ def with_measures(runs: pd.DataFrame, measures: dict[str, dict[str, float]], g: 
 
 def prepare(study: UncertaintyStudy) -> None:
     """Generate (and cache) the synthetic records once, before workers start."""
-    from rockyade.motion.synthetic import paper_suite, suite_record
+    from rockyade.motion.suite_cache import suite_record
+    from rockyade.motion.synthetic import paper_suite
 
     for _label, table in study.motions:
         record = table.get("record")
