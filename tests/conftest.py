@@ -141,3 +141,14 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
     row = {"test": item.nodeid, "wall_s": wall, "cpu_s": own1 - own0, "children_cpu_s": children1 - children0}
     with open(f"{log}.{worker}", "a", encoding="utf-8") as out:
         out.write(json.dumps(row) + "\n")
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Compile, once and before any test, the solvers' numba code that numba's cache lacks
+    (``make setup`` compiles it: then this only looks): else each ``pytest -n 2`` worker would
+    compile the same kernels at once. An xdist worker leaves it to the controller."""
+    if hasattr(session.config, "workerinput"):
+        return
+    from rockyade.solvers.compile_cache import compile_all
+
+    compile_all(lambda line: print(f"rockyade: {line}", flush=True), missing_only=True)
