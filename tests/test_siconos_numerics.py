@@ -30,6 +30,9 @@ from rockyade.solvers.siconos import SiconosSolver
 from .conftest import EXAMPLES
 from .processes import require_siconos
 
+#: every test here runs Debian's Siconos (a worker or its numerics): make check leaves them to make test
+pytestmark = pytest.mark.siconos
+
 
 @pytest.fixture(scope="module", autouse=True)
 def _siconos_present():
