@@ -23,7 +23,7 @@ $(STAMP): pyproject.toml
 # the solvers' numba code compiled into numba's cache once, here, so that no run and no test
 # worker waits on it; every make looks (a second or two), as a change of a kernel's file stales it
 compiled: $(STAMP)
-	@$(BIN)/python -m rockyade.solvers.compile_cache --quiet
+	@$(BIN)/python -m rockyade.solvers.compile_cache --quiet --workers $(WORKERS)
 
 lint: setup
 	$(BIN)/ruff check .
