@@ -28,15 +28,9 @@ from rockyade.solvers import make_solver
 from rockyade.solvers.siconos import SiconosSolver
 
 from .conftest import EXAMPLES
-from .processes import require_siconos
 
-#: every test here runs Debian's Siconos (a worker or its numerics): make check leaves them to make test
-pytestmark = pytest.mark.siconos
-
-
-@pytest.fixture(scope="module", autouse=True)
-def _siconos_present():
-    require_siconos()
+#: Every test here runs the real Siconos: marked ``siconos`` through the fixture (tests/conftest.py).
+pytestmark = pytest.mark.usefixtures("siconos_present")
 
 
 def _raised(gap_m: float, duration_s: float = 1.0) -> dict:
