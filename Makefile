@@ -7,9 +7,9 @@ STAMP := $(VENV)/.installed-stamp
 WORKERS ?= 2
 OUT ?= reports/paper
 
-.PHONY: setup system test lint check run bench bench-all clean
+.PHONY: setup system compiled test lint check run bench bench-all clean
 
-setup: system $(STAMP)
+setup: system $(STAMP) compiled
 
 system:
 	@tools/install-system-deps.sh
@@ -19,6 +19,11 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@touch $(STAMP)
+
+# the solvers' numba code compiled into numba's cache once, here, so that no run and no test
+# worker waits on it; every make looks (a second or two), as a change of a kernel's file stales it
+compiled: $(STAMP)
+	@$(BIN)/python -m rockyade.solvers.compile_cache --quiet --workers $(WORKERS)
 
 lint: setup
 	$(BIN)/ruff check .

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import resource
+import time
 from pathlib import Path
 
 import pytest
@@ -106,3 +109,46 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
         for engine in ENGINE_MARKERS:
             if engine in values or f"{engine}_present" in getattr(item, "fixturenames", ()):
                 item.add_marker(getattr(pytest.mark, engine))
+
+
+#: Environment variable naming a file that receives, one JSON line per test, its wall and CPU
+#: seconds (this process and the children it waited for: subprocesses, CLI runs, engines'
+#: workers that ended); each xdist worker appends to its own ``<file>.<worker>``. Unset: nothing.
+CPU_LOG_ENV = "ROCKYADE_TEST_CPU_LOG"
+
+
+def _cpu_s() -> tuple[float, float]:
+    """CPU seconds (user + system) of this process and of its waited-for children."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime, children.ru_utime + children.ru_stime
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
+    """With ``$ROCKYADE_TEST_CPU_LOG`` set, log each test's wall and CPU time (set-up, call and
+    tear-down together): the suite's cost measured where the machine is shared."""
+    log = os.environ.get(CPU_LOG_ENV)
+    if not log:
+        yield
+        return
+    own0, children0 = _cpu_s()
+    start = time.perf_counter()
+    yield
+    wall = time.perf_counter() - start
+    own1, children1 = _cpu_s()
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
+    row = {"test": item.nodeid, "wall_s": wall, "cpu_s": own1 - own0, "children_cpu_s": children1 - children0}
+    with open(f"{log}.{worker}", "a", encoding="utf-8") as out:
+        out.write(json.dumps(row) + "\n")
+
+
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Compile, once and before any test, the solvers' numba code that numba's cache lacks
+    (``make setup`` compiles it: then this only looks): else each ``pytest -n 2`` worker would
+    compile the same kernels at once. An xdist worker leaves it to the controller."""
+    if hasattr(session.config, "workerinput"):
+        return
+    from rockyade.solvers.compile_cache import compile_all
+
+    compile_all(lambda line: print(f"rockyade: {line}", flush=True), missing_only=True)

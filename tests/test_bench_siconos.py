@@ -19,6 +19,7 @@ BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_siconos.py"
 
 
 @pytest.mark.yade
+@pytest.mark.siconos
 def test_the_siconos_benchmark_runs_every_part_in_its_quick_mode(capsys, monkeypatch):
     require_yade()
     require_siconos()

@@ -113,12 +113,12 @@ class FragilityPlan:
 
     def cost_line(self, workers: int) -> str:
         """The cost of the first round: the longest record's run estimate, times the runs,
-        over the workers."""
+        over the workers (and the solver's compilation, when numba's cache lacks it)."""
         plan = self.stripes
         longest = int(np.argmax(plan.durations_s))
         top = max(self.levels_si)
         estimate = plan.solver.estimate_cost(plan.scene_for(longest, plan.load_factor(longest, top)))
-        total = estimate.wall_time_s * self.runs_planned / max(workers, 1)
+        total = estimate.wall_time_s * self.runs_planned / max(workers, 1) + estimate.compile_s
         return (
             f"cost: {self.runs_planned} runs of {plan.solver.name}, each at most {estimate.describe()}; "
             f"about {duration_text(total)} on {workers} worker(s)"

@@ -49,7 +49,7 @@ def cmd_compare(args: argparse.Namespace) -> int:
     for solver in [*runners, *finer]:
         check_scene(solver, scene)
         estimates.append(check_cost(scene, solver, allow_large=args.allow_large))
-    seconds = sum(e.wall_time_s for e in estimates)
+    seconds = sum(e.wall_time_s for e in estimates) + sum({e.solver: e.compile_s for e in estimates}.values())
     print(
         f"cost: {len(estimates)} run(s), about {duration_text(seconds)} in all, one after another on an idle machine ("
         + ", ".join(

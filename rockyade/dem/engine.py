@@ -7,9 +7,7 @@ Both the reference DEM solver and the matched calibration run models through her
 from __future__ import annotations
 
 import math
-import sys
 import time
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -196,13 +194,6 @@ def simulate_model(
 _WARM: set[str] = set()
 
 
-def _compiled_kernel_cached() -> bool:
-    """True when numba's on-disk cache holds the kernel (next to the module, where numba puts
-    it when that folder is writable; elsewhere the note below may show once per process)."""
-    cache = Path(kernel.__file__).parent / "__pycache__"
-    return any(cache.glob("simulation.simulate-*.nbi"))
-
-
 def warm_up(single: bool = False, runs: bool = False) -> None:
     """Run the kernel (``single``: the single-body path, :mod:`rockyade.kernel.single`;
     ``runs``: many runs at once, :mod:`rockyade.kernel.runs`) once on a tiny problem so that
@@ -225,12 +216,6 @@ def warm_up(single: bool = False, runs: bool = False) -> None:
             *pack(tiny_problem(), stop_on_overturn=True, record_energy=False, record_corners=True, coherent=True)
         )
         return
-    if not _compiled_kernel_cached():
-        print(
-            "rockyade: compiling the DEM kernel (numba, once per installation: 20-40 s) ...",
-            file=sys.stderr,
-            flush=True,
-        )
     flags = {"stop_on_overturn": True, "record_energy": True, "record_corners": True, "coherent": True}
     kernel.simulate(*pack(tiny_problem(), **flags))
 

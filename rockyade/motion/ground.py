@@ -112,10 +112,13 @@ class GroundMotion:
 
     def __init__(self, t_s: ArrayLike, ah_m_s2: ArrayLike, av_m_s2: ArrayLike | None = None, label: str = "") -> None:
         # Written out (not the dataclass's) so that the arguments may be any array-like and
-        # ``av_m_s2`` None (no vertical motion), while the attributes are always float arrays.
-        t = np.ascontiguousarray(t_s, dtype=float)
-        ah = np.ascontiguousarray(ah_m_s2, dtype=float)
-        av = np.zeros_like(ah) if av_m_s2 is None else np.ascontiguousarray(av_m_s2, dtype=float)
+        # ``av_m_s2`` None (no vertical motion), while the attributes are always float arrays,
+        # contiguous and writable (a read-only one, a cached synthetic record's, is copied): numba
+        # compiles a kernel once per argument type, and a read-only array is another type, which
+        # would compile every kernel twice and miss the code ``make setup`` compiled.
+        t = np.require(t_s, dtype=float, requirements=["C", "W"])
+        ah = np.require(ah_m_s2, dtype=float, requirements=["C", "W"])
+        av = np.zeros_like(ah) if av_m_s2 is None else np.require(av_m_s2, dtype=float, requirements=["C", "W"])
         if t.ndim != 1 or t.size < 2 or ah.shape != t.shape or av.shape != t.shape:
             raise ValueError("t_s, ah_m_s2 and av_m_s2 must be 1-D arrays of the same length >= 2")
         if not np.all(np.diff(t) > 0):

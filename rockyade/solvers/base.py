@@ -27,6 +27,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import functools
+import sys
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -211,6 +212,7 @@ def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene]
             from rockyade.limit.standing import check_loads_stand
 
             check_loads_stand(scene)
+        say_if_compiling(self, scene)
         result = run(self, scene)
         if result.meta.motion_coverage is None:
             result.meta = dataclasses.replace(result.meta, motion_coverage=motion_coverage(scene))
@@ -219,6 +221,36 @@ def _with_coverage(run: Callable[[Any, Scene], Result]) -> Callable[[Any, Scene]
         return result
 
     wrapper.records_coverage = True  # type: ignore[attr-defined]
+    return wrapper
+
+
+def say_if_compiling(solver: Any, scene: Scene) -> None:
+    """Say on stderr, before a run, that it compiles the solver's code first (numba's cache
+    lacks it, :meth:`SolverBase.compiled_cached`): else the first run of a process is silent
+    for a minute or more. ``make setup`` compiles it ahead (:mod:`rockyade.solvers.compile_cache`)."""
+    compiled_cached = getattr(solver, "compiled_cached", None)
+    if compiled_cached is None or compiled_cached(scene):
+        return
+    print(
+        f"rockyade: compiling the solver (first run only): {solver.name}, not in numba's cache (about "
+        f"{solver.COMPILE_S:.0f} s of CPU; 'python -m rockyade.solvers.compile_cache' compiles every solver ahead) ...",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+def _with_compile_cost(estimate_cost: Callable[[Any, Scene], CostEstimate]) -> Callable[[Any, Scene], CostEstimate]:
+    """``estimate_cost`` whose estimate counts the compilation a cold cache costs the first run
+    (``compile_s``, :attr:`SolverBase.COMPILE_S`)."""
+
+    @functools.wraps(estimate_cost)
+    def wrapper(self: Any, scene: Scene) -> CostEstimate:
+        estimate = estimate_cost(self, scene)
+        if self.COMPILE_S and not estimate.compile_s and not self.compiled_cached(scene):
+            estimate = dataclasses.replace(estimate, compile_s=self.COMPILE_S)
+        return estimate
+
+    wrapper.counts_compile = True  # type: ignore[attr-defined]
     return wrapper
 
 
@@ -236,6 +268,10 @@ class SolverBase:
     #: The solver computes in this process (numba code a parent loads once before it forks
     #: workers); False: it runs another program (YADE, Siconos).
     IN_PROCESS: ClassVar[bool] = False
+    #: CPU time compiling this solver's numba code when the cache lacks it, s (0: it compiles
+    #: nothing here), every path it takes; measured by ``python -m rockyade.solvers.compile_cache``
+    #: on a cold cache (the 2-core machine: reference 79 s, twoblock 24 s, housner 9 s).
+    COMPILE_S: ClassVar[float] = 0.0
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
@@ -243,6 +279,9 @@ class SolverBase:
         if run is not None and not getattr(run, "records_coverage", False):
             # Replacing each subclass's own run with its wrapped self is deliberate (class docstring).
             cls.run = _with_coverage(run)  # type: ignore[method-assign,assignment]
+        estimate = cls.__dict__.get("estimate_cost")
+        if estimate is not None and not getattr(estimate, "counts_compile", False):
+            cls.estimate_cost = _with_compile_cost(estimate)  # type: ignore[method-assign,assignment]
 
     @classmethod
     def from_options(cls, options: Mapping[str, Any], fields: Mapping[str, str] | None = None) -> Self:
@@ -273,6 +312,12 @@ class SolverBase:
         (:func:`rockyade.solvers.cost_estimate.numba_cached`): else the first run in a process
         compiles it. True for a solver that compiles nothing here."""
         return True
+
+    def warm_up(self) -> None:
+        """Load this solver's compiled code in this process, compiling it into numba's cache
+        when the cache lacks it (:mod:`rockyade.solvers.compile_cache`); nothing for a solver
+        that compiles nothing here."""
+        return None
 
     def check_scene(self, scene: Scene) -> None:
         """Refuse, before anything runs, a scene that :meth:`run` would refuse with an

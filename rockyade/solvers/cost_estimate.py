@@ -53,6 +53,10 @@ class CostEstimate:
         Peak memory, bytes (estimate).
     wall_time_s
         Run time, s (order of magnitude).
+    compile_s
+        CPU time compiling the solver's code before the run, s: 0 when numba's cache holds it
+        (``make setup`` compiles it, :mod:`rockyade.solvers.compile_cache`), else once per
+        process (the first run); not in ``wall_time_s``, which each run of a study costs.
     """
 
     solver: str
@@ -63,6 +67,7 @@ class CostEstimate:
     motion_samples: int
     memory_bytes: float
     wall_time_s: float
+    compile_s: float = 0.0
 
     def over_limits(self, limits: dict[str, float]) -> list[str]:
         """The limits this run exceeds (names of ``limits``, e.g. :data:`rockyade.runner.cost_limits.LIMITS`)."""
@@ -73,9 +78,12 @@ class CostEstimate:
         steps = f"{self.integration_steps:.3g} integration steps"
         if not math.isnan(self.time_step_s):
             steps += f" (dt = {self.time_step_s:.3g} s)"
+        compiling = ""
+        if self.compile_s:
+            compiling = f" after ~{duration_text(self.compile_s)} of CPU compiling the solver (first run only)"
         return (
             f"{steps}, {self.output_samples:.3g} output samples, {self.motion_samples:.3g} motion samples, "
-            f"~{self.memory_bytes / 1024**3:.2g} GiB, ~{duration_text(self.wall_time_s)}"
+            f"~{self.memory_bytes / 1024**3:.2g} GiB, ~{duration_text(self.wall_time_s)}{compiling}"
         )
 
 
@@ -180,15 +188,24 @@ def estimate_dict(estimate: CostEstimate) -> dict[str, Any]:
 
 
 def numba_cached(*kernels: object) -> bool:
-    """Whether numba's on-disk cache holds every one of ``kernels`` (compiled functions): else
-    the first run in a process compiles them (a minute of CPU). Read from numba's index of each
-    function's cache, empty when missing or of another source (stale); should numba's internals
-    move, the cache is taken to be there (the smaller estimate)."""
+    """Whether running ``kernels`` (compiled functions) compiles nothing: each is loaded in this
+    process already, or numba's on-disk cache holds it; else the first run in a process
+    compiles it (a minute of CPU). Read from numba's index of each function's cache, empty when
+    missing or of another source (stale); should numba's internals move, the cache is taken to
+    be there (the smaller estimate). A cache found is remembered for the process."""
     for kernel in kernels:
+        if getattr(kernel, "overloads", None) or id(kernel) in _FOUND_CACHED:
+            continue
         try:
             cache: Any = getattr(kernel, "_cache", None)
             if not cache._cache_file._load_index():
                 return False
         except Exception:
             return True
+        _FOUND_CACHED.add(id(kernel))
     return True
+
+
+#: ``id`` of the compiled functions whose on-disk cache :func:`numba_cached` found (module-level
+#: functions: they live as long as the process).
+_FOUND_CACHED: set[int] = set()

@@ -25,7 +25,7 @@ from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
-from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage
+from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage, say_if_compiling
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 
 
@@ -44,6 +44,7 @@ class HousnerSolver(SolverBase):
     name: ClassVar[str] = "housner"
     IN_PROCESS = True
     OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
+    COMPILE_S: ClassVar[float] = 9.0
 
     dt_factor: float = 1.0
 
@@ -53,6 +54,10 @@ class HousnerSolver(SolverBase):
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the integrator (:data:`rockyade.housner.integrator.KERNELS`)."""
         return numba_cached(*KERNELS)
+
+    def warm_up(self) -> None:
+        """Load (or compile) the integrator (:func:`rockyade.housner.integrator.warm_up`)."""
+        warm_up()
 
     def _step_s(self, model: HousnerModel) -> float:
         """The largest Runge-Kutta step, s: ``dt_factor`` / (``STEPS_PER_RADIAN`` p)."""
@@ -139,6 +144,7 @@ class HousnerSolver(SolverBase):
             In the scenes' order: each run's metadata (as :meth:`run`'s Result, without the
             history; ``wall_time_s`` the run's integration) and its sampled theta.
         """
+        say_if_compiling(self, scenes[0])
         start = time.perf_counter()
         first = scenes[0]
         if len(first.blocks) != 1:

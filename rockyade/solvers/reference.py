@@ -47,7 +47,15 @@ from rockyade.kernel.state import pack
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
-from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, check_flag, classical_meta, motion_coverage
+from rockyade.solvers.base import (
+    GroupRun,
+    SolverBase,
+    check_dt_factor,
+    check_flag,
+    classical_meta,
+    motion_coverage,
+    say_if_compiling,
+)
 from rockyade.solvers.cost_estimate import CostEstimate, dem_cost, numba_cached
 
 _STATUS_NAMES = {
@@ -79,6 +87,7 @@ class ReferenceSolver(SolverBase):
     OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag, "dt_factor": check_dt_factor}
     #: Kernel time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 150e-9
+    COMPILE_S: ClassVar[float] = 80.0
 
     record_energy: bool = True
     record_contacts: bool = True
@@ -92,6 +101,13 @@ class ReferenceSolver(SolverBase):
         grouped and single-body paths, for several the general loop."""
         single = len(scene.blocks) == 1
         return numba_cached(*((simulate_runs, simulate_single) if single else (kernel.simulate,)))
+
+    def warm_up(self) -> None:
+        """Load (or compile) the three paths of the kernel: the general loop, the single-body
+        path and the runs stepped together (:func:`rockyade.dem.engine.warm_up`)."""
+        warm_up()
+        warm_up(single=True)
+        warm_up(runs=True)
 
     def run(self, scene: Scene) -> Result:
         """Run a scene with the reference DEM.
@@ -150,6 +166,7 @@ class ReferenceSolver(SolverBase):
             In the scenes' order: each run's metadata (as :meth:`run`'s Result, without the
             history) and its sampled theta.
         """
+        say_if_compiling(self, scenes[0])
         start = time.perf_counter()
         base = calibrated_model(scenes[0]).with_dt_factor(self.dt_factor)
         models = [base] + [

@@ -15,9 +15,9 @@ from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.solvers.base import SolverBase, check_dt_factor
-from rockyade.solvers.cost_estimate import CostEstimate, sample_cost
+from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 from rockyade.twoblock import TwoBlockModel, TwoBlockTrajectory, solve, two_block_model, warm_up
-from rockyade.twoblock.event_driven import REST_FRACTION
+from rockyade.twoblock.event_driven import REST_FRACTION, integrate
 from rockyade.twoblock.time_history import two_block_frame
 from rockyade.twoblock.trajectory import max_step
 
@@ -49,11 +49,20 @@ class TwoBlockSolver(SolverBase):
     name: ClassVar[str] = "twoblock"
     IN_PROCESS = True
     OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
+    COMPILE_S: ClassVar[float] = 24.0
 
     dt_factor: float = 1.0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
+
+    def compiled_cached(self, scene: Scene) -> bool:
+        """Whether numba's cache holds the event-driven integrator."""
+        return numba_cached(integrate)
+
+    def warm_up(self) -> None:
+        """Load (or compile) the integrator (:func:`rockyade.twoblock.warm_up`)."""
+        warm_up()
 
     def model(self, scene: Scene) -> TwoBlockModel:
         """The scene's stack (:func:`rockyade.twoblock.two_block_model`), with the scene's mu

@@ -5,9 +5,7 @@ from __future__ import annotations
 
 import functools
 import math
-import sys
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -217,24 +215,12 @@ def solve(
     )
 
 
-def _compiled_cached() -> bool:
-    """True when numba's on-disk cache holds the integrator (next to the module, where numba
-    puts it when that folder is writable)."""
-    return any((Path(integ.__file__).parent / "__pycache__").glob("event_driven.integrate-*.nbi"))
-
-
 @functools.cache
 def warm_up() -> None:
     """Load the compiled kernel once per process, so that wall times measure the solve (the
-    first run after an installation compiles it: a note says so)."""
+    first run after an installation compiles it: the solver says so,
+    :func:`rockyade.solvers.base.say_if_compiling`)."""
     from rockyade.twoblock.stack import TwoBlockModel
-
-    if not _compiled_cached():
-        print(
-            "rockyade: compiling the two-block solver (numba, once per installation: about a minute) ...",
-            file=sys.stderr,
-            flush=True,
-        )
 
     model = TwoBlockModel(
         names=("lower", "upper"),
