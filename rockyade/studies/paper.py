@@ -21,7 +21,7 @@ from pathlib import Path
 
 from rockyade import __version__
 from rockyade.io.atomic import write_text
-from rockyade.studies.report import Report
+from rockyade.studies.report import Report, cpu_seconds
 
 PARTS = ("tables", "free", "harmonic", "random", "patterns", "sensitivity", "fragility", "overturning", "crosscheck")
 
@@ -68,7 +68,7 @@ def run_paper_study(
 
     report = Report(Path(out))
     report.out.mkdir(parents=True, exist_ok=True)
-    timings = {}
+    timings: dict[str, tuple[float, float]] = {}
     steps = {
         "tables": lambda: run_tables(report),
         "free": lambda: free_rocking.run(report, workers, use_yade),
@@ -84,7 +84,7 @@ def run_paper_study(
         if part not in parts:
             continue
         report.part = part
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), cpu_seconds()
         print(f"[paper] {part} ...", flush=True)
         sections_before = len(report.sections)
         try:
@@ -98,16 +98,17 @@ def run_paper_study(
             report.note(f"**This part stopped with an error** and its results are missing or partial: {reason}.")
             report.record(f"part '{part}'", "-", "failed", reason)
             print(f"[paper] {part} FAILED: {reason}", file=sys.stderr, flush=True)
-        timings[part] = time.perf_counter() - start
+        timings[part] = (time.perf_counter() - start, cpu_seconds() - cpu_start)
         report.close_part(part)
         n_failed = len(report.failures(part))
         tail = f", {n_failed} FAILED run(s)" if n_failed else ""
-        print(f"[paper] {part} done in {timings[part]:.0f} s{tail}", flush=True)
+        wall, cpu = timings[part]
+        print(f"[paper] {part} done in {wall:.0f} s ({cpu:.0f} s of CPU){tail}", flush=True)
     report.part = "run"
     report.section(
         "Run",
-        "Wall time of each part (s): "
-        + ", ".join(f"{k} {v:.0f}" for k, v in timings.items())
+        "Wall time of each part (s; CPU time, all processes, in brackets): "
+        + ", ".join(f"{k} {wall:.0f} ({cpu:.0f})" for k, (wall, cpu) in timings.items())
         + f"; rockyade {__version__}, {workers} worker(s), YADE {'on' if use_yade else 'off'}.",
     )
     report.write_index(

@@ -25,7 +25,7 @@ from rockyade.assess import paper_suite_set, parse_measure
 from rockyade.runner import Executor
 from rockyade.scene import Scene, scene_from_dict
 from rockyade.studies.crosscheck import Summary, crosscheck_plan, run_crosscheck
-from rockyade.studies.report import Report
+from rockyade.studies.report import Report, cpu_seconds
 from rockyade.studies.specimen_scenes import block_table, scene_dict
 
 SPECIMENS = ("1", "2", "3", "4")
@@ -114,11 +114,15 @@ def run_job(job: Job, out: Path, executor: Executor) -> Summary:
         dt_factors=job.dt_factors,
         resolution=job.resolution,
         executor=executor,
-        progress=False,
+        progress=True,
     )
     target = out / "crosscheck" / job.folder
     resume = (target / "partial").is_dir()
-    return run_crosscheck(plan, target, executor, resume=resume, progress=False, say=lambda _s: None)
+
+    def say(line: str) -> None:
+        print(f"[paper] crosscheck, {job.label}: {line}", flush=True)
+
+    return run_crosscheck(plan, target, executor, resume=resume, progress=True, say=say)
 
 
 def run(report: Report, workers: int, use_yade: bool = True) -> None:
@@ -140,9 +144,12 @@ def run(report: Report, workers: int, use_yade: bool = True) -> None:
     todo, left_out = jobs(use_yade)
     for job in todo:
         label, folder = job.label, job.folder
-        start = time.perf_counter()
+        start, cpu_start = time.perf_counter(), cpu_seconds()
+        print(f"[paper] crosscheck, {label}: {', '.join(job.solvers)}, {job.records} records", flush=True)
         summary = run_job(job, report.out, executor)
-        timings.append(f"{label} {time.perf_counter() - start:.0f} s")
+        wall, cpu = time.perf_counter() - start, cpu_seconds() - cpu_start
+        timings.append(f"{label} {wall:.0f} s ({cpu:.0f} s of CPU)")
+        print(f"[paper] crosscheck, {label}: done in {wall:.0f} s ({cpu:.0f} s of CPU)", flush=True)
         for _, row in summary.runs.iterrows():
             reason = row["failure_reason"] if isinstance(row["failure_reason"], str) else ""
             status = "failed" if row["collapsed"] is None or pd.isna(row["collapsed"]) else str(row["status"])

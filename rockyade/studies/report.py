@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import re
+import resource
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -145,6 +146,13 @@ class Report:
         self.index_path = self.out / "index.md"
         write_text(self.index_path, "\n".join(lines))
         return self.index_path
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process and of its finished children (the workers of each batch, YADE,
+    Siconos), user + system, s: the part's cost on an idle machine, which a loaded one hides."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
 def describe_failures(solver: str, reason: str, runs: Sequence[str], shown: int = 3) -> str:
