@@ -58,7 +58,9 @@ QUICK: dict[str, tuple[list[str], list[str], str]] = {
 RUN_ELSEWHERE = {
     "bench_siconos.py": "tests/test_bench_siconos.py",
     "bench_limit.py": "tests/test_limit_large.py::test_the_benchmark_runs_in_its_quick_mode",
-    "bench_twoblock.py": "tests/test_twoblock.py::test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling",
+    "bench_twoblock.py": (
+        "tests/test_twoblock.py::test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling"
+    ),
 }
 #: Not benchmarks: a module the others import, and the runner of them all.
 HELPERS = {"floor.py", "run_all.py"}
@@ -74,6 +76,7 @@ def test_every_benchmark_script_is_run_by_a_test():
         assert not name or f"def {name}(" in (root / path).read_text(), test
 
 
+@pytest.mark.slow  # about 4 min of CPU over all the scripts (the machine's load decides the wall time)
 @pytest.mark.parametrize(
     "script",
     [
