@@ -153,7 +153,10 @@ def cpu_seconds() -> float:
     """CPU time, user + system, s, of this process and of every process below it: the finished
     ones (the workers of each batch, the solvers' programs they waited for) and the ones still
     running (a warm YADE or Siconos program kept between runs, read from ``/proc`` where there is
-    one): a part's cost on an idle machine, which a loaded one hides in its wall time."""
+    one): a part's cost on an idle machine, which a loaded one hides in its wall time. Not
+    counted: a program whose parent ended without waiting for it (the warm YADE and Siconos
+    programs of a batch's workers, which end with their worker): its time is lost to every
+    parent, so YADE's and Siconos's runs are missing from the figure."""
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime + _running_descendants_cpu()
 
