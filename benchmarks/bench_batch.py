@@ -1,22 +1,33 @@
 """The collapse study as a batch: 1,200 reference-DEM runs of 25 s (4 specimens x 30
 synthetic records x load factors 0.1-1.0), on 2 local processes and on a 2-worker Dask
-LocalCluster (loopback): wall time and runs per second."""
+LocalCluster (loopback): wall time and runs per second.
+
+Run: ``python benchmarks/bench_batch.py [--quick]`` (``--quick``: specimen 1, 3 records, 2 load
+factors, local processes only; a test runs it so that it cannot rot)."""
 
 from __future__ import annotations
 
+import sys
 import tempfile
 import time
 from pathlib import Path
 
+from rockyade.paper import SINGLE_SPECIMENS
 from rockyade.studies import fragility_study
 
 LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 11))
 
 
 def main() -> None:
-    fragility_study.prepare()
+    quick = "--quick" in sys.argv[1:]
+    grid = (
+        {"specimens": ("1",), "records": range(1, 4), "load_factors": (0.3, 0.6)}
+        if quick
+        else {"load_factors": LOAD_FACTORS}
+    )
+    fragility_study.prepare(grid.get("specimens", SINGLE_SPECIMENS))
     out = Path(tempfile.mkdtemp(prefix="rockyade-bench-batch-"))
-    tasks = fragility_study.tasks(out / "local", load_factors=LOAD_FACTORS, solvers=("reference",))
+    tasks = fragility_study.tasks(**grid, solvers=("reference",))
     from rockyade.batch import run_study_tasks
 
     start = time.perf_counter()
@@ -27,12 +38,14 @@ def main() -> None:
         f"collapse batch, {n} reference-DEM runs of 25 s: local processes (2): {local:.1f} s, {n / local:.1f} runs/s "
         f"({(summary.status == 'overturned').sum()} overturned, {(summary.status == 'failed').sum()} failed)"
     )
+    if quick:
+        return
     try:
         from dask.distributed import LocalCluster
     except ImportError:
         print("dask.distributed not installed: no Dask figure")
         return
-    tasks = fragility_study.tasks(out / "dask", load_factors=LOAD_FACTORS, solvers=("reference",))
+    tasks = fragility_study.tasks(**grid, solvers=("reference",))
     with LocalCluster(
         n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
     ) as cluster:

@@ -5,7 +5,9 @@ time (``time.process_time``) counts all of it; the best of ``--repeat`` passes. 
 study, runs per CPU-second one run at a time and grouped, and their ratio, and checks that
 both give the same verdicts; and the parent's cost of making a study's tasks.
 
-    .venv/bin/python benchmarks/bench_groups.py [--repeat 3]
+    .venv/bin/python benchmarks/bench_groups.py [--repeat 3] [--quick]
+
+``--quick``: one pass over 2 records x 2 load factors (a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -53,7 +55,7 @@ def fragility(solver: str, repeat: int) -> tuple[int, float, float, bool]:
         def work(grouped: bool = grouped) -> Any:
             folder = _folder()
             try:
-                tasks = fragility_study.tasks(folder, ("1",), RECORDS, LOAD_FACTORS, (solver,))
+                tasks = fragility_study.tasks(("1",), RECORDS, LOAD_FACTORS, (solver,))
                 return run_study_tasks(
                     tasks, folder, executor=Executor("threads", 1), progress=False, group_runs=grouped
                 )
@@ -130,21 +132,23 @@ def uncertainty(solver: str, repeat: int) -> tuple[int, float, float, bool]:
 
 def task_making(repeat: int) -> list[tuple[str, int, float]]:
     """The parent's CPU per task to make a study's tasks (scenes read, validated, hashed)."""
-    folder = _folder()
     frag, tasks = best_cpu(
-        lambda: fragility_study.tasks(folder, ("1", "2"), tuple(range(1, 11)), (0.4, 0.8, 1.2, 1.6, 2.0)), repeat
+        lambda: fragility_study.tasks(("1", "2"), tuple(range(1, 11)), (0.4, 0.8, 1.2, 1.6, 2.0)), repeat
     )
     study = _uncertainty_study(["housner", "reference"])
     samples = draw_samples(study)
     unc, utasks = best_cpu(lambda: build_tasks(study, samples), repeat)
-    shutil.rmtree(folder, ignore_errors=True)
     return [("fragility expand", len(tasks), frag), ("uncertainty build_tasks", len(utasks), unc)]
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--quick", action="store_true", help="one pass over 2 records x 2 load factors")
     args = parser.parse_args()
+    if args.quick:
+        global RECORDS, LOAD_FACTORS  # the grids every part reads
+        RECORDS, LOAD_FACTORS, args.repeat = (1, 2), (0.4, 1.2), 1
     fragility_study.prepare(("1", "2"))
     print(f"{'study (small grid)':44s} {'runs':>5s} {'alone':>9s} {'grouped':>9s} {'ratio':>6s}  same")
     print(f"{'':44s} {'':5s} {'runs/CPU-s':>20s}")

@@ -5,11 +5,15 @@
 * Batch API: 1,000 variants of specimen 1 under different harmonic base motions (10 s
   each), through the runner (:func:`rockyade.runner.solve_scenes`) on 1 and 2 threads of
   this process: scenes per second.
+
+Run: ``python benchmarks/bench_reference.py [--quick]`` (``--quick``: 2 s of free rocking and
+10 variants, once; a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
 
 import math
+import sys
 import time
 
 import numpy as np
@@ -52,13 +56,13 @@ def harmonic_scene(freq: float, amp_m: float, duration: float = 10.0):
     )
 
 
-def single_block() -> dict[str, float]:
-    model = calibrated_model(free_scene())
+def single_block(duration: float = 20.0, repeat: int = 3) -> dict[str, float]:
+    model = calibrated_model(free_scene(duration))
     run_model(calibrated_model(free_scene(0.1)))  # JIT warm-up
     out = {}
     for energy in (False, True):
         best = math.inf
-        for _ in range(3):
+        for _ in range(repeat):
             result = run_model(model, record_energy=energy)
             best = min(best, result.meta.wall_time_s)
         out[f"wall_s_energy_{energy}"] = best
@@ -88,15 +92,18 @@ def batch(n: int = 1000) -> dict[str, float]:
 
 
 def main() -> None:
-    s = single_block()
+    quick = "--quick" in sys.argv[1:]
+    duration = 2.0 if quick else 20.0
+    s = single_block(duration, 1 if quick else 3)
     print(
-        f"reference DEM, single block, 20 s simulated at dt = {s['dt_s']:.3g} s ({s['n_steps']} steps): "
+        f"reference DEM, single block, {duration:g} s simulated at dt = {s['dt_s']:.3g} s ({s['n_steps']} steps): "
         f"{s['wall_s_energy_False'] * 1e3:.1f} ms ({s['ns_per_step_energy_False']:.0f} ns/step); "
         f"with energy terms {s['wall_s_energy_True'] * 1e3:.1f} ms ({s['ns_per_step_energy_True']:.0f} ns/step)"
     )
-    b = batch()
+    n = 10 if quick else 1000
+    b = batch(n)
     print(
-        f"reference DEM batch, 1000 x 10 s harmonic variants: {b['scenes_per_s_1_workers']:.1f} scenes/s on 1 thread, "
+        f"reference DEM batch, {n} x 10 s harmonic variants: {b['scenes_per_s_1_workers']:.1f} scenes/s on 1 thread, "
         f"{b['scenes_per_s_2_workers']:.1f} scenes/s on 2 ({b['wall_s_2_workers']:.1f} s; "
         f"{b['overturned']} overturned, {b['failed']} failed)"
     )

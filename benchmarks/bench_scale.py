@@ -18,7 +18,8 @@ measured by ``tracemalloc`` (numpy's arrays, those the numba kernel allocates in
 the Result frame). The ratio is against the single brick under the same motion. The machine
 is shared: the best of several runs is the figure to read.
 
-Run: ``.venv/bin/python benchmarks/bench_scale.py [--sizes 1 10 100 1000] [--duration 0.2]``.
+Run: ``.venv/bin/python benchmarks/bench_scale.py [--sizes 1 10 100 1000] [--duration 0.2] [--quick]``
+(``--quick``: 1 and 10 blocks, 0.02 s, once; a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -111,7 +112,10 @@ def main() -> None:
     parser.add_argument("--sizes", type=int, nargs="+", default=[1, 10, 100, 1000])
     parser.add_argument("--duration", type=float, default=0.2, help="simulated time per case, s")
     parser.add_argument("--repeat", type=int, default=3, help="timed runs per case (the best counts)")
+    parser.add_argument("--quick", action="store_true", help="1 and 10 blocks, 0.02 s, once")
     args = parser.parse_args()
+    if args.quick:
+        args.sizes, args.duration, args.repeat = [1, 10], 0.02, 1
     print(
         f"{'motion':6} {'blocks':>6} {'ns/step':>10} {'ns/block-step':>14} {'ratio':>6} {'pairs':>6} "
         f"{'rebuilds':>8} {'SAT/pair-step':>13} {'build s':>8} {'peak MB':>8}  status"

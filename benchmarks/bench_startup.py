@@ -9,7 +9,8 @@ The bare interpreter (``python -c pass``) is
 printed for scale. Best of ``--repeat`` runs; the machine may be shared, so its load
 average is printed with the numbers.
 
-Run: ``.venv/bin/python benchmarks/bench_startup.py [--repeat 5] [--commands run params]``.
+Run: ``.venv/bin/python benchmarks/bench_startup.py [--repeat 5] [--commands run params] [--quick]``
+(``--quick``: once, the ``params`` command; a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -70,7 +71,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="runs per measurement; the best counts")
     ap.add_argument("--commands", nargs="*", help="commands to time (default: all)")
+    ap.add_argument("--quick", action="store_true", help="once, the params command")
     opts = ap.parse_args()
+    if opts.quick:
+        opts.repeat, opts.commands = 1, opts.commands or ["params"]
     cli = [sys.executable, "-m", "rockyade"]
     commands = opts.commands or command_names()
     with tempfile.TemporaryDirectory() as tmp:

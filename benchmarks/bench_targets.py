@@ -19,7 +19,9 @@ load average is printed. "Before" figures: measured by the project on a quiet 2-
 machine before this work (kernel 60 / 71 ns/step without / with energy terms, a batch run
 75 ms of CPU of which the kernel 53 ms, fragility 14.8 runs/s on 1 worker and 29.3 on 2).
 
-Run: ``.venv/bin/python benchmarks/bench_targets.py [--repeat 5] [--no-wall]`` (or ``make bench``).
+Run: ``.venv/bin/python benchmarks/bench_targets.py [--repeat 5] [--no-wall] [--quick]`` (or ``make bench``);
+``--quick``: every target once on a few runs, no wall (the figures mean nothing; a test runs it so
+that it cannot rot).
 """
 
 from __future__ import annotations
@@ -64,7 +66,7 @@ def best_cpu(fn, repeat: int) -> float:
     return best
 
 
-def kernel_target(repeat: int) -> None:
+def kernel_target(repeat: int, duration_s: float = 25.0) -> None:
     from rockyade.calibration.model_stage import calibrated_model
     from rockyade.dem.engine import model_arrays
     from rockyade.kernel import simulation as kernel
@@ -73,7 +75,7 @@ def kernel_target(repeat: int) -> None:
     from rockyade.scene import load_scene, scene_from_dict
 
     d = load_scene("examples/specimen2_record21.toml").to_dict()
-    d["duration_s"] = 25.0
+    d["duration_s"] = duration_s
     model = calibrated_model(scene_from_dict(d))
     arrays = model_arrays(model)
     flags = {"stop_on_overturn": True, "record_corners": False, "coherent": True}
@@ -98,7 +100,7 @@ def kernel_target(repeat: int) -> None:
         for a, b in zip(general, single, strict=True)
     )
     print(
-        f"kernel, specimen 2 record 21, 25 s ({model.n_steps} steps), ns/step: "
+        f"kernel, specimen 2 record 21, {duration_s:g} s ({model.n_steps} steps), ns/step: "
         + ", ".join(f"{k} {v:.1f}" for k, v in ns.items())
     )
     row(
@@ -153,7 +155,7 @@ def kernel_cpu(tasks) -> tuple[float, float]:
     return one / len(tasks), together / len(tasks)
 
 
-def overhead_target(repeat: int) -> None:
+def overhead_target(repeat: int, records: int = 10) -> None:
     from rockyade.batch.running import output, run_job, run_task
     from rockyade.studies import fragility_study
 
@@ -165,7 +167,7 @@ def overhead_target(repeat: int) -> None:
         nonlocal n
         n += 1
         tasks = fragility_study.tasks(
-            specimens=("2",), records=range(1, 11), load_factors=(0.3,), solvers=("reference",)
+            specimens=("2",), records=range(1, records + 1), load_factors=(0.3,), solvers=("reference",)
         )
         return tasks, output(out / f"o{n}")
 
@@ -202,16 +204,18 @@ def cpu_now() -> float:
     return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
 
 
-def batch_target() -> None:
+def batch_target(specimens: tuple[str, ...] = ("1", "2", "3", "4"), records: int = 30) -> None:
     from rockyade.batch import run_study_tasks
     from rockyade.studies import fragility_study
 
-    fragility_study.prepare()
+    fragility_study.prepare(specimens)
     out = Path(tempfile.mkdtemp(prefix="rockyade-bench-targets-"))
     figures, per_cpu, verdicts = {}, {}, {}
     for name, workers, grouped in (("per-run", 1, False), ("grouped", 1, True), ("grouped", 2, True)):
         folder = out / f"{name}{workers}"
-        tasks = fragility_study.tasks(load_factors=(0.2, 0.4, 0.6, 0.8), solvers=("reference",))
+        tasks = fragility_study.tasks(
+            specimens, range(1, records + 1), load_factors=(0.2, 0.4, 0.6, 0.8), solvers=("reference",)
+        )
         start, cpu = time.perf_counter(), cpu_now()
         summary = run_study_tasks(tasks, folder, workers=workers, progress=False, group_runs=grouped)
         wall, cpu = time.perf_counter() - start, cpu_now() - cpu
@@ -292,14 +296,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=5)
     parser.add_argument("--no-wall", action="store_true", help="leave out the 1,000-block wall")
+    parser.add_argument(
+        "--quick", action="store_true", help="one repeat, a 2 s kernel run, 3 records of one specimen, no wall"
+    )
     args = parser.parse_args()
+    if args.quick:
+        args.repeat, args.no_wall = 1, True
     print(
         f"load average at start: {os.getloadavg()[0]:.2f} on {os.cpu_count()} cores (a shared machine: "
         "read the best of several runs)"
     )
-    kernel_target(args.repeat)
-    overhead_target(args.repeat)
-    batch_target()
+    kernel_target(args.repeat, 2.0 if args.quick else 25.0)
+    overhead_target(args.repeat, 3 if args.quick else 10)
+    if args.quick:
+        batch_target(("2",), 3)
+    else:
+        batch_target()
     if not args.no_wall:
         wall_target()
     print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")

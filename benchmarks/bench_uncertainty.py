@@ -217,12 +217,12 @@ def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("reports/bench_uncertainty"))
-    parser.add_argument("--quick", action="store_true", help="5 samples, 6 records, N up to 100, one seed")
+    parser.add_argument("--quick", action="store_true", help="3 samples, 3 records, N up to 40, one seed")
     parser.add_argument("--only", choices=["sensitivity", "convergence"])
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    samples, records = (5, [1, 2, 3, 4, 5, 6]) if args.quick else (20, "all")
-    sizes, seeds = ((25, 50, 100), (1,)) if args.quick else (CONVERGENCE_SAMPLES, CONVERGENCE_SEEDS)
+    samples, records = (3, [1, 2, 3]) if args.quick else (20, "all")
+    sizes, seeds = ((20, 40), (1,)) if args.quick else (CONVERGENCE_SAMPLES, CONVERGENCE_SEEDS)
     start = time.perf_counter()
     if args.only in (None, "sensitivity"):
         print("sensitivity of specimens 1-4 (Housner, synthetic suite):")

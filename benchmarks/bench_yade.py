@@ -13,6 +13,9 @@
 * Assemblies: dry running-bond walls of about 10 and 100 blocks under a one-sine pulse,
   us per block-step and start-up time of YADE beside the reference DEM's
   (:func:`assembly_costs`, which ``bench_scale.py`` can call).
+
+Run: ``python benchmarks/bench_yade.py [--quick]`` (``--quick``: the 10-block wall, 1 s of
+free rocking, 2 runs of 0.5 s, 2 warm/cold pairs of 1 s; a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -220,11 +223,12 @@ def print_warm_vs_cold(runs: int = 20, duration: float = 20.0) -> None:
     )
 
 
-def main() -> None:
+def main(quick: bool = False) -> None:
     if not yade_backend.yade_available():
         print("YADE is not installed: no YADE figures")
         return
-    for row in assembly_costs():
+    free_s, runs = (1.0, 2) if quick else (20.0, 8)
+    for row in assembly_costs((10,), 0.05) if quick else assembly_costs():
         yade = (
             f"YADE {row['yade_us_per_block_step']:.2f} us/block-step + {row['yade_startup_s']:.2f} s start-up"
             if "yade_us_per_block_step" in row
@@ -236,34 +240,40 @@ def main() -> None:
             else f"reference: {row['reference_error']}"
         )
         print(f"wall of {row['blocks']} blocks, {row['steps']} steps of {row['dt_s']:.3g} s: {yade}; {ref}")
-    model = calibrated_model(scene(20.0))
+    model = calibrated_model(scene(free_s))
     run_model(calibrated_model(scene(0.1)), record_energy=False)  # JIT warm-up
     ref = min(run_model(model, record_energy=False).meta.wall_time_s for _ in range(3))
     y = yade_backend.run_model(model)
     assert y.ok, y.meta.failure_reason
     yade_run, startup = y.meta.wall_time_s, y.meta.startup_time_s
     print(
-        f"specimen 1, 20 s simulated, dt = {model.dt_s:.3g} s ({model.n_steps} steps): YADE {yade_run:.2f} s "
-        f"({yade_run / 20 * 1e3:.0f} ms per simulated s, {1e6 * yade_run / model.n_steps:.1f} us/step) + "
-        f"{startup:.2f} s start-up; reference DEM {ref * 1e3:.1f} ms ({ref / 20 * 1e3:.2f} ms per simulated s)"
+        f"specimen 1, {free_s:g} s simulated, dt = {model.dt_s:.3g} s ({model.n_steps} steps): YADE {yade_run:.2f} s "
+        f"({yade_run / free_s * 1e3:.0f} ms per simulated s, {1e6 * yade_run / model.n_steps:.1f} us/step) + "
+        f"{startup:.2f} s start-up; reference DEM {ref * 1e3:.1f} ms ({ref / free_s * 1e3:.2f} ms per simulated s)"
     )
     print(
         f"reference DEM / YADE per simulated second: {yade_run / ref:.0f}x faster "
         f"({(yade_run + startup) / ref:.0f}x counting YADE's start-up)"
     )
-    scenes = [scene(5.0, 0.05 + 0.01 * k) for k in range(8)]
+    scenes = [scene(0.5 if quick else 5.0, 0.05 + 0.01 * k) for k in range(runs)]
     for workers in (1, 2):
         start = time.perf_counter()
         results = solve_scenes(YadeSolver(), scenes, executor=Executor("threads", workers))
         wall = time.perf_counter() - start
         ok = sum(r.ok for r in results)
         rate = 60 * len(scenes) / wall
-        print(f"YADE, 8 runs of 5 s simulated on {workers} worker(s): {wall:.1f} s, {rate:.0f} runs/min ({ok} ok)")
+        print(
+            f"YADE, {len(scenes)} runs of {scenes[0].duration_s:g} s simulated on {workers} worker(s): {wall:.1f} s, "
+            f"{rate:.0f} runs/min ({ok} ok)"
+        )
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["warm"]:
         print_warm_vs_cold(*(int(a) for a in sys.argv[2:3]))
+    elif "--quick" in sys.argv[1:]:
+        main(quick=True)
+        print_warm_vs_cold(2, 1.0)
     else:
         main()
         print_warm_vs_cold()

@@ -11,6 +11,8 @@ ag 0.25 g), Housner against the reference DEM by ``rockyade crosscheck``'s study
 Usage (minutes each on a quiet 2-core machine)::
 
     .venv/bin/python benchmarks/specimen3_gap.py --variants base,stiff10,p_geom,theoretical --count 6
+
+``--quick``: the ``base`` variant on 2 records, bisection to 10 % (a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -56,7 +58,10 @@ def main() -> None:
     parser.add_argument("--resolution", type=float, default=0.02)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--out", type=Path, default=Path("runs/specimen3_gap"))
+    parser.add_argument("--quick", action="store_true", help="the base variant on 2 records, bisection to 10 %%")
     args = parser.parse_args()
+    if args.quick:
+        args.variants, args.count, args.resolution = "base", 2, 0.1
     executor = Executor("local", args.workers)
     for name in args.variants.split(","):
         the_scene, factors = VARIANTS[name]()

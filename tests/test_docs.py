@@ -1,7 +1,11 @@
 """The documentation stands alone and is true: no path outside the project, the paper
 cited by its title, a licence that matches pyproject, links that resolve, the paper's
 inconsistency counts in step with ``rockyade tables``, and every command and Python
-block of the README and docs/ runs as printed from a fresh checkout (relative paths)."""
+block of the README and docs/ runs as printed from a fresh checkout (relative paths): the
+indented commands each in a fresh folder, the fenced ones page by page in order (a later one
+may read what an earlier one wrote), and where a page shows a command's output (``$ command``
+then its lines) the lines it shows are the ones printed, in that order (``...`` stands for
+lines left out; a wall time is a number that may differ)."""
 
 from __future__ import annotations
 
@@ -29,23 +33,98 @@ BIN = Path(sys.executable).parent
 #: Paths of the development machine that users do not have (spelled so that this file
 #: does not contain them).
 OUTSIDE = ("../" + "shared", "/work/" + "shared")
-#: Commands of the docs that need more than a test can give: the whole paper study (make run
-#: runs it) and a Dask cluster (placeholder address).
-NOT_RUN_HERE = ("rockyade paper", "SCHEDULER")
+#: Commands of the docs that need more than a test can give, each with the reason: the whole
+#: paper study and the assemblies' verification (``make run`` runs both: minutes), a Dask
+#: cluster and a study named by placeholders (``SCHEDULER``, ``tcp://host``, ``STUDY.toml``).
+NOT_RUN_HERE = ("rockyade paper", "rockyade verify", "SCHEDULER", "tcp://host", "STUDY.toml")
+#: What may differ between the page and the run in a shown output line: wall times.
+VOLATILE = (re.compile(r"wall time [0-9.e+-]+ s"), re.compile(r", [0-9.e+-]+ s \(total\)"))
+
+
+def _shown(page: Path) -> list[tuple[str, list[str], bool]]:
+    """Every command of the page, in order: (command, the output lines the page shows after it,
+    whether it is in a fenced block). Indented blocks: `.venv/bin/...` lines; fenced blocks:
+    `rockyade ...` or `.venv/bin/rockyade ...` lines (continued by a trailing backslash, a
+    trailing ``# comment`` dropped). Output: the lines after a ``$ command`` up to a blank line,
+    the next command or the block's end."""
+    out: list[tuple[str, list[str], bool]] = []
+    fenced = False
+    lines = page.read_text().splitlines()
+    i = 0
+    while i < len(lines):
+        line = lines[i]
+        i += 1
+        if line.lstrip().startswith("```"):
+            fenced = not fenced
+            continue
+        pattern = r"^\s*(\$ )?((?:\.venv/bin/)?rockyade [a-z].*)$" if fenced else r"^ {4}(\$ )?(\.venv/bin/\S+.*)$"
+        m = re.match(pattern, line)
+        if not m:
+            continue
+        command = m.group(2)
+        while command.endswith("\\") and i < len(lines):
+            command = command[:-1] + " " + lines[i].strip()
+            i += 1
+        command = " ".join(re.sub(r"\s+#.*$", "", command).split())
+        shown: list[str] = []
+        while m.group(1) and i < len(lines) and lines[i].strip() and not lines[i].lstrip().startswith("```"):
+            if re.match(pattern, lines[i]) or not (fenced or lines[i].startswith("    ")):
+                break
+            if lines[i].lstrip().startswith("$ "):  # another program's command (yade ...): no more output
+                break
+            shown.append(lines[i] if fenced else lines[i][4:])
+            i += 1
+        out.append((command, shown, fenced))
+    return out
 
 
 def _commands(page: Path) -> list[str]:
     """Every `.venv/bin/...` line of the page's indented blocks, in order."""
-    out = []
-    for line in page.read_text().splitlines():
-        m = re.match(r"^ {4}(?:\$ )?(\.venv/bin/\S+.*)$", line)
-        if m and not any(skip in m.group(1) for skip in NOT_RUN_HERE):
-            out.append(m.group(1).strip())
-    return out
+    return [c for c, _, fenced in _shown(page) if not fenced and not any(skip in c for skip in NOT_RUN_HERE)]
 
 
 #: Each documented command once (pages repeat some), with the first page that shows it.
 COMMANDS = {command: page.relative_to(ROOT).as_posix() for page in reversed(PAGES) for command in _commands(page)}
+#: The output lines each command's page shows (the first page that shows any).
+OUTPUTS = {c: shown for page in reversed(PAGES) for c, shown, _ in _shown(page) if shown}
+#: Pages with fenced commands, run in order in one folder per page.
+FENCED = {
+    page.relative_to(ROOT).as_posix(): [
+        (c, shown) for c, shown, fenced in _shown(page) if fenced and not any(skip in c for skip in NOT_RUN_HERE)
+    ]
+    for page in PAGES
+}
+FENCED = {page: commands for page, commands in FENCED.items() if commands}
+
+
+def _same(shown: str, printed: str) -> bool:
+    """A shown output line is the printed one (wall times aside)."""
+    for pattern in VOLATILE:
+        shown, printed = pattern.sub("<time>", shown), pattern.sub("<time>", printed)
+    return shown.rstrip() == printed.rstrip()
+
+
+def check_output(command: str, shown: list[str], printed: str) -> None:
+    """Every line the page shows is printed, in the page's order (``...``: lines left out)."""
+    lines = printed.splitlines()
+    at = 0
+    for want in shown:
+        if want.strip() == "...":
+            continue
+        found = next((k for k in range(at, len(lines)) if _same(want, lines[k])), None)
+        assert found is not None, f"{command}\nthe page shows:\n  {want}\nnot printed (in order) in:\n{printed[-3000:]}"
+        at = found + 1
+
+
+def _run_as_printed(command: str, cwd: Path, shown: list[str]) -> None:
+    """Run ``command`` in ``cwd`` with this environment's rockyade; exit 0 (or 2 where the page
+    shows the refusal) and the shown lines printed."""
+    args = shlex.split(command)
+    args[0] = str(BIN / Path(args[0]).name)
+    proc = subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=600)
+    refused = any(line.startswith("rockyade: error:") for line in shown)
+    assert proc.returncode == (2 if refused else 0), f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
+    check_output(command, shown, proc.stdout + proc.stderr)
 
 
 def _python_blocks() -> list[tuple[str, str, list[str]]]:
@@ -187,11 +266,31 @@ def test_python_page_shows_keyword_only_arguments_as_such():
 @pytest.mark.slow
 @pytest.mark.parametrize("command", list(COMMANDS), ids=[f"{COMMANDS[c]}: {c[18:80]}" for c in COMMANDS])
 def test_documented_command_runs_as_printed(command, tmp_path):
-    """Each command of the README and docs/, in a fresh folder; no command needs another's output."""
-    args = shlex.split(command)
-    args[0] = str(BIN / Path(args[0]).name)
-    proc = subprocess.run(args, cwd=_fresh_checkout(tmp_path), capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, f"{COMMANDS[command]}: {command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
+    """Each indented command of the README and docs/, in a fresh folder (no command needs
+    another's output), prints the lines its page shows."""
+    _run_as_printed(command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("page", list(FENCED))
+def test_fenced_commands_run_as_printed(page, tmp_path):
+    """The fenced commands of a page, in order in one folder, print the lines the page shows."""
+    cwd = _fresh_checkout(tmp_path)
+    (cwd / "runs").mkdir()
+    for command, shown in FENCED[page]:
+        _run_as_printed(command, cwd, shown)
+
+
+def test_shown_output_is_compared_line_by_line():
+    """The comparison finds a changed line, a line out of order and lets ``...`` and a wall
+    time through (the docs' outputs are checked by the slow tests above)."""
+    printed = "wrote a.csv\nsolver housner: status completed, wall time 0.01 s\n  max = 1\n"
+    check_output("c", ["wrote a.csv", "...", "solver housner: status completed, wall time 2.5 s"], printed)
+    with pytest.raises(AssertionError, match="max = 2"):
+        check_output("c", ["wrote a.csv", "  max = 2"], printed)
+    with pytest.raises(AssertionError, match=r"wrote a\.csv"):
+        check_output("c", ["  max = 1", "wrote a.csv"], printed)
+    assert any(shown for shown in OUTPUTS.values()) and FENCED  # the pages' outputs and fenced commands are found
 
 
 @pytest.mark.slow

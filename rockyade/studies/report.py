@@ -5,7 +5,9 @@ by cause, and the numbers and sentences of its captions."""
 from __future__ import annotations
 
 import math
+import os
 import re
+import resource
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -145,6 +147,41 @@ class Report:
         self.index_path = self.out / "index.md"
         write_text(self.index_path, "\n".join(lines))
         return self.index_path
+
+
+def cpu_seconds() -> float:
+    """CPU time, user + system, s, of this process and of every process below it: the finished
+    ones (the workers of each batch, the solvers' programs they waited for) and the ones still
+    running (a warm YADE or Siconos program kept between runs, read from ``/proc`` where there is
+    one): a part's cost on an idle machine, which a loaded one hides in its wall time. Not
+    counted: a program whose parent ended without waiting for it (the warm YADE and Siconos
+    programs of a batch's workers, which end with their worker): its time is lost to every
+    parent, so YADE's and Siconos's runs are missing from the figure."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime + _running_descendants_cpu()
+
+
+def _running_descendants_cpu() -> float:
+    """CPU time of the processes below this one that still run, with their own finished
+    children's (``/proc/<pid>/stat``: utime, stime, cutime, cstime), s; 0 without ``/proc``."""
+    proc = Path("/proc")
+    if not (proc / "self" / "stat").is_file():
+        return 0.0
+    tree: dict[int, list[tuple[int, float]]] = {}
+    tick = os.sysconf("SC_CLK_TCK")
+    for stat in proc.glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except (OSError, IndexError):  # a process that ended meanwhile
+            continue
+        ppid, times = int(fields[1]), sum(int(v) for v in fields[11:15]) / tick
+        tree.setdefault(ppid, []).append((int(stat.parent.name), times))
+    total, todo = 0.0, [os.getpid()]
+    while todo:
+        for pid, times in tree.get(todo.pop(), []):
+            total += times
+            todo.append(pid)
+    return total
 
 
 def describe_failures(solver: str, reason: str, runs: Sequence[str], shown: int = 3) -> str:

@@ -1,0 +1,104 @@
+"""Every script of ``benchmarks/`` runs in its quick mode and prints its figures, so that none
+can rot (``make bench`` crashed on a signature that had changed under it). The numbers of a
+quick run mean nothing; what is checked is that the script ends cleanly and prints the lines
+that carry its figures.
+
+Scripts run elsewhere in their quick mode are named in :data:`RUN_ELSEWHERE` with the test
+that runs them; a new script that is in neither list fails
+:func:`test_every_benchmark_script_is_run_by_a_test`."""
+
+from __future__ import annotations
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from .processes import require_siconos, require_yade
+
+BENCHMARKS = Path(__file__).resolve().parents[1] / "benchmarks"
+
+#: Script -> (arguments of its quick run, patterns its output must hold, what it needs).
+QUICK: dict[str, tuple[list[str], list[str], str]] = {
+    "bench_batch.py": (["--quick"], [r"collapse batch, 6 reference-DEM runs of 25 s: .* runs/s"], ""),
+    "bench_groups.py": (
+        ["--quick"],
+        [r"fragility, housner +\d+", r"overturning scans, reference", r"uncertainty, reference", r"ms CPU per task"],
+        "",
+    ),
+    "bench_housner.py": (["--quick"], [r"housner free rocking, 2 s simulated", r"housner under a 2 s record"], ""),
+    "bench_identify.py": (["--quick"], [r"white noise", r"AR\(1\) noise"], ""),
+    "bench_reference.py": (["--quick"], [r"ns/step", r"reference DEM batch, 10 x 10 s harmonic variants"], ""),
+    "bench_scale.py": (["--quick"], [r"^pulse +10 "], ""),
+    "bench_startup.py": (["--quick"], [r"params --help +[0-9.]+", r"run --solver reference \(1 s\)"], ""),
+    "bench_synthetic.py": (["--quick"], [r"synthetic suite, 3 EC8 Type 2 / D records of 20 s"], ""),
+    "bench_targets.py": (
+        ["--quick"],
+        [r"kernel: single-body path / hand-written floor", r"overhead of a 25 s batch run", r"parallel efficiency"],
+        "",
+    ),
+    "bench_uncertainty.py": (
+        ["--quick", "--out", "bench_uncertainty"],
+        [r"sensitivity of specimens 1-4", r"fragility convergence", r"wrote bench_uncertainty in"],
+        "",
+    ),
+    "bench_yade.py": (["--quick"], [r"wall of \d+ blocks", r"YADE, 2 runs of 0.5 s", r"cold and warm"], "yade"),
+    "bench_siconos_mu.py": (["--quick"], [r"^1\. ", r"^2\. ", r"^3\. "], "siconos"),
+    "specimen3_gap.py": (["--quick", "--out", "gap"], [r"\[base\] housner dt x 1 / reference dt x 1: "], ""),
+    # the cross-check suite's smallest run: one specimen, two records, one step, coarse bisection
+    "crosscheck_suite.py": (
+        ["--scenes", "1", "--count", "2", "--dt-factors", "1", "--resolution", "0.1", "--out", "xc"],
+        [r"\| 1 \| housner / reference \| 1 \| 2 \|"],
+        "",
+    ),
+}
+#: Scripts whose quick mode another test runs (script -> that test).
+RUN_ELSEWHERE = {
+    "bench_siconos.py": "tests/test_bench_siconos.py",
+    "bench_limit.py": "tests/test_limit_large.py::test_the_benchmark_runs_in_its_quick_mode",
+    "bench_twoblock.py": (
+        "tests/test_twoblock.py::test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling"
+    ),
+}
+#: Not benchmarks: a module the others import, and the runner of them all.
+HELPERS = {"floor.py", "run_all.py"}
+
+
+def test_every_benchmark_script_is_run_by_a_test():
+    scripts = {p.name for p in BENCHMARKS.glob("*.py")}
+    assert scripts - HELPERS == set(QUICK) | set(RUN_ELSEWHERE)
+    root = BENCHMARKS.parent
+    for test in RUN_ELSEWHERE.values():
+        path, _, name = test.partition("::")
+        assert (root / path).is_file(), test
+        assert not name or f"def {name}(" in (root / path).read_text(), test
+
+
+@pytest.mark.slow  # about 4 min of CPU over all the scripts (the machine's load decides the wall time)
+@pytest.mark.parametrize(
+    "script",
+    [
+        pytest.param(name, marks=[getattr(pytest.mark, needs)] if needs else [])
+        for name, (_, _, needs) in sorted(QUICK.items())
+    ],
+)
+def test_benchmark_runs_in_its_quick_mode(script, tmp_path):
+    args, patterns, needs = QUICK[script]
+    if needs == "yade":
+        require_yade()
+    if needs == "siconos":
+        require_siconos()
+    (tmp_path / "examples").symlink_to(BENCHMARKS.parent / "examples")  # as from a checkout, relative paths
+    proc = subprocess.run(
+        [sys.executable, str(BENCHMARKS / script), *args],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=900,
+    )
+    assert proc.returncode == 0, f"{script}\n{proc.stdout[-2000:]}\n{proc.stderr[-3000:]}"
+    for pattern in patterns:
+        assert re.search(pattern, proc.stdout, re.M), f"{script}: no line matches {pattern!r}\n{proc.stdout[-3000:]}"
+    assert "Traceback" not in proc.stderr, proc.stderr[-3000:]

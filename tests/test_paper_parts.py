@@ -1,0 +1,59 @@
+"""``make run``'s paper study: its cross-check has the bi-block with the exact two-block solver
+and says which PGA it scans; its header names every solver it runs; the CPU time it prints
+counts the processes below it, finished or still running. No study runs here."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from rockyade.solvers import make_solver
+from rockyade.studies import paper, paper_crosscheck
+from rockyade.studies.report import cpu_seconds
+
+
+def test_the_cross_check_has_the_bi_block_with_the_exact_solver_at_both_steps():
+    todo, _ = paper_crosscheck.jobs(use_yade=False)
+    [job] = [j for j in todo if j.folder == "biblock"]
+    assert job.solvers == ("twoblock", "reference") and job.dt_factors == (1.0, 0.5)
+    assert job.records >= 10  # a bootstrap interval that is not "rough"
+    scene = paper_crosscheck.specimen_scene(job.specimen, job.calibration)
+    assert len(scene.blocks) == 2
+    for name in job.solvers:  # both reach the scene's alpha, p and mu (twoblock refuses a mu it cannot reach)
+        make_solver(name).check_scene(scene)
+
+
+def test_the_cross_check_says_its_pga_is_the_records_own_peak_not_ag_s():
+    line = paper_crosscheck.PGA_LINE
+    assert "own peak ground acceleration times the load factor" in line and "ag S" in line
+
+
+def test_the_report_header_names_every_solver_the_parts_run():
+    from rockyade.siconos.backend import siconos_available
+
+    line = paper.solvers_line(paper.PARTS, use_yade=True)
+    for name in ("Housner", "reference DEM", "twoblock", "YADE", "Siconos"):
+        assert name in line, name
+    assert ("not Siconos" in line) != siconos_available()
+    quick = paper.solvers_line(("tables", "free"), use_yade=False)
+    assert "twoblock" not in quick and "Siconos" not in quick and "--no-yade" in quick
+
+
+def test_cpu_time_counts_a_child_still_running_and_after_it_ended():
+    start = cpu_seconds()
+    child = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import time\nt = time.process_time()\nwhile time.process_time() - t < 0.5: pass\n"
+            "import sys; sys.stdout.write('x'); sys.stdout.flush(); time.sleep(30)",
+        ],
+        stdout=subprocess.PIPE,
+    )
+    try:
+        assert child.stdout is not None and child.stdout.read(1) == b"x"  # it has burnt its 0.5 s of CPU
+        assert cpu_seconds() - start >= 0.5  # counted while it runs (/proc)
+    finally:
+        child.kill()
+        child.wait()
+    assert cpu_seconds() - start >= 0.5  # and once it has ended (its parent waited for it)
