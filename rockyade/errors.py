@@ -30,6 +30,26 @@ class InputError(RockyadeError, ValueError):
         super().__init__(f"{where}{field}: {message}")
 
 
+class InputNote(UserWarning):
+    """An input accepted as given but unusual enough to say so (a warning: the ``rockyade``
+    command prints it as one line, ``rockyade: note: FIELD: ...``).
+
+    Parameters
+    ----------
+    field
+        Dotted path of the field, e.g. ``loads[0].mass_kg``.
+    message
+        What is unusual, and what the default would have been.
+    source
+        Optional file name the value came from.
+    """
+
+    def __init__(self, field: str, message: str, source: str | None = None) -> None:
+        self.field = field
+        where = f"{source}: " if source else ""
+        super().__init__(f"{where}{field}: {message}")
+
+
 class CalibrationError(RockyadeError):
     """A calibration that cannot be carried out (e.g. target outside the reachable range)."""
 

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rockyade.constants import G
-from rockyade.errors import InputError
+from rockyade.errors import InputError, InputNote
 from rockyade.housner import housner_model
 from rockyade.limit import limit_analysis
 from rockyade.scene import scene_from_dict
@@ -121,6 +121,39 @@ def test_a_negative_load_mass_is_refused():
     with pytest.raises(InputError) as info:
         block_scene(top_load(0.0, 100.0, mass=-1.0))
     assert info.value.field == "loads[0].mass_kg"
+
+
+def test_a_load_mass_ten_times_its_weight_over_g_is_accepted_with_a_note(tmp_path, capsys):
+    """Issue 34: mass_kg = 10 N / g was accepted silently (a unit slip, or a floor carried
+    elsewhere): accepted as given, with a note naming the field, the ratio and the default; the
+    command prints it as one line and exits 0. A mass within twice N / g, or none, says nothing."""
+    import warnings
+
+    from rockyade.cli import main
+
+    with pytest.warns(
+        InputNote, match=r"loads\[0\]\.mass_kg: 1\.019e\+04 kg is 10 times the load's weight / g"
+    ) as notes:
+        scene = block_scene(top_load(0.0, 10000.0, mass=10 * 10000.0 / G))
+    assert scene.loads[0].mass_kg == pytest.approx(10 * 10000.0 / G)  # as given
+    assert "mass_kg = -fy / g" in str(notes[0].message)
+    with pytest.warns(InputNote, match="does not weigh on the block"):
+        block_scene(top_load(0.0, 0.0, mass=500.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputNote)
+        block_scene(top_load(0.0, 10000.0, mass=2 * 10000.0 / G))
+        block_scene(top_load(0.0, 10000.0, mass=None))
+        block_scene(top_load(0.0, 10000.0, mass=0.0))
+    path = tmp_path / "heavy.toml"
+    path.write_text(
+        "duration_s = 1.0\nsample_dt_s = 0.01\n"
+        '[[blocks]]\nname = "pier"\nwidth_m = 0.4\nheight_m = 2.0\nthickness_m = 1.0\nmass_kg = 1000\n'
+        '[motion]\ntype = "rest"\n'
+        '[[loads]]\nblock = "pier"\npoint_m = [0.0, 2.0]\nforce_N = [0.0, -5000.0]\nmass_kg = 5097\n'
+    )
+    assert main(["params", "--scene", str(path)]) == 0
+    err = [line for line in capsys.readouterr().err.splitlines() if line]
+    assert len(err) == 1 and err[0].startswith("rockyade: note: ") and "loads[0].mass_kg: 5097 kg is 10 times" in err[0]
 
 
 def test_the_default_mass_is_the_weight_over_g():

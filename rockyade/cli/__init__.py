@@ -24,6 +24,7 @@ import os
 import re
 import sys
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
@@ -151,7 +152,27 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_INTERRUPTED
 
 
+def _show_notes_as_lines() -> None:
+    """An :class:`~rockyade.errors.InputNote` (an input accepted but unusual) prints as one line,
+    ``rockyade: note: ...``; other warnings as Python shows them."""
+    from rockyade.errors import InputNote
+
+    shown = warnings.showwarning
+    if getattr(shown, "rockyade_notes", False):  # installed by an earlier main() in this process
+        return
+
+    def show(message: Warning | str, category: type[Warning], *rest: Any, **kwargs: Any) -> None:
+        if issubclass(category, InputNote):
+            _error(f"note: {message}")
+        else:
+            shown(message, category, *rest, **kwargs)
+
+    show.rockyade_notes = True  # type: ignore[attr-defined]
+    warnings.showwarning = show
+
+
 def _main(argv: Sequence[str] | None) -> int:
+    _show_notes_as_lines()
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
     args, extras = parser.parse_known_args(argv)

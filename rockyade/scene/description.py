@@ -509,6 +509,7 @@ def _check_loads(scene: Scene, names: list[str]) -> None:
                 f"({weight / G:.4g} kg): check the units (kg)",
                 scene.source,
             )
+        _note_mass_apart_from_weight(load, field_name, scene.source)
         block = placed[index]
         outside = _outside(block.vertices_m, load.point_m)
         if outside > LOAD_POINT_TOL * block.size_m:
@@ -518,6 +519,40 @@ def _check_loads(scene: Scene, names: list[str]) -> None:
                 f"(allowed: {LOAD_POINT_TOL:g} of its size); the point is in the base frame at rest",
                 scene.source,
             )
+
+
+#: A load's mass above this many times its weight / g is accepted with a note.
+LOAD_MASS_NOTE_RATIO = 2.0
+
+
+def _note_mass_apart_from_weight(load: LoadSpec, field_name: str, source: str | None) -> None:
+    """Say so (an :class:`~rockyade.errors.InputNote`) when a load's ``mass_kg`` is more than
+    :data:`LOAD_MASS_NOTE_RATIO` times its weight / g (``-fy / g``, the default): its mass moves
+    with the block (Circolare 2019 C8.7.1: the masses the horizontal acceleration acts on) while
+    only ``fy`` bears on it, which is possible (a floor carried elsewhere) but more often a unit
+    slip (a weight in kN given as a mass in kg, or a mass in kg per metre of a longer wall)."""
+    if load.mass_kg is None or load.mass_kg <= 0.0:
+        return
+    weight_mass = max(-load.force_N[1], 0.0) / G
+    if load.mass_kg > LOAD_MASS_NOTE_RATIO * weight_mass:
+        import warnings
+
+        from rockyade.errors import InputNote
+
+        against = (
+            f"is {load.mass_kg / weight_mass:.3g} times the load's weight / g ({weight_mass:.4g} kg, its -fy / g)"
+            if weight_mass > 0.0
+            else "moves with a load that does not weigh on the block (fy >= 0)"
+        )
+        warnings.warn(
+            InputNote(
+                f"{field_name}.mass_kg",
+                f"{load.mass_kg:.4g} kg {against}: the mass moves with the block while only fy bears on it; "
+                "accepted as given (by default mass_kg = -fy / g: check the units)",
+                source,
+            ),
+            stacklevel=2,
+        )
 
 
 def _outside(poly: Any, point: tuple[float, float]) -> float:
