@@ -309,6 +309,12 @@ def _fmt(v: float, digits: int = 4) -> str:
     return f"{v:.{digits}g}" if isinstance(v, (int, float)) and math.isfinite(v) else "-"
 
 
+def subsets_text(plan: CrosscheckPlan) -> str:
+    """The solvers run on the first records only (``records_per_solver``), in words; "" when none."""
+    parts = [f"{s} on the first {len(plan.records_of(s))}" for s in plan.solvers if s in plan.records_per_solver]
+    return f" ({', '.join(parts)}; a pair is over the records both ran)" if parts else ""
+
+
 def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
     """``index.md``: the verdicts in words and numbers, then how the study was made."""
     m = plan.measure
@@ -324,8 +330,9 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
         f"Collapse intensity: the smallest {m.name} ({m.unit}) of each record's scaling at which the scene collapses "
         f"({collapse_rule(plan.scene, sp.fallen_blocks)}), by a scan over {len(plan.scan_si)} levels "
         f"({', '.join(_fmt(m.shown(v), 3) for v in plan.scan_si)} {m.unit}) then bisection to "
-        f"{100 * plan.resolution:g} %. Records: {plan.motions.describe()}. Agreement: the median ratio of two "
-        f"solvers' collapse intensities, paired by record, within {100 * plan.tolerance:g} % of 1 and its bootstrap "
+        f"{100 * plan.resolution:g} %. Records: {plan.motions.describe()}{subsets_text(plan)}. Agreement: the "
+        f"median ratio of two solvers' collapse intensities, paired by record, within {100 * plan.tolerance:g} % of 1 "
+        "and its bootstrap "
         f"95 % interval within {200 * plan.tolerance:g} %. Time-step factors: "
         f"{', '.join(f'{f:g}' for f in plan.dt_factors)}.",
         "",
