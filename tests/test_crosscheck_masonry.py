@@ -104,3 +104,42 @@ def test_records_per_solver_is_checked_before_anything_runs(value, records, tmp_
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 2 and len(err) == 1 and "--records-per-solver" in err[0], err
     assert not (tmp_path / "o").exists()
+
+
+def test_a_partial_summary_leaves_unfinished_searches_out_of_the_ratios(records):
+    """After Ctrl-C a search stopped between its scan and its bisection has a bracket (the scan's
+    step) that is not its answer: the partial summary says it is unfinished and pairs only
+    finished searches; the complete summary of the same runs would bracket it."""
+    from rockyade.studies.crosscheck import Outcomes, summarise
+    from rockyade.studies.crosscheck.reporting import UNFINISHED
+
+    from .test_crosscheck import small_plan
+
+    plan = small_plan(records, dt_factors=(1.0,))
+    low, mid, high = plan.scan_si
+    outcomes = Outcomes()
+    row = {"status": "completed", "failure_reason": "", "run": "r"}
+    for solver in ("housner", "reference"):
+        for i in range(plan.motions.count):
+            outcomes.add((solver, 1.0, i), low, row, False)
+            outcomes.add((solver, 1.0, i), mid, row, True)
+            outcomes.add((solver, 1.0, i), high, row, True)
+    # housner's searches bisected to the resolution (10 %) between the two first levels
+    level = low
+    while level * 1.1 < mid:
+        level *= 1.09
+        for i in range(plan.motions.count):
+            outcomes.add(("housner", 1.0, i), level, row, False)
+    step = level
+    for i in range(plan.motions.count):
+        outcomes.add(("housner", 1.0, i), mid, row, True)
+    assert mid / step <= 1.1 + 1e-12
+    partial = summarise(plan, outcomes, partial=True)
+    ci = partial.collapse.set_index(["solver", "record_index"])
+    assert (ci.loc["reference", "status"] == UNFINISHED).all()
+    assert ci.loc["reference", "collapse_intensity"].isna().all()
+    assert (ci.loc["housner", "status"] == BRACKETED).all()
+    pair = partial.pairs[partial.pairs.kind == "solvers"].iloc[0]
+    assert pair.records == 0  # no ratio from a bracket the search had not narrowed
+    complete = summarise(plan, outcomes, partial=False)
+    assert (complete.collapse.status == BRACKETED).all()

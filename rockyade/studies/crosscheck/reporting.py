@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +35,18 @@ from rockyade.io.atomic import atomic_open, write_json, write_text
 from rockyade.runner.rows import Cells
 from rockyade.studies.crosscheck.plan import CrosscheckPlan, Outcomes
 
+#: The status of a search a partial summary finds unfinished: its bracket so far is not an answer,
+#: and it is left out of the ratios.
+UNFINISHED = "unfinished (the study was stopped)"
+
+
+def unfinished(plan: CrosscheckPlan, outcomes: Outcomes, key: tuple[str, float, int]) -> bool:
+    """Whether the search ``key`` has runs still to make (as
+    :meth:`rockyade.studies.crosscheck.search.Study.pending` chooses them: a level that failed
+    ends it)."""
+    verdicts = outcomes.verdicts.get(key, {})
+    return any(level not in verdicts for level in plan.next_levels(key[2], verdicts))
+
 
 @dataclass(frozen=True)
 class Summary:
@@ -59,6 +71,8 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
     for key in plan.searches():
         solver, f, i = key
         found = collapse_summary(outcomes.verdicts.get(key, {}), scan)
+        if partial and unfinished(plan, outcomes, key):  # a bracket so far is not the search's answer
+            found = replace(found, collapse_intensity=math.nan, status=UNFINISHED)
         searches[key] = found
         rows.append(
             {
