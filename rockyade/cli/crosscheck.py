@@ -21,6 +21,27 @@ def _fraction(text: str, option: str) -> float:
         raise InputError(option, f"must be a number, got {text!r}") from None
 
 
+def _records_per_solver(text: str | None, names: tuple[str, ...]) -> dict[str, int]:
+    """``yade=5,siconos=10`` as solver -> how many of the records (the first ones) it runs."""
+    out: dict[str, int] = {}
+    for item in (text or "").split(","):
+        if not item.strip():
+            continue
+        name, _, count = item.partition("=")
+        name = name.strip()
+        try:
+            value = int(count)
+        except ValueError:
+            value = 0
+        if name not in names or name in out or value < 1:
+            raise InputError(
+                "--records-per-solver",
+                f"must be SOLVER=N pairs (a solver of --solvers, N >= 1 records), comma-separated, got {text!r}",
+            )
+        out[name] = value
+    return out
+
+
 def cmd_crosscheck(args: argparse.Namespace) -> int:
     """Plan (cost line), run the rounds, write the set and swap it in; exit 1 when a run failed."""
     from rockyade.assess import parse_measure
@@ -35,10 +56,12 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
         parse_solvers,
         run_crosscheck,
     )
+    from rockyade.studies.crosscheck.reporting import subsets_text
 
     check_output_dir(args.out, "--out")
     check_out(args.out, args.resume)
     names = parse_solvers(args.solvers)
+    subsets = _records_per_solver(args.records_per_solver, names)
     measure = parse_measure(args.intensity)
     levels = float_list(args.levels, "--levels") if args.levels else None
     dt_factors = check_dt_factors(float_list(args.dt_factors, "--dt-factors"))
@@ -63,6 +86,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
         dt_factors=dt_factors,
         resolution=resolution,
         tolerance=tolerance,
+        records_per_solver=subsets,
         solver_options=options,
         executor=record_executor,
         fallen_blocks=args.fallen_blocks,
@@ -72,7 +96,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
         allow_large=args.allow_large,
         workers=args.workers,
     )
-    print(f"crosscheck of {args.scene}: {', '.join(names)} over {motions.describe()}", flush=True)
+    print(f"crosscheck of {args.scene}: {', '.join(names)} over {motions.describe()}{subsets_text(plan)}", flush=True)
     print(
         f"levels ({measure.unit}): {', '.join(f'{measure.shown(v):.4g}' for v in plan.scan_si)} "
         f"({plan.stripes.levels_source})",
@@ -117,6 +141,12 @@ def register(sub: Any) -> None:
         "--solvers",
         default="housner,reference",
         help=f"comma-separated solvers, at least two, among {', '.join(SOLVER_NAMES)} (default housner,reference)",
+    )
+    p.add_argument(
+        "--records-per-solver",
+        metavar="SOLVER=N,...",
+        help="run a costly solver on the first N records only, e.g. yade=5 (default: every solver on every record; "
+        "the pairs are over the records both solvers ran)",
     )
     p.add_argument(
         "--intensity",

@@ -13,10 +13,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from rockyade.analysis.crosscheck_statistics import RESOLUTION, TOLERANCE
+from rockyade.analysis.crosscheck_statistics import RESOLUTION, TOLERANCE, next_levels
 from rockyade.assess.fragility_analysis import FragilityPlan, fragility_plan
 from rockyade.assess.measures import Measure
 from rockyade.assess.motions import MotionSet
+from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.batch import MAX_RUNS
 from rockyade.constants import CODE_GRAVITY, G
 from rockyade.errors import InputError
@@ -118,6 +119,15 @@ class CrosscheckPlan:
     def solver(self, name: str, dt_factor: float) -> Solver:
         """The solver ``name`` at ``dt_factor`` with the options it takes."""
         return _solver(name, dt_factor, self.solver_options)
+
+    def next_levels(self, record: int, verdicts: Mapping[float, bool | None]) -> list[float]:
+        """The levels (SI) a search of ``record`` runs next after ``verdicts`` (level -> collapsed,
+        stood or failed): the scan, its extensions within the record's load-factor limits, then
+        bisection (:func:`rockyade.analysis.crosscheck_statistics.next_levels`); none when it is done."""
+        im = self.stripes.stripes.im_si[record]
+        return next_levels(
+            dict(verdicts), self.scan_si, self.resolution, lowest=im * 1e-3, highest=im * MAX_LOAD_FACTOR
+        )
 
     def searches(self) -> list[tuple[str, float, int]]:
         """Every (solver, dt factor, record index) searched."""

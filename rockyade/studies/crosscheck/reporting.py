@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -35,6 +35,18 @@ from rockyade.io.atomic import atomic_open, write_json, write_text
 from rockyade.runner.rows import Cells
 from rockyade.studies.crosscheck.plan import CrosscheckPlan, Outcomes
 
+#: The status of a search a partial summary finds unfinished: its bracket so far is not an answer,
+#: and it is left out of the ratios.
+UNFINISHED = "unfinished (the study was stopped)"
+
+
+def unfinished(plan: CrosscheckPlan, outcomes: Outcomes, key: tuple[str, float, int]) -> bool:
+    """Whether the search ``key`` has runs still to make (as
+    :meth:`rockyade.studies.crosscheck.search.Study.pending` chooses them: a level that failed
+    ends it)."""
+    verdicts = outcomes.verdicts.get(key, {})
+    return any(level not in verdicts for level in plan.next_levels(key[2], verdicts))
+
 
 @dataclass(frozen=True)
 class Summary:
@@ -59,6 +71,8 @@ def summarise(plan: CrosscheckPlan, outcomes: Outcomes, partial: bool) -> Summar
     for key in plan.searches():
         solver, f, i = key
         found = collapse_summary(outcomes.verdicts.get(key, {}), scan)
+        if partial and unfinished(plan, outcomes, key):  # a bracket so far is not the search's answer
+            found = replace(found, collapse_intensity=math.nan, status=UNFINISHED)
         searches[key] = found
         rows.append(
             {
@@ -309,6 +323,12 @@ def _fmt(v: float, digits: int = 4) -> str:
     return f"{v:.{digits}g}" if isinstance(v, (int, float)) and math.isfinite(v) else "-"
 
 
+def subsets_text(plan: CrosscheckPlan) -> str:
+    """The solvers run on the first records only (``records_per_solver``), in words; "" when none."""
+    parts = [f"{s} on the first {len(plan.records_of(s))}" for s in plan.solvers if s in plan.records_per_solver]
+    return f" ({', '.join(parts)}; a pair is over the records both ran)" if parts else ""
+
+
 def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
     """``index.md``: the verdicts in words and numbers, then how the study was made."""
     m = plan.measure
@@ -324,8 +344,9 @@ def index_text(plan: CrosscheckPlan, summary: Summary, seconds: float) -> str:
         f"Collapse intensity: the smallest {m.name} ({m.unit}) of each record's scaling at which the scene collapses "
         f"({collapse_rule(plan.scene, sp.fallen_blocks)}), by a scan over {len(plan.scan_si)} levels "
         f"({', '.join(_fmt(m.shown(v), 3) for v in plan.scan_si)} {m.unit}) then bisection to "
-        f"{100 * plan.resolution:g} %. Records: {plan.motions.describe()}. Agreement: the median ratio of two "
-        f"solvers' collapse intensities, paired by record, within {100 * plan.tolerance:g} % of 1 and its bootstrap "
+        f"{100 * plan.resolution:g} %. Records: {plan.motions.describe()}{subsets_text(plan)}. Agreement: the "
+        f"median ratio of two solvers' collapse intensities, paired by record, within {100 * plan.tolerance:g} % of 1 "
+        "and its bootstrap "
         f"95 % interval within {200 * plan.tolerance:g} %. Time-step factors: "
         f"{', '.join(f'{f:g}' for f in plan.dt_factors)}.",
         "",

@@ -36,8 +36,6 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from rockyade.analysis.crosscheck_statistics import next_levels
-from rockyade.assess.stripes import MAX_LOAD_FACTOR
 from rockyade.batch import BatchTask, batch_task, run_study
 from rockyade.batch.running import output
 from rockyade.errors import BatchInterruptedError
@@ -147,20 +145,14 @@ class Study:
 
     def pending(self) -> list[Pending]:
         """The runs of the next round: each search advanced over the runs on disk first."""
-        plan, sp = self.plan, self.plan.stripes.stripes
+        plan = self.plan
         todo: list[Pending] = []
         for key in plan.searches():
             i = key[2]
             verdicts = self.outcomes.verdicts.setdefault(key, {})
             while True:
-                levels = next_levels(
-                    verdicts,
-                    plan.scan_si,
-                    plan.resolution,
-                    lowest=sp.im_si[i] * 1e-3,
-                    highest=sp.im_si[i] * MAX_LOAD_FACTOR,
-                )
-                levels = [level for level in levels if level not in verdicts]  # a run that failed: the search ends
+                # a level already run that failed: the search ends
+                levels = [level for level in plan.next_levels(i, verdicts) if level not in verdicts]
                 missing = []
                 for level in levels:
                     task = self.task(key, level)
