@@ -16,8 +16,9 @@ system:
 
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --upgrade pip
-	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	$(BIN)/python -m pip install -qq --root-user-action=ignore --upgrade pip
+	# -qq: errors only (setuptools' editable install otherwise prints its notice in a box of asterisks)
+	$(BIN)/python -m pip install -qq --root-user-action=ignore -e '.[dev]'
 	@touch $(STAMP)
 
 # the solvers' numba code compiled into numba's cache once, here, so that no run and no test
