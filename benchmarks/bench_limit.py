@@ -29,7 +29,7 @@ from rockyade.limit.rigid_blocks import rigid_block_model
 from rockyade.scene import scene_from_dict
 from rockyade.scene.generators import wall
 from rockyade.scene.generators.scene_tables import udec_contact
-from rockyade.scene.generators.walls import DEFAULT_DENSITY_KG_M3
+from rockyade.scene.generators.walls import WALL
 
 #: (courses, units per course) of the walls of about 100, 300, 1,000, 3,000 and 10,000 blocks (the
 #: last two as issue 34 measured them: 50 x 60 and 100 x 100).
@@ -77,7 +77,7 @@ def main() -> None:
     for n in args.sizes:
         courses, units = shape_for(n)
         jkn = 3e10 if courses > 50 else 2e10  # stiff enough that the base course does not sink (build wall)
-        contact = udec_contact(0.2, DEFAULT_DENSITY_KG_M3, jkn_Pa_per_m=jkn)
+        contact = udec_contact(0.2, WALL.density_kg_m3, jkn_Pa_per_m=jkn)
         scene = scene_from_dict(wall(courses=courses, units_per_course=units, contact=contact))
         lambdas = []
         for sliding in (True, False):
