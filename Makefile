@@ -14,10 +14,10 @@ setup: system $(STAMP) compiled
 system:
 	@tools/install-system-deps.sh
 
+# pip -qq: errors only (setuptools' editable install otherwise prints its notice in a box of asterisks)
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -qq --root-user-action=ignore --upgrade pip
-	# -qq: errors only (setuptools' editable install otherwise prints its notice in a box of asterisks)
 	$(BIN)/python -m pip install -qq --root-user-action=ignore -e '.[dev]'
 	@touch $(STAMP)
 
