@@ -70,6 +70,9 @@ def main() -> None:
     parser.add_argument("--load-factor", type=float, default=0.5, help="on paper record 1 (default 0.5: 0.14 g)")
     parser.add_argument("--quick", action="store_true", help="durations 0.5 and 1 s")
     args = parser.parse_args()
+    unknown = [n.strip() for n in args.scenes.split(",") if n.strip() not in SCENES]
+    if unknown:
+        parser.error(f"--scenes: {', '.join(unknown)} unknown; choose among {', '.join(SCENES)}")
     short, long_ = (0.5, 1.0) if args.quick else tuple(float(v) for v in args.durations.split(","))
     rockyade = str(Path(sys.executable).with_name("rockyade"))
     print(f"load average {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores", flush=True)

@@ -47,6 +47,12 @@ QUICK: dict[str, tuple[list[str], list[str], str]] = {
     "bench_yade.py": (["--quick"], [r"wall of \d+ blocks", r"YADE, 2 runs of 0.5 s", r"cold and warm"], "yade"),
     "bench_siconos_mu.py": (["--quick"], [r"^1\. ", r"^2\. ", r"^3\. "], "siconos"),
     "specimen3_gap.py": (["--quick", "--out", "gap"], [r"\[base\] housner dt x 1 / reference dt x 1: "], ""),
+    # the masonry scenes' costs, on the bi-block with the exact solver and Siconos (its child's CPU counted)
+    "crosscheck_costs.py": (
+        ["--quick", "--scenes", "biblock-geometry", "--solvers", "twoblock,siconos"],
+        [r"^\| biblock-geometry \| twoblock \| [0-9.]+ \|", r"^\| biblock-geometry \| siconos \| [0-9.]+ \|"],
+        "siconos",
+    ),
     # the cross-check suite's smallest run: one specimen, two records, one step, coarse bisection
     "crosscheck_suite.py": (
         ["--scenes", "1", "--count", "2", "--dt-factors", "1", "--resolution", "0.1", "--out", "xc"],
