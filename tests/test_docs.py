@@ -9,11 +9,17 @@ lines left out; a wall time is a number that may differ)."""
 
 from __future__ import annotations
 
+import json
+import os
 import re
+import select
 import shlex
+import signal
 import subprocess
 import sys
 import tomllib
+from collections.abc import Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
@@ -116,12 +122,88 @@ def check_output(command: str, shown: list[str], printed: str) -> None:
         at = found + 1
 
 
-def _run_as_printed(command: str, cwd: Path, shown: list[str]) -> None:
+@dataclass
+class Ran:
+    """A finished command: its exit code and what it printed."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+
+
+class CommandStarter:
+    """The documented commands, each run in its own process forked from a Python that has
+    imported rockyade once (``tests/command_server.py``): as printed, without ~2 s of imports
+    per command. The console script itself is run from a shell by the CLI's own tests."""
+
+    def __init__(self, scratch: Path) -> None:
+        self.scratch = scratch
+        self.count = 0
+        self.proc = subprocess.Popen(
+            [sys.executable, str(ROOT / "tests/command_server.py")],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        assert self._reply(600) == {"ready": True}
+
+    def _reply(self, timeout: float) -> dict:
+        assert self.proc.stdout is not None
+        ready, _, _ = select.select([self.proc.stdout], [], [], timeout)
+        line = self.proc.stdout.readline() if ready else ""
+        if not line:
+            raise AssertionError(f"the command starter gave no answer within {timeout:.0f} s")
+        return json.loads(line)
+
+    def run(self, kind: str, cwd: Path, argv: list[str] = (), code: str = "", env: dict | None = None) -> Ran:
+        """Run one command (``kind``: rockyade, script or code) in ``cwd``; 600 s at most."""
+        assert self.proc.stdin is not None
+        self.count += 1
+        out, err = self.scratch / f"{self.count}.out", self.scratch / f"{self.count}.err"
+        request = {"kind": kind, "argv": list(argv), "code": code, "cwd": str(cwd), "env": env}
+        self.proc.stdin.write(json.dumps({**request, "stdout": str(out), "stderr": str(err)}) + "\n")
+        self.proc.stdin.flush()
+        pid = self._reply(60)["pid"]
+        try:
+            reply = self._reply(600)
+            returncode = reply["returncode"]
+            if os.environ.get("DOCS_CPU_LOG"):
+                with open(os.environ["DOCS_CPU_LOG"], "a") as log:
+                    log.write(f"{reply['cpu_s']:8.2f} {kind} {' '.join(argv)[:150]}\n")
+        except AssertionError:
+            os.kill(pid, signal.SIGKILL)
+            raise
+        return Ran(returncode, out.read_text(errors="replace"), err.read_text(errors="replace"))
+
+    def close(self) -> None:
+        assert self.proc.stdin is not None
+        self.proc.stdin.close()
+        self.proc.wait(60)
+
+
+@pytest.fixture(scope="session")
+def starter(tmp_path_factory) -> Iterator[CommandStarter]:
+    started = CommandStarter(tmp_path_factory.mktemp("commands"))
+    yield started
+    started.close()
+
+
+def run_printed(starter: CommandStarter, command: str, cwd: Path, env: dict | None = None) -> Ran:
+    """``command`` as a shell would run it in ``cwd``: ``.venv/bin/rockyade ...`` or
+    ``rockyade ...`` by the console script's entry point, ``.venv/bin/python FILE ...`` as a
+    script."""
+    args = shlex.split(command)
+    program = Path(args[0]).name
+    if program == "rockyade":
+        return starter.run("rockyade", cwd, args[1:], env=env)
+    assert program == "python", f"{command}: a program the docs' tests do not know"
+    return starter.run("script", cwd, args[1:], env=env)
+
+
+def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: list[str]) -> None:
     """Run ``command`` in ``cwd`` with this environment's rockyade; exit 0 (or 2 where the page
     shows the refusal) and the shown lines printed."""
-    args = shlex.split(command)
-    args[0] = str(BIN / Path(args[0]).name)
-    proc = subprocess.run(args, cwd=cwd, capture_output=True, text=True, timeout=600)
+    proc = run_printed(starter, command, cwd)
     refused = any(line.startswith("rockyade: error:") for line in shown)
     assert proc.returncode == (2 if refused else 0), f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
     check_output(command, shown, proc.stdout + proc.stderr)
@@ -265,20 +347,20 @@ def test_python_page_shows_keyword_only_arguments_as_such():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("command", list(COMMANDS), ids=[f"{COMMANDS[c]}: {c[18:80]}" for c in COMMANDS])
-def test_documented_command_runs_as_printed(command, tmp_path):
+def test_documented_command_runs_as_printed(command, tmp_path, starter):
     """Each indented command of the README and docs/, in a fresh folder (no command needs
     another's output), prints the lines its page shows."""
-    _run_as_printed(command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
+    _run_as_printed(starter, command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("page", list(FENCED))
-def test_fenced_commands_run_as_printed(page, tmp_path):
+def test_fenced_commands_run_as_printed(page, tmp_path, starter):
     """The fenced commands of a page, in order in one folder, print the lines the page shows."""
     cwd = _fresh_checkout(tmp_path)
     (cwd / "runs").mkdir()
     for command, shown in FENCED[page]:
-        _run_as_printed(command, cwd, shown)
+        _run_as_printed(starter, command, cwd, shown)
 
 
 def test_shown_output_is_compared_line_by_line():
@@ -295,20 +377,13 @@ def test_shown_output_is_compared_line_by_line():
 
 @pytest.mark.slow
 @pytest.mark.parametrize(("page", "code", "setup"), _python_blocks(), ids=[p for p, _, _ in _python_blocks()])
-def test_documented_python_runs_as_printed(page, code, setup, tmp_path):
+def test_documented_python_runs_as_printed(page, code, setup, tmp_path, starter):
     (_fresh_checkout(tmp_path) / "runs").mkdir()
     for command in setup:  # the page's commands that write what the block reads
-        args = shlex.split(command)
-        proc = subprocess.run([str(BIN / args[0]), *args[1:]], cwd=tmp_path, capture_output=True, text=True)
+        proc = run_printed(starter, command, tmp_path)
         assert proc.returncode == 0, f"{page}: {command}\n{proc.stderr[-2500:]}"
-    proc = subprocess.run(
-        [sys.executable, "-c", code],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env={"MPLBACKEND": "Agg", "PATH": str(BIN), "HOME": str(Path.home())},
-    )
+    env = {"MPLBACKEND": "Agg", "PATH": str(BIN), "HOME": str(Path.home())}
+    proc = starter.run("code", tmp_path, code=code, env=env)
     assert proc.returncode == 0, f"{page}\n{code}\n{proc.stderr[-2500:]}"
 
 

@@ -491,10 +491,26 @@ def animate(
         clock.set_text(f"{_title(scene, None)}\nt = {t[indices[k]]:.2f} s{note}")
         return coll, clock
 
+    if path is not None:
+        _write_frames(fig, update, len(indices), path, writer)
     update(0)
     anim = animation.FuncAnimation(fig, update, frames=len(indices), blit=False)
     if path is not None:
-        # the writers open the file themselves and take its format from its suffix
-        with atomic_path(path) as tmp:
-            anim.save(str(tmp), writer=writer, dpi=90)
+        # its frames are in the file: matplotlib would warn that it was dropped unseen
+        anim._draw_was_started = True  # type: ignore[attr-defined]
     return fig, ax, anim
+
+
+def _write_frames(fig, update, n_frames: int, path: str | Path, writer) -> None:
+    """Each frame drawn once into ``writer`` (``FuncAnimation.save`` draws each twice), with
+    the layout of the first frame kept: the blocks move inside axes whose limits do not change,
+    so the constrained layout is solved once rather than on every frame. The writer opens the
+    file itself and takes its format from its suffix; written atomically."""
+    engine = fig.get_layout_engine()
+    with atomic_path(path) as tmp, writer.saving(fig, str(tmp), dpi=90):
+        for k in range(n_frames):
+            update(k)
+            writer.grab_frame()
+            if k == 0:
+                fig.set_layout_engine("none")
+    fig.set_layout_engine(engine)
