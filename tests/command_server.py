@@ -17,12 +17,15 @@ Run as a script: ``python tests/command_server.py``."""
 
 from __future__ import annotations
 
+import atexit
+import gc
 import importlib
 import json
 import os
 import runpy
 import signal
 import sys
+import threading
 import time
 import traceback
 from typing import TextIO
@@ -112,7 +115,16 @@ def _child(request: dict, pipes: tuple[TextIO, TextIO]) -> None:
         os.dup2(out, fd)
         os.close(out)
     code = _run(request)
-    sys.exit(code)  # Python's normal exit: threads joined, atexit handlers, streams flushed
+    # Python's exit, less the freeing of every object (which would copy each page shared with
+    # the starter): threads joined, atexit handlers run, streams flushed
+    threading._shutdown()  # type: ignore[attr-defined]
+    atexit._run_exitfuncs()
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            code = code or 120  # as Python's own exit when its streams cannot be flushed
+    os._exit(code)
 
 
 def main() -> None:
@@ -123,6 +135,7 @@ def main() -> None:
     os.dup2(devnull, 0)
     os.dup2(2, 1)
     _preload()
+    gc.freeze()  # what the imports made stays out of the collector: no forked command copies it
     reader = os.fdopen(requests, "r")
     writer = os.fdopen(replies, "w")
     writer.write(json.dumps({"ready": True}) + "\n")

@@ -113,7 +113,9 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
 
 #: Environment variable naming a file that receives, one JSON line per test, its wall and CPU
 #: seconds (this process and the children it waited for: subprocesses, CLI runs, engines'
-#: workers that ended); each xdist worker appends to its own ``<file>.<worker>``. Unset: nothing.
+#: workers that ended; the docs' commands forked by test_docs.py's starter, whose own end, with
+#: all of theirs again, falls to the worker's last test); each xdist worker appends to its own
+#: ``<file>.<worker>``. Unset: nothing.
 CPU_LOG_ENV = "ROCKYADE_TEST_CPU_LOG"
 
 
@@ -138,7 +140,8 @@ def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
     wall = time.perf_counter() - start
     own1, children1 = _cpu_s()
     worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
-    row = {"test": item.nodeid, "wall_s": wall, "cpu_s": own1 - own0, "children_cpu_s": children1 - children0}
+    forked = sum(value for name, value in item.user_properties if name == "forked_cpu_s")  # test_docs.py's
+    row = {"test": item.nodeid, "wall_s": wall, "cpu_s": own1 - own0, "children_cpu_s": children1 - children0 + forked}
     with open(f"{log}.{worker}", "a", encoding="utf-8") as out:
         out.write(json.dumps(row) + "\n")
 

@@ -139,6 +139,7 @@ class CommandStarter:
     def __init__(self, scratch: Path) -> None:
         self.scratch = scratch
         self.count = 0
+        self.cpu_s = 0.0  # the commands' CPU seconds, theirs and their children's
         self.proc = subprocess.Popen(
             [sys.executable, str(ROOT / "tests/command_server.py")],
             stdin=subprocess.PIPE,
@@ -167,9 +168,7 @@ class CommandStarter:
         try:
             reply = self._reply(600)
             returncode = reply["returncode"]
-            if os.environ.get("DOCS_CPU_LOG"):
-                with open(os.environ["DOCS_CPU_LOG"], "a") as log:
-                    log.write(f"{reply['cpu_s']:8.2f} {kind} {' '.join(argv)[:150]}\n")
+            self.cpu_s += reply["cpu_s"]
         except AssertionError:
             os.kill(pid, signal.SIGKILL)
             raise
@@ -182,10 +181,19 @@ class CommandStarter:
 
 
 @pytest.fixture(scope="session")
-def starter(tmp_path_factory) -> Iterator[CommandStarter]:
+def _started(tmp_path_factory) -> Iterator[CommandStarter]:
     started = CommandStarter(tmp_path_factory.mktemp("commands"))
     yield started
     started.close()
+
+
+@pytest.fixture
+def starter(_started: CommandStarter, record_property) -> Iterator[CommandStarter]:
+    """The session's command starter; the CPU its commands spent in this test is recorded as the
+    test's property ``forked_cpu_s`` (counted by ``$ROCKYADE_TEST_CPU_LOG``, conftest.py)."""
+    before = _started.cpu_s
+    yield _started
+    record_property("forked_cpu_s", _started.cpu_s - before)
 
 
 def run_printed(starter: CommandStarter, command: str, cwd: Path, env: dict | None = None) -> Ran:
