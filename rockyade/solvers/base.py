@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkab
 import numpy as np
 
 from rockyade.errors import InputError, RockyadeError
+from rockyade.io.warm_program import check_timeout
 from rockyade.run_meta import RunMeta
 
 if TYPE_CHECKING:
@@ -138,6 +139,26 @@ def check_flag(value: Any, field: str) -> bool:
     return value
 
 
+def check_float(value: Any, field: str, lo: float, hi: float, what: str, *, lo_open: bool = False) -> float:
+    """``value`` (a number, or text that reads as one; not a bool) as a float in [lo, hi], or
+    in (lo, hi] with ``lo_open``; else InputError naming ``field``: "must be ``what``"."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be {what}, got {value!r}") from None
+    low_ok = x > lo if lo_open else x >= lo
+    if isinstance(value, bool) or not (low_ok and x <= hi):
+        raise InputError(field, f"must be {what}, got {value!r}")
+    return x
+
+
+def check_folder(value: Any, field: str) -> str | None:
+    """A folder path (text or a Path) or None."""
+    if value is not None and not isinstance(value, (str, Path)):
+        raise InputError(field, f"must be a folder path, got {value!r}")
+    return None if value is None else str(value)
+
+
 #: Range of ``dt_factor``, the factor on a solver's own time step: [DT_FACTOR_MIN, 1].
 DT_FACTOR_MIN = 1e-3
 
@@ -151,6 +172,17 @@ def check_dt_factor(value: Any, field: str) -> float:
             field, f"must be a number in [{DT_FACTOR_MIN:g}, 1] (a factor on the solver's time step), got {value!r}"
         )
     return float(value)
+
+
+#: The options of a solver that runs another program in a worker (YADE, Siconos): the run's
+#: timeout, a warm worker or a process of its own, the factor on the time step, the folder its
+#: files are kept in.
+WORKER_OPTIONS: Mapping[str, OptionCheck] = {
+    "timeout_s": check_timeout,
+    "warm": check_flag,
+    "dt_factor": check_dt_factor,
+    "workdir": check_folder,
+}
 
 
 def motion_coverage(scene: Scene) -> dict[str, Any]:
@@ -303,6 +335,12 @@ class SolverBase:
             checked[key] = cls.OPTIONS[key](value, field)
         return cls(**checked)
 
+    def __post_init__(self) -> None:
+        """Check every option field by its :data:`OPTIONS` entry: a solver built in Python is
+        checked as one built from options by name (:meth:`from_options`)."""
+        for key, check in self.OPTIONS.items():
+            object.__setattr__(self, key, check(getattr(self, key), key))
+
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """Itself: this solver keeps no files."""
         return self
@@ -334,3 +372,15 @@ class SolverBase:
         def estimate_cost(self, scene: Scene) -> CostEstimate:
             """What running ``scene`` will cost (defined by each subclass)."""
             ...
+
+
+@dataclass(frozen=True)
+class StepFactorSolver(SolverBase):
+    """An in-process solver whose one option is ``dt_factor``, a factor in [0.001, 1] on the
+    largest step of its integrator (:func:`check_dt_factor`; the subclass's docstring says
+    which step): the exact solvers (Housner's, the two-block one)."""
+
+    IN_PROCESS = True
+    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
+
+    dt_factor: float = 1.0

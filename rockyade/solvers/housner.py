@@ -25,12 +25,12 @@ from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
-from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage, say_if_compiling
+from rockyade.solvers.base import GroupRun, StepFactorSolver, motion_coverage, say_if_compiling
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 
 
 @dataclass(frozen=True)
-class HousnerSolver(SolverBase):
+class HousnerSolver(StepFactorSolver):
     """Housner's exact solution as a solver (single blocks on a rigid base).
 
     Attributes
@@ -42,14 +42,7 @@ class HousnerSolver(SolverBase):
     """
 
     name: ClassVar[str] = "housner"
-    IN_PROCESS = True
-    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
     COMPILE_S: ClassVar[float] = 9.0
-
-    dt_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
 
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the integrator (:data:`rockyade.housner.integrator.KERNELS`)."""
@@ -125,18 +118,9 @@ class HousnerSolver(SolverBase):
         """Run scenes of one :meth:`group_key` together: the model (classical parameters, loads)
         is built once, each run's base motion once (the run and its coverage read the same
         arrays), and no time-history frame is made; each run is integrated as :meth:`run`
-        integrates it (the same numbers, bit for bit).
-
-        Parameters
-        ----------
-        scenes
-            Scenes with one group key.
-        uplift_rad
-            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
-        threads
-            Unused: the runs are integrated one after the other in this thread (a batch's
-            workers run one job each); taken for the interface of
-            :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`.
+        integrates it (the same numbers, bit for bit). The parameters are those of
+        :meth:`rockyade.solvers.base.GroupSolver.run_group`; ``threads`` is unused: the runs are
+        integrated one after the other in this thread (a batch's workers run one job each).
 
         Returns
         -------

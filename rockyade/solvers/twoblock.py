@@ -14,7 +14,7 @@ from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
 from rockyade.run_meta import RunMeta, as_status
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_dt_factor
+from rockyade.solvers.base import StepFactorSolver
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 from rockyade.twoblock import TwoBlockModel, TwoBlockTrajectory, solve, two_block_model, warm_up
 from rockyade.twoblock.event_driven import REST_FRACTION, integrate
@@ -35,7 +35,7 @@ OVERTURN_CRITERION = (
 
 
 @dataclass(frozen=True)
-class TwoBlockSolver(SolverBase):
+class TwoBlockSolver(StepFactorSolver):
     """The two-block exact solver (module docstring).
 
     Attributes
@@ -47,14 +47,7 @@ class TwoBlockSolver(SolverBase):
     """
 
     name: ClassVar[str] = "twoblock"
-    IN_PROCESS = True
-    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
     COMPILE_S: ClassVar[float] = 24.0
-
-    dt_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
 
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the event-driven integrator."""
