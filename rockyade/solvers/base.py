@@ -35,9 +35,10 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkab
 
 import numpy as np
 
+from rockyade import __version__
 from rockyade.errors import InputError, RockyadeError
 from rockyade.io.warm_program import check_timeout
-from rockyade.run_meta import RunMeta
+from rockyade.run_meta import RunMeta, as_status
 
 if TYPE_CHECKING:
     from rockyade.result import Result
@@ -384,3 +385,61 @@ class StepFactorSolver(SolverBase):
     OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
 
     dt_factor: float = 1.0
+
+
+class EventTrajectory(Protocol):
+    """What an exact (event-driven) solver's trajectory tells its Result's metadata."""
+
+    step_s: float
+    status: str
+    impacts: np.ndarray
+    peaks: np.ndarray
+    uplift_times_s: np.ndarray
+
+
+def exact_meta(
+    solver: str,
+    method: str,
+    scene: Scene,
+    traj: EventTrajectory,
+    wall: float,
+    dt_factor: float,
+    before: Mapping[str, object],
+    after: Mapping[str, object],
+    **fields: Any,
+) -> RunMeta:
+    """The Result's metadata of an exact solver's run (Housner's, the two-block one): the run's
+    identity, status and step, ``fields`` (the RunMeta fields the solver knows), and in
+    ``extra`` the first 200 impacts, peaks and uplifts between the solver's own entries.
+
+    Parameters
+    ----------
+    solver, method
+        The solver's name, and its method for the version (e.g. "RK4").
+    scene, traj, wall
+        The scene run, its trajectory and the integration's wall time, s.
+    dt_factor
+        The factor on the largest step (:class:`StepFactorSolver`).
+    before, after
+        The solver's ``extra`` entries before the events' lists (the overturn criterion, the
+        counts) and after them.
+    """
+    return RunMeta(
+        solver=solver,
+        version=f"rockyade {__version__} ({method}, step {traj.step_s:.3g} s, events by root finding)",
+        scene_hash=scene.scene_hash,
+        wall_time_s=wall,
+        status=as_status(traj.status),
+        sample_dt_s=scene.sample_dt_s,
+        duration_s=scene.duration_s,
+        dt_factor=dt_factor,
+        dt_s=traj.step_s,
+        extra={
+            **before,
+            "impacts": traj.impacts[:200].tolist(),
+            "peaks": traj.peaks[:200].tolist(),
+            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
+            **after,
+        },
+        **fields,
+    )

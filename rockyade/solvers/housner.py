@@ -13,7 +13,6 @@ from typing import ClassVar
 
 import numpy as np
 
-from rockyade import __version__
 from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.errors import InputError
@@ -22,10 +21,10 @@ from rockyade.housner.integrator import KERNELS, REST_FRACTION, STEPS_PER_RADIAN
 from rockyade.housner.sdof import HousnerModel, housner_model
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
-from rockyade.run_meta import RunMeta, as_status
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
-from rockyade.solvers.base import GroupRun, StepFactorSolver, motion_coverage, say_if_compiling
+from rockyade.solvers.base import GroupRun, StepFactorSolver, exact_meta, motion_coverage, say_if_compiling
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 
 
@@ -178,29 +177,27 @@ def _meta(
 ) -> RunMeta:
     """The Result's metadata: status, events (the first 200 of each) and the parameters."""
     name = scene.blocks[0].name
-    return RunMeta(
-        solver=HousnerSolver.name,
-        version=f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
-        scene_hash=scene.scene_hash,
-        wall_time_s=wall,
-        status=as_status(traj.status),
+    before = {
+        "overturn_criterion": "|theta| reached pi/2",
+        "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
+        "n_impacts": traj.n_impacts,
+    }
+    after = {
+        "rest_fraction_of_alpha": REST_FRACTION,
+        "motion": motion.label if motion is not None else "free",
+        "loads": [q.as_dict() for q in scene.loads],
+    }
+    return exact_meta(
+        HousnerSolver.name,
+        "RK4",
+        scene,
+        traj,
+        wall,
+        dt_factor,
+        before,
+        after,
         overturn_time_s=traj.overturn_time_s,
         overturned_block=name if traj.status == "overturned" else None,
         blocks=(name,),
-        sample_dt_s=scene.sample_dt_s,
-        duration_s=scene.duration_s,
         classical={name: cp.as_dict()},
-        dt_factor=dt_factor,
-        dt_s=traj.step_s,
-        extra={
-            "overturn_criterion": "|theta| reached pi/2",
-            "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
-            "n_impacts": traj.n_impacts,
-            "impacts": traj.impacts[:200].tolist(),
-            "peaks": traj.peaks[:200].tolist(),
-            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
-            "rest_fraction_of_alpha": REST_FRACTION,
-            "motion": motion.label if motion is not None else "free",
-            "loads": [q.as_dict() for q in scene.loads],
-        },
     )
