@@ -406,11 +406,11 @@ def exact_meta(
     dt_factor: float,
     before: Mapping[str, object],
     after: Mapping[str, object],
-    **fields: Any,
 ) -> RunMeta:
     """The Result's metadata of an exact solver's run (Housner's, the two-block one): the run's
-    identity, status and step, ``fields`` (the RunMeta fields the solver knows), and in
-    ``extra`` the first 200 impacts, peaks and uplifts between the solver's own entries.
+    identity, status and step, and in ``extra`` the first 200 impacts, peaks and uplifts between
+    the solver's own entries; the solver adds the fields it knows (``dataclasses.replace``, which
+    the type checker checks).
 
     Parameters
     ----------
@@ -441,5 +441,4 @@ def exact_meta(
             "uplift_times_s": traj.uplift_times_s[:200].tolist(),
             **after,
         },
-        **fields,
     )

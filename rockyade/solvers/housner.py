@@ -187,15 +187,8 @@ def _meta(
         "motion": motion.label if motion is not None else "free",
         "loads": [q.as_dict() for q in scene.loads],
     }
-    return exact_meta(
-        HousnerSolver.name,
-        "RK4",
-        scene,
-        traj,
-        wall,
-        dt_factor,
-        before,
-        after,
+    return dataclasses.replace(
+        exact_meta(HousnerSolver.name, "RK4", scene, traj, wall, dt_factor, before, after),
         overturn_time_s=traj.overturn_time_s,
         overturned_block=name if traj.status == "overturned" else None,
         blocks=(name,),

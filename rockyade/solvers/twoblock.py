@@ -192,15 +192,8 @@ def _meta(
         "motion": motion.label if motion is not None else "free",
         **_check_mu(scene, model),
     }
-    return exact_meta(
-        TwoBlockSolver.name,
-        "two-block modes, RK4",
-        scene,
-        traj,
-        wall,
-        dt_factor,
-        before,
-        after,
+    return replace(
+        exact_meta(TwoBlockSolver.name, "two-block modes, RK4", scene, traj, wall, dt_factor, before, after),
         failure_reason=traj.failure_reason,
         partial=True if failed else None,
         partial_samples=len(traj.t_s) if failed else None,
