@@ -196,10 +196,10 @@ class RunMeta:
         """This metadata with ``values`` added to (or replacing in) :attr:`extra`."""
         return dataclasses.replace(self, extra={**self.extra, **values})
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """The flat JSON-ready form (module docstring): every field (those that are None
         only when :data:`ALWAYS_WRITTEN` names them), then the extra's keys."""
-        out: dict[str, Any] = {}
+        out: dict[str, object] = {}
         for f in dataclasses.fields(self):
             if f.name == "extra":
                 continue

@@ -194,11 +194,11 @@ class Assessment:
             return math.nan
         return self.dynamic.fit.fragility.median / self.code_capacity_ag_m_s2
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready (the code's quantities at the top; each check with its demand, capacity,
         verdict and source; strict: a number that does not exist is null)."""
         lim = self.limit.to_dict()
-        out: dict[str, Any] = {
+        out: dict[str, object] = {
             "code": self.code,
             "FC": self.fc,
             "FC_source": self.fc_source,

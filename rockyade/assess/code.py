@@ -200,7 +200,7 @@ class Check:
         """capacity / demand (>= 1: verified)."""
         return self.capacity / self.demand if self.applies and self.demand > 0 else math.nan
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready (the demand and capacity with their unit, the verdict, its source)."""
         return {
             "name": self.name,

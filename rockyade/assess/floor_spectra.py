@@ -40,7 +40,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -153,7 +152,7 @@ class FloorSpectrum:
             f"eta(xi = {100 * damping:g} %) = {self.amplification(damping):.4g} (xi1 as a ratio)"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready: the inputs and the peak."""
         return {
             "T1_s": self.T1_s,

@@ -25,7 +25,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
@@ -343,7 +343,7 @@ class FragilityResult:
             "fraction_hi": float(r.fraction_hi),
         }
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready (strict: a number that does not exist is null): the fit, the stripes, the
         records, how the levels were chosen."""
         m, plan = self.measure, self.plan

@@ -120,9 +120,9 @@ class RecordFiles:
             f"with the site's spectrum (NTC 2018 3.2.3.6; {worst}); lambda = 1 is its scaling{few}"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready."""
-        out: dict[str, Any] = {"kind": "records", "files": list(self.files), "units": self.units}
+        out: dict[str, object] = {"kind": "records", "files": list(self.files), "units": self.units}
         if self.scale_factors is not None:
             out["scale_factors"] = list(self.scale_factors)
             out["selection"] = self.selection
@@ -186,7 +186,7 @@ class SyntheticSuite:
         spec = self.spec
         return f"{self.count} records of the synthetic suite '{spec.name}' ({spec.target.label}, seed {spec.seed})"
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready."""
         spec = self.spec
         return {

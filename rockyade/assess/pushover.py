@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -113,7 +112,7 @@ class PushoverCheck:
             )
         return f"no onset measured: the run ended before the first held level ({a0})"
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data: the onset, its difference from alpha0 in %, the rule, the curve."""
         return {
             "pushover_onset_lambda": self.onset.multiplier,

@@ -31,7 +31,6 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
-from typing import Any
 
 from rockyade.assess.floor_spectra import BUILDING_DAMPING, SLV_DAMPING, FloorSpectrum, check_damping
 from rockyade.constants import CODE_GRAVITY as G
@@ -150,7 +149,7 @@ class Site:
             f"ag = {self.ag_m_s2 / G:.4g} g{gi} ({self.ag_m_s2:.4g} m/s^2)"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready: the inputs and the spectrum's parameters."""
         return {
             "spectrum_type": self.spectrum_type,
@@ -260,7 +259,7 @@ class NtcSite:
             f"TD = {sp.TD_s:.4g} s"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready: the inputs and the spectrum's parameters."""
         return {
             "spectrum_code": self.spectrum_code,
@@ -457,7 +456,7 @@ class Position:
             f"{self.period_source}; {form})"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """JSON-ready."""
         damping = {} if self.method == "circolare2009" else {"mechanism_damping_nonlinear": self.xi_slv}
         if not self.at_height:

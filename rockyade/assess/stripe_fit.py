@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -113,7 +112,7 @@ class StripeFit:
         m = self.fragility.median
         return bool(self.levels_si) and math.isfinite(m) and not min(self.levels_si) <= m <= max(self.levels_si)
 
-    def to_dict(self, scale: float, unit: str) -> dict[str, Any]:
+    def to_dict(self, scale: float, unit: str) -> dict[str, object]:
         """JSON-ready, intensities in SI and divided by ``scale`` (in ``unit``)."""
         f = self.fragility
         shown = f"_{unit.replace('/', '_')}"

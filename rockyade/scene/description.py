@@ -55,12 +55,13 @@ import math
 import re
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NotRequired, TypedDict
 
 from rockyade.blocks.classical import ClassicalParameters, classical_parameters
 from rockyade.blocks.geometry import Block
 from rockyade.constants import DEFAULT_FRICTION_ANGLE_DEG, DEFAULT_TIME_STEP_FRAC, G
 from rockyade.errors import InputError
+from rockyade.scene.frozen_cache import computed_once, without_caches
 
 if TYPE_CHECKING:  # a name only: the dataclasses load without the motion types (scipy, numba)
     from rockyade.motion.spec import MotionSpec
@@ -79,11 +80,6 @@ LOAD_POINT_TOL = 1e-6
 NAME_PATTERN = re.compile(r"^[A-Za-z][A-Za-z0-9_]{0,63}$")
 CALIBRATIONS = ("paper", "matched")
 MAX_SAMPLES = 50_000_000
-
-
-def _without_caches(obj: object) -> dict[str, Any]:
-    """A frozen object's fields for pickling, without what it computed and kept (keys with "_")."""
-    return {k: v for k, v in obj.__dict__.items() if not k.startswith("_")}
 
 
 @dataclass(frozen=True)
@@ -106,30 +102,20 @@ class BlockSpec:
     rotation_rad: float = 0.0
     fixed: bool = False
 
-    def __getstate__(self) -> dict[str, Any]:
-        return _without_caches(self)
+    def __getstate__(self) -> dict[str, object]:
+        return without_caches(self)
 
     def block(self) -> Block:
         """The rigid block (geometry, mass, inertia); built once (both are frozen)."""
-        cached = self.__dict__.get("_block")
-        if cached is None:
-            cached = self.__dict__["_block"] = self._new_block()
-        return cached
+        return computed_once(self, "_block", self._new_block)
 
     def _new_block(self) -> Block:
         if self.vertices_m is not None:
-            return Block.polygon(
-                self.vertices_m,
-                self.thickness_m,
-                mass_kg=self.mass_kg,
-                density_kg_m3=self.density_kg_m3,
-                inertia_kgm2=self.inertia_kgm2,
-                name=self.name,
-            )
-        assert self.width_m is not None and self.height_m is not None  # loading requires them without vertices
-        return Block.rectangle(
-            self.width_m,
-            self.height_m,
+            shape = functools.partial(Block.polygon, self.vertices_m)
+        else:
+            assert self.width_m is not None and self.height_m is not None  # loading requires them without vertices
+            shape = functools.partial(Block.rectangle, self.width_m, self.height_m)
+        return shape(
             self.thickness_m,
             mass_kg=self.mass_kg,
             density_kg_m3=self.density_kg_m3,
@@ -193,6 +179,16 @@ class JointOverride:
         return dict(self.values).get(key)
 
 
+class LoadTable(TypedDict):
+    """A ``[[loads]]`` table: a force, N, at a point of a block, m (base frame at rest), with
+    the mass it carries, kg (:class:`LoadSpec`)."""
+
+    block: str
+    point_m: list[float]
+    force_N: list[float]
+    mass_kg: NotRequired[float]
+
+
 @dataclass(frozen=True)
 class LoadSpec:
     """One ``[[loads]]`` entry: a constant force on a block, with its mass (module docstring).
@@ -215,9 +211,9 @@ class LoadSpec:
     force_N: tuple[float, float]
     mass_kg: float | None = None
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> LoadTable:
         """The ``[[loads]]`` table (``mass_kg`` only when given)."""
-        out: dict[str, Any] = {"block": self.block, "point_m": list(self.point_m), "force_N": list(self.force_N)}
+        out: LoadTable = {"block": self.block, "point_m": list(self.point_m), "force_N": list(self.force_N)}
         if self.mass_kg is not None:
             out["mass_kg"] = self.mass_kg
         return out
@@ -255,8 +251,8 @@ class Scene:
     joints: tuple[JointOverride, ...] = ()
     loads: tuple[LoadSpec, ...] = ()
 
-    def __getstate__(self) -> dict[str, Any]:
-        return _without_caches(self)
+    def __getstate__(self) -> dict[str, object]:
+        return without_caches(self)
 
     # ------------------------------------------------------------------ queries
     @property

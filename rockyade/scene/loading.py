@@ -10,6 +10,7 @@ import json
 import math
 import os
 import tomllib
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -312,13 +313,18 @@ def _parse_output(r: TableReader) -> OutputSpec:
     return OutputSpec(point, lowpass)
 
 
+def _list_readers(raw: Any, key: str, source: str | None) -> Iterator[TableReader]:
+    """A reader of each table of the list ``[[key]]`` in turn (named ``key[k]`` in errors)."""
+    if not isinstance(raw, list):
+        raise InputError(key, f"must be a list of tables ([[{key}]])", source)
+    for k, table in enumerate(raw):
+        yield TableReader(table, f"{key}[{k}]", source)
+
+
 def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
     """The ``[[joints]]`` list: per-pair overrides by block names (see scene.description.JointOverride)."""
-    if not isinstance(raw, list):
-        raise InputError("joints", "must be a list of tables ([[joints]])", source)
     out = []
-    for k, table in enumerate(raw):
-        r = TableReader(table, f"joints[{k}]", source)
+    for r in _list_readers(raw, "joints", source):
         names = r.raw("blocks")
         if not isinstance(names, list) or len(names) != 2 or not all(isinstance(n, str) for n in names):
             raise r.error("blocks", 'must be two block names, e.g. ["b1", "b2"] or ["b1", "base"]')
@@ -339,11 +345,8 @@ def _parse_joints(raw: Any, source: str | None) -> tuple[JointOverride, ...]:
 
 def _parse_loads(raw: Any, source: str | None) -> tuple[LoadSpec, ...]:
     """The ``[[loads]]`` list (see scene.description.LoadSpec); the cross-checks are in ``_check_scene``."""
-    if not isinstance(raw, list):
-        raise InputError("loads", "must be a list of tables ([[loads]])", source)
     out = []
-    for k, table in enumerate(raw):
-        r = TableReader(table, f"loads[{k}]", source)
+    for r in _list_readers(raw, "loads", source):
         block = r.string("block")
         point = r.number_list("point_m", min_len=2, unit="m")
         force = r.number_list("force_N", min_len=2, unit="N")

@@ -21,6 +21,8 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.scene.frozen_cache import computed_once
+
 #: Overlaps deeper than this fraction of the smaller block's size are refused.
 OVERLAP_TOL = 1e-6
 #: Edges within this fraction of the block size of each other's line touch at rest.
@@ -111,10 +113,7 @@ def placed_blocks(scene) -> list[PlacedBlock]:
     scene
         A :class:`~rockyade.scene.Scene` (positioned or column).
     """
-    cached = scene.__dict__.get("_placed_blocks")
-    if cached is None:
-        cached = scene.__dict__["_placed_blocks"] = tuple(_placed_blocks(scene))
-    return list(cached)
+    return list(computed_once(scene, "_placed_blocks", lambda: tuple(_placed_blocks(scene))))
 
 
 def scene_rest_contacts(scene) -> list[RestContact]:
@@ -125,10 +124,7 @@ def scene_rest_contacts(scene) -> list[RestContact]:
     scene
         A :class:`~rockyade.scene.Scene` (positioned or column).
     """
-    cached = scene.__dict__.get("_rest_contacts")
-    if cached is None:
-        cached = scene.__dict__["_rest_contacts"] = tuple(rest_contacts(placed_blocks(scene)))
-    return list(cached)
+    return list(computed_once(scene, "_rest_contacts", lambda: tuple(rest_contacts(placed_blocks(scene)))))
 
 
 def _placed_blocks(scene) -> list[PlacedBlock]:

@@ -35,8 +35,10 @@ from typing import TYPE_CHECKING, Any, ClassVar, Protocol, Self, runtime_checkab
 
 import numpy as np
 
+from rockyade import __version__
 from rockyade.errors import InputError, RockyadeError
-from rockyade.run_meta import RunMeta
+from rockyade.io.warm_program import check_timeout
+from rockyade.run_meta import RunMeta, as_status
 
 if TYPE_CHECKING:
     from rockyade.result import Result
@@ -138,6 +140,26 @@ def check_flag(value: Any, field: str) -> bool:
     return value
 
 
+def check_float(value: Any, field: str, lo: float, hi: float, what: str, *, lo_open: bool = False) -> float:
+    """``value`` (a number, or text that reads as one; not a bool) as a float in [lo, hi], or
+    in (lo, hi] with ``lo_open``; else InputError naming ``field``: "must be ``what``"."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise InputError(field, f"must be {what}, got {value!r}") from None
+    low_ok = x > lo if lo_open else x >= lo
+    if isinstance(value, bool) or not (low_ok and x <= hi):
+        raise InputError(field, f"must be {what}, got {value!r}")
+    return x
+
+
+def check_folder(value: Any, field: str) -> str | None:
+    """A folder path (text or a Path) or None."""
+    if value is not None and not isinstance(value, (str, Path)):
+        raise InputError(field, f"must be a folder path, got {value!r}")
+    return None if value is None else str(value)
+
+
 #: Range of ``dt_factor``, the factor on a solver's own time step: [DT_FACTOR_MIN, 1].
 DT_FACTOR_MIN = 1e-3
 
@@ -151,6 +173,17 @@ def check_dt_factor(value: Any, field: str) -> float:
             field, f"must be a number in [{DT_FACTOR_MIN:g}, 1] (a factor on the solver's time step), got {value!r}"
         )
     return float(value)
+
+
+#: The options of a solver that runs another program in a worker (YADE, Siconos): the run's
+#: timeout, a warm worker or a process of its own, the factor on the time step, the folder its
+#: files are kept in.
+WORKER_OPTIONS: Mapping[str, OptionCheck] = {
+    "timeout_s": check_timeout,
+    "warm": check_flag,
+    "dt_factor": check_dt_factor,
+    "workdir": check_folder,
+}
 
 
 def motion_coverage(scene: Scene) -> dict[str, Any]:
@@ -303,6 +336,12 @@ class SolverBase:
             checked[key] = cls.OPTIONS[key](value, field)
         return cls(**checked)
 
+    def __post_init__(self) -> None:
+        """Check every option field by its :data:`OPTIONS` entry: a solver built in Python is
+        checked as one built from options by name (:meth:`from_options`)."""
+        for key, check in self.OPTIONS.items():
+            object.__setattr__(self, key, check(getattr(self, key), key))
+
     def keeping_files(self, folder: str | Path, stem: str | None = None) -> Self:
         """Itself: this solver keeps no files."""
         return self
@@ -334,3 +373,72 @@ class SolverBase:
         def estimate_cost(self, scene: Scene) -> CostEstimate:
             """What running ``scene`` will cost (defined by each subclass)."""
             ...
+
+
+@dataclass(frozen=True)
+class StepFactorSolver(SolverBase):
+    """An in-process solver whose one option is ``dt_factor``, a factor in [0.001, 1] on the
+    largest step of its integrator (:func:`check_dt_factor`; the subclass's docstring says
+    which step): the exact solvers (Housner's, the two-block one)."""
+
+    IN_PROCESS = True
+    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
+
+    dt_factor: float = 1.0
+
+
+class EventTrajectory(Protocol):
+    """What an exact (event-driven) solver's trajectory tells its Result's metadata."""
+
+    step_s: float
+    status: str
+    impacts: np.ndarray
+    peaks: np.ndarray
+    uplift_times_s: np.ndarray
+
+
+def exact_meta(
+    solver: str,
+    method: str,
+    scene: Scene,
+    traj: EventTrajectory,
+    wall: float,
+    dt_factor: float,
+    before: Mapping[str, object],
+    after: Mapping[str, object],
+) -> RunMeta:
+    """The Result's metadata of an exact solver's run (Housner's, the two-block one): the run's
+    identity, status and step, and in ``extra`` the first 200 impacts, peaks and uplifts between
+    the solver's own entries; the solver adds the fields it knows (``dataclasses.replace``, which
+    the type checker checks).
+
+    Parameters
+    ----------
+    solver, method
+        The solver's name, and its method for the version (e.g. "RK4").
+    scene, traj, wall
+        The scene run, its trajectory and the integration's wall time, s.
+    dt_factor
+        The factor on the largest step (:class:`StepFactorSolver`).
+    before, after
+        The solver's ``extra`` entries before the events' lists (the overturn criterion, the
+        counts) and after them.
+    """
+    return RunMeta(
+        solver=solver,
+        version=f"rockyade {__version__} ({method}, step {traj.step_s:.3g} s, events by root finding)",
+        scene_hash=scene.scene_hash,
+        wall_time_s=wall,
+        status=as_status(traj.status),
+        sample_dt_s=scene.sample_dt_s,
+        duration_s=scene.duration_s,
+        dt_factor=dt_factor,
+        dt_s=traj.step_s,
+        extra={
+            **before,
+            "impacts": traj.impacts[:200].tolist(),
+            "peaks": traj.peaks[:200].tolist(),
+            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
+            **after,
+        },
+    )

@@ -13,7 +13,6 @@ from typing import ClassVar
 
 import numpy as np
 
-from rockyade import __version__
 from rockyade.blocks.classical import ClassicalParameters
 from rockyade.constants import G
 from rockyade.errors import InputError
@@ -22,15 +21,15 @@ from rockyade.housner.integrator import KERNELS, REST_FRACTION, STEPS_PER_RADIAN
 from rockyade.housner.sdof import HousnerModel, housner_model
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
-from rockyade.run_meta import RunMeta, as_status
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
 from rockyade.scene.carried import loaded_classical
-from rockyade.solvers.base import GroupRun, SolverBase, check_dt_factor, motion_coverage, say_if_compiling
+from rockyade.solvers.base import GroupRun, StepFactorSolver, exact_meta, motion_coverage, say_if_compiling
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 
 
 @dataclass(frozen=True)
-class HousnerSolver(SolverBase):
+class HousnerSolver(StepFactorSolver):
     """Housner's exact solution as a solver (single blocks on a rigid base).
 
     Attributes
@@ -42,14 +41,7 @@ class HousnerSolver(SolverBase):
     """
 
     name: ClassVar[str] = "housner"
-    IN_PROCESS = True
-    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
     COMPILE_S: ClassVar[float] = 9.0
-
-    dt_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
 
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the integrator (:data:`rockyade.housner.integrator.KERNELS`)."""
@@ -125,18 +117,9 @@ class HousnerSolver(SolverBase):
         """Run scenes of one :meth:`group_key` together: the model (classical parameters, loads)
         is built once, each run's base motion once (the run and its coverage read the same
         arrays), and no time-history frame is made; each run is integrated as :meth:`run`
-        integrates it (the same numbers, bit for bit).
-
-        Parameters
-        ----------
-        scenes
-            Scenes with one group key.
-        uplift_rad
-            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
-        threads
-            Unused: the runs are integrated one after the other in this thread (a batch's
-            workers run one job each); taken for the interface of
-            :meth:`rockyade.solvers.reference.ReferenceSolver.run_group`.
+        integrates it (the same numbers, bit for bit). The parameters are those of
+        :meth:`rockyade.solvers.base.GroupSolver.run_group`; ``threads`` is unused: the runs are
+        integrated one after the other in this thread (a batch's workers run one job each).
 
         Returns
         -------
@@ -194,29 +177,20 @@ def _meta(
 ) -> RunMeta:
     """The Result's metadata: status, events (the first 200 of each) and the parameters."""
     name = scene.blocks[0].name
-    return RunMeta(
-        solver=HousnerSolver.name,
-        version=f"rockyade {__version__} (RK4, step {traj.step_s:.3g} s, events by root finding)",
-        scene_hash=scene.scene_hash,
-        wall_time_s=wall,
-        status=as_status(traj.status),
+    before = {
+        "overturn_criterion": "|theta| reached pi/2",
+        "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
+        "n_impacts": traj.n_impacts,
+    }
+    after = {
+        "rest_fraction_of_alpha": REST_FRACTION,
+        "motion": motion.label if motion is not None else "free",
+        "loads": [q.as_dict() for q in scene.loads],
+    }
+    return dataclasses.replace(
+        exact_meta(HousnerSolver.name, "RK4", scene, traj, wall, dt_factor, before, after),
         overturn_time_s=traj.overturn_time_s,
         overturned_block=name if traj.status == "overturned" else None,
         blocks=(name,),
-        sample_dt_s=scene.sample_dt_s,
-        duration_s=scene.duration_s,
         classical={name: cp.as_dict()},
-        dt_factor=dt_factor,
-        dt_s=traj.step_s,
-        extra={
-            "overturn_criterion": "|theta| reached pi/2",
-            "alpha_exceeded_time_s": traj.alpha_exceeded_time_s,
-            "n_impacts": traj.n_impacts,
-            "impacts": traj.impacts[:200].tolist(),
-            "peaks": traj.peaks[:200].tolist(),
-            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
-            "rest_fraction_of_alpha": REST_FRACTION,
-            "motion": motion.label if motion is not None else "free",
-            "loads": [q.as_dict() for q in scene.loads],
-        },
     )

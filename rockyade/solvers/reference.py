@@ -93,9 +93,6 @@ class ReferenceSolver(SolverBase):
     record_contacts: bool = True
     dt_factor: float = 1.0
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
-
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the kernels ``scene``'s runs take: for one block the
         grouped and single-body paths, for several the general loop."""
@@ -149,16 +146,9 @@ class ReferenceSolver(SolverBase):
     def run_group(self, scenes: Sequence[Scene], uplift_rad: float, threads: int = 1) -> list[GroupRun]:
         """Run scenes of one :meth:`group_key` together: the model is built once, its motion
         replaced per run, and the runs stepped in parallel (:func:`rockyade.kernel.runs.simulate_runs`;
-        the same per-run results, bit for bit, as :meth:`run`).
-
-        Parameters
-        ----------
-        scenes
-            Scenes with one group key.
-        uplift_rad
-            |theta| above which the block counts as lifted off (``uplift_time_s``), rad.
-        threads
-            Threads stepping the runs (numba's, in this thread; a batch's workers run one each).
+        the same per-run results, bit for bit, as :meth:`run`). The parameters are those of
+        :meth:`rockyade.solvers.base.GroupSolver.run_group`; ``threads`` are numba's threads
+        stepping the runs, in this thread (a batch's workers run one each).
 
         Returns
         -------

@@ -18,13 +18,12 @@ from typing import Any, ClassVar
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.model import DemModel
 from rockyade.errors import InputError
-from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
 from rockyade.scene import ContactSpec, Scene
 from rockyade.siconos.backend import SICONOS, run_model
 from rockyade.siconos.calibration import DT_MAX_S, DT_MIN_S, DT_P_FRACTION, check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import INTEGRATORS, Numerics, penetration_bound
-from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
+from rockyade.solvers.base import WORKER_OPTIONS, SolverBase, check_float, check_folder
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
 #: Largest time step accepted, s.
@@ -34,23 +33,11 @@ DT_LIMIT_S = 0.01
 def _check_dt(value: Any, field: str) -> float | None:
     if value is None:
         return None
-    try:
-        dt = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a time step in s, got {value!r}") from None
-    if not (0.0 < dt <= DT_LIMIT_S):
-        raise InputError(field, f"must be in (0, {DT_LIMIT_S:g}] s, got {value!r}")
-    return dt
+    return check_float(value, field, 0.0, DT_LIMIT_S, f"a time step in (0, {DT_LIMIT_S:g}] s", lo_open=True)
 
 
 def _check_tol(value: Any, field: str) -> float:
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a tolerance in [1e-14, 1e-3], got {value!r}") from None
-    if isinstance(value, bool) or not (1e-14 <= tol <= 1e-3):
-        raise InputError(field, f"must be a tolerance in [1e-14, 1e-3], got {value!r}")
-    return tol
+    return check_float(value, field, 1e-14, 1e-3, "a tolerance in [1e-14, 1e-3]")
 
 
 def _check_count(low: int, high: int):
@@ -63,13 +50,7 @@ def _check_count(low: int, high: int):
 
 
 def _check_restitution(value: Any, field: str) -> float:
-    try:
-        e = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"must be a number in [0, 1], got {value!r}") from None
-    if isinstance(value, bool) or not (0.0 <= e <= 1.0):
-        raise InputError(field, f"must be a number in [0, 1], got {value!r}")
-    return e
+    return check_float(value, field, 0.0, 1.0, "a number in [0, 1]")
 
 
 def _check_integrator(value: Any, field: str) -> str:
@@ -80,12 +61,6 @@ def _check_integrator(value: Any, field: str) -> str:
 
 def _check_optional_tol(value: Any, field: str) -> float | None:
     return None if value is None else _check_tol(value, field)
-
-
-def _check_folder(value: Any, field: str) -> str | None:
-    if value is not None and not isinstance(value, (str, Path)):
-        raise InputError(field, f"must be a folder path, got {value!r}")
-    return None if value is None else str(value)
 
 
 #: The stiffness of the joints of Siconos's DEM model, N/m: the model builder wants one; Siconos's
@@ -148,16 +123,13 @@ class SiconosSolver(SolverBase):
 
     name: ClassVar[str] = "siconos"
     OPTIONS: ClassVar = {
-        "timeout_s": check_timeout,
-        "warm": check_flag,
+        **WORKER_OPTIONS,
         "dt_s": _check_dt,
-        "dt_factor": check_dt_factor,
         "restitution": _check_restitution,
         "integrator": _check_integrator,
         "solver_tol": _check_optional_tol,
         "solver_max_iter": _check_count(1, 100_000),
         "newton_max_iter": _check_count(1, 100),
-        "workdir": _check_folder,
     }
     #: Siconos's time per step, s: STEP_S + BODY_STEP_S x n for n moving blocks (cost estimate),
     #: the numerics path at its default step and tolerance. Measured with benchmarks/
@@ -193,20 +165,8 @@ class SiconosSolver(SolverBase):
     stem: str | None = None
 
     def __post_init__(self) -> None:
-        for key in (
-            "timeout_s",
-            "dt_s",
-            "dt_factor",
-            "restitution",
-            "integrator",
-            "solver_tol",
-            "solver_max_iter",
-            "newton_max_iter",
-        ):
-            object.__setattr__(self, key, self.OPTIONS[key](getattr(self, key), key))
-        object.__setattr__(self, "warm", check_flag(self.warm, "warm"))
-        object.__setattr__(self, "workdir", _check_folder(self.workdir, "workdir"))
-        object.__setattr__(self, "failed_dir", _check_folder(self.failed_dir, "failed_dir"))
+        super().__post_init__()
+        object.__setattr__(self, "failed_dir", check_folder(self.failed_dir, "failed_dir"))
 
     def model(self, scene: Scene) -> DemModel:
         """The scene's blocks, motion, loads and start as the DEMs build them, and its friction

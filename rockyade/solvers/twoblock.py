@@ -8,13 +8,12 @@ import time
 from dataclasses import dataclass, replace
 from typing import ClassVar
 
-from rockyade import __version__
 from rockyade.errors import InputError
 from rockyade.motion.ground import GroundMotion
 from rockyade.result import Result
-from rockyade.run_meta import RunMeta, as_status
+from rockyade.run_meta import RunMeta
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_dt_factor
+from rockyade.solvers.base import StepFactorSolver, exact_meta
 from rockyade.solvers.cost_estimate import CostEstimate, numba_cached, sample_cost
 from rockyade.twoblock import TwoBlockModel, TwoBlockTrajectory, solve, two_block_model, warm_up
 from rockyade.twoblock.event_driven import REST_FRACTION, integrate
@@ -35,7 +34,7 @@ OVERTURN_CRITERION = (
 
 
 @dataclass(frozen=True)
-class TwoBlockSolver(SolverBase):
+class TwoBlockSolver(StepFactorSolver):
     """The two-block exact solver (module docstring).
 
     Attributes
@@ -47,14 +46,7 @@ class TwoBlockSolver(SolverBase):
     """
 
     name: ClassVar[str] = "twoblock"
-    IN_PROCESS = True
-    OPTIONS: ClassVar = {"dt_factor": check_dt_factor}
     COMPILE_S: ClassVar[float] = 24.0
-
-    dt_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
 
     def compiled_cached(self, scene: Scene) -> bool:
         """Whether numba's cache holds the event-driven integrator."""
@@ -178,12 +170,30 @@ def _meta(
     overturned = names[traj.overturned_block] if traj.overturned_block is not None else None
     failed = traj.status == "failed"
     classical = {spec.name: spec.classical().as_dict() for spec in scene.blocks}
-    return RunMeta(
-        solver=TwoBlockSolver.name,
-        version=f"rockyade {__version__} (two-block modes, RK4, step {traj.step_s:.3g} s, events by root finding)",
-        scene_hash=scene.scene_hash,
-        wall_time_s=wall,
-        status=as_status(traj.status),
+    before = {
+        "overturn_criterion": OVERTURN_CRITERION,
+        "failure_time_s": traj.end_time_s if failed else None,
+        "n_impacts": traj.counts["impacts"],
+    }
+    after = {
+        "mode_changes": traj.mode_changes[:200].tolist(),
+        "event_counts": traj.counts,
+        "friction": {
+            "coefficient": dict(zip(("base", "seat"), model.friction, strict=True)),
+            "max_ratio": dict(zip(("base", "seat"), traj.friction_max, strict=True)),
+            "exceeded_time_s": dict(zip(("base", "seat"), traj.friction_exceeded_s, strict=True)),
+            "max_impulse_ratio": dict(zip(("base", "seat"), traj.impulse_ratio_max, strict=True)),
+        },
+        "pivot_tension_time_s": dict(zip(("base", "seat"), traj.pivot_tension_s, strict=True)),
+        "onset_multiplier": model.onset_multiplier,
+        "uplift_multipliers": model.uplift_multipliers(),
+        "model_notes": list(model.notes),
+        "rest_fraction_of_alpha": REST_FRACTION,
+        "motion": motion.label if motion is not None else "free",
+        **_check_mu(scene, model),
+    }
+    return replace(
+        exact_meta(TwoBlockSolver.name, "two-block modes, RK4", scene, traj, wall, dt_factor, before, after),
         failure_reason=traj.failure_reason,
         partial=True if failed else None,
         partial_samples=len(traj.t_s) if failed else None,
@@ -191,34 +201,7 @@ def _meta(
         overturned_block=overturned,
         overturn_times_s={overturned: traj.end_time_s} if overturned and traj.end_time_s is not None else {},
         blocks=names,
-        sample_dt_s=scene.sample_dt_s,
-        duration_s=scene.duration_s,
         classical=classical,
-        dt_factor=dt_factor,
-        dt_s=traj.step_s,
-        extra={
-            "overturn_criterion": OVERTURN_CRITERION,
-            "failure_time_s": traj.end_time_s if failed else None,
-            "n_impacts": traj.counts["impacts"],
-            "impacts": traj.impacts[:200].tolist(),
-            "peaks": traj.peaks[:200].tolist(),
-            "uplift_times_s": traj.uplift_times_s[:200].tolist(),
-            "mode_changes": traj.mode_changes[:200].tolist(),
-            "event_counts": traj.counts,
-            "friction": {
-                "coefficient": dict(zip(("base", "seat"), model.friction, strict=True)),
-                "max_ratio": dict(zip(("base", "seat"), traj.friction_max, strict=True)),
-                "exceeded_time_s": dict(zip(("base", "seat"), traj.friction_exceeded_s, strict=True)),
-                "max_impulse_ratio": dict(zip(("base", "seat"), traj.impulse_ratio_max, strict=True)),
-            },
-            "pivot_tension_time_s": dict(zip(("base", "seat"), traj.pivot_tension_s, strict=True)),
-            "onset_multiplier": model.onset_multiplier,
-            "uplift_multipliers": model.uplift_multipliers(),
-            "model_notes": list(model.notes),
-            "rest_fraction_of_alpha": REST_FRACTION,
-            "motion": motion.label if motion is not None else "free",
-            **_check_mu(scene, model),
-        },
     )
 
 

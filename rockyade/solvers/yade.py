@@ -15,18 +15,11 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from rockyade.errors import InputError
-from rockyade.io.warm_program import check_timeout
 from rockyade.result import Result
 from rockyade.scene import Scene
-from rockyade.solvers.base import SolverBase, check_dt_factor, check_flag
+from rockyade.solvers.base import WORKER_OPTIONS, SolverBase
 from rockyade.solvers.cost_estimate import CostEstimate, dem_cost
 from rockyade.yade.backend import run_model, yade_model
-
-
-def _check_folder(value: Any, field: str) -> str | None:
-    if value is not None and not isinstance(value, (str, Path)):
-        raise InputError(field, f"must be a folder path, got {value!r}")
-    return None if value is None else str(value)
 
 
 def _check_stem(value: Any, field: str) -> str | None:
@@ -61,13 +54,7 @@ class YadeSolver(SolverBase):
     """
 
     name: ClassVar[str] = "yade"
-    OPTIONS: ClassVar = {
-        "timeout_s": check_timeout,
-        "workdir": _check_folder,
-        "stem": _check_stem,
-        "warm": check_flag,
-        "dt_factor": check_dt_factor,
-    }
+    OPTIONS: ClassVar = {**WORKER_OPTIONS, "stem": _check_stem}
     #: YADE's time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 5e-6
 
@@ -76,13 +63,6 @@ class YadeSolver(SolverBase):
     stem: str | None = None
     warm: bool = True
     dt_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "dt_factor", check_dt_factor(self.dt_factor, "dt_factor"))
-        object.__setattr__(self, "timeout_s", check_timeout(self.timeout_s, "timeout_s"))
-        object.__setattr__(self, "stem", _check_stem(self.stem, "stem"))
-        if self.workdir is not None:
-            object.__setattr__(self, "workdir", str(self.workdir))
 
     def run(self, scene: Scene) -> Result:
         """Run a scene in YADE (:func:`rockyade.yade.backend.run_model`)."""

@@ -28,6 +28,7 @@ import numpy as np
 
 from rockyade import __version__
 from rockyade.assess.assessment import Assessment
+from rockyade.assess.motions import RecordFiles
 from rockyade.assess.report_model import (
     FIGURE_CHECK,
     FIGURE_FRAGILITY,
@@ -203,7 +204,7 @@ def _draw_selection(a: Assessment, path: Path) -> None:
 
     assert a.dynamic is not None
     motions = a.dynamic.plan.stripes.motions
-    selection = motions.to_dict().get("selection") or {}
+    selection = (motions.selection if isinstance(motions, RecordFiles) else None) or {}
     t_range = tuple(selection.get("period_range_s") or (0.15, 2.0))
     records = [motions.record(i) for i in range(motions.count)]
     longest = min(r.duration_s for r in records)

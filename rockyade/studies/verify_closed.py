@@ -365,35 +365,36 @@ def loaded_block_scene(
     )
 
 
+def _multiplier_rows(case: str, scene: Scene, expected: float, src: str) -> tuple[list[Row], LimitResult]:
+    """The limit analysis's lambda towards +x and Housner's uplift multiplier about the +x
+    (right) pivot of a loaded block, each against ``expected`` (closed form ``src``); and the
+    limit analysis's result."""
+    from rockyade.housner import housner_model
+    from rockyade.limit import limit_analysis
+
+    result = limit_analysis(scene, direction="+x")
+    lam = known(result.load_multiplier, "load multiplier")
+    housner = housner_model(scene).uplift_multiplier(-1)
+    return [
+        Row(case, "limit", "lambda towards +x", lam, expected, src, relative(1e-6)),
+        Row(case, "housner", "uplift multiplier about the +x pivot", housner, expected, src, relative(1e-6)),
+    ], result
+
+
 def check_loaded_mass(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """The loaded block with the load's mass (its weight / g) shaking with it: the limit
     analysis and Housner's uplift multiplier against (W b + N d) / (W h_c + N h_N), h_N the
     load's height (its horizontal force lambda N at its point), and the code's e* with the
     load as a P_i at h_N: (W h_c + N h_N)^2 / ((W + N) (W h_c^2 + N h_N^2))."""
-    from rockyade.limit import limit_analysis
-    from rockyade.solvers.housner import housner_model
-
     scene = loaded_block_scene(load_mass_kg=LOADED_N / G)
     w, n = LOADED_MASS_KG * G, LOADED_N
     b, h_c, h_n = LOADED_WIDTH_M / 2, LOADED_HEIGHT_M / 2, LOADED_HEIGHT_M
     expected = (w * b + n * (b - LOADED_X_M)) / (w * h_c + n * h_n)
-    result = limit_analysis(scene, direction="+x")
-    lam = known(result.load_multiplier, "load multiplier")
-    housner = housner_model(scene).uplift_multiplier(-1)
+    rows, result = _multiplier_rows("loaded_mass", scene, expected, "(W b + N d) / (W h_c + N h_N)")
     e_star = _kinematic(result).e_star
     e_expected = (w * h_c + n * h_n) ** 2 / ((w + n) * (w * h_c**2 + n * h_n**2))
-    src = "(W b + N d) / (W h_c + N h_N)"
     return [
-        Row("loaded_mass", "limit", "lambda towards +x", lam, expected, src, relative(1e-6)),
-        Row(
-            "loaded_mass",
-            "housner",
-            "uplift multiplier about the +x pivot",
-            housner,
-            expected,
-            src,
-            relative(1e-6),
-        ),
+        *rows,
         Row(
             "loaded_mass",
             "limit",
@@ -409,23 +410,5 @@ def check_loaded_mass(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]
 def check_loaded_block(solvers: list[str]) -> tuple[list[Row], dict[str, Result]]:
     """The loaded block's multiplier (module docstring) from the limit analysis and from
     Housner's uplift multiplier about the +x (right) pivot, against the closed form."""
-    from rockyade.housner import housner_model
-    from rockyade.limit import limit_analysis
-
-    scene = loaded_block_scene()
-    expected = loaded_lambda()
-    lam = known(limit_analysis(scene, direction="+x").load_multiplier, "load multiplier")
-    housner = housner_model(scene).uplift_multiplier(-1)
-    src = "(W b + N d) / (W h_c)"
-    return [
-        Row("loaded_block", "limit", "lambda towards +x", lam, expected, src, relative(1e-6)),
-        Row(
-            "loaded_block",
-            "housner",
-            "uplift multiplier about the +x pivot",
-            housner,
-            expected,
-            src,
-            relative(1e-6),
-        ),
-    ], {}
+    rows, _ = _multiplier_rows("loaded_block", loaded_block_scene(), loaded_lambda(), "(W b + N d) / (W h_c)")
+    return rows, {}

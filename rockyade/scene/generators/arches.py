@@ -37,6 +37,7 @@ import numpy as np
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.scene_tables import (
+    BlockTable,
     digits,
     exact,
     num,
@@ -169,7 +170,7 @@ def arch(
     density = check("arch", "density_kg_m3", density_kg_m3)
     if piers == "fixed" and ph == 0:
         raise InputError("piers", '"fixed" needs piers: give pier_height_m > 0')
-    blocks: list[dict[str, Any]] = []
+    blocks: list[BlockTable] = []
     if ph > 0:
         half = exact(span) / 2
         fixed = piers == "fixed"

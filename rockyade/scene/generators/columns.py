@@ -24,6 +24,9 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import MAX_STACK_BLOCKS, STACK_WIDTHS_M, check, defaults, param
 from rockyade.scene.generators.scene_tables import (
+    BlockTable,
+    Outline,
+    block_table,
     check_count,
     digits,
     exact,
@@ -49,19 +52,16 @@ def _block(
     thickness: float,
     density: float,
     layout: str,
-) -> dict[str, Any]:
+) -> BlockTable:
     """A rectangle (equal widths) or a symmetric trapezoid, base centre at (0, y)."""
     if bottom_width == top_width:
         table = rect_block(name, bottom_width, height, Fraction(0), y, thickness, density)
     else:
         b, t = bottom_width / 2, top_width / 2
-        table = {
-            "name": name,
-            "vertices_m": [[num(-b), 0.0], [num(b), 0.0], [num(t), num(height)], [num(-t), num(height)]],
-            "thickness_m": float(thickness),
-            "density_kg_m3": float(density),
-            "position_m": [0.0, num(y)],
+        outline: Outline = {
+            "vertices_m": [[num(-b), 0.0], [num(b), 0.0], [num(t), num(height)], [num(-t), num(height)]]
         }
+        table = block_table(name, outline, (Fraction(0), y), thickness, density)
     if layout == "column":
         del table["position_m"]
     return table

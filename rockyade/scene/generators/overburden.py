@@ -25,6 +25,7 @@ import numpy as np
 
 from rockyade.constants import G
 from rockyade.errors import InputError
+from rockyade.scene.description import LoadTable
 from rockyade.scene.generator_options import LINE_LOAD, OFFSET, POINT_LOAD
 
 KINDS = ("section", "line", "point")
@@ -48,7 +49,7 @@ def _top_face(block) -> tuple[float, float, float]:
     return 0.5 * (float(xs.min()) + float(xs.max())), top, float(xs.max() - xs.min())
 
 
-def _load(block: str, point: list[float], force: float, with_mass: bool) -> dict[str, Any]:
+def _load(block: str, point: list[float], force: float, with_mass: bool) -> LoadTable:
     """A vertical [[loads]] entry of ``force`` N downwards, with the mass of its weight or none."""
     return {"block": block, "point_m": point, "force_N": [0.0, -force], "mass_kg": force / G if with_mass else 0.0}
 

@@ -15,7 +15,7 @@ import math
 from collections.abc import Mapping, Sequence
 from fractions import Fraction
 from pathlib import Path
-from typing import Any
+from typing import Any, Required, TypedDict
 
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import DENSITY, LENGTH, LENGTH_OR_ZERO, Range, count, defaults
@@ -109,6 +109,57 @@ def digits(count: int) -> int:
 # ---------------------------------------------------------------------- tables
 
 
+class Outline(TypedDict, total=False):
+    """A block's shape in a ``[[blocks]]`` table: a rectangle (``width_m``, ``height_m``) or a
+    polygon in its own frame (``vertices_m``), m."""
+
+    width_m: float
+    height_m: float
+    vertices_m: list[list[float]]
+
+
+class BlockTable(Outline, total=False):
+    """A generated ``[[blocks]]`` table (the scene format's keys: docs/assemblies.md): its
+    outline, a density or a mass and inertia of its own, placed by ``position_m`` (absent in
+    a column scene) and turned by ``rotation_rad``."""
+
+    name: Required[str]
+    thickness_m: Required[float]
+    density_kg_m3: float
+    mass_kg: float
+    inertia_kgm2: float
+    position_m: list[float]
+    rotation_rad: float
+    fixed: bool
+
+
+def block_table(
+    name: str,
+    outline: Outline,
+    position_m: Sequence[float | Fraction],
+    thickness_m: float,
+    density_kg_m3: float,
+    *,
+    rotation_rad: float = 0.0,
+    fixed: bool = False,
+) -> BlockTable:
+    """A ``[[blocks]]`` table: the name, the outline, thickness, density and position, then
+    the rotation and ``fixed`` where they are not the defaults (in the order scene files
+    show them)."""
+    table: BlockTable = {
+        "name": name,
+        **outline,
+        "thickness_m": float(thickness_m),
+        "density_kg_m3": float(density_kg_m3),
+        "position_m": [num(position_m[0]), num(position_m[1])],
+    }
+    if rotation_rad != 0.0:
+        table["rotation_rad"] = float(rotation_rad)
+    if fixed:
+        table["fixed"] = True
+    return table
+
+
 def rect_block(
     name: str,
     width: Fraction,
@@ -119,19 +170,10 @@ def rect_block(
     density_kg_m3: float,
     *,
     fixed: bool = False,
-) -> dict[str, Any]:
+) -> BlockTable:
     """A ``[[blocks]]`` table of a rectangle whose base edge centre sits at (x, y), m."""
-    table: dict[str, Any] = {
-        "name": name,
-        "width_m": num(width),
-        "height_m": num(height),
-        "thickness_m": float(thickness_m),
-        "density_kg_m3": float(density_kg_m3),
-        "position_m": [num(x), num(y)],
-    }
-    if fixed:
-        table["fixed"] = True
-    return table
+    outline: Outline = {"width_m": num(width), "height_m": num(height)}
+    return block_table(name, outline, (x, y), thickness_m, density_kg_m3, fixed=fixed)
 
 
 def polygon_block(
@@ -143,23 +185,13 @@ def polygon_block(
     density_kg_m3: float,
     *,
     fixed: bool = False,
-) -> dict[str, Any]:
+) -> BlockTable:
     """A ``[[blocks]]`` table of a polygon given in its own frame, placed and rotated."""
-    table: dict[str, Any] = {
-        "name": name,
-        "vertices_m": [[float(x), float(y)] for x, y in vertices_m],
-        "thickness_m": float(thickness_m),
-        "density_kg_m3": float(density_kg_m3),
-        "position_m": [float(position_m[0]), float(position_m[1])],
-    }
-    if rotation_rad != 0.0:
-        table["rotation_rad"] = float(rotation_rad)
-    if fixed:
-        table["fixed"] = True
-    return table
+    outline: Outline = {"vertices_m": [[float(x), float(y)] for x, y in vertices_m]}
+    return block_table(name, outline, position_m, thickness_m, density_kg_m3, rotation_rad=rotation_rad, fixed=fixed)
 
 
-def paper_contact() -> dict[str, Any]:
+def paper_contact() -> dict[str, str]:
     """``[contact]`` of the paper's calibration (Eqs 10-15 from the block above each bed joint).
 
     For slender blocks (columns, frames, stacks): the paper's equations need
@@ -174,7 +206,7 @@ def udec_contact(
     jkn_Pa_per_m: float = DEFAULT_JKN_PA_PER_M,
     damping_ratio: float = DEFAULT_JOINT_DAMPING_RATIO,
     friction_angle_deg: float = DEFAULT_FRICTION_ANGLE_DEG,
-) -> dict[str, Any]:
+) -> dict[str, float]:
     """``[contact]`` with UDEC-style joint stiffness per unit area and an explicit damping.
 
     The paper's calibration (Eqs 10-15) holds for slender blocks only, so masonry units
@@ -270,14 +302,22 @@ def default_duration_s(motion: Mapping[str, Any] | None, base_dir: str | Path | 
     return math.ceil(round((length + RECORD_TAIL_S) * 1000.0, 6)) / 1000.0  # to the ms above
 
 
+class JointTable(TypedDict):
+    """A generated ``[[joints]]`` table: the joint of two blocks by name, with its friction
+    angle, deg (:class:`rockyade.scene.description.JointOverride`)."""
+
+    blocks: list[str]
+    friction_angle_deg: float
+
+
 def scene_table(
-    blocks: list[dict[str, Any]],
+    blocks: list[BlockTable],
     *,
     contact: Mapping[str, Any] | None,
     motion: Mapping[str, Any] | None,
     duration_s: float | None,
     sample_dt_s: float,
-    joints: list[dict[str, Any]] | None = None,
+    joints: list[JointTable] | None = None,
 ) -> dict[str, Any]:
     """The scene dictionary (keys in the order a reader expects them in the file).
 

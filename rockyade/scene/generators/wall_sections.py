@@ -57,6 +57,8 @@ from rockyade.errors import InputError
 from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.overburden import add_overburden
 from rockyade.scene.generators.scene_tables import (
+    BlockTable,
+    JointTable,
     exact,
     rect_block,
     scene_table,
@@ -139,7 +141,7 @@ def wall_section(
     blocks = [
         rect_block(f"w{i + 1:02d}", T, levels[i + 1] - levels[i], zero, levels[i], length, density) for i in range(n)
     ]
-    fixed: list[dict[str, Any]] = []
+    fixed: list[BlockTable] = []
     touching: list[str] = []
     if kind == "restrained" and gap <= 0:
         raise InputError(
@@ -173,7 +175,7 @@ def wall_section(
         slab = T + rw
         fixed.append(rect_block("floor", slab, rh, -T / 2 + slab / 2, H + gap, length, density, fixed=True))
         touching = [blocks[-1]["name"]]
-    joints = None
+    joints: list[JointTable] | None = None
     if fixed and restraint_friction_deg is not None:
         joints = [
             {"blocks": [name, block["name"]], "friction_angle_deg": float(restraint_friction_deg)}

@@ -33,6 +33,7 @@ from typing import Any
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import check, defaults, param
 from rockyade.scene.generators.scene_tables import (
+    BlockTable,
     check_length,
     digits,
     exact,
@@ -268,7 +269,7 @@ def wall(
     if not pieces and not lintels:
         raise InputError("openings", "leave no masonry: every unit is cut away")
     width_c = digits(courses)
-    blocks: list[dict[str, Any]] = []
+    blocks: list[BlockTable] = []
     for c in range(courses):
         row = sorted((r for k, r in pieces if k == c), key=lambda r: (r[0], r[2]))
         width_u = digits(len(row))
