@@ -10,7 +10,7 @@ intervals apply.
 
     .venv/bin/python benchmarks/bench_identify.py [--trials 100] [--ar1-trials 40] [--quick]
 
-``--quick``: 4 trials and 2 with AR(1) noise (a test runs it so that it cannot rot).
+``--quick``: 2 trials and 1 with AR(1) noise (a test runs it so that it cannot rot).
 """
 
 from __future__ import annotations
@@ -112,10 +112,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--trials", type=int, default=100)
     parser.add_argument("--ar1-trials", type=int, default=100)
-    parser.add_argument("--quick", action="store_true", help="4 trials and 2 with AR(1) noise")
+    parser.add_argument("--quick", action="store_true", help="2 trials and 1 with AR(1) noise")
     args = parser.parse_args()
     if args.quick:
-        args.trials, args.ar1_trials = 4, 2
+        args.trials, args.ar1_trials = 2, 1
     identify(synthetic_measurement(0.2, 4.0, 0.95, theta0_rad=0.1, noise_rad=1e-4))  # compile the kernel
     report("white noise 0.2-1 % of alpha", range(args.trials))
     if args.ar1_trials:

@@ -40,6 +40,11 @@ SENSITIVITY_LOAD_FACTORS = [0.4, 0.6, 0.8, 1.0, 1.2, 1.4]
 CONVERGENCE_LOAD_FACTORS = [round(0.1 * k, 1) for k in range(2, 16)]
 CONVERGENCE_SAMPLES = (25, 50, 100, 200, 400)
 CONVERGENCE_SEEDS = (1, 2, 3)
+#: --quick, whose numbers mean nothing (the script must only run through): 2 samples, 2 records
+#: and 3 load factors per specimen, a free-rocking test of 4 s identified, N = 10 and 20 at 5 load
+#: factors, in threads (a process pool per study cost more than its runs), no figure per study
+QUICK_SENSITIVITY = {"samples": 2, "records": [1, 2], "load_factors": [0.6, 1.0, 1.4], "identified_s": 4.0}
+QUICK_CONVERGENCE = {"sizes": (10, 20), "seeds": (1,), "load_factors": [0.2, 0.5, 0.8, 1.1, 1.4]}
 MEASURES = ["pga_over_g_tan_alpha", "pgv_m_s", "pga_m_s2", "pgv_p_over_g_tan_alpha", "arias_m_s"]
 
 
@@ -47,7 +52,7 @@ def _uniform(values: dict[str, float], pct: float) -> dict:
     return {k: {"distribution": "uniform", "mean": v, "plus_minus_pct": pct} for k, v in values.items()}
 
 
-def _identified(key: str, out: Path) -> Path:
+def _identified(key: str, out: Path, duration_s: float = 8.0) -> Path:
     """An identification of a synthetic free-rocking test of the specimen, written as JSON."""
     e = paper.specimen(key).experimental
     history = synthetic_measurement(
@@ -56,7 +61,7 @@ def _identified(key: str, out: Path) -> Path:
         e["mu"],
         theta0_rad=0.5 * e["alpha_rad"],
         rate_hz=200.0,
-        duration_s=8.0,
+        duration_s=duration_s,
         hold_s=0.5,
         release_offset_s=0.0021,
         offset_rad=0.002,
@@ -87,10 +92,18 @@ def _study(
     }
 
 
-def sensitivity(out: Path, samples: int, records) -> pd.DataFrame:
+def sensitivity(
+    out: Path,
+    samples: int,
+    records,
+    load_factors=SENSITIVITY_LOAD_FACTORS,
+    executor="local",
+    figure=True,
+    identified_s=8.0,
+) -> pd.DataFrame:
     rows = []
     for key in paper.SINGLE_SPECIMENS:
-        ident_path = _identified(key, out)
+        ident_path = _identified(key, out, identified_s)
         ident = json.loads(ident_path.read_text())
         cases = {
             "+/-5 % uniform": _uniform(paper.specimen(key).experimental, 5.0),
@@ -98,13 +111,13 @@ def sensitivity(out: Path, samples: int, records) -> pd.DataFrame:
         }
         for case, parameters in cases.items():
             study = uncertainty_study_from_dict(
-                _study(key, parameters, samples, 100 + int(key), SENSITIVITY_LOAD_FACTORS, "all", records),
+                _study(key, parameters, samples, 100 + int(key), load_factors, "all", records),
                 str(out / "study.toml"),
                 out,
             )
             start = time.perf_counter()
             folder = out / "sensitivity" / f"specimen{key}_{'pm5' if case.startswith('+') else 'identified'}"
-            result = run_uncertainty(study, folder, workers=2, progress=False)
+            result = run_uncertainty(study, folder, executor=executor, workers=2, progress=False, figure=figure)
             seconds = time.perf_counter() - start
             spread = result.spread.copy()
             spread.insert(0, "case", case)
@@ -128,7 +141,7 @@ def sensitivity(out: Path, samples: int, records) -> pd.DataFrame:
     return table
 
 
-def convergence(out: Path, sizes, seeds) -> pd.DataFrame:
+def convergence(out: Path, sizes, seeds, load_factors=CONVERGENCE_LOAD_FACTORS, executor="local") -> pd.DataFrame:
     key = "2"
     rows = []
     for n in sizes:
@@ -139,13 +152,18 @@ def convergence(out: Path, sizes, seeds) -> pd.DataFrame:
                     _uniform(paper.specimen(key).experimental, 5.0),
                     n,
                     seed,
-                    CONVERGENCE_LOAD_FACTORS,
+                    load_factors,
                     "sampled",
                     nominal=False,
                 )
             )
             result = run_uncertainty(
-                study, out / "convergence" / f"n{n}_seed{seed}", workers=2, progress=False, figure=False
+                study,
+                out / "convergence" / f"n{n}_seed{seed}",
+                executor=executor,
+                workers=2,
+                progress=False,
+                figure=False,
             )
             for fit in result.fragility.itertuples(index=False):
                 rows.append(
@@ -176,11 +194,11 @@ def convergence(out: Path, sizes, seeds) -> pd.DataFrame:
                 f"beta {g['beta'].mean():.3g} ({g['beta'].min():.3g}-{g['beta'].max():.3g}); "
                 f"max |median / reference - 1| {100 * np.max(np.abs(g['median'] / ref_median - 1)):.1f} %"
             )
-    _convergence_figure(table, out / "fragility_convergence.png")
+    _convergence_figure(table, out / "fragility_convergence.png", len(load_factors))
     return table
 
 
-def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
+def _convergence_figure(table: pd.DataFrame, path: Path, n_load_factors: int) -> None:
     fig, axes = file_figure(1, 3, figsize=(15, 4.4))
     measure = "pga_over_g_tan_alpha"
     sel = table[table.measure == measure]
@@ -191,7 +209,7 @@ def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
     for ax, name in ((axes[0], "median PGA / (g tan alpha)"), (axes[1], "beta (log standard deviation)")):
         ax.set_xticks(sizes, [str(n) for n in sizes])
         ax.minorticks_off()
-        ax.set_xlabel("samples N (one record each, x 14 load factors)")
+        ax.set_xlabel(f"samples N (one record each, x {n_load_factors} load factors)")
         ax.set_ylabel(name)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
@@ -217,19 +235,21 @@ def _convergence_figure(table: pd.DataFrame, path: Path) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("reports/bench_uncertainty"))
-    parser.add_argument("--quick", action="store_true", help="3 samples, 3 records, N up to 40, one seed")
+    parser.add_argument("--quick", action="store_true", help="a few runs of each part (QUICK_*), to see it runs")
     parser.add_argument("--only", choices=["sensitivity", "convergence"])
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    samples, records = (3, [1, 2, 3]) if args.quick else (20, "all")
-    sizes, seeds = ((20, 40), (1,)) if args.quick else (CONVERGENCE_SAMPLES, CONVERGENCE_SEEDS)
+    full = {"samples": 20, "records": "all", "load_factors": SENSITIVITY_LOAD_FACTORS}
+    sens = {**QUICK_SENSITIVITY, "executor": "threads", "figure": False} if args.quick else full
+    full = {"sizes": CONVERGENCE_SAMPLES, "seeds": CONVERGENCE_SEEDS, "load_factors": CONVERGENCE_LOAD_FACTORS}
+    conv = {**QUICK_CONVERGENCE, "executor": "threads"} if args.quick else full
     start = time.perf_counter()
     if args.only in (None, "sensitivity"):
         print("sensitivity of specimens 1-4 (Housner, synthetic suite):")
-        sensitivity(args.out, samples, records)
+        sensitivity(args.out, **sens)
     if args.only in (None, "convergence"):
         print("fragility convergence (specimen 2):")
-        convergence(args.out, sizes, seeds)
+        convergence(args.out, **conv)
     print(f"wrote {args.out} in {time.perf_counter() - start:.0f} s")
 
 

@@ -9,7 +9,22 @@
 // usage: siconos_lzb_rocking half_width_m half_height_m theta0_rad e K_left K_right eta dP t_end
 // prints  I t omega_minus omega_plus vy_plus   at each impact, and
 //         S t theta omega                       at every other event (1 ms grid).
-#include "SiconosKernel.hpp"
+// the headers of the classes used, not SiconosKernel.hpp (which took 2 s more of compiling)
+#include "BlockVector.hpp"
+#include "Event.hpp"
+#include "EventDriven.hpp"
+#include "EventsManager.hpp"
+#include "Interaction.hpp"
+#include "LCP.hpp"
+#include "LagrangianLinearTIDS.hpp"
+#include "LagrangianScleronomousR.hpp"
+#include "LsodarOSI.hpp"
+#include "MultipleImpact.hpp"
+#include "MultipleImpactNSL.hpp"
+#include "NonSmoothDynamicalSystem.hpp"
+#include "SiconosVector.hpp"
+#include "SimpleMatrix.hpp"
+#include "TimeDiscretisation.hpp"
 
 #include <cmath>
 #include <cstdio>

@@ -18,6 +18,22 @@ from rockyade.errors import InputError
 from rockyade.scene.generator_options import COMMON, KINDS, OVERBURDEN, Param, options, param
 from rockyade.scene.generators import GENERATORS, free_motion, pulse_motion, record_motion, udec_contact
 
+
+@pytest.fixture(autouse=True, scope="module")
+def _one_parser():
+    """``main`` builds its argument parser once for this module's ~970 calls, not per call
+    (20 ms each, most of this file's time): parsing does not change a parser, so each call
+    parses as a fresh ``rockyade`` would."""
+    import rockyade.cli
+
+    built = rockyade.cli.build_parser
+    parser = built()
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(rockyade.cli, "build_parser", lambda: parser)
+        yield
+    assert rockyade.cli.build_parser is built
+
+
 #: Values every numeric option is tried with: zero, negative, not a number, infinite, huge.
 FLOATS = ("0", "-2400", "-0.2", "nan", "inf", "-inf", "1e300")
 INTEGERS = ("0", "-1", "1000000000", "nan", "inf", "2.5")

@@ -137,8 +137,12 @@ def test_a_swap_killed_half_way_is_finished_by_the_next_writer(tmp_path, moved):
 # ---------------------------------------------------------------------- commands
 
 
+#: The fragility's load levels (x 2 records: the runs of a study); runs of under a second each.
+LEVELS = 10
+
+
 def _fragility(folder: Path, *extra: str) -> list[str]:
-    levels = ",".join(f"{0.3 + 0.05 * i:.2f}" for i in range(20))
+    levels = ",".join(f"{0.3 + 0.1 * i:.2f}" for i in range(LEVELS))
     return [
         sys.executable,
         "-m",
@@ -195,7 +199,7 @@ def _wait_for_records(proc: subprocess.Popen[str], partial: Path, n: int) -> Non
 def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, how):
     """Ctrl-C (a partial summary marked partial) or kill -9 in the middle of a fragility,
     then ``--resume``: every run finished before the stop is read back, none is run twice,
-    and the result is the whole set (40 runs, each once)."""
+    and the result is the whole set (20 runs, each once)."""
     proc = _start(tmp_path, _fragility(tmp_path))
     partial = tmp_path / "frag" / "partial"
     _wait_for_records(proc, partial, 2)
@@ -212,7 +216,7 @@ def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, 
         proc.communicate(timeout=600)
     assert not (tmp_path / "frag" / "fragility.json").exists()  # nothing that looks complete
     kept = _records_in(partial)
-    assert 2 <= len(kept) < 40
+    assert 2 <= len(kept) < 2 * LEVELS
     done = subprocess.run(
         _fragility(tmp_path, "--resume"),
         cwd=tmp_path,
@@ -224,7 +228,7 @@ def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, 
     assert done.returncode == 0, done.stderr
     assert f"resumed: {len(kept)} run(s) read back" in done.stdout  # runs repeated: 0
     runs = pd.read_csv(tmp_path / "frag" / "runs.csv")
-    assert sorted(runs["run"]) == list(range(40)) and runs["scene_hash"].is_unique
+    assert sorted(runs["run"]) == list(range(2 * LEVELS)) and runs["scene_hash"].is_unique
     assert not partial.exists() and (tmp_path / "frag" / "fragility.json").is_file()
 
 

@@ -184,8 +184,9 @@ def _process_sockets(pid: int) -> set[str]:
     return found
 
 
-def _listening_while_running(cmd: list[str], seconds: float) -> tuple[int, int]:
-    """(listening sockets seen, samples taken) while ``cmd`` runs (at most ``seconds``)."""
+def _listening_while_running(cmd: list[str], seconds: float, until_seen: bool = False) -> tuple[int, int]:
+    """(listening sockets seen, samples taken) while ``cmd`` runs (at most ``seconds``; with
+    ``until_seen``, until a first one is seen)."""
     proc = subprocess.Popen(
         cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env={**os.environ, "OMP_NUM_THREADS": "1"}
     )
@@ -193,7 +194,7 @@ def _listening_while_running(cmd: list[str], seconds: float) -> tuple[int, int]:
     samples = 0
     start = time.time()
     try:
-        while proc.poll() is None and time.time() - start < seconds:
+        while proc.poll() is None and time.time() - start < seconds and not (until_seen and seen):
             seen |= _process_sockets(proc.pid) & _listening_inodes()
             samples += 1
             time.sleep(0.05)
@@ -219,7 +220,7 @@ def test_yade_run_listens_on_no_port(tmp_path):
     if launcher.is_file():
         script = tmp_path / "sleep.py"
         script.write_text("import time\ntime.sleep(6)\n")
-        stock, _ = _listening_while_running([str(launcher), "-n", "-x", str(script)], 30)
+        stock, _ = _listening_while_running([str(launcher), "-n", "-x", str(script)], 30, until_seen=True)
         assert stock >= 1
 
 

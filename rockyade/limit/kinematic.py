@@ -182,7 +182,8 @@ def kinematic_quantities(
     fc
         Confidence factor FC (default 1.35).
     nonlinear
-        Also follow the mechanism to alpha = 0 (skipped, with a note, when a joint slides).
+        Also follow the mechanism to alpha = 0 (skipped, with a note, when a joint slides with friction
+        or when alpha0 is 0).
     """
     fc = check_fc(fc)
     d = DIRECTIONS[direction]
@@ -202,6 +203,8 @@ def kinematic_quantities(
     values: dict[str, float | None] = dict.fromkeys(("d0", "du", "ds", "as", "Ts"))
     if not nonlinear:
         note = "not asked for"
+    elif alpha0 <= 0.0:
+        note = "alpha0 = 0: the mechanism moves under any load, so it has no capacity curve to follow"
     elif any(model.interfaces[s.interface].friction_angle_deg for s in mechanism.sliding):
         note = (
             "a joint slides with friction: the code's nonlinear analysis follows rocking mechanisms (hinges, "
