@@ -274,13 +274,7 @@ def _calibrate_identified(args: argparse.Namespace, blocks: list[NamedBlock]) ->
 
 
 def register(sub: Any) -> None:
-    """Add ``params`` and ``calibrate``.
-
-    Parameters
-    ----------
-    sub
-        The subparsers of ``rockyade``'s parser.
-    """
+    """Add ``params`` and ``calibrate``."""
     p = add_command(sub, cmd_params)
     _add_block_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON")

@@ -126,13 +126,7 @@ def _start_lines(result: Identification) -> list[str]:
 
 
 def register(sub: Any) -> None:
-    """Add ``rockyade identify``.
-
-    Parameters
-    ----------
-    sub
-        The subparsers of ``rockyade``'s parser.
-    """
+    """Add ``rockyade identify``."""
     p = add_command(sub, cmd_identify)
     p.add_argument("measured", type=Path, help="measured history (CSV with a header row)")
     p.add_argument("--time-column", default="t_s", help="time column, s (default t_s)")
