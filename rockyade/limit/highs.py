@@ -21,7 +21,7 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, TypedDict
+from typing import Any
 
 import numpy as np
 import scipy.sparse as sp
@@ -33,20 +33,6 @@ from rockyade.errors import InputError
 #: with its crossover to a vertex), "hipo" (the interior point method HiPO, no crossover: a point of
 #: the optimal face's interior, to HiGHS's tolerance 1e-8).
 SOLVERS = ("simplex", "ipx", "hipo")
-
-
-class ProgrammeArrays(TypedDict):
-    """A programme as plain arrays (:meth:`Programme.arrays`, the child's ``programme.npz``)."""
-
-    c: NDArray[np.float64]
-    indptr: NDArray[np.signedinteger[Any]]  # int32 or int64, as scipy chooses
-    indices: NDArray[np.signedinteger[Any]]
-    data: NDArray[np.float64]
-    shape: NDArray[np.int64]
-    row_lower: NDArray[np.float64]
-    row_upper: NDArray[np.float64]
-    col_lower: NDArray[np.float64]
-    col_upper: NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -77,20 +63,20 @@ class Programme:
         """(rows, columns)."""
         return (int(self.A.shape[0]), int(self.A.shape[1]))
 
-    def arrays(self) -> ProgrammeArrays:
-        """Plain arrays (for ``numpy.savez``), the matrix as CSC."""
+    def arrays(self) -> dict[str, NDArray[Any]]:
+        """Plain arrays (for ``numpy.savez``), the matrix as CSC; :meth:`from_arrays` reads them."""
         A = sp.csc_matrix(self.A)
-        return ProgrammeArrays(
-            c=self.c,
-            indptr=A.indptr,
-            indices=A.indices,
-            data=A.data,
-            shape=np.asarray(A.shape),
-            row_lower=self.row_lower,
-            row_upper=self.row_upper,
-            col_lower=self.col_lower,
-            col_upper=self.col_upper,
-        )
+        return {
+            "c": self.c,
+            "indptr": A.indptr,
+            "indices": A.indices,
+            "data": A.data,
+            "shape": np.asarray(A.shape),
+            "row_lower": self.row_lower,
+            "row_upper": self.row_upper,
+            "col_lower": self.col_lower,
+            "col_upper": self.col_upper,
+        }
 
     @classmethod
     def from_arrays(cls, a: Mapping[str, NDArray[Any]]) -> Programme:
