@@ -156,14 +156,6 @@ def at_least(value: float, digits: int = 3) -> str:
 
 
 def at_most(value: float, digits: int = 3) -> str:
-    """``value`` with ``digits`` significant digits, rounded down (towards -inf): an upper
-    bound or a limit that stays within once printed.
-
-    Parameters
-    ----------
-    value
-        The number.
-    digits
-        Significant digits printed.
-    """
+    """``value`` with ``digits`` significant digits (as :func:`at_least`), rounded down
+    (towards -inf): an upper bound or a limit that stays within once printed."""
     return _directed(value, digits, "ROUND_FLOOR")

@@ -8,7 +8,7 @@ import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import check_output_dir, json_out, print_wrote
+from rockyade.cli.common import add_command, check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     accept_negative_values,
@@ -84,8 +84,23 @@ def _dynamic(args: argparse.Namespace) -> DynamicSettings | None:
 
 
 def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None = None) -> int:
-    """The checks, the dynamics, the text (or JSON), with --out the files, with --report the page
-    (``parser``: the command's, which tells the options given from rockyade's defaults)."""
+    """the code's kinematic checks of a wall (NTC 2018) and the rocking dynamics beside them
+
+    The collapse mechanism and the kinematic quantities by limit analysis (alpha0, M*, e*, a0*, d0*, du*, Ts), the
+    checks of NTC 2018 (Circolare 2019 C8.7.1) against the site's NTC 2018 spectrum (or EC8's), each with its clause
+    and formula, the checks not made listed, and, unless --static-only, the same scene under a spectrum-compatible
+    suite scaled to the site (or your records), at stripes of load factors on that scaling: the fraction of records
+    that collapse it at the code's demand, the fragility median and beta in ag, and their ratio to the code's
+    capacity. Exit 0 with a verdict (verified or not), 1 when the scene cannot stand, 2 on bad input. See
+    docs/howto/is-this-wall-safe.md.
+
+    Parameters
+    ----------
+    args
+        The parsed command line.
+    parser
+        The command's parser, which tells the options given from rockyade's defaults.
+    """
     from rockyade.assess import assess
     from rockyade.assess.code import check_code, confidence_factor
     from rockyade.assess.report_lines import assessment_lines
@@ -306,19 +321,7 @@ def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dic
 
 def register(sub: Any) -> None:
     """Add ``rockyade assess``."""
-    p = sub.add_parser(
-        "assess",
-        help="the code's kinematic checks of a wall (NTC 2018) and the rocking dynamics beside them",
-        description="The collapse mechanism and the kinematic quantities by limit analysis (alpha0, M*, e*, a0*, "
-        "d0*, du*, Ts), the checks of NTC 2018 (Circolare 2019 C8.7.1) against the site's NTC 2018 spectrum "
-        "(or EC8's), "
-        "each with its clause and formula, the checks not made listed, and, "
-        "unless --static-only, the same scene under a spectrum-compatible suite scaled to the site (or your "
-        "records), at stripes of load factors on that scaling: the fraction of records that collapse it at the "
-        "code's demand, the fragility median and beta in ag, and their ratio to the code's capacity. Exit 0 with "
-        "a verdict (verified or not), 1 when the scene cannot stand, 2 on bad input. See "
-        "docs/howto/is-this-wall-safe.md.",
-    )
+    p = add_command(sub, cmd_assess)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     p.add_argument("--code", default="ntc2018", help="the code whose checks are made: ntc2018 (default)")
     add_site_options(p)

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import json_out, print_calibration
+from rockyade.cli.common import add_command, json_out, print_calibration
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: blocks are imported when a command runs
@@ -126,7 +126,9 @@ def _is_rectangle(vertices_m: ArrayLike) -> bool:
 
 
 def cmd_params(args: argparse.Namespace) -> int:
-    """Classical parameters of one or more blocks (``rockyade params``).
+    """classical parameters alpha, p, mu of a block
+
+    Classical rocking parameters (paper Eqs 2-4, general polygon forms).
 
     Parameters
     ----------
@@ -183,7 +185,10 @@ def cmd_params(args: argparse.Namespace) -> int:
 
 
 def cmd_calibrate(args: argparse.Namespace) -> int:
-    """DEM contact parameters (``rockyade calibrate``: paper Eqs 7-15, or matched to mu).
+    """DEM contact parameters from classical parameters
+
+    DEM contact parameters of a specimen: K (Eq 10), b_eq (Eq 11), beta (Eq 13 or matched to mu with the reference
+    DEM), xi_min (Eq 15), f_min (Eq 14), dt (Eq 7).
 
     Parameters
     ----------
@@ -269,28 +274,12 @@ def _calibrate_identified(args: argparse.Namespace, blocks: list[NamedBlock]) ->
 
 
 def register(sub: Any) -> None:
-    """Add ``params`` and ``calibrate``.
-
-    Parameters
-    ----------
-    sub
-        The subparsers of ``rockyade``'s parser.
-    """
-    p = sub.add_parser(
-        "params",
-        help="classical parameters alpha, p, mu of a block",
-        description="Classical rocking parameters (paper Eqs 2-4, general polygon forms).",
-    )
+    """Add ``params`` and ``calibrate``."""
+    p = add_command(sub, cmd_params)
     _add_block_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=cmd_params)
 
-    p = sub.add_parser(
-        "calibrate",
-        help="DEM contact parameters from classical parameters",
-        description="DEM contact parameters of a specimen: K (Eq 10), b_eq (Eq 11), beta (Eq 13 or "
-        "matched to mu with the reference DEM), xi_min (Eq 15), f_min (Eq 14), dt (Eq 7).",
-    )
+    p = add_command(sub, cmd_calibrate)
     _add_block_arguments(p)
     p.add_argument("--from", dest="from_identified", type=Path, help="identified values (rockyade identify --out)")
     p.add_argument(
@@ -312,4 +301,3 @@ def register(sub: Any) -> None:
     )
     p.add_argument("--friction-angle", type=float, default=30.0, help="joint friction angle, degrees (default 30)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=cmd_calibrate)

@@ -18,7 +18,7 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_file
+from rockyade.cli.common import add_command, check_output_file
 from rockyade.cli.drawings import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import ALIASES, COMMON, COMMON_PARAMS, KINDS, OVERBURDEN, Param, options
@@ -370,7 +370,11 @@ def cmd_build(args: argparse.Namespace) -> int:
 
 
 def cmd_draw(args: argparse.Namespace) -> int:
-    """Draw a scene at rest; with --result, snapshots and an animation of that run."""
+    """draw a scene's blocks with their names (and snapshots of a run)
+
+    Draw an assembly at rest: block names, fixed blocks grey and hatched, the base, axes in m. With --result (a run of
+    this scene) also snapshots at chosen times and an animation.
+    """
     from rockyade.figures.assembly import draw_assembly, drawn_names
     from rockyade.scene import load_scene
 
@@ -449,16 +453,10 @@ def register(sub: Any) -> None:
         k.add_argument("--draw", type=Path, metavar="PNG", help="also draw the scene (PNG)")
         k.set_defaults(func=cmd_build)
 
-    d = sub.add_parser(
-        "draw",
-        help="draw a scene's blocks with their names (and snapshots of a run)",
-        description="Draw an assembly at rest: block names, fixed blocks grey and hatched, the base, axes in m. "
-        "With --result (a run of this scene) also snapshots at chosen times and an animation.",
-    )
+    d = add_command(sub, cmd_draw)
     d.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     d.add_argument("--out", type=Path, required=True, help="PNG of the assembly at rest")
     d.add_argument("--title", help="figure title (default: the file name and block counts)")
     d.add_argument("--no-labels", action="store_true", help="leave out the block names")
     d.add_argument("--result", type=Path, help="result CSV of a run of this scene (for snapshots and animation)")
     add_snapshot_options(d)
-    d.set_defaults(func=cmd_draw)

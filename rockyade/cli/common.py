@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
+import re
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -44,6 +47,38 @@ def print_wrote(path: Path, json_mode: bool = False) -> None:
     import sys
 
     print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
+
+
+def add_command(sub: Any, run: Callable[..., int], name: str | None = None) -> argparse.ArgumentParser:
+    """Add the sub-command that ``run`` carries out, documented by ``run``'s docstring: its
+    first paragraph is the one-line help of ``rockyade --help``, the rest the description of
+    ``rockyade NAME --help`` (one text for readers of the code and users of the command), up
+    to its numpydoc sections (``Parameters``, ``Returns``), which are for readers only.
+
+    Parameters
+    ----------
+    sub
+        The sub-parsers to add to (``add_subparsers``' answer).
+    run
+        The command function, ``run(args) -> exit code``.
+    name
+        The command's name; default ``run``'s name without ``cmd_``, ``_`` written ``-``.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The command's parser, for its arguments.
+    """
+    text = re.split(r"\n\n(?:Parameters|Returns)\n---", inspect.getdoc(run) or "")[0]  # numpydoc sections stay
+    summary, _, description = text.partition("\n\n")
+    if name is None:
+        name = run.__name__.removeprefix("cmd_").replace("_", "-")
+    # argparse %-formats a help string (not a description): a "%" in the summary is a percent sign
+    parser: argparse.ArgumentParser = sub.add_parser(
+        name, help=" ".join(summary.split()).replace("%", "%%"), description=description or None
+    )
+    parser.set_defaults(func=run)
+    return parser
 
 
 def add_allow_large(p: argparse.ArgumentParser) -> None:

@@ -8,7 +8,7 @@ import argparse
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import add_allow_large, check_output_dir
+from rockyade.cli.common import add_allow_large, add_command, check_output_dir
 from rockyade.cli.fragility_options import add_record_source
 from rockyade.cli.resumable import add_executor_options
 from rockyade.errors import InputError
@@ -43,7 +43,16 @@ def _records_per_solver(text: str | None, names: tuple[str, ...]) -> dict[str, i
 
 
 def cmd_crosscheck(args: argparse.Namespace) -> int:
-    """Plan (cost line), run the rounds, write the set and swap it in; exit 1 when a run failed."""
+    """several solvers on one scene over a record set: collapse intensities paired by record, with intervals
+
+    For each solver, each time-step factor and each record, find the collapse intensity (the smallest scale of the
+    record, in the intensity measure, at which the scene collapses) by a scan then bisection; compare the solvers by
+    the median of their paired ratios with a bootstrap 95 % interval, the share of runs with the same verdict and the
+    fragility per solver; rerun each solver with dt halved and report its own change beside. Writes
+    collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, crosscheck.png and index.md, a set replaced as a
+    whole when done; each run is written to --out/partial/ as it ends. Exit 0, 1 when a run failed, 2 on bad input,
+    130 after Ctrl-C (--resume finishes it). See docs/verification.md.
+    """
     from rockyade.assess import parse_measure
     from rockyade.cli.common import solver_options
     from rockyade.cli.fragility_options import float_list, motions_from
@@ -119,19 +128,7 @@ def register(sub: Any) -> None:
     """Add ``rockyade crosscheck``."""
     from rockyade.cli.common import SOLVER_NAMES, add_yade_timeout
 
-    p = sub.add_parser(
-        "crosscheck",
-        help="several solvers on one scene over a record set: collapse intensities paired by record, with intervals",
-        description="For each solver, each time-step factor and each record, find the collapse intensity (the "
-        "smallest scale of the record, in the intensity measure, at which the scene collapses) by a scan then "
-        "bisection; compare the solvers by the median of their paired ratios with a bootstrap 95 % interval, "
-        "the share of runs with the same verdict and the fragility per solver; rerun each solver with dt halved "
-        "and report its own change beside. Writes collapse_intensities.csv, pairs.csv, runs.csv, crosscheck.json, "
-        "crosscheck.png and index.md, a set replaced as a whole when done; each run is written to --out/partial/ "
-        "as it ends. "
-        "Exit 0, 1 when a run failed, 2 on bad input, 130 after Ctrl-C (--resume finishes it). See "
-        "docs/verification.md.",
-    )
+    p = add_command(sub, cmd_crosscheck)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
     add_record_source(p)
     p.add_argument("--count", type=int, help="records of a synthetic suite (default 20; the paper's: 30)")
@@ -184,4 +181,3 @@ def register(sub: Any) -> None:
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     add_yade_timeout(p)
     add_allow_large(p)
-    p.set_defaults(func=cmd_crosscheck)

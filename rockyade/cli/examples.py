@@ -18,6 +18,7 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.common import add_command
 from rockyade.errors import InputError, RockyadeError
 from rockyade.io.atomic import atomic_open, fsync_dir
 
@@ -114,7 +115,12 @@ def _umask() -> int:
 
 
 def cmd_examples(args: argparse.Namespace) -> int:
-    """Write the examples into ``--out`` and list what was written."""
+    """copy the example scenes, studies and records into a folder
+
+    Copy the example scenes (single blocks, assemblies), studies and ground-motion records shipped with rockyade into
+    DIR, listing each file written. DIR must be new or empty unless --force; a new DIR appears complete or not at all;
+    nothing is written through a symlink.
+    """
     out: Path = args.out
     written = write_examples(out, force=args.force)
     for rel in written:
@@ -125,13 +131,6 @@ def cmd_examples(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade examples``."""
-    p = sub.add_parser(
-        "examples",
-        help="copy the example scenes, studies and records into a folder",
-        description="Copy the example scenes (single blocks, assemblies), studies and ground-motion records "
-        "shipped with rockyade into DIR, listing each file written. DIR must be new or empty unless --force; "
-        "a new DIR appears complete or not at all; nothing is written through a symlink.",
-    )
+    p = add_command(sub, cmd_examples)
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="destination folder")
     p.add_argument("--force", action="store_true", help="write into an existing non-empty folder, replacing files")
-    p.set_defaults(func=cmd_examples)

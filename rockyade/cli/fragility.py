@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import check_output_dir
+from rockyade.cli.common import add_command, check_output_dir
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     add_record_source,
@@ -25,8 +25,16 @@ if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a c
 
 
 def cmd_fragility(args: argparse.Namespace) -> int:
-    """Run the stripes, fit the curve, write the CSVs, JSON and figure (a set replaced as a
-    whole); Ctrl-C writes a partial summary that ``--resume`` goes on from."""
+    """collapse fragility of a scene: records scaled to stripes of PGA, PGV or Sa(T), lognormal fit
+
+    Replace the scene's motion by each record scaled (a load factor on its accelerations as read) to stripes of an
+    intensity measure, run every run through the runner (local processes, or Dask: --executor), count the runs that
+    collapse (a single block: overturned; several blocks: --fallen-blocks fell) and fit a lognormal curve by maximum
+    likelihood with a bootstrap band over the records. Writes runs.csv, stripes.csv, records.csv, fragility.json and
+    fragility.png in --out, a set replaced as a whole; each run is written to --out/partial/ as it ends, Ctrl-C leaves
+    a partial summary there and --resume goes on from it. Exit 0, 1 when a run failed or the scene cannot stand, 2 on
+    bad input. See docs/howto/is-this-wall-safe.md.
+    """
     from rockyade.assess import fragility_plan, parse_measure, run_fragility
     from rockyade.assess.report_lines import fit_lines
     from rockyade.assess.stripes import StripesInterruptedError, runs_frame
@@ -93,18 +101,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade fragility``."""
-    p = sub.add_parser(
-        "fragility",
-        help="collapse fragility of a scene: records scaled to stripes of PGA, PGV or Sa(T), lognormal fit",
-        description="Replace the scene's motion by each record scaled (a load factor on its accelerations as read) "
-        "to stripes of an intensity measure, run every run through the runner (local processes, or Dask: "
-        "--executor), count the runs that collapse (a single block: overturned; several blocks: --fallen-blocks "
-        "fell) and fit a lognormal curve by maximum likelihood with a bootstrap band over the records. Writes "
-        "runs.csv, stripes.csv, records.csv, fragility.json and fragility.png in --out, a set replaced as a whole; "
-        "each run is written to --out/partial/ as it ends, Ctrl-C leaves a partial summary there and --resume goes "
-        "on from it. Exit 0, 1 when a run failed or the scene cannot stand, 2 on bad input. See "
-        "docs/howto/is-this-wall-safe.md.",
-    )
+    p = add_command(sub, cmd_fragility)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")
     add_record_source(p)
     p.add_argument(
@@ -120,4 +117,3 @@ def register(sub: Any) -> None:
     )
     p.add_argument("--out", type=Path, required=True, help="output directory")
     add_run_options(p, f"records of a synthetic suite (default {DEFAULT_COUNT})")
-    p.set_defaults(func=cmd_fragility)

@@ -7,7 +7,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
+from rockyade.cli.common import add_command, check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: the identification is imported when the command runs
@@ -24,7 +24,12 @@ def _led_columns(text: str | None) -> tuple[str, str] | None:
 
 
 def cmd_identify(args: argparse.Namespace) -> int:
-    """Identify the classical parameters of a measured free-rocking record (``rockyade identify``).
+    """alpha, p, mu with 95 % intervals from a measured free-rocking test
+
+    Fit Housner's free rocking (exact solver) to a measured rotation history: alpha, p, mu, the release time, the
+    release tilt and the sensor offset by least squares, with 95 % intervals. Input: CSV with t_s and theta_rad (or
+    theta_deg), or two LED displacement columns. Exit code 1 when a parameter cannot be identified (the message says
+    why). See docs/identification.md.
 
     Parameters
     ----------
@@ -121,21 +126,8 @@ def _start_lines(result: Identification) -> list[str]:
 
 
 def register(sub: Any) -> None:
-    """Add ``rockyade identify``.
-
-    Parameters
-    ----------
-    sub
-        The subparsers of ``rockyade``'s parser.
-    """
-    p = sub.add_parser(
-        "identify",
-        help="alpha, p, mu with 95 %% intervals from a measured free-rocking test",
-        description="Fit Housner's free rocking (exact solver) to a measured rotation history: alpha, p, mu, "
-        "the release time, the release tilt and the sensor offset by least squares, with 95 % intervals. "
-        "Input: CSV with t_s and theta_rad (or theta_deg), or two LED displacement columns. "
-        "Exit code 1 when a parameter cannot be identified (the message says why). See docs/identification.md.",
-    )
+    """Add ``rockyade identify``."""
+    p = add_command(sub, cmd_identify)
     p.add_argument("measured", type=Path, help="measured history (CSV with a header row)")
     p.add_argument("--time-column", default="t_s", help="time column, s (default t_s)")
     p.add_argument("--theta-column", help="rotation column (default theta_rad, or theta_deg in degrees)")
@@ -158,4 +150,3 @@ def register(sub: Any) -> None:
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--out", type=Path, help="write the identified values as JSON (input of calibrate --from)")
     p.add_argument("--plot", type=Path, help="directory for the fit and error-surface figures (PNG)")
-    p.set_defaults(func=cmd_identify)

@@ -11,7 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import add_allow_large, check_output_file, json_out, print_wrote
+from rockyade.cli.common import add_allow_large, add_command, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError, RockyadeError
 
 #: The coulomb rule's progress: first after this many seconds, then at most every PROGRESS_EVERY_S.
@@ -27,7 +27,14 @@ EXIT_UNSTABLE = 1
 
 
 def cmd_limit(args: argparse.Namespace) -> int:
-    """Solve the scene's limit analysis and print (or --json) the answer."""
+    """static collapse by limit analysis: load multiplier, mechanism, the code's kinematic quantities
+
+    The horizontal acceleration (in g, on every block's mass) at which an assembly of rigid blocks with no-tension
+    joints collapses, by the equilibrium linear programme (HiGHS); the mechanism (hinges, sliding joints) from its
+    dual; and the kinematic method's quantities of NTC 2018 / Circolare 2019 C8.7.1 (alpha0, M*, e*, a0*, d0*, du*,
+    Ts). Exit 0 on collapse, 1 when the assembly cannot stand under gravity or the coulomb rule does not converge, 2
+    on bad input. See docs/limit.md.
+    """
     if args.plot is not None:
         check_output_file(args.plot, "--plot", ".png")
     from rockyade.limit import limit_analysis
@@ -159,15 +166,7 @@ class _Progress:
 
 def register(sub: Any) -> None:
     """Add ``rockyade limit``."""
-    p = sub.add_parser(
-        "limit",
-        help="static collapse by limit analysis: load multiplier, mechanism, the code's kinematic quantities",
-        description="The horizontal acceleration (in g, on every block's mass) at which an assembly of rigid "
-        "blocks with no-tension joints collapses, by the equilibrium linear programme (HiGHS); the mechanism "
-        "(hinges, sliding joints) from its dual; and the kinematic method's quantities of NTC 2018 / "
-        "Circolare 2019 C8.7.1 (alpha0, M*, e*, a0*, d0*, du*, Ts). Exit 0 on collapse, 1 when the assembly "
-        "cannot stand under gravity or the coulomb rule does not converge, 2 on bad input. See docs/limit.md.",
-    )
+    p = add_command(sub, cmd_limit)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     p.add_argument(
         "--direction",
@@ -219,4 +218,3 @@ def register(sub: Any) -> None:
     p.add_argument("--plot", type=Path, metavar="PNG", help="draw the assembly at rest and along the mechanism")
     # "-x" is a value of --direction, not an option: let the parser read it as it reads "-1"
     p._negative_number_matcher = re.compile(r"^-x$|^-\d+$|^-\d*\.\d+$")
-    p.set_defaults(func=cmd_limit)

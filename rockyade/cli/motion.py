@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_dir, check_output_file, json_out, print_wrote
+from rockyade.cli.common import add_command, check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.cli.site_options import add_period_option, add_site_options
 from rockyade.errors import InputError
 
@@ -65,7 +65,10 @@ def _accel_text(value_m_s2: float, unit: str) -> str:
 
 
 def cmd_info(args: argparse.Namespace) -> int:
-    """Summary of a record."""
+    """summary of a record
+
+    Samples, dt, duration, PGA of a record.
+    """
     from rockyade.constants import STANDARD_GRAVITY
 
     rec = _read(args)
@@ -103,7 +106,10 @@ def cmd_info(args: argparse.Namespace) -> int:
 
 
 def cmd_spectrum(args: argparse.Namespace) -> int:
-    """Pseudo-acceleration response spectrum of a record."""
+    """response spectrum of a record
+
+    Pseudo-acceleration spectrum by the exact piecewise-linear recurrence.
+    """
     import pandas as pd
 
     from rockyade.constants import STANDARD_GRAVITY
@@ -164,7 +170,10 @@ def _suite_spec(args: argparse.Namespace):
 
 
 def cmd_synth(args: argparse.Namespace) -> int:
-    """Generate a spectrum-compatible suite into a directory."""
+    """spectrum-compatible synthetic suite (EC8)
+
+    Generate records compatible with an EC8 elastic spectrum.
+    """
     import pandas as pd
     from tqdm import tqdm
 
@@ -244,7 +253,10 @@ def _plot_report(records, target, report, path) -> None:
 
 
 def cmd_check(args: argparse.Namespace) -> int:
-    """Compatibility report of a suite directory written by ``motion synth``."""
+    """compatibility report of a suite directory
+
+    Mean spectrum / target, PGAs and durations of a suite written by 'motion synth'.
+    """
     from rockyade.motion.ec8 import ElasticSpectrum
     from rockyade.motion.records import read_two_column
     from rockyade.motion.synthetic import compatibility_report
@@ -284,7 +296,14 @@ def cmd_check(args: argparse.Namespace) -> int:
 
 
 def cmd_select(args: argparse.Namespace) -> int:
-    """Records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)."""
+    """records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)
+
+    Pick from a folder of records (PEER .AT2, ESM .ASC, text) a set of --count records and a scale factor for each
+    whose mean 5 % spectrum lies nowhere more than 10 % below the site's elastic spectrum nor more than 30 % above it
+    over 0.15-2.0 s (0.15 s-2 T1 when longer), NTC 2018 3.2.3.6. Writes selection.csv, spectra.png, selection.json and
+    the chosen records into --out (a set that 'assess --records' reads); exit 1 with the best deviation reached and an
+    estimate of the records needed when no set is compatible. See docs/howto/base-motions.md.
+    """
     import numpy as np
 
     from rockyade.assess.motions import records_in_folder
@@ -438,18 +457,13 @@ def register(sub: Any) -> None:
     )
     msub = motion.add_subparsers(dest="motion_command", required=True, metavar="MOTION_COMMAND")
 
-    p = msub.add_parser("info", help="summary of a record", description="Samples, dt, duration, PGA of a record.")
+    p = add_command(msub, cmd_info)
     _add_record_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON (pga_m_s2 and pga_g)")
     p.add_argument("--plot", type=Path, help="PNG of acceleration, velocity and displacement")
     _add_accel_units(p)
-    p.set_defaults(func=cmd_info)
 
-    p = msub.add_parser(
-        "spectrum",
-        help="response spectrum of a record",
-        description="Pseudo-acceleration spectrum by the exact piecewise-linear recurrence.",
-    )
+    p = add_command(msub, cmd_spectrum)
     _add_record_arguments(p)
     p.add_argument("--damping", type=float, default=0.05, help="damping ratio (default 0.05 = 5%%)")
     p.add_argument("--t-min", type=float, default=0.02, help="shortest period, s")
@@ -458,13 +472,8 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, help="CSV with period_s, psa_g and psa_m_s2")
     p.add_argument("--plot", type=Path, help="PNG of the spectrum")
     _add_accel_units(p)
-    p.set_defaults(func=cmd_spectrum)
 
-    p = msub.add_parser(
-        "synth",
-        help="spectrum-compatible synthetic suite (EC8)",
-        description="Generate records compatible with an EC8 elastic spectrum.",
-    )
+    p = add_command(msub, cmd_synth)
     p.add_argument("--type", type=int, choices=[1, 2], required=True, help="EC8 spectrum type")
     p.add_argument("--ground", choices=list("ABCDE"), required=True, help="EC8 ground type")
     p.add_argument("--ag", type=float, help="design ground acceleration ag, m/s^2")
@@ -480,31 +489,16 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--plot", type=Path, help="PNG: target vs mean spectrum with the +/-10%% band")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.set_defaults(func=cmd_synth)
 
-    p = msub.add_parser(
-        "check",
-        help="compatibility report of a suite directory",
-        description="Mean spectrum / target, PGAs and durations of a suite written by 'motion synth'.",
-    )
+    p = add_command(msub, cmd_check)
     p.add_argument("dir", type=Path, help="suite directory")
     p.add_argument(
         "--range", type=float, nargs=2, default=[0.05, 2.0], metavar=("T_MIN", "T_MAX"), help="period range, s"
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument("--plot", type=Path, help="PNG: target vs mean spectrum with the +/-10%% band")
-    p.set_defaults(func=cmd_check)
 
-    p = msub.add_parser(
-        "select",
-        help="records of a folder selected and scaled to the site's spectrum (NTC 2018 3.2.3.6)",
-        description="Pick from a folder of records (PEER .AT2, ESM .ASC, text) a set of --count records and a "
-        "scale factor for each whose mean 5 % spectrum lies nowhere more than 10 % below the site's elastic "
-        "spectrum nor more than 30 % above it over 0.15-2.0 s (0.15 s-2 T1 when longer), NTC 2018 3.2.3.6. "
-        "Writes selection.csv, spectra.png, selection.json and the chosen records into --out (a set that "
-        "'assess --records' reads); exit 1 with the best deviation reached and an estimate of the records "
-        "needed when no set is compatible. See docs/howto/base-motions.md.",
-    )
+    p = add_command(msub, cmd_select)
     p.add_argument("--records", type=Path, required=True, metavar="DIR", help="folder of the records to select from")
     p.add_argument(
         "--count",
@@ -534,7 +528,6 @@ def register(sub: Any) -> None:
     add_period_option(p, "the range checked becomes 0.15 s-2 T1 when 2 T1 > 2 s (T1 <= 2 s)")
     p.add_argument("--out", type=Path, help="the selection's folder (written only for a compatible set)")
     p.add_argument("--json", action="store_true", help="print the answer as JSON")
-    p.set_defaults(func=cmd_select)
 
 
 __all__ = ["register"]

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from rockyade.cli.common import (
     SOLVER_NAMES,
     add_allow_large,
+    add_command,
     add_yade_timeout,
     check_output_file,
     json_out,
@@ -28,7 +29,10 @@ if TYPE_CHECKING:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    """Run a scene through a solver."""
+    """run a scene through a solver
+
+    Run a scene file through a solver; write the result CSV + JSON.
+    """
     import contextlib
 
     from rockyade.io.locking import output_lock
@@ -218,7 +222,11 @@ def _print_structure(m: dict[str, Any], result: Any, scene: Any) -> None:
 
 
 def cmd_tables(args: argparse.Namespace) -> int:
-    """Tables 1-6 of the paper reproduced."""
+    """the paper's Tables 1-6 reproduced
+
+    Tables 1-6: paper value, ours, difference and a flag where the printed number does not follow from the paper's own
+    equations.
+    """
     from rockyade.paper.tables import format_report, reproduction_report
 
     if args.out:
@@ -244,11 +252,7 @@ def cmd_tables(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``run`` and ``tables``."""
-    p = sub.add_parser(
-        "run",
-        help="run a scene through a solver",
-        description="Run a scene file through a solver; write the result CSV + JSON.",
-    )
+    p = add_command(sub, cmd_run)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     p.add_argument(
         "--solver",
@@ -261,14 +265,7 @@ def register(sub: Any) -> None:
     add_yade_timeout(p)
     add_snapshot_options(p)
     add_allow_large(p)
-    p.set_defaults(func=cmd_run)
 
-    p = sub.add_parser(
-        "tables",
-        help="the paper's Tables 1-6 reproduced",
-        description="Tables 1-6: paper value, ours, difference and a flag where the printed number "
-        "does not follow from the paper's own equations.",
-    )
+    p = add_command(sub, cmd_tables)
     p.add_argument("--out", type=Path, help="directory for CSV files")
     p.add_argument("--json", action="store_true", help="print JSON instead of text")
-    p.set_defaults(func=cmd_tables)

@@ -9,6 +9,7 @@ from typing import Any
 from rockyade.cli.common import (
     SOLVER_NAMES,
     add_allow_large,
+    add_command,
     add_yade_timeout,
     check_output_dir,
     mu_note_line,
@@ -21,7 +22,13 @@ from rockyade.errors import InputError
 
 
 def cmd_compare(args: argparse.Namespace) -> int:
-    """Run one scene through several solvers and tabulate their agreement."""
+    """one scene through several solvers, with agreement metrics
+
+    Run a scene through several solvers; write each result, a CSV of agreement metrics (peaks, peak times, effective
+    mu, max |theta|, overturn, RMS of theta differences) against the reference solver (never a solver against itself)
+    and a figure of theta(t); print a one-line verdict: the outcome agreement, the peak difference, and whether
+    halving the time step changed the peaks more than the solvers differ.
+    """
     solvers = [s.strip() for s in args.solvers.split(",") if s.strip()]
     unknown = [s for s in solvers if s not in SOLVER_NAMES]
     if unknown or not solvers or len(set(solvers)) != len(solvers):
@@ -131,7 +138,11 @@ def _with_dt_factor(solvers: list[Any], factor: float, check: bool) -> tuple[lis
 
 
 def cmd_batch(args: argparse.Namespace) -> int:
-    """Run a study file's grid of scenes."""
+    """run a study file (grid of scenes x solvers) on local processes or Dask
+
+    Expand a study file into scenes and run them; one result per run (named by scene hash and solver) and a summary
+    table. A failed run never stops the batch.
+    """
     check_output_dir(args.out, "out")
     from rockyade.batch import failures, load_study, run_study_tasks, study_tasks
     from rockyade.runner import Executor
@@ -162,7 +173,11 @@ def cmd_batch(args: argparse.Namespace) -> int:
 
 
 def cmd_paper(args: argparse.Namespace) -> int:
-    """Reproduce the paper: tables, figures and index.md; exit 1 when any run failed."""
+    """reproduce the seed paper end to end (make run)
+
+    Tables 1-6, free rocking, harmonic and random tests, the bi-block pattern map, sensitivity, collapse fragility and
+    the overturning spectrum: CSV, PNG and index.md.
+    """
     from rockyade.studies.paper import PARTS, run_paper_study
     from rockyade.studies.report import describe_failures
 
@@ -194,26 +209,15 @@ def _part_line(report: Any, part: str) -> str:
 
 def register(sub: Any) -> None:
     """Add ``rockyade compare``, ``rockyade batch`` and ``rockyade paper``."""
-    p = sub.add_parser(
-        "batch",
-        help="run a study file (grid of scenes x solvers) on local processes or Dask",
-        description="Expand a study file into scenes and run them; one result per run (named by scene "
-        "hash and solver) and a summary table. A failed run never stops the batch.",
-    )
+    p = add_command(sub, cmd_batch)
     p.add_argument("study", type=Path, help="study file (.toml)")
     p.add_argument("--out", type=Path, required=True, help="output directory")
     add_executor_options(p, "skip runs already completed; re-run failed ones")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_yade_timeout(p)
     add_allow_large(p)
-    p.set_defaults(func=cmd_batch)
 
-    p = sub.add_parser(
-        "paper",
-        help="reproduce the seed paper end to end (make run)",
-        description="Tables 1-6, free rocking, harmonic and random tests, the bi-block pattern map, "
-        "sensitivity, collapse fragility and the overturning spectrum: CSV, PNG and index.md.",
-    )
+    p = add_command(sub, cmd_paper)
     p.add_argument("--out", type=Path, default=Path("reports/paper"), help="output directory (default reports/paper)")
     p.add_argument("--workers", type=int, default=2, help="parallel workers (default 2)")
     p.add_argument(
@@ -228,17 +232,8 @@ def register(sub: Any) -> None:
         help="unit of the fragility figure's PGA axis: g (standard gravity; the default) or m/s2, the other "
         "unit on the opposite axis (the CSV files keep m/s^2)",
     )
-    p.set_defaults(func=cmd_paper)
 
-    p = sub.add_parser(
-        "compare",
-        help="one scene through several solvers, with agreement metrics",
-        description="Run a scene through several solvers; write each result, a CSV of agreement "
-        "metrics (peaks, peak times, effective mu, max |theta|, overturn, RMS of theta differences) "
-        "against the reference solver (never a solver against itself) and a figure of theta(t); print a "
-        "one-line verdict: the outcome agreement, the peak difference, and whether halving the time step "
-        "changed the peaks more than the solvers differ.",
-    )
+    p = add_command(sub, cmd_compare)
     p.add_argument("scene", type=Path, help="scene file")
     p.add_argument(
         "--solvers",
@@ -257,4 +252,3 @@ def register(sub: Any) -> None:
     p.add_argument("--out", type=Path, default=Path("compare"), help="output directory")
     add_yade_timeout(p)
     add_allow_large(p)
-    p.set_defaults(func=cmd_compare)

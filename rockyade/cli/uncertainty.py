@@ -6,9 +6,17 @@ import argparse
 from pathlib import Path
 from typing import Any
 
+from rockyade.cli.common import add_command
+
 
 def cmd_uncertainty(args: argparse.Namespace) -> int:
-    """Run an uncertainty study and print its probabilities and fragility fits."""
+    """probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)
+
+    Draw alpha, p, mu (normal, lognormal, uniform, or an identification's joint normal) by Latin hypercube, run every
+    sample under the records and load factors (each multiplies the records' accelerations as read) with each solver
+    (batch engine, local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 % Wilson bands,
+    fragility fits against intensity measures and the spread due to the parameters. See docs/identification.md.
+    """
     from rockyade.cli.common import check_output_dir
     from rockyade.runner.study_folder import UNCERTAINTY, check_out
     from rockyade.studies.uncertainty import load_uncertainty_study, run_uncertainty
@@ -87,15 +95,7 @@ def register(sub: Any) -> None:
     """Add ``rockyade uncertainty``."""
     from rockyade.cli.resumable import add_executor_options
 
-    p = sub.add_parser(
-        "uncertainty",
-        help="probability of overturning with alpha, p, mu drawn from distributions (Latin hypercube)",
-        description="Draw alpha, p, mu (normal, lognormal, uniform, or an identification's joint normal) by "
-        "Latin hypercube, run every sample under the records and load factors (each multiplies the records' "
-        "accelerations as read) with each solver (batch engine, "
-        "local or Dask), and report P(overturn) and P(theta/alpha >= level) with 95 % Wilson bands, fragility "
-        "fits against intensity measures and the spread due to the parameters. See docs/identification.md.",
-    )
+    p = add_command(sub, cmd_uncertainty)
     p.add_argument("study", type=Path, help="uncertainty study file (.toml)")
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--samples", type=int, help="override the number of parameter samples")
@@ -109,4 +109,3 @@ def register(sub: Any) -> None:
         help="unit of PGA medians and axes: g (standard gravity, 9.80665 m/s^2; the default) or m/s2; the other "
         "unit is given beside it (the CSV files keep m/s^2, named so)",
     )
-    p.set_defaults(func=cmd_uncertainty)

@@ -7,13 +7,23 @@ import sys
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import check_output_dir
+from rockyade.cli.common import add_command, check_output_dir
 from rockyade.errors import InputError
 from rockyade.studies.verification_checks import CHECKS
 
 
 def cmd_verify(args: argparse.Namespace) -> int:
-    """Run the verification checks; exit 1 when any quantity is out of its tolerance."""
+    """verification report: assemblies in both DEMs against closed forms and each other
+
+    Rocking frame (Makris & Vassiliou p_hat), 8-drum column uplift, pad case overlaps, a 1,000-block wall at rest,
+    reference DEM against YADE, this version's single-block and bi-block baseline, the limit analysis' kinematic
+    quantities and the code's checks against closed forms and a hand calculation, the fragility fit recovering a known
+    curve, and a block with a top load (its multiplier from the limit analysis, Housner's uplift and the reference
+    DEM's pushover against the closed form), and the limit analysis' multiplier against the reference DEM's pushover
+    onset for a block, a 20-voussoir arch, a wall restrained at its top and a running-bond panel (within 2 %), and
+    Siconos against closed forms (free-rocking restitution, a block's pushover, the rocking frame, a stack at rest).
+    Writes verify.csv, a figure per check and index.md; exits 1 if any check fails.
+    """
     checks = [c.strip() for c in args.only.split(",")] if args.only else list(CHECKS)
     unknown = [c for c in checks if c not in CHECKS]
     if unknown or not checks:
@@ -42,20 +52,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade verify``."""
-    p = sub.add_parser(
-        "verify",
-        help="verification report: assemblies in both DEMs against closed forms and each other",
-        description="Rocking frame (Makris & Vassiliou p_hat), 8-drum column uplift, pad case overlaps, a "
-        "1,000-block wall at rest, reference DEM against YADE, this version's single-block and bi-block "
-        "baseline, the limit analysis' kinematic quantities and the code's checks against closed forms and a hand "
-        "calculation, the fragility fit recovering a known curve, and a block with a top load (its "
-        "multiplier from the limit analysis, Housner's uplift and the reference DEM's pushover against the closed "
-        "form), and the limit analysis' multiplier against the reference DEM's pushover onset for a block, a "
-        "20-voussoir arch, a wall restrained at its top and a running-bond panel (within 2 %), and Siconos against "
-        "closed forms (free-rocking restitution, a block's pushover, the rocking frame, a stack at rest). "
-        "Writes verify.csv, a figure per check and index.md; exits 1 if any check fails.",
-    )
+    p = add_command(sub, cmd_verify)
     p.add_argument("--out", type=Path, required=True, help="output directory")
     p.add_argument("--only", help=f"comma-separated checks among {', '.join(CHECKS)} (default: all)")
     p.add_argument("--no-yade", action="store_true", help="the reference DEM only")
-    p.set_defaults(func=cmd_verify)

@@ -14,7 +14,12 @@ LAUNCHER_WARNING = (
 
 
 def cmd_yade_script(args: argparse.Namespace) -> int:
-    """Write run.py and scene.json for YADE's own launcher."""
+    """a scene as a standalone YADE script (run.py + scene.json) to go on by hand
+
+    Write run.py (the script rockyade runs in YADE) and scene.json (the scene's data) into a folder.
+    `yade -x DIR/run.py` runs it in batch, `yade DIR/run.py` with YADE's GUI; it writes result.npz and
+    result.csv beside itself.
+    """
     from rockyade.cli.common import check_output_dir
     from rockyade.scene import load_scene
     from rockyade.yade.backend import write_script
@@ -33,13 +38,9 @@ def cmd_yade_script(args: argparse.Namespace) -> int:
 
 def register(sub: Any) -> None:
     """Add ``rockyade yade-script``."""
-    p = sub.add_parser(
-        "yade-script",
-        help="a scene as a standalone YADE script (run.py + scene.json) to go on by hand",
-        description="Write run.py (the script rockyade runs in YADE) and scene.json (the scene's data) "
-        "into a folder. `yade -x DIR/run.py` runs it in batch, `yade DIR/run.py` with YADE's GUI; it "
-        "writes result.npz and result.csv beside itself. " + LAUNCHER_WARNING + ".",
-    )
+    from rockyade.cli.common import add_command
+
+    p = add_command(sub, cmd_yade_script)
+    p.description = f"{p.description} {LAUNCHER_WARNING}."  # the warning the command prints, written once
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
     p.add_argument("--out", type=Path, required=True, help="folder for run.py and scene.json")
-    p.set_defaults(func=cmd_yade_script)

@@ -19,13 +19,13 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from rockyade.figures.canvas import save_figure, single_axes
+from rockyade.figures.styles import LineStyle
 from rockyade.probability.fragility_curves import Fragility
 
 #: How a missing curve shows in the legend: a red cross, its text red.
@@ -217,9 +217,9 @@ def _draw_curve(ax: Axes, c: FragilityCurve, grid: np.ndarray, x_max: float) -> 
             ax.plot(min(f.median, x_max), 0.5, shape, color=c.colour, mfc="white", ms=6, mew=1.3, zorder=5)
     elif f is not None and f.status == "separated":
         ax.axvline(f.median, color=c.colour, lw=1.4, label=c.curve_label or None)
-    style: dict[str, Any] = {"color": c.point_colour or c.colour, "ms": 4.5, "label": c.label}
+    style: LineStyle = {"color": c.point_colour or c.colour, "ms": 4.5, "label": c.label}
     if not c.filled:
-        style.update(mfc="none", mew=1.2)
+        style["mfc"], style["mew"] = "none", 1.2
     if c.fraction_lo is not None and c.fraction_hi is not None:
         lo = np.clip(c.fractions - c.fraction_lo, 0.0, None)  # >= 0 (the interval's rounding)
         hi = np.clip(c.fraction_hi - c.fractions, 0.0, None)

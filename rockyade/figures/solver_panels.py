@@ -21,10 +21,10 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
-from rockyade.figures.styles import plot_solver
+from rockyade.figures.styles import LineStyle, plot_solver
 
 #: How a failed run shows: a legend entry with a red cross and no curve.
-FAILED_STYLE: dict[str, Any] = {"color": "red", "ls": "none", "marker": "x"}
+FAILED_STYLE: LineStyle = {"color": "red", "ls": "none", "marker": "x"}
 
 
 @dataclass(frozen=True)

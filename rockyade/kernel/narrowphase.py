@@ -200,22 +200,31 @@ def clip_manifold(wv, wn, flen, nverts, ref: int, face: int, inc: int, edge: int
     off = tx * r0x + ty * r0y
     d0 = off - (tx * p0x + ty * p0y)
     d1 = off - (tx * p1x + ty * p1y)
-    if d0 > 0.0 and d1 > 0.0:
+    inside, p0x, p0y, p1x, p1y = _clip_segment(d0, d1, p0x, p0y, p1x, p1y)
+    if not inside:
         return 0
-    if d0 > 0.0:
-        w = d0 / (d0 - d1)
-        p0x = p0x + w * (p1x - p0x)
-        p0y = p0y + w * (p1y - p0y)
-    elif d1 > 0.0:
-        w = d0 / (d0 - d1)
-        p1x = p0x + w * (p1x - p0x)
-        p1y = p0y + w * (p1y - p0y)
     # side plane at r1: keep t.p <= t.r1
     off = tx * r1x + ty * r1y
     d0 = tx * p0x + ty * p0y - off
     d1 = tx * p1x + ty * p1y - off
-    if d0 > 0.0 and d1 > 0.0:
+    inside, p0x, p0y, p1x, p1y = _clip_segment(d0, d1, p0x, p0y, p1x, p1y)
+    if not inside:
         return 0
+    nx = wn[ref, face, 0]
+    ny = wn[ref, face, 1]
+    off = nx * r0x + ny * r0y
+    n = _keep_if_below(out, 0, p0x, p0y, nx * p0x + ny * p0y - off)
+    return _keep_if_below(out, n, p1x, p1y, nx * p1x + ny * p1y - off)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _clip_segment(
+    d0: float, d1: float, p0x: float, p0y: float, p1x: float, p1y: float
+) -> tuple[bool, float, float, float, float]:
+    """The segment p0-p1 clipped to the side d <= 0 of a side plane, ``d0`` and ``d1`` its ends'
+    signed distances (m): (False, ...) when the whole segment is beyond, else (True, new ends)."""
+    if d0 > 0.0 and d1 > 0.0:
+        return False, p0x, p0y, p1x, p1y
     if d0 > 0.0:
         w = d0 / (d0 - d1)
         p0x = p0x + w * (p1x - p0x)
@@ -224,22 +233,18 @@ def clip_manifold(wv, wn, flen, nverts, ref: int, face: int, inc: int, edge: int
         w = d0 / (d0 - d1)
         p1x = p0x + w * (p1x - p0x)
         p1y = p0y + w * (p1y - p0y)
-    nx = wn[ref, face, 0]
-    ny = wn[ref, face, 1]
-    off = nx * r0x + ny * r0y
-    n = 0
-    s = nx * p0x + ny * p0y - off
+    return True, p0x, p0y, p1x, p1y
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _keep_if_below(out, n: int, px: float, py: float, s: float) -> int:
+    """Write point (px, py) with penetration -``s`` (m) as ``out``'s row ``n`` when it is on or below
+    the reference face (``s`` <= 0, its signed distance); the number of rows written."""
     if s <= 0.0:
-        out[n, 0] = p0x
-        out[n, 1] = p0y
+        out[n, 0] = px
+        out[n, 1] = py
         out[n, 2] = -s
-        n += 1
-    s = nx * p1x + ny * p1y - off
-    if s <= 0.0:
-        out[n, 0] = p1x
-        out[n, 1] = p1y
-        out[n, 2] = -s
-        n += 1
+        return n + 1
     return n
 
 

@@ -87,6 +87,38 @@ def new_samples(nb: int, maxv: int, n_samples: int, record_corners: bool) -> Sam
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
+def output_of(
+    s: Samples,
+    status: int,
+    n_filled: int,
+    t_stop: float,
+    stop_body: int,
+    n_builds: int,
+    max_pairs: int,
+    n_tests: int,
+) -> Output:
+    """The run's :class:`Output`: its samples ``s`` and how it ended (the fields' meanings there)."""
+    return Output(
+        s.pos,
+        s.ang,
+        s.angvel,
+        s.vpoint,
+        s.corner_states,
+        s.energy,
+        status,
+        n_filled,
+        t_stop,
+        stop_body,
+        s.n_contacts,
+        s.slipping,
+        s.overturn_time,
+        n_builds,
+        max_pairs,
+        n_tests,
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
 def new_tally(nb: int, maxv: int) -> Tally:
     """An empty tally."""
     return Tally(np.zeros(nb, dtype=np.int32), np.zeros(nb, dtype=np.bool_), np.zeros((nb, maxv), dtype=np.int8))

@@ -60,6 +60,43 @@ class RunsOutput(NamedTuple):
     uplift_time: NDArray[np.float64]  #: (R,) first sample time with |theta| > the threshold, s
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _sample_arrays(n_runs: int, n_samples: int):
+    """The runs' samples, NaN until written: positions (R, n_samples, 2), angles and angular
+    velocities (R, n_samples)."""
+    return (
+        np.full((n_runs, n_samples, 2), np.nan),
+        np.full((n_runs, n_samples), np.nan),
+        np.full((n_runs, n_samples), np.nan),
+    )
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def _summaries(ang, n_filled, rest: float, uplift_rad: float, sample_dt: float):
+    """The summary's metrics of every run from its samples (module docstring; theta = angle -
+    ``rest``): peak |theta| (rad), its first sample time (s), the residual theta (rad) and the
+    uplift time (s), each (R,) and NaN for a run without samples (the uplift: NaN when never)."""
+    n_runs = n_filled.size
+    peak = np.full(n_runs, np.nan)
+    peak_t = np.full(n_runs, np.nan)
+    residual = np.full(n_runs, np.nan)
+    uplift = np.full(n_runs, np.nan)
+    for r in numba.prange(n_runs):
+        nf = n_filled[r]
+        best = -1.0
+        for k in range(nf):
+            th = ang[r, k] - rest
+            if abs(th) > best:
+                best = abs(th)
+                peak_t[r] = k * sample_dt
+            if abs(th) > uplift_rad and np.isnan(uplift[r]):
+                uplift[r] = k * sample_dt
+        if nf > 0:
+            peak[r] = best
+            residual[r] = ang[r, nf - 1] - rest
+    return peak, peak_t, residual, uplift
+
+
 @numba.njit(cache=True, nogil=True, parallel=True)
 def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
     """Run R motions on one body, each by :func:`rockyade.kernel.single.run_body` (the per-run
@@ -93,13 +130,7 @@ def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, 
     t_stop = np.zeros(n_runs)
     n_filled = np.zeros(n_runs, dtype=np.int64)
     overturn_t = np.zeros(n_runs)
-    pos = np.full((n_runs, n_samples, 2), np.nan)
-    ang = np.full((n_runs, n_samples), np.nan)
-    angvel = np.full((n_runs, n_samples), np.nan)
-    peak = np.full(n_runs, np.nan)
-    peak_t = np.full(n_runs, np.nan)
-    residual = np.full(n_runs, np.nan)
-    uplift = np.full(n_runs, np.nan)
+    pos, ang, angvel = _sample_arrays(n_runs, n_samples)
     for r in numba.prange(n_runs):
         a, b = starts[r], starts[r + 1]
         vpoint = np.empty((n_samples, 2))
@@ -147,18 +178,7 @@ def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, 
             states,
         )
         status[r], t_stop[r], n_filled[r], overturn_t[r] = st, ts, nf, ot
-        # the summary's metrics from this run's samples (theta = angle - rest angle)
-        best = -1.0
-        for k in range(nf):
-            th = ang[r, k] - rest
-            if abs(th) > best:
-                best = abs(th)
-                peak_t[r] = k * sample_dt
-            if abs(th) > uplift_rad and np.isnan(uplift[r]):
-                uplift[r] = k * sample_dt
-        if nf > 0:
-            peak[r] = best
-            residual[r] = ang[r, nf - 1] - rest
+    peak, peak_t, residual, uplift = _summaries(ang, n_filled, rest, uplift_rad, sample_dt)
     return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)
 
 
@@ -404,13 +424,7 @@ def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplif
     t_stop = np.full(n_runs, -1.0)
     n_filled = np.zeros(n_runs, dtype=np.int64)
     overturn_t = np.full(n_runs, np.nan)
-    pos = np.full((n_runs, n_samples, 2), np.nan)
-    ang = np.full((n_runs, n_samples), np.nan)
-    angvel = np.full((n_runs, n_samples), np.nan)
-    peak = np.full(n_runs, np.nan)
-    peak_t = np.full(n_runs, np.nan)
-    residual = np.full(n_runs, np.nan)
-    uplift = np.full(n_runs, np.nan)
+    pos, ang, angvel = _sample_arrays(n_runs, n_samples)
     n_chunks = (n_runs + CHUNK_RUNS - 1) // CHUNK_RUNS
     verts = np.ascontiguousarray(bodies.verts[0, :nv])
     for c in numba.prange(n_chunks):
@@ -455,18 +469,5 @@ def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplif
                 ang,
                 angvel,
             )
-    for r in numba.prange(n_runs):
-        # the summary's metrics from this run's samples (theta = angle - rest angle)
-        nf = n_filled[r]
-        best = -1.0
-        for k in range(nf):
-            th = ang[r, k] - rest
-            if abs(th) > best:
-                best = abs(th)
-                peak_t[r] = k * sample_dt
-            if abs(th) > uplift_rad and np.isnan(uplift[r]):
-                uplift[r] = k * sample_dt
-        if nf > 0:
-            peak[r] = best
-            residual[r] = ang[r, nf - 1] - rest
+    peak, peak_t, residual, uplift = _summaries(ang, n_filled, rest, uplift_rad, sample_dt)
     return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)

@@ -79,6 +79,7 @@ from rockyade.kernel.recording import (
     Tally,
     new_samples,
     new_tally,
+    output_of,
     record_energy_sample,
     record_sample,
     reset_tally,
@@ -168,25 +169,7 @@ def simulate(bodies, joints, motion, settings, initial) -> Output:
         work = Work(kin, world, work.base, pairs, dash, work.tally, samples, work.totals, work.clip)
         n_builds += 1
         max_pairs = max(max_pairs, pairs.keys.size)
-    s = samples
-    return Output(
-        s.pos,
-        s.ang,
-        s.angvel,
-        s.vpoint,
-        s.corner_states,
-        s.energy,
-        status,
-        n_filled,
-        t_stop,
-        stop_body,
-        s.n_contacts,
-        s.slipping,
-        s.overturn_time,
-        n_builds,
-        max_pairs,
-        n_tests,
-    )
+    return output_of(samples, status, n_filled, t_stop, stop_body, n_builds, max_pairs, n_tests)
 
 
 # Compiled without numba's reference counting (``_nrt=False``): it allocates nothing and

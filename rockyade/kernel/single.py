@@ -33,7 +33,7 @@ import numpy as np
 
 from rockyade.kernel.contact_law import STATE_SLIP
 from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
-from rockyade.kernel.recording import Output, new_samples
+from rockyade.kernel.recording import Output, new_samples, output_of
 from rockyade.kernel.step import (
     base_point,
     beyond_stop_angle,
@@ -317,22 +317,4 @@ def simulate_single(bodies, joints, motion, settings, initial) -> Output:
     )
     samples.overturn_time[0] = overturn_t
     stop_body = 0 if status != STATUS_COMPLETED else -1
-    s = samples
-    return Output(
-        s.pos,
-        s.ang,
-        s.angvel,
-        s.vpoint,
-        s.corner_states,
-        s.energy,
-        status,
-        n_filled,
-        t_stop,
-        stop_body,
-        s.n_contacts,
-        s.slipping,
-        s.overturn_time,
-        1,
-        0,
-        0,
-    )
+    return output_of(samples, status, n_filled, t_stop, stop_body, 1, 0, 0)

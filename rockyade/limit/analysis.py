@@ -9,11 +9,11 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -91,7 +91,7 @@ class FrictionCheck:
         lam = self.coulomb_multiplier
         return self.associated / lam if lam else math.nan
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data (the JSON's ``code_friction``)."""
         return {
             "associated": self.associated,
@@ -204,10 +204,10 @@ class LimitResult:
             )
         return out
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data (JSON-ready): the keys of ``rockyade limit --json``."""
         model = self.model
-        out: dict[str, Any] = {
+        out: dict[str, object] = {
             "status": self.status,
             "load_multiplier": self.load_multiplier,
             "direction": self.direction,
@@ -349,20 +349,19 @@ def limit_analysis(
         model = scene
     else:
         model = rigid_block_model(scene, loads=loads, friction_angle_deg=friction_angle_deg, sliding=sliding)
-    options: dict[str, Any] = dict(
-        fc=fc, max_iterations=max_iterations, on_iteration=on_iteration, on_progress=on_progress
+    # the settings every pass shares (the crushing iteration's, the coulomb check's)
+    solve = functools.partial(
+        limit_analysis, fc=fc, max_iterations=max_iterations, on_iteration=on_iteration, on_progress=on_progress
     )
     if fm_MPa is not None:
         start = time.perf_counter()
         _, crushed_model, crushing = iterate_crushing(
             model,
             fm_MPa,
-            lambda m: limit_analysis(m, direction, nonlinear=False, friction_rule=friction_rule, **options),
+            lambda m: solve(m, direction, nonlinear=False, friction_rule=friction_rule),
         )
         left = None if time_limit_s is None else max(time_limit_s - (time.perf_counter() - start), 1e-3)
-        result = limit_analysis(
-            crushed_model, direction, nonlinear=nonlinear, friction_rule=friction_rule, time_limit_s=left, **options
-        )
+        result = solve(crushed_model, direction, nonlinear=nonlinear, friction_rule=friction_rule, time_limit_s=left)
         result = replace(result, crushing=crushing)
     else:
         result = _limit_analysis(
@@ -370,25 +369,18 @@ def limit_analysis(
         )
     if coulomb_check and friction_rule == "associated" and slides_with_friction(result.model, result.mechanism):
         assert result.load_multiplier is not None  # a mechanism comes with its multiplier
-        coulomb = limit_analysis(
-            model,
-            direction,
-            nonlinear=nonlinear,
-            friction_rule="coulomb",
-            time_limit_s=time_limit_s,
-            fm_MPa=fm_MPa,
-            **options,
+        coulomb = solve(
+            model, direction, nonlinear=nonlinear, friction_rule="coulomb", time_limit_s=time_limit_s, fm_MPa=fm_MPa
         )
         result = replace(result, friction_check=FrictionCheck(result.load_multiplier, coulomb))
     if fm_MPa is not None and (friction_rule == "coulomb" or result.friction_check is not None):
-        rigid = limit_analysis(
+        rigid = solve(
             model,
             direction,
             nonlinear=nonlinear,
             friction_rule=friction_rule,
             time_limit_s=time_limit_s,
             coulomb_check=coulomb_check,
-            **options,
         )
         result = replace(result, rigid=rigid)
     return result

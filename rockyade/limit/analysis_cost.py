@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 from rockyade.errors import InputError, at_least, at_most
 from rockyade.limit.lp import CHILD_COLUMNS, choose_solver
@@ -111,7 +110,7 @@ class LimitCost:
             f"{_duration(self.expected_time_s)} and about {self.memory_bytes / 1e6:.0f} MB"
         )
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data (the ``cost`` of ``rockyade limit --json``)."""
         return {
             "blocks": self.blocks,

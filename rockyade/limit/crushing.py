@@ -31,13 +31,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.errors import InputError
-from rockyade.limit.rigid_blocks import RigidBlockModel
+from rockyade.limit.rigid_blocks import Interface, RigidBlockModel
 
 #: The equivalent rectangular stress block's factor on fm (NTC 2018 7.8.2.2.1, Eq 7.8.2).
 STRESS_BLOCK_FACTOR = 0.85
@@ -72,6 +72,19 @@ def check_fm(value: Any, field: str = "fm_MPa") -> float:
     return float(value)
 
 
+class JointShift(TypedDict):
+    """One joint's row of :attr:`Crushing.joints`: where its hinge moved (module docstring)."""
+
+    a: str
+    b: str
+    normal_N: float
+    depth_m: float
+    width_m: float
+    shift_m: float
+    length_m: float
+    crushed: bool
+
+
 @dataclass(frozen=True)
 class Crushing:
     """How the hinges moved into the joints (module docstring).
@@ -98,7 +111,7 @@ class Crushing:
     converged: bool
     iterations: int
     history: tuple[float, ...]
-    joints: tuple[dict[str, Any], ...]
+    joints: tuple[JointShift, ...]
     reason: str = ""
 
     @property
@@ -107,11 +120,11 @@ class Crushing:
         return [f"{j['a']}-{j['b']}" for j in self.joints if j["crushed"]]
 
     @property
-    def largest_shift(self) -> dict[str, Any] | None:
+    def largest_shift(self) -> JointShift | None:
         """The joint whose hinge moved furthest."""
         return max(self.joints, key=lambda j: j["shift_m"], default=None)
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data (the JSON's ``crushing``)."""
         return {
             "fm_MPa": self.fm_MPa,
@@ -138,12 +151,15 @@ def joint_depths(model: RigidBlockModel) -> NDArray[np.float64]:
     return np.array(out)
 
 
-def shifted(model: RigidBlockModel, normal_N: NDArray[np.float64], fm_MPa: float) -> tuple[RigidBlockModel, list]:
+def shifted(
+    model: RigidBlockModel, normal_N: NDArray[np.float64], fm_MPa: float
+) -> tuple[RigidBlockModel, list[JointShift]]:
     """``model`` with every joint shortened at both ends by a / 2, a = N / (0.85 fm t) (module
     docstring), N its total normal force in ``normal_N`` (n_interfaces,); and the joints' rows."""
     fm_pa = fm_MPa * 1.0e6
     depths = joint_depths(model)
-    interfaces, rows = [], []
+    interfaces: list[Interface] = []
+    rows: list[JointShift] = []
     for k, itf in enumerate(model.interfaces):
         e0, e1 = itf.ends_m
         length = float(np.hypot(*(e1 - e0)))
@@ -156,16 +172,16 @@ def shifted(model: RigidBlockModel, normal_N: NDArray[np.float64], fm_MPa: float
         u = (e1 - e0) / length
         interfaces.append(replace(itf, ends_m=np.array([e0 + shift * u, e1 - shift * u])))
         rows.append(
-            {
-                "a": model.body_name(itf.a),
-                "b": model.body_name(itf.b),
-                "normal_N": n,
-                "depth_m": float(depths[k]),
-                "width_m": width,
-                "shift_m": shift,
-                "length_m": length,
-                "crushed": 0.5 * width >= 0.5 * length,
-            }
+            JointShift(
+                a=model.body_name(itf.a),
+                b=model.body_name(itf.b),
+                normal_N=n,
+                depth_m=float(depths[k]),
+                width_m=width,
+                shift_m=shift,
+                length_m=length,
+                crushed=0.5 * width >= 0.5 * length,
+            )
         )
     return replace(model, interfaces=tuple(interfaces)), rows
 

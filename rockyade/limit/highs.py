@@ -19,6 +19,7 @@ end at once, and that dies with its parent.
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -62,8 +63,8 @@ class Programme:
         """(rows, columns)."""
         return (int(self.A.shape[0]), int(self.A.shape[1]))
 
-    def arrays(self) -> dict[str, Any]:
-        """Plain arrays (for ``numpy.savez``), the matrix as CSC."""
+    def arrays(self) -> dict[str, NDArray[Any]]:
+        """Plain arrays (for ``numpy.savez``), the matrix as CSC; :meth:`from_arrays` reads them."""
         A = sp.csc_matrix(self.A)
         return {
             "c": self.c,
@@ -78,7 +79,7 @@ class Programme:
         }
 
     @classmethod
-    def from_arrays(cls, a) -> Programme:
+    def from_arrays(cls, a: Mapping[str, NDArray[Any]]) -> Programme:
         """The programme of :meth:`arrays`."""
         shape = tuple(int(s) for s in a["shape"])
         A = sp.csc_matrix((a["data"], a["indices"], a["indptr"]), shape=shape)

@@ -131,7 +131,8 @@ def solve_in_child(
     check_solver(solver)
     folder = Path(tempfile.mkdtemp(prefix="rockyade-limit-"))
     try:
-        np.savez(folder / "programme.npz", **programme.arrays())
+        # numpy's stubs type savez's keywords as its allow_pickle flag: the arrays' names are not that
+        np.savez(folder / "programme.npz", **programme.arrays())  # type: ignore[arg-type]
         limit = "none" if time_limit_s is None else repr(float(time_limit_s))
         with open(folder / "stderr.txt", "wb") as err, open(folder / "highs.log", "wb") as log:
             proc = subprocess.Popen(

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -112,9 +111,9 @@ class KinematicQuantities:
         scale = self.g / (self.e_star * self.FC)
         return self.curve.dk_m * self.d_star_factor, self.curve.alpha * scale
 
-    def to_dict(self) -> dict[str, Any]:
+    def to_dict(self) -> dict[str, object]:
         """Plain data (the curve as lists of d* and alpha)."""
-        out: dict[str, Any] = {
+        out: dict[str, object] = {
             "alpha0": self.alpha0,
             "M_star_kg": self.M_star_kg,
             "e_star": self.e_star,

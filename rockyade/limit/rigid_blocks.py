@@ -25,7 +25,7 @@ import functools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import TypedDict
 
 import numpy as np
 from numpy.typing import NDArray
@@ -66,6 +66,17 @@ class PointLoad:
     point_m: tuple[float, float]
     force_N: tuple[float, float]
     mass_kg: float | None = None
+
+
+class LoadRow(TypedDict):
+    """A given load as plain data (:meth:`RigidBlockModel.loads_table`, the JSON's ``loads``)."""
+
+    block: str
+    point_m: list[float]
+    force_N: list[float]
+    mass_kg: float
+    mass_takes_part: bool
+    why: str
 
 
 @dataclass(frozen=True)
@@ -190,10 +201,10 @@ class RigidBlockModel:
                 out.append((i, np.asarray(load.point_m, dtype=float), float(load.mass_kg)))
         return out
 
-    def loads_table(self) -> list[dict[str, Any]]:
+    def loads_table(self) -> list[LoadRow]:
         """Each given load as plain data: its block, point, force, mass and whether the mass
         takes part in the horizontal acceleration (and so in the code's P_i)."""
-        out = []
+        out: list[LoadRow] = []
         for q in self.given_loads:
             i = int(q.block)
             mass = float(q.mass_kg or 0.0)
@@ -204,14 +215,14 @@ class RigidBlockModel:
             else:
                 why = "given without mass (mass_kg = 0): its horizontal force is taken elsewhere"
             out.append(
-                {
-                    "block": self.names[i],
-                    "point_m": list(q.point_m),
-                    "force_N": list(q.force_N),
-                    "mass_kg": mass,
-                    "mass_takes_part": bool(mass > 0.0 and not self.fixed[i]),
-                    "why": why,
-                }
+                LoadRow(
+                    block=self.names[i],
+                    point_m=list(q.point_m),
+                    force_N=list(q.force_N),
+                    mass_kg=mass,
+                    mass_takes_part=bool(mass > 0.0 and not self.fixed[i]),
+                    why=why,
+                )
             )
         return out
 

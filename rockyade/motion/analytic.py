@@ -115,14 +115,16 @@ class Harmonic:
         a = A * (w2 * s + 2.0 * w1 * self.omega * c - w * self.omega**2 * s)
         return d, v, a
 
+    @property
+    def sample_count(self) -> int:
+        """Samples of :meth:`ground_motion`: 400 points per cycle from t = 0 to the end."""
+        return math.ceil(self.phases_s["end_s"] * self.frequency_hz * 400) + 1
+
     def ground_motion(self, load_factor: float = 1.0) -> GroundMotion:
         """Acceleration sampled at 400 points per cycle from t = 0 to the end."""
-        end = self.phases_s["end_s"]
-        n = math.ceil(end * self.frequency_hz * 400) + 1
-        t = np.linspace(0.0, end, n)
-        a = self.kinematics(t)[2]
+        t = np.linspace(0.0, self.phases_s["end_s"], self.sample_count)
         label = f"harmonic {self.frequency_hz:g} Hz, {self.amplitude_mm:g} mm, {self.cycles} cycles"
-        return GroundMotion(t, load_factor * a, None, label + (f", x{load_factor:g}" if load_factor != 1 else ""))
+        return _scaled(t, self.kinematics(t)[2], label, load_factor)
 
 
 @dataclass(frozen=True)
@@ -177,17 +179,28 @@ class Pulse:
             a = (1 - 2 * u * u) * np.exp(-u * u)
         return np.where(inside, self.amplitude_m_s2 * a, 0.0)
 
+    @property
+    def _jumps(self) -> bool:
+        """The pulse starts with a jump (a cosine after t = 0): a sample pair puts it at the start
+        time exactly in the piecewise-linear history."""
+        return self.kind == "cosine" and self.start_s > 0
+
+    @property
+    def sample_count(self) -> int:
+        """Samples of :meth:`ground_motion`: T / 400 (at most 1 ms) from t = 0 to the end, and
+        the second of the jump's pair."""
+        end = self.start_s + self.duration_s
+        return math.ceil(end / min(self.period_s / 400.0, 1e-3)) + 1 + int(self._jumps)
+
     def ground_motion(self, load_factor: float = 1.0) -> GroundMotion:
         """Acceleration sampled at T / 400 (at most 1 ms) from t = 0 to the end."""
-        end = self.start_s + self.duration_s
-        dt = min(self.period_s / 400.0, 1e-3)
-        n = math.ceil(end / dt) + 1
-        t = np.linspace(0.0, end, n)
-        a = self.acceleration(t)
-        if self.kind == "cosine" and self.start_s > 0:
-            # the pulse starts with a jump: put it on a sample pair so that the piecewise-
-            # linear history has the jump at the start time exactly
+        t = np.linspace(0.0, self.start_s + self.duration_s, self.sample_count - int(self._jumps))
+        if self._jumps:
             t = np.sort(np.concatenate([t, [np.nextafter(self.start_s, -np.inf)]]))
-            a = self.acceleration(t)
         label = f"{self.shape} pulse a_p = {self.amplitude_m_s2:g} m/s^2, T = {self.period_s:g} s"
-        return GroundMotion(t, load_factor * a, None, label + (f", x{load_factor:g}" if load_factor != 1 else ""))
+        return _scaled(t, self.acceleration(t), label, load_factor)
+
+
+def _scaled(t: NDArray[np.float64], accel: NDArray[np.float64], label: str, load_factor: float) -> GroundMotion:
+    """An analytic motion's samples times ``load_factor`` (named in the label when not 1)."""
+    return GroundMotion(t, load_factor * accel, None, label + (f", x{load_factor:g}" if load_factor != 1 else ""))

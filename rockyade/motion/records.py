@@ -272,6 +272,24 @@ def _columns(path: Path, lineno: int, body: str) -> list[str]:
     return columns
 
 
+def _column_read(
+    path: Path,
+    count: int,
+    column: list[tuple[str, int]],
+    header_line: int | None,
+    header_unit: str | None,
+    units: str | None,
+) -> str:
+    """The checks a text column makes once read (2 to :data:`MAX_RECORD_SAMPLES` samples, its
+    last value not cut off) and its unit: the header's or ``units`` (m/s2 when neither names one)."""
+    if count < 2:
+        raise RecordError(path, None, "fewer than 2 samples")
+    if count > MAX_RECORD_SAMPLES:
+        raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
+    check_not_cut(path, column, True)
+    return resolve_units(path, header_line, header_unit, units) or "m/s2"
+
+
 def read_two_column(path: str | Path, units: str | None = None, dt_s: float | None = None) -> Record:
     """Read time (s) and acceleration columns (module docstring: separators, decimal commas).
 
@@ -328,12 +346,7 @@ def read_two_column(path: str | Path, units: str | None = None, dt_s: float | No
         times.append(number_at(path, lineno, columns[0], "time"))
         accel.append(number_at(path, lineno, columns[1]))
         column.append((columns[1], lineno))
-    if len(times) < 2:
-        raise RecordError(path, None, "fewer than 2 samples")
-    if len(times) > MAX_RECORD_SAMPLES:
-        raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
-    check_not_cut(path, column, True)
-    unit = resolve_units(path, header_line, header_unit, units) or "m/s2"
+    unit = _column_read(path, len(times), column, header_line, header_unit, units)
     t = np.asarray(times)
     bad = np.nonzero(np.diff(t) <= 0)[0]
     if bad.size:
@@ -422,12 +435,7 @@ def read_single_column(path: str | Path, dt_s: float, units: str | None = None) 
                 )
         values.append(number_at(path, lineno, token))
         column.append((token, lineno))
-    if len(values) < 2:
-        raise RecordError(path, None, "fewer than 2 samples")
-    if len(values) > MAX_RECORD_SAMPLES:
-        raise RecordError(path, None, f"more than {MAX_RECORD_SAMPLES} samples")
-    check_not_cut(path, column, True)
-    unit = resolve_units(path, header_line, header_unit, units) or "m/s2"
+    unit = _column_read(path, len(values), column, header_line, header_unit, units)
     a = accel_si(path, values, unit)
     return Record(np.arange(a.size) * dt_s, a, unit, str(path), "", {"format": "single"})
 

@@ -40,7 +40,7 @@ Scene tables (all take ``load_factor``, default 1)::
 from __future__ import annotations
 
 import hashlib
-import math
+from abc import abstractmethod
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -64,8 +64,27 @@ def _load_factor(r: TableReader) -> float:
     return r.number("load_factor", 1.0, lo=0.0, hi=100.0)
 
 
+class _AnalyticMotion(MotionSpec):
+    """A motion of :mod:`rockyade.motion.analytic`, times the spec's ``load_factor``."""
+
+    load_factor: float
+
+    @property
+    @abstractmethod
+    def analytic(self) -> Harmonic | Pulse:
+        """The analytic motion."""
+
+    def ground_motion(self, duration_s: float) -> GroundMotion:
+        """The analytic motion's acceleration times ``load_factor``, sampled as it samples itself; m/s^2."""
+        return self.analytic.ground_motion(self.load_factor)
+
+    def sample_count(self, duration_s: float) -> int:
+        """The analytic motion's samples (:attr:`~rockyade.motion.analytic.Harmonic.sample_count`)."""
+        return self.analytic.sample_count
+
+
 @dataclass(frozen=True)
-class HarmonicMotion(MotionSpec):
+class HarmonicMotion(_AnalyticMotion):
     """``type = "harmonic"``: see :class:`rockyade.motion.analytic.Harmonic`."""
 
     type: ClassVar[str] = "harmonic"
@@ -78,17 +97,13 @@ class HarmonicMotion(MotionSpec):
 
     @property
     def harmonic(self) -> Harmonic:
-        """The analytic motion."""
+        """The analytic motion (400 samples per cycle)."""
         return Harmonic(self.amplitude_mm, self.frequency_hz, self.cycles, self.ramp_cycles, self.start_s)
 
-    def ground_motion(self, duration_s: float) -> GroundMotion:
-        """The harmonic base displacement's acceleration times ``load_factor`` (400 samples per cycle); m/s^2."""
-        return self.harmonic.ground_motion(self.load_factor)
-
-    def sample_count(self, duration_s: float) -> int:
-        # as Harmonic.ground_motion samples it: 400 points per cycle to the end
-        """Samples at 400 points per cycle to the motion's end."""
-        return math.ceil(self.harmonic.phases_s["end_s"] * self.frequency_hz * 400) + 1
+    @property
+    def analytic(self) -> Harmonic:
+        """:attr:`harmonic`, the motion :class:`_AnalyticMotion` samples."""
+        return self.harmonic
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> HarmonicMotion:
@@ -108,7 +123,7 @@ class HarmonicMotion(MotionSpec):
 
 
 @dataclass(frozen=True)
-class PulseMotion(MotionSpec):
+class PulseMotion(_AnalyticMotion):
     """``type = "pulse"``: see :class:`rockyade.motion.analytic.Pulse`."""
 
     type: ClassVar[str] = "pulse"
@@ -120,19 +135,9 @@ class PulseMotion(MotionSpec):
     load_factor: float = 1.0
 
     @property
-    def pulse(self) -> Pulse:
-        """The analytic pulse."""
+    def analytic(self) -> Pulse:
+        """The analytic pulse (sampled at T/400, at most 1 ms)."""
         return Pulse(self.shape, self.amplitude_m_s2, self.period_s, self.cycles, self.start_s)
-
-    def ground_motion(self, duration_s: float) -> GroundMotion:
-        """The pulse times ``load_factor``, sampled at T/400 (at most 1 ms); m/s^2."""
-        return self.pulse.ground_motion(self.load_factor)
-
-    def sample_count(self, duration_s: float) -> int:
-        # as Pulse.ground_motion samples it: T / 400, at most 1 ms, to the end
-        """Samples at T/400 (at most 1 ms) to the pulse's end."""
-        pulse = self.pulse
-        return math.ceil((pulse.start_s + pulse.duration_s) / min(pulse.period_s / 400.0, 1e-3)) + 2
 
     @classmethod
     def parse(cls, r: TableReader, base_dir: Path | None) -> PulseMotion:
