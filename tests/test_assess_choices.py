@@ -55,6 +55,7 @@ def test_the_knowledge_levels_give_the_codes_fc():
     assert exc.value.field == "--knowledge-level"
 
 
+@pytest.mark.slow
 def test_fc_scales_a0_star_and_is_reported_with_its_source(capsys):
     data = {}
     for level in ("LC1", "LC2", "LC3"):
@@ -67,6 +68,7 @@ def test_fc_scales_a0_star_and_is_reported_with_its_source(capsys):
     assert ratio == pytest.approx(1.35, rel=1e-12)  # a0* = alpha0 g / (e* FC)
 
 
+@pytest.mark.slow
 def test_q_and_its_clause_beside_every_linear_check(capsys):
     code, out, _ = run(capsys, "assess", ROOF, *NTC, "--knowledge-level", "LC1")
     assert code == 0

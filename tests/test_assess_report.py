@@ -59,6 +59,7 @@ def _digits(text: str) -> int:
     return max(len(mantissa), 1)
 
 
+@pytest.mark.slow
 def test_the_page_loads_every_figure_in_chromium_and_shows_the_numbers_of_assess_json(report, tmp_path):
     out, page = report
     data = json.loads((out / "assess.json").read_text())
@@ -135,6 +136,7 @@ def test_the_markdown_twin_links_its_figures_beside_it(report):
     assert sorted(p.name for p in page.iterdir()) == sorted([*links, "report.md", "report.html"])
 
 
+@pytest.mark.slow
 def test_a_report_is_replaced_whole_or_not_at_all(tmp_path, monkeypatch, capsys):
     folder = tmp_path / "page"
     static = ["assess", WALL, *LC1, *SITE, "--static-only"]

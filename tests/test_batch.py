@@ -202,6 +202,7 @@ def test_no_network_listening_in_local_batches(tmp_path):
     assert not sockets
 
 
+@pytest.mark.slow
 def test_paper_command_writes_index(tmp_path, capsys):
     from rockyade.cli import main
 

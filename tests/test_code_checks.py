@@ -113,6 +113,7 @@ def test_the_checks_not_made_are_in_the_output_itself(tmp_path, capsys):
     assert "clause: Circolare 2019 C8.7.1.2.1.8, nonlinear kinematic analysis at height" in text
 
 
+@pytest.mark.slow
 def test_every_load_says_whether_its_mass_takes_part(tmp_path, capsys):
     """The engineer's roof: alpha0 = 0.1050 with its mass (test_loads checks it by hand), 0.1979 without."""
     for mass, alpha0, words in (("carried", 0.1050, "with its mass 611.6 kg"), ("none", 0.1979, "without mass")):

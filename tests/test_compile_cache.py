@@ -14,6 +14,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from rockyade.scene import scene_from_dict
 from rockyade.solvers import make_solver
 from rockyade.solvers.compile_cache import compile_all, main
@@ -47,6 +49,7 @@ def _probe(cache: Path) -> tuple[dict, str]:
     return json.loads(out.stdout), out.stderr
 
 
+@pytest.mark.slow
 def test_a_cold_cache_is_said_once_and_counted_in_the_estimate(tmp_path: Path) -> None:
     answer, stderr = _probe(tmp_path)
     assert stderr.count(COMPILING) == 1, stderr  # the first run says it, the second (loaded) does not

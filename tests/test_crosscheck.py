@@ -193,6 +193,7 @@ def complete(plan, tmp_path_factory):
     return out, run(plan, out)
 
 
+@pytest.mark.slow
 def test_small_real_crosscheck(complete, plan):
     out, summary = complete
     assert summary.partial is False and summary.verdicts
@@ -244,6 +245,7 @@ def test_small_real_crosscheck(complete, plan):
     assert "## Verdicts" in index and "PARTIAL" not in index and "housner / reference" in index
 
 
+@pytest.mark.slow
 def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, monkeypatch):
     import rockyade.studies.crosscheck as cc
 
@@ -289,6 +291,7 @@ def test_resume_after_an_interruption_repeats_no_run(plan, complete, tmp_path, m
     pd.testing.assert_frame_equal(same, pd.read_csv(reference_out / "collapse_intensities.csv"))
 
 
+@pytest.mark.slow
 def test_resume_after_kill_replays_from_disk(plan, complete, tmp_path, monkeypatch):
     """A process killed mid-study (no summary written): the runs on disk are all it left."""
     import rockyade.studies.crosscheck as cc
@@ -351,6 +354,7 @@ def test_a_second_study_on_the_same_out_never_mixes(plan, complete, records, tmp
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == sorted(cc.RESULT_FILES)
 
 
+@pytest.mark.slow
 def test_ctrl_c_mid_run_leaves_the_previous_set_intact(complete, records, tmp_path):
     """A real ``rockyade crosscheck`` process sent SIGINT once its first run is in the journal:
     exit 130, the earlier complete set byte for byte as it was (no file of the new study in it,
@@ -452,6 +456,7 @@ print(len(simulate_runs.signatures), len(simulate_single.signatures))
 """
 
 
+@pytest.mark.slow
 def test_warm_up_loads_the_kernels_the_workers_run(records, tmp_path):
     """In a fresh process, the study's warm-up loads the reference DEM's grouped and single-run
     kernels as the batch runs them (the lean solver, without energy terms): the workers forked

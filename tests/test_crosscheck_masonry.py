@@ -66,6 +66,7 @@ def biblock(records, tmp_path_factory):
     return code, out
 
 
+@pytest.mark.slow
 def test_the_bi_block_runs_with_its_exact_solver_on_dask(biblock):
     code, out = biblock
     assert code == 0

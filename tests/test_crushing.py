@@ -39,6 +39,7 @@ def test_one_block_against_the_closed_form(fm):
     assert kin.d0_star_m == pytest.approx(one_block(fm) * 2.5 / 2, rel=1e-4)  # the centroid over the moved hinge
 
 
+@pytest.mark.slow
 def test_the_multiplier_falls_with_fm_and_tends_to_the_rigid_one():
     scene = course_wall_scene(6, unit_length=0.5, unit_height=0.4)
     rigid = limit_analysis(scene, "+x").load_multiplier
@@ -71,6 +72,7 @@ def test_fm_at_or_below_zero_exits_2_naming_it(command, value, capsys):
     assert "--fm" in err and err.count("\n") == 1
 
 
+@pytest.mark.slow
 def test_assess_lists_crushing_among_the_checks_made(capsys):
     wall = str(EXAMPLES / "free_standing_wall.toml")
     site = ["--spectrum-type", "1", "--ground", "B", "--ag", "0.25g", "--static-only", "--knowledge-level", "LC1"]

@@ -88,6 +88,7 @@ print("reason", reason, flush=True)
 """
 
 
+@pytest.mark.slow
 def test_no_python_runs_in_a_worker_between_fork_and_exec(tmp_path):
     done = subprocess.run(
         [sys.executable, "-c", NO_PYTHON_IN_CHILD, str(tmp_path)],
@@ -103,6 +104,7 @@ def test_no_python_runs_in_a_worker_between_fork_and_exec(tmp_path):
 
 
 @pytest.mark.parametrize("executor", ["dask", "threads"])
+@pytest.mark.slow
 def test_ctrl_c_twice_while_workers_start_runs_the_handler_once_and_raises_nothing(executor):
     if executor == "dask":
         pytest.importorskip("dask")

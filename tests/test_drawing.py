@@ -54,6 +54,7 @@ def _rocking_result(scene, theta: np.ndarray, t: np.ndarray, pivot_block: str) -
     return Result(pd.DataFrame(data), RunMeta(status="completed", blocks=tuple(names), solver="synthetic"))
 
 
+@pytest.mark.slow
 def test_draw_writes_a_png_with_names_and_counts_the_names_left_out(tmp_path):
     small = scene_from_dict(wall(courses=3, units_per_course=4, openings=[(0.4, 0.0, 0.4, 0.2)]))
     _, ax = draw_assembly(small, tmp_path / "wall.png")
@@ -101,6 +102,7 @@ def test_sample_index_refuses_times_outside_the_run():
         sample_index(result, 1.5)
 
 
+@pytest.mark.slow
 def test_snapshots_and_animation_of_a_real_reference_run(tmp_path):
     scene = scene_from_dict(
         rocking_frame(
@@ -141,6 +143,7 @@ def test_mp4_needs_ffmpeg_and_other_suffixes_are_refused(tmp_path):
         animation_writer_for(tmp_path / "a.avi", 10)
 
 
+@pytest.mark.slow
 def test_run_and_draw_commands_write_snapshots_from_relative_paths(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     scene = stack(

@@ -51,6 +51,7 @@ def test_motion_info_on_a_shipped_record_from_the_repository():
     assert info["npts"] == 2001 and info["dt_s"] == pytest.approx(0.01)
 
 
+@pytest.mark.slow
 def test_a_scene_reads_its_record_relative_to_the_scene_file(tmp_path):
     proc = subprocess.run(
         [str(ROCKYADE), "run", str(EXAMPLES / "specimen1_record.toml"), "--solver", "housner", "--out", "r/x.csv"],
@@ -75,6 +76,7 @@ def test_the_record_generator_runs(tmp_path):
 
 
 @pytest.mark.parametrize("script", GALLERY, ids=[p.stem for p in GALLERY])
+@pytest.mark.slow
 def test_gallery_script_runs_and_writes_its_figure(script, tmp_path):
     env = dict(os.environ, MPLBACKEND="Agg")
     proc = subprocess.run(

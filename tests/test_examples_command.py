@@ -7,6 +7,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from rockyade.cli import main
 from rockyade.cli.examples import example_files, examples_root
 
@@ -70,6 +72,7 @@ def test_a_file_is_refused(tmp_path, capsys):
     assert "file" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_a_copied_scene_runs(tmp_path):
     out = tmp_path / "ex"
     assert main(["examples", "--out", str(out)]) == 0

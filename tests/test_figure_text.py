@@ -120,6 +120,7 @@ def drawn(monkeypatch):
         ["run", "specimen1_free.toml", "--solver", "housner", "--out", "OUT/free.csv", "--plot", "OUT/free.png"],
     ],
 )
+@pytest.mark.slow
 def test_the_howto_figures_have_no_overlapping_text(tmp_path, drawn, argv):
     args = [str(EXAMPLES / a) if a.endswith(".toml") else a.replace("OUT", str(tmp_path)) for a in argv]
     assert main(args) == 0

@@ -25,6 +25,7 @@ def housner_result():
     return run(scene_from_dict(free_scene_dict(duration=1.0)), solver="housner")
 
 
+@pytest.mark.slow
 def test_importing_figures_and_studies_keeps_the_users_backend():
     code = (
         "import matplotlib; matplotlib.use('svg');"

@@ -128,6 +128,7 @@ def test_the_2009_form_is_kept_by_name_and_says_so():
     assert pos.to_dict()["code_form"] == "circolare2009"
 
 
+@pytest.mark.slow
 def test_assess_prints_the_floor_spectrum_checks_with_their_clauses(tmp_path, capsys):
     scene = wall(tmp_path, capsys)
     assert main(["assess", str(scene), *NTC, "--static-only", *HEIGHT]) == 0

@@ -107,6 +107,7 @@ def damaged(draw: st.DrawFn) -> tuple[str, bytes]:
 
 @fuzz_settings(500)
 @given(damaged())
+@pytest.mark.slow
 def test_fuzz_damaged_records_never_crash(case):
     name, data = case
     rec = outcome("records damaged", lambda: _read(name, data))
@@ -176,6 +177,7 @@ def numeric_text(draw: st.DrawFn) -> tuple[str, bytes]:
 
 @fuzz_settings(400)
 @given(case=numeric_text(), fmt=st.sampled_from([None, "csv", "single"]), dt_s=st.sampled_from([None, 0.01]))
+@pytest.mark.slow
 def test_fuzz_random_numeric_text_gives_a_record_or_a_clean_error(case, fmt, dt_s):
     name, data = case
     rec = outcome("records numeric text", lambda: _read_as(fmt, Path(name).suffix, data, dt_s))

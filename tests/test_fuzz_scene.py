@@ -95,6 +95,7 @@ def _load_and_estimate(d: dict) -> None:
 
 @fuzz_settings(400)
 @given(mutated_scenes())
+@pytest.mark.slow
 def test_fuzz_scene_dictionaries(d):
     outcome("scene dict", lambda: _load_and_estimate(d))
 
@@ -163,6 +164,7 @@ def mutated_toml(draw: st.DrawFn) -> bytes:
 
 @fuzz_settings(400)
 @given(mutated_toml())
+@pytest.mark.slow
 def test_fuzz_scene_toml_bytes(data):
     def load() -> None:
         with tempfile.TemporaryDirectory() as folder:
@@ -254,5 +256,6 @@ def _run(d: dict) -> None:
 
 @fuzz_settings(40)
 @given(perturbed_scenes())
+@pytest.mark.slow
 def test_fuzz_runs_of_perturbed_scenes(d):
     outcome("scene runs", lambda: _run(d), compiles=True)

@@ -33,6 +33,7 @@ def _record_in_g(path, pga_g):
     return path
 
 
+@pytest.mark.slow
 def test_motion_info_and_assess_print_the_same_m_s2_for_the_same_g(tmp_path, capsys):
     """0.15 g is 1.471 m/s^2 (standard gravity) in `motion info` and in `assess --ag 0.15g`; with 9.81 in
     the check it was 1.472 there."""

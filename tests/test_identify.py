@@ -83,6 +83,7 @@ def test_model_is_the_solver_shifted_to_a_release_between_samples():
     assert np.all(theta[:26] == -0.5 * 0.235 + 0.001)  # the hold
 
 
+@pytest.mark.slow
 def test_cli_identify_json_and_figures(tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     rel = os.path.relpath(MEASURED, tmp_path)

@@ -98,6 +98,7 @@ def test_stored_and_released_energy():
 # ---------------------------------------------------------------------- ground motion
 
 
+@pytest.mark.slow
 def test_ground_lookup_equals_linear_interpolation_for_any_time_order():
     rng = np.random.default_rng(3)
     t_s = np.cumsum(rng.uniform(0.001, 0.02, 400))

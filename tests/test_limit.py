@@ -271,6 +271,7 @@ def test_bad_direction_and_friction_are_refused():
 # ---------------------------------------------------------------------- arches
 
 
+@pytest.mark.slow
 def test_a_20_voussoir_arch_of_t_over_r_015_on_fixed_piers_collapses_at_0149():
     """Independent value: 0.1494 (a semicircular arch of 20 voussoirs, t/R = 0.15, fixed supports),
     by a four-hinge mechanism."""
@@ -291,6 +292,7 @@ def _minimum_thickness(voussoirs: int, tol: float = 5e-5) -> float:
     return 0.5 * (lo + hi)
 
 
+@pytest.mark.slow
 def test_the_minimum_thickness_of_a_semicircular_arch_approaches_milankovitchs():
     """Independent values: t/R = 0.1073 for 20 voussoirs, 0.1075 (Milankovitch) for many."""
     t20 = _minimum_thickness(20)

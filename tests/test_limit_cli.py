@@ -62,6 +62,7 @@ def test_limit_json_has_the_documented_keys(capsys):
     assert data["checks"]["virtual_work_residual"] < 1e-9
 
 
+@pytest.mark.slow
 def test_direction_minus_x_is_read_as_a_value(capsys):
     scene = str(EXAMPLES / "assemblies/column_8_drums.toml")
     _, out_plus, _ = run_cli(capsys, "limit", scene, "--json")
@@ -125,6 +126,7 @@ def test_a_missing_scene_and_clashing_options_exit_2(tmp_path):
         assert proc.returncode == 2 and "Traceback" not in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow
 def test_the_plot_is_written_and_json_stays_clean(capsys, tmp_path):
     png = tmp_path / "figs" / "arch.png"
     code, out, err = run_cli(

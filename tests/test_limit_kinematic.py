@@ -115,6 +115,7 @@ def test_the_rocking_frame_keeps_tan_alpha_minus_theta_for_any_beam(gamma):
     assert np.max(np.abs(kin.curve.alpha - np.tan(alpha - theta))) < 1e-8
 
 
+@pytest.mark.slow
 def test_an_arch_mechanism_is_followed_from_its_multiplier_down_to_zero():
     result = limit_analysis(arch_scene(0.15, 20), sliding=False)
     kin = result.kinematic
@@ -149,6 +150,7 @@ def test_fc_scales_a0_star_and_is_checked():
             limit_analysis(scene, fc=bad)
 
 
+@pytest.mark.slow
 def test_hinges_that_would_lock_a_wall_mechanism_open_on_the_way():
     """A wall with a door and a window, no sliding: the mechanism's ten hinges are compatible at
     rest to first order only; some open as it moves (hinges are unilateral) and alpha falls

@@ -38,6 +38,7 @@ def wall_305():
     return rigid_block_model(scene_from_dict(wall(courses=10, units_per_course=30)))
 
 
+@pytest.mark.slow
 def test_hipo_gives_the_simplex_multiplier_and_mechanism(wall_305):
     simplex = solve_equilibrium(wall_305, "+x", method="highs-ds")
     hipo = solve_equilibrium(wall_305, "+x", method="highs-hipo")
@@ -176,6 +177,7 @@ def _cmdline(pid: int) -> str:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads the processes from Linux's /proc")
+@pytest.mark.slow
 def test_ctrl_c_ends_a_long_limit_analysis_and_its_highs_process(tmp_path):
     """SIGINT once HiGHS runs in its child process (seen in /proc, not after a sleep): exit 130, no
     traceback, the child gone and its folder removed. A 1,965-block wall under the coulomb rule solves a
@@ -211,6 +213,7 @@ def test_ctrl_c_ends_a_long_limit_analysis_and_its_highs_process(tmp_path):
     assert out == ""
 
 
+@pytest.mark.slow
 def test_the_benchmark_runs_in_its_quick_mode():
     bench = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_limit.py"
     proc = subprocess.run([sys.executable, str(bench), "--quick"], capture_output=True, text=True, timeout=600)

@@ -298,6 +298,7 @@ def test_spectrum_of_a_sampled_sinusoid_against_steady_state():
     np.testing.assert_allclose(psa, expected, rtol=0.005)
 
 
+@pytest.mark.slow
 def test_short_periods_are_substepped():
     """T / dt < 10: the peak between samples is found (against a fine direct integration)."""
     rng = np.random.default_rng(1)
@@ -386,6 +387,7 @@ def paper_records():
             os.environ["ROCKYADE_CACHE"] = old
 
 
+@pytest.mark.slow
 def test_paper_suite_is_compatible(paper_records):
     spec, records = paper_records
     report = compatibility_report(records, spec.target, (0.05, 2.0))

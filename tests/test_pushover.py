@@ -207,6 +207,7 @@ def test_pushover_onset_of_a_loaded_block_is_the_closed_form(solver):
 
 
 @pytest.mark.parametrize("solver", ["reference", "yade"])
+@pytest.mark.slow
 def test_pushover_onset_of_a_20_voussoir_arch_is_the_limit_analysis(solver):
     """t/R = 0.15 on fixed piers: the limit analysis gives 0.1494 (four hinges); both DEMs'
     onset is within 2 % of it."""

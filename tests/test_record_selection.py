@@ -55,6 +55,7 @@ def selection(tmp_path_factory):
     return out
 
 
+@pytest.mark.slow
 def test_the_set_written_is_compatible_when_checked_independently(selection):
     table = pd.read_csv(selection / "selection.csv")
     assert list(table.columns) == ["record", "scale_factor", "pga_m_s2", "pga_g"]
@@ -87,6 +88,7 @@ def test_the_shipped_selection_is_what_the_command_writes(selection):
     assert records_in_folder(shipped).count == 7
 
 
+@pytest.mark.slow
 def test_selecting_again_gives_the_same_set_and_replaces_it_whole(selection, tmp_path, capsys):
     out = tmp_path / "again"
     shutil.copytree(selection, out)

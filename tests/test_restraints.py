@@ -276,6 +276,7 @@ def test_sliding_with_friction_says_why_it_is_not_followed():
     assert "slides with friction" in res.kinematic.nonlinear_note
 
 
+@pytest.mark.slow
 def test_the_pushover_of_a_wall_with_a_gap_sees_the_onset_before_the_restraint_holds_it():
     """The wall turns at alpha0 = 0.1979 but only until its top meets the restraint 1 mm away (its control
     point, w08's centroid, then moved 0.94 mm): the pushover's growth threshold of 1 mm would never be

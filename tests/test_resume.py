@@ -196,6 +196,7 @@ def _wait_for_records(proc: subprocess.Popen[str], partial: Path, n: int) -> Non
 
 
 @pytest.mark.parametrize("how", ["ctrl-c", "kill-9"])
+@pytest.mark.slow
 def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, how):
     """Ctrl-C (a partial summary marked partial) or kill -9 in the middle of a fragility,
     then ``--resume``: every run finished before the stop is read back, none is run twice,
@@ -327,6 +328,7 @@ def _namespace_or_skip() -> None:
         pytest.skip("cannot mount a tmpfs here (no user namespaces)")
 
 
+@pytest.mark.slow
 def test_a_full_disk_leaves_the_previous_set_whole_and_names_the_file(tmp_path, wall, records):
     """A real full disk (a small tmpfs): a complete fragility set, the disk filled but for
     room for the new runs' records and tables, a new fragility over it: it fails naming the
@@ -469,6 +471,7 @@ def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
     release.set()
 
 
+@pytest.mark.slow
 def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, records):
     """Ctrl-C in the dynamics of ``assess --out``: the static answer is written (marked
     partial) with the runs that finished, and ``--resume`` runs only the others."""
@@ -494,6 +497,7 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
 
 
 @pytest.mark.parametrize("executor", ["local", "dask"])
+@pytest.mark.slow
 def test_a_fragility_opens_no_listening_socket(tmp_path, wall, records, executor):
     """The study commands on local processes or Dask's threaded scheduler open no port (polled
     over the process tree while it runs, to the end)."""

@@ -84,6 +84,7 @@ def _workers_of(proc: subprocess.Popen[str], count: int) -> set[int]:
 # ---------------------------------------------------------------------- Ctrl-C
 
 
+@pytest.mark.slow
 def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
     # 6 runs: at most 2 are in flight (rockyade.runner.local), so at Ctrl-C, one or two ended,
     # two running and two or more not started
@@ -126,6 +127,7 @@ def test_first_ctrl_c_lets_running_runs_finish_and_writes_the_summary(tmp_path):
 
 
 @pytest.mark.parametrize("executor", ["local", "dask"])
+@pytest.mark.slow
 def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path, executor):
     if executor == "dask":
         pytest.importorskip("dask")
@@ -152,6 +154,7 @@ def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path, executor):
     assert not _leftovers(tmp_path / "out")
 
 
+@pytest.mark.slow
 def test_sigkilled_parent_takes_its_workers_and_resume_loses_nothing(tmp_path):
     # 5 runs: killed after two ended, with at most two running (rockyade.runner.local), so the
     # resume has lost runs to run again and at least one that never started
@@ -229,6 +232,7 @@ def test_the_socket_poller_sees_a_listening_socket():
         assert _listening_sockets_of_tree(os.getpid())
 
 
+@pytest.mark.slow
 def test_dask_batch_without_scheduler_opens_no_listening_socket(tmp_path):
     pytest.importorskip("dask")
     _study(tmp_path, duration_s=60.0, runs=6)
@@ -301,6 +305,7 @@ def test_full_disk_fails_one_run_and_the_batch_goes_on(tmp_path, monkeypatch):
     assert not list((tmp_path / "runs").glob(f"{victim_hash}_{victim.solver.name}.*"))
 
 
+@pytest.mark.slow
 def test_tiny_tmpfs_full_disk_is_a_clear_failure(tmp_path):
     """A real full disk: a 64 KiB tmpfs in a private mount namespace (skipped where it
     cannot be mounted)."""

@@ -173,6 +173,7 @@ def test_a_folder_in_place_of_a_cache_file_is_named_and_the_record_generated(cac
     assert cache.is_dir() and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated):
     """A read-only cache folder (a read-only file system: root writes through permissions)."""
     folder = tmp_path / "ro"
@@ -209,6 +210,7 @@ def test_an_unwritable_cache_gives_the_record_and_a_warning(tmp_path, generated)
     assert "Traceback" not in proc.stderr
 
 
+@pytest.mark.slow
 def test_two_processes_regenerating_at_once_both_get_the_record(cache, generated):
     cache.write_bytes(b"")  # damaged: both processes regenerate it and rename a file into place
     code = textwrap.dedent(

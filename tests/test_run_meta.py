@@ -188,6 +188,7 @@ def _strict_load(path: Path) -> object:
     return json.loads(path.read_text(), parse_constant=_refuse)
 
 
+@pytest.mark.slow
 def test_every_json_a_small_run_batch_and_assess_write_is_strict(tmp_path, capsys):
     """A Housner run (free rocking: its metadata holds NaN, a time never reached), a batch of
     two runs (their journal records) and an assessment (code checks, a fragility of a few runs)

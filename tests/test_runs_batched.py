@@ -46,6 +46,7 @@ def _kernel_inputs(tasks, repeat: int = 1):
 
 
 @pytest.mark.parametrize("specimen", SINGLE_SPECIMENS)
+@pytest.mark.slow
 def test_runs_stepped_together_are_bit_identical_to_one_at_a_time(tmp_path, specimen):
     # more runs than a chunk (so that chunks and drop-outs mix), on one thread and on two
     args = _kernel_inputs(_tasks(tmp_path, specimen), repeat=CHUNK_RUNS // len(RECORDS) // len(LOAD_FACTORS) + 1)

@@ -23,6 +23,7 @@ def _fine_grid_psa(accel: np.ndarray, dt: float, period: float, damping: float) 
 
 
 @pytest.mark.parametrize("damping", [0.0, 0.05])
+@pytest.mark.slow
 def test_spectrum_peaks_within_0p1_percent_of_a_fine_grid(damping):
     """Periods of 1.5-60 samples, where taking the peak at samples alone is up to 2 % low."""
     rng = np.random.default_rng(3)

@@ -312,6 +312,7 @@ def test_scenes_it_cannot_treat_are_refused_with_the_reason(change, field, words
         solver.run(scene)
 
 
+@pytest.mark.slow
 def test_cli_runs_the_bi_block_and_refuses_a_single_block_with_exit_2(tmp_path):
     """``rockyade run SCENE --solver twoblock`` as a user types it; a single block: exit 2, one line."""
     ok = subprocess.run(
@@ -386,6 +387,7 @@ def test_pattern_map_figure_has_a_panel_per_solver(tmp_path):
     assert "exact two-block solver: pattern 2 2 of 2 cells" in report.sections[-1][1][-1]
 
 
+@pytest.mark.slow
 def test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling():
     """``benchmarks/bench_twoblock.py --quick`` runs both solvers on the record and prints the
     sampling check: the same impact times at 0.01 s and 0.001 s (no speed is asserted)."""

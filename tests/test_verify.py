@@ -50,6 +50,7 @@ def test_cli_knows_every_check():
     assert CLI_CHECKS == CHECKS == tuple(CHECK_FUNCTIONS)
 
 
+@pytest.mark.slow
 def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path):
     """``--only loaded_block,loaded_pushover``: the limit analysis and Housner's uplift give
     (W b + N d) / (W h_c) within 1e-6, the reference DEM's pushover onset lies within 2 % of it."""
@@ -79,6 +80,7 @@ def test_loaded_mass_check_gives_the_closed_form_with_the_loads_mass(tmp_path):
     assert table["value"].to_numpy()[2] == pytest.approx(25810.0**2 / (17810.0 * 41810.0), rel=1e-6)
 
 
+@pytest.mark.slow
 def test_the_checks_an_engineer_signs_pass(tmp_path):
     """``--only loaded_classical,code_friction,crushing`` (issue 33): the loaded wall's alpha 0.0841 rad
     towards +x and 0.1239 towards -x, each mu and uplift multiplier by hand; the frictionless corner's
@@ -93,6 +95,7 @@ def test_the_checks_an_engineer_signs_pass(tmp_path):
     assert friction["35 deg corner: the code's lambda = the lower"] == pytest.approx(1.6205, abs=5e-5)
 
 
+@pytest.mark.slow
 def test_limit_pushover_check_passes_against_the_closed_forms(tmp_path):
     """``limit_pushover``: the limit analysis gives b/h = 0.2 for the block, 17/35 for the restrained
     wall's three hinges, tan(30 deg) for the sliding panel and 0.1494 for the arch, and the
