@@ -10,6 +10,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -221,3 +222,23 @@ def test_the_benchmark_runs_in_its_quick_mode():
     rows = [line.split() for line in proc.stdout.splitlines() if line.split()[:1] == ["99"]]
     assert [(r[2], r[3]) for r in rows] == [(s, m) for s in ("True", "False") for m in ("highs", "highs-hipo")]
     assert {r[9] for r in rows if r[2] == "True"} == {"0.57735"}  # tan(30 deg): the courses slide
+
+
+def test_the_kill_of_the_highs_process_does_not_wait_on_popens_lock():
+    """A Ctrl-C raised just after ``Popen.wait``/``poll`` took their lock leaves it held (seen once,
+    a limit analysis hanging for ever after Ctrl-C under load): the parent's kill then reaps the
+    child without that lock."""
+    from rockyade.limit import highs_child
+
+    proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    assert proc._waitpid_lock.acquire(blocking=False)  # as the interrupted wait left it
+    stopper = threading.Thread(target=highs_child._stop, args=(proc,), daemon=True)
+    stopper.start()
+    stopper.join(timeout=60)  # a guard against the hang, not a measure of speed
+    alive = stopper.is_alive()
+    proc._waitpid_lock.release()
+    if alive:
+        proc.kill()
+        proc.wait()
+    assert not alive, "the kill waited on Popen's lock"
+    assert proc.returncode == -signal.SIGKILL

@@ -49,7 +49,7 @@ PROGRESS_EVERY_S = 10.0
 #: Seconds past the time limit after which the parent kills a child that has not stopped by itself.
 KILL_MARGIN_S = 30.0
 #: Seconds between the parent's looks at the child.
-POLL_S = 0.2
+POLL_S = 0.05
 
 _NUMBER = r"[-+]?\d+\.?\d*(?:e[-+]?\d+)?"
 #: HiPO's iteration row: iteration, primal and dual objectives, infeasibilities, relative gap, time.
@@ -101,12 +101,28 @@ def _write_outcome(path: Path, outcome: ProgrammeOutcome) -> None:
     os.replace(part, path)  # whole or absent: the parent never reads half an answer
 
 
+def _ended(proc: subprocess.Popen) -> bool:
+    """Whether the child has ended, left unreaped (``waitid`` with ``WNOWAIT``). A look that takes
+    none of ``Popen``'s locks: ``Popen.wait``/``poll`` hold one briefly, and a Ctrl-C raised right
+    after they take it leaves it held, so that the kill's ``wait`` then hangs for ever (seen once
+    in the suite under load)."""
+    return os.waitid(os.P_PID, proc.pid, os.WEXITED | os.WNOHANG | os.WNOWAIT) is not None
+
+
+def _reap(proc: subprocess.Popen) -> None:
+    """Wait for the child (ended or killed) and keep its exit code, without ``Popen``'s lock."""
+    if proc.returncode is None:
+        _, status = os.waitpid(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+
+
 def _stop(proc: subprocess.Popen) -> None:
     """Kill the child and wait until it is gone."""
-    if proc.poll() is None:
+    if proc.returncode is None:
         with contextlib.suppress(ProcessLookupError):
-            proc.kill()
-    proc.wait()
+            os.kill(proc.pid, signal.SIGKILL)  # unreaped until _reap: the pid is still the child's
+    with contextlib.suppress(ChildProcessError):  # reaped already, by a _reap that a Ctrl-C cut short
+        _reap(proc)
 
 
 def solve_in_child(
@@ -146,10 +162,8 @@ def solve_in_child(
         next_progress = start + progress_every_s
         deadline = math.inf if time_limit_s is None else start + time_limit_s + KILL_MARGIN_S
         try:
-            while True:
-                with contextlib.suppress(subprocess.TimeoutExpired):
-                    proc.wait(timeout=POLL_S)
-                    break
+            while not _ended(proc):
+                time.sleep(POLL_S)
                 now = time.perf_counter()
                 if now > deadline:
                     _stop(proc)
@@ -157,6 +171,7 @@ def solve_in_child(
                 if on_progress is not None and now >= next_progress:
                     next_progress = now + progress_every_s
                     on_progress(now - start, last_iteration(folder / "highs.log"))
+            _reap(proc)
         except BaseException:
             _stop(proc)  # Ctrl-C, or anything else: the child goes first
             raise
