@@ -31,6 +31,7 @@ Run: ``python benchmarks/bench_siconos.py [wall] [arch] [biblock] [block] [costs
 
 from __future__ import annotations
 
+import argparse
 import math
 import os
 import statistics
@@ -373,14 +374,28 @@ PARTS = ("wall", "arch", "biblock", "block", "costs", "convergence")
 
 
 def main(argv: list[str]) -> None:
-    parts = [a for a in argv if not a.startswith("--")] or ["wall", "arch", "biblock", "convergence"]
-    unknown = sorted(set(parts) - set(PARTS))
+    parser = argparse.ArgumentParser(
+        description="Siconos beside warm YADE on the wall, the arches and the bi-block; the step's and the "
+        "tolerance's convergence; a single block; the cost estimates (docs/siconos.md)."
+    )
+    parser.add_argument(
+        "parts",
+        nargs="*",
+        metavar="PART",
+        help=f"what to run, of {', '.join(PARTS)} (default: wall arch biblock convergence)",
+    )
+    parser.add_argument("--quick", action="store_true", help="small scenes and short runs (the test's mode)")
+    parser.add_argument("--record", action="store_true", help="the wall under a 25 s record as well")
+    parser.add_argument("--repeat", type=int, default=None, help="repetitions of the single block (1 quick, 3 full)")
+    args = parser.parse_args(argv)
+    unknown = sorted(set(args.parts) - set(PARTS))
     if unknown:
-        raise SystemExit(f"unknown part(s) {', '.join(unknown)}: choose from {', '.join(PARTS)}")
-    size = QUICK if "--quick" in argv else FULL
-    repeat = next((int(a.split("=", 1)[1]) for a in argv if a.startswith("--repeat=")), 1 if size is QUICK else 3)
+        parser.error(f"unknown part(s) {', '.join(unknown)}: choose from {', '.join(PARTS)}")
+    parts = args.parts or ["wall", "arch", "biblock", "convergence"]
+    size = QUICK if args.quick else FULL
+    repeat = args.repeat if args.repeat is not None else (1 if size is QUICK else 3)
     if "wall" in parts:
-        wall_costs(size, "--record" in argv)
+        wall_costs(size, args.record)
     if "arch" in parts:
         arch_costs(size)
     if "biblock" in parts:
