@@ -30,6 +30,8 @@ from rockyade.limit.rigid_blocks import MAX_FRICTION_ANGLE_DEG, rigid_block_mode
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.scene.generators import wall
 
+from .processes import sigint_default
+
 WALL = Path(__file__).resolve().parents[1] / "examples" / "assemblies" / "wall_5_courses.toml"
 
 
@@ -188,7 +190,15 @@ def test_ctrl_c_ends_a_long_limit_analysis_and_its_highs_process(tmp_path):
     assert main([*build, "--out", str(tmp_path / "wall.toml")]) == 0
     cmd = [sys.executable, "-m", "rockyade.cli", "limit", "wall.toml", "--friction-rule", "coulomb"]
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=env, text=True)
+    proc = subprocess.Popen(  # SIGINT's default action in it, whatever this run inherited (processes.py)
+        cmd,
+        cwd=tmp_path,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env=env,
+        text=True,
+        preexec_fn=sigint_default,
+    )
     child = None
     guard = time.monotonic() + 600.0  # against a hang (no child ever), not a measure of speed
     try:
@@ -225,9 +235,9 @@ def test_the_benchmark_runs_in_its_quick_mode():
 
 
 def test_the_kill_of_the_highs_process_does_not_wait_on_popens_lock():
-    """A Ctrl-C raised just after ``Popen.wait``/``poll`` took their lock leaves it held (seen once,
-    a limit analysis hanging for ever after Ctrl-C under load): the parent's kill then reaps the
-    child without that lock."""
+    """A Ctrl-C raised just after ``Popen.wait``/``poll`` took their lock leaves it held, and a kill
+    that then waits through ``Popen`` hangs for ever: the parent reaps the HiGHS child without
+    that lock."""
     from rockyade.limit import highs_child
 
     proc = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
