@@ -7,10 +7,11 @@ factors, local processes only; a test runs it so that it cannot rot)."""
 
 from __future__ import annotations
 
-import sys
 import tempfile
 import time
 from pathlib import Path
+
+from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.paper import SINGLE_SPECIMENS
 from rockyade.studies import fragility_study
@@ -19,7 +20,7 @@ LOAD_FACTORS = tuple(round(0.1 * k, 1) for k in range(1, 11))
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv[1:]
+    quick = quick_mode(__doc__)
     grid = (
         {"specimens": ("1",), "records": range(1, 4), "load_factors": (0.3, 0.6)}
         if quick

@@ -6,10 +6,10 @@ runs it so that it cannot rot)."""
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
+from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.housner import HousnerModel, solve
 from rockyade.motion.ground import GroundMotion
@@ -25,7 +25,7 @@ def best_of(fn, repeat: int = 5) -> float:
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv[1:]
+    quick = quick_mode(__doc__)
     duration, repeat = (2.0, 1) if quick else (20.0, 5)
     model = HousnerModel.symmetric(0.235, 3.84, 0.936)
     free = best_of(lambda: solve(model, None, duration, 0.1175), repeat)

@@ -13,10 +13,10 @@ Run: ``python benchmarks/bench_reference.py [--quick]`` (``--quick``: 2 s of fre
 from __future__ import annotations
 
 import math
-import sys
 import time
 
 import numpy as np
+from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.runner import Executor, solve_scenes
@@ -92,7 +92,7 @@ def batch(n: int = 1000) -> dict[str, float]:
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv[1:]
+    quick = quick_mode(__doc__)
     duration = 2.0 if quick else 20.0
     s = single_block(duration, 1 if quick else 3)
     print(

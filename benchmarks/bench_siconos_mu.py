@@ -25,11 +25,11 @@ from __future__ import annotations
 import math
 import shutil
 import subprocess
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
+from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.blocks.restitution import find_peaks, restitution_per_impact
 from rockyade.errors import InputError
@@ -168,7 +168,7 @@ def lzb(quick: bool) -> None:
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv[1:]
+    quick = quick_mode(__doc__)
     targets()
     moreau_jean(quick)
     lzb(quick)

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import sys
 import tempfile
 import time
+
+from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.motion.suite_cache import generate_suite
 from rockyade.motion.synthetic import compatibility_report, paper_suite
@@ -18,7 +19,7 @@ from rockyade.motion.synthetic import compatibility_report, paper_suite
 def main() -> None:
     os.environ["ROCKYADE_CACHE"] = tempfile.mkdtemp(prefix="rockyade-bench-")
     spec = paper_suite()
-    if "--quick" in sys.argv[1:]:
+    if quick_mode(__doc__):
         spec = dataclasses.replace(spec, count=3)
     start = time.perf_counter()
     records = generate_suite(spec)

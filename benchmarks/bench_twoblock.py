@@ -21,11 +21,11 @@ from __future__ import annotations
 
 import math
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
+from quick_option import quick_parser  # type: ignore[import-not-found]
 
 from rockyade.constants import G
 from rockyade.scene import scene_from_dict
@@ -114,8 +114,10 @@ def _peak_change(a, b) -> float:
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv[1:]
-    repeat = next((int(a.split("=", 1)[1]) for a in sys.argv[1:] if a.startswith("--repeat=")), 3)
+    parser = quick_parser(__doc__)
+    parser.add_argument("--repeat", type=int, default=3, help="repetitions of each timing (best of)")
+    args = parser.parse_args()
+    quick, repeat = args.quick, args.repeat
     levels = [0.3] if quick else [0.2, 0.3, 0.45]
     duration = 5.0 if quick else 25.0
     speed(levels, duration, 1 if quick else repeat)

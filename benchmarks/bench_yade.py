@@ -27,6 +27,8 @@ import sys
 import time
 from pathlib import Path
 
+from quick_option import quick_parser  # type: ignore[import-not-found]
+
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.errors import InputError
 from rockyade.io import warm_program
@@ -269,9 +271,13 @@ def main(quick: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["warm"]:
-        print_warm_vs_cold(*(int(a) for a in sys.argv[2:3]))
-    elif "--quick" in sys.argv[1:]:
+    parser = quick_parser(__doc__)
+    parser.add_argument("mode", nargs="?", choices=["warm"], help="warm: a warm worker against cold processes")
+    parser.add_argument("runs", nargs="?", type=int, help="with warm: how many runs")
+    args = parser.parse_args()
+    if args.mode == "warm":
+        print_warm_vs_cold(*([args.runs] if args.runs is not None else []))
+    elif args.quick:
         main(quick=True)
         print_warm_vs_cold(2, 1.0)
     else:

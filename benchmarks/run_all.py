@@ -13,4 +13,5 @@ if __name__ == "__main__":
         if selected and path.stem not in selected:
             continue
         print(f"=== {path.stem}")
+        sys.argv = [str(path)]  # each script its own options (none: its full run), not this selection
         runpy.run_path(str(path), run_name="__main__")

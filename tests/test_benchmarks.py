@@ -68,8 +68,8 @@ RUN_ELSEWHERE = {
         "tests/test_twoblock.py::test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling"
     ),
 }
-#: Not benchmarks: a module the others import, and the runner of them all.
-HELPERS = {"floor.py", "run_all.py"}
+#: Not benchmarks: modules the others import, and the runner of them all.
+HELPERS = {"floor.py", "quick_option.py", "run_all.py"}
 
 
 def test_every_benchmark_script_is_run_by_a_test():
@@ -108,3 +108,22 @@ def test_benchmark_runs_in_its_quick_mode(script, tmp_path):
     for pattern in patterns:
         assert re.search(pattern, proc.stdout, re.M), f"{script}: no line matches {pattern!r}\n{proc.stdout[-3000:]}"
     assert "Traceback" not in proc.stderr, proc.stderr[-3000:]
+
+
+#: An option read from ``sys.argv`` by hand: a flag looked up in it, a slice compared, a loop over it.
+BY_HAND = r"\"-[\w-]+\" in sys\.argv|sys\.argv\[\d+:\d+\]|for \w+ in sys\.argv"
+
+
+def test_every_benchmark_takes_its_options_through_argparse():
+    """No script reads ``sys.argv`` by hand (``--help`` then ran the whole benchmark, minutes,
+    and an unknown option was ignored): each parses its options (``quick_option.py`` or its own
+    ``argparse``), so ``--help`` prints the usage and an unknown option exits 2."""
+    by_hand = [
+        p.name for p in sorted(BENCHMARKS.glob("*.py")) if p.name != "run_all.py" and re.search(BY_HAND, p.read_text())
+    ]
+    assert by_hand == []
+    script = str(BENCHMARKS / "bench_housner.py")
+    shown = subprocess.run([sys.executable, script, "--help"], capture_output=True, text=True, timeout=300)
+    assert shown.returncode == 0 and shown.stdout.startswith("usage:") and "--quick" in shown.stdout
+    refused = subprocess.run([sys.executable, script, "--qiuck"], capture_output=True, text=True, timeout=300)
+    assert refused.returncode == 2 and "unrecognized arguments: --qiuck" in refused.stderr
