@@ -9,16 +9,24 @@ OUT ?= reports/paper
 
 .PHONY: setup system compiled test lint check run bench bench-all clean
 
+# Python keeps its bytecode (__pycache__) even where the environment says otherwise: the suite
+# starts hundreds of Pythons, and each would otherwise compile rockyade's modules again, and
+# pytest rewrite every test module's asserts again in each worker.
+unexport PYTHONDONTWRITEBYTECODE
+
 setup: system $(STAMP) compiled
 
 system:
 	@tools/install-system-deps.sh
 
-# pip -qq: errors only (setuptools' editable install otherwise prints its notice in a box of asterisks)
+# pip -qq: errors only (setuptools' editable install otherwise prints its notice in a box of asterisks);
+# --no-compile, then compileall on every core: the same bytecode as pip's own, which writes it one
+# file at a time
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -qq --root-user-action=ignore --upgrade pip
-	$(BIN)/python -m pip install -qq --root-user-action=ignore -e '.[dev]'
+	$(BIN)/python -m pip install -qq --root-user-action=ignore --no-compile -e '.[dev]'
+	$(BIN)/python -m compileall -q -j 0 $(VENV)/lib > /dev/null || true
 	@touch $(STAMP)
 
 # the solvers' numba code compiled into numba's cache once, here, so that no run and no test
@@ -26,7 +34,8 @@ $(STAMP): pyproject.toml
 compiled: $(STAMP)
 	@$(BIN)/python -m rockyade.solvers.compile_cache --quiet --workers $(WORKERS)
 
-lint: setup
+# lint needs the tools, not the compiled solvers: `make test` runs it beside the compilation
+lint: system $(STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/lint-imports
@@ -36,7 +45,9 @@ lint: setup
 check: setup lint
 	$(BIN)/python -m pytest -n $(WORKERS) -q -m "not slow and not yade and not siconos"
 
-test: setup lint
+# the compilation (one process per core) and lint side by side, then the suite
+test: system $(STAMP)
+	@$(MAKE) --no-print-directory -j $(WORKERS) --output-sync=target compiled lint
 	ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 ROCKYADE_REQUIRE_CHROMIUM=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
 
 run: setup

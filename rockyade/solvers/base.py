@@ -358,6 +358,12 @@ class SolverBase:
         that compiles nothing here."""
         return None
 
+    def warm_up_paths(self) -> dict[str, tuple[Callable[[], None], float]]:
+        """The parts of :meth:`warm_up` that compile independently, each with its CPU s on a cold
+        cache (together :attr:`COMPILE_S`): :mod:`rockyade.solvers.compile_cache` spreads them
+        over its processes. One part, :meth:`warm_up` itself, unless a solver splits it."""
+        return {"all": (self.warm_up, self.COMPILE_S)}
+
     def check_scene(self, scene: Scene) -> None:
         """Refuse, before anything runs, a scene that :meth:`run` would refuse with an
         InputError whatever its motion (e.g. a target the solver cannot reach); nothing here:

@@ -63,21 +63,26 @@ def _warm_spectra() -> None:
     response_spectrum(np.array([0.0, 1.0, 0.0, -1.0, 0.0]), 0.025, np.array([0.1, 0.5]))
 
 
-#: (name, cached?, warm up, CPU s compiling it) of a part with numba code.
-Part = tuple[str, Callable[[], bool], Callable[[], None], float]
+#: How one part of a solver's compiled code is loaded (compiled), and its CPU s on a cold cache.
+WarmPath = tuple[Callable[[], None], float]
+
+#: (name, cached?, its paths by name) of a part with numba code: a solver, or the spectra.
+Part = tuple[str, Callable[[], bool], dict[str, WarmPath]]
 
 
 def parts() -> list[Part]:
     """Every part with numba code: the in-process solvers (the registry's,
-    :func:`rockyade.solvers.solver_names`) and the response spectra (measured: 1 s)."""
+    :func:`rockyade.solvers.solver_names`), each with the paths it compiles independently
+    (:meth:`rockyade.solvers.base.SolverBase.warm_up_paths`), and the response spectra
+    (measured: 1 s)."""
     found: list[Part] = []
     for name in solver_names():
         cls = solver_class(name)
         if not cls.IN_PROCESS:
             continue
         solver = cls()
-        found.append((name, _solver_cached(solver), solver.warm_up, cls.COMPILE_S))
-    found.append(("spectra", _spectra_cached, _warm_spectra, 1.0))
+        found.append((name, _solver_cached(solver), solver.warm_up_paths()))
+    found.append(("spectra", _spectra_cached, {"all": (_warm_spectra, 1.0)}))
     return found
 
 
@@ -108,12 +113,21 @@ def _scene(n_blocks: int) -> dict[str, object]:
     }
 
 
-def _compile_part(name: str) -> float:
-    """Load (compile) the part ``name`` in this process, a worker of :func:`compile_all`; its CPU s."""
+def _compile_path(name: str, path: str) -> float:
+    """Load (compile) the path ``path`` of the part ``name`` in this process, a worker of
+    :func:`compile_all`; its CPU s."""
     start = time.process_time()
-    for part, _, warm, _ in parts():
+    for part, _, paths in parts():
         if part == name:
-            warm()
+            paths[path][0]()
+    return time.process_time() - start
+
+
+def _warm_all(paths: dict[str, WarmPath]) -> float:
+    """Load (compile) every path in this process; the CPU s."""
+    start = time.process_time()
+    for warm, _ in paths.values():
+        warm()
     return time.process_time() - start
 
 
@@ -125,33 +139,36 @@ def compile_all(say: Callable[[str], None] = print, missing_only: bool = False, 
     missing_only
         Leave alone (unloaded) what the cache holds.
     workers
-        Processes compiling side by side, longest first, when several parts are missing (each
-        a fresh interpreter that writes numba's cache; this process then has not loaded them):
-        on 2 cores, about the reference DEM's time instead of the sum.
+        Processes compiling side by side, longest path first, when several paths are missing
+        (each a fresh interpreter that writes numba's cache; this process then has not loaded
+        them): on 2 cores, about the reference DEM's general loop instead of the sum.
     """
     todo = []
-    for name, cached, warm, compile_s in parts():
+    for name, cached, paths in parts():
         was_cached = cached()
         if was_cached and missing_only:
             continue
         if not was_cached:
-            say(f"compiling {name} (numba, once: about {compile_s:.0f} s of CPU) ...")
-        todo.append((name, was_cached, warm, compile_s))
-    cold = sorted((p for p in todo if not p[1]), key=lambda p: -p[3])
+            cost = sum(s for _, s in paths.values())
+            say(f"compiling {name} (numba, once: about {cost:.0f} s of CPU) ...")
+        todo.append((name, was_cached, paths))
+    cold = sorted(
+        ((name, path, s) for name, was_cached, paths in todo if not was_cached for path, (_, s) in paths.items()),
+        key=lambda task: -task[2],
+    )
     seconds: dict[str, float] = {}
     if workers > 1 and len(cold) > 1:
         from rockyade.solvers import compile_cache  # this module by its name, whatever ran it
 
         spawn = multiprocessing.get_context("spawn")  # no fork of a process that holds numba's threads
         with ProcessPoolExecutor(max_workers=min(workers, len(cold)), mp_context=spawn) as pool:
-            futures = {p[0]: pool.submit(compile_cache._compile_part, p[0]) for p in cold}
-            seconds = {name: future.result() for name, future in futures.items()}
+            futures = [(name, pool.submit(compile_cache._compile_path, name, path)) for name, path, _ in cold]
+            for name, future in futures:
+                seconds[name] = seconds.get(name, 0.0) + future.result()
     done = []
-    for name, was_cached, warm, _ in todo:
+    for name, was_cached, paths in todo:
         if name not in seconds:
-            start = time.process_time()
-            warm()
-            seconds[name] = time.process_time() - start
+            seconds[name] = _warm_all(paths)
         done.append(Compiled(name, was_cached, seconds[name]))
         say(f"{name}: {'in the cache, loaded' if was_cached else 'compiled'} in {seconds[name]:.1f} s of CPU")
     return done
