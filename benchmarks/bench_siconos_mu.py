@@ -15,6 +15,8 @@ Three parts, each printing a table:
    C++ headers (Siconos 4.4's Python has the law but not its one-step problem), on the same
    geometry: the law's energetic restitution e, the corners' stiffness ratio and the
    elasticity exponent eta. Skipped, saying why, without g++ or ``libsiconos-kernel-dev``.
+   The executable is compiled once and kept in ``$ROCKYADE_CACHE/siconos_lzb/`` (default
+   ``~/.cache/rockyade``), under a key of its source, the compiler and Siconos's files.
 
 Run: ``python benchmarks/bench_siconos_mu.py [--quick]`` (about 3 min; ``--quick`` runs
 fewer cases, the LZB ones with a coarser impulse step). Needs python3-siconos (parts 2-3).
@@ -22,8 +24,11 @@ fewer cases, the LZB ones with a coarser impulse step). Needs python3-siconos (p
 
 from __future__ import annotations
 
+import hashlib
 import math
+import os
 import shutil
+import stat
 import subprocess
 import tempfile
 from pathlib import Path
@@ -33,6 +38,7 @@ from quick_option import quick_mode  # type: ignore[import-not-found]
 
 from rockyade.blocks.restitution import find_peaks, restitution_per_impact
 from rockyade.errors import InputError
+from rockyade.motion.suite_cache import cache_dir
 from rockyade.scene import load_scene, scene_from_dict
 from rockyade.siconos.calibration import check_target_mu, model_restitution
 from rockyade.solvers import make_solver
@@ -104,14 +110,9 @@ def moreau_jean(quick: bool) -> None:
             print(_row(f"friction {friction:g} deg, e = {e:g}{status}", per))
 
 
-def _compile_lzb(workdir: Path) -> Path | str:
-    if shutil.which("g++") is None:
-        return "no g++"
-    if not (SICONOS_INCLUDE / "kernel" / "MultipleImpact.hpp").exists():
-        return "no Siconos C++ headers (apt-get install libsiconos-kernel-dev)"
-    exe = workdir / "lzb_rocking"
+def _compile_command(exe: Path) -> list[str]:
     flags = [f"-I{SICONOS_INCLUDE / d}" for d in ("kernel", "numerics", "")]
-    cmd = [
+    return [
         "g++",
         "-O1",
         "-std=c++17",
@@ -122,8 +123,53 @@ def _compile_lzb(workdir: Path) -> Path | str:
         "-lsiconos_kernel",
         "-lsiconos_numerics",
     ]
-    done = subprocess.run(cmd, capture_output=True, text=True, check=False)
-    return exe if done.returncode == 0 else f"compilation failed: {done.stderr.strip().splitlines()[-1:]}"
+
+
+def _lzb_key() -> str:
+    """What the probe's executable depends on: its source, the compiler (``g++ --version``), the
+    compile command and Siconos's headers and libraries (their sizes and modification times)."""
+    digest = hashlib.sha256(LZB_SOURCE.read_bytes())
+    version = subprocess.run(["g++", "--version"], capture_output=True, text=True, check=False).stdout
+    digest.update(version.encode())
+    command = _compile_command(Path("lzb_rocking"))
+    digest.update(" ".join(c for c in command if c not in ("lzb_rocking", str(LZB_SOURCE))).encode())
+    libraries = sorted(Path("/usr/lib").glob("*/libsiconos_*.so*")) + sorted(Path("/usr/lib").glob("libsiconos_*.so*"))
+    for path in (SICONOS_INCLUDE / "SiconosConfig.h", SICONOS_INCLUDE / "kernel" / "MultipleImpact.hpp", *libraries):
+        info = path.stat()
+        digest.update(f"{path} {info.st_size} {info.st_mtime_ns}".encode())
+    return digest.hexdigest()[:20]
+
+
+def _compile_lzb(workdir: Path) -> Path | str:
+    """The LZB probe's executable: compiled once (some 15 s of CPU, nearly all of it in Siconos's
+    headers) into ``$ROCKYADE_CACHE/siconos_lzb/<key>/`` (:func:`_lzb_key`) and taken from there
+    while nothing it depends on changed; compiled into ``workdir`` when the cache is not writable."""
+    if shutil.which("g++") is None:
+        return "no g++"
+    if not (SICONOS_INCLUDE / "kernel" / "MultipleImpact.hpp").exists():
+        return "no Siconos C++ headers (apt-get install libsiconos-kernel-dev)"
+    folder = cache_dir() / "siconos_lzb" / _lzb_key()
+    cached = folder / "lzb_rocking"
+    try:
+        info = cached.lstat()
+        if stat.S_ISREG(info.st_mode) and info.st_mode & stat.S_IXUSR:  # a file, never a link
+            return cached
+    except FileNotFoundError:
+        pass
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        build = Path(tempfile.mkdtemp(dir=folder, prefix=".build-"))
+    except OSError:  # a cache that cannot be written: compiled for this run only
+        build, cached = workdir, workdir / "lzb_rocking"
+    try:
+        done = subprocess.run(_compile_command(build / "lzb_rocking"), capture_output=True, text=True, check=False)
+        if done.returncode != 0:
+            return f"compilation failed: {done.stderr.strip().splitlines()[-1:]}"
+        os.replace(build / "lzb_rocking", cached)  # complete or absent: runs at once each rename a whole file
+        return cached
+    finally:
+        if build.parent == folder:
+            shutil.rmtree(build, ignore_errors=True)
 
 
 def _lzb(exe: Path, e: float, k_ratio: float, eta: float, dp: float = 1e-4) -> tuple[float, np.ndarray, int]:
