@@ -57,31 +57,52 @@ def _matched(example: str):
     return scene_from_dict(d)
 
 
-def _probe(name: str) -> dict:
+#: The probes of YADE's pitfalls (tests/yade_probes/), each printing its JSON line last.
+PROBE_FILES = ("inertia_pitfall.py", "default_damping.py")
+
+#: Runs each probe given, in turn, in one Python (each resets YADE's scene before each of its
+#: cases). YADE is imported here first: its import needs the main module's namespace.
+RUN_PROBES = (
+    "import runpy, sys\nsys.path.insert(1, sys.argv[1])\nimport yade\n"
+    "for path in sys.argv[2:]:\n    runpy.run_path(path, run_name='__main__')\n"
+)
+
+
+@pytest.fixture(scope="module")
+def probes() -> dict[str, dict]:
+    """Every probe's JSON, by file name: one start of YADE's Python for all (about 2 s each)."""
     out = subprocess.run(
-        [yade_backend.YADE_PYTHON, str(PROBES / name)],
+        [
+            yade_backend.YADE_PYTHON,
+            "-c",
+            RUN_PROBES,
+            str(yade_backend.YADE_PY_DIR),
+            *(str(PROBES / name) for name in PROBE_FILES),
+        ],
         capture_output=True,
         text=True,
         timeout=120,
         env={**os.environ, "OMP_NUM_THREADS": "1"},
     )
     assert out.returncode == 0, out.stderr
-    return json.loads(out.stdout.strip().splitlines()[-1])
+    lines = [json.loads(line) for line in out.stdout.splitlines() if line.startswith("{")]
+    assert len(lines) == len(PROBE_FILES), out.stdout
+    return dict(zip(PROBE_FILES, lines, strict=True))
 
 
 # ------------------------------------------------------------------ the pitfalls
 
 
-def test_pitfall_inertia_under_blocked_rotations():
+def test_pitfall_inertia_under_blocked_rotations(probes):
     """With blocked rotations YADE divides the torque by the clump's principal inertia: the
     default gives the wrong angular acceleration, the isotropic inertia the right one."""
-    probe = _probe("inertia_pitfall.py")
+    probe = probes["inertia_pitfall.py"]
     assert probe["isotropic"] == pytest.approx(probe["expected"], rel=1e-9)
     assert abs(probe["principal"] / probe["expected"] - 1) > 0.01
 
 
-def test_pitfall_default_damping():
-    probe = _probe("default_damping.py")
+def test_pitfall_default_damping(probes):
+    probe = probes["default_damping.py"]
     assert probe["default_damping"] == pytest.approx(0.2)
     assert probe["default"] == pytest.approx(0.8 * probe["expected"], rel=1e-6)
     assert probe["zero"] == pytest.approx(probe["expected"], rel=1e-9)

@@ -73,8 +73,8 @@ def test_a_warm_worker_gives_the_results_of_one_process_per_run_bit_for_bit():
 
 def test_a_scene_that_raises_or_crashes_costs_only_that_scene(tmp_path, monkeypatch):
     good = _scene("specimen3_free.toml", 0.5)
-    reference = YadeSolver(warm=False).run(good)
-    assert YadeSolver().run(good).ok
+    reference = YadeSolver().run(good)  # a warm worker's result is one process's, bit for bit (above)
+    assert reference.ok
     real = yade_backend.scene_payload
 
     def broken(model):
@@ -126,7 +126,7 @@ def test_each_scene_has_its_own_timeout_and_a_timed_out_run_keeps_its_samples(tm
     assert slow.meta.partial is True and 0 < n == len(slow.frame) < calibrated_model(long).n_samples
     assert slow.meta.overturn_time_s is None
     assert not list(tmp_path.glob("*.part"))
-    complete = YadeSolver(warm=False).run(_scene("specimen1_free.toml", 1.0, sample_dt_s=0.01))
+    complete = YadeSolver().run(_scene("specimen1_free.toml", 1.0, sample_dt_s=0.01))  # in the same worker
     m = min(n, len(complete.frame))
     for column in ("theta_rad", "omega_rad_s", "x_m", "y_m"):
         assert np.array_equal(slow.frame[column].to_numpy()[:m], complete.frame[column].to_numpy()[:m]), column
