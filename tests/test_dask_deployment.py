@@ -17,6 +17,7 @@ import pandas as pd
 import pytest
 
 from rockyade.batch import comparable
+from rockyade.cli import main
 from rockyade.result import Result
 
 from .conftest import EXAMPLES
@@ -124,11 +125,12 @@ def _batch(folder: Path, out: str, *extra: str) -> subprocess.Popen[str]:
 
 
 @pytest.mark.slow
-def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(tmp_path, cluster):
+def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(
+    tmp_path, cluster, monkeypatch, capsys
+):
     _study(tmp_path, duration_s=8.0, runs=6)
-    local = _batch(tmp_path, "local", "--workers", "2")
-    _stdout, stderr = local.communicate(timeout=300)
-    assert local.returncode == 0, stderr
+    monkeypatch.chdir(tmp_path)  # the local batch, the reference, runs in this process: only its summary is used
+    assert main(["batch", "study.toml", "--out", "local", "--quiet", "--workers", "2"]) == 0, capsys.readouterr().err
     remote = _batch(tmp_path, "remote", "--executor", "dask", "--scheduler", cluster.address)  # relative --out
     seen: dict = {}
     while remote.poll() is None:
@@ -146,10 +148,11 @@ def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_list
 
 @pytest.mark.slow
 def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster):
-    # runs of a few seconds each; 4: when two have ended, each worker is in one of the other two
-    # (or the victim still in its first), so the kill lands in a run that the other worker reruns
+    # runs of about a second of CPU each (200 s simulated; polled every 0.05 s); 4: when two have
+    # ended, each worker is in one of the other two (or the victim still in its first), so the
+    # kill lands in a run that the other worker reruns
     runs = 4
-    _study(tmp_path, duration_s=400.0, runs=runs)
+    _study(tmp_path, duration_s=200.0, runs=runs)
     batch = _batch(tmp_path, "out", "--executor", "dask", "--scheduler", cluster.address)
     out = tmp_path / "out"
     _wait_for(lambda: len(list((out / "runs").glob("*.json"))) >= 2, 300, "two finished runs")
