@@ -79,8 +79,10 @@ def test_dask_executor_equals_local(tmp_path):
     tasks_local = _tasks(tmp_path / "local")
     tasks_dask = _tasks(tmp_path / "dask")
     local = run_study_tasks(tasks_local, tmp_path / "local", workers=2, progress=False)
+    # one worker process: the test is about a scheduler's results equal to local ones, not about
+    # parallelism (a second worker only adds its start-up: a Python importing dask and rockyade)
     with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
     ) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")  # loopback only
         dask = run_study_tasks(

@@ -52,14 +52,13 @@ def test_motion_info_on_a_shipped_record_from_the_repository():
 
 
 @pytest.mark.slow
-def test_a_scene_reads_its_record_relative_to_the_scene_file(tmp_path):
-    proc = subprocess.run(
-        [str(ROCKYADE), "run", str(EXAMPLES / "specimen1_record.toml"), "--solver", "housner", "--out", "r/x.csv"],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-    )
-    assert proc.returncode == 0, proc.stderr
+def test_a_scene_reads_its_record_relative_to_the_scene_file(tmp_path, monkeypatch, capsys):
+    """Run from another folder than the scene's (the command's ``main``, in this process)."""
+    from rockyade.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    code = main(["run", str(EXAMPLES / "specimen1_record.toml"), "--solver", "housner", "--out", "r/x.csv"])
+    assert code == 0, capsys.readouterr().err
     assert json.loads((tmp_path / "r/x.json").read_text())["status"] == "completed"
 
 

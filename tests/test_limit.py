@@ -274,9 +274,11 @@ def test_bad_direction_and_friction_are_refused():
 @pytest.mark.slow
 def test_a_20_voussoir_arch_of_t_over_r_015_on_fixed_piers_collapses_at_0149():
     """Independent value: 0.1494 (a semicircular arch of 20 voussoirs, t/R = 0.15, fixed supports),
-    by a four-hinge mechanism."""
+    by a four-hinge mechanism. (Without the nonlinear capacity curve, 1.7 s of the 1.73 s of each
+    analysis and nothing asserted here: the multiplier, mechanism and forces are the same bits;
+    test_limit_kinematic follows an arch's curve.)"""
     for sliding in (False, True):  # 30 degrees of friction: no joint slides
-        result = limit_analysis(arch_scene(0.15, 20), sliding=sliding)
+        result = limit_analysis(arch_scene(0.15, 20), sliding=sliding, nonlinear=False)
         assert result.load_multiplier == pytest.approx(0.1494, abs=2e-4)
         assert len(result.mechanism.hinges) == 4 and not result.mechanism.slides
         _assert_sound(result)
@@ -300,8 +302,8 @@ def test_the_minimum_thickness_of_a_semicircular_arch_approaches_milankovitchs()
     assert t20 == pytest.approx(0.1073, abs=2e-4)
     assert t60 == pytest.approx(0.1075, abs=2e-4)
     assert t20 < t60
-    assert limit_analysis(arch_scene(0.105, 20), sliding=False).status == "unstable"
-    assert limit_analysis(arch_scene(0.110, 20), sliding=False).status == "collapse"
+    assert limit_analysis(arch_scene(0.105, 20), sliding=False, nonlinear=False).status == "unstable"
+    assert limit_analysis(arch_scene(0.110, 20), sliding=False, nonlinear=False).status == "collapse"
 
 
 # ---------------------------------------------------------------------- walls

@@ -197,10 +197,11 @@ def _wait_for_records(proc: subprocess.Popen[str], partial: Path, n: int) -> Non
 
 @pytest.mark.parametrize("how", ["ctrl-c", "kill-9"])
 @pytest.mark.slow
-def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, how):
+def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, how, monkeypatch, capsys):
     """Ctrl-C (a partial summary marked partial) or kill -9 in the middle of a fragility,
     then ``--resume``: every run finished before the stop is read back, none is run twice,
-    and the result is the whole set (20 runs, each once)."""
+    and the result is the whole set (20 runs, each once). The stop hits a real process; the
+    resume runs in this one (the same ``main``; a second process would only add its start-up)."""
     proc = _start(tmp_path, _fragility(tmp_path))
     partial = tmp_path / "frag" / "partial"
     _wait_for_records(proc, partial, 2)
@@ -218,16 +219,12 @@ def test_fragility_stopped_then_resumed_repeats_no_run(tmp_path, wall, records, 
     assert not (tmp_path / "frag" / "fragility.json").exists()  # nothing that looks complete
     kept = _records_in(partial)
     assert 2 <= len(kept) < 2 * LEVELS
-    done = subprocess.run(
-        _fragility(tmp_path, "--resume"),
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=900,
-        env={**os.environ, "PYTHONPATH": str(ROOT)},
-    )
-    assert done.returncode == 0, done.stderr
-    assert f"resumed: {len(kept)} run(s) read back" in done.stdout  # runs repeated: 0
+    capsys.readouterr()
+    monkeypatch.chdir(tmp_path)
+    code = main(_fragility(tmp_path, "--resume")[3:])  # without `python -m rockyade`
+    done = capsys.readouterr()
+    assert code == 0, done.err
+    assert f"resumed: {len(kept)} run(s) read back" in done.out  # runs repeated: 0
     runs = pd.read_csv(tmp_path / "frag" / "runs.csv")
     assert sorted(runs["run"]) == list(range(2 * LEVELS)) and runs["scene_hash"].is_unique
     assert not partial.exists() and (tmp_path / "frag" / "fragility.json").is_file()
@@ -329,20 +326,23 @@ def _namespace_or_skip() -> None:
 
 
 @pytest.mark.slow
-def test_a_full_disk_leaves_the_previous_set_whole_and_names_the_file(tmp_path, wall, records):
+def test_a_full_disk_leaves_the_previous_set_whole_and_names_the_file(tmp_path, wall, records, monkeypatch):
     """A real full disk (a small tmpfs): a complete fragility set, the disk filled but for
-    room for the new runs' records and tables, a new fragility over it: it fails naming the
-    file it could not write, and the previous set is there byte for byte (it used to leave the
-    new runs.csv, stripes.csv and fragility.json beside the old fragility.png)."""
+    room for the new runs' records and tables, a new fragility over it (a real process): it
+    fails naming the file it could not write, and the previous set is there byte for byte (it
+    used to leave the new runs.csv, stripes.csv and fragility.json beside the old
+    fragility.png). The previous set is written in this process and copied onto the disk."""
     _namespace_or_skip()
     disk = tmp_path / "disk"
     disk.mkdir()
-    shutil.copytree(records, disk / "records")
-    shutil.copy(wall, disk / "wall.toml")
+    monkeypatch.chdir(tmp_path)
+    first = ["fragility", "wall.toml", "--records", "records", "--out", "frag", "--quiet", "--levels", "0.2,0.5,1,2"]
+    assert main(first) == 0
     py = f"PYTHONPATH={ROOT} {sys.executable} -m rockyade fragility wall.toml --records records --out frag --quiet"
     script = (
-        f"mount -t tmpfs -o size=1m tmpfs {disk} && cp -r {tmp_path}/records {tmp_path}/wall.toml {disk}/ && "
-        f"cd {disk} && {py} --levels 0.2,0.5,1,2 >/dev/null && sha256sum frag/*.* && echo FIRST && "
+        f"mount -t tmpfs -o size=1m tmpfs {disk} && "
+        f"cp -r {tmp_path}/records {tmp_path}/wall.toml {tmp_path}/frag {disk}/ && "
+        f"cd {disk} && sha256sum frag/*.* && echo FIRST && "
         "(cat /dev/zero > filler 2>/dev/null; true) && truncate -s -64k filler && "
         f"{py} --levels 0.3,0.6,1.2,2.4; echo EXIT $? && sha256sum frag/*.* && ls -A frag && echo FILES"
     )
@@ -472,9 +472,10 @@ def test_threads_stop_at_a_safe_point_after_the_second_ctrl_c():
 
 
 @pytest.mark.slow
-def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, records):
-    """Ctrl-C in the dynamics of ``assess --out``: the static answer is written (marked
-    partial) with the runs that finished, and ``--resume`` runs only the others."""
+def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, records, monkeypatch, capsys):
+    """Ctrl-C in the dynamics of ``assess --out`` (a real process): the static answer is written
+    (marked partial) with the runs that finished, and ``--resume`` (run in this process) runs
+    only the others."""
     factors = ",".join(f"{0.5 + 0.1 * i:.1f}" for i in range(15))
     argv = [sys.executable, "-m", "rockyade", "assess", "wall.toml", "--knowledge-level", "LC1", "--spectrum-type", "1",
             "--ground", "B", "--ag", "0.25g", "--records", "records", "--load-factors", factors, "--no-extend",
@@ -489,10 +490,12 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
     assert static["partial"] is True and static["alpha0"] > 0 and static["verdict"]
     assert "a/partial/runs.csv" in err and not (tmp_path / "a" / "assess.json").exists()
     kept = _records_in(partial)
-    done = subprocess.run([*argv, "--resume"], cwd=tmp_path, capture_output=True, text=True, timeout=900,
-                          env={**os.environ, "PYTHONPATH": str(ROOT)})  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    assert f"resumed: {len(kept)} run(s) read back" in done.stdout
+    capsys.readouterr()
+    monkeypatch.chdir(tmp_path)
+    code = main([*argv[3:], "--resume"])  # without `python -m rockyade`
+    done = capsys.readouterr()
+    assert code == 0, done.err
+    assert f"resumed: {len(kept)} run(s) read back" in done.out
     assert len(pd.read_csv(tmp_path / "a" / "runs.csv")) == 30 and not partial.exists()
 
 

@@ -9,6 +9,7 @@ import sys
 import pandas as pd
 import pytest
 
+from rockyade.cli import main
 from rockyade.studies.verification import verify
 
 
@@ -17,17 +18,21 @@ def _rockyade(*args, cwd):
 
 
 @pytest.mark.yade
-def test_verify_frame_and_pad_from_another_folder(tmp_path):
+def test_verify_frame_and_pad_from_another_folder(tmp_path, monkeypatch, capsys):
     """Both DEMs: the frame against Makris & Vassiliou's p_hat, the pad case's overlaps;
-    relative output path, exit 0, a CSV of passed rows, a figure per check, index.md."""
-    proc = _rockyade("verify", "--only", "frame,pad", "--out", "report", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    relative output path, exit 0, a CSV of passed rows, a figure per check, index.md. (The
+    command's ``main`` in this process, run from another folder: a process of its own would only
+    add its start-up.)"""
+    monkeypatch.chdir(tmp_path)
+    code = main(["verify", "--only", "frame,pad", "--out", "report"])
+    proc = capsys.readouterr()
+    assert code == 0, proc.out + proc.err
     table = pd.read_csv(tmp_path / "report" / "verify.csv")
     assert set(table["check"]) == {"frame", "pad"} and set(table["solver"]) == {"reference", "yade"}
     assert table["passed"].all()
     for name in ("index.md", "verify_frame.png", "verify_pad.png"):
         assert (tmp_path / "report" / name).stat().st_size > 0
-    assert "0 failed" in proc.stdout
+    assert "0 failed" in proc.out
 
 
 def test_baseline_unchanged_in_the_reference_dem(tmp_path):
@@ -51,11 +56,13 @@ def test_cli_knows_every_check():
 
 
 @pytest.mark.slow
-def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path):
+def test_loaded_block_checks_run_from_the_command_and_pass(tmp_path, monkeypatch, capsys):
     """``--only loaded_block,loaded_pushover``: the limit analysis and Housner's uplift give
-    (W b + N d) / (W h_c) within 1e-6, the reference DEM's pushover onset lies within 2 % of it."""
-    proc = _rockyade("verify", "--only", "loaded_block,loaded_pushover", "--no-yade", "--out", "report", cwd=tmp_path)
-    assert proc.returncode == 0, proc.stdout + proc.stderr
+    (W b + N d) / (W h_c) within 1e-6, the reference DEM's pushover onset lies within 2 % of it
+    (the command's ``main``, in this process)."""
+    monkeypatch.chdir(tmp_path)
+    code = main(["verify", "--only", "loaded_block,loaded_pushover", "--no-yade", "--out", "report"])
+    assert code == 0, capsys.readouterr()
     table = pd.read_csv(tmp_path / "report" / "verify.csv")
     assert list(table["check"]) == ["loaded_block"] * 2 + ["loaded_pushover"] * 2
     assert set(table["solver"]) == {"limit", "housner", "reference"}
