@@ -571,6 +571,7 @@ def test_records_folder_follows_links_to_record_files_and_ignores_hidden_entries
     for path in sorted(records.iterdir()):
         (folder / path.name).symlink_to(path)
     (folder / ".cache").mkdir()
+    (folder / "__pycache__").mkdir()  # Python's, beside an imported script of the folder
     (folder / "README.md").write_text("two records")
     motions = records_in_folder(folder)
     assert motions.count == 2 and [Path(p) for p in motions.files] == sorted(p.resolve() for p in records.iterdir())

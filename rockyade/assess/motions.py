@@ -264,8 +264,10 @@ def record_files(folder: Path, field: str = "--records") -> list[Path]:
     followed and counted as the file it names (a folder of links to a shared set of records
     reads as that set). Nothing else is followed or skipped silently: a subfolder (records are
     not read from it) and any other link (to a folder, to nothing, or without a record
-    suffix) are refused, naming them. Hidden entries (``.name``) and other regular files
-    (a README) are not records and are left alone.
+    suffix) are refused, naming them. Hidden entries (``.name``), Python's bytecode folder
+    (``__pycache__``, written beside a script of the folder that was imported, as
+    ``examples/records/make_example_records.py``) and other regular files (a README) are not
+    records and are left alone.
 
     Raises
     ------
@@ -285,7 +287,7 @@ def record_files(folder: Path, field: str = "--records") -> list[Path]:
                 f"{p} is a symbolic link to {what} ({os.readlink(p)}), not to a record file; the records are read "
                 f"from {folder} itself, links only to record files ({', '.join(RECORD_SUFFIXES)}): remove or fix it",
             )
-        if p.name.startswith("."):
+        if p.name.startswith(".") or (p.name == "__pycache__" and p.is_dir()):
             continue
         if p.is_dir():
             raise InputError(
