@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import matplotlib
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
@@ -504,13 +505,16 @@ def animate(
 def _write_frames(fig, update, n_frames: int, path: str | Path, writer) -> None:
     """Each frame drawn once into ``writer`` (``FuncAnimation.save`` draws each twice), with
     the layout of the first frame kept: the blocks move inside axes whose limits do not change,
-    so the constrained layout is solved once rather than on every frame. The writer opens the
-    file itself and takes its format from its suffix; written atomically."""
+    so the constrained layout is solved once rather than on every frame. After the first frame
+    the figure has no layout engine at all: with any engine, even ``"none"``'s placeholder,
+    each ``savefig`` of the writer draws the figure once more before drawing it into the frame.
+    The writer opens the file itself and takes its format from its suffix; written atomically."""
     engine = fig.get_layout_engine()
     with atomic_path(path) as tmp, writer.saving(fig, str(tmp), dpi=90):
         for k in range(n_frames):
             update(k)
             writer.grab_frame()
             if k == 0:
-                fig.set_layout_engine("none")
+                with matplotlib.rc_context({"figure.autolayout": False, "figure.constrained_layout.use": False}):
+                    fig.set_layout_engine(None)  # None under these settings: no engine
     fig.set_layout_engine(engine)
