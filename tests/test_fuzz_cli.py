@@ -4,9 +4,11 @@ never a traceback or a hang."""
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import io
 import os
+import shutil
 import tempfile
 from pathlib import Path
 
@@ -20,6 +22,7 @@ from .conftest import EXAMPLES
 from .fuzzing import COUNTS, fuzz_settings, outcome, report
 
 FOLDER = Path(tempfile.mkdtemp(prefix="rockyade-fuzz-cli-"))
+atexit.register(shutil.rmtree, FOLDER, True)  # the suite leaves nothing in the temporary folder
 RECORD = FOLDER / "quake.AT2"
 RECORD.write_text(
     "PEER\nquake\nACCELERATION IN UNITS OF G\nNPTS= 10, DT= .0100 SEC\n"

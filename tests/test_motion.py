@@ -373,14 +373,17 @@ def test_damping_correction_floor():
 @pytest.fixture(scope="module")
 def paper_records():
     import os
+    import shutil
     import tempfile
 
     old = os.environ.get("ROCKYADE_CACHE")
-    os.environ["ROCKYADE_CACHE"] = tempfile.mkdtemp(prefix="rockyade-suite-")
+    cache = tempfile.mkdtemp(prefix="rockyade-suite-")
+    os.environ["ROCKYADE_CACHE"] = cache
     try:
         spec = paper_suite()
         return spec, [suite_record(spec, i) for i in range(1, 31)]
     finally:
+        shutil.rmtree(cache, ignore_errors=True)  # the records are in memory: nothing left in the temporary folder
         if old is None:
             del os.environ["ROCKYADE_CACHE"]
         else:
