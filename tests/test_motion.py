@@ -31,6 +31,7 @@ from rockyade.motion.synthetic import (
 from rockyade.scene import scene_from_dict
 
 from .conftest import EXAMPLES, external_records_dir, free_scene_dict, needs_records
+from .oscillator import fine_grid_psa
 
 RECORDS = external_records_dir() or Path()
 needs_peer_records = needs_records(
@@ -300,19 +301,13 @@ def test_spectrum_of_a_sampled_sinusoid_against_steady_state():
 
 @pytest.mark.slow
 def test_short_periods_are_substepped():
-    """T / dt < 10: the peak between samples is found (against a fine direct integration)."""
+    """T / dt < 10: the peak between samples is found (against the oscillator's exact response
+    on a grid of dt / 100, tests/oscillator.py)."""
     rng = np.random.default_rng(1)
     a = np.convolve(rng.standard_normal(1500), np.ones(3) / 3, "same")
     dt, T, xi = 0.01, 0.04, 0.05
     _, psa = response_spectrum(a, dt, np.array([T]), xi)
-    t = np.arange(a.size) * dt
-    w = 2 * math.pi / T
-
-    def rhs(tt, y):
-        return [y[1], -np.interp(tt, t, a) - 2 * xi * w * y[1] - w * w * y[0]]
-
-    sol = solve_ivp(rhs, (0, t[-1]), [0, 0], max_step=dt / 20, rtol=1e-9, atol=1e-12)
-    assert psa[0] == pytest.approx(w * w * np.max(np.abs(sol.y[0])), rel=2e-3)
+    assert psa[0] == pytest.approx(fine_grid_psa(a, dt, T, xi, free_s=0.0), rel=2e-3)
 
 
 @needs_peer_records

@@ -1,7 +1,8 @@
 """Runs of one structure stepped together (rockyade.kernel.runs.simulate_runs) give the same
-bits as one run at a time: against the per-run kernel (simulate_runs_each) and against the
-reference DEM's own run of each scene (ReferenceSolver.run), over the paper's four specimens,
-several synthetic records and load factors that overturn some of them."""
+bits as one run at a time: against the single-body kernel run once per motion
+(rockyade.kernel.single.simulate_single, the path of one run) and against the reference DEM's
+own run of each scene (ReferenceSolver.run), over the paper's four specimens, several
+synthetic records and load factors that overturn some of them."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ import pytest
 from rockyade.analysis.metrics import uplift_threshold_rad
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.engine import model_arrays
-from rockyade.kernel.runs import CHUNK_RUNS, simulate_runs, simulate_runs_each
+from rockyade.kernel.runs import CHUNK_RUNS, RunsOutput, _summaries, simulate_runs
+from rockyade.kernel.single import simulate_single
 from rockyade.kernel.state import pack
 from rockyade.paper.specimens import SINGLE_SPECIMENS
 from rockyade.solvers.reference import model_arrays_motion
@@ -31,27 +33,56 @@ def _tasks(tmp_path, specimen: str):
     )
 
 
+def _runs(tasks, repeat: int = 1):
+    """The models of one group's runs (each task ``repeat`` times): the calibrated structure of
+    the first with each task's motion."""
+    base = calibrated_model(tasks[0].scene)
+    return [replace(base, motion=t.scene.motion.ground_motion(t.scene.duration_s)) for t in tasks] * repeat
+
+
+def _packed(model):
+    """The kernel's records of one model, as the group's kernel gets them."""
+    return pack(model_arrays(model), stop_on_overturn=True, record_energy=False, record_corners=False, coherent=True)
+
+
 def _kernel_inputs(tasks, repeat: int = 1):
     """The packed structure and the runs' motions (each task ``repeat`` times) of one group."""
-    base = calibrated_model(tasks[0].scene)
-    models = [replace(base, motion=t.scene.motion.ground_motion(t.scene.duration_s)) for t in tasks] * repeat
-    b, j, _, st, i = pack(
-        model_arrays(base), stop_on_overturn=True, record_energy=False, record_corners=False, coherent=True
-    )
+    models = _runs(tasks, repeat)
+    b, j, _, st, i = _packed(models[0])
     motions = [model_arrays_motion(m) for m in models]
     starts = np.cumsum([0] + [m[0].size for m in motions])
     mt, mah, mav = (np.concatenate([m[k] for m in motions]) for k in range(3))
     alpha = tasks[0].scene.blocks[0].classical().alpha_rad
-    return (b, j, st, i, mt, mah, mav, starts, uplift_threshold_rad(alpha), base.sample_dt_s)
+    return (b, j, st, i, mt, mah, mav, starts, uplift_threshold_rad(alpha), models[0].sample_dt_s)
+
+
+def _one_at_a_time(tasks, repeat: int, uplift_rad: float, sample_dt: float) -> RunsOutput:
+    """What :func:`simulate_runs` returns, from the single-body kernel run once per motion
+    (the summaries by the same function from those samples)."""
+    outs = [simulate_single(*_packed(m)) for m in _runs(tasks, repeat)]
+    ang = np.stack([o.ang[:, 0] for o in outs])
+    n_filled = np.array([o.n_filled for o in outs], dtype=np.int64)
+    rest = _packed(_runs(tasks)[0])[0].rest_ang[0]
+    return RunsOutput(
+        np.array([o.status for o in outs], dtype=np.int64),
+        np.array([o.t_stop for o in outs]),
+        n_filled,
+        np.array([o.overturn_time[0] for o in outs]),
+        np.stack([o.pos[:, 0, :] for o in outs]),
+        ang,
+        np.stack([o.angvel[:, 0] for o in outs]),
+        *_summaries(ang, n_filled, rest, uplift_rad, sample_dt),
+    )
 
 
 @pytest.mark.parametrize("specimen", SINGLE_SPECIMENS)
 @pytest.mark.slow
 def test_runs_stepped_together_are_bit_identical_to_one_at_a_time(tmp_path, specimen):
     # more runs than a chunk (so that chunks and drop-outs mix), on one thread and on two
-    args = _kernel_inputs(_tasks(tmp_path, specimen), repeat=CHUNK_RUNS // len(RECORDS) // len(LOAD_FACTORS) + 1)
+    tasks, repeat = _tasks(tmp_path, specimen), CHUNK_RUNS // len(RECORDS) // len(LOAD_FACTORS) + 1
+    args = _kernel_inputs(tasks, repeat)
     assert args[7].size - 1 > CHUNK_RUNS
-    each = simulate_runs_each(*args)
+    each = _one_at_a_time(tasks, repeat, args[8], args[9])
     before = numba.get_num_threads()
     try:
         for threads in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):  # type: ignore[attr-defined]

@@ -177,7 +177,7 @@ def _first_root(kind, t, th, om, h, side, level, prm, mt, mah, mav):
             if kind != 0 or om == 0.0:
                 return tau if kind == 0 else -1.0
             # turning point (omega = 0) inside (0, tau), then the fall back to theta = 0
-            tp = _bisect(2, t, th, om, side, level, 0.0, tau, om, prm, mt, mah, mav)
+            tp = _bisect(np.int64(2), t, th, om, side, level, 0.0, tau, om, prm, mt, mah, mav)
             thp, omp = _rk4(t, th, om, tp, side, prm, mt, mah, mav)
             if not _before(kind, _event_value(kind, thp, omp, side, level), f0):
                 return tp
@@ -239,6 +239,9 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
     peaks = np.zeros((max_events, 2))
     uplifts = np.zeros(max_events)
     counts = np.zeros(3, dtype=np.int64)  # impacts, peaks, uplifts
+    # the event kinds of _event_value, as int64 rather than literal constants: numba would
+    # otherwise compile _first_root, _bisect and their callees once per kind (three copies)
+    impact, overturn, peak = np.int64(0), np.int64(1), np.int64(2)
     status = 0
     t_over = -1.0
     t_alpha = -1.0
@@ -284,17 +287,17 @@ def _integrate(prm, mt, mah, mav, duration, theta0, omega0, dt_sample, n_samples
         tau_end = h
         event = 0  # 0 none, 1 impact, 2 overturn
         if side * th1 >= 0.5 * math.pi:
-            tau = _first_root(1, t, th, om, h, side, 0.5 * math.pi, prm, mt, mah, mav)
+            tau = _first_root(overturn, t, th, om, h, side, 0.5 * math.pi, prm, mt, mah, mav)
             if tau >= 0.0:
                 tau_end = tau
                 event = 2
         if side * th1 <= 0.0:
-            tau = _first_root(0, t, th, om, h, side, 0.0, prm, mt, mah, mav)
+            tau = _first_root(impact, t, th, om, h, side, 0.0, prm, mt, mah, mav)
             if tau >= 0.0 and tau <= tau_end:
                 tau_end = tau
                 event = 1
         if om * om1 < 0.0 or (event != 0 and om != 0.0):
-            tau = _first_root(2, t, th, om, tau_end, side, 0.0, prm, mt, mah, mav)
+            tau = _first_root(peak, t, th, om, tau_end, side, 0.0, prm, mt, mah, mav)
             if tau > 0.0 and tau < tau_end:
                 thp, _omp = _rk4(t, th, om, tau, side, prm, mt, mah, mav)
                 if counts[1] < max_events:

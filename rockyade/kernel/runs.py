@@ -6,8 +6,8 @@ parallel over numba's threads (``prange``), each chunk advanced step by step wit
 loop over its runs (:func:`step_runs`: the runs' state held by field), and a run that ends
 drops out of its chunk. Each run's arithmetic is that of
 the single-body loop (:func:`rockyade.kernel.single.run_body`), both from :mod:`.step`, so
-the results are the same bits as one run at a time (:func:`simulate_runs_each`, which runs
-each by ``run_body``; ``tests/test_runs_batched.py``). The summary's metrics are computed
+the results are the same bits as one run at a time (each by the single-body kernel,
+:func:`rockyade.kernel.single.simulate_single`; ``tests/test_runs_batched.py``). The summary's metrics are computed
 in the kernel from each run's samples:
 
 * peak |theta| over the samples and the time of its first sample, rad and s;
@@ -29,7 +29,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
-from rockyade.kernel.single import run_body
 from rockyade.kernel.step import (
     base_point,
     beyond_stop_angle,
@@ -95,91 +94,6 @@ def _summaries(ang, n_filled, rest: float, uplift_rad: float, sample_dt: float):
             peak[r] = best
             residual[r] = ang[r, nf - 1] - rest
     return peak, peak_t, residual, uplift
-
-
-@numba.njit(cache=True, nogil=True, parallel=True)
-def simulate_runs_each(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
-    """Run R motions on one body, each by :func:`rockyade.kernel.single.run_body` (the per-run
-    path that :func:`simulate_runs` is checked against; the same arguments and results).
-
-    Parameters
-    ----------
-    bodies, joints, settings, initial
-        The records of :func:`rockyade.kernel.state.pack` for the shared structure (one
-        moving body, ``record_energy`` off: :func:`rockyade.kernel.single.single_body`).
-    mt, mah, mav
-        The runs' base motions one after the other: s, m/s^2, m/s^2.
-    starts
-        (R + 1,) where each run's motion starts in them (the last: their length).
-    uplift_rad
-        |theta| above which the block has lifted off, rad.
-    sample_dt
-        Time between samples, s.
-
-    Returns
-    -------
-    RunsOutput
-    """
-    n_runs = starts.size - 1
-    maxv = bodies.verts.shape[1]
-    nv = bodies.nverts[0]
-    n_samples = settings.n_steps // settings.steps_per_sample + 1
-    j = joints.base_joint[0]
-    rest = bodies.rest_ang[0]
-    status = np.zeros(n_runs, dtype=np.int64)
-    t_stop = np.zeros(n_runs)
-    n_filled = np.zeros(n_runs, dtype=np.int64)
-    overturn_t = np.zeros(n_runs)
-    pos, ang, angvel = _sample_arrays(n_runs, n_samples)
-    for r in numba.prange(n_runs):
-        a, b = starts[r], starts[r + 1]
-        vpoint = np.empty((n_samples, 2))
-        ncont = np.empty(n_samples, dtype=np.int32)
-        slip = np.empty(n_samples, dtype=np.bool_)
-        states = np.zeros((n_samples if settings.record_corners else 1, maxv), dtype=np.int8)
-        st, ts, nf, ot = run_body(
-            bodies.verts[0],
-            nv,
-            bodies.mass[0],
-            bodies.inertia[0],
-            joints.kn[j],
-            joints.ks[j],
-            joints.cn[j],
-            joints.cs[j],
-            joints.tanphi[j],
-            rest,
-            bodies.stop_angle[0],
-            bodies.accel_points[0, 0],
-            bodies.accel_points[0, 1],
-            settings.g,
-            settings.dt,
-            settings.n_steps,
-            settings.steps_per_sample,
-            settings.mass_damping,
-            settings.stop_on_overturn,
-            settings.record_corners,
-            mt[a:b],
-            mah[a:b],
-            mav[a:b],
-            initial.pos[0, 0],
-            initial.pos[0, 1],
-            initial.ang[0],
-            initial.vel[0, 0],
-            initial.vel[0, 1],
-            initial.angvel[0],
-            np.zeros(maxv),
-            np.zeros(maxv, dtype=np.int8),
-            pos[r],
-            ang[r],
-            angvel[r],
-            vpoint,
-            ncont,
-            slip,
-            states,
-        )
-        status[r], t_stop[r], n_filled[r], overturn_t[r] = st, ts, nf, ot
-    peak, peak_t, residual, uplift = _summaries(ang, n_filled, rest, uplift_rad, sample_dt)
-    return RunsOutput(status, t_stop, n_filled, overturn_t, pos, ang, angvel, peak, peak_t, residual, uplift)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -395,7 +309,8 @@ CHUNK_RUNS = 16
 def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplift_rad: float, sample_dt: float):
     """Run R motions on one body, stepped together (module docstring): the runs are cut into
     chunks of at most :data:`CHUNK_RUNS` runs, in parallel over numba's threads, and each chunk is stepped by
-    :func:`step_runs`; the same results, bit for bit, as :func:`simulate_runs_each`.
+    :func:`step_runs`; the same results, bit for bit, as one run at a time by
+    :func:`rockyade.kernel.single.simulate_single`.
 
     Parameters
     ----------

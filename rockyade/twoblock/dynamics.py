@@ -39,6 +39,7 @@ from __future__ import annotations
 import math
 
 import numba
+import numpy as np
 
 from rockyade.motion.ground import ground_acceleration
 
@@ -414,7 +415,8 @@ def energy(th1, phi, w1, wphi, sb, ss, prm):
 def at_rest_margins(ah, av, prm):
     """The four moment margins of the stack at rest under the base acceleration (a_h, a_v):
     (base left, base right, seat left, seat right), N m; affine in (a_h, a_v)."""
-    out = contact_state(0.0, 0.0, 0.0, 0.0, 0, 0, ah, av, prm)
+    closed = np.int64(0)  # not the literal 0: numba would compile contact_state's callees again for it
+    out = contact_state(0.0, 0.0, 0.0, 0.0, closed, closed, ah, av, prm)
     return out[2], out[3], out[6], out[7]
 
 

@@ -320,6 +320,11 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
     fexceed = np.full(2, -1.0)
     tension = np.full(2, -1.0)
     imp_ratio = np.zeros(2)
+    # a closed joint (0), the joints' indices and the flags of choose_mode as int64 and bool,
+    # not literal constants: numba would otherwise compile choose_mode, post_impact and their
+    # callees again for each literal
+    closed, base_joint, seat_joint = np.int64(0), np.int64(0), np.int64(1)
+    yes, no = np.bool_(True), np.bool_(False)
     status = 0
     fail_code = 0
     t_end_run = -1.0
@@ -363,7 +368,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
             t = tu
             th1, phi, w1, wp = 0.0, 0.0, 0.0, 0.0
             ah, av, _ = ground_acceleration(t, mt, mah, mav, 0)
-            sb, ss, viol = choose_mode(0.0, 0.0, 0.0, 0.0, 0, 0, ah, av, prm, True, True, False, False)
+            sb, ss, viol = choose_mode(0.0, 0.0, 0.0, 0.0, closed, closed, ah, av, prm, yes, yes, no, no)
             if viol > ADMISSIBLE_TOL:
                 status, fail_code, t_end_run = 2, FAIL_NO_MODE, t
                 break
@@ -444,11 +449,11 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
             if ratio > imp_ratio[joint]:
                 imp_ratio[joint] = ratio
             # a joint left too little to lift closes: the impact's outcome with it closed
-            if nsb != 0 and th1 == 0.0 and _lift_too_small(0, nw1, prm, rest_fraction):
-                nsb = 0
+            if nsb != 0 and th1 == 0.0 and _lift_too_small(base_joint, nw1, prm, rest_fraction):
+                nsb = closed
                 nw1, nwp = post_impact(th1, phi, w1, wp, sb, ss, nsb, nss, prm)
-            if nss != 0 and phi == 0.0 and _lift_too_small(1, nwp, prm, rest_fraction):
-                nss = 0
+            if nss != 0 and phi == 0.0 and _lift_too_small(seat_joint, nwp, prm, rest_fraction):
+                nss = closed
                 nw1, nwp = post_impact(th1, phi, w1, wp, sb, ss, nsb, nss, prm)
             sb, ss, w1, wp = nsb, nss, nw1, nwp
             if counts[0] < cap:
@@ -460,7 +465,7 @@ def integrate(prm, mt, mah, mav, duration, th1, phi, w1, wp, sb, ss, dt_sample, 
                 resting = True
                 th1, phi, w1, wp = 0.0, 0.0, 0.0, 0.0
             else:
-                nsb, nss, viol = choose_mode(th1, phi, w1, wp, sb, ss, ah, av, prm, sb == 0, ss == 0, False, False)
+                nsb, nss, viol = choose_mode(th1, phi, w1, wp, sb, ss, ah, av, prm, sb == 0, ss == 0, no, no)
                 if viol > ADMISSIBLE_TOL:
                     status, fail_code, t_end_run = 2, FAIL_NO_MODE, t
                     break
