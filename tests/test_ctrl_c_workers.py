@@ -33,10 +33,11 @@ ROOT = Path(__file__).resolve().parent.parent
 TRIALS = 10
 
 #: TRIALS batches of runs that each start a worker of the engine-free driver; each batch's first
-#: run presses Ctrl-C (SIGINT to the process group, as a terminal does) twice, 0.08 s apart,
-#: as it starts its worker.
+#: run to start (Dask's threaded scheduler starts the last job first: waiting for job 0 there
+#: let two whole runs pass before the press) presses Ctrl-C (SIGINT to the process group, as a
+#: terminal does) twice, 0.08 s apart, as it starts its worker.
 BATCHES = """
-import functools, json, os, signal, sys, threading, time, tempfile
+import functools, itertools, json, os, signal, sys, threading, time, tempfile
 from pathlib import Path
 from rockyade.io import warm_program
 from rockyade.runner import Executor, run_jobs
@@ -50,8 +51,8 @@ def press_twice():
     os.killpg(0, signal.SIGINT)
     presses[0].start()
 
-def job(i, of_trial):
-    if i == 0:
+def job(i, of_trial, order):
+    if next(order) == 0:  # the first to start (itertools' count is atomic under the GIL)
         press_twice()
     scene = folder / f"{of_trial}-{i}.json"
     scene.write_text(json.dumps({"name": str(i), "sleep_s": 0.1}))
@@ -61,7 +62,8 @@ def job(i, of_trial):
 hard = 0
 for trial in range(int(sys.argv[2])):
     presses.clear()
-    outcome = run_jobs(range(4), functools.partial(job, of_trial=trial), executor=Executor(sys.argv[1], 2))
+    pressing = functools.partial(job, of_trial=trial, order=itertools.count())
+    outcome = run_jobs(range(4), pressing, executor=Executor(sys.argv[1], 2))
     presses[0].join()
     hard += outcome.hard
 for thread in threading.enumerate():  # the runs abandoned after each second Ctrl-C
