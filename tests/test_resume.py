@@ -509,7 +509,8 @@ def test_a_fragility_opens_no_listening_socket(tmp_path, wall, records, executor
         pytest.importorskip("dask")
     from .test_robust_batch import _listening_sockets_of_tree
 
-    proc = _start(tmp_path, _fragility(tmp_path, "--executor", executor, "--workers", "2", levels_count=2))  # the last --workers
+    argv = _fragility(tmp_path, "--executor", executor, "--workers", "2", levels_count=2)  # the last --workers
+    proc = _start(tmp_path, argv)
     seen: set[str] = set()
     polls = 0
     while proc.poll() is None:

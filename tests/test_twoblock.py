@@ -23,6 +23,7 @@ from rockyade.solvers import make_solver, run, solver_names
 from rockyade.twoblock import dynamics as dyn
 from rockyade.twoblock import solve, two_block_model
 
+from .benchrun import run_quick
 from .conftest import EXAMPLES
 
 ROCKYADE = Path(sys.executable).parent / "rockyade"
@@ -390,10 +391,9 @@ def test_pattern_map_figure_has_a_panel_per_solver(tmp_path):
 
 
 @pytest.mark.slow
-def test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling():
+def test_benchmark_quick_mode_runs_and_finds_the_events_independent_of_sampling(monkeypatch, capsys):
     """``benchmarks/bench_twoblock.py --quick`` runs both solvers on the record and prints the
-    sampling check: the same impact times at 0.01 s and 0.001 s (no speed is asserted)."""
-    bench = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_twoblock.py"
-    proc = subprocess.run([sys.executable, str(bench), "--quick"], capture_output=True, text=True, timeout=600)
-    assert proc.returncode == 0, proc.stderr
-    assert "runs/s" in proc.stdout and "largest difference 0 s" in proc.stdout
+    sampling check: the same impact times at 0.01 s and 0.001 s (no speed is asserted). In this
+    process (tests/benchrun.py)."""
+    out = run_quick(Path(__file__).resolve().parents[1] / "benchmarks" / "bench_twoblock.py", monkeypatch, capsys)
+    assert "runs/s" in out and "largest difference 0 s" in out
