@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -119,6 +120,15 @@ def _study(folder: Path, duration_s: float, runs: int) -> None:
     )
 
 
+def _cpu_s(pid: int) -> float:
+    """The CPU seconds ``pid`` used, from /proc (0 once it is gone)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def listening_of_trees(pids: list[int]) -> dict[str, tuple[str, int]]:
     """The listening TCP sockets of the processes ``pids`` and every process below them: the
     kernel's tables read once for all (~10 ms a read, per poll), not once a process."""
@@ -178,25 +188,35 @@ def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_list
 
 @pytest.mark.slow
 def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster, monkeypatch, capsys):
-    # runs of about a second of CPU each (200 s simulated; polled every 0.05 s); 4: when two have
-    # ended, each worker is in one of the other two (or the victim still in its first), so the
-    # kill lands in a run that the other worker reruns
+    # runs of about half a second of CPU each (100 s simulated); 4: when two have ended, a worker
+    # in one of the other two (its CPU seen growing in /proc, polled every 0.05 s) is killed
+    # in the middle of it, and the other worker reruns it
     runs = 4
-    _study(tmp_path, duration_s=200.0, runs=runs)
+    _study(tmp_path, duration_s=100.0, runs=runs)
     monkeypatch.chdir(tmp_path)
     out = tmp_path / "out"
-    victim = cluster.workers[0]
+    killed: list[subprocess.Popen[bytes]] = []
 
-    def kill_after_two_runs(running) -> None:
+    def kill_a_running_worker(running) -> None:
         _wait_for(lambda: len(list((out / "runs").glob("*.json"))) >= 2 or not running(), 300, "two finished runs")
-        assert running(), "the batch ended before a worker was killed"
-        victim.send_signal(signal.SIGKILL)  # in the middle of its next run
-        victim.wait()
+        before = {proc: _cpu_s(proc.pid) for proc in cluster.workers}
+        while running() and not killed:
+            time.sleep(0.05)
+            for proc in cluster.workers:
+                now = _cpu_s(proc.pid)
+                if now - before[proc] >= 0.02:  # two clock ticks in 50 ms: running a run
+                    killed.append(proc)
+                    break
+                before[proc] = now
+        assert killed, "the batch ended before a worker was killed"
+        killed[0].send_signal(signal.SIGKILL)  # in the middle of its run
+        killed[0].wait()
 
-    code = _batch_beside(kill_after_two_runs, "out", "--executor", "dask", "--scheduler", cluster.address)
+    code = _batch_beside(kill_a_running_worker, "out", "--executor", "dask", "--scheduler", cluster.address)
     assert code == 0, capsys.readouterr().err
+    [victim] = killed
     assert victim.returncode == -signal.SIGKILL
-    assert alive(cluster.workers[1].pid)
+    assert all(alive(proc.pid) for proc in cluster.workers if proc is not victim)
     summary = pd.read_csv(out / "summary.csv")
     assert list(summary["index"]) == list(range(runs)) and summary.run.is_unique
     assert (summary.status == "completed").all(), summary.failure_reason.tolist()
