@@ -33,10 +33,11 @@ ROOT = Path(__file__).resolve().parent.parent
 TRIALS = 10
 
 #: TRIALS batches of runs that each start a worker of the engine-free driver; each batch's first
-#: run presses Ctrl-C (SIGINT to the process group, as a terminal does) twice, 0.08 s apart,
-#: as it starts its worker.
+#: run to start (Dask's threaded scheduler starts the last job first: waiting for job 0 there
+#: let two whole runs pass before the press) presses Ctrl-C (SIGINT to the process group, as a
+#: terminal does) twice, 0.08 s apart, as it starts its worker.
 BATCHES = """
-import functools, json, os, signal, sys, threading, time, tempfile
+import functools, itertools, json, os, signal, subprocess, sys, threading, time, tempfile
 from pathlib import Path
 from rockyade.io import warm_program
 from rockyade.runner import Executor, run_jobs
@@ -50,23 +51,31 @@ def press_twice():
     os.killpg(0, signal.SIGINT)
     presses[0].start()
 
-def job(i, of_trial):
-    if i == 0:
+def job(i, of_trial, order):
+    if next(order) == 0:  # the first to start (itertools' count is atomic under the GIL)
         press_twice()
     scene = folder / f"{of_trial}-{i}.json"
     scene.write_text(json.dumps({"name": str(i), "sleep_s": 0.1}))
     out, log = scene.with_suffix(".npz"), scene.with_suffix(".log")
     return warm_program.run_scene(fake_program(), scene, out, log, 60.0, warm=False)
 
+# a loaded machine while the batches run (not while this Python imports): a busy loop in a
+# session of its own (the presses are for this process group only)
+busy = subprocess.Popen([sys.executable, "-c", "while True: pass"], start_new_session=True)
 hard = 0
-for trial in range(int(sys.argv[2])):
-    presses.clear()
-    outcome = run_jobs(range(4), functools.partial(job, of_trial=trial), executor=Executor(sys.argv[1], 2))
-    presses[0].join()
-    hard += outcome.hard
-for thread in threading.enumerate():  # the runs abandoned after each second Ctrl-C
-    if thread is not threading.main_thread() and not thread.daemon:
-        thread.join(60)
+try:
+    for trial in range(int(sys.argv[2])):
+        presses.clear()
+        pressing = functools.partial(job, of_trial=trial, order=itertools.count())
+        outcome = run_jobs(range(4), pressing, executor=Executor(sys.argv[1], 2))
+        presses[0].join()
+        hard += outcome.hard
+    for thread in threading.enumerate():  # the runs abandoned after each second Ctrl-C
+        if thread is not threading.main_thread() and not thread.daemon:
+            thread.join(60)
+finally:
+    busy.kill()
+    busy.wait()
 print("hard", hard, flush=True)
 """
 
@@ -108,21 +117,16 @@ def test_no_python_runs_in_a_worker_between_fork_and_exec(tmp_path):
 def test_ctrl_c_twice_while_workers_start_runs_the_handler_once_and_raises_nothing(executor):
     if executor == "dask":
         pytest.importorskip("dask")
-    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])  # a loaded machine
-    try:
-        done = subprocess.run(
-            [sys.executable, "-c", BATCHES, executor, str(TRIALS)],
-            cwd=ROOT,
-            env={**os.environ, "PYTHONPATH": str(ROOT)},
-            capture_output=True,
-            text=True,
-            timeout=600,
-            start_new_session=True,  # its own process group, as a command in a terminal
-            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
-        )
-    finally:
-        busy.kill()
-        busy.wait()
+    done = subprocess.run(  # (with a busy loop beside its batches: a loaded machine)
+        [sys.executable, "-c", BATCHES, executor, str(TRIALS)],
+        cwd=ROOT,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+        capture_output=True,
+        text=True,
+        timeout=600,
+        start_new_session=True,  # its own process group, as a command in a terminal
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     err = done.stderr
     assert done.returncode == 0 and done.stdout.startswith("hard "), (done.stdout, err)
     hard = int(done.stdout.split()[1])

@@ -1,15 +1,17 @@
 """A real Dask deployment: a scheduler and workers started with Dask's own commands
-(``dask scheduler``, ``dask worker``) on the loopback interface, no dashboard; batches run
-against it from the command line. Nothing listens beyond 127.0.0.1; the summary equals a
+(``dask scheduler``, ``dask worker``) on the loopback interface, no dashboard; batches (the
+command's ``main`` in the test's process) run against it. Nothing listens beyond 127.0.0.1; the summary equals a
 local run's; a worker killed mid-study costs no run and duplicates none."""
 
 from __future__ import annotations
 
 import contextlib
 import json
+import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -89,10 +91,13 @@ class Cluster:
             proc.wait()
 
 
-@pytest.fixture
-def cluster(request, tmp_path):
-    """A cluster of two workers, or of ``@pytest.mark.parametrize("cluster", [n], indirect=True)``."""
-    c = Cluster(tmp_path / "cluster", workers=getattr(request, "param", 2))
+@pytest.fixture(scope="module")
+def cluster(tmp_path_factory):
+    """A cluster of two workers for the module's tests: the batch compared with a local one
+    runs on it whole, and the test of a killed worker (the last: a cluster it leaves with one
+    worker still runs any batch) kills one. A scheduler and a worker are Pythons that import
+    distributed (the worker rockyade and the kernels too): started once, not once a test."""
+    c = Cluster(tmp_path_factory.mktemp("dask") / "cluster", workers=2)
     try:
         yield c
     finally:
@@ -115,6 +120,15 @@ def _study(folder: Path, duration_s: float, runs: int) -> None:
     )
 
 
+def _cpu_s(pid: int) -> float:
+    """The CPU seconds ``pid`` used, from /proc (0 once it is gone)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def listening_of_trees(pids: list[int]) -> dict[str, tuple[str, int]]:
     """The listening TCP sockets of the processes ``pids`` and every process below them: the
     kernel's tables read once for all (~10 ms a read, per poll), not once a process."""
@@ -122,34 +136,49 @@ def listening_of_trees(pids: list[int]) -> dict[str, tuple[str, int]]:
     return {inode: where for inode, where in listening_tcp().items() if inode in mine}
 
 
-def _batch(folder: Path, out: str, *extra: str) -> subprocess.Popen[str]:
-    return subprocess.Popen(
-        [sys.executable, "-m", "rockyade", "batch", "study.toml", "--out", out, "--quiet", *extra],
-        cwd=folder,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
+def _batch_beside(watch, out: str, *extra: str) -> int:
+    """``rockyade batch study.toml --out OUT --quiet ...`` (the command's ``main``, in this
+    process, run from the study's folder) with ``watch(running)`` in a thread beside it, to its
+    end (``running()`` is False once the batch returned): the exit code. What the tests
+    watch, kill and poll are the cluster's processes; a process of its own for the batch only
+    added its start-up (Python, rockyade and distributed imported again)."""
+    finished = threading.Event()
+    failures: list[BaseException] = []
+
+    def watching() -> None:
+        try:
+            watch(lambda: not finished.is_set())
+        except BaseException as exc:  # handed to the test's thread
+            failures.append(exc)
+
+    watcher = threading.Thread(target=watching, name="watch-cluster")
+    watcher.start()
+    try:
+        code = main(["batch", "study.toml", "--out", out, "--quiet", *extra])
+    finally:
+        finished.set()
+        watcher.join()
+    if failures:
+        raise failures[0]
+    return code
 
 
-# one worker: equality with a local batch and the listening sockets of `dask scheduler` and `dask
-# worker` need no second one (each worker is a Python that imports distributed, rockyade and the
-# kernels before its first run); two run in the test of a killed worker below
-@pytest.mark.parametrize("cluster", [1], indirect=True)
 @pytest.mark.slow
 def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_listens_on_loopback_only(
     tmp_path, cluster, monkeypatch, capsys
 ):
     _study(tmp_path, duration_s=8.0, runs=6)
-    monkeypatch.chdir(tmp_path)  # the local batch, the reference, runs in this process: only its summary is used
+    monkeypatch.chdir(tmp_path)  # both batches run in this process (_batch_beside), from the study's folder
     assert main(["batch", "study.toml", "--out", "local", "--quiet", "--workers", "2"]) == 0, capsys.readouterr().err
-    remote = _batch(tmp_path, "remote", "--executor", "dask", "--scheduler", cluster.address)  # relative --out
     seen: dict = {}
-    while remote.poll() is None:
-        seen |= listening_of_trees([proc.pid for proc in cluster.processes()])
-        time.sleep(0.05)
-    _stdout, stderr = remote.communicate()
-    assert remote.returncode == 0, stderr
+
+    def poll(running) -> None:
+        while running():
+            seen.update(listening_of_trees([proc.pid for proc in cluster.processes()]))
+            time.sleep(0.05)
+
+    code = _batch_beside(poll, "remote", "--executor", "dask", "--scheduler", cluster.address)  # relative --out
+    assert code == 0, capsys.readouterr().err
     assert cluster.address.startswith("tcp://127.0.0.1:")
     assert seen and {host for host, _port in seen.values()} == {"127.0.0.1"}, seen  # no 0.0.0.0, no dashboard
     summary = pd.read_csv(tmp_path / "remote" / "summary.csv")
@@ -158,21 +187,36 @@ def test_a_batch_on_dask_s_own_scheduler_and_workers_equals_a_local_one_and_list
 
 
 @pytest.mark.slow
-def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster):
-    # runs of about a second of CPU each (200 s simulated; polled every 0.05 s); 4: when two have
-    # ended, each worker is in one of the other two (or the victim still in its first), so the
-    # kill lands in a run that the other worker reruns
+def test_a_worker_killed_mid_study_costs_no_run_and_duplicates_none(tmp_path, cluster, monkeypatch, capsys):
+    # runs of about half a second of CPU each (100 s simulated); 4: when two have ended, a worker
+    # in one of the other two (its CPU seen growing in /proc, polled every 0.05 s) is killed
+    # in the middle of it, and the other worker reruns it
     runs = 4
-    _study(tmp_path, duration_s=200.0, runs=runs)
-    batch = _batch(tmp_path, "out", "--executor", "dask", "--scheduler", cluster.address)
+    _study(tmp_path, duration_s=100.0, runs=runs)
+    monkeypatch.chdir(tmp_path)
     out = tmp_path / "out"
-    _wait_for(lambda: len(list((out / "runs").glob("*.json"))) >= 2, 300, "two finished runs")
-    victim = cluster.workers[0]
-    victim.send_signal(signal.SIGKILL)  # in the middle of its next run
-    victim.wait()
-    _stdout, stderr = batch.communicate(timeout=600)
-    assert batch.returncode == 0, stderr
-    assert alive(cluster.workers[1].pid)
+    killed: list[subprocess.Popen[bytes]] = []
+
+    def kill_a_running_worker(running) -> None:
+        _wait_for(lambda: len(list((out / "runs").glob("*.json"))) >= 2 or not running(), 300, "two finished runs")
+        before = {proc: _cpu_s(proc.pid) for proc in cluster.workers}
+        while running() and not killed:
+            time.sleep(0.05)
+            for proc in cluster.workers:
+                now = _cpu_s(proc.pid)
+                if now - before[proc] >= 0.02:  # two clock ticks in 50 ms: running a run
+                    killed.append(proc)
+                    break
+                before[proc] = now
+        assert killed, "the batch ended before a worker was killed"
+        killed[0].send_signal(signal.SIGKILL)  # in the middle of its run
+        killed[0].wait()
+
+    code = _batch_beside(kill_a_running_worker, "out", "--executor", "dask", "--scheduler", cluster.address)
+    assert code == 0, capsys.readouterr().err
+    [victim] = killed
+    assert victim.returncode == -signal.SIGKILL
+    assert all(alive(proc.pid) for proc in cluster.workers if proc is not victim)
     summary = pd.read_csv(out / "summary.csv")
     assert list(summary["index"]) == list(range(runs)) and summary.run.is_unique
     assert (summary.status == "completed").all(), summary.failure_reason.tolist()

@@ -141,8 +141,8 @@ def test_a_swap_killed_half_way_is_finished_by_the_next_writer(tmp_path, moved):
 LEVELS = 10
 
 
-def _fragility(folder: Path, *extra: str) -> list[str]:
-    levels = ",".join(f"{0.3 + 0.1 * i:.2f}" for i in range(LEVELS))
+def _fragility(folder: Path, *extra: str, levels_count: int = LEVELS) -> list[str]:
+    levels = ",".join(f"{0.3 + 0.1 * i:.2f}" for i in range(levels_count))
     return [
         sys.executable,
         "-m",
@@ -503,12 +503,14 @@ def test_assess_stopped_keeps_its_static_answer_and_resumes(tmp_path, wall, reco
 @pytest.mark.slow
 def test_a_fragility_opens_no_listening_socket(tmp_path, wall, records, executor):
     """The study commands on local processes or Dask's threaded scheduler open no port (polled
-    over the process tree while it runs, to the end)."""
+    over the process tree while it runs, to the end). Two levels (4 runs): every part of the
+    study (its runs on the executor, the fit, the figure) runs as with more."""
     if executor == "dask":
         pytest.importorskip("dask")
     from .test_robust_batch import _listening_sockets_of_tree
 
-    proc = _start(tmp_path, _fragility(tmp_path, "--executor", executor, "--workers", "2"))  # the last --workers
+    argv = _fragility(tmp_path, "--executor", executor, "--workers", "2", levels_count=2)  # the last --workers
+    proc = _start(tmp_path, argv)
     seen: set[str] = set()
     polls = 0
     while proc.poll() is None:

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import NamedTuple
 
 import pandas as pd
 import pytest
@@ -86,6 +87,31 @@ def _resume(folder: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.Captur
     return main(["batch", "study.toml", "--out", "out", "--quiet", "--resume"])
 
 
+class _Stat(NamedTuple):
+    pgrp: int
+    cpu_s: float
+
+
+def _stat(pid: int, task: int | None = None) -> _Stat:
+    """A process's (or one of its threads') process group and CPU seconds, from /proc (a process
+    gone: no group, no CPU)."""
+    where = f"/proc/{pid}" if task is None else f"/proc/{pid}/task/{task}"
+    try:
+        fields = Path(f"{where}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return _Stat(-1, 0.0)
+    return _Stat(int(fields[2]), (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK"))
+
+
+def _threads_cpu_s(pid: int) -> list[float]:
+    """The CPU seconds of each thread of ``pid`` but its main thread."""
+    try:
+        tasks = [int(t) for t in os.listdir(f"/proc/{pid}/task")]
+    except OSError:
+        return []
+    return [_stat(pid, t).cpu_s for t in tasks if t != pid]
+
+
 def _workers_of(proc: subprocess.Popen[str], count: int) -> set[int]:
     _wait_for(lambda: len(descendants(proc.pid)) >= count, 120, f"{count} worker processes")
     return descendants(proc.pid)
@@ -136,16 +162,24 @@ def test_second_ctrl_c_stops_at_once_and_no_worker_survives(tmp_path, executor):
         pytest.importorskip("dask")
     _study(tmp_path, duration_s=4000.0, runs=4, sample_dt=0.05)  # runs of ~20 s
     proc = _batch(tmp_path, "--workers", "2", "--executor", executor)
+    # the runs under way (seen in /proc, not after a sleep): two workers that set themselves up
+    # (Ctrl-C ignored, a process group of their own) and run, or two threads of the batch running
     if executor == "local":
         workers = _workers_of(proc, 2)
+        _wait_for(
+            lambda: sum(_stat(pid).pgrp == pid and _stat(pid).cpu_s > 0.1 for pid in workers) >= 2, 120, "two runs"
+        )
     else:  # the runs are threads of the batch process
         workers = set()
-        _wait_for(lambda: (tmp_path / "out" / "runs").is_dir(), 120, "the runs to start")
-    time.sleep(1.5)  # the runs are under way
+        _wait_for(lambda: sum(cpu > 0.1 for cpu in _threads_cpu_s(proc.pid)) >= 2, 120, "two runs")
     os.killpg(proc.pid, signal.SIGINT)
-    time.sleep(0.3)
+    assert proc.stderr is not None
+    said = [proc.stderr.readline()]  # the second press once the first was handled (its line)
+    while said[-1] and "Ctrl-C: no new run starts" not in said[-1]:
+        said.append(proc.stderr.readline())
     os.killpg(proc.pid, signal.SIGINT)
-    _stdout, stderr = proc.communicate(timeout=60)
+    _stdout, rest = proc.communicate(timeout=60)
+    stderr = "".join(said) + rest
     assert not _results(tmp_path / "out")  # the running runs (~20 s each) were stopped, not let finish
     assert proc.returncode == 130 and "Traceback" not in stderr
     assert "Ctrl-C again: stopping the running runs now" in stderr
@@ -235,7 +269,8 @@ def test_the_socket_poller_sees_a_listening_socket():
 @pytest.mark.slow
 def test_dask_batch_without_scheduler_opens_no_listening_socket(tmp_path):
     pytest.importorskip("dask")
-    _study(tmp_path, duration_s=60.0, runs=6)
+    runs = 4  # two at a time on Dask's two threads, twice
+    _study(tmp_path, duration_s=30.0, runs=runs)
     proc = _batch(tmp_path, "--executor", "dask", "--workers", "2")
     seen: set[str] = set()
     while_running = 0  # looks taken while Dask's runs were under way (its runs folder there)
@@ -248,7 +283,7 @@ def test_dask_batch_without_scheduler_opens_no_listening_socket(tmp_path):
     assert proc.returncode == 0, stderr
     assert while_running >= 1 and not seen
     summary = pd.read_csv(tmp_path / "out" / "summary.csv")
-    assert (summary.status == "completed").all() and len(summary) == 6
+    assert (summary.status == "completed").all() and len(summary) == runs
 
 
 def _tasks(out: Path, duration: float = 1.0) -> list:
