@@ -228,7 +228,8 @@ def _listening_while_running(cmd: list[str], seconds: float, until_seen: bool = 
 def test_yade_run_listens_on_no_port(tmp_path):
     """A rockyade YADE run opens no listening socket; the same check finds the two servers
     that the stock ``yade`` launcher opens (so the check can fail)."""
-    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 8.0})
+    # 4 s of rocking (8 s before): with YADE's start-up the watcher takes dozens of samples
+    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 4.0})
     model = calibrated_model(scene)
     path = tmp_path / "s.yade.json"
     path.write_text(json.dumps(yade_payload.scene_payload(model)))
@@ -580,7 +581,9 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     d.update(NEVER_FINISHES)
     (tmp_path / "long.json").write_text(json.dumps(d))
     monkeypatch.chdir(tmp_path)
-    assert main(["run", "long.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
+    # the complete result: a short scene (an hour of Housner's samples, written as CSV, before)
+    (tmp_path / "short.json").write_text(json.dumps({**d, "duration_s": 0.5, "sample_dt_s": 0.01}))
+    assert main(["run", "short.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
     before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
     _warm_yade()
     assert main(["run", "long.json", "--solver", "yade", "--out", "r/long.csv", "--yade-timeout", "2"]) == 1
