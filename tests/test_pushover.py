@@ -300,8 +300,8 @@ def test_a_slender_running_bond_panel_goes_below_the_limit_analysis_by_non_assoc
     forbids (it asks an opening of tan(60 deg) times the slip). Its multiplier, without the little
     friction of that head joint, is 0.4343, and the DEMs' onset is within 2 % of it, 13 % below the
     limit analysis (docs/assemblies.md). The rise is 1 g/s, not 0.2 (3.2 s simulated against
-    4.9 s), and both DEMs step at twice Eq 7's time step (:func:`twice_eq7_step`; the panel's
-    step is then the stability margin's): measured at 0.2 g/s with Eq 7's step, at 1 g/s with it
+    4.9 s), and both DEMs step at twice Eq 7's time step (:func:`twice_eq7_step`, 0.74 of
+    the panel's stability limit): measured at 0.2 g/s with Eq 7's step, at 1 g/s with it
     and at 1 g/s with twice it, both DEMs' onset 1.01 and level below 1.00 of the heel multiplier,
     the heel units turned under 3e-6 rad and the others over 3e-3 rad."""
     if solver == "yade":
