@@ -228,7 +228,8 @@ def _listening_while_running(cmd: list[str], seconds: float, until_seen: bool = 
 def test_yade_run_listens_on_no_port(tmp_path):
     """A rockyade YADE run opens no listening socket; the same check finds the two servers
     that the stock ``yade`` launcher opens (so the check can fail)."""
-    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 8.0})
+    # 4 s of rocking (8 s before): with YADE's start-up the watcher takes dozens of samples
+    scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), "duration_s": 4.0})
     model = calibrated_model(scene)
     path = tmp_path / "s.yade.json"
     path.write_text(json.dumps(yade_payload.scene_payload(model)))
@@ -386,7 +387,7 @@ def _warm_yade() -> None:
     )
 
 
-#: A run no machine finishes within the tests' timeouts (2 to 3 s): an hour of specimen 1
+#: A run no machine finishes within the tests' timeouts (1 to 2 s): an hour of specimen 1
 #: rocking (7.2e7 body-steps, minutes of YADE on the fastest machine seen, where 60 s of
 #: it, the earlier choice, finished within 3 s), sampled every 0.01 s to stay within the
 #: cost limits.
@@ -397,7 +398,7 @@ def test_timeout_gives_failed_result(tmp_path):
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), **NEVER_FINISHES})
     _warm_yade()
     start = time.time()
-    result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=3.0).run(scene)
+    result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(scene)
     assert time.time() - start < 30
     assert result.status == "failed" and result.meta.failure_reason.startswith("timeout")
     # stopped by the driver at the deadline: what it recorded is kept, marked partial
@@ -580,7 +581,9 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     d.update(NEVER_FINISHES)
     (tmp_path / "long.json").write_text(json.dumps(d))
     monkeypatch.chdir(tmp_path)
-    assert main(["run", "long.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
+    # the complete result: a short scene (an hour of Housner's samples, written as CSV, before)
+    (tmp_path / "short.json").write_text(json.dumps({**d, "duration_s": 0.5, "sample_dt_s": 0.01}))
+    assert main(["run", "short.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
     before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
     _warm_yade()
     assert main(["run", "long.json", "--solver", "yade", "--out", "r/long.csv", "--yade-timeout", "2"]) == 1
@@ -589,8 +592,8 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     assert Result.read(Path("r/long.csv")).status == "completed"
     failed = Result.read(Path("r/long_failed.csv"))
     assert failed.status == "failed" and failed.meta.partial is True
-    # a failed result is not worth keeping over another failed one
-    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "2"]) == 1
+    # a failed result is not worth keeping over another failed one (with samples or without)
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "1"]) == 1
     assert not Path("r/long_failed_failed.csv").exists()
 
 
