@@ -103,7 +103,7 @@ def test_model_is_the_solver_shifted_to_a_release_between_samples():
 def test_cli_identify_json_and_figures(tmp_path, monkeypatch, capsys):
     import rockyade.figures.identification_fit as drawing
 
-    exact = drawing.error_surface  # the error surface on 11 x 11 points, not 41 x 41 (1681 runs of Housner)
+    exact = drawing.error_surface  # the error surface on 11 x 11 points, not 15 x 15 (225 runs of Housner)
     monkeypatch.setattr(drawing, "error_surface", lambda result, a, p, n: exact(result, a, p, 11))
     monkeypatch.chdir(tmp_path)
     rel = os.path.relpath(MEASURED, tmp_path)
