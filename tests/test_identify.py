@@ -24,6 +24,7 @@ from rockyade.identification.fit import (
 )
 from rockyade.identification.identified import calibrate_from_identified, load_identified
 from rockyade.identification.measurement import measured_history, read_measurement, rotation_from_leds
+from rockyade.identification.start import quarter_period_p1
 from tests.conftest import EXAMPLES
 
 MEASURED = EXAMPLES / "measured" / "specimen1_free_rocking.csv"
@@ -71,6 +72,21 @@ def test_recovery_and_coverage_over_seeded_trials():
     assert min(covered.values()) >= 17, covered
 
 
+@pytest.mark.parametrize("alpha", [0.05, 0.235, 1.0, 1.5])
+def test_quarter_period_is_the_solvers_first_impact(alpha):
+    """The closed form (Housner's energy integral as an elliptic integral) is the exact solver's
+    time from rest at theta_0 = r alpha to the first impact, at p = 1 and at p = 3.84 (1/p)."""
+    ratios = np.array([0.01, 0.2, 0.5, 0.8, 0.98])
+    closed = quarter_period_p1(ratios, alpha)
+    for r, tq in zip(ratios, closed, strict=True):
+        for p in (1.0, 3.84):
+            traj = solve(HousnerModel.symmetric(alpha, p, 1.0), None, 6.0 / p, r * alpha, 0.0, sample_dt_s=6.0 / p)
+            assert traj.impacts[0, 0] == pytest.approx(tq / p, rel=1e-10)
+    # the linearised value arccosh(1 / (1 - r)) for a small tilt, within O(alpha^2) (measured: alpha^2 / 12)
+    assert closed[0] == pytest.approx(np.arccosh(1.0 / (1.0 - 0.01)), rel=alpha**2 / 8)
+    assert np.all(np.isinf(quarter_period_p1(np.array([0.0, 1.0, 1.2]), alpha)))  # upright, or no way back
+
+
 def test_model_is_the_solver_shifted_to_a_release_between_samples():
     """The modelled record equals Housner's solution at t - t_r, also when t_r falls between samples."""
     fit = FreeRockingFit(0.235, 3.84, 0.936, 0.2537, 0.001, 0.5, -1)
@@ -87,7 +103,7 @@ def test_model_is_the_solver_shifted_to_a_release_between_samples():
 def test_cli_identify_json_and_figures(tmp_path, monkeypatch, capsys):
     import rockyade.figures.identification_fit as drawing
 
-    exact = drawing.error_surface  # the error surface on 11 x 11 points, not 41 x 41 (1681 runs of Housner)
+    exact = drawing.error_surface  # the error surface on 11 x 11 points, not 15 x 15 (225 runs of Housner)
     monkeypatch.setattr(drawing, "error_surface", lambda result, a, p, n: exact(result, a, p, 11))
     monkeypatch.chdir(tmp_path)
     rel = os.path.relpath(MEASURED, tmp_path)

@@ -9,10 +9,13 @@ from pathlib import Path
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from scipy import stats
+from scipy import interpolate, stats
 
 from rockyade.figures.canvas import axes_list, figure_of, new_figure, save_figure
 from rockyade.identification.fit import CONFIDENCE, Identification, error_surface
+
+#: Points along each axis of the grid the error surface's contours are drawn on.
+DRAWN_GRID = 81
 
 
 def _value_text(result: Identification, name: str, unit: str, digits: int) -> str:
@@ -96,7 +99,7 @@ def plot_fit(
 
 
 def plot_error_surface(
-    result: Identification, path: str | Path | None = None, n: int = 41, *, ax: Axes | None = None
+    result: Identification, path: str | Path | None = None, n: int = 15, *, ax: Axes | None = None
 ) -> tuple[Figure, Axes]:
     """RMS misfit (rad) over the alpha (rad) - p (1/s) plane (other unknowns at the optimum),
     with the optimum and the joint 95 % confidence ellipse of (alpha, p).
@@ -108,7 +111,12 @@ def plot_error_surface(
     path
         PNG to write (atomically); None writes nothing.
     n
-        Grid points along each axis.
+        Grid points along each axis where the misfit is computed (one Housner solution
+        each). The contours are drawn on a :data:`DRAWN_GRID` square grid from a bicubic
+        spline of the mean square misfit through them (a smooth function of alpha and p): on
+        the shipped example, 15 x 15 computed points give the misfit computed on 41 x 41
+        within 0.02 %, where contours drawn straight from 41 x 41 points would interpolate it
+        linearly (1.4 % off between the points).
     ax
         Axes to draw into; None: a new figure (pyplot's without ``path``).
 
@@ -123,8 +131,8 @@ def plot_error_surface(
     half_a = max(4.0 * sa, 0.01 * fit.alpha_rad)
     half_p = max(4.0 * sp, 0.01 * fit.p_rad_s)
     a_lo = max(fit.alpha_rad - half_a, 1.001 * abs(fit.theta0_rad))
-    alphas, ps, rms = error_surface(
-        result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n
+    alphas, ps, rms = _drawn_surface(
+        *error_surface(result, (a_lo, fit.alpha_rad + half_a), (fit.p_rad_s - half_p, fit.p_rad_s + half_p), n)
     )
     if ax is None:
         fig, ax = new_figure(path, figsize=(7.4, 5.8))
@@ -150,6 +158,17 @@ def plot_error_surface(
     if path is not None:
         save_figure(fig, path)
     return fig, ax
+
+
+def _drawn_surface(alphas: np.ndarray, ps: np.ndarray, rms: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The rms misfit on the drawing grid, from a bicubic spline of its square through the
+    computed points (``scipy.interpolate.RectBivariateSpline``, interpolating)."""
+    k = min(3, alphas.size - 1, ps.size - 1)
+    spline = interpolate.RectBivariateSpline(ps, alphas, rms**2, kx=k, ky=k)
+    fine_a = np.linspace(alphas[0], alphas[-1], DRAWN_GRID)
+    fine_p = np.linspace(ps[0], ps[-1], DRAWN_GRID)
+    mean_square = np.maximum(spline(fine_p, fine_a), 0.25 * float(rms.min()) ** 2)
+    return fine_a, fine_p, np.sqrt(mean_square)
 
 
 def _log_norm(levels: np.ndarray):
