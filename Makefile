@@ -35,12 +35,15 @@ $(STAMP): pyproject.toml
 compiled: $(STAMP)
 	@$(BIN)/python -m rockyade.solvers.compile_cache --quiet --workers $(WORKERS)
 
-# lint needs the tools, not the compiled solvers: `make test` runs it beside the compilation
+# lint needs the tools, not the compiled solvers: `make test` runs it beside the compilation, at a
+# lower priority (LINT_PRIORITY), so that the longest compilation (the reference DEM's general
+# loop, most of a minute of CPU in one process) keeps a core and the lint takes what is left
+LINT_PRIORITY ?=
 lint: system $(STAMP)
-	$(BIN)/ruff check .
-	$(BIN)/ruff format --check .
-	$(BIN)/lint-imports
-	$(BIN)/mypy rockyade
+	$(LINT_PRIORITY) $(BIN)/ruff check .
+	$(LINT_PRIORITY) $(BIN)/ruff format --check .
+	$(LINT_PRIORITY) $(BIN)/lint-imports
+	$(LINT_PRIORITY) $(BIN)/mypy rockyade
 
 # One thread per library in each test worker: pytest runs one worker per core already, and
 # OpenBLAS's threads, waiting for work on a machine whose cores are all busy, cost CPU (on a
@@ -54,7 +57,7 @@ check: setup lint
 
 # the compilation (one process per core) and lint side by side, then the suite
 test: system $(STAMP)
-	@$(MAKE) --no-print-directory -j $(WORKERS) --output-sync=target compiled lint
+	@$(MAKE) --no-print-directory -j $(WORKERS) --output-sync=target compiled lint LINT_PRIORITY='nice -n 10'
 	$(SINGLE_THREADED) ROCKYADE_REQUIRE_YADE=1 ROCKYADE_REQUIRE_SICONOS=1 ROCKYADE_REQUIRE_CHROMIUM=1 $(BIN)/python -m pytest -n $(WORKERS) --durations=15
 
 run: setup

@@ -6,6 +6,7 @@ import json
 import math
 import os
 import resource
+import tempfile
 import time
 from pathlib import Path
 
@@ -59,6 +60,26 @@ def free_scene_dict(theta0: float = 0.1175, duration: float = 4.0, **block_overr
         "contact": {"calibration": "paper"},
         "motion": {"type": "free", "theta0_rad": theta0},
     }
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _temporary_files_in_pytests_folder(tmp_path_factory: pytest.TempPathFactory):
+    """Every temporary file of the session (this process's, and its children's: CLI runs,
+    engines' workers, Dask's scratch space) in a folder of pytest's own base folder, which
+    pytest keeps for its last three sessions only: the tests that provoke failures or kill runs
+    leave what a failed run keeps by design (a failed Siconos run's private folder, a killed
+    Dask worker's scratch space) there, not in the system's temporary folder for good. The
+    tests of what a run leaves behind set TMPDIR themselves."""
+    folder = tmp_path_factory.mktemp("tmp", numbered=False)
+    before = os.environ.get("TMPDIR")
+    os.environ["TMPDIR"] = str(folder)
+    tempfile.tempdir = None  # tempfile caches the folder it found first
+    yield
+    if before is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = before
+    tempfile.tempdir = None
 
 
 @pytest.fixture
