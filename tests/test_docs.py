@@ -217,9 +217,18 @@ def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: lis
     check_output(command, shown, proc.stdout + proc.stderr)
 
 
+def _without_plot(command: str, keep: set[str]) -> str:
+    """``command`` without its ``--plot PATH`` unless ``keep`` names that path."""
+    match = re.search(r" --plot (\S+)", command)
+    if match is None or match.group(1) in keep:
+        return command
+    return command[: match.start()] + command[match.end() :]
+
+
 def _python_blocks() -> list[tuple[str, str, list[str]]]:
     """(page, code, setup): each Python block, with the page's earlier commands whose ``--out``
-    is a file the block names (it reads what they wrote)."""
+    is a file the block names (it reads what they wrote), without their ``--plot`` where the
+    block does not name the figure (the command itself runs as printed in its own test)."""
     out = []
     for page in PAGES:
         text = page.read_text()
@@ -227,7 +236,7 @@ def _python_blocks() -> list[tuple[str, str, list[str]]]:
             code = m.group(1)
             quoted = set(re.findall(r"[\"']([^\"'\s]+\.\w+)[\"']", code))
             setup = [
-                c.group(1).strip()
+                _without_plot(c.group(1).strip(), quoted)
                 for c in re.finditer(r"^\s*(?:\$ )?(?:\.venv/bin/)?(rockyade .*)$", text[: m.start()], re.M)
                 if quoted & set(re.findall(r"--out (\S+)", c.group(1)))
             ]
