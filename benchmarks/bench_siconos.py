@@ -70,38 +70,13 @@ class Size:
     record_s: float
     block_s: float
     pulse_s: float
-    #: The single block's record intensities, g.
-    block_pgas: tuple[float, ...]
-    #: Whether the single block's solvers run once untimed first (worker started, kernel loaded).
-    block_warm_up: bool
 
 
-FULL = Size(
-    courses=5,
-    units=6,
-    voussoirs=20,
-    wall_s=0.4,
-    arch_s=1.0,
-    record_s=RECORD_S,
-    block_s=30.0,
-    pulse_s=1.5,
-    block_pgas=(0.15, 0.3),
-    block_warm_up=True,
-)
+FULL = Size(courses=5, units=6, voussoirs=20, wall_s=0.4, arch_s=1.0, record_s=RECORD_S, block_s=30.0, pulse_s=1.5)
 #: Every part and every line, on scenes and runs as short as keep them running (the numbers mean
-#: nothing): a run this short costs about the same whatever its length, so fewer runs too.
-QUICK = Size(
-    courses=2,
-    units=2,
-    voussoirs=6,
-    wall_s=0.02,
-    arch_s=0.05,
-    record_s=0.1,
-    block_s=0.1,
-    pulse_s=0.05,
-    block_pgas=(0.3,),
-    block_warm_up=False,
-)
+#: nothing): a run this short costs about the same whatever its length, so fewer runs too
+#: (:func:`block_costs`: one intensity, no warm-up runs).
+QUICK = Size(courses=2, units=2, voussoirs=6, wall_s=0.02, arch_s=0.05, record_s=0.1, block_s=0.1, pulse_s=0.05)
 
 
 def wall_scene(size: Size, amplitude_g: float = 0.3, duration_s: float | None = None) -> Any:
@@ -279,16 +254,17 @@ def biblock_costs(size: Size) -> None:
 
 
 def block_costs(size: Size, repeat: int) -> None:
-    """The single block, ``repeat`` rounds in alternation: median time and median ratio to YADE."""
+    """The single block, ``repeat`` rounds in alternation: median time and median ratio to YADE
+    (quick: at 0.3 g only, its solvers not warmed up first)."""
     rows = [
         ("YADE (warm)", make_solver("yade")),
         ("reference DEM", make_solver("reference")),
         ("Siconos", make_solver("siconos")),
         ("Siconos, dt / 2", make_solver("siconos", dt_factor=0.5)),
     ]
-    for _, solver in rows[:3] if size.block_warm_up else ():
+    for _, solver in rows[:3] if size is not QUICK else ():
         solver.run(block_scene(0.2, 0.15))  # warm: worker started, kernel compiled
-    for pga_g in size.block_pgas:
+    for pga_g in (0.15, 0.3) if size is not QUICK else (0.3,):
         scene = block_scene(size.block_s, pga_g)
         print(f"single block, {scene.duration_s:g} s at {pga_g:g} g, {repeat} rounds ({load()})")
         seconds: dict[str, list[float]] = {label: [] for label, _ in rows}
