@@ -7,11 +7,10 @@ factors, local processes only; a test runs it so that it cannot rot)."""
 
 from __future__ import annotations
 
-import tempfile
 import time
-from pathlib import Path
 
 from quick_option import quick_mode  # type: ignore[import-not-found]
+from scratch import scratch_folder  # type: ignore[import-not-found]
 
 from rockyade.paper import SINGLE_SPECIMENS
 from rockyade.studies import fragility_study
@@ -27,7 +26,7 @@ def main() -> None:
         else {"load_factors": LOAD_FACTORS}
     )
     fragility_study.prepare(grid.get("specimens", SINGLE_SPECIMENS))
-    out = Path(tempfile.mkdtemp(prefix="rockyade-bench-batch-"))
+    out = scratch_folder("rockyade-bench-batch-")
     tasks = fragility_study.tasks(**grid, solvers=("reference",))
     from rockyade.batch import run_study_tasks
 

@@ -17,11 +17,12 @@ from __future__ import annotations
 import argparse
 import math
 import shutil
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
+
+from scratch import scratch_folder  # type: ignore[import-not-found]
 
 from rockyade.batch import comparable, run_study_tasks
 from rockyade.runner import Executor
@@ -50,7 +51,7 @@ def best_cpu(work: Callable[[], Any], repeat: int) -> tuple[float, Any]:
 
 
 def _folder() -> Path:
-    return Path(tempfile.mkdtemp(prefix="bench_groups_"))
+    return scratch_folder("rockyade-bench-groups-")
 
 
 def fragility(solver: str, repeat: int) -> tuple[int, float, float, bool]:

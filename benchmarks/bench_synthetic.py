@@ -7,17 +7,17 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import tempfile
 import time
 
 from quick_option import quick_mode  # type: ignore[import-not-found]
+from scratch import scratch_folder  # type: ignore[import-not-found]
 
 from rockyade.motion.suite_cache import generate_suite
 from rockyade.motion.synthetic import compatibility_report, paper_suite
 
 
 def main() -> None:
-    os.environ["ROCKYADE_CACHE"] = tempfile.mkdtemp(prefix="rockyade-bench-")
+    os.environ["ROCKYADE_CACHE"] = str(scratch_folder("rockyade-bench-"))
     spec = paper_suite()
     if quick_mode(__doc__):
         spec = dataclasses.replace(spec, count=3)

@@ -31,11 +31,11 @@ import math
 import os
 import resource
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
+from scratch import scratch_folder  # type: ignore[import-not-found]
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
@@ -159,7 +159,7 @@ def overhead_target(repeat: int, records: int = 10) -> None:
     from rockyade.batch.running import output, run_job, run_task
     from rockyade.studies import fragility_study
 
-    out = Path(tempfile.mkdtemp(prefix="rockyade-bench-targets-"))
+    out = scratch_folder("rockyade-bench-targets-")
     n = 0
 
     def fresh():
@@ -209,7 +209,7 @@ def batch_target(specimens: tuple[str, ...] = ("1", "2", "3", "4"), records: int
     from rockyade.studies import fragility_study
 
     fragility_study.prepare(specimens)
-    out = Path(tempfile.mkdtemp(prefix="rockyade-bench-targets-"))
+    out = scratch_folder("rockyade-bench-targets-")
     figures, per_cpu, verdicts = {}, {}, {}
     for name, workers, grouped in (("per-run", 1, False), ("grouped", 1, True), ("grouped", 2, True)):
         folder = out / f"{name}{workers}"

@@ -39,12 +39,12 @@ Run (the machine's load decides the time; the study says its cost before it star
 from __future__ import annotations
 
 import argparse
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from scratch import scratch_folder  # type: ignore[import-not-found]
 
 from rockyade.assess import ec8_suite, paper_suite_set, parse_measure, records_in_folder
 from rockyade.constants import G
@@ -125,7 +125,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, default=Path("runs/crosscheck"))
     parser.add_argument("--quick", action="store_true", help="three short records, coarse: a check that it runs")
     args = parser.parse_args()
-    quick_dir = Path(tempfile.mkdtemp(prefix="crosscheck-quick-")) if args.quick else None
+    quick_dir = scratch_folder("rockyade-bench-crosscheck-") if args.quick else None
     solvers = [s.strip() for s in args.solvers.split(",")]
     factors = [float(v) for v in args.dt_factors.split(",")]
     executor = Executor("local", args.workers)

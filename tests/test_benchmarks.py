@@ -70,7 +70,7 @@ RUN_ELSEWHERE = {
     ),
 }
 #: Not benchmarks: modules the others import, and the runner of them all.
-HELPERS = {"floor.py", "quick_option.py", "run_all.py"}
+HELPERS = {"floor.py", "quick_option.py", "run_all.py", "scratch.py"}
 
 
 def test_every_benchmark_script_is_run_by_a_test():
