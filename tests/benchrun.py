@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 
 
-def run_quick(script: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> str:
-    """``python SCRIPT --quick`` in this process: what it printed on stdout (it must end with exit
-    status 0; its error output is in the failure's message)."""
-    monkeypatch.setattr(sys, "argv", [str(script), "--quick"])
+def run_quick(script: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str], *args: str) -> str:
+    """``python SCRIPT --quick ARGS`` in this process: what it printed on stdout (it must end with
+    exit status 0; its error output is in the failure's message)."""
+    monkeypatch.setattr(sys, "argv", [str(script), "--quick", *args])
     monkeypatch.setattr(sys, "path", [str(script.parent), *sys.path])
     capsys.readouterr()
     try:

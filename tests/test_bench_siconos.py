@@ -7,12 +7,11 @@ YADE or Siconos is absent (``make test`` requires both)."""
 from __future__ import annotations
 
 import re
-import runpy
-import sys
 from pathlib import Path
 
 import pytest
 
+from .benchrun import run_quick
 from .processes import require_siconos, require_yade
 
 BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_siconos.py"
@@ -23,11 +22,7 @@ BENCH = Path(__file__).resolve().parents[1] / "benchmarks" / "bench_siconos.py"
 def test_the_siconos_benchmark_runs_every_part_in_its_quick_mode(capsys, monkeypatch):
     require_yade()
     require_siconos()
-    monkeypatch.setattr(
-        sys, "argv", [str(BENCH), "--quick", "wall", "arch", "biblock", "block", "costs", "convergence"]
-    )
-    runpy.run_path(str(BENCH), run_name="__main__")
-    out = capsys.readouterr().out
+    out = run_quick(BENCH, monkeypatch, capsys, "wall", "arch", "biblock", "block", "costs", "convergence")
     headings = ("wall of 5 blocks", "arch of 6 voussoirs", "bi-block under the EC8 record", "single block")
     for heading in (*headings, "measured against estimate_cost"):
         assert heading in out, heading
