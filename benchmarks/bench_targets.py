@@ -283,7 +283,7 @@ def wall_target() -> None:
         scene = scene_for(n, "rest", duration_s)
         moving = sum(1 for spec in scene.blocks if not spec.fixed)
         metas = [solver.run(scene).meta for _ in range(repeat)]
-        user[n] = min(1e9 * m["wall_time_s"] / (m["n_steps"] * moving) for m in metas)
+        user[n] = min(1e9 * m.wall_time_s / (m.n_steps * moving) for m in metas if m.wall_time_s and m.n_steps)
     row(
         "assembly: the same as `rockyade run` reports it (wall_time_s per block-step; 1 block over 2 s)",
         f"{user[1000]:.0f} / {user[1]:.0f} ns",
