@@ -150,19 +150,29 @@ def _cpu_s() -> tuple[float, float]:
 @pytest.hookimpl(hookwrapper=True)
 def pytest_runtest_protocol(item: pytest.Item, nextitem: pytest.Item | None):
     """With ``$ROCKYADE_TEST_CPU_LOG`` set, log each test's wall and CPU time (set-up, call and
-    tear-down together): the suite's cost measured where the machine is shared."""
+    tear-down together), its worker's pid and its start (Unix time, s): the suite's cost measured
+    where the machine is shared, and, with the pid and start, the processes a test started (as
+    process accounting lists them) found."""
     log = os.environ.get(CPU_LOG_ENV)
     if not log:
         yield
         return
     own0, children0 = _cpu_s()
+    started_at = time.time()
     start = time.perf_counter()
     yield
     wall = time.perf_counter() - start
     own1, children1 = _cpu_s()
     worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
     forked = sum(value for name, value in item.user_properties if name == "forked_cpu_s")  # test_docs.py's
-    row = {"test": item.nodeid, "wall_s": wall, "cpu_s": own1 - own0, "children_cpu_s": children1 - children0 + forked}
+    row = {
+        "test": item.nodeid,
+        "pid": os.getpid(),
+        "started_at": started_at,
+        "wall_s": wall,
+        "cpu_s": own1 - own0,
+        "children_cpu_s": children1 - children0 + forked,
+    }
     with open(f"{log}.{worker}", "a", encoding="utf-8") as out:
         out.write(json.dumps(row) + "\n")
 
