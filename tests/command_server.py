@@ -30,6 +30,8 @@ import time
 import traceback
 from typing import TextIO
 
+import numpy as np
+
 #: What a rockyade command imports before its first line of work (measured with
 #: ``python -X importtime``): loaded here once, shared by every forked command.
 PRELOAD = (
@@ -64,6 +66,31 @@ def _preload() -> None:
     import rockyade.cli
 
     rockyade.cli.build_parser()  # imports every command's module (each registers its options)
+    _load_kernels()
+
+
+def _load_kernels() -> None:
+    """Load the solvers' single-threaded numba code from numba's cache (``make test`` compiled
+    it): numba's first use in a process sets up its typing and code-generation registries (and
+    imports scipy's BLAS), ~0.3 CPU-s, then each kernel's loading; done here once, a forked
+    command finds them loaded. The runs stepped together (:mod:`rockyade.kernel.runs`) are left
+    out: they run on numba's threads, and this process starts none before it forks."""
+    from rockyade.dem.engine import warm_up
+    from rockyade.housner.integrator import warm_up as warm_housner
+    from rockyade.motion.spectra import response_spectrum
+    from rockyade.twoblock import warm_up as warm_twoblock
+
+    threads = len(os.listdir("/proc/self/task"))  # the BLAS libraries' own, where not set to one
+    warm_up()  # the general loop
+    warm_up(single=True)
+    warm_housner()
+    warm_twoblock()
+    response_spectrum(np.array([0.0, 1.0, 0.0]), 0.025, np.array([0.5]))
+    started = len(os.listdir("/proc/self/task")) - threads
+    if started:  # a thread would not survive the fork, and whatever it holds would stay held
+        raise RuntimeError(
+            f"loading the kernels started {started} thread(s) in the command starter; it must start none"
+        )
 
 
 def _run(request: dict) -> int:
