@@ -7,8 +7,8 @@ anything; forked from this process, a command starts with those imports done and
 as it would from a shell: its own process (its own signal handlers, environment, working folder
 and exit code), ``rockyade.cli.main`` as the console script calls it, stdout and stderr
 to files, Python's normal exit (threads joined, ``atexit`` run). The starter loads the single-threaded
-kernels (a tiny run of each) and starts no thread of its own before it forks (the BLAS libraries'
-idle pools aside, one thread each under ``make test``).
+kernels (a tiny run of each) and starts no thread of its own before it forks (its libraries start
+idle ones on import: BLAS pools, one more under ``make test``'s one-thread settings).
 
 Protocol (one JSON object a line): the test writes a request on stdin ``{"kind": "rockyade" |
 "script" | "code", "argv": [...], "code": str, "cwd": str, "env": {...} | null, "stdout": path,
