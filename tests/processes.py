@@ -9,11 +9,14 @@ from pathlib import Path
 
 import pytest
 
-from rockyade.yade import backend as yade_backend
-
 
 def require_yade() -> None:
     """Skip without YADE; fail instead where ``ROCKYADE_REQUIRE_YADE=1`` (``make test``, CI)."""
+    # imported here, not with the module: YADE's backend brings the calibration and the
+    # reference DEM's kernels (~1.5 s of CPU), which test_ctrl_c_workers' fresh Pythons, that
+    # import this module for fake_program alone, paid for nothing
+    from rockyade.yade import backend as yade_backend
+
     if yade_backend.yade_available():
         return
     message = f"YADE is not installed ({yade_backend.YADE_PYTHON}, {yade_backend.YADE_PY_DIR}): apt-get install yade"

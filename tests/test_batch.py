@@ -79,10 +79,13 @@ def test_dask_executor_equals_local(tmp_path):
     tasks_local = _tasks(tmp_path / "local")
     tasks_dask = _tasks(tmp_path / "dask")
     local = run_study_tasks(tasks_local, tmp_path / "local", workers=2, progress=False)
-    # one worker process: the test is about a scheduler's results equal to local ones, not about
-    # parallelism (a second worker only adds its start-up: a Python importing dask and rockyade)
+    # one worker, a thread of this process, the scheduler's comms on TCP (every job and result
+    # serialised through the loopback, as to a remote worker): the test is about a scheduler's
+    # results equal to local ones, not about its processes (a worker process only added its
+    # start-up, a Python importing dask and rockyade; test_dask_deployment runs Dask's own
+    # scheduler and worker processes)
     with distributed.LocalCluster(
-        n_workers=1, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None
+        n_workers=1, threads_per_worker=1, processes=False, protocol="tcp", host="127.0.0.1", dashboard_address=None
     ) as cluster:
         assert cluster.scheduler_address.startswith("tcp://127.0.0.1:")  # loopback only
         dask = run_study_tasks(

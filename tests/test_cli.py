@@ -230,11 +230,12 @@ def test_motion_commands(capsys, tmp_path, monkeypatch):
 
 
 @pytest.mark.parametrize("sub", ["info", "spectrum", "synth", "check"])
-def test_motion_help(sub):
-    proc = subprocess.run(
-        [sys.executable, "-m", "rockyade.cli", "motion", sub, "--help"], capture_output=True, text=True
-    )
-    assert proc.returncode == 0 and "usage:" in proc.stdout
+def test_motion_help(sub, capsys):
+    """The parser's help, in this process (``python -m rockyade.cli`` is
+    :func:`test_help_for_every_command`'s)."""
+    with pytest.raises(SystemExit) as ended:
+        main(["motion", sub, "--help"])
+    assert ended.value.code == 0 and "usage:" in capsys.readouterr().out
 
 
 OUTPUT_UNDER_A_FILE = [

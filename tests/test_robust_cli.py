@@ -36,12 +36,6 @@ def _python(code: str, cwd: Path | None = None) -> subprocess.CompletedProcess[s
     )
 
 
-def _rockyade(*argv: str, cwd: Path | None = None, **kwargs) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, "-m", "rockyade", *argv], capture_output=True, text=True, cwd=cwd, timeout=300, **kwargs
-    )
-
-
 def test_building_the_parser_imports_no_heavy_module():
     proc = _python(
         f"""
@@ -214,15 +208,36 @@ def test_output_files_respect_the_umask(tmp_path):
     assert Result.read(tmp_path / "r.csv").status == "completed"
 
 
-def test_a_second_writer_of_the_same_output_is_refused(tmp_path):
-    from rockyade.io.locking import output_lock
+#: Another process writing ``sys.argv[1]``: holds its lock until its standard input closes,
+#: then releases it as a writer that ends does (the lock file removed).
+HOLD_UNTIL_STDIN_CLOSES = (
+    "import sys\nfrom rockyade.io.locking import output_lock\n"
+    "with output_lock(sys.argv[1]):\n    print('held', flush=True)\n    sys.stdin.read()\n"
+)
 
+
+def test_a_second_writer_of_the_same_output_is_refused(tmp_path, capsys):
+    """The first writer is another process holding the output's lock (it imports the lock
+    alone); the second is the command's ``main`` in this process (a process of its own only
+    added rockyade's imports, some 1.2 s of CPU)."""
     out = tmp_path / "r.csv"
-    with output_lock(out):
-        proc = _rockyade("run", str(EXAMPLES / "specimen1_free.toml"), "--out", str(out))
-        assert proc.returncode == 2, proc.stderr
-        assert "error: out:" in proc.stderr and "being written by another rockyade process" in proc.stderr
-        assert f"pid {os.getpid()}" in proc.stderr
+    holder = subprocess.Popen(
+        [sys.executable, "-c", HOLD_UNTIL_STDIN_CLOSES, str(out)],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        capsys.readouterr()
+        code = main(["run", str(EXAMPLES / "specimen1_free.toml"), "--out", str(out)])
+        err = capsys.readouterr().err
+        assert code == 2, err
+        assert "error: out:" in err and "being written by another rockyade process" in err
+        assert f"pid {holder.pid}" in err
+    finally:
+        holder.communicate(timeout=60)  # its input closed: it releases the lock and ends
+    assert holder.returncode == 0
     assert not out.exists()
     assert not (tmp_path / ".r.csv.lock").exists()  # released and removed
     assert main(["run", str(EXAMPLES / "specimen1_free.toml"), "--out", str(out)]) == 0 and out.is_file()

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy import optimize, special, stats
+from scipy import optimize, special
 
 from rockyade.errors import InputError
 
@@ -80,7 +80,7 @@ class Fragility:
         if self.status != "fitted":
             return np.full(x.shape, 0.0 if self.status == "no collapse" else 1.0)
         with np.errstate(divide="ignore"):
-            return stats.norm.cdf(np.log(np.maximum(x, 1e-300) / self.median) / self.beta)
+            return special.ndtr(np.log(np.maximum(x, 1e-300) / self.median) / self.beta)  # the normal's CDF
 
 
 def fit_lognormal(
@@ -288,7 +288,7 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
         Two-sided level.
     """
     _check_counts(k, n)
-    z = float(stats.norm.ppf(0.5 + confidence / 2.0))
+    z = float(special.ndtri(0.5 + confidence / 2.0))  # the normal's quantile
     phat = k / n
     den = 1.0 + z * z / n
     centre = (phat + z * z / (2 * n)) / den
@@ -299,6 +299,11 @@ def wilson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, fl
 def clopper_pearson_interval(k: int, n: int, confidence: float = 0.95) -> tuple[float, float]:
     """Exact (Clopper & Pearson 1934) interval of a binomial proportion k / n; parameters as
     :func:`wilson_interval`."""
+    # scipy.stats here, not with the module: its import costs some 0.7 s of CPU, which every
+    # fragility and assess command paid at start-up for the normal distribution alone
+    # (scipy.special's ndtr and ndtri, the functions scipy.stats.norm itself calls)
+    from scipy import stats
+
     _check_counts(k, n)
     a = 1.0 - confidence
     lo = 0.0 if k == 0 else float(stats.beta.ppf(a / 2, k, n - k + 1))
