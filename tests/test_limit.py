@@ -69,7 +69,9 @@ def _assert_sound(result) -> None:
 @pytest.mark.parametrize("sliding", [True, False])
 def test_a_block_rocks_at_b_over_h(width, height, direction, sliding):
     """Housner's static uplift: lambda = b / h_c = width / height, about the corner on the load's side."""
-    result = limit_analysis(block_scene(width, height, friction_deg=60.0), direction=direction, sliding=sliding)
+    result = limit_analysis(
+        block_scene(width, height, friction_deg=60.0), direction=direction, sliding=sliding, nonlinear=False
+    )
     assert result.status == "collapse"
     assert result.load_multiplier == pytest.approx(width / height, rel=EXACT)
     (hinge,) = result.mechanism.hinges
@@ -95,7 +97,7 @@ def test_an_off_centre_vertical_load_changes_the_multiplier_as_statics_says(x_lo
     b, h_c = width / 2, height / 2
     s = 1.0 if direction == "+x" else -1.0
     load = PointLoad("b01", (x_load, height), (0.0, -N), mass_kg=0.0)
-    result = limit_analysis(scene, direction=direction, loads=[load], sliding=False)
+    result = limit_analysis(scene, direction=direction, loads=[load], sliding=False, nonlinear=False)
     expected = (W * b + N * (b - s * x_load)) / (W * h_c)
     assert result.load_multiplier == pytest.approx(expected, rel=EXACT)
     _assert_sound(result)
@@ -108,7 +110,7 @@ def test_a_horizontal_dead_load_counts_without_the_multiplier():
     scene = block_scene(width, height)
     W = float(rigid_block_model(scene).masses_kg[0] * G)
     H, y_H = 0.05 * W, 1.5
-    result = limit_analysis(scene, loads=[PointLoad(0, (0.0, y_H), (H, 0.0))], sliding=False)
+    result = limit_analysis(scene, loads=[PointLoad(0, (0.0, y_H), (H, 0.0))], sliding=False, nonlinear=False)
     assert result.load_multiplier == pytest.approx((W * width / 2 - H * y_H) / (W * height / 2), rel=EXACT)
     _assert_sound(result)
 
@@ -120,8 +122,8 @@ def test_loads_on_fixed_blocks_change_nothing_and_bad_loads_are_refused():
             {"name": "post", "width_m": 0.3, "height_m": 1.0, "position_m": [1.0, 0.0], "fixed": True},
         ]
     )
-    plain = limit_analysis(scene, sliding=False).load_multiplier
-    loaded = limit_analysis(scene, loads=[PointLoad("post", (1.0, 1.0), (0.0, -1e4))], sliding=False)
+    plain = limit_analysis(scene, sliding=False, nonlinear=False).load_multiplier
+    loaded = limit_analysis(scene, loads=[PointLoad("post", (1.0, 1.0), (0.0, -1e4))], sliding=False, nonlinear=False)
     assert loaded.load_multiplier == pytest.approx(plain, rel=EXACT) == pytest.approx(0.2)
     for bad, field in [
         (PointLoad("nope", (0.0, 1.0), (0.0, -1.0)), "loads[0].block"),
@@ -162,7 +164,7 @@ def _weakest_joint(widths, heights, density=2400.0):
 )
 def test_a_stack_fails_at_its_weakest_joint(widths, heights):
     lambdas = _weakest_joint(widths, heights)
-    result = limit_analysis(stack_scene(widths, heights), sliding=False)
+    result = limit_analysis(stack_scene(widths, heights), sliding=False, nonlinear=False)
     assert result.load_multiplier == pytest.approx(lambdas.min(), rel=EXACT)
     j = int(np.argmin(lambdas))
     (hinge,) = result.mechanism.hinges
@@ -176,7 +178,7 @@ def test_a_stack_fails_at_its_weakest_joint(widths, heights):
 
 def test_a_squat_block_slides_at_tan_phi_and_rocks_without_sliding():
     scene = block_scene(2.0, 0.4, friction_deg=10.0)
-    slides = limit_analysis(scene)
+    slides = limit_analysis(scene, nonlinear=False)
     assert slides.load_multiplier == pytest.approx(math.tan(math.radians(10.0)), rel=EXACT)
     assert slides.mechanism.hinges == () and len(slides.mechanism.sliding) == 1
     (slide,) = slides.mechanism.sliding
@@ -184,18 +186,20 @@ def test_a_squat_block_slides_at_tan_phi_and_rocks_without_sliding():
     assert slide.opening == pytest.approx(math.tan(math.radians(10.0)))  # associated flow dilates
     assert slides.friction_angle_deg == 10.0 and any("associated" in note for note in slides.notes)
     _assert_sound(slides)
-    rocks = limit_analysis(scene, sliding=False)
+    rocks = limit_analysis(scene, sliding=False, nonlinear=False)
     assert rocks.load_multiplier == pytest.approx(2.0 / 0.4, rel=EXACT)
     assert len(rocks.mechanism.hinges) == 1 and rocks.mechanism.sliding == ()
     assert rocks.friction_angle_deg is None and rocks.notes == []
     # the friction angle given for every joint replaces the scene's
-    assert limit_analysis(scene, friction_angle_deg=20.0).load_multiplier == pytest.approx(math.tan(math.radians(20)))
+    assert limit_analysis(scene, friction_angle_deg=20.0, nonlinear=False).load_multiplier == pytest.approx(
+        math.tan(math.radians(20))
+    )
 
 
 def test_a_joint_entry_of_the_scene_sets_that_joints_friction():
     blocks = [{"name": "slab", "width_m": 2.0, "height_m": 0.4, "position_m": [0.0, 0.0]}]
     joints = [{"blocks": ["slab", "base"], "friction_angle_deg": 5.0}]
-    result = limit_analysis(positioned_scene(blocks, friction_deg=30.0, joints=joints))
+    result = limit_analysis(positioned_scene(blocks, friction_deg=30.0, joints=joints), nonlinear=False)
     assert result.load_multiplier == pytest.approx(math.tan(math.radians(5.0)), rel=EXACT)
     assert result.model.interfaces[0].friction_angle_deg == 5.0
 
@@ -206,7 +210,7 @@ def test_a_wall_slides_on_its_base_at_tan_phi_when_that_is_weakest():
 
     data = wall(courses=2, units_per_course=6, bond="stack")
     data["contact"]["friction_angle_deg"] = 15.0
-    result = limit_analysis(scene_from_dict(data))
+    result = limit_analysis(scene_from_dict(data), nonlinear=False)
     assert result.load_multiplier == pytest.approx(math.tan(math.radians(15.0)), rel=1e-7)
     assert result.mechanism.slides
     _assert_sound(result)
@@ -235,7 +239,7 @@ def test_a_scene_that_cannot_stand_is_unstable():
             {"name": "upper", "width_m": 0.4, "height_m": 0.4, "position_m": [0.15, 0.4]},
         ]
     )
-    result = limit_analysis(scene, sliding=False)
+    result = limit_analysis(scene, sliding=False, nonlinear=False)
     assert result.status == "collapse" and result.load_multiplier == pytest.approx(0.05 / 0.2)  # upper on the corner
 
 
@@ -249,13 +253,13 @@ def test_a_block_boxed_in_by_fixed_blocks_has_no_mechanism():
     scene = positioned_scene(blocks)
     for sliding in (True, False):
         for direction in ("+x", "-x"):
-            result = limit_analysis(scene, direction=direction, sliding=sliding)
+            result = limit_analysis(scene, direction=direction, sliding=sliding, nonlinear=False)
             assert result.status == "no_mechanism" and result.load_multiplier is None
 
 
 def test_a_large_multiplier_is_not_mistaken_for_no_mechanism():
     """A block 2,000 times wider than tall: lambda = 2,000, above the first solve's cap."""
-    result = limit_analysis(block_scene(200.0, 0.1), sliding=False)
+    result = limit_analysis(block_scene(200.0, 0.1), sliding=False, nonlinear=False)
     assert result.status == "collapse" and result.load_multiplier == pytest.approx(2000.0, rel=1e-7)
 
 
@@ -341,6 +345,6 @@ def test_a_joint_that_opens_while_moving_along_is_not_sliding(examples_dir):
 def test_what_the_model_leaves_out_is_said(examples_dir):
     from rockyade.scene import load_scene
 
-    result = limit_analysis(load_scene(examples_dir / "specimen1_free.toml"), sliding=False)
+    result = limit_analysis(load_scene(examples_dir / "specimen1_free.toml"), sliding=False, nonlinear=False)
     assert any("alpha_rad given for specimen1 is not used" in note for note in result.notes)
     assert result.load_multiplier == pytest.approx(0.25 / 1.0)  # the geometry's b / h_c, not tan(0.235)
