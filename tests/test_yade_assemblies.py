@@ -21,6 +21,7 @@ from rockyade.blocks.restitution import find_peaks
 from rockyade.calibration.model_stage import calibrated_model
 from rockyade.dem.statics import rest_springs, static_penetration
 from rockyade.errors import InputError
+from rockyade.result import Result
 from rockyade.scene import scene_from_dict
 from rockyade.scene.placement import penetration_depth, rotation_matrix
 from rockyade.solvers import reference
@@ -271,7 +272,7 @@ def test_pad_case_blocks_do_not_pass_through_each_other():
     backend let it sink 117 mm)."""
     scene = pad_case()
     model = calibrated_model(scene)
-    result = YadeSolver().run(scene)
+    result = _yade_run(scene, model)  # the same run as test_pad_case_yade_vs_reference's at Eq 7's step
     assert result.ok, result.meta.failure_reason
     worst = _max_overlap(model, result)
     assert worst < 1e-3
@@ -408,6 +409,18 @@ def _dt_halved(run, model):
     return run(model), run(model.with_dt(model.dt_s / 2))
 
 
+#: YADE's runs of a scene's model at its own time step, by scene hash: a scene two tests run
+#: (the pad case: its overlaps, its agreement with the reference DEM) runs once per process.
+_YADE_RUNS: dict[str, Result] = {}
+
+
+def _yade_run(scene, model) -> Result:
+    """YADE's run of ``model`` (``calibrated_model(scene)``), once per scene in this process."""
+    if scene.scene_hash not in _YADE_RUNS:
+        _YADE_RUNS[scene.scene_hash] = yade_backend.run_model(model)
+    return _YADE_RUNS[scene.scene_hash]
+
+
 def _metrics(result, names, alpha):
     """Per block: max |theta|, the time of its first peak and max |x| (centroid)."""
     out = {}
@@ -434,7 +447,7 @@ def _compare_with_reference(scene, names, alpha, floors):
         pytest.skip(reason)
     model = calibrated_model(scene)
     ref, ref_half = _dt_halved(lambda m: reference.run_model(m, record_energy=False), model)
-    yade, yade_half = _dt_halved(yade_backend.run_model, model)
+    yade, yade_half = _yade_run(scene, model), yade_backend.run_model(model.with_dt(model.dt_s / 2))
     for r in (ref, ref_half, yade, yade_half):
         assert r.ok, r.meta.failure_reason
     mr, mr2, my, my2 = (_metrics(r, names, alpha) for r in (ref, ref_half, yade, yade_half))
@@ -457,8 +470,10 @@ def test_wall_yade_vs_reference():
 
 def test_frame_yade_vs_reference():
     """The rocking frame under its one-sine pulse: the columns' max |theta|, first peak times
-    and max |x| within max(3 %, 2 %, 3 %) or 1.5x the DEMs' own dt/2 change."""
-    scene, alpha = _frame_pulse(amplitude=1.3, duration=1.5)
+    and max |x| within max(3 %, 2 %, 3 %) or 1.5x the DEMs' own dt/2 change. The run ends at
+    0.9 s, after the largest excursion (0.779 s in all four runs): the metrics are those of the
+    1.5 s run it replaced, to the last digit (measured)."""
+    scene, alpha = _frame_pulse(amplitude=1.3, duration=0.9)
     _compare_with_reference(scene, ["left", "right"], alpha, [0.03, 0.02, 0.03])
 
 

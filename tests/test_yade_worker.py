@@ -277,7 +277,7 @@ def test_yade_runs_leave_nothing_in_the_temporary_folder(tmp_path):
         "r = YadeSolver(timeout_s=0.01, workdir='/tmp/kept0').run(long)\n"  # shorter than YADE's start-up
         "assert r.meta.failure_reason.startswith('timeout'), r.meta\n"
         "assert YadeSolver(warm=False).run(s).ok and YadeSolver().run(s).ok and YadeSolver().run(s).ok\n"
-        "r = YadeSolver(timeout_s=1.5, workdir='/tmp/kept').run(long)\n"
+        "r = YadeSolver(timeout_s=0.5, workdir='/tmp/kept').run(long)\n"  # in the warm worker: stopped mid-run
         "assert r.meta.failure_reason.startswith('timeout'), r.meta\n"
     )
     # a checkout or a virtual environment under /tmp (a fresh clone in /tmp/fresh) stays
