@@ -8,7 +8,7 @@ import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import add_command, check_output_dir, json_out, print_wrote
+from rockyade.cli.common import Commands, add_command, check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     accept_negative_values,
@@ -319,7 +319,7 @@ def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dic
     print_wrote(Path(f"{', '.join(written)} in {out}"), args.json)
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade assess``."""
     p = add_command(sub, cmd_assess)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")

@@ -8,13 +8,19 @@ import os
 import re
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:
+    from rockyade.cli import CommandParser
     from rockyade.run_meta import RunMeta
     from rockyade.solvers.base import Solver
+
+
+#: A parser's table of sub-commands, as ``ArgumentParser.add_subparsers`` returns it (its
+#: parsers are of their parent's class, :class:`~rockyade.cli.CommandParser`).
+Commands: TypeAlias = "argparse._SubParsersAction[CommandParser]"
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
@@ -49,7 +55,7 @@ def print_wrote(path: Path, json_mode: bool = False) -> None:
     print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
 
 
-def add_command(sub: Any, run: Callable[..., int], name: str | None = None) -> argparse.ArgumentParser:
+def add_command(sub: Commands, run: Callable[..., int], name: str | None = None) -> argparse.ArgumentParser:
     """Add the sub-command that ``run`` carries out, documented by ``run``'s docstring: its
     first paragraph is the one-line help of ``rockyade --help``, the rest the description of
     ``rockyade NAME --help`` (one text for readers of the code and users of the command), up
@@ -74,9 +80,7 @@ def add_command(sub: Any, run: Callable[..., int], name: str | None = None) -> a
     if name is None:
         name = run.__name__.removeprefix("cmd_").replace("_", "-")
     # argparse %-formats a help string (not a description): a "%" in the summary is a percent sign
-    parser: argparse.ArgumentParser = sub.add_parser(
-        name, help=" ".join(summary.split()).replace("%", "%%"), description=description or None
-    )
+    parser = sub.add_parser(name, help=" ".join(summary.split()).replace("%", "%%"), description=description or None)
     parser.set_defaults(func=run)
     return parser
 
@@ -94,6 +98,19 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="run even when the cost estimate (integration steps, samples, memory) is above the documented limits",
     )
+
+
+def add_accel_units(p: argparse.ArgumentParser, help_text: str) -> None:
+    """``--accel-units``: g (the default) or m/s2, the unit accelerations are shown in.
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    help_text
+        The option's help: what is shown in that unit, and where the other unit goes.
+    """
+    p.add_argument("--accel-units", choices=["g", "m/s2"], default="g", help=help_text)
 
 
 def check_output_dir(path: Path, option: str) -> None:
@@ -226,7 +243,7 @@ def print_calibration(result: dict[str, Any], method: str) -> None:
         print(f"  note: {note}")
 
 
-def add_yade_timeout(p: Any) -> None:
+def add_yade_timeout(p: argparse.ArgumentParser) -> None:
     """The ``--yade-timeout`` option (run, compare, batch): YADE's ``timeout_s``."""
     p.add_argument(
         "--yade-timeout",

@@ -9,9 +9,8 @@ import re
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_allow_large, add_command, check_output_file, json_out, print_wrote
+from rockyade.cli.common import Commands, add_allow_large, add_command, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError, RockyadeError
 
 #: The coulomb rule's progress: first after this many seconds, then at most every PROGRESS_EVERY_S.
@@ -164,7 +163,7 @@ class _Progress:
             _say(f"coulomb iteration {iteration}/{self.max_iterations}: lambda = {multiplier:.6g}, {seconds:.0f} s")
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade limit``."""
     p = add_command(sub, cmd_limit)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
