@@ -18,7 +18,7 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import Commands, add_command, check_output_file
+from rockyade.cli.common import Commands, add_command, add_command_group, check_output_file
 from rockyade.cli.drawings import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import ALIASES, COMMON, COMMON_PARAMS, KINDS, OVERBURDEN, Param, options
@@ -418,13 +418,14 @@ def _result_of(scene: Any, args: argparse.Namespace) -> Any:
 
 def register(sub: Commands) -> None:
     """Add ``build`` (one sub-command per kind) and ``draw``."""
-    p = sub.add_parser(
+    kinds = add_command_group(
+        sub,
         "build",
-        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
-        description="Generate a scene file of a masonry assembly (every block placed by position_m) that you "
+        "generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
+        "Generate a scene file of a masonry assembly (every block placed by position_m) that you "
         "can read and edit. Options are SI, with units in their names.",
+        "kind",
     )
-    kinds = p.add_subparsers(dest="kind", required=True, metavar="KIND")
     for kind, (text, params) in KINDS.items():
         k = kinds.add_parser(
             kind,

@@ -85,6 +85,28 @@ def add_command(sub: Commands, run: Callable[..., int], name: str | None = None)
     return parser
 
 
+def add_command_group(sub: Commands, name: str, help_text: str, description: str, dest: str) -> Commands:
+    """Add a command whose first argument names one of its own sub-commands (``rockyade build
+    KIND``, ``rockyade motion MOTION_COMMAND``).
+
+    Parameters
+    ----------
+    sub
+        The sub-parsers to add to.
+    name, help_text, description
+        The command's name, its line in ``rockyade --help`` and the head of ``rockyade NAME --help``.
+    dest
+        The attribute of the parsed arguments that names the sub-command (shown in capitals).
+
+    Returns
+    -------
+    Commands
+        The command's own sub-parsers, for its sub-commands.
+    """
+    group = sub.add_parser(name, help=help_text, description=description)
+    return group.add_subparsers(dest=dest, required=True, metavar=dest.upper())
+
+
 def add_allow_large(p: argparse.ArgumentParser) -> None:
     """``--allow-large``: run above the documented cost limits (docs/robustness.md).
 

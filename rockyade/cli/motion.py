@@ -11,6 +11,7 @@ from rockyade.cli.common import (
     Commands,
     add_accel_units,
     add_command,
+    add_command_group,
     check_output_dir,
     check_output_file,
     json_out,
@@ -453,13 +454,14 @@ def _write_selection(args, chosen, folder, records, shown, spectra, target, t_ra
 
 def register(sub: Commands) -> None:
     """Add ``rockyade motion ...``."""
-    motion = sub.add_parser(
+    msub = add_command_group(
+        sub,
         "motion",
-        help="records, response spectra, synthetic EC8 suites, records selected to a site",
-        description="Base motions: read records, response spectra, spectrum-compatible suites, records selected "
+        "records, response spectra, synthetic EC8 suites, records selected to a site",
+        "Base motions: read records, response spectra, spectrum-compatible suites, records selected "
         "and scaled to a site's spectrum.",
+        "motion_command",
     )
-    msub = motion.add_subparsers(dest="motion_command", required=True, metavar="MOTION_COMMAND")
 
     p = add_command(msub, cmd_info)
     _add_record_arguments(p)
