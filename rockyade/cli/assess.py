@@ -27,8 +27,12 @@ from rockyade.errors import InputError
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
     from collections.abc import Callable
 
-    from rockyade.assess import DynamicSettings, Position
+    from rockyade.assess import Assessment, DynamicSettings, Position
+    from rockyade.assess.fragility_analysis import FragilityPlan
+    from rockyade.assess.stripes import StripesInterruptedError
+    from rockyade.runner import Executor
     from rockyade.runner.study_folder import StudyFolder
+    from rockyade.scene import Scene
 
 #: Exit code of a scene that cannot stand (the answer is not a number).
 EXIT_UNSTABLE = 1
@@ -223,7 +227,7 @@ def _check_report_option(args: argparse.Namespace) -> None:
 
 
 def _report(
-    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Any, data: dict[str, Any]
+    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Assessment, data: dict[str, object]
 ) -> None:
     """With --report: the page, written from ``data`` (what assess.json holds) as a set of its own."""
     if args.report is None:
@@ -238,11 +242,16 @@ def _report(
 
 
 def _dynamics(
-    args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, folder: StudyFolder | None
+    args: argparse.Namespace,
+    result: Assessment,
+    scene: Scene,
+    dynamic: DynamicSettings,
+    executor: Executor,
+    folder: StudyFolder | None,
 ) -> None:
     from rockyade.assess.assessment import add_dynamics
 
-    def on_plan(plan: Any) -> None:
+    def on_plan(plan: FragilityPlan) -> None:
         if not args.json:
             print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
             print_plan(plan, args.workers, indent="  ")
@@ -259,13 +268,15 @@ def _dynamics(
     )
 
 
-def _static_data(args: argparse.Namespace, result: Any) -> dict[str, object]:
+def _static_data(args: argparse.Namespace, result: Assessment) -> dict[str, object]:
     data: dict[str, object] = result.to_dict()
     data["scene"] = str(args.scene)
     return data
 
 
-def _interrupted(args: argparse.Namespace, result: Any, exc: Any, folder: StudyFolder) -> str:
+def _interrupted(
+    args: argparse.Namespace, result: Assessment, exc: StripesInterruptedError, folder: StudyFolder
+) -> str:
     """After Ctrl-C: the static answer (``partial/assess.json``, marked partial) and the runs
     that finished (``partial/runs.csv``), for ``--resume`` to go on from; what the message names."""
     from rockyade.assess.stripes import runs_frame
@@ -283,7 +294,7 @@ def _interrupted(args: argparse.Namespace, result: Any, exc: Any, folder: StudyF
     return path
 
 
-def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, object]:
+def _finish(args: argparse.Namespace, result: Assessment, scene: Scene) -> dict[str, object]:
     """The pushover, the dynamics' text, the JSON."""
     from rockyade.assess.report_lines import dynamic_lines
 
@@ -302,7 +313,7 @@ def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, obje
     return data
 
 
-def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dict[str, object]) -> None:
+def _write(folder: StudyFolder, args: argparse.Namespace, result: Assessment, data: dict[str, object]) -> None:
     """The result set, replaced as a whole (:mod:`rockyade.io.resultset`)."""
     from rockyade.figures.wall_assessment import draw_assessment
     from rockyade.io.atomic import write_json
