@@ -8,7 +8,7 @@ import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import Commands, add_command, check_output_dir, json_out, print_wrote
+from rockyade.cli.common import Commands, add_command, add_joint_options, check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     accept_negative_values,
@@ -349,23 +349,13 @@ def register(sub: Commands) -> None:
         default="both",
         help="the sense of the static load (default both: the smaller a0* governs)",
     )
-    joints = p.add_mutually_exclusive_group()
-    joints.add_argument(
-        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 89.9]"
-    )
-    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
-    p.add_argument(
-        "--friction-rule",
-        metavar="RULE",
-        help="the limit analysis's friction: associated (alone: sliding joints dilate, an upper bound) or coulomb "
+    add_joint_options(
+        p,
+        "friction angle of every joint, degrees in [0, 89.9]",
+        "the limit analysis's friction: associated (alone: sliding joints dilate, an upper bound) or coulomb "
         "(alone: non-dilatant, iterated: see rockyade limit); default: associated, and where its mechanism slides "
         "with friction a coulomb pass too, the check taking the lower multiplier (both printed)",
-    )
-    p.add_argument(
-        "--fm",
-        type=float,
-        metavar="MPA",
-        help="the masonry's compressive strength fm, MPa (> 0): the hinges move into their joints by the stress "
+        "the masonry's compressive strength fm, MPa (> 0): the hinges move into their joints by the stress "
         "block 0.85 fm (NTC 2018 7.8.2.2.1), iterated with the limit analysis' normal forces; default: rigid blocks",
     )
     height = p.add_argument_group("a mechanism at height (default: at ground level)")

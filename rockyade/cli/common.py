@@ -135,6 +135,26 @@ def add_accel_units(p: argparse.ArgumentParser, help_text: str) -> None:
     p.add_argument("--accel-units", choices=["g", "m/s2"], default="g", help=help_text)
 
 
+def add_joint_options(
+    p: argparse.ArgumentParser, friction_angle_help: str, friction_rule_help: str, fm_help: str
+) -> None:
+    """The joints of a limit analysis (``limit``, ``assess``): ``--friction-angle-deg`` or
+    ``--no-sliding``, ``--friction-rule`` and ``--fm`` (each checked where it is read).
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    friction_angle_help, friction_rule_help, fm_help
+        The help of ``--friction-angle-deg``, ``--friction-rule`` and ``--fm`` in this command.
+    """
+    joints = p.add_mutually_exclusive_group()
+    joints.add_argument("--friction-angle-deg", type=float, metavar="DEG", help=friction_angle_help)
+    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
+    p.add_argument("--friction-rule", metavar="RULE", help=friction_rule_help)
+    p.add_argument("--fm", type=float, metavar="MPA", help=fm_help)
+
+
 def check_output_dir(path: Path, option: str) -> None:
     """Refuse an output directory that cannot be created or written (InputError naming
     ``option``, e.g. ``out`` or ``--out``), before any work; nothing is created here.
