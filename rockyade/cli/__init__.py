@@ -122,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command."""
     import importlib
 
-    parser = CommandParser(
+    parser: argparse.ArgumentParser = CommandParser(
         prog="rockyade",
         description="Seismic rocking of rigid blocks: classical (Housner) parameters, exact "
         "Housner solver, DEM calibration from the classical parameters, reference DEM, YADE and Siconos.",

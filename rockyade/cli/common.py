@@ -13,14 +13,13 @@ from typing import TYPE_CHECKING, Any, TypeAlias
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:
-    from rockyade.cli import CommandParser
     from rockyade.run_meta import RunMeta
     from rockyade.solvers.base import Solver
 
 
-#: A parser's table of sub-commands, as ``ArgumentParser.add_subparsers`` returns it (its
-#: parsers are of their parent's class, :class:`~rockyade.cli.CommandParser`).
-Commands: TypeAlias = "argparse._SubParsersAction[CommandParser]"
+#: A parser's table of sub-commands, as ``ArgumentParser.add_subparsers`` returns it (at run
+#: time its parsers are of their parent's class, :class:`~rockyade.cli.CommandParser`).
+Commands: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
