@@ -23,6 +23,7 @@ check at height stands alone).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -456,7 +457,7 @@ def assess(
     executor: Executor | None = None,
     allow_large: bool = False,
     progress: bool = True,
-    on_plan: Any = None,
+    on_plan: Callable[[FragilityPlan], None] | None = None,
 ) -> Assessment:
     """The code's verdict on a scene's mechanism and the dynamics beside it (module docstring).
 
@@ -536,7 +537,7 @@ def add_dynamics(
     *,
     allow_large: bool = False,
     progress: bool = True,
-    on_plan: Any = None,
+    on_plan: Callable[[FragilityPlan], None] | None = None,
     folder: StudyFolder | None = None,
 ) -> Assessment:
     """Run the dynamic part of an assessment (module docstring) and attach it; the same

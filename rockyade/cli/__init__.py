@@ -26,7 +26,7 @@ import sys
 import time
 import warnings
 from collections.abc import Callable, Sequence
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from rockyade import __version__
 from rockyade.errors import (
@@ -38,6 +38,9 @@ from rockyade.errors import (
     SolverUnavailableError,
     os_error_message,
 )
+
+if TYPE_CHECKING:
+    from rockyade.cli.common import Commands
 
 #: Modules that add sub-commands, each through ``register(subparsers)``.
 COMMAND_MODULES: list[str] = [
@@ -119,7 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     """The argument parser with every sub-command."""
     import importlib
 
-    parser = CommandParser(
+    parser: argparse.ArgumentParser = CommandParser(
         prog="rockyade",
         description="Seismic rocking of rigid blocks: classical (Housner) parameters, exact "
         "Housner solver, DEM calibration from the classical parameters, reference DEM, YADE and Siconos.",
@@ -127,7 +130,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"rockyade {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     for module_name in COMMAND_MODULES:
-        register: Callable[[Any], None] = importlib.import_module(module_name).register
+        register: Callable[[Commands], None] = importlib.import_module(module_name).register
         register(sub)
     return parser
 

@@ -8,7 +8,7 @@ import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import add_command, check_output_dir, json_out, print_wrote
+from rockyade.cli.common import Commands, add_command, add_joint_options, check_output_dir, json_out, print_wrote
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     accept_negative_values,
@@ -27,8 +27,12 @@ from rockyade.errors import InputError
 if TYPE_CHECKING:  # the parser stays fast: rockyade.assess is imported when a command runs
     from collections.abc import Callable
 
-    from rockyade.assess import DynamicSettings, Position
+    from rockyade.assess import Assessment, DynamicSettings, Position
+    from rockyade.assess.fragility_analysis import FragilityPlan
+    from rockyade.assess.stripes import StripesInterruptedError
+    from rockyade.runner import Executor
     from rockyade.runner.study_folder import StudyFolder
+    from rockyade.scene import Scene
 
 #: Exit code of a scene that cannot stand (the answer is not a number).
 EXIT_UNSTABLE = 1
@@ -223,7 +227,7 @@ def _check_report_option(args: argparse.Namespace) -> None:
 
 
 def _report(
-    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Any, data: dict[str, Any]
+    args: argparse.Namespace, parser: argparse.ArgumentParser | None, result: Assessment, data: dict[str, object]
 ) -> None:
     """With --report: the page, written from ``data`` (what assess.json holds) as a set of its own."""
     if args.report is None:
@@ -238,11 +242,16 @@ def _report(
 
 
 def _dynamics(
-    args: argparse.Namespace, result: Any, scene: Any, dynamic: Any, executor: Any, folder: StudyFolder | None
+    args: argparse.Namespace,
+    result: Assessment,
+    scene: Scene,
+    dynamic: DynamicSettings,
+    executor: Executor,
+    folder: StudyFolder | None,
 ) -> None:
     from rockyade.assess.assessment import add_dynamics
 
-    def on_plan(plan: Any) -> None:
+    def on_plan(plan: FragilityPlan) -> None:
         if not args.json:
             print(f"dynamics: the same scene under records scaled to the site ({plan.runs_planned} runs planned)")
             print_plan(plan, args.workers, indent="  ")
@@ -259,13 +268,15 @@ def _dynamics(
     )
 
 
-def _static_data(args: argparse.Namespace, result: Any) -> dict[str, object]:
+def _static_data(args: argparse.Namespace, result: Assessment) -> dict[str, object]:
     data: dict[str, object] = result.to_dict()
     data["scene"] = str(args.scene)
     return data
 
 
-def _interrupted(args: argparse.Namespace, result: Any, exc: Any, folder: StudyFolder) -> str:
+def _interrupted(
+    args: argparse.Namespace, result: Assessment, exc: StripesInterruptedError, folder: StudyFolder
+) -> str:
     """After Ctrl-C: the static answer (``partial/assess.json``, marked partial) and the runs
     that finished (``partial/runs.csv``), for ``--resume`` to go on from; what the message names."""
     from rockyade.assess.stripes import runs_frame
@@ -283,7 +294,7 @@ def _interrupted(args: argparse.Namespace, result: Any, exc: Any, folder: StudyF
     return path
 
 
-def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, object]:
+def _finish(args: argparse.Namespace, result: Assessment, scene: Scene) -> dict[str, object]:
     """The pushover, the dynamics' text, the JSON."""
     from rockyade.assess.report_lines import dynamic_lines
 
@@ -302,7 +313,7 @@ def _finish(args: argparse.Namespace, result: Any, scene: Any) -> dict[str, obje
     return data
 
 
-def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dict[str, object]) -> None:
+def _write(folder: StudyFolder, args: argparse.Namespace, result: Assessment, data: dict[str, object]) -> None:
     """The result set, replaced as a whole (:mod:`rockyade.io.resultset`)."""
     from rockyade.figures.wall_assessment import draw_assessment
     from rockyade.io.atomic import write_json
@@ -319,7 +330,7 @@ def _write(folder: StudyFolder, args: argparse.Namespace, result: Any, data: dic
     print_wrote(Path(f"{', '.join(written)} in {out}"), args.json)
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade assess``."""
     p = add_command(sub, cmd_assess)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
@@ -338,23 +349,13 @@ def register(sub: Any) -> None:
         default="both",
         help="the sense of the static load (default both: the smaller a0* governs)",
     )
-    joints = p.add_mutually_exclusive_group()
-    joints.add_argument(
-        "--friction-angle-deg", type=float, metavar="DEG", help="friction angle of every joint, degrees in [0, 89.9]"
-    )
-    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
-    p.add_argument(
-        "--friction-rule",
-        metavar="RULE",
-        help="the limit analysis's friction: associated (alone: sliding joints dilate, an upper bound) or coulomb "
+    add_joint_options(
+        p,
+        "friction angle of every joint, degrees in [0, 89.9]",
+        "the limit analysis's friction: associated (alone: sliding joints dilate, an upper bound) or coulomb "
         "(alone: non-dilatant, iterated: see rockyade limit); default: associated, and where its mechanism slides "
         "with friction a coulomb pass too, the check taking the lower multiplier (both printed)",
-    )
-    p.add_argument(
-        "--fm",
-        type=float,
-        metavar="MPA",
-        help="the masonry's compressive strength fm, MPa (> 0): the hinges move into their joints by the stress "
+        "the masonry's compressive strength fm, MPa (> 0): the hinges move into their joints by the stress "
         "block 0.85 fm (NTC 2018 7.8.2.2.1), iterated with the limit analysis' normal forces; default: rigid blocks",
     )
     height = p.add_argument_group("a mechanism at height (default: at ground level)")

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rockyade.cli.common import add_command, json_out, print_calibration
+from rockyade.cli.common import Commands, add_command, json_out, print_calibration
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: blocks are imported when a command runs
@@ -273,7 +273,7 @@ def _calibrate_identified(args: argparse.Namespace, blocks: list[NamedBlock]) ->
     return 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``params`` and ``calibrate``."""
     p = add_command(sub, cmd_params)
     _add_block_arguments(p)

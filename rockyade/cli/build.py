@@ -18,7 +18,7 @@ import shlex
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import add_command, check_output_file
+from rockyade.cli.common import Commands, add_command, add_command_group, check_output_file
 from rockyade.cli.drawings import add_snapshot_options, check_run_drawings, write_run_drawings
 from rockyade.errors import InputError
 from rockyade.scene.generator_options import ALIASES, COMMON, COMMON_PARAMS, KINDS, OVERBURDEN, Param, options
@@ -76,7 +76,7 @@ def _integer(p: Param) -> Any:
     return parse
 
 
-def _add(parser: argparse.ArgumentParser | Any, p: Param) -> None:
+def _add(parser: argparse._ActionsContainer, p: Param) -> None:
     """The argparse option of a parameter of the table."""
     kind = _floats if p.many or p.repeat else str if p.range is None else _integer(p) if p.integer else float
     kwargs: dict[str, Any] = {"default": p.default, "help": p.help, "dest": p.dest, "metavar": _metavar(p)}
@@ -416,15 +416,16 @@ def _result_of(scene: Any, args: argparse.Namespace) -> Any:
 # ---------------------------------------------------------------------- parser
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``build`` (one sub-command per kind) and ``draw``."""
-    p = sub.add_parser(
+    kinds = add_command_group(
+        sub,
         "build",
-        help="generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
-        description="Generate a scene file of a masonry assembly (every block placed by position_m) that you "
+        "generate an assembly scene: wall, column, arch, frame, stack, restrained-wall, wall-section",
+        "Generate a scene file of a masonry assembly (every block placed by position_m) that you "
         "can read and edit. Options are SI, with units in their names.",
+        "kind",
     )
-    kinds = p.add_subparsers(dest="kind", required=True, metavar="KIND")
     for kind, (text, params) in KINDS.items():
         k = kinds.add_parser(
             kind,
@@ -432,12 +433,12 @@ def register(sub: Any) -> None:
             description=f"Generate {text}." + (f" {ALIASES[kind]}" if kind in ALIASES else ""),
             formatter_class=_DefaultsFormatter,
         )
-        for p in params:
-            _add(k, p)
+        for param in params:
+            _add(k, param)
         if kind in OVERBURDEN:
             loads = k.add_argument_group("overburden (written as [[loads]], with the mass of its weight by default)")
-            for p in OVERBURDEN[kind].params:
-                _add(loads, p)
+            for param in OVERBURDEN[kind].params:
+                _add(loads, param)
             loads.add_argument(
                 "--overburden-mass",
                 choices=("carried", "none"),
@@ -447,8 +448,8 @@ def register(sub: Any) -> None:
                 "elsewhere)",
             )
         group = k.add_argument_group("material, time, motion and joints")
-        for p in COMMON:
-            _add(group, p)
+        for param in COMMON:
+            _add(group, param)
         k.add_argument("--out", type=Path, required=True, help="scene file to write (.toml or .json)")
         k.add_argument("--draw", type=Path, metavar="PNG", help="also draw the scene (PNG)")
         k.set_defaults(func=cmd_build)

@@ -8,13 +8,18 @@ import os
 import re
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:
     from rockyade.run_meta import RunMeta
     from rockyade.solvers.base import Solver
+
+
+#: A parser's table of sub-commands, as ``ArgumentParser.add_subparsers`` returns it (at run
+#: time its parsers are of their parent's class, :class:`~rockyade.cli.CommandParser`).
+Commands: TypeAlias = "argparse._SubParsersAction[argparse.ArgumentParser]"
 
 #: The solvers' names, as :func:`rockyade.solvers.solver_names` lists them (kept here so that
 #: building the parser does not import the solvers; a test checks the two agree).
@@ -49,7 +54,7 @@ def print_wrote(path: Path, json_mode: bool = False) -> None:
     print(f"wrote {path}", file=sys.stderr if json_mode else sys.stdout)
 
 
-def add_command(sub: Any, run: Callable[..., int], name: str | None = None) -> argparse.ArgumentParser:
+def add_command(sub: Commands, run: Callable[..., int], name: str | None = None) -> argparse.ArgumentParser:
     """Add the sub-command that ``run`` carries out, documented by ``run``'s docstring: its
     first paragraph is the one-line help of ``rockyade --help``, the rest the description of
     ``rockyade NAME --help`` (one text for readers of the code and users of the command), up
@@ -74,11 +79,31 @@ def add_command(sub: Any, run: Callable[..., int], name: str | None = None) -> a
     if name is None:
         name = run.__name__.removeprefix("cmd_").replace("_", "-")
     # argparse %-formats a help string (not a description): a "%" in the summary is a percent sign
-    parser: argparse.ArgumentParser = sub.add_parser(
-        name, help=" ".join(summary.split()).replace("%", "%%"), description=description or None
-    )
+    parser = sub.add_parser(name, help=" ".join(summary.split()).replace("%", "%%"), description=description or None)
     parser.set_defaults(func=run)
     return parser
+
+
+def add_command_group(sub: Commands, name: str, help_text: str, description: str, dest: str) -> Commands:
+    """Add a command whose first argument names one of its own sub-commands (``rockyade build
+    KIND``, ``rockyade motion MOTION_COMMAND``).
+
+    Parameters
+    ----------
+    sub
+        The sub-parsers to add to.
+    name, help_text, description
+        The command's name, its line in ``rockyade --help`` and the head of ``rockyade NAME --help``.
+    dest
+        The attribute of the parsed arguments that names the sub-command (shown in capitals).
+
+    Returns
+    -------
+    Commands
+        The command's own sub-parsers, for its sub-commands.
+    """
+    group = sub.add_parser(name, help=help_text, description=description)
+    return group.add_subparsers(dest=dest, required=True, metavar=dest.upper())
 
 
 def add_allow_large(p: argparse.ArgumentParser) -> None:
@@ -94,6 +119,39 @@ def add_allow_large(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="run even when the cost estimate (integration steps, samples, memory) is above the documented limits",
     )
+
+
+def add_accel_units(p: argparse.ArgumentParser, help_text: str) -> None:
+    """``--accel-units``: g (the default) or m/s2, the unit accelerations are shown in.
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    help_text
+        The option's help: what is shown in that unit, and where the other unit goes.
+    """
+    p.add_argument("--accel-units", choices=["g", "m/s2"], default="g", help=help_text)
+
+
+def add_joint_options(
+    p: argparse.ArgumentParser, friction_angle_help: str, friction_rule_help: str, fm_help: str
+) -> None:
+    """The joints of a limit analysis (``limit``, ``assess``): ``--friction-angle-deg`` or
+    ``--no-sliding``, ``--friction-rule`` and ``--fm`` (each checked where it is read).
+
+    Parameters
+    ----------
+    p
+        The command's parser.
+    friction_angle_help, friction_rule_help, fm_help
+        The help of ``--friction-angle-deg``, ``--friction-rule`` and ``--fm`` in this command.
+    """
+    joints = p.add_mutually_exclusive_group()
+    joints.add_argument("--friction-angle-deg", type=float, metavar="DEG", help=friction_angle_help)
+    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
+    p.add_argument("--friction-rule", metavar="RULE", help=friction_rule_help)
+    p.add_argument("--fm", type=float, metavar="MPA", help=fm_help)
 
 
 def check_output_dir(path: Path, option: str) -> None:
@@ -226,7 +284,7 @@ def print_calibration(result: dict[str, Any], method: str) -> None:
         print(f"  note: {note}")
 
 
-def add_yade_timeout(p: Any) -> None:
+def add_yade_timeout(p: argparse.ArgumentParser) -> None:
     """The ``--yade-timeout`` option (run, compare, batch): YADE's ``timeout_s``."""
     p.add_argument(
         "--yade-timeout",

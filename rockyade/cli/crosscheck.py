@@ -6,9 +6,8 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_allow_large, add_command, check_output_dir
+from rockyade.cli.common import Commands, add_allow_large, add_command, check_output_dir
 from rockyade.cli.fragility_options import add_record_source
 from rockyade.cli.resumable import add_executor_options
 from rockyade.errors import InputError
@@ -124,7 +123,7 @@ def cmd_crosscheck(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade crosscheck``."""
     from rockyade.cli.common import SOLVER_NAMES, add_yade_timeout
 

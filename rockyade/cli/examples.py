@@ -16,9 +16,8 @@ import shutil
 import stat
 import tempfile
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_command
+from rockyade.cli.common import Commands, add_command
 from rockyade.errors import InputError, RockyadeError
 from rockyade.io.atomic import atomic_open, fsync_dir
 
@@ -129,7 +128,7 @@ def cmd_examples(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade examples``."""
     p = add_command(sub, cmd_examples)
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="destination folder")

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from rockyade.cli.common import add_command, check_output_dir
+from rockyade.cli.common import Commands, add_command, check_output_dir
 from rockyade.cli.fragility_options import (
     DEFAULT_COUNT,
     add_record_source,
@@ -99,7 +99,7 @@ def cmd_fragility(args: argparse.Namespace) -> int:
     return 1 if result.failed else 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade fragility``."""
     p = add_command(sub, cmd_fragility)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json); its motion is replaced")

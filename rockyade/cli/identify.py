@@ -5,9 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from rockyade.cli.common import add_command, check_output_dir, check_output_file, json_out, print_wrote
+from rockyade.cli.common import Commands, add_command, check_output_dir, check_output_file, json_out, print_wrote
 from rockyade.errors import InputError
 
 if TYPE_CHECKING:  # the parser stays fast: the identification is imported when the command runs
@@ -125,7 +125,7 @@ def _start_lines(result: Identification) -> list[str]:
     return [release, f"sensor offset {fit.offset_rad:.4g} rad [{o_lo:.4g}, {o_hi:.4g}]"]
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade identify``."""
     p = add_command(sub, cmd_identify)
     p.add_argument("measured", type=Path, help="measured history (CSV with a header row)")

@@ -9,9 +9,16 @@ import re
 import sys
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_allow_large, add_command, check_output_file, json_out, print_wrote
+from rockyade.cli.common import (
+    Commands,
+    add_allow_large,
+    add_command,
+    add_joint_options,
+    check_output_file,
+    json_out,
+    print_wrote,
+)
 from rockyade.errors import InputError, RockyadeError
 
 #: The coulomb rule's progress: first after this many seconds, then at most every PROGRESS_EVERY_S.
@@ -164,7 +171,7 @@ class _Progress:
             _say(f"coulomb iteration {iteration}/{self.max_iterations}: lambda = {multiplier:.6g}, {seconds:.0f} s")
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade limit``."""
     p = add_command(sub, cmd_limit)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")
@@ -174,27 +181,14 @@ def register(sub: Any) -> None:
         default="+x",
         help="sense of the horizontal load lambda m g (default +x)",
     )
-    joints = p.add_mutually_exclusive_group()
-    joints.add_argument(
-        "--friction-angle-deg",
-        type=float,
-        metavar="DEG",
-        help="friction angle of every joint, degrees in [0, 89.9] (default: each joint's from the scene)",
-    )
-    joints.add_argument("--no-sliding", action="store_true", help="no joint slides (rocking mechanisms only)")
-    p.add_argument(
-        "--friction-rule",
-        metavar="RULE",
-        help="associated (the linear programme alone, sliding joints dilate) or coulomb (sliding without "
+    add_joint_options(
+        p,
+        "friction angle of every joint, degrees in [0, 89.9] (default: each joint's from the scene)",
+        "associated (the linear programme alone, sliding joints dilate) or coulomb (sliding without "
         "dilatancy, by iterated programmes: Gilbert, Casapulla & Ahmed 2006; exit 1 if it does not converge); "
         "default: associated, and where its mechanism slides with friction a coulomb pass too, the code's "
         "quantities taking the lower multiplier (both printed)",
-    )
-    p.add_argument(
-        "--fm",
-        type=float,
-        metavar="MPA",
-        help="the masonry's compressive strength fm, MPa (> 0): each hinge moves into its joint by the stress "
+        "the masonry's compressive strength fm, MPa (> 0): each hinge moves into its joint by the stress "
         "block's resultant, a / 2 with a = N / (0.85 fm t) (NTC 2018 7.8.2.2.1), iterated with the programme's "
         "normal forces; default: rigid blocks (hinges at the joints' edges)",
     )

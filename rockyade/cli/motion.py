@@ -7,7 +7,16 @@ import json
 from pathlib import Path
 from typing import Any
 
-from rockyade.cli.common import add_command, check_output_dir, check_output_file, json_out, print_wrote
+from rockyade.cli.common import (
+    Commands,
+    add_accel_units,
+    add_command,
+    add_command_group,
+    check_output_dir,
+    check_output_file,
+    json_out,
+    print_wrote,
+)
 from rockyade.cli.site_options import add_period_option, add_site_options
 from rockyade.errors import InputError
 
@@ -45,15 +54,11 @@ def _add_record_arguments(p: argparse.ArgumentParser) -> None:
     )
 
 
-def _add_accel_units(p: argparse.ArgumentParser) -> None:
-    """``--accel-units``: the unit accelerations are printed and plotted in (g by default)."""
-    p.add_argument(
-        "--accel-units",
-        choices=["g", "m/s2"],
-        default="g",
-        help="unit of the accelerations printed and plotted: g (standard gravity, 9.80665 m/s^2; the default) "
-        "or m/s2; the other unit is given beside it",
-    )
+#: ``--accel-units``' help: the unit accelerations are printed and plotted in (g by default).
+_ACCEL_UNITS_HELP = (
+    "unit of the accelerations printed and plotted: g (standard gravity, 9.80665 m/s^2; the default) "
+    "or m/s2; the other unit is given beside it"
+)
 
 
 def _accel_text(value_m_s2: float, unit: str) -> str:
@@ -447,21 +452,22 @@ def _write_selection(args, chosen, folder, records, shown, spectra, target, t_ra
     print_wrote(Path(f"{', '.join(written)} in {args.out}"), args.json)
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade motion ...``."""
-    motion = sub.add_parser(
+    msub = add_command_group(
+        sub,
         "motion",
-        help="records, response spectra, synthetic EC8 suites, records selected to a site",
-        description="Base motions: read records, response spectra, spectrum-compatible suites, records selected "
+        "records, response spectra, synthetic EC8 suites, records selected to a site",
+        "Base motions: read records, response spectra, spectrum-compatible suites, records selected "
         "and scaled to a site's spectrum.",
+        "motion_command",
     )
-    msub = motion.add_subparsers(dest="motion_command", required=True, metavar="MOTION_COMMAND")
 
     p = add_command(msub, cmd_info)
     _add_record_arguments(p)
     p.add_argument("--json", action="store_true", help="print JSON (pga_m_s2 and pga_g)")
     p.add_argument("--plot", type=Path, help="PNG of acceleration, velocity and displacement")
-    _add_accel_units(p)
+    add_accel_units(p, _ACCEL_UNITS_HELP)
 
     p = add_command(msub, cmd_spectrum)
     _add_record_arguments(p)
@@ -471,7 +477,7 @@ def register(sub: Any) -> None:
     p.add_argument("-n", type=int, default=100, help="number of periods (log-spaced)")
     p.add_argument("--out", type=Path, help="CSV with period_s, psa_g and psa_m_s2")
     p.add_argument("--plot", type=Path, help="PNG of the spectrum")
-    _add_accel_units(p)
+    add_accel_units(p, _ACCEL_UNITS_HELP)
 
     p = add_command(msub, cmd_synth)
     p.add_argument("--type", type=int, choices=[1, 2], required=True, help="EC8 spectrum type")

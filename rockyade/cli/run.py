@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 from rockyade.cli.common import (
     SOLVER_NAMES,
+    Commands,
     add_allow_large,
     add_command,
     add_yade_timeout,
@@ -250,7 +251,7 @@ def cmd_tables(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``run`` and ``tables``."""
     p = add_command(sub, cmd_run)
     p.add_argument("scene", type=Path, help="scene file (.toml or .json)")

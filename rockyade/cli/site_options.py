@@ -6,7 +6,7 @@ T1. Declared once here so that both commands take the same options with the same
 from __future__ import annotations
 
 import argparse
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from rockyade.errors import InputError
 
@@ -58,7 +58,7 @@ def add_site_options(p: argparse.ArgumentParser) -> None:
     ec8.add_argument("--importance", type=float, help="importance factor gamma_I, in [0.5, 2] (default 1)")
 
 
-def add_period_option(group: Any, use: str) -> None:
+def add_period_option(group: argparse._ActionsContainer, use: str) -> None:
     """``--t1``: the building's fundamental period, s, in (0, 4] (checked where it is used).
 
     Parameters

@@ -8,6 +8,8 @@ from typing import Any
 
 from rockyade.cli.common import (
     SOLVER_NAMES,
+    Commands,
+    add_accel_units,
     add_allow_large,
     add_command,
     add_yade_timeout,
@@ -207,7 +209,7 @@ def _part_line(report: Any, part: str) -> str:
     return f"{part} {total}" + (f" ({failed} FAILED)" if failed else "")
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade compare``, ``rockyade batch`` and ``rockyade paper``."""
     p = add_command(sub, cmd_batch)
     p.add_argument("study", type=Path, help="study file (.toml)")
@@ -225,11 +227,9 @@ def register(sub: Any) -> None:
         help="comma-separated parts: tables,free,harmonic,random,patterns,sensitivity,fragility,overturning,crosscheck",
     )
     p.add_argument("--no-yade", action="store_true", help="skip the YADE runs")
-    p.add_argument(
-        "--accel-units",
-        choices=["g", "m/s2"],
-        default="g",
-        help="unit of the fragility figure's PGA axis: g (standard gravity; the default) or m/s2, the other "
+    add_accel_units(
+        p,
+        "unit of the fragility figure's PGA axis: g (standard gravity; the default) or m/s2, the other "
         "unit on the opposite axis (the CSV files keep m/s^2)",
     )
 

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_command
+from rockyade.cli.common import Commands, add_accel_units, add_command
 
 
 def cmd_uncertainty(args: argparse.Namespace) -> int:
@@ -91,7 +90,7 @@ def _measure_text(value: float, measure: str, unit: str) -> str:
     return f"{g_text} ({si_text})" if unit == "g" else f"{si_text} ({g_text})"
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade uncertainty``."""
     from rockyade.cli.resumable import add_executor_options
 
@@ -102,10 +101,8 @@ def register(sub: Any) -> None:
     p.add_argument("--seed", type=int, help="override the seed of the Latin hypercube")
     add_executor_options(p, "skip runs already completed by an interrupted run of the same study")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument(
-        "--accel-units",
-        choices=["g", "m/s2"],
-        default="g",
-        help="unit of PGA medians and axes: g (standard gravity, 9.80665 m/s^2; the default) or m/s2; the other "
+    add_accel_units(
+        p,
+        "unit of PGA medians and axes: g (standard gravity, 9.80665 m/s^2; the default) or m/s2; the other "
         "unit is given beside it (the CSV files keep m/s^2, named so)",
     )

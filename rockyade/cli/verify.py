@@ -5,9 +5,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
 
-from rockyade.cli.common import add_command, check_output_dir
+from rockyade.cli.common import Commands, add_command, check_output_dir
 from rockyade.errors import InputError
 from rockyade.studies.verification_checks import CHECKS
 
@@ -50,7 +49,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
     return 1 if len(failed) else 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade verify``."""
     p = add_command(sub, cmd_verify)
     p.add_argument("--out", type=Path, required=True, help="output directory")

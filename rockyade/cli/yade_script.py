@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from rockyade.cli.common import Commands
 
 LAUNCHER_WARNING = (
     "note: YADE's own launcher opens a Python console and an XMLRPC server on all network interfaces "
@@ -36,7 +39,7 @@ def cmd_yade_script(args: argparse.Namespace) -> int:
     return 0
 
 
-def register(sub: Any) -> None:
+def register(sub: Commands) -> None:
     """Add ``rockyade yade-script``."""
     from rockyade.cli.common import add_command
 

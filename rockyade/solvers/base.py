@@ -133,7 +133,7 @@ def check_scene(solver: Solver, scene: Scene) -> None:
         check(scene)
 
 
-def check_flag(value: Any, field: str) -> bool:
+def check_flag(value: object, field: str) -> bool:
     """A true/false option."""
     if not isinstance(value, bool):
         raise InputError(field, f"must be true or false, got {value!r}")
@@ -153,7 +153,7 @@ def check_float(value: Any, field: str, lo: float, hi: float, what: str, *, lo_o
     return x
 
 
-def check_folder(value: Any, field: str) -> str | None:
+def check_folder(value: object, field: str) -> str | None:
     """A folder path (text or a Path) or None."""
     if value is not None and not isinstance(value, (str, Path)):
         raise InputError(field, f"must be a folder path, got {value!r}")
@@ -164,7 +164,7 @@ def check_folder(value: Any, field: str) -> str | None:
 DT_FACTOR_MIN = 1e-3
 
 
-def check_dt_factor(value: Any, field: str) -> float:
+def check_dt_factor(value: object, field: str) -> float:
     """A factor on the solver's own time step, in [0.001, 1] (1: the step the solver chooses;
     0.5: half of it, the convergence check of a cross-check). Below :data:`DT_FACTOR_MIN`
     it is refused (a thousand times the steps is not a check, it is a hang)."""
