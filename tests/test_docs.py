@@ -89,8 +89,11 @@ def _commands(page: Path) -> list[str]:
     return [c for c, _, fenced in _shown(page) if not fenced and not any(skip in c for skip in NOT_RUN_HERE)]
 
 
-#: Each documented command once (pages repeat some), with the first page that shows it.
-COMMANDS = {command: page.relative_to(ROOT).as_posix() for page in reversed(PAGES) for command in _commands(page)}
+def _bare(command: str) -> str:
+    """``command`` as a fenced block prints it: ``rockyade ...``, not ``.venv/bin/rockyade ...``."""
+    return re.sub(r"^\.venv/bin/(?=rockyade )", "", command)
+
+
 #: The output lines each command's page shows (the first page that shows any).
 OUTPUTS = {c: shown for page in reversed(PAGES) for c, shown, _ in _shown(page) if shown}
 #: Pages with fenced commands, run in order in one folder per page.
@@ -101,6 +104,22 @@ FENCED = {
     for page in PAGES
 }
 FENCED = {page: commands for page, commands in FENCED.items() if commands}
+#: Each documented indented command once (pages repeat some), with the first page that shows
+#: it; one that a page's fenced block prints too is run there (see ALSO_SHOWN), not twice.
+COMMANDS = {
+    command: page.relative_to(ROOT).as_posix()
+    for page in reversed(PAGES)
+    for command in _commands(page)
+    if not any(_bare(command) == _bare(c) for commands in FENCED.values() for c, _ in commands)
+}
+#: The output lines the pages' indented blocks show for a command a fenced block runs: checked
+#: against that run, beside the fenced page's own.
+ALSO_SHOWN = {
+    _bare(c): shown
+    for page in reversed(PAGES)
+    for c, shown, fenced in _shown(page)
+    if shown and not fenced and any(_bare(c) == _bare(f) for commands in FENCED.values() for f, _ in commands)
+}
 
 
 def _same(shown: str, printed: str) -> bool:
@@ -208,13 +227,15 @@ def run_printed(starter: CommandStarter, command: str, cwd: Path, env: dict | No
     return starter.run("script", cwd, args[1:], env=env)
 
 
-def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: list[str]) -> None:
+def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: list[str], also: list[str] = ()) -> None:
     """Run ``command`` in ``cwd`` with this environment's rockyade; exit 0 (or 2 where the page
-    shows the refusal) and the shown lines printed."""
+    shows the refusal) and the shown lines printed (and ``also``, what another page shows after
+    the same command, each page's lines in its own order)."""
     proc = run_printed(starter, command, cwd)
-    refused = any(line.startswith("rockyade: error:") for line in shown)
+    refused = any(line.startswith("rockyade: error:") for line in [*shown, *also])
     assert proc.returncode == (2 if refused else 0), f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
     check_output(command, shown, proc.stdout + proc.stderr)
+    check_output(command, list(also), proc.stdout + proc.stderr)
 
 
 def _without_plot(command: str, keep: set[str]) -> str:
@@ -366,7 +387,8 @@ def test_python_page_shows_keyword_only_arguments_as_such():
 @pytest.mark.parametrize("command", list(COMMANDS), ids=[f"{COMMANDS[c]}: {c[18:80]}" for c in COMMANDS])
 def test_documented_command_runs_as_printed(command, tmp_path, starter):
     """Each indented command of the README and docs/, in a fresh folder (no command needs
-    another's output), prints the lines its page shows."""
+    another's output), prints the lines its page shows (one that a fenced block prints too is
+    run and checked with that block's page, ``ALSO_SHOWN``)."""
     _run_as_printed(starter, command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
 
 
@@ -377,7 +399,7 @@ def test_fenced_commands_run_as_printed(page, tmp_path, starter):
     cwd = _fresh_checkout(tmp_path)
     (cwd / "runs").mkdir()
     for command, shown in FENCED[page]:
-        _run_as_printed(starter, command, cwd, shown)
+        _run_as_printed(starter, command, cwd, shown, ALSO_SHOWN.get(_bare(command), []))
 
 
 def test_shown_output_is_compared_line_by_line():
