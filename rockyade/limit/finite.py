@@ -40,7 +40,9 @@ the gap closed gives).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -95,6 +97,21 @@ class CapacityCurve:
     closed_dk_m: float | None = None
 
 
+_T = TypeVar("_T")
+#: How many configurations' constraints and null spaces are kept (a step visits three).
+_REMEMBERED = 4
+
+
+def _remembered(memo: dict[bytes, _T], key: bytes, compute: Callable[[], _T]) -> _T:
+    """``memo[key]``, computed by ``compute`` where missing; the oldest entry dropped beyond
+    ``_REMEMBERED``."""
+    if key not in memo:
+        if len(memo) >= _REMEMBERED:
+            del memo[next(iter(memo))]
+        memo[key] = compute()
+    return memo[key]
+
+
 class _Kinematics:
     """Positions, joint constraints and compatible velocities of the moving rigid groups.
 
@@ -145,6 +162,12 @@ class _Kinematics:
         self.active = np.ones(len(self.points), dtype=bool)
         self.ever_opened: set[int] = set()
         self.slides = self._slides(mechanism)
+        self.scale = np.ones(self.n_dof)
+        self.scale[2::3] = model.size_m  # rotations to lengths: comparable columns
+        # the last few configurations' (gap, Jacobian) and null spaces: a step asks for the same twice,
+        # and a step tried again with half the length starts again from the same configuration
+        self._constraints_at: dict[bytes, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
+        self._null_space_at: dict[bytes, NDArray[np.float64]] = {}
 
     def _slides(self, mechanism: Mechanism):
         """The ends of frictionless joints that slide without opening, as (point at rest, group of the
@@ -243,8 +266,17 @@ class _Kinematics:
             normal = np.array([c * normal[0] - sn * normal[1], sn * normal[0] + c * normal[1]])
         return xa - xb, J, normal
 
+    def _key(self, s: NDArray[np.float64]) -> bytes:
+        """What the constraints depend on that changes along a curve: the configuration and the
+        hinges still active."""
+        return s.tobytes() + self.active.tobytes()
+
     def constraints(self, s: NDArray[np.float64]):
-        """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
+        """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative (the
+        last configuration's kept: the caller must not write into them)."""
+        return _remembered(self._constraints_at, self._key(s), lambda: self._constraints(s))
+
+    def _constraints(self, s: NDArray[np.float64]):
         rows = [self._rows(s, int(k)) for k in np.flatnonzero(self.active)]
         slid = [self._slide_row(s, k) for k in range(len(self.slides))]
         if not rows and not slid:
@@ -262,19 +294,17 @@ class _Kinematics:
         return out
 
     def _null_space(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Orthonormal basis of the compatible velocities, in (vx, vy, omega x size)."""
+        """Orthonormal basis of the compatible velocities, in (vx, vy, omega x size) (the last
+        configuration's kept: the caller must not write into it)."""
+        return _remembered(self._null_space_at, self._key(s), lambda: self._basis(s))
+
+    def _basis(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
         _, C = self.constraints(s)
         if C.shape[0] == 0:
             return np.eye(self.n_dof)
         _, sv, vt = np.linalg.svd(C / self.scale, full_matrices=True)
         rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0))) if sv.size else 0
         return vt[rank:].T
-
-    @property
-    def scale(self) -> NDArray[np.float64]:
-        out = np.ones(self.n_dof)
-        out[2::3] = self.model.size_m  # rotations to lengths: comparable columns
-        return out
 
     def release(self, s: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """When the hinges kept lock the mechanism (they are compatible at rest only to first
