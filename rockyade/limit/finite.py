@@ -162,6 +162,14 @@ class _Kinematics:
         self.active = np.ones(len(self.points), dtype=bool)
         self.ever_opened: set[int] = set()
         self.slides = self._slides(mechanism)
+        # what does not change along a curve: each group's reference point and each point's rest
+        # position, groups and arms X - ref (ref_a, ref_b)
+        self._refs = [(float(x), float(y)) for x, y in self.refs]
+        self._static = []
+        for rest, ga, gb, _ in self.points:
+            arms = tuple((rest - self.refs[g]).tolist() if g >= 0 else [0.0, 0.0] for g in (ga, gb))
+            self._static.append((float(rest[0]), float(rest[1]), ga, gb, arms))
+        self._frame_at: tuple[bytes, list[tuple[float, float, float, float]]] | None = None
         self.scale = np.ones(self.n_dof)
         self.scale[2::3] = model.size_m  # rotations to lengths: comparable columns
         # the last few configurations' (gap, Jacobian) and null spaces: a step asks for the same twice,
@@ -220,16 +228,27 @@ class _Kinematics:
     def n_dof(self) -> int:
         return 3 * len(self.members)
 
+    def _frame(self, s: NDArray[np.float64]) -> list[tuple[float, float, float, float]]:
+        """Each group's (ref_x + t_x, ref_y + t_y, cos theta, sin theta) in configuration ``s`` (the
+        last configuration's kept: a configuration places many points)."""
+        key = s.tobytes()
+        if self._frame_at is None or self._frame_at[0] != key:
+            state = s.tolist()
+            frame = []
+            for g, (x, y) in enumerate(self._refs):
+                theta = s[3 * g + 2]
+                frame.append((x + state[3 * g], y + state[3 * g + 1], float(np.cos(theta)), float(np.sin(theta))))
+            self._frame_at = key, frame
+        return self._frame_at[1]
+
     def place(self, s: NDArray[np.float64], group: int, rest: NDArray[np.float64]):
         """Position of a group's material point and its arm R(theta)(X - ref) (None for the ground)."""
         if group < 0:
             return rest, None
-        t = s[3 * group : 3 * group + 2]
-        theta = s[3 * group + 2]
-        c, sn = np.cos(theta), np.sin(theta)
+        x, y, c, sn = self._frame(s)[group]
         r = rest - self.refs[group]
         arm = np.array([c * r[0] - sn * r[1], sn * r[0] + c * r[1]])
-        return self.refs[group] + t + arm, arm
+        return np.array([x + arm[0], y + arm[1]]), arm
 
     def point_velocity(self, s, q, group: int, rest) -> NDArray[np.float64]:
         """Velocity of a group's material point (rest position ``rest``)."""
@@ -247,24 +266,36 @@ class _Kinematics:
             q[3 * g : 3 * g + 3] = (v[0] - v[2] * r[1], v[1] + v[2] * r[0], v[2])
         return q
 
+    def _point(self, frame: list[tuple[float, float, float, float]], k: int):
+        """(x_a - x_b as 2 floats, the two rows of its Jacobian as lists) of point ``k`` in the
+        configuration whose ``_frame`` is ``frame``."""
+        rest_x, rest_y, ga, gb, arms = self._static[k]
+        rows = ([0.0] * self.n_dof, [0.0] * self.n_dof)
+        xs = []
+        for group, (rx, ry), sign in ((ga, arms[0], 1.0), (gb, arms[1], -1.0)):
+            if group < 0:
+                xs.append((rest_x, rest_y))
+                continue
+            x, y, c, sn = frame[group]
+            arm_x, arm_y = c * rx - sn * ry, sn * rx + c * ry
+            xs.append((x + arm_x, y + arm_y))
+            rows[0][3 * group] += sign
+            rows[1][3 * group + 1] += sign
+            rows[0][3 * group + 2] += -sign * arm_y
+            rows[1][3 * group + 2] += sign * arm_x
+        (xa, ya), (xb, yb) = xs
+        return (xa - xb, ya - yb), rows
+
     def _rows(self, s: NDArray[np.float64], k: int):
         """(x_a - x_b, its 2 x n Jacobian, the current normal) of point ``k``; the normal turns
         with body b (the face a bears on)."""
-        rest, ga, gb, normal = self.points[k]
-        xa, arm_a = self.place(s, ga, rest)
-        xb, arm_b = self.place(s, gb, rest)
-        J = np.zeros((2, self.n_dof))
-        for group, arm, sign in ((ga, arm_a, 1.0), (gb, arm_b, -1.0)):
-            if group < 0:
-                continue
-            J[0, 3 * group] += sign
-            J[1, 3 * group + 1] += sign
-            J[0, 3 * group + 2] += -sign * arm[1]
-            J[1, 3 * group + 2] += sign * arm[0]
+        frame = self._frame(s)
+        gap, rows = self._point(frame, k)
+        _, gb, normal = self.points[k][1:]
         if gb >= 0:
-            c, sn = np.cos(s[3 * gb + 2]), np.sin(s[3 * gb + 2])
+            _, _, c, sn = frame[gb]
             normal = np.array([c * normal[0] - sn * normal[1], sn * normal[0] + c * normal[1]])
-        return xa - xb, J, normal
+        return np.array(gap), np.array(rows), normal
 
     def _key(self, s: NDArray[np.float64]) -> bytes:
         """What the constraints depend on that changes along a curve: the configuration and the
@@ -277,13 +308,20 @@ class _Kinematics:
         return _remembered(self._constraints_at, self._key(s), lambda: self._constraints(s))
 
     def _constraints(self, s: NDArray[np.float64]):
-        rows = [self._rows(s, int(k)) for k in np.flatnonzero(self.active)]
-        slid = [self._slide_row(s, k) for k in range(len(self.slides))]
-        if not rows and not slid:
+        frame = self._frame(s)
+        gaps: list[float] = []
+        rows: list[list[float]] = []
+        for k in np.flatnonzero(self.active).tolist():
+            gap, jac = self._point(frame, k)
+            gaps += gap
+            rows += jac
+        for k in range(len(self.slides)):
+            v, J = self._slide_row(s, k)
+            gaps.append(v)
+            rows.append(J.tolist())
+        if not rows:
             return np.zeros(0), np.zeros((0, self.n_dof))
-        g = np.concatenate([r[0] for r in rows] + [np.array([v for v, _ in slid])])
-        C = np.vstack([r[1] for r in rows] + [J[None, :] for _, J in slid])
-        return g, C
+        return np.array(gaps), np.array(rows)
 
     def normal_gaps(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
         """(x_a - x_b) . n at every point (> 0: open), m."""
