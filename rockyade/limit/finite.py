@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import VELOCITY_TOL, Mechanism, relative_velocity
 from rockyade.limit.rigid_blocks import RigidBlockModel, _outside
-from rockyade.scene.placement import candidate_pairs, penetration_depth
+from rockyade.scene.placement import _edge_normals, candidate_pairs, penetration_depth
 
 #: Largest rotation of any block in one step, rad.
 MAX_STEP_ROTATION_RAD = 2.0e-3
@@ -250,6 +250,15 @@ class _Kinematics:
         arm = np.array([c * r[0] - sn * r[1], sn * r[0] + c * r[1]])
         return np.array([x + arm[0], y + arm[1]]), arm
 
+    def place_polygon(self, s: NDArray[np.float64], group: int, rest: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Positions of a group's material points ``rest`` (n x 2): ``place`` of each, element by element."""
+        x, y, c, sn = self._frame(s)[group]
+        r = rest - self.refs[group]
+        out = np.empty_like(r)
+        out[:, 0] = x + (c * r[:, 0] - sn * r[:, 1])
+        out[:, 1] = y + (sn * r[:, 0] + c * r[:, 1])
+        return out
+
     def point_velocity(self, s, q, group: int, rest) -> NDArray[np.float64]:
         """Velocity of a group's material point (rest position ``rest``)."""
         _, arm = self.place(s, group, rest)
@@ -425,9 +434,10 @@ class _Kinematics:
         return float(max(0.0, -gaps.min()))
 
 
-def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int]]:
-    """(moving block, fixed block) pairs that do not touch at rest and lie within a quarter of the
-    assembly's size of each other: where a gap can close (module docstring)."""
+def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int, NDArray[np.float64]]]:
+    """(moving block, fixed block, the fixed block's edge normals) of the pairs that do not touch at
+    rest and lie within a quarter of the assembly's size of each other: where a gap can close
+    (module docstring)."""
     touching = {frozenset((itf.a, itf.b)) for itf in model.interfaces}
     touching |= {frozenset((c.a, c.b)) for c in model.corners}
     fixed = [j for j in range(model.n_blocks) if model.fixed[j]]
@@ -441,17 +451,17 @@ def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, 
         a, b = bodies[i], bodies[j]
         if model.fixed[a] == model.fixed[b] or frozenset((a, b)) in touching:
             continue
-        out.append((a, b) if not model.fixed[a] else (b, a))
+        moved, still = (a, b) if not model.fixed[a] else (b, a)
+        out.append((moved, still, _edge_normals(model.polygons_m[still])))
     return out
 
 
 def _closed(model: RigidBlockModel, kin: _Kinematics, s, pairs) -> tuple[int, int] | None:
     """The first watched pair whose blocks overlap in configuration ``s``, else None."""
     tol = 1e-9 * model.size_m
-    for a, b in pairs:
-        rest = model.polygons_m[a]
-        moved = np.array([kin.place(s, kin.group_of[a], p)[0] for p in rest])
-        if penetration_depth(moved, model.polygons_m[b]) > tol:
+    for a, b, normals_b in pairs:
+        moved = kin.place_polygon(s, kin.group_of[a], model.polygons_m[a])
+        if penetration_depth(moved, model.polygons_m[b], (_edge_normals(moved), normals_b)) > tol:
             return a, b
     return None
 
