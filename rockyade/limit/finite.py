@@ -40,7 +40,9 @@ the gap closed gives).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 import numpy as np
 from numpy.typing import NDArray
@@ -48,7 +50,7 @@ from numpy.typing import NDArray
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import VELOCITY_TOL, Mechanism, relative_velocity
 from rockyade.limit.rigid_blocks import RigidBlockModel, _outside
-from rockyade.scene.placement import candidate_pairs, penetration_depth
+from rockyade.scene.placement import _edge_normals, candidate_pairs, penetration_depth
 
 #: Largest rotation of any block in one step, rad.
 MAX_STEP_ROTATION_RAD = 2.0e-3
@@ -93,6 +95,21 @@ class CapacityCurve:
     opened: tuple[tuple[int, int], ...] = ()
     max_overlap_m: float = 0.0
     closed_dk_m: float | None = None
+
+
+_T = TypeVar("_T")
+#: How many configurations' constraints and null spaces are kept (a step visits three).
+_REMEMBERED = 4
+
+
+def _remembered(memo: dict[bytes, _T], key: bytes, compute: Callable[[], _T]) -> _T:
+    """``memo[key]``, computed by ``compute`` where missing; the oldest entry dropped beyond
+    ``_REMEMBERED``."""
+    if key not in memo:
+        if len(memo) >= _REMEMBERED:
+            del memo[next(iter(memo))]
+        memo[key] = compute()
+    return memo[key]
 
 
 class _Kinematics:
@@ -145,6 +162,20 @@ class _Kinematics:
         self.active = np.ones(len(self.points), dtype=bool)
         self.ever_opened: set[int] = set()
         self.slides = self._slides(mechanism)
+        # what does not change along a curve: each group's reference point and each point's rest
+        # position, groups and arms X - ref (ref_a, ref_b)
+        self._refs = [(float(x), float(y)) for x, y in self.refs]
+        self._static = []
+        for rest, ga, gb, _ in self.points:
+            arms = tuple((rest - self.refs[g]).tolist() if g >= 0 else [0.0, 0.0] for g in (ga, gb))
+            self._static.append((float(rest[0]), float(rest[1]), ga, gb, arms))
+        self._frame_at: tuple[bytes, list[tuple[float, float, float, float]]] | None = None
+        self.scale = np.ones(self.n_dof)
+        self.scale[2::3] = model.size_m  # rotations to lengths: comparable columns
+        # the last few configurations' (gap, Jacobian) and null spaces: a step asks for the same twice,
+        # and a step tried again with half the length starts again from the same configuration
+        self._constraints_at: dict[bytes, tuple[NDArray[np.float64], NDArray[np.float64]]] = {}
+        self._null_space_at: dict[bytes, NDArray[np.float64]] = {}
 
     def _slides(self, mechanism: Mechanism):
         """The ends of frictionless joints that slide without opening, as (point at rest, group of the
@@ -197,16 +228,36 @@ class _Kinematics:
     def n_dof(self) -> int:
         return 3 * len(self.members)
 
+    def _frame(self, s: NDArray[np.float64]) -> list[tuple[float, float, float, float]]:
+        """Each group's (ref_x + t_x, ref_y + t_y, cos theta, sin theta) in configuration ``s`` (the
+        last configuration's kept: a configuration places many points)."""
+        key = s.tobytes()
+        if self._frame_at is None or self._frame_at[0] != key:
+            state = s.tolist()
+            frame = []
+            for g, (x, y) in enumerate(self._refs):
+                theta = s[3 * g + 2]
+                frame.append((x + state[3 * g], y + state[3 * g + 1], float(np.cos(theta)), float(np.sin(theta))))
+            self._frame_at = key, frame
+        return self._frame_at[1]
+
     def place(self, s: NDArray[np.float64], group: int, rest: NDArray[np.float64]):
         """Position of a group's material point and its arm R(theta)(X - ref) (None for the ground)."""
         if group < 0:
             return rest, None
-        t = s[3 * group : 3 * group + 2]
-        theta = s[3 * group + 2]
-        c, sn = np.cos(theta), np.sin(theta)
+        x, y, c, sn = self._frame(s)[group]
         r = rest - self.refs[group]
         arm = np.array([c * r[0] - sn * r[1], sn * r[0] + c * r[1]])
-        return self.refs[group] + t + arm, arm
+        return np.array([x + arm[0], y + arm[1]]), arm
+
+    def place_polygon(self, s: NDArray[np.float64], group: int, rest: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Positions of a group's material points ``rest`` (n x 2): ``place`` of each, element by element."""
+        x, y, c, sn = self._frame(s)[group]
+        r = rest - self.refs[group]
+        out = np.empty_like(r)
+        out[:, 0] = x + (c * r[:, 0] - sn * r[:, 1])
+        out[:, 1] = y + (sn * r[:, 0] + c * r[:, 1])
+        return out
 
     def point_velocity(self, s, q, group: int, rest) -> NDArray[np.float64]:
         """Velocity of a group's material point (rest position ``rest``)."""
@@ -224,34 +275,62 @@ class _Kinematics:
             q[3 * g : 3 * g + 3] = (v[0] - v[2] * r[1], v[1] + v[2] * r[0], v[2])
         return q
 
+    def _point(self, frame: list[tuple[float, float, float, float]], k: int):
+        """(x_a - x_b as 2 floats, the two rows of its Jacobian as lists) of point ``k`` in the
+        configuration whose ``_frame`` is ``frame``."""
+        rest_x, rest_y, ga, gb, arms = self._static[k]
+        rows = ([0.0] * self.n_dof, [0.0] * self.n_dof)
+        xs = []
+        for group, (rx, ry), sign in ((ga, arms[0], 1.0), (gb, arms[1], -1.0)):
+            if group < 0:
+                xs.append((rest_x, rest_y))
+                continue
+            x, y, c, sn = frame[group]
+            arm_x, arm_y = c * rx - sn * ry, sn * rx + c * ry
+            xs.append((x + arm_x, y + arm_y))
+            rows[0][3 * group] += sign
+            rows[1][3 * group + 1] += sign
+            rows[0][3 * group + 2] += -sign * arm_y
+            rows[1][3 * group + 2] += sign * arm_x
+        (xa, ya), (xb, yb) = xs
+        return (xa - xb, ya - yb), rows
+
     def _rows(self, s: NDArray[np.float64], k: int):
         """(x_a - x_b, its 2 x n Jacobian, the current normal) of point ``k``; the normal turns
         with body b (the face a bears on)."""
-        rest, ga, gb, normal = self.points[k]
-        xa, arm_a = self.place(s, ga, rest)
-        xb, arm_b = self.place(s, gb, rest)
-        J = np.zeros((2, self.n_dof))
-        for group, arm, sign in ((ga, arm_a, 1.0), (gb, arm_b, -1.0)):
-            if group < 0:
-                continue
-            J[0, 3 * group] += sign
-            J[1, 3 * group + 1] += sign
-            J[0, 3 * group + 2] += -sign * arm[1]
-            J[1, 3 * group + 2] += sign * arm[0]
+        frame = self._frame(s)
+        gap, rows = self._point(frame, k)
+        _, gb, normal = self.points[k][1:]
         if gb >= 0:
-            c, sn = np.cos(s[3 * gb + 2]), np.sin(s[3 * gb + 2])
+            _, _, c, sn = frame[gb]
             normal = np.array([c * normal[0] - sn * normal[1], sn * normal[0] + c * normal[1]])
-        return xa - xb, J, normal
+        return np.array(gap), np.array(rows), normal
+
+    def _key(self, s: NDArray[np.float64]) -> bytes:
+        """What the constraints depend on that changes along a curve: the configuration and the
+        hinges still active."""
+        return s.tobytes() + self.active.tobytes()
 
     def constraints(self, s: NDArray[np.float64]):
-        """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative."""
-        rows = [self._rows(s, int(k)) for k in np.flatnonzero(self.active)]
-        slid = [self._slide_row(s, k) for k in range(len(self.slides))]
-        if not rows and not slid:
+        """(gap vector g, Jacobian C): x_a - x_b at every active point and its derivative (the
+        last configuration's kept: the caller must not write into them)."""
+        return _remembered(self._constraints_at, self._key(s), lambda: self._constraints(s))
+
+    def _constraints(self, s: NDArray[np.float64]):
+        frame = self._frame(s)
+        gaps: list[float] = []
+        rows: list[list[float]] = []
+        for k in np.flatnonzero(self.active).tolist():
+            gap, jac = self._point(frame, k)
+            gaps += gap
+            rows += jac
+        for k in range(len(self.slides)):
+            v, J = self._slide_row(s, k)
+            gaps.append(v)
+            rows.append(J.tolist())
+        if not rows:
             return np.zeros(0), np.zeros((0, self.n_dof))
-        g = np.concatenate([r[0] for r in rows] + [np.array([v for v, _ in slid])])
-        C = np.vstack([r[1] for r in rows] + [J[None, :] for _, J in slid])
-        return g, C
+        return np.array(gaps), np.array(rows)
 
     def normal_gaps(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
         """(x_a - x_b) . n at every point (> 0: open), m."""
@@ -262,19 +341,17 @@ class _Kinematics:
         return out
 
     def _null_space(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Orthonormal basis of the compatible velocities, in (vx, vy, omega x size)."""
+        """Orthonormal basis of the compatible velocities, in (vx, vy, omega x size) (the last
+        configuration's kept: the caller must not write into it)."""
+        return _remembered(self._null_space_at, self._key(s), lambda: self._basis(s))
+
+    def _basis(self, s: NDArray[np.float64]) -> NDArray[np.float64]:
         _, C = self.constraints(s)
         if C.shape[0] == 0:
             return np.eye(self.n_dof)
         _, sv, vt = np.linalg.svd(C / self.scale, full_matrices=True)
         rank = int(np.sum(sv > 1e-9 * max(sv.max(), 1.0))) if sv.size else 0
         return vt[rank:].T
-
-    @property
-    def scale(self) -> NDArray[np.float64]:
-        out = np.ones(self.n_dof)
-        out[2::3] = self.model.size_m  # rotations to lengths: comparable columns
-        return out
 
     def release(self, s: NDArray[np.float64]) -> NDArray[np.float64] | None:
         """When the hinges kept lock the mechanism (they are compatible at rest only to first
@@ -357,9 +434,10 @@ class _Kinematics:
         return float(max(0.0, -gaps.min()))
 
 
-def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int]]:
-    """(moving block, fixed block) pairs that do not touch at rest and lie within a quarter of the
-    assembly's size of each other: where a gap can close (module docstring)."""
+def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, int, NDArray[np.float64]]]:
+    """(moving block, fixed block, the fixed block's edge normals) of the pairs that do not touch at
+    rest and lie within a quarter of the assembly's size of each other: where a gap can close
+    (module docstring)."""
     touching = {frozenset((itf.a, itf.b)) for itf in model.interfaces}
     touching |= {frozenset((c.a, c.b)) for c in model.corners}
     fixed = [j for j in range(model.n_blocks) if model.fixed[j]]
@@ -373,17 +451,17 @@ def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, 
         a, b = bodies[i], bodies[j]
         if model.fixed[a] == model.fixed[b] or frozenset((a, b)) in touching:
             continue
-        out.append((a, b) if not model.fixed[a] else (b, a))
+        moved, still = (a, b) if not model.fixed[a] else (b, a)
+        out.append((moved, still, _edge_normals(model.polygons_m[still])))
     return out
 
 
 def _closed(model: RigidBlockModel, kin: _Kinematics, s, pairs) -> tuple[int, int] | None:
     """The first watched pair whose blocks overlap in configuration ``s``, else None."""
     tol = 1e-9 * model.size_m
-    for a, b in pairs:
-        rest = model.polygons_m[a]
-        moved = np.array([kin.place(s, kin.group_of[a], p)[0] for p in rest])
-        if penetration_depth(moved, model.polygons_m[b]) > tol:
+    for a, b, normals_b in pairs:
+        moved = kin.place_polygon(s, kin.group_of[a], model.polygons_m[a])
+        if penetration_depth(moved, model.polygons_m[b], (_edge_normals(moved), normals_b)) > tol:
             return a, b
     return None
 
