@@ -50,7 +50,7 @@ from numpy.typing import NDArray
 from rockyade.limit.lp import DIRECTIONS
 from rockyade.limit.mechanism import VELOCITY_TOL, Mechanism, relative_velocity
 from rockyade.limit.rigid_blocks import RigidBlockModel, _outside
-from rockyade.scene.placement import _edge_normals, candidate_pairs, penetration_depth
+from rockyade.scene.placement import candidate_pairs, edge_normals, penetration_depth
 
 #: Largest rotation of any block in one step, rad.
 MAX_STEP_ROTATION_RAD = 2.0e-3
@@ -452,7 +452,7 @@ def _watched_pairs(model: RigidBlockModel, kin: _Kinematics) -> list[tuple[int, 
         if model.fixed[a] == model.fixed[b] or frozenset((a, b)) in touching:
             continue
         moved, still = (a, b) if not model.fixed[a] else (b, a)
-        out.append((moved, still, _edge_normals(model.polygons_m[still])))
+        out.append((moved, still, edge_normals(model.polygons_m[still])))
     return out
 
 
@@ -461,7 +461,7 @@ def _closed(model: RigidBlockModel, kin: _Kinematics, s, pairs) -> tuple[int, in
     tol = 1e-9 * model.size_m
     for a, b, normals_b in pairs:
         moved = kin.place_polygon(s, kin.group_of[a], model.polygons_m[a])
-        if penetration_depth(moved, model.polygons_m[b], (_edge_normals(moved), normals_b)) > tol:
+        if penetration_depth(moved, model.polygons_m[b], (edge_normals(moved), normals_b)) > tol:
             return a, b
     return None
 

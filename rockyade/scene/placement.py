@@ -172,7 +172,7 @@ def candidate_pairs(polygons: list[NDArray[np.float64]], margin: float = 0.0) ->
     return sorted(pairs)
 
 
-def _edge_normals(poly: NDArray[np.float64]) -> NDArray[np.float64]:
+def edge_normals(poly: NDArray[np.float64]) -> NDArray[np.float64]:
     """Outward unit normals of a counter-clockwise polygon's edges."""
     edges = np.concatenate((poly[1:], poly[:1])) - poly  # np.roll(poly, -1, axis=0) - poly
     normals = np.column_stack([edges[:, 1], -edges[:, 0]])
@@ -191,7 +191,7 @@ def penetration_depth(
     the caller has them.
     """
     depth = math.inf
-    for axes in normals if normals is not None else (_edge_normals(p), _edge_normals(q)):
+    for axes in normals if normals is not None else (edge_normals(p), edge_normals(q)):
         pp = p @ axes.T
         qq = q @ axes.T
         overlap = np.minimum(pp.max(axis=0), qq.max(axis=0)) - np.maximum(pp.min(axis=0), qq.min(axis=0))
@@ -205,7 +205,7 @@ def overlapping_pairs(blocks: list[PlacedBlock], tol: float = OVERLAP_TOL) -> li
     Returns (i, j, depth_m) triples.
     """
     polys = [b.vertices_m for b in blocks]
-    normals = [_edge_normals(p) for p in polys]
+    normals = [edge_normals(p) for p in polys]
     out = []
     for i, j in candidate_pairs(polys):
         depth = penetration_depth(polys[i], polys[j], (normals[i], normals[j]))
@@ -225,8 +225,8 @@ def _shared_segment(
 ) -> tuple[float, NDArray[np.float64], tuple[tuple[float, float], tuple[float, float]]]:
     """The boundary segment two touching convex polygons share: length, normal (q -> p), ends.
 
-    ``normals`` are the two polygons' :func:`_edge_normals`, when the caller has them."""
-    np_, nq = normals if normals is not None else (_edge_normals(p), _edge_normals(q))
+    ``normals`` are the two polygons' :func:`edge_normals`, when the caller has them."""
+    np_, nq = normals if normals is not None else (edge_normals(p), edge_normals(q))
     best, normal, ends = 0.0, np.zeros(2), ((0.0, 0.0), (0.0, 0.0))
     # the edge pairs that can be anti-parallel, all at once (a looser test than the exact one
     # below, which decides), in the order of a loop over e, then f
@@ -261,7 +261,7 @@ def rest_contacts(blocks: list[PlacedBlock], polygons: list[NDArray[np.float64]]
         pass theirs, whose base corners may sit at the equivalent base b_eq (Eq 11).
     """
     polys = polygons if polygons is not None else [b.vertices_m for b in blocks]
-    normals = [_edge_normals(p) for p in polys]
+    normals = [edge_normals(p) for p in polys]
     out: list[RestContact] = []
     for i, p in enumerate(polys):
         if blocks[i].fixed:
