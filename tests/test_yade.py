@@ -387,7 +387,7 @@ def _warm_yade() -> None:
     )
 
 
-#: A run no machine finishes within the tests' timeouts (1 to 2 s): an hour of specimen 1
+#: A run no machine finishes within the tests' timeouts (0.5 to 1 s): an hour of specimen 1
 #: rocking (7.2e7 body-steps, minutes of YADE on the fastest machine seen, where 60 s of
 #: it, the earlier choice, finished within 3 s), sampled every 0.01 s to stay within the
 #: cost limits.
@@ -398,7 +398,7 @@ def test_timeout_gives_failed_result(tmp_path):
     scene = scene_from_dict({**load_scene(EXAMPLES / "specimen1_free.toml").to_dict(), **NEVER_FINISHES})
     _warm_yade()
     start = time.time()
-    result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=2.0).run(scene)
+    result = YadeSolver(workdir=tmp_path, stem="slow", timeout_s=1.0).run(scene)
     assert time.time() - start < 30
     assert result.status == "failed" and result.meta.failure_reason.startswith("timeout")
     # stopped by the driver at the deadline: what it recorded is kept, marked partial
@@ -556,10 +556,10 @@ def test_cli_yade_timeout_stops_the_run(tmp_path, monkeypatch, capsys):
     before = descendants(os.getpid())
     _warm_yade()
     start = time.time()
-    code = main(["run", "long.json", "--solver", "yade", "--out", "t/long.csv", "--yade-timeout", "2"])
+    code = main(["run", "long.json", "--solver", "yade", "--out", "t/long.csv", "--yade-timeout", "1"])
     assert code == 1 and time.time() - start < 30
     out = capsys.readouterr().out
-    assert "timeout: YADE did not finish within 2 s" in out
+    assert "timeout: YADE did not finish within 1 s" in out
     kept = Result.read(Path("t/long.csv"))
     assert kept.status == "failed" and kept.meta.partial is True and len(kept.frame) > 0
     # the scene was stopped: its warm YADE waits idle for the next one, and quits when asked
@@ -586,14 +586,14 @@ def test_a_failed_run_never_replaces_a_complete_result(tmp_path, monkeypatch, ca
     assert main(["run", "short.json", "--solver", "housner", "--out", "r/long.csv"]) == 0
     before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
     _warm_yade()
-    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long.csv", "--yade-timeout", "2"]) == 1
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long.csv", "--yade-timeout", "1"]) == 1
     assert "keeps the complete result of an earlier run" in capsys.readouterr().out
     assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
     assert Result.read(Path("r/long.csv")).status == "completed"
     failed = Result.read(Path("r/long_failed.csv"))
     assert failed.status == "failed" and failed.meta.partial is True
     # a failed result is not worth keeping over another failed one (with samples or without)
-    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "1"]) == 1
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/long_failed.csv", "--yade-timeout", "0.5"]) == 1
     assert not Path("r/long_failed_failed.csv").exists()
 
 
@@ -612,7 +612,7 @@ def test_a_failed_yade_run_never_touches_a_complete_runs_files(tmp_path, monkeyp
     before = {p.name: p.read_bytes() for p in Path("r").iterdir()}
     assert {"x.csv", "x.json", "x.yade.json", "x.yade.npz", "x.yade.log"} <= set(before)
     _warm_yade()
-    assert main(["run", "long.json", "--solver", "yade", "--out", "r/x.csv", "--yade-timeout", "2"]) == 1
+    assert main(["run", "long.json", "--solver", "yade", "--out", "r/x.csv", "--yade-timeout", "1"]) == 1
     capsys.readouterr()
     assert {p.name: p.read_bytes() for p in Path("r").iterdir() if p.name in before} == before
     complete = Result.read(Path("r/x.csv"))
