@@ -58,11 +58,14 @@ def _kernel_inputs(tasks, repeat: int = 1):
 
 def _one_at_a_time(tasks, repeat: int, uplift_rad: float, sample_dt: float) -> RunsOutput:
     """What :func:`simulate_runs` returns, from the single-body kernel run once per motion
-    (the summaries by the same function from those samples)."""
-    outs = [simulate_single(*_packed(m)) for m in _runs(tasks, repeat)]
+    (the summaries by the same function from those samples). A repeated task's run is its
+    first run's: the single-body kernel is a function of its inputs alone (the group repeats
+    tasks only to hold more runs than a chunk)."""
+    models = _runs(tasks)
+    outs = [simulate_single(*_packed(m)) for m in models] * repeat
     ang = np.stack([o.ang[:, 0] for o in outs])
     n_filled = np.array([o.n_filled for o in outs], dtype=np.int64)
-    rest = _packed(_runs(tasks)[0])[0].rest_ang[0]
+    rest = _packed(models[0])[0].rest_ang[0]
     return RunsOutput(
         np.array([o.status for o in outs], dtype=np.int64),
         np.array([o.t_stop for o in outs]),

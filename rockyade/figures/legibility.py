@@ -32,9 +32,14 @@ def _visible(artist) -> bool:
 
 
 def _draw(fig: Figure):
-    """Draw ``fig`` (on Agg when it has no canvas that renders) and return its renderer."""
+    """Lay ``fig`` out (on Agg when it has no canvas that renders) and return its renderer.
+
+    A draw without rendering (``Figure.draw_without_rendering``): every artist is placed and
+    every text measured by Agg's renderer, as in a draw, but no pixel is painted; the window
+    extents (and so what is found) are a full draw's.
+    """
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
-    canvas.draw()
+    fig.draw_without_rendering()
     return canvas.get_renderer()
 
 
