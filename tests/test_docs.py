@@ -18,13 +18,15 @@ import signal
 import subprocess
 import sys
 import tomllib
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import pytest
 
 from .conftest import ROOT
+from .test_examples import GALLERY, GALLERY_RUN, RECORDS_RUN, check_gallery_figure, check_generated_records
 
 TITLE = "Modeling the dynamic behavior of masonry walls as rigid blocks"
 DOCS = sorted((ROOT / "docs").rglob("*.md"))
@@ -45,6 +47,14 @@ OUTSIDE = ("../" + "shared", "/work/" + "shared")
 NOT_RUN_HERE = ("rockyade paper", "rockyade verify", "SCHEDULER", "tcp://host", "STUDY.toml")
 #: What may differ between the page and the run in a shown output line: wall times.
 VOLATILE = (re.compile(r"wall time [0-9.e+-]+ s"), re.compile(r", [0-9.e+-]+ s \(total\)"))
+
+
+#: Checks of what a documented command wrote, made after it ran as printed (folder, printed
+#: text): the examples' own (tests/test_examples.py), so each script runs once in the suite.
+AFTER: dict[str, Callable[[Path, str], None]] = {
+    RECORDS_RUN: check_generated_records,
+    **{GALLERY_RUN.format(stem=script.stem): partial(check_gallery_figure, script.stem) for script in GALLERY},
+}
 
 
 def _shown(page: Path) -> list[tuple[str, list[str], bool]]:
@@ -227,7 +237,7 @@ def run_printed(starter: CommandStarter, command: str, cwd: Path, env: dict | No
     return starter.run("script", cwd, args[1:], env=env)
 
 
-def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: list[str], also: list[str] = ()) -> None:
+def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: list[str], also: list[str] = ()) -> str:
     """Run ``command`` in ``cwd`` with this environment's rockyade; exit 0 (or 2 where the page
     shows the refusal) and the shown lines printed (and ``also``, what another page shows after
     the same command, each page's lines in its own order)."""
@@ -236,6 +246,7 @@ def _run_as_printed(starter: CommandStarter, command: str, cwd: Path, shown: lis
     assert proc.returncode == (2 if refused else 0), f"{command}\n{proc.stdout[-1500:]}\n{proc.stderr[-2500:]}"
     check_output(command, shown, proc.stdout + proc.stderr)
     check_output(command, list(also), proc.stdout + proc.stderr)
+    return proc.stdout + proc.stderr
 
 
 def _without_plot(command: str, keep: set[str]) -> str:
@@ -388,8 +399,11 @@ def test_python_page_shows_keyword_only_arguments_as_such():
 def test_documented_command_runs_as_printed(command, tmp_path, starter):
     """Each indented command of the README and docs/, in a fresh folder (no command needs
     another's output), prints the lines its page shows (one that a fenced block prints too is
-    run and checked with that block's page, ``ALSO_SHOWN``)."""
-    _run_as_printed(starter, command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
+    run and checked with that block's page, ``ALSO_SHOWN``), and what it wrote passes the
+    examples' checks where it has some (``AFTER``)."""
+    printed = _run_as_printed(starter, command, _fresh_checkout(tmp_path), OUTPUTS.get(command, []))
+    if command in AFTER:
+        AFTER[command](tmp_path, printed)
 
 
 @pytest.mark.slow

@@ -4,9 +4,6 @@ scene that uses one, and a gallery of scripts that run."""
 from __future__ import annotations
 
 import json
-import runpy
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +14,6 @@ from rockyade.motion.records import read_record
 
 from .conftest import EXAMPLES, ROOT
 
-ROCKYADE = Path(sys.executable).parent / "rockyade"
 RECORDS = EXAMPLES / "records"
 GALLERY = sorted((EXAMPLES / "gallery").glob("*.py"))
 
@@ -38,16 +34,14 @@ def test_the_ricker_record_is_the_pulse_it_says():
     np.testing.assert_allclose(rec.accel_m_s2, expected, atol=1e-7)
 
 
-def test_motion_info_on_a_shipped_record_from_the_repository():
-    """As the README prints it: a relative path from the repository root."""
-    proc = subprocess.run(
-        [str(ROCKYADE), "motion", "info", "examples/records/ec8_type2_D_record21.AT2", "--json"],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        check=True,
-    )
-    info = json.loads(proc.stdout)
+def test_motion_info_on_a_shipped_record_from_the_repository(monkeypatch, capsys):
+    """As the README prints it: a relative path from the repository root (the command's
+    ``main``, in this process: the console script is started by tests/test_docs.py)."""
+    from rockyade.cli import main
+
+    monkeypatch.chdir(ROOT)
+    assert main(["motion", "info", "examples/records/ec8_type2_D_record21.AT2", "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
     assert info["npts"] == 2001 and info["dt_s"] == pytest.approx(0.01)
 
 
@@ -62,37 +56,35 @@ def test_a_scene_reads_its_record_relative_to_the_scene_file(tmp_path, monkeypat
     assert json.loads((tmp_path / "r/x.json").read_text())["status"] == "completed"
 
 
-@pytest.mark.slow
-def test_the_record_generator_runs(tmp_path):
-    proc = subprocess.run(
-        [sys.executable, str(RECORDS / "make_example_records.py"), "out"], cwd=tmp_path, capture_output=True, text=True
-    )
-    assert proc.returncode == 0, proc.stderr
-    fresh = read_record(tmp_path / "out/ricker_pulse_T0.5s.AT2")
+#: The commands of examples/records/README.md and examples/gallery/README.md that run the
+#: record generator and each gallery script: tests/test_docs.py runs each once, as printed, and
+#: checks what it wrote with the functions below (``AFTER``).
+RECORDS_RUN = ".venv/bin/python examples/records/make_example_records.py runs/records"
+GALLERY_RUN = ".venv/bin/python examples/gallery/{stem}.py gallery"
+
+
+def check_generated_records(cwd: Path, printed: str) -> None:
+    """The generator (``RECORDS_RUN``, run in ``cwd``) rewrites the shipped records exactly."""
+    fresh = read_record(cwd / "runs/records/ricker_pulse_T0.5s.AT2")
     shipped = read_record(RECORDS / "ricker_pulse_T0.5s.AT2")
     np.testing.assert_array_equal(fresh.accel_m_s2, shipped.accel_m_s2)
-    assert read_record(tmp_path / "out/ec8_type2_D_record21.AT2").npts == 2001
+    assert read_record(cwd / "runs/records/ec8_type2_D_record21.AT2").npts == 2001
 
 
-@pytest.mark.parametrize("script", GALLERY, ids=[p.stem for p in GALLERY])
-@pytest.mark.slow
-def test_gallery_script_runs_and_writes_its_figure(script, tmp_path, monkeypatch, capsys):
-    """Each script, run as ``python SCRIPT gallery`` would run it (as ``__main__``, with that
-    argument, in a fresh folder), but in this process: the test is about the script, not about
-    starting Python (examples/gallery/README.md's commands start it, tests/test_docs.py)."""
-    import matplotlib.pyplot as plt
-
-    monkeypatch.chdir(tmp_path)
-    monkeypatch.setattr(sys, "argv", [str(script), "gallery"])
-    before = set(plt.get_fignums())
-    try:
-        runpy.run_path(str(script), run_name="__main__")
-    finally:
-        for number in set(plt.get_fignums()) - before:
-            plt.close(number)
-    assert f"wrote {Path('gallery') / f'{script.stem}.png'}" in capsys.readouterr().out
-    png = tmp_path / "gallery" / f"{script.stem}.png"
+def check_gallery_figure(stem: str, cwd: Path, printed: str) -> None:
+    """A gallery script (``GALLERY_RUN``, run in ``cwd``) said it wrote its PNG, and did."""
+    assert f"wrote {Path('gallery') / f'{stem}.png'}" in printed
+    png = cwd / "gallery" / f"{stem}.png"
     assert png.read_bytes()[:4] == b"\x89PNG" and png.stat().st_size > 20_000
+
+
+def test_the_docs_tests_run_the_record_generator_and_each_gallery_script_and_check_them():
+    """Each script runs once in the suite: as its README prints it, by tests/test_docs.py, which
+    then checks what it wrote (the generator's records, each script's figure)."""
+    from .test_docs import AFTER, COMMANDS
+
+    wanted = [RECORDS_RUN, *(GALLERY_RUN.format(stem=script.stem) for script in GALLERY)]
+    assert [command for command in wanted if command not in COMMANDS or command not in AFTER] == []
 
 
 def test_the_gallery_has_scripts():
