@@ -22,13 +22,15 @@ system:
 # The packages go in with uv (installed into the environment by its own pip first): it resolves
 # and unpacks in parallel where pip works one wheel at a time (measured here, warm caches, loaded
 # machine: pip 15.7 s against uv 6.2 s for the same versions), and it upgrades the environment's
-# pip on the way (tests/test_wheel.py builds the wheel with it). Then compileall on every core:
+# pip on the way (tests/test_wheel.py builds the wheel with it). uv reads no pip configuration
+# (pip.conf, PIP_INDEX_URL): where it cannot install, pip does, as before. Then compileall on every core:
 # the packages' bytecode, less their own test suites (no run imports them; Python would compile
 # such a file when imported); a file compileall cannot compile is left to Python too, hence `|| true`
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -qq --root-user-action=ignore --disable-pip-version-check uv
-	$(BIN)/uv pip install -q --python $(BIN)/python --upgrade-package pip pip -e '.[dev]'
+	$(BIN)/uv pip install -q --python $(BIN)/python --upgrade-package pip pip -e '.[dev]' \
+	  || $(BIN)/python -m pip install -qq --root-user-action=ignore --upgrade --no-compile pip -e '.[dev]'
 	$(BIN)/python -m compileall -q -j 0 -x '/(tests?|testing)/' $(VENV)/lib > /dev/null || true
 	@touch $(STAMP)
 
