@@ -88,7 +88,7 @@ class ReferenceSolver(SolverBase):
     OPTIONS: ClassVar = {"record_energy": check_flag, "record_contacts": check_flag, "dt_factor": check_dt_factor}
     #: Kernel time per body-step, s (cost estimate; this project's benchmarks).
     SECONDS_PER_BODY_STEP: ClassVar[float] = 150e-9
-    COMPILE_S: ClassVar[float] = 80.0
+    COMPILE_S: ClassVar[float] = 68.0
 
     record_energy: bool = True
     record_contacts: bool = True
@@ -110,7 +110,7 @@ class ReferenceSolver(SolverBase):
         """The kernel's three paths, which compile independently, with their CPU s on a cold cache
         (measured on the 2-core machine, each in a fresh process: the general loop is the most)."""
         return {
-            "general loop": (warm_up, 62.0),
+            "general loop": (warm_up, 50.0),
             "single body": (functools.partial(warm_up, single=True), 7.0),
             "runs stepped together": (functools.partial(warm_up, runs=True), 11.0),
         }
