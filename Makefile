@@ -23,14 +23,18 @@ system:
 # and unpacks in parallel where pip works one wheel at a time (measured here, warm caches, loaded
 # machine: pip 15.7 s against uv 6.2 s for the same versions), and it upgrades the environment's
 # pip on the way (tests/test_wheel.py builds the wheel with it). uv reads no pip configuration
-# (pip.conf, PIP_INDEX_URL): where it cannot install, pip does, as before. Then compileall on every core:
+# (pip.conf, PIP_INDEX_URL): where it cannot install, pip does, as before. Its temporary folder is
+# one in the environment, removed after (uv leaves an empty lock file there for each build of the
+# package, which would pile up in /tmp). Then compileall on every core:
 # the packages' bytecode, less their own test suites (no run imports them; Python would compile
 # such a file when imported); a file compileall cannot compile is left to Python too, hence `|| true`
 $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -qq --root-user-action=ignore --disable-pip-version-check uv
-	$(BIN)/uv pip install -q --python $(BIN)/python --upgrade-package pip pip -e '.[dev]' \
+	mkdir -p $(VENV)/tmp
+	TMPDIR=$(abspath $(VENV))/tmp $(BIN)/uv pip install -q --python $(BIN)/python --upgrade-package pip pip -e '.[dev]' \
 	  || $(BIN)/python -m pip install -qq --root-user-action=ignore --upgrade --no-compile pip -e '.[dev]'
+	rm -rf $(VENV)/tmp
 	$(BIN)/python -m compileall -q -j 0 -x '/(tests?|testing)/' $(VENV)/lib > /dev/null || true
 	@touch $(STAMP)
 
