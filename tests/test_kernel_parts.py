@@ -13,6 +13,7 @@ from rockyade.kernel import simulation as kernel
 from rockyade.kernel.contact_law import (
     STATE_SLIP,
     STATE_STICK,
+    JointLaw,
     add_released_energy,
     add_stored_energy,
     contact_law,
@@ -27,7 +28,7 @@ KN, KS, CN, CS, TANPHI, DT = 2.0e8, 1.5e8, 3.0e3, 2.5e3, math.tan(math.radians(3
 
 
 def law(delta, ddot, vt, s_old):
-    return contact_law(delta, ddot, vt, s_old, KN, KS, CN, CS, TANPHI, DT)
+    return contact_law(delta, ddot, vt, s_old, JointLaw(KN, KS, CN, CS, TANPHI), DT)
 
 
 # ---------------------------------------------------------------------- contact law

@@ -18,7 +18,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from rockyade.kernel.contact_law import add_released_energy, add_stored_energy
+from rockyade.kernel.contact_law import add_released_energy, add_stored_energy, joint_law
 from rockyade.kernel.energy import push_dashpot
 from rockyade.kernel.recording import count_point
 from rockyade.kernel.step import base_point
@@ -87,8 +87,7 @@ def body_on_base(
     wv, shear, vstate = world.wv, base.shear, tally.vstate
     pos, vel, angvel, force, torque = kin.pos, kin.vel, kin.angvel, kin.force, kin.torque
     record_energy, record_corners, dt = settings.record_energy, settings.record_corners, settings.dt
-    j = joints.base_joint[a]
-    kn, ks, cn, cs, tanphi = joints.kn[j], joints.ks[j], joints.cn[j], joints.cs[j], joints.tanphi[j]
+    law = joint_law(joints, joints.base_joint[a])
     touching = False
     for v in range(bodies.nverts[a]):
         px = wv[a, v, 0]
@@ -98,12 +97,12 @@ def body_on_base(
             if shear[a, v] != 0.0:
                 # the contact opened: its shear memory (and stored energy) is lost
                 if record_energy:
-                    d_fric = add_released_energy(d_fric, shear[a, v] ** 2, ks)
+                    d_fric = add_released_energy(d_fric, shear[a, v] ** 2, law.ks)
                 shear[a, v] = 0.0
             continue
         touching = True
         fx, fy, tz, fn, fn_spring, s_new, visc, state, slip_work = base_point(
-            px, py, pos[a, 0], pos[a, 1], vel[a, 0], vel[a, 1], angvel[a], shear[a, v], kn, ks, cn, cs, tanphi, dt
+            px, py, pos[a, 0], pos[a, 1], vel[a, 0], vel[a, 1], angvel[a], shear[a, v], law, dt
         )
         shear[a, v] = s_new
         force[a, 0] += fx
@@ -115,7 +114,7 @@ def body_on_base(
                 vstate[a, v] = state
         if record_energy:
             d_fric += slip_work
-            e_el = add_stored_energy(e_el, fn_spring, delta, s_new, ks)
+            e_el = add_stored_energy(e_el, fn_spring, delta, s_new, law.ks)
             n_dash = push_dashpot(dash, n_dash, a, -1, px, py, fn - fn_spring, visc, 0.0, 1.0)
     base.on_base[a] = touching
     return e_el, n_dash, d_fric

@@ -20,10 +20,31 @@ applies the force F_n n - (S + c_s v_t) t; the law itself is the same for every 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, NamedTuple
+
 import numba
+
+if TYPE_CHECKING:
+    from rockyade.kernel.state import Joints
 
 #: Contact states of a point (and of a vertex: the worst state of the points at it).
 STATE_OPEN, STATE_STICK, STATE_SLIP = 0, 1, 2
+
+
+class JointLaw(NamedTuple):
+    """The constants of one joint's law (module docstring), as every contact path takes them."""
+
+    kn: float  #: normal stiffness K, N/m
+    ks: float  #: shear stiffness K_s, N/m
+    cn: float  #: normal dashpot c_n = beta K, N s/m
+    cs: float  #: shear dashpot c_s = beta K_s, N s/m
+    tanphi: float  #: friction coefficient tan(phi)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def joint_law(joints: Joints, j: int) -> JointLaw:
+    """The law of joint ``j`` of the packed joints (:class:`rockyade.kernel.state.Joints`)."""
+    return JointLaw(joints.kn[j], joints.ks[j], joints.cn[j], joints.cs[j], joints.tanphi[j])
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -32,11 +53,7 @@ def contact_law(
     ddot: float,
     vt: float,
     s_old: float,
-    kn: float,
-    ks: float,
-    cn: float,
-    cs: float,
-    tanphi: float,
+    law: JointLaw,
     dt: float,
 ) -> tuple[float, float, float, float, int, float]:
     """Forces of one contact point (module docstring).
@@ -49,8 +66,8 @@ def contact_law(
         Tangential relative velocity, m/s.
     s_old
         Shear spring force of the last step, N (0 for a new point).
-    kn, ks, cn, cs, tanphi
-        Normal and shear stiffness (N/m), dashpots (N s/m) and friction coefficient.
+    law
+        The joint's stiffnesses, dashpots and friction coefficient.
     dt
         Time step, s.
 
@@ -69,6 +86,7 @@ def contact_law(
     slip_work
         Energy dissipated by friction in this step, J (0 while sticking, or with K_s = 0).
     """
+    kn, ks, cn, cs, tanphi = law
     fn_spring = kn * delta
     fn = fn_spring + cn * ddot
     if fn < 0.0:

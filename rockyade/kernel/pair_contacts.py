@@ -30,18 +30,30 @@ Last step's points that find no successor opened: their spring energy is lost.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numba
 
-from rockyade.kernel.contact_law import add_released_energy, add_stored_energy, contact_law
+from rockyade.kernel.contact_law import add_released_energy, add_stored_energy, contact_law, joint_law
 from rockyade.kernel.energy import push_dashpot
 from rockyade.kernel.narrowphase import HYSTERESIS_REL, NO_FACE, clip_manifold, incident_edge, separating_axis_test
 from rockyade.kernel.recording import count_point, mark_pair_corners
 
+if TYPE_CHECKING:
+    import numpy as np
+    from numpy.typing import NDArray
+
+    from rockyade.kernel.energy import Dashpots
+    from rockyade.kernel.integration import Motion
+    from rockyade.kernel.pairs import PairState
+    from rockyade.kernel.recording import Tally
+    from rockyade.kernel.state import Bodies, Joints, Settings
+    from rockyade.kernel.world import World
+
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def pair_manifold(
-    k: int, bodies, kin, world, pairs, coherent: bool, clip
+    k: int, bodies: Bodies, kin: Motion, world: World, pairs: PairState, coherent: bool, clip: NDArray[np.float64]
 ) -> tuple[int, bool, int, int, int, int, int, int]:
     """Contact points of pair k written to ``clip``.
 
@@ -105,7 +117,7 @@ def pair_manifold(
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def pair_opened(k: int, pairs, joints, apart: bool, record_energy: bool, d_fric: float) -> float:
+def pair_opened(k: int, pairs: PairState, joints: Joints, apart: bool, record_energy: bool, d_fric: float) -> float:
     """Pair k has no contact point this step: last step's points opened (their spring energy
     added to ``d_fric``, returned). Unless a separating axis holds, the cached test no longer
     does (the boxes parted, or the manifold emptied without one): test again next time."""
@@ -159,15 +171,15 @@ def pair_points(
     inc: int,
     face: int,
     edge: int,
-    bodies,
-    joints,
-    settings,
-    kin,
-    world,
-    pairs,
-    tally,
-    dash,
-    clip,
+    bodies: Bodies,
+    joints: Joints,
+    settings: Settings,
+    kin: Motion,
+    world: World,
+    pairs: PairState,
+    tally: Tally,
+    dash: Dashpots,
+    clip: NDArray[np.float64],
     sampling: bool,
     e_el: float,
     n_dash: int,
@@ -181,8 +193,7 @@ def pair_points(
     record_energy, record_corners, dt = settings.record_energy, settings.record_corners, settings.dt
     a = pairs.a[k]
     b = pairs.b[k]
-    j = pairs.joint[k]
-    kn, ks, cn, cs, tanphi = joints.kn[j], joints.ks[j], joints.cn[j], joints.cs[j], joints.tanphi[j]
+    law = joint_law(joints, pairs.joint[k])
     # normal from b into a (the reference normal points from ref into inc)
     sgn = 1.0 if ref == b else -1.0
     nx = sgn * wn[ref, face, 0]
@@ -215,7 +226,7 @@ def pair_points(
         vrx = vel[a, 0] - angvel[a] * ray - (vel[b, 0] - angvel[b] * rby)
         vry = vel[a, 1] + angvel[a] * rax - (vel[b, 1] + angvel[b] * rbx)
         fn, fn_spring, s_new, visc, state, slip_work = contact_law(
-            delta, -(vrx * nx + vry * ny), vrx * tx + vry * ty, s_old, kn, ks, cn, cs, tanphi, dt
+            delta, -(vrx * nx + vry * ny), vrx * tx + vry * ty, s_old, law, dt
         )
         pt[k, i, 0] = px
         pt[k, i, 1] = py
@@ -236,13 +247,13 @@ def pair_points(
                 mark_pair_corners(tally, world, bodies, a, b, ref, face, inc, edge, px, py, state)
         if record_energy:
             d_fric += slip_work
-            e_el = add_stored_energy(e_el, fn_spring, delta, s_new, ks)
+            e_el = add_stored_energy(e_el, fn_spring, delta, s_new, law.ks)
             n_dash = push_dashpot(dash, n_dash, a, b, px, py, fn - fn_spring, visc, nx, ny)
     # last step's points that found no successor opened
     if record_energy:
         if n_old > 0 and not used0:
-            d_fric = add_released_energy(d_fric, s0x * s0x + s0y * s0y, ks)
+            d_fric = add_released_energy(d_fric, s0x * s0x + s0y * s0y, law.ks)
         if n_old > 1 and not used1:
-            d_fric = add_released_energy(d_fric, s1x * s1x + s1y * s1y, ks)
+            d_fric = add_released_energy(d_fric, s1x * s1x + s1y * s1y, law.ks)
     pairs.n[k] = n_new
     return e_el, n_dash, d_fric

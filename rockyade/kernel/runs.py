@@ -28,6 +28,7 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
+from rockyade.kernel.contact_law import JointLaw, joint_law
 from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
 from rockyade.kernel.step import (
     base_point,
@@ -115,11 +116,7 @@ def step_runs(
     nv: int,
     mass: float,
     inertia: float,
-    kn: float,
-    ks: float,
-    cn: float,
-    cs: float,
-    tanphi: float,
+    law: JointLaw,
     rest_ang: float,
     stop_angle: float,
     g: float,
@@ -156,7 +153,7 @@ def step_runs(
     ----------
     lo, hi
         The runs stepped by this call.
-    verts, nv, mass, inertia, kn, ks, cn, cs, tanphi, rest_ang, stop_angle, g, dt, n_steps, sps, mass_damping,
+    verts, nv, mass, inertia, law, rest_ang, stop_angle, g, dt, n_steps, sps, mass_damping,
     stop_on_overturn
         As :func:`rockyade.kernel.single.run_body` (SI units).
     mt, mah, mav, starts
@@ -234,7 +231,7 @@ def step_runs(
                     continue
                 px = world_x(xi, c, s, verts[v, 0], verts[v, 1])
                 cfx, cfy, ctz, _fn, _spring, s_new, _visc, _state, _slip = base_point(
-                    px, py, xi, yi, vxi, vyi, wi, shear[i, v], kn, ks, cn, cs, tanphi, dt
+                    px, py, xi, yi, vxi, vyi, wi, shear[i, v], law, dt
                 )
                 shear[i, v] = s_new
                 fx += cfx
@@ -353,11 +350,7 @@ def simulate_runs(bodies, joints, settings, initial, mt, mah, mav, starts, uplif
                 nv,
                 bodies.mass[0],
                 bodies.inertia[0],
-                joints.kn[j],
-                joints.ks[j],
-                joints.cn[j],
-                joints.cs[j],
-                joints.tanphi[j],
+                joint_law(joints, j),
                 rest,
                 bodies.stop_angle[0],
                 settings.g,

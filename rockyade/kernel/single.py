@@ -31,7 +31,7 @@ import math
 import numba
 import numpy as np
 
-from rockyade.kernel.contact_law import STATE_SLIP
+from rockyade.kernel.contact_law import STATE_SLIP, JointLaw, joint_law
 from rockyade.kernel.integration import STATUS_COMPLETED, STATUS_FAILED, STATUS_OVERTURNED
 from rockyade.kernel.recording import Output, new_samples, output_of
 from rockyade.kernel.step import (
@@ -76,11 +76,7 @@ def run_body(
     nv: int,
     mass: float,
     inertia: float,
-    kn: float,
-    ks: float,
-    cn: float,
-    cs: float,
-    tanphi: float,
+    law: JointLaw,
     rest_ang: float,
     stop_angle: float,
     apx: float,
@@ -119,8 +115,8 @@ def run_body(
         (maxv, 2) polygon relative to the centroid, body frame, m; ``nv`` vertices used.
     mass, inertia
         kg and kg m^2.
-    kn, ks, cn, cs, tanphi
-        The base joint: stiffness (N/m), dashpots (N s/m), friction coefficient.
+    law
+        The base joint's law: stiffnesses (N/m), dashpots (N s/m), friction coefficient.
     rest_ang, stop_angle
         Orientation at rest and |theta| at which the body has overturned, rad.
     apx, apy
@@ -206,7 +202,7 @@ def run_body(
                 continue
             px = world_x(x, c, s, verts[v, 0], verts[v, 1])
             cfx, cfy, ctz, _fn, _spring, s_new, _visc, state, _slip = base_point(
-                px, py, x, y, vx, vy, w, shear[v], kn, ks, cn, cs, tanphi, dt
+                px, py, x, y, vx, vy, w, shear[v], law, dt
             )
             shear[v] = s_new
             fx += cfx
@@ -280,11 +276,7 @@ def simulate_single(bodies, joints, motion, settings, initial) -> Output:
         bodies.nverts[0],
         bodies.mass[0],
         bodies.inertia[0],
-        joints.kn[j],
-        joints.ks[j],
-        joints.cn[j],
-        joints.cs[j],
-        joints.tanphi[j],
+        joint_law(joints, j),
         bodies.rest_ang[0],
         bodies.stop_angle[0],
         bodies.accel_points[0, 0],

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numba
 
-from rockyade.kernel.contact_law import contact_law
+from rockyade.kernel.contact_law import JointLaw, contact_law
 
 #: Beyond these the state is a numerical blow-up, not rocking (a block overturning under
 #: gravity turns at a few rad/s): the run fails instead of being called overturned.
@@ -73,11 +73,7 @@ def base_point(
     vy: float,
     w: float,
     s_old: float,
-    kn: float,
-    ks: float,
-    cn: float,
-    cs: float,
-    tanphi: float,
+    law: JointLaw,
     dt: float,
 ) -> tuple[float, float, float, float, float, float, float, int, float]:
     """The force of the base on a vertex p = (px, py) below it (delta = -p_y >= 0, m).
@@ -95,8 +91,8 @@ def base_point(
         The body's centroid (m), velocity (m/s) and angular velocity (rad/s).
     s_old
         The vertex's shear spring of the last step, N.
-    kn, ks, cn, cs, tanphi, dt
-        The base joint (N/m, N s/m, friction coefficient) and the time step, s.
+    law, dt
+        The base joint's law and the time step, s.
 
     Returns
     -------
@@ -110,7 +106,7 @@ def base_point(
     ray = py - y
     vrx = vx - w * ray
     vry = vy + w * rax
-    fn, fn_spring, s_new, visc, state, slip_work = contact_law(delta, -vry, -vrx, s_old, kn, ks, cn, cs, tanphi, dt)
+    fn, fn_spring, s_new, visc, state, slip_work = contact_law(delta, -vry, -vrx, s_old, law, dt)
     fx = s_new + visc
     return fx, fn, rax * fn - ray * fx, fn, fn_spring, s_new, visc, state, slip_work
 
