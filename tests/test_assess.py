@@ -462,3 +462,19 @@ def test_the_dem_pushover_of_the_example_wall_lands_on_the_codes_curve(tmp_path,
     written = json.loads((tmp_path / "out" / "assess.json").read_text())
     assert abs(written["pushover_onset_minus_alpha0_pct"]) <= 2.0
     assert (tmp_path / "out" / "assess.png").stat().st_size > 0
+
+
+def test_the_figures_heading_wraps_to_its_panel(tmp_path, capsys):
+    """An NTC 2018 site's line (~180 characters) is wrapped over the one panel of a static check,
+    not drawn on one line that widened the PNG to twice the panel's width (6.4 inches at 130 dpi:
+    832 px)."""
+    import matplotlib.image
+
+    from rockyade.cli import main
+
+    site = ["--knowledge-level", "LC1", "--ag", "0.2g", "--f0", "2.4", "--tc-star", "0.3", "--soil", "B"]
+    out = tmp_path / "out"
+    code = main(["assess", str(EXAMPLES / "tuff_wall_roof.toml"), *site, "--static-only", "--out", str(out)])
+    assert code == 0 and "NOT VERIFIED" in capsys.readouterr().out
+    height, width = matplotlib.image.imread(out / "assess.png").shape[:2]
+    assert width <= 1.1 * 6.4 * 130, (width, height)

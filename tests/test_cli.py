@@ -107,6 +107,9 @@ def test_bad_input_exit_code_and_message(capsys):
     assert code == 2 and "contact.stiffness_scale" in err and "sinks" in err
     code, _, err = run_cli(capsys, "params", "--width", "-1", "--height", "1", "--thickness", "1", "--mass", "1")
     assert code == 2 and "width" in err
+    # millimetres for metres: a height a scene refuses is refused here too, naming its range
+    code, _, err = run_cli(capsys, "params", "--width", "250", "--height", "2400", "--thickness", "1", "--mass", "1")
+    assert code == 2 and "--height: must be in [0.001, 1000] m, got 2400" in err
 
 
 @pytest.mark.parametrize(
@@ -116,6 +119,9 @@ def test_bad_input_exit_code_and_message(capsys):
         (["--mass", "3", "--density", "2000"], "--mass: give exactly one of --mass and --density"),
         (["--density", "-1"], "--density: must be a finite number > 0"),
         (["--mass", "3", "--chamfer", "0.2"], "--chamfer: must be in (0, 0.125) m"),
+        # a scene's ranges (rockyade.scene.bounds): a density in kg/dm^3 or g/cm^3, a mass in tonnes x 1e9
+        (["--density", "2.2e6"], "--density: must be in [1, 100000] kg/m^3, got 2.2e+06"),
+        (["--mass", "2e9"], "--mass: must be in [0.001, 1e+09] kg, got 2e+09"),
     ],
 )
 def test_params_block_errors_name_the_options(capsys, extra, expected):

@@ -659,6 +659,19 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
 
+def test_compare_refuses_an_out_that_holds_a_study(tmp_path, capsys):
+    """compare writes loose files (<scene>_<solver>.csv, ...): into a study's folder (here a
+    fragility's set) they would be mixed with its set; refused naming --out and the study, before
+    any run, the folder left as it was."""
+    out = tmp_path / "frag"
+    out.mkdir()
+    (out / "fragility.json").write_text("{}")
+    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner", "--out", str(out))
+    err = capsys.readouterr().err
+    assert code == 2 and "--out" in err and "'rockyade fragility'" in err and "Traceback" not in err
+    assert [p.name for p in out.iterdir()] == ["fragility.json"]
+
+
 def test_free_rocking_verdict_compares_the_peaks_after_release():
     """In free rocking max |theta| is the release angle for every solver: the verdict compares the
     peaks after the release (the table's peak1-4), and a zero step change with a zero gap between

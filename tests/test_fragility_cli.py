@@ -153,6 +153,17 @@ def test_a_level_out_of_a_records_reach_is_refused_before_any_run(capsys, tmp_pa
     assert code == 2 and "load factor" in err and not (tmp_path / "o" / "runs.csv").exists()
 
 
+def test_an_out_that_holds_other_files_is_refused_before_any_run(capsys, tmp_path, wall, records):
+    """A folder of another command's files (a comparison's) is refused, naming --out and one of
+    them, and left as it was: the fragility's set would be mixed with them."""
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "wall_compare.csv").write_text("block,solver\n")
+    code, _, err = run_cli(capsys, "fragility", wall, "--records", records, "--levels", "0.5,1", "--out", out)
+    assert code == 2 and err.count("\n") == 1 and "--out" in err and "wall_compare.csv" in err
+    assert sorted(p.name for p in out.iterdir()) == ["wall_compare.csv"]
+
+
 def test_assess_static_only_gives_the_documented_json(capsys, wall):
     code, text, _ = run_cli(
         capsys,

@@ -82,6 +82,15 @@ def test_a_programme_in_a_child_process_gives_the_answer_of_this_process():
     assert child.marginals == pytest.approx([-0.4, -0.2])  # d(objective)/d(row bound), as scipy's marginals
 
 
+def test_a_programme_solved_here_writes_nothing_on_standard_output(capfd):
+    """HiGHS's banner ("Running HiGHS ...") stays off this process's standard output (file
+    descriptor 1, where HiGHS's C++ writes): `rockyade limit --json` prints JSON and nothing
+    before it."""
+    outcome = solve_programme(_small_programme(), "simplex")
+    assert outcome.status == 0
+    assert capfd.readouterr().out == ""
+
+
 def test_progress_names_hipos_and_the_simplexs_latest_iteration(tmp_path):
     log = tmp_path / "highs.log"
     log.write_text(

@@ -201,19 +201,9 @@ def _say(args: argparse.Namespace) -> Callable[[str], None]:
 def check_assess_folder(out: Path) -> None:
     """Refuse an --out that holds files that are not an assessment's (another command's set, ...):
     its set would be mixed with them (InputError naming --out)."""
-    from rockyade.io.folders import other_files
-    from rockyade.runner.study_folder import ASSESS, PARTIAL_DIR
+    from rockyade.runner.study_folder import ASSESS, check_only_its_set
 
-    if not out.is_dir():
-        return
-    others = other_files(out, (*ASSESS.names, PARTIAL_DIR))  # besides its set: an unfinished run's journal
-    if others:
-        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
-        raise InputError(
-            "--out",
-            f"{out} holds files that are not an assessment's ({shown}): give an empty folder, or one a previous "
-            "'assess --out' wrote (its set is then replaced as a whole)",
-        )
+    check_only_its_set(out, ASSESS, "an assessment")
 
 
 def _check_report_option(args: argparse.Namespace) -> None:

@@ -100,7 +100,26 @@ def _blocks_from_args(args: argparse.Namespace) -> list[NamedBlock]:
         for field, option in options.items():
             message = message.replace(field, option)
         raise InputError(options.get(exc.field, exc.field), message) from None
+    _check_scene_ranges(args)
     return [("block", block, {})]
+
+
+def _check_scene_ranges(args: argparse.Namespace) -> None:
+    """The dimensions, mass and density in the ranges a scene takes (:data:`rockyade.scene.bounds.BOUNDS`):
+    a block given in millimetres or a density in kg/dm^3 is refused here as it is in a scene."""
+    from rockyade.scene.bounds import BOUNDS
+
+    given = (
+        ("--width", args.width, "length_m"),
+        ("--height", args.height, "length_m"),
+        ("--thickness", args.thickness, "length_m"),
+        ("--mass", args.mass, "mass_kg"),
+        ("--density", args.density, "density_kg_m3"),
+    )
+    for option, value, field in given:
+        bound = BOUNDS[field]
+        if value is not None and not bound.lo <= value <= bound.hi:
+            raise InputError(option, f"must be in [{bound.lo:g}, {bound.hi:g}] {bound.unit}, got {value:g}")
 
 
 #: Block.polygon's field names as this command's options (its messages name the options).

@@ -41,6 +41,9 @@ def cmd_compare(args: argparse.Namespace) -> int:
         raise InputError("reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}")
     out: Path = args.out
     check_output_dir(out, "out")
+    from rockyade.runner.study_folder import check_no_study
+
+    check_no_study(out, "compare")  # its files would be mixed with a study's set
     runners = solvers_from_args(solvers, args)
     runners, finer = _with_dt_factor(runners, args.dt_factor, not args.no_dt_check)
 

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -40,6 +42,8 @@ DEMAND = "#b2182b"
 CODE = "#e08214"
 OK = "#1b7837"
 PUSH = "#762a83"
+#: Characters of the 10-point heading one 6.4-inch panel holds (wider, the PNG grows to fit it).
+TITLE_CHARACTERS_PER_PANEL = 88
 
 
 def plot_fragility(
@@ -253,8 +257,10 @@ def draw_assessment(a: Assessment, path: str | Path, title: str | None = None) -
             + (f"; median / code capacity = {ratio:.2f}" if not math.isnan(ratio) else ""),
             fontsize=9,
         )
-    if title:
-        fig.suptitle(f"{title}: {a.site.describe().replace('m/s^2', 'm/s²')}", fontsize=10)
+    if title:  # the site's line wrapped to the panels' width (an NTC 2018 site's is ~180 characters)
+        heading = f"{title}: {a.site.describe().replace('m/s^2', 'm/s²')}"
+        unbroken = re.sub(r" (?==)|(?<==) |(?<=\d) (?=[a-zA-Z%(])", "\u00a0", heading)  # "TC = 0.42 s" whole
+        fig.suptitle(textwrap.fill(unbroken, width=TITLE_CHARACTERS_PER_PANEL * panels), fontsize=10)
     return save_figure(fig, path)
 
 

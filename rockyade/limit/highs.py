@@ -159,11 +159,16 @@ def solve_programme(
         HiGHS writes its log (its progress) on standard output (the child process's: a file).
     """
     import highspy
+    from highspy._core import _Highs
 
     check_solver(solver)
     A = sp.csc_matrix(programme.A)
     m, n = A.shape
-    h = highspy.Highs()
+    # The solver itself, not highspy.Highs: that wrapper's constructor calls a HiGHS method while
+    # output_flag is still at its default (on), which logs HiGHS's banner ("Running HiGHS ...") on
+    # this process's standard output, in front of `rockyade limit --json`'s and `assess --json`'s
+    # JSON. Nothing of the wrapper's (callbacks, its own Ctrl-C handling) is used here.
+    h = _Highs()
     h.setOptionValue("output_flag", log)
     for key, value in _options(solver).items():
         h.setOptionValue(key, value)

@@ -160,6 +160,58 @@ def holders(out: Path) -> list[tuple[str, str]]:
     return list(found.items())
 
 
+def check_only_its_set(out: Path, kind: StudySet, what: str, field: str = "--out") -> None:
+    """Refuse an ``out`` that holds files that are not ``kind``'s set nor its journal (another
+    command's files, a scene, ...): the set would be mixed with them.
+
+    Parameters
+    ----------
+    out, kind
+        The folder and the command's set.
+    what
+        The set in words, in the message ("an assessment", "a fragility study").
+    field
+        The option that names ``out``.
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` and the first five files that are not the set's.
+    """
+    from rockyade.io.folders import other_files
+
+    if not out.is_dir():
+        return
+    others = other_files(out, (*kind.names, kind.journal, PARTIAL_DIR))
+    if others:
+        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
+        raise InputError(
+            field,
+            f"{out} holds files that are not {what}'s ({shown}): give an empty folder, or one a previous "
+            f"'{kind.command} --out' wrote (its set is then replaced as a whole)",
+        )
+
+
+def check_no_study(out: Path, command: str, field: str = "--out") -> None:
+    """Refuse an ``out`` that holds a study's result set or journal (:func:`holders`) for a
+    command that writes its own files beside what a folder holds (``compare``): they would be
+    mixed with the study's set.
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` and the study's command.
+    """
+    found = holders(out) if out.is_dir() else []
+    if found:
+        other, why = found[0]
+        raise InputError(
+            field,
+            f"{out} holds the results of 'rockyade {other}' ({why}); 'rockyade {command}' never writes into "
+            "another command's results: give another folder, or remove that one first",
+        )
+
+
 class StudyFolder:
     """A study's output folder while the study runs (module docstring); a context manager.
 
