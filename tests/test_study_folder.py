@@ -148,6 +148,38 @@ def test_the_python_api_refuses_too_and_its_own_results_are_welcome(tmp_path):
 
 
 @pytest.mark.parametrize("command", ["fragility", "assess", "crosscheck", "uncertainty", "batch"])
+def test_every_study_refuses_an_out_holding_files_that_are_not_its_set(command, inputs, capsys):
+    """A comparison's loose files (no study's mark) are not a set to replace: exit 2 naming --out
+    and a file, before any run, and the folder as it was (batch, uncertainty and crosscheck used
+    to write their sets beside them)."""
+    out = inputs / "out"
+    out.mkdir()
+    (out / "wall_compare.csv").write_text("block,solver\n")
+    (out / "wall_compare.png").write_bytes(b"png")
+    before = _bytes(out)
+    code = main(_argv(command, inputs, out))
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert "--out" in err and "wall_compare.csv" in err and len(err.strip().splitlines()) == 1
+    assert _bytes(out) == before
+
+
+def test_the_python_api_refuses_loose_files_once_it_holds_the_folder(tmp_path):
+    """run_study_tasks checks the folder's files under its lock: the same refusal from Python."""
+    from rockyade.batch import expand, run_study_tasks
+    from rockyade.scene import load_scene
+
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    base = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
+    with pytest.raises(InputError, match="notes.txt") as info:
+        run_study_tasks(expand([("s", base)], {}, ["housner"]), out, workers=1, progress=False)
+    assert info.value.field == "out"
+    assert _bytes(out) == {"notes.txt": b"mine\n"}
+
+
+@pytest.mark.parametrize("command", ["fragility", "assess", "crosscheck", "uncertainty", "batch"])
 @pytest.mark.parametrize("dangling", [False, True], ids=["link", "dangling link"])
 def test_every_study_refuses_an_out_that_is_a_link(command, dangling, inputs, capsys):
     """One rule for all (batch used to write through a link crosscheck refused; a dangling link

@@ -120,7 +120,6 @@ def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None 
     if args.out is not None:
         check_output_dir(args.out, "--out")
         check_out(args.out, ASSESS, resume_field="--resume" if args.resume else None)  # before any work
-        check_assess_folder(args.out)
     elif args.resume:
         raise InputError("--resume", "needs --out (the folder whose finished runs it keeps)")
     if args.report is not None:
@@ -196,14 +195,6 @@ def cmd_assess(args: argparse.Namespace, parser: argparse.ArgumentParser | None 
 def _say(args: argparse.Namespace) -> Callable[[str], None]:
     """Where the output folder's notes go: the text, or nowhere beside the JSON."""
     return (lambda _line: None) if args.json else print
-
-
-def check_assess_folder(out: Path) -> None:
-    """Refuse an --out that holds files that are not an assessment's (another command's set, ...):
-    its set would be mixed with them (InputError naming --out)."""
-    from rockyade.runner.study_folder import ASSESS, check_only_its_set
-
-    check_only_its_set(out, ASSESS, "an assessment")
 
 
 def _check_report_option(args: argparse.Namespace) -> None:

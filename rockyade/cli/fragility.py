@@ -41,12 +41,11 @@ def cmd_fragility(args: argparse.Namespace) -> int:
     from rockyade.cli.resumable import file_digest, identity
     from rockyade.errors import BatchInterruptedError
     from rockyade.io.atomic import write_json
-    from rockyade.runner.study_folder import FRAGILITY, StudyFolder, check_only_its_set, check_out
+    from rockyade.runner.study_folder import FRAGILITY, StudyFolder, check_out
     from rockyade.scene import load_scene
 
     check_output_dir(args.out, "--out")
     check_out(args.out, FRAGILITY, resume_field="--resume" if args.resume else None)  # before the plan
-    check_only_its_set(args.out, FRAGILITY, "a fragility study")  # nothing else beside its set
     measure = parse_measure(args.intensity)
     levels = float_list(args.levels, "--levels") if args.levels else None
     executor = executor_from(args)

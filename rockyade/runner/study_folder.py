@@ -62,12 +62,15 @@ class StudySet:
     journal
         The journal's folder in ``--out``: :data:`PARTIAL_DIR` (it goes once the set is
         complete) or :data:`RUNS_DIR` (the runs are part of the result, kept).
+    what
+        The set in words, in messages ("a fragility study").
     """
 
     command: str
     names: tuple[str, ...]
     last: str
     journal: str = PARTIAL_DIR
+    what: str = "a study"
 
     @property
     def keeps_runs(self) -> bool:
@@ -77,15 +80,24 @@ class StudySet:
 
 #: The result sets of the study commands (a batch's is its summary; an uncertainty study
 #: writes a batch summary of its runs beside its report).
-BATCH = StudySet("batch", ("summary.parquet", "summary.csv"), "summary.csv", RUNS_DIR)
+BATCH = StudySet("batch", ("summary.parquet", "summary.csv"), "summary.csv", RUNS_DIR, "a batch")
 FRAGILITY = StudySet(
-    "fragility", ("runs.csv", "stripes.csv", "records.csv", "fragility.png", "fragility.json"), "fragility.json"
+    "fragility",
+    ("runs.csv", "stripes.csv", "records.csv", "fragility.png", "fragility.json"),
+    "fragility.json",
+    what="a fragility study",
 )
-ASSESS = StudySet("assess", ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json"), "assess.json")
+ASSESS = StudySet(
+    "assess",
+    ("runs.csv", "stripes.csv", "records.csv", "assess.png", "assess.json"),
+    "assess.json",
+    what="an assessment",
+)
 CROSSCHECK = StudySet(
     "crosscheck",
     ("collapse_intensities.csv", "pairs.csv", "runs.csv", "crosscheck.json", "crosscheck.png", "index.md"),
     "crosscheck.json",
+    what="a cross-check",
 )
 UNCERTAINTY = StudySet(
     "uncertainty",
@@ -100,15 +112,20 @@ UNCERTAINTY = StudySet(
     ),
     "uncertainty.json",
     RUNS_DIR,
+    "an uncertainty study",
 )
 #: Every command's set, the most specific mark first (an uncertainty study's folder also holds
 #: a batch summary).
 STUDY_SETS = (UNCERTAINTY, CROSSCHECK, FRAGILITY, ASSESS, BATCH)
 
 
-def check_out(out: Path, kind: StudySet, field: str = "--out", resume_field: str | None = None) -> None:
+def check_out(
+    out: Path, kind: StudySet, field: str = "--out", resume_field: str | None = None, *, only_its_set: bool = True
+) -> None:
     """Refuse, before anything is made or written, an ``out`` that is a link or a file, whose
-    journal folder is a link, or that holds another command's set (:func:`holders`).
+    journal folder is a link, that holds another command's set (:func:`holders`), or that holds
+    files that are not this command's set (:func:`check_only_its_set`): its set would be mixed
+    with them.
 
     Parameters
     ----------
@@ -119,6 +136,10 @@ def check_out(out: Path, kind: StudySet, field: str = "--out", resume_field: str
     resume_field
         The option given to resume (None: not resuming), named when it would resume another
         command's study.
+    only_its_set
+        Also refuse files that are not the set's (False: the study folder checks them once it
+        holds the folder's lock, so that a folder another process is writing in is refused for
+        that).
 
     Raises
     ------
@@ -141,6 +162,8 @@ def check_out(out: Path, kind: StudySet, field: str = "--out", resume_field: str
             f"{resuming}); 'rockyade {kind.command}' never writes over another command's results: give another "
             "folder, or remove that one first",
         )
+    if only_its_set:
+        check_only_its_set(out, kind, field)
 
 
 def holders(out: Path) -> list[tuple[str, str]]:
@@ -160,7 +183,7 @@ def holders(out: Path) -> list[tuple[str, str]]:
     return list(found.items())
 
 
-def check_only_its_set(out: Path, kind: StudySet, what: str, field: str = "--out") -> None:
+def check_only_its_set(out: Path, kind: StudySet, field: str = "--out") -> None:
     """Refuse an ``out`` that holds files that are not ``kind``'s set nor its journal (another
     command's files, a scene, ...): the set would be mixed with them.
 
@@ -168,8 +191,6 @@ def check_only_its_set(out: Path, kind: StudySet, what: str, field: str = "--out
     ----------
     out, kind
         The folder and the command's set.
-    what
-        The set in words, in the message ("an assessment", "a fragility study").
     field
         The option that names ``out``.
 
@@ -187,7 +208,7 @@ def check_only_its_set(out: Path, kind: StudySet, what: str, field: str = "--out
         shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
         raise InputError(
             field,
-            f"{out} holds files that are not {what}'s ({shown}): give an empty folder, or one a previous "
+            f"{out} holds files that are not {kind.what}'s ({shown}): give an empty folder, or one a previous "
             f"'{kind.command} --out' wrote (its set is then replaced as a whole)",
         )
 
@@ -300,10 +321,11 @@ class StudyFolder:
         from rockyade.io.folders import output_folder
         from rockyade.io.locking import output_lock
 
-        check_out(self.out, self.kind, self.field, self.resume_field if self.resume else None)
+        check_out(self.out, self.kind, self.field, self.resume_field if self.resume else None, only_its_set=False)
         with contextlib.ExitStack() as stack:
             self.created = stack.enter_context(output_folder(self.out))
             stack.enter_context(output_lock(self.out, self.field))
+            check_only_its_set(self.out, self.kind, self.field)
             self._settle()
             nothing = not self.kind.keeps_runs and not self.unfinished() and self.complete()
             if self.resume and self.resume_field and nothing:
