@@ -173,7 +173,7 @@ def test_the_python_api_refuses_loose_files_once_it_holds_the_folder(tmp_path):
     out.mkdir()
     (out / "notes.txt").write_text("mine\n")
     base = load_scene(EXAMPLES / "specimen1_free.toml").to_dict()
-    with pytest.raises(InputError, match="notes.txt") as info:
+    with pytest.raises(InputError, match=r"notes\.txt") as info:
         run_study_tasks(expand([("s", base)], {}, ["housner"]), out, workers=1, progress=False)
     assert info.value.field == "out"
     assert _bytes(out) == {"notes.txt": b"mine\n"}
