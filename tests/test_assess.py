@@ -82,6 +82,12 @@ def test_an_acceleration_needs_its_unit_and_a_sane_value():
         assert info.value.field == "--ag"
 
 
+def test_a_negative_acceleration_with_its_unit_is_told_its_range_not_its_unit():
+    with pytest.raises(InputError) as info:
+        parse_acceleration("-0.2g")
+    assert "must be in (0, " in info.value.message and "with its unit" not in info.value.message
+
+
 @pytest.mark.parametrize(
     ("kwargs", "field"),
     [

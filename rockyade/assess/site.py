@@ -55,7 +55,7 @@ CODE_FORMS = ("circolare2019", "circolare2009")
 #: Largest mechanism period T0 accepted, s (the spectra are used up to 4 s).
 MAX_MECHANISM_PERIOD_S = 4.0
 
-_ACCEL = re.compile(r"^\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(g|m/s2|m/s\^2|m/s\*\*2)\s*$")
+_ACCEL = re.compile(r"^\s*([-+]?[0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*(g|m/s2|m/s\^2|m/s\*\*2)\s*$")
 
 
 def parse_acceleration(text: str | float, field: str = "--ag", max_g: float = MAX_AG_G) -> float:
