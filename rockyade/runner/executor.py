@@ -12,10 +12,12 @@
 from __future__ import annotations
 
 import math
+import os
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
-from rockyade.errors import InputError
+from rockyade.errors import InputError, InputNote
 from rockyade.runner.stopping import StopRequest
 from rockyade.runner.threads import Batch, Failed, Job, Value
 
@@ -24,6 +26,14 @@ MAX_WORKERS = 1024
 #: Seconds to wait for a Dask scheduler to answer (default), and the range allowed.
 SCHEDULER_TIMEOUT_S = 10.0
 SCHEDULER_TIMEOUT_RANGE_S = (0.1, 3600.0)
+
+
+def usable_cores() -> int:
+    """The cores this process may run on (its CPU affinity where the system says, else the
+    machine's count)."""
+    if hasattr(os, "sched_getaffinity"):
+        return len(os.sched_getaffinity(0))
+    return os.cpu_count() or 1
 
 
 @dataclass(frozen=True)
@@ -58,6 +68,17 @@ class Executor:
         timeout = self.scheduler_timeout_s
         if not (isinstance(timeout, (int, float)) and math.isfinite(timeout) and lo <= timeout <= hi):
             raise InputError("scheduler_timeout_s", f"must be in [{lo:g}, {hi:g}] s, got {timeout!r}")
+        cores = usable_cores()
+        if self.scheduler is None and self.workers > max(2, cores):
+            warnings.warn(
+                InputNote(
+                    "workers",
+                    f"{self.workers} parallel workers on this machine's {cores} cores: they share the cores and "
+                    f"each pays its start-up before its first run, so {cores} or fewer usually finish sooner; "
+                    "accepted as given",
+                ),
+                stacklevel=2,
+            )
 
     @property
     def in_process(self) -> bool:
