@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 
@@ -135,11 +136,14 @@ def sensitivity(
             spread["runs"] = len(result.runs)
             rows.append(spread)
             for row in spread.itertuples(index=False):
+                factor = row.theta_spread_factor
+                # NaN: no record rocks in every sample (spread_table), so there is no ratio to show
+                shown = f"x{factor:.2f}" if math.isfinite(factor) else "- (no record rocks in every sample)"
                 print(
                     f"  specimen {key} {case:15s} x{row.load_factor:<4g} nominal P {row.p_overturn_nominal:.3f}; "
                     f"per-sample P {row.p_overturn_sample_q05:.3f}-{row.p_overturn_sample_q95:.3f}; "
                     f"records with mixed outcome {100 * row.records_mixed_fraction:3.0f} %; "
-                    f"peak theta/alpha spread x{row.theta_spread_factor:.2f}"
+                    f"peak theta/alpha spread {shown}"
                 )
             extra = f"; identified alpha +/-{spread['alpha_ci_pct'].iloc[0]:.2f} %" if case == "identification" else ""
             print(f"  ({len(result.runs)} runs in {seconds:.0f} s{extra})")
