@@ -127,6 +127,39 @@ def test_latin_hypercube_is_stratified_reproducible_and_truncated():
     assert not np.allclose(values, other)
 
 
+def test_every_sample_is_a_block_its_runs_take():
+    """mu beyond the 0.9999 a scene takes, or p beyond 0.99 sqrt(g / R), was drawn and the
+    sample's scenes refused ('blocks[0].mu: must be in [0.05, 0.9999], got 0.99991583' from
+    specimen 2 +/-5 % in ``make bench-all``): samples are drawn in the ranges a scene takes for
+    the block, and a distribution cut there by more than 1 % is said."""
+    import warnings
+
+    from rockyade.errors import InputNote
+    from rockyade.scene import scene_from_dict
+    from rockyade.scene.bounds import p_range
+    from rockyade.studies.uncertainty.sample_tasks import build_tasks, draw_samples
+
+    cases = (
+        ("mu", {"mu": {"distribution": "normal", "mean": 0.99, "std": 0.01}}),
+        ("p_rad_s", {"p_rad_s": {"distribution": "lognormal", "mean": 4.05, "cov": 0.3}}),
+    )
+    for name, parameters in cases:
+        data = _study(block={"specimen": "2"}, parameters=parameters, samples=60, seed=1)
+        data["motion"] = dict(data["motion"], records=[1], load_factors=[1.0])
+        study = uncertainty_study_from_dict(data)
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            samples = draw_samples(study)
+        probe = scene_from_dict(
+            {"duration_s": 1.0, "sample_dt_s": 0.1, "blocks": [dict(study.block)], "motion": {"type": "rest"}}
+        )
+        hi = {"mu": 0.9999, "p_rad_s": p_range(probe.blocks[0].block())[1]}[name]
+        assert hi * 0.99 < samples[name].max() <= hi  # the range reached, never passed
+        notes = [str(w.message) for w in said if issubclass(w.category, InputNote)]
+        assert len(notes) == 1 and notes[0].startswith(f"parameters.{name}: ") and f"{hi:.6g}" in notes[0]
+        assert len(build_tasks(study, samples)) == len(samples)  # every sample's scene is taken
+
+
 def test_joint_normal_from_an_identification_keeps_its_covariance():
     cov = np.array([[4e-6, -6e-5, 0.0], [-6e-5, 1.6e-3, 0.0], [0.0, 0.0, 1e-8]])
     joint = joint_from_identified({"alpha_rad": 0.235, "p_rad_s": 3.84, "mu": 0.936, "covariance_alpha_p_mu": cov})

@@ -81,6 +81,22 @@ def bound(name: str) -> Bound:
     return BOUNDS[name]
 
 
+def p_range(block: object) -> tuple[float, float]:
+    """The range of a block's ``p_rad_s`` override, rad/s: [P_MIN_FRACTION, P_MAX_FRACTION] x
+    sqrt(g / R), R the distance from the centroid to the farthest base corner (p^2 = M g R / I_O
+    and I_O >= M R^2: no rigid block rocks faster than sqrt(g / R)).
+
+    Parameters
+    ----------
+    block
+        A :class:`rockyade.blocks.geometry.Block`.
+    """
+    cx, cy = block.centroid_m  # type: ignore[attr-defined]
+    r = max(math.hypot(cx - x, cy) for x in block.level_vertices("base"))  # type: ignore[attr-defined]
+    p_limit = math.sqrt(G / r)
+    return P_MIN_FRACTION * p_limit, P_MAX_FRACTION * p_limit
+
+
 def check_block_ranges(block: object, spec: object, field_prefix: str, source: str | None) -> None:
     """Ranges that depend on the block's geometry: extent, mass from a density, given inertia, p override.
 
@@ -130,9 +146,8 @@ def check_block_ranges(block: object, spec: object, field_prefix: str, source: s
             )
     p = getattr(spec, "p_rad_s", None)
     if p is not None:
-        r = max(math.hypot(cx - x, cy) for x in block.level_vertices("base"))  # type: ignore[attr-defined]
-        p_limit = math.sqrt(G / r)
-        lo, hi = P_MIN_FRACTION * p_limit, P_MAX_FRACTION * p_limit
+        lo, hi = p_range(block)
+        p_limit = hi / P_MAX_FRACTION
         if not lo <= p <= hi:
             raise InputError(
                 f"{field_prefix}p_rad_s",

@@ -1,7 +1,8 @@
 """Distributions of the classical parameters and their Latin hypercube samples.
 
 Each of alpha_rad, p_rad_s, mu is fixed or drawn from a normal, lognormal or uniform
-distribution truncated to its physical range (alpha in (0, pi/2), p > 0, mu in (0, 1]);
+distribution truncated to the range a scene takes (:func:`parameter_ranges`: alpha in
+[0.001, pi/2 - 0.001] rad, mu in [0.05, 0.9999], p in [0.01, 0.99] sqrt(g / R) for the block);
 or the three are drawn jointly from the normal distribution of an identification (its
 estimate and covariance, ``rockyade identify --out``). Samples are a Latin hypercube
 (McKay, Beckman & Conover 1979; :class:`scipy.stats.qmc.LatinHypercube`) with an explicit
@@ -20,6 +21,7 @@ Study-file tables (one per parameter, under ``[parameters]``)::
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,14 +30,25 @@ from numpy.typing import NDArray
 from scipy import stats
 from scipy.stats import qmc
 
-from rockyade.errors import InputError
+from rockyade.errors import InputError, InputNote
 from rockyade.io.fields import TableReader
+from rockyade.scene.bounds import BOUNDS
 
 PARAMETERS = ("alpha_rad", "p_rad_s", "mu")
 DISTRIBUTIONS = ("normal", "lognormal", "uniform", "fixed")
-#: Physical range of each parameter (open, open / closed at 1 for mu).
-RANGES = {"alpha_rad": (0.0, 0.5 * math.pi), "p_rad_s": (0.0, math.inf), "mu": (0.0, 1.0)}
 Z95 = float(stats.norm.ppf(0.975))
+#: A distribution cut by more than this fraction of its mass at its parameter's range is said.
+CUT_NOTE = 0.01
+#: A parameter's closed range [lo, hi].
+Ranges = dict[str, tuple[float, float]]
+
+
+def parameter_ranges(p_rad_s: tuple[float, float] = (0.0, math.inf)) -> Ranges:
+    """The range a sample of each parameter may take: a scene's (:data:`rockyade.scene.bounds.BOUNDS`)
+    for alpha_rad (rad) and mu, and ``p_rad_s`` (rad/s) for p, whose range is the block's
+    (:func:`rockyade.scene.bounds.p_range`), so that every sample is a block a scene takes."""
+    alpha, mu = BOUNDS["alpha_rad"], BOUNDS["mu"]
+    return {"alpha_rad": (alpha.lo, alpha.hi), "p_rad_s": p_rad_s, "mu": (mu.lo, mu.hi)}
 
 
 @dataclass(frozen=True)
@@ -65,21 +78,32 @@ class Marginal:
             return stats.lognorm(s=self.b, scale=self.a)
         return stats.uniform(loc=self.a, scale=self.b - self.a)
 
-    def quantile(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Values at probabilities ``u`` of the distribution truncated to the physical range."""
+    def quantile(self, u: NDArray[np.float64], ranges: Ranges | None = None) -> NDArray[np.float64]:
+        """Values at probabilities ``u`` of the distribution truncated to the parameter's range
+        (``ranges``, default :func:`parameter_ranges`)."""
         if self.kind == "fixed":
             return np.full(np.shape(u), self.a)
         dist = self._frozen()
-        lo, hi = RANGES[self.name]
+        lo, hi = (ranges or parameter_ranges())[self.name]
         f_lo, f_hi = float(dist.cdf(lo)), float(dist.cdf(hi))
         if f_hi - f_lo < 0.5:
             raise InputError(
                 f"parameters.{self.name}",
                 f"the {self.kind} distribution has {100 * (1 - (f_hi - f_lo)):.0f} % of its mass outside "
-                f"the physical range ({lo:g}, {hi:g}]: check its mean and spread",
+                f"the range [{lo:.6g}, {hi:.6g}] a block takes: check its mean and spread",
+            )
+        if f_hi - f_lo < 1.0 - CUT_NOTE:
+            warnings.warn(
+                InputNote(
+                    f"parameters.{self.name}",
+                    f"{100 * (1 - (f_hi - f_lo)):.0f} % of the {self.kind} distribution's mass lies outside "
+                    f"[{lo:.6g}, {hi:.6g}], the range a block takes: drawn truncated to it (its mean and spread "
+                    "are then not those given)",
+                ),
+                stacklevel=2,
             )
         x = dist.ppf(f_lo + np.asarray(u) * (f_hi - f_lo))
-        return np.clip(x, np.nextafter(lo, math.inf), hi)
+        return np.clip(x, lo, hi)
 
     def describe(self) -> str:
         """Short text, e.g. ``normal(mean 0.235, std 0.0047)``."""
@@ -156,19 +180,21 @@ class JointNormal:
     covariance: tuple[tuple[float, ...], ...]
     source: str = ""
 
-    def sample(self, u: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Values (n, 3) from stratified probabilities ``u`` (n, 3)."""
+    def sample(self, u: NDArray[np.float64], ranges: Ranges | None = None) -> NDArray[np.float64]:
+        """Values (n, 3) from stratified probabilities ``u`` (n, 3); refused where one falls
+        outside its range (``ranges``, default :func:`parameter_ranges`)."""
         z = stats.norm.ppf(u)
         cov = np.array(self.covariance)
         w, v = np.linalg.eigh(cov)
         factor = v * np.sqrt(np.maximum(w, 0.0))  # cov = factor factor^T (also when singular)
         x = np.array(self.mean) + z @ factor.T
+        ranges = ranges or parameter_ranges()
         for k, name in enumerate(PARAMETERS):
-            lo, hi = RANGES[name]
-            if np.any(x[:, k] <= lo) or np.any(x[:, k] > hi):
+            lo, hi = ranges[name]
+            if np.any(x[:, k] < lo) or np.any(x[:, k] > hi):
                 raise InputError(
                     f"parameters.{name}",
-                    f"the identified distribution {self.source} draws values outside ({lo:g}, {hi:g}]: "
+                    f"the identified distribution {self.source} draws values outside [{lo:.6g}, {hi:.6g}]: "
                     "give this parameter its own truncated distribution instead",
                 )
         return x
@@ -210,9 +236,21 @@ def draw_parameters(
     marginals: dict[str, Marginal] | None = None,
     joint: JointNormal | None = None,
     extra_dimensions: int = 0,
+    ranges: Ranges | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Latin hypercube samples of (alpha_rad, p_rad_s, mu), and ``extra_dimensions`` more
     stratified probabilities (e.g. to draw a record per sample).
+
+    Parameters
+    ----------
+    n, seed
+        Samples, and the seed that makes them.
+    marginals, joint
+        One distribution per parameter, or the three drawn jointly.
+    extra_dimensions
+        Stratified probabilities drawn beside them.
+    ranges
+        The range of each parameter (default :func:`parameter_ranges`: p unbounded above).
 
     Returns
     -------
@@ -223,8 +261,8 @@ def draw_parameters(
     """
     u = latin_hypercube(n, 3 + extra_dimensions, seed)
     if joint is not None:
-        values = joint.sample(u[:, :3])
+        values = joint.sample(u[:, :3], ranges)
     else:
         assert marginals is not None
-        values = np.column_stack([marginals[name].quantile(u[:, k]) for k, name in enumerate(PARAMETERS)])
+        values = np.column_stack([marginals[name].quantile(u[:, k], ranges) for k, name in enumerate(PARAMETERS)])
     return values, u[:, 3:]

@@ -12,7 +12,7 @@ import pandas as pd
 
 from rockyade.batch import BatchTask, batch_task
 from rockyade.motion.intensity import intensity_measures, scaled
-from rockyade.studies.sampling import PARAMETERS, draw_parameters
+from rockyade.studies.sampling import PARAMETERS, Ranges, draw_parameters, parameter_ranges
 from rockyade.studies.uncertainty.study_file import UncertaintyStudy
 
 
@@ -22,7 +22,8 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
     Columns: sample, nominal, alpha_rad, p_rad_s, mu, and for pairing "sampled" the record.
     """
     extra = 1 if study.pairing == "sampled" else 0
-    values, u = draw_parameters(study.samples, study.seed, study.marginals, study.joint, extra)
+    ranges = sample_ranges(study)
+    values, u = draw_parameters(study.samples, study.seed, study.marginals, study.joint, extra, ranges)
     frame = pd.DataFrame(values, columns=list(PARAMETERS))
     frame.insert(0, "nominal", False)
     frame.insert(0, "sample", np.arange(1, study.samples + 1))
@@ -35,6 +36,20 @@ def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
             nominal["record"] = "all"
         frame = pd.concat([pd.DataFrame([nominal]), frame], ignore_index=True)
     return frame
+
+
+def sample_ranges(study: UncertaintyStudy) -> Ranges:
+    """The range each parameter's samples are drawn in: those a scene takes for this block
+    (:func:`rockyade.studies.sampling.parameter_ranges`, p's from the block's geometry), so that
+    every sample is a block its runs can be given."""
+    from rockyade.scene import scene_from_dict
+    from rockyade.scene.bounds import p_range
+
+    probe = scene_from_dict(
+        {"duration_s": 1.0, "sample_dt_s": 0.1, "blocks": [dict(study.block)], "motion": {"type": "rest"}},
+        source=study.source or None,
+    )
+    return parameter_ranges(p_range(probe.blocks[0].block()))
 
 
 def build_tasks(study: UncertaintyStudy, samples: pd.DataFrame) -> list[BatchTask]:
