@@ -697,6 +697,30 @@ def test_free_rocking_verdict_compares_the_peaks_after_release():
     assert "within 0.0 %" in line and "says nothing" not in line and "agree to the step's accuracy" in line
 
 
+def test_verdict_leaves_out_a_block_at_rest_in_every_solver():
+    """The bi-block with its upper block released: the lower block only tilts (the DEM's springs,
+    about 5e-4 rad; the exact solver's micro-uplift, 4e-5 rad), 0.1 % of its alpha. The relative
+    difference of two such tilts (92.6 %) once was the verdict's number, while the rocking block
+    agreed within 5 %: a block at rest in every solver is left out and named, a block that
+    rocks is compared."""
+    from rockyade.analysis.compare import _peaks, _relative, verdict
+    from rockyade.scene import load_scene
+    from rockyade.solvers import make_solver
+
+    scene = load_scene(EXAMPLES / "biblock_free.toml")
+    results = {n: make_solver(n).run(scene) for n in ("twoblock", "reference")}
+    upper = _relative(_peaks(scene, results["twoblock"])["upper"], _peaks(scene, results["reference"])["upper"])
+    line = verdict(scene, results, "reference")
+    assert 0.001 < upper < 0.1
+    assert f"within {100 * upper:.1f} % of reference (largest: twoblock, upper)" in line
+    assert "(lower at rest in every solver, below 1 % of its alpha: not compared)" in line
+    # a block that rocks in one solver only is compared: the lower block's tilt against itself x 100
+    lifted = make_solver("twoblock").run(scene)
+    lifted.frame["lower_theta_rad"] *= 100
+    line = verdict(scene, {"twoblock": lifted, "reference": results["reference"]}, "reference")
+    assert "largest: twoblock, lower" in line and "at rest" not in line
+
+
 # ---------------------------------------------------------------------- real records
 
 
