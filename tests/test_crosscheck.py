@@ -872,6 +872,31 @@ def test_a_scene_a_solver_refuses_is_refused_before_any_run(records, tmp_path, c
     assert "cost:" not in captured.out and not (tmp_path / "o").exists()
 
 
+def test_housner_on_a_stack_is_refused_before_any_run(records, tmp_path, capsys):
+    """Housner's solution is for one block: a cross-check of the bi-block with housner is one line
+    naming blocks, exit 2, before any run (before, every reference run ran, every Housner run
+    failed with that message, and the study ended with exit 1)."""
+    code = cli(
+        "crosscheck",
+        str(EXAMPLES / "biblock_geometry.toml"),
+        "--records",
+        str(records),
+        "--solvers",
+        "housner,reference",
+        "--levels",
+        "0.3,0.6",
+        "--dt-factors",
+        "1",
+        "--out",
+        str(tmp_path / "o"),
+        "--quiet",
+    )
+    captured = capsys.readouterr()
+    err = captured.err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and "blocks:" in err[0] and "housner solver takes one block" in err[0], err
+    assert "twoblock" in err[0] and "cost:" not in captured.out and not (tmp_path / "o").exists()
+
+
 def test_runs_that_failed_are_said_and_a_pair_whose_solver_always_failed_says_so(plan):
     """Outcomes where the reference DEM failed every run: the pair's verdict says so with the
     reason (not "inconclusive"), its searches say "every run failed" (not "no runs") and
