@@ -659,6 +659,18 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
 
+def test_compare_refuses_a_single_solver(tmp_path, capsys):
+    """compare never compares a solver with itself: with one solver it wrote a table of that
+    solver against itself (zero differences) and the verdict "same outcome"; now refused naming
+    solvers, exit 2, nothing written."""
+    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner", "--out", str(tmp_path / "c"))
+    err = capsys.readouterr().err
+    assert (
+        code == 2 and err.startswith("rockyade: error: solvers: must name at least two solvers") and "'housner'" in err
+    )
+    assert not (tmp_path / "c").exists()
+
+
 def test_compare_refuses_an_out_that_holds_a_study(tmp_path, capsys):
     """compare writes loose files (<scene>_<solver>.csv, ...): into a study's folder (here a
     fragility's set) they would be mixed with its set; refused naming --out and the study, before
@@ -666,7 +678,7 @@ def test_compare_refuses_an_out_that_holds_a_study(tmp_path, capsys):
     out = tmp_path / "frag"
     out.mkdir()
     (out / "fragility.json").write_text("{}")
-    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner", "--out", str(out))
+    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner,reference", "--out", str(out))
     err = capsys.readouterr().err
     assert code == 2 and "--out" in err and "'rockyade fragility'" in err and "Traceback" not in err
     assert [p.name for p in out.iterdir()] == ["fragility.json"]
