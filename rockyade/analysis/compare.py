@@ -214,8 +214,9 @@ def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dic
     }
     diffs = {s: d for s, d in diffs.items() if math.isfinite(d[0])}
     resting = sorted(set.intersection(*still.values()), key=[b.name for b in scene.blocks].index)
+    named = ", ".join(resting[:4]) + (f" and {len(resting) - 4} more" if len(resting) > 4 else "")
     at_rest = (
-        f" ({', '.join(resting)} at rest in every solver, below {100 * ROCK_FRACTION:g} % of its alpha: not compared)"
+        f" ({named} at rest in every solver, below {100 * ROCK_FRACTION:g} % of its alpha: not compared)"
         if resting
         else ""
     )
