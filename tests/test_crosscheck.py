@@ -659,6 +659,18 @@ def test_compare_never_compares_a_solver_with_itself_and_gives_a_verdict(tmp_pat
     assert json.loads((tmp_path / "c" / "specimen1_record_housner.json").read_text())["dt_factor"] == 0.5
 
 
+def test_compare_refuses_a_single_solver(tmp_path, capsys):
+    """compare never compares a solver with itself: with one solver it wrote a table of that
+    solver against itself (zero differences) and the verdict "same outcome"; now refused naming
+    solvers, exit 2, nothing written."""
+    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner", "--out", str(tmp_path / "c"))
+    err = capsys.readouterr().err
+    assert (
+        code == 2 and err.startswith("rockyade: error: solvers: must name at least two solvers") and "'housner'" in err
+    )
+    assert not (tmp_path / "c").exists()
+
+
 def test_compare_refuses_an_out_that_holds_a_study(tmp_path, capsys):
     """compare writes loose files (<scene>_<solver>.csv, ...): into a study's folder (here a
     fragility's set) they would be mixed with its set; refused naming --out and the study, before
@@ -666,7 +678,7 @@ def test_compare_refuses_an_out_that_holds_a_study(tmp_path, capsys):
     out = tmp_path / "frag"
     out.mkdir()
     (out / "fragility.json").write_text("{}")
-    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner", "--out", str(out))
+    code = cli("compare", str(EXAMPLES / "specimen1_free.toml"), "--solvers", "housner,reference", "--out", str(out))
     err = capsys.readouterr().err
     assert code == 2 and "--out" in err and "'rockyade fragility'" in err and "Traceback" not in err
     assert [p.name for p in out.iterdir()] == ["fragility.json"]
@@ -695,6 +707,30 @@ def test_free_rocking_verdict_compares_the_peaks_after_release():
     same = {"housner": results["housner"], "reference": results["housner"]}
     line = verdict(scene, same, "reference", same)
     assert "within 0.0 %" in line and "says nothing" not in line and "agree to the step's accuracy" in line
+
+
+def test_verdict_leaves_out_a_block_at_rest_in_every_solver():
+    """The bi-block with its upper block released: the lower block only tilts (the DEM's springs,
+    about 5e-4 rad; the exact solver's micro-uplift, 4e-5 rad), 0.1 % of its alpha. The relative
+    difference of two such tilts (92.6 %) once was the verdict's number, while the rocking block
+    agreed within 5 %: a block at rest in every solver is left out and named, a block that
+    rocks is compared."""
+    from rockyade.analysis.compare import _peaks, _relative, verdict
+    from rockyade.scene import load_scene
+    from rockyade.solvers import make_solver
+
+    scene = load_scene(EXAMPLES / "biblock_free.toml")
+    results = {n: make_solver(n).run(scene) for n in ("twoblock", "reference")}
+    upper = _relative(_peaks(scene, results["twoblock"])["upper"], _peaks(scene, results["reference"])["upper"])
+    line = verdict(scene, results, "reference")
+    assert 0.001 < upper < 0.1
+    assert f"within {100 * upper:.1f} % of reference (largest: twoblock, upper)" in line
+    assert "(lower at rest in every solver, below 1 % of its alpha: not compared)" in line
+    # a block that rocks in one solver only is compared: the lower block's tilt against itself x 100
+    lifted = make_solver("twoblock").run(scene)
+    lifted.frame["lower_theta_rad"] *= 100
+    line = verdict(scene, {"twoblock": lifted, "reference": results["reference"]}, "reference")
+    assert "largest: twoblock, lower" in line and "at rest" not in line
 
 
 # ---------------------------------------------------------------------- real records
@@ -821,17 +857,26 @@ def test_paper_part_runs_siconos_on_a_subset_it_can_run():
 # ---------------------------------------------------------------------- refused up front
 
 
-def test_a_scene_a_solver_refuses_is_refused_before_any_run(records, tmp_path, capsys):
-    """Specimen 1's matched mu 0.936 is beyond Siconos's reach: one line naming the field and
-    the solver, exit 2, before any run and with no --out written (before, every Housner run
-    ran, every Siconos run failed and a set with an "inconclusive" verdict replaced --out)."""
+@pytest.mark.parametrize(
+    ("scene", "solvers", "words"),
+    [
+        # Specimen 1's matched mu 0.936 is beyond Siconos's reach (before, every Housner run ran,
+        # every Siconos run failed and a set with an "inconclusive" verdict replaced --out)
+        ("specimen1_record.toml", "housner,siconos", ("contact.calibration", "siconos")),
+        # Housner's solution is for one block (before, every reference run ran, every Housner run
+        # failed with this refusal, and the study ended with exit 1)
+        ("biblock_geometry.toml", "housner,reference", ("blocks:", "housner solver takes one block", "twoblock")),
+    ],
+)
+def test_a_scene_a_solver_refuses_is_refused_before_any_run(scene, solvers, words, records, tmp_path, capsys):
+    """One line naming the field and the solver, exit 2, before any run and with no --out written."""
     code = cli(
         "crosscheck",
-        str(EXAMPLES / "specimen1_record.toml"),
+        str(EXAMPLES / scene),
         "--records",
         str(records),
         "--solvers",
-        "housner,siconos",
+        solvers,
         "--levels",
         "0.3,0.6",
         "--resolution",
@@ -844,7 +889,7 @@ def test_a_scene_a_solver_refuses_is_refused_before_any_run(records, tmp_path, c
     )
     captured = capsys.readouterr()
     err = captured.err.strip().splitlines()
-    assert code == 2 and len(err) == 1 and "contact.calibration" in err[0] and "siconos" in err[0], err
+    assert code == 2 and len(err) == 1 and all(w in err[0] for w in words), err
     assert "cost:" not in captured.out and not (tmp_path / "o").exists()
 
 

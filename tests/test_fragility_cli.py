@@ -153,6 +153,26 @@ def test_a_level_out_of_a_records_reach_is_refused_before_any_run(capsys, tmp_pa
     assert code == 2 and "load factor" in err and not (tmp_path / "o" / "runs.csv").exists()
 
 
+def test_a_solver_that_refuses_the_scene_is_refused_before_any_run(capsys, tmp_path, records):
+    """--solver housner on the bi-block: one line naming blocks, exit 2, no --out (before, every
+    run failed with that refusal and a set of failed runs was written, exit 1)."""
+    code, _, err = run_cli(
+        capsys,
+        "fragility",
+        EXAMPLES / "biblock_geometry.toml",
+        "--records",
+        records,
+        "--solver",
+        "housner",
+        "--levels",
+        "0.5,1",
+        "--out",
+        tmp_path / "o",
+    )
+    assert code == 2 and err.count("\n") == 1 and "blocks:" in err and "housner solver takes one block" in err
+    assert not (tmp_path / "o").exists()
+
+
 def test_an_out_that_holds_other_files_is_refused_before_any_run(capsys, tmp_path, wall, records):
     """A folder of another command's files (a comparison's) is refused, naming --out and one of
     them, and left as it was: the fragility's set would be mixed with them."""

@@ -94,6 +94,47 @@ def test_a_mass_outside_its_range_is_refused_however_it_is_given(tmp_path, capsy
     assert "blocks[0].density_kg_m3" in capsys.readouterr().err
 
 
+def _wall(top_gap_m: float) -> dict:
+    """Three 0.25 x 0.5 m courses; the top one ``top_gap_m`` above the second."""
+    ys = (0.0, 0.5, 1.0 + top_gap_m)
+    return {
+        "duration_s": 0.2,
+        "sample_dt_s": 0.002,
+        "contact": {"calibration": "paper"},
+        "motion": {"type": "rest"},
+        "blocks": [
+            {
+                "name": f"b{k}",
+                "width_m": 0.25,
+                "height_m": 0.5,
+                "thickness_m": 1.0,
+                "density_kg_m3": 1800.0,
+                "position_m": [0.0, y],
+            }
+            for k, y in enumerate(ys)
+        ],
+    }
+
+
+def test_a_block_beyond_the_pairs_reach_above_its_support_is_refused(tmp_path, capsys):
+    """Siconos's pairs are found once, from the start, within PAIR_REACH_FRACTION (0.25) of the
+    smaller block's largest dimension: a top course 0.2 m above the second (0.125 m of reach) fell
+    through it and the run said ``overturned`` where both DEMs land it. Refused naming the field,
+    the gap and the reach, exit 2, before Siconos starts; within the reach, and touching, it runs."""
+    from rockyade.cli import main
+    from rockyade.siconos.reach import check_landing_reach
+
+    with pytest.raises(InputError, match=r"b2 starts 0.2 m above block b1, beyond the 0.125 m") as refused:
+        check_landing_reach(scene_from_dict(_wall(0.2)))
+    assert refused.value.field == "blocks[2].position_m"
+    check_landing_reach(scene_from_dict(_wall(0.1)))  # within the reach: paired, it lands
+    check_landing_reach(scene_from_dict(_wall(0.0)))
+    (tmp_path / "gap.json").write_text(json.dumps(_wall(0.2)))
+    assert main(["run", str(tmp_path / "gap.json"), "--solver", "siconos"]) == 2
+    err = capsys.readouterr().err
+    assert "blocks[2].position_m" in err and "Traceback" not in err
+
+
 @pytest.mark.parametrize("kind", ["missing", "not executable", "without siconos", "not a python"])
 def test_a_bad_siconos_python_is_refused_naming_the_variable(kind, tmp_path, monkeypatch, capsys):
     from rockyade.cli import main

@@ -19,6 +19,7 @@ import math
 import numpy as np
 import pandas as pd
 
+from rockyade.analysis.collapse import ROCK_FRACTION, ROCK_MIN_RAD
 from rockyade.blocks.restitution import MU_EFF_IMPACTS, effective_restitution, find_peaks
 from rockyade.result import Result
 from rockyade.scene import Scene
@@ -131,6 +132,24 @@ def _peaks(scene: Scene, result: Result) -> dict[str, tuple[float, ...]]:
     return out
 
 
+def _still(scene: Scene, result: Result) -> set[str]:
+    """The blocks that never rock in ``result``: max |theta| at most ``ROCK_FRACTION`` of the
+    block's alpha (and ``ROCK_MIN_RAD``), the threshold of
+    :func:`~rockyade.analysis.collapse.block_states`. Their theta is the contacts' elastic tilt
+    (the DEMs) or a micro-uplift (a lower block thrown open by the landing of the one above): a
+    relative difference of two such tilts is large and says nothing about the rocking."""
+    if not result.ok:
+        return set()
+    out = set()
+    for spec in scene.blocks:
+        if spec.fixed or spec.name not in result.blocks:
+            continue
+        largest = float(np.nanmax(np.abs(result.series("theta_rad", spec.name))))
+        if largest <= max(ROCK_MIN_RAD, ROCK_FRACTION * spec.classical().alpha_rad):
+            out.add(spec.name)
+    return out
+
+
 def _relative(va: tuple[float, ...], vb: tuple[float, ...]) -> float:
     """The largest |a - b| / max(a, b) over the peaks both have (NaN: none comparable); when
     one has no peak after the release and the other has, their first values (max |theta| and
@@ -143,12 +162,16 @@ def _relative(va: tuple[float, ...], vb: tuple[float, ...]) -> float:
     return worst
 
 
-def _largest_difference(a: dict[str, tuple[float, ...]], b: dict[str, tuple[float, ...]]) -> tuple[float, str]:
+def _largest_difference(
+    a: dict[str, tuple[float, ...]], b: dict[str, tuple[float, ...]], still: set[str] | frozenset[str] = frozenset()
+) -> tuple[float, str]:
     """The largest relative difference |a - b| / max(a, b) over the blocks both have and their
     peaks (symmetric: a solver's change with dt and two solvers' gap are measured alike), and
-    its block."""
+    its block; the blocks in ``still`` (at rest in both runs: :func:`_still`) are left out."""
     worst, where = 0.0, ""
     for block, vb in b.items():
+        if block in still:
+            continue
         d = _relative(a.get(block, ()), vb)
         if math.isfinite(d) and (d > worst or not where):
             worst, where = d, block
@@ -183,18 +206,34 @@ def verdict(scene: Scene, results: dict[str, Result], reference: str, finer: dic
         outcome = "outcomes differ (" + ", ".join(f"{s} {o}" for s, o in outcomes.items()) + ")"
     what = f"the first {FREE_PEAKS} peaks after release" if scene.motion.type == "free" else "peak |theta|"
     ref = _peaks(scene, results[reference])
-    diffs = {s: _largest_difference(_peaks(scene, r), ref) for s, r in results.items() if s != reference}
+    still = {s: _still(scene, r) for s, r in results.items()}
+    diffs = {
+        s: _largest_difference(_peaks(scene, r), ref, still[s] & still[reference])
+        for s, r in results.items()
+        if s != reference
+    }
     diffs = {s: d for s, d in diffs.items() if math.isfinite(d[0])}
+    resting = sorted(set.intersection(*still.values()), key=[b.name for b in scene.blocks].index)
+    named = ", ".join(resting[:4]) + (f" and {len(resting) - 4} more" if len(resting) > 4 else "")
+    at_rest = (
+        f" ({named} at rest in every solver, below {100 * ROCK_FRACTION:g} % of its alpha: not compared)"
+        if resting
+        else ""
+    )
     if diffs:
         solver = max(diffs, key=lambda s: diffs[s][0])
         gap, block = diffs[solver]
-        peak = f"{what} within {100 * gap:.1f} % of {reference} (largest: {solver}, {block})"
+        peak = f"{what} within {100 * gap:.1f} % of {reference} (largest: {solver}, {block}){at_rest}"
     else:
-        gap, peak = math.nan, "no peaks to compare"
+        gap, peak = math.nan, f"no peaks to compare{at_rest}"
     if not finer:
         return f"{outcome}; {peak}; the time step not checked"
     changes = {
-        s: _largest_difference(_peaks(scene, finer[s]), _peaks(scene, results[s]))[0] for s in finer if s in results
+        s: _largest_difference(
+            _peaks(scene, finer[s]), _peaks(scene, results[s]), _still(scene, finer[s]) & still.get(s, set())
+        )[0]
+        for s in finer
+        if s in results
     }
     changes = {s: c for s, c in changes.items() if math.isfinite(c)}
     flips = [s for s in finer if s in results and finer[s].status != results[s].status]

@@ -51,7 +51,7 @@ from rockyade.runner import Executor
 from rockyade.runner.study_folder import StudyFolder
 from rockyade.scene import Scene
 from rockyade.solvers import as_solver
-from rockyade.solvers.base import Solver
+from rockyade.solvers.base import Solver, check_scene
 from rockyade.solvers.cost_estimate import duration_text
 
 if TYPE_CHECKING:
@@ -226,6 +226,7 @@ def fragility_plan(
     """
     executor = executor or Executor("local", 2)
     solver = as_solver(solver or default_solver(scene))
+    check_scene(solver, scene)  # what every run would refuse (housner on a stack), before any run
     fallen_blocks = check_fallen_blocks(scene, fallen_blocks)
     if not (math.isfinite(sample_dt_s) and 1e-4 <= sample_dt_s <= 0.1):
         raise InputError("--sample-dt", f"must be in [0.0001, 0.1] s, got {sample_dt_s!r}")

@@ -137,7 +137,8 @@ def add_run_options(p: argparse.ArgumentParser, count_help: str) -> None:
     p.add_argument(
         "--solver",
         choices=SOLVER_NAMES,
-        help="housner, reference, yade or siconos (default: housner for a single block, the reference DEM otherwise)",
+        help="housner, reference, yade, siconos or twoblock (default: housner for a single block, the reference "
+        "DEM otherwise)",
     )
     add_yade_timeout(p)
     add_executor_options(p)

@@ -39,6 +39,8 @@ def cmd_compare(args: argparse.Namespace) -> int:
         )
     if args.reference is not None and args.reference not in solvers:
         raise InputError("reference", f"must be one of the solvers run ({', '.join(solvers)}), got {args.reference!r}")
+    if len(solvers) < 2:  # one solver was compared with itself: a table of zeros and "same outcome"
+        raise InputError("solvers", f"must name at least two solvers to compare, got {args.solvers!r}")
     out: Path = args.out
     check_output_dir(out, "out")
     from rockyade.runner.study_folder import check_no_study
@@ -241,7 +243,7 @@ def register(sub: Commands) -> None:
     p.add_argument(
         "--solvers",
         default="housner,reference,yade",
-        help=f"comma-separated solvers among {', '.join(SOLVER_NAMES)} (default housner,reference,yade)",
+        help=f"comma-separated solvers, at least two, among {', '.join(SOLVER_NAMES)} (default housner,reference,yade)",
     )
     p.add_argument("--reference", help="solver the others are compared with (default: reference)")
     p.add_argument(

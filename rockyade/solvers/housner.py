@@ -67,22 +67,34 @@ class HousnerSolver(StepFactorSolver):
             self._step_s(model),
         )
 
+    def check_scene(self, scene: Scene) -> None:
+        """Refuse, before any run, a scene of more than one block: the classical theory is for
+        one block on a rigid base (studies call this first, so that a cross-check of a wall
+        with ``housner`` stops with exit 2 instead of running every other solver's runs and
+        failing each of Housner's).
+
+        Raises
+        ------
+        InputError
+            Naming ``blocks``.
+        """
+        if len(scene.blocks) != 1:
+            raise InputError(
+                "blocks",
+                f"the housner solver takes one block on a rigid base; this scene has {len(scene.blocks)} "
+                "(two stacked blocks: the twoblock solver; more: the reference, yade or siconos solver)",
+                scene.source,
+            )
+
     def run(self, scene: Scene) -> Result:
         """Solve a single-block scene with Housner's equation and return a Result.
 
         Raises
         ------
         InputError
-            If the scene has more than one block (the classical theory is for one block on
-            a rigid base).
+            If the scene has more than one block (:meth:`check_scene`).
         """
-        if len(scene.blocks) != 1:
-            raise InputError(
-                "blocks",
-                f"the housner solver takes one block on a rigid base; this scene has {len(scene.blocks)} "
-                "(use the reference or yade solver for stacks)",
-                scene.source,
-            )
+        self.check_scene(scene)
         spec = scene.blocks[0]
         cp = loaded_classical(scene, G)[spec.name]  # the body that rocks, with the masses its loads carry
         model = housner_model(scene)

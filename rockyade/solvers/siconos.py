@@ -23,6 +23,7 @@ from rockyade.scene import ContactSpec, Scene
 from rockyade.siconos.backend import SICONOS, run_model
 from rockyade.siconos.calibration import DT_MAX_S, DT_MIN_S, DT_P_FRACTION, check_target_mu, default_dt, steps_for
 from rockyade.siconos.payload import INTEGRATORS, Numerics, penetration_bound
+from rockyade.siconos.reach import check_landing_reach
 from rockyade.solvers.base import WORKER_OPTIONS, SolverBase, check_float, check_folder
 from rockyade.solvers.cost_estimate import CostEstimate, stepped_cost
 
@@ -207,8 +208,11 @@ class SiconosSolver(SolverBase):
         Raises
         ------
         InputError
-            A target mu the model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`).
+            A target mu the model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`);
+            a block that starts beyond the pairs' reach above the block it would land on
+            (:func:`rockyade.siconos.reach.check_landing_reach`).
         """
+        check_landing_reach(scene)
         model = self.model(scene)
         mu = check_target_mu(scene, model)
         numerics, how = self.numerics(model)
@@ -225,8 +229,9 @@ class SiconosSolver(SolverBase):
         )
 
     def check_scene(self, scene: Scene) -> None:
-        """Refuse before any run what :meth:`run` refuses whatever the motion: a target mu the
-        model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`), a bad
+        """Refuse before any run what :meth:`run` refuses whatever the motion: a block beyond the
+        pairs' reach above its support (:func:`rockyade.siconos.reach.check_landing_reach`), a
+        target mu the model cannot reach (:func:`rockyade.siconos.calibration.check_target_mu`), a bad
         ``ROCKYADE_SICONOS_PYTHON`` (:meth:`rockyade.dem.worker_backend.WorkerBackend.check_variable`).
 
         Raises
@@ -234,6 +239,7 @@ class SiconosSolver(SolverBase):
         InputError
             As :meth:`run` would.
         """
+        check_landing_reach(scene)
         check_target_mu(scene, self.model(scene))
         SICONOS.check_variable()
 
