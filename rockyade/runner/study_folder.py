@@ -185,14 +185,8 @@ def holders(out: Path) -> list[tuple[str, str]]:
 
 def check_only_its_set(out: Path, kind: StudySet, field: str = "--out") -> None:
     """Refuse an ``out`` that holds files that are not ``kind``'s set nor its journal (another
-    command's files, a scene, ...): the set would be mixed with them.
-
-    Parameters
-    ----------
-    out, kind
-        The folder and the command's set.
-    field
-        The option that names ``out``.
+    command's files, a scene, ...): the set would be mixed with them. ``out``, ``kind`` and
+    ``field`` as in :func:`check_out`.
 
     Raises
     ------
