@@ -197,7 +197,8 @@ def check_only_its_set(out: Path, kind: StudySet, field: str = "--out") -> None:
 
     if not out.is_dir():
         return
-    others = other_files(out, (*kind.names, kind.journal, PARTIAL_DIR))
+    summary = BATCH.names if kind.keeps_runs else ()  # a study whose runs are kept has their batch summary
+    others = other_files(out, (*kind.names, *summary, kind.journal, PARTIAL_DIR))
     if others:
         shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
         raise InputError(
