@@ -23,8 +23,8 @@ from rockyade.runner.study_folder import (
     FRAGILITY,
     UNCERTAINTY,
     StudyFolder,
-    check_out,
     StudySet,
+    check_out,
     holders,
 )
 from rockyade.scene.generators import rest_motion, stack, write_scene
