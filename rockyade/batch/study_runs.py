@@ -186,6 +186,7 @@ def run_study(
         desc=desc,
         skipped=reused,
         stop=stop,
+        size=len,
     )
     for i in outcome.unfinished:
         reason = "stopped by Ctrl-C" if i in outcome.started else "not started: Ctrl-C"

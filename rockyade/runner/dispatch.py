@@ -62,7 +62,7 @@ class Outcome(Generic[Value]):
 
 
 def progress_bar(total: int, enabled: bool, desc: str) -> Any:
-    """A tqdm progress bar on stderr (``update(1)`` per finished job)."""
+    """A tqdm progress bar on stderr, counting runs (``update(n)`` as a job of n runs ends)."""
     from tqdm import tqdm
 
     return tqdm(total=total, disable=not enabled, desc=desc, unit="run", smoothing=0.05)
@@ -80,6 +80,7 @@ def run_jobs(
     desc: str = "runs",
     skipped: int = 0,
     stop: StopRequest | None = None,
+    size: Callable[[Job], int] | None = None,
 ) -> Outcome[Value]:
     """Run ``fn(job)`` for every job on ``executor`` (module docstring).
 
@@ -97,7 +98,10 @@ def run_jobs(
     progress, desc
         Show a progress bar named ``desc``.
     skipped
-        Jobs done before (a resumed batch): counted on the bar as already finished.
+        Runs done before (a resumed batch): counted on the bar as already finished.
+    size
+        The runs a job holds, as the bar counts them (None: one each; a study's jobs are groups
+        of runs, and its bar counts runs).
     stop
         The stop request (Ctrl-C) of a study of several rounds, entered by the caller (None:
         this call installs its own): a Ctrl-C between two rounds stays requested for the next.
@@ -105,12 +109,13 @@ def run_jobs(
     jobs = list(jobs)
     values: dict[int, Value] = {}
     started: set[int] = set()
-    bar = progress_bar(len(jobs) + skipped, progress, desc)
+    runs = [1 if size is None else size(job) for job in jobs]
+    bar = progress_bar(sum(runs) + skipped, progress, desc)
     bar.update(skipped)
 
     def done(i: int, value: Value) -> None:
         values[i] = value
-        bar.update(1)
+        bar.update(runs[i])
         if on_done is not None:
             on_done(i, value)
         line = describe_failure(value) if describe_failure is not None else None
