@@ -353,3 +353,16 @@ def test_shipped_study_comment_points_at_the_readme_identified_file(tmp_path, mo
     )
     loaded = load_uncertainty_study("examples/studies/identified_study.toml")
     assert loaded.nominal["alpha_rad"] == pytest.approx(0.23)
+
+
+def test_degrees_read_as_radians_is_refused_naming_the_column(tmp_path, monkeypatch, capsys):
+    # a rotation column in degrees named as radians (no --degrees): the initial guess took
+    # alpha = 7.9 "rad" and scipy raised a traceback; now one line naming the field, exit 2
+    monkeypatch.chdir(tmp_path)
+    history = synthetic_measurement(0.235, 3.84, 0.936, theta0_rad=0.12, rate_hz=100.0, duration_s=3.0, seed=1)
+    pd.DataFrame({"t_s": history.t_s, "rot": np.degrees(history.theta_rad)}).to_csv("deg.csv", index=False)
+    assert main(["identify", "deg.csv", "--theta-column", "rot"]) == 2
+    err = capsys.readouterr().err
+    assert "theta_rad" in err and "pi/2" in err and "--degrees" in err and "Traceback" not in err
+    with pytest.raises(InputError, match="below pi/2"):
+        measured_history(history.t_s, np.full(history.t_s.size, 1.6))
