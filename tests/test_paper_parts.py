@@ -9,7 +9,7 @@ import sys
 
 from rockyade.analysis.crosscheck_statistics import MIN_RECORDS
 from rockyade.solvers import make_solver
-from rockyade.studies import paper, paper_crosscheck
+from rockyade.studies import free_rocking, paper, paper_crosscheck
 from rockyade.studies.report import cpu_seconds
 
 
@@ -60,3 +60,12 @@ def test_cpu_time_counts_a_child_still_running_and_after_it_ended():
         child.kill()
         child.wait()
     assert cpu_seconds() - start >= 0.5  # and once it has ended (its parent waited for it)
+
+
+def test_the_free_rocking_caption_names_yade_only_where_it_ran():
+    # `rockyade paper --only free --no-yade` captioned every figure "... and YADE (dashed green ...)"
+    # although no YADE curve was drawn
+    without = free_rocking.figure_caption("specimen 1", with_yade=False)
+    assert "dashed green" not in without and "YADE off" in without
+    with_yade = free_rocking.figure_caption("specimen 1", with_yade=True, extra=" Note.")
+    assert "YADE (dashed green" in with_yade and with_yade.endswith(" Note.")
