@@ -69,3 +69,22 @@ def test_the_free_rocking_caption_names_yade_only_where_it_ran():
     assert "dashed green" not in without and "YADE off" in without
     with_yade = free_rocking.figure_caption("specimen 1", with_yade=True, extra=" Note.")
     assert "YADE (dashed green" in with_yade and with_yade.endswith(" Note.")
+
+
+def test_paper_refuses_a_linked_out_and_another_commands_results(tmp_path, monkeypatch, capsys):
+    # `rockyade paper --out DIR` wrote its tables and index.md into an uncertainty study's folder
+    # and through a symbolic link, exit 0; every other study refuses both
+    from rockyade.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "frag").mkdir()
+    (tmp_path / "frag" / "fragility.json").write_text("{}")
+    assert main(["paper", "--only", "tables", "--no-yade", "--out", "frag"]) == 2
+    err = capsys.readouterr().err
+    assert "--out" in err and "'rockyade fragility'" in err
+    assert sorted(p.name for p in (tmp_path / "frag").iterdir()) == ["fragility.json"]
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to("real")
+    assert main(["paper", "--only", "tables", "--no-yade", "--out", "link"]) == 2
+    assert "symbolic link" in capsys.readouterr().err
+    assert not any((tmp_path / "real").iterdir())
