@@ -197,7 +197,9 @@ def check_only_its_set(out: Path, kind: StudySet, field: str = "--out") -> None:
 
     if not out.is_dir():
         return
-    others = other_files(out, (*kind.names, kind.journal, PARTIAL_DIR))
+    # an uncertainty study writes a batch summary of its runs beside its set (STUDY_SETS)
+    summary = BATCH.names if kind is UNCERTAINTY else ()
+    others = other_files(out, (*kind.names, *summary, kind.journal, PARTIAL_DIR))
     if others:
         shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
         raise InputError(
