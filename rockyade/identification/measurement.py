@@ -243,6 +243,15 @@ def read_measurement(
             theta_column = (
                 "theta_rad" if "theta_rad" in frame.columns or "theta_deg" not in frame.columns else "theta_deg"
             )
+        if degrees and theta_column.endswith("_rad"):
+            # the name says radians: read as degrees, a 0.1 rad swing became 0.0017 rad, and the
+            # fit returned a block 57 times less slender without a word
+            raise InputError(
+                "degrees",
+                f"column {theta_column!r} is in radians by its name; --degrees is for a column in degrees "
+                "(one named theta_deg is read as degrees without it)",
+                source,
+            )
         in_degrees = theta_column.endswith("_deg") if degrees is None else degrees
         theta = column(theta_column, "theta_column")
         if in_degrees:
