@@ -88,3 +88,16 @@ def test_paper_refuses_a_linked_out_and_another_commands_results(tmp_path, monke
     assert main(["paper", "--only", "tables", "--no-yade", "--out", "link"]) == 2
     assert "symbolic link" in capsys.readouterr().err
     assert not any((tmp_path / "real").iterdir())
+
+
+def test_paper_refuses_a_worker_count_out_of_range_before_any_part(tmp_path, monkeypatch, capsys):
+    # `rockyade paper --only free --workers 0` ran, the part stopped on the executor's check
+    # (a traceback in free_error.log) and the study ended with exit 1
+    from rockyade.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    for workers in ("0", "-1", "1025"):
+        assert main(["paper", "--only", "free", "--no-yade", "--workers", workers, "--out", "out"]) == 2
+        err = capsys.readouterr().err
+        assert "--workers" in err and "[1, 1024]" in err
+    assert not (tmp_path / "out").exists()

@@ -192,6 +192,10 @@ def cmd_paper(args: argparse.Namespace) -> int:
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
         raise InputError("only", f"parts must be among {', '.join(PARTS)}, got {unknown}")
+    from rockyade.runner.executor import MAX_WORKERS
+
+    if not 1 <= args.workers <= MAX_WORKERS:  # before any part: a part would stop on it, exit 1
+        raise InputError("--workers", f"must be an integer in [1, {MAX_WORKERS}], got {args.workers}")
     check_paper_out(args.out)
     report = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade, accel_unit=args.accel_units)
     failed = report.failures()
