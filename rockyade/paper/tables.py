@@ -99,7 +99,9 @@ def _geometry_rows() -> list[dict[str, object]]:
                 "I_0",
                 "-",
                 "kg m^2",
-                "M (b^2+h^2)/3 + M R^2 (uniform density)",
+                "I_O of the polygon about its pivot (uniform density)"
+                if spec.chamfer_m
+                else "M (b^2+h^2)/3 + M R^2 (uniform density)",
                 spec.inertia_I0_printed_kgm2,
                 cp.I_O_kgm2,
                 dec,
