@@ -139,5 +139,7 @@ def test_the_chamfered_specimens_inertia_names_its_own_formula():
     assert "polygon" in four["equation"] and four["ours"] == pytest.approx(18.3376, abs=1e-3)
     rect = 4.0 / 3.0 * 245 * (0.08**2 + 0.2285**2)  # the rectangle's formula, by hand
     assert abs(rect - four["ours"]) > 0.5
+    assert report.loc[(3, "specimen 4", "alpha", "T")]["equation"] == "Eq 2, polygon form"
+    assert report.loc[(3, "specimen 1", "alpha", "T")]["equation"] == "Eq 2"
     one = report.loc[(1, "specimen 1", "I_0", "-")]
     assert one["equation"].startswith("M (b^2+h^2)/3") and one["ours"] == pytest.approx(4 / 3 * 503 * 0.265625)

@@ -131,7 +131,7 @@ def _classical_rows() -> list[dict[str, object]]:
                     quantity,
                     "T",
                     unit,
-                    eq,
+                    f"{eq}, polygon form" if spec.chamfer_m else eq,
                     spec.theoretical[
                         f"{quantity}_rad" if quantity == "alpha" else ("p_rad_s" if quantity == "p" else "mu")
                     ],
