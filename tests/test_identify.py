@@ -353,3 +353,27 @@ def test_shipped_study_comment_points_at_the_readme_identified_file(tmp_path, mo
     )
     loaded = load_uncertainty_study("examples/studies/identified_study.toml")
     assert loaded.nominal["alpha_rad"] == pytest.approx(0.23)
+
+
+def test_degrees_read_as_radians_is_refused_naming_the_column(tmp_path, monkeypatch, capsys):
+    # a rotation column in degrees named as radians (no --degrees): the initial guess took
+    # alpha = 7.9 "rad" and scipy raised a traceback; now one line naming the field, exit 2
+    monkeypatch.chdir(tmp_path)
+    history = synthetic_measurement(0.235, 3.84, 0.936, theta0_rad=0.12, rate_hz=100.0, duration_s=3.0, seed=1)
+    pd.DataFrame({"t_s": history.t_s, "rot": np.degrees(history.theta_rad)}).to_csv("deg.csv", index=False)
+    assert main(["identify", "deg.csv", "--theta-column", "rot"]) == 2
+    err = capsys.readouterr().err
+    assert "theta_rad" in err and "pi/2" in err and "--degrees" in err and "Traceback" not in err
+    with pytest.raises(InputError, match="below pi/2"):
+        measured_history(history.t_s, np.full(history.t_s.size, 1.6))
+
+
+def test_degrees_for_a_column_named_in_radians_is_refused(tmp_path, monkeypatch, capsys):
+    # --degrees with the default theta_rad column read radians as degrees: alpha 0.0043 rad
+    # identified for a block of 0.245, exit 0
+    monkeypatch.chdir(tmp_path)
+    history = synthetic_measurement(0.235, 3.84, 0.936, theta0_rad=0.12, rate_hz=100.0, duration_s=3.0, seed=1)
+    pd.DataFrame({"t_s": history.t_s, "theta_rad": history.theta_rad}).to_csv("rad.csv", index=False)
+    assert main(["identify", "rad.csv", "--degrees"]) == 2
+    err = capsys.readouterr().err
+    assert "degrees" in err and "'theta_rad' is in radians" in err and "Traceback" not in err

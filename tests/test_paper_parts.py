@@ -9,7 +9,7 @@ import sys
 
 from rockyade.analysis.crosscheck_statistics import MIN_RECORDS
 from rockyade.solvers import make_solver
-from rockyade.studies import paper, paper_crosscheck
+from rockyade.studies import free_rocking, paper, paper_crosscheck
 from rockyade.studies.report import cpu_seconds
 
 
@@ -60,3 +60,44 @@ def test_cpu_time_counts_a_child_still_running_and_after_it_ended():
         child.kill()
         child.wait()
     assert cpu_seconds() - start >= 0.5  # and once it has ended (its parent waited for it)
+
+
+def test_the_free_rocking_caption_names_yade_only_where_it_ran():
+    # `rockyade paper --only free --no-yade` captioned every figure "... and YADE (dashed green ...)"
+    # although no YADE curve was drawn
+    without = free_rocking.figure_caption("specimen 1", with_yade=False)
+    assert "dashed green" not in without and "YADE off" in without
+    with_yade = free_rocking.figure_caption("specimen 1", with_yade=True, extra=" Note.")
+    assert "YADE (dashed green" in with_yade and with_yade.endswith(" Note.")
+
+
+def test_paper_refuses_a_linked_out_and_another_commands_results(tmp_path, monkeypatch, capsys):
+    # `rockyade paper --out DIR` wrote its tables and index.md into an uncertainty study's folder
+    # and through a symbolic link, exit 0; every other study refuses both
+    from rockyade.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "frag").mkdir()
+    (tmp_path / "frag" / "fragility.json").write_text("{}")
+    assert main(["paper", "--only", "tables", "--no-yade", "--out", "frag"]) == 2
+    err = capsys.readouterr().err
+    assert "--out" in err and "'rockyade fragility'" in err
+    assert sorted(p.name for p in (tmp_path / "frag").iterdir()) == ["fragility.json"]
+    (tmp_path / "real").mkdir()
+    (tmp_path / "link").symlink_to("real")
+    assert main(["paper", "--only", "tables", "--no-yade", "--out", "link"]) == 2
+    assert "symbolic link" in capsys.readouterr().err
+    assert not any((tmp_path / "real").iterdir())
+
+
+def test_paper_refuses_a_worker_count_out_of_range_before_any_part(tmp_path, monkeypatch, capsys):
+    # `rockyade paper --only free --workers 0` ran, the part stopped on the executor's check
+    # (a traceback in free_error.log) and the study ended with exit 1
+    from rockyade.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    for workers in ("0", "-1", "1025"):
+        assert main(["paper", "--only", "free", "--no-yade", "--workers", workers, "--out", "out"]) == 2
+        err = capsys.readouterr().err
+        assert "--workers" in err and "[1, 1024]" in err
+    assert not (tmp_path / "out").exists()

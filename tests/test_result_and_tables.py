@@ -129,3 +129,17 @@ def test_result_csv_text_is_pandas_to_csv_byte_for_byte(odd: str | None) -> None
     )
     empty = frame.iloc[:0]
     assert csv_text(empty, "%.8g") == empty.to_csv(index=False, float_format="%.8g", lineterminator="\n")
+
+
+def test_the_chamfered_specimens_inertia_names_its_own_formula():
+    # specimen 4's I_0 (18.34 kg m^2) is the chamfered polygon's about its pivot; the row printed the
+    # rectangle's formula, which gives 19.15 for the printed 0.16 x 0.457 m block and 245 kg
+    report = reproduction_report().set_index(["table", "row", "quantity", "column"])
+    four = report.loc[(1, "specimen 4", "I_0", "-")]
+    assert "polygon" in four["equation"] and four["ours"] == pytest.approx(18.3376, abs=1e-3)
+    rect = 4.0 / 3.0 * 245 * (0.08**2 + 0.2285**2)  # the rectangle's formula, by hand
+    assert abs(rect - four["ours"]) > 0.5
+    assert report.loc[(3, "specimen 4", "alpha", "T")]["equation"] == "Eq 2, polygon form"
+    assert report.loc[(3, "specimen 1", "alpha", "T")]["equation"] == "Eq 2"
+    one = report.loc[(1, "specimen 1", "I_0", "-")]
+    assert one["equation"].startswith("M (b^2+h^2)/3") and one["ours"] == pytest.approx(4 / 3 * 503 * 0.265625)

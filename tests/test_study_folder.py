@@ -375,3 +375,14 @@ def test_a_ctrl_c_between_two_rounds_of_stripes_stops_the_fragility(inputs, monk
     with pytest.raises(StripesInterruptedError) as info:
         fa.run_fragility(plan, Executor("threads", 1), progress=False)
     assert rounds == [4] and len(info.value.rows) == 4 and info.value.plan is plan
+
+
+def test_an_uncertainty_study_runs_again_into_the_folder_it_wrote(tmp_path):
+    """Its folder holds the batch summary of its runs beside its set: 'rockyade uncertainty' run
+    again into its own --out was refused for summary.csv and summary.parquet, the files it wrote."""
+    out = tmp_path / "uncertainty"
+    _complete_set(out, UNCERTAINTY)
+    check_out(out, UNCERTAINTY)
+    (out / "notes.txt").write_text("mine\n")
+    with pytest.raises(InputError, match=r"notes\.txt"):
+        check_out(out, UNCERTAINTY)

@@ -74,7 +74,7 @@ class MeasuredHistory:
 def measured_history(
     t_s: NDArray[np.float64], theta_rad: NDArray[np.float64], source: str = "", notes: tuple[str, ...] = ()
 ) -> MeasuredHistory:
-    """Validate samples and wrap them: finite, at least 20, equally spaced, >= 50 Hz.
+    """Validate samples and wrap them: finite, |theta| < pi/2, at least 20, equally spaced, >= 50 Hz.
 
     Parameters
     ----------
@@ -104,6 +104,16 @@ def measured_history(
     if bad.size:
         raise InputError(
             "theta_rad", f"contains empty, NaN or infinite values (first at row {bad[0] + 1})", source or None
+        )
+    peak = float(np.max(np.abs(theta)))
+    if peak >= 0.5 * math.pi:
+        # a rocking block turns by less than its slenderness alpha < pi/2: a larger value is
+        # not a rotation in radians (most often degrees read as radians)
+        raise InputError(
+            "theta_rad",
+            f"|rotation| reaches {peak:.4g} rad, must stay below pi/2 = 1.5708 rad "
+            "(in degrees? name the column theta_deg or give --degrees)",
+            source or None,
         )
     steps = np.diff(t)
     if np.any(steps <= 0):
@@ -232,6 +242,15 @@ def read_measurement(
         if theta_column is None:
             theta_column = (
                 "theta_rad" if "theta_rad" in frame.columns or "theta_deg" not in frame.columns else "theta_deg"
+            )
+        if degrees and theta_column.endswith("_rad"):
+            # the name says radians: read as degrees, a 0.1 rad swing became 0.0017 rad, and the
+            # fit returned a block 57 times less slender without a word
+            raise InputError(
+                "degrees",
+                f"column {theta_column!r} is in radians by its name; --degrees is for a column in degrees "
+                "(one named theta_deg is read as degrees without it)",
+                source,
             )
         in_degrees = theta_column.endswith("_deg") if degrees is None else degrees
         theta = column(theta_column, "theta_column")

@@ -99,7 +99,9 @@ def _geometry_rows() -> list[dict[str, object]]:
                 "I_0",
                 "-",
                 "kg m^2",
-                "M (b^2+h^2)/3 + M R^2 (uniform density)",
+                "I_O of the polygon about its pivot (uniform density)"
+                if spec.chamfer_m
+                else "M (b^2+h^2)/3 + M R^2 (uniform density)",
                 spec.inertia_I0_printed_kgm2,
                 cp.I_O_kgm2,
                 dec,
@@ -129,7 +131,7 @@ def _classical_rows() -> list[dict[str, object]]:
                     quantity,
                     "T",
                     unit,
-                    eq,
+                    f"{eq}, polygon form" if spec.chamfer_m else eq,
                     spec.theoretical[
                         f"{quantity}_rad" if quantity == "alpha" else ("p_rad_s" if quantity == "p" else "mu")
                     ],

@@ -217,13 +217,24 @@ def draw_figure(report: Report, key: str, exact, cases, table: pd.DataFrame) -> 
     )
     if failed:
         extra += f" No curve for the failed runs of: {', '.join(failed)} (see free_rocking.csv)."
-    report.figure(
-        name,
-        f"Free rocking of the {spec.label}: theta(t) by Housner (thin blue), the reference DEM (wide orange band) "
-        f"and YADE (dashed green, with its largest difference from the DEM), paper (Eq 13, left) and matched "
-        f"(right) calibration, theoretical (top) and experimental (bottom) parameters.{extra}",
-    )
+    with_yade = any(c.get("yade") is not None for c in cases if c["key"] == key)
+    report.figure(name, figure_caption(spec.label, with_yade, extra))
     return display
+
+
+def figure_caption(label: str, with_yade: bool, extra: str = "") -> str:
+    """The caption of a block's free-rocking figure: it names YADE only where YADE ran
+    (``--no-yade`` draws no YADE curve)."""
+    solvers = (
+        "Housner (thin blue), the reference DEM (wide orange band) and YADE (dashed green, with its largest "
+        "difference from the DEM)"
+        if with_yade
+        else "Housner (thin blue) and the reference DEM (wide orange band); YADE off"
+    )
+    return (
+        f"Free rocking of the {label}: theta(t) by {solvers}, paper (Eq 13, left) and matched "
+        f"(right) calibration, theoretical (top) and experimental (bottom) parameters.{extra}"
+    )
 
 
 def _panel(key: str, params: str, cal: str, housner: Result, cases: list[dict], table: pd.DataFrame) -> Panel:
