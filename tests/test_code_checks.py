@@ -253,3 +253,31 @@ def test_the_ag_at_which_a_check_is_met_is_met_there_on_an_ntc_site(position):
     # on soil B at 0.2 g SS is at its bound 1.2 down to ag = 0: proportional, the same as before
     flat = code_checks(kin, NtcSite(0.2, 2.4, 0.3, "B"), Position())[0]
     assert flat.ag_capacity_m_s2 == pytest.approx(0.2 * CODE_GRAVITY * flat.ratio, rel=1e-9)
+
+
+def test_a_mechanism_turning_above_the_scenes_base_at_height_says_which_z_the_code_means(tmp_path, capsys):
+    """Z is the height of the lines the mechanism turns about (Circolare 2019 C8.7.1.2.1.5): a two-storey
+    wall whose upper storey overturns on the lower one turns 3.2 m above the scene's base, and --z given as
+    the wall's base put the floor's demand at psi = 3.3 / 9.8 where the code's is 6.5 / 9.8, without a word."""
+    blocks = [
+        ("w01", 0.8, 3.2, 0.0),
+        ("w02", 0.4, 3.3, 3.2),
+    ]
+    text = 'duration_s = 3.0\nsample_dt_s = 0.002\n[contact]\nfriction_angle_deg = 30.0\n[motion]\ntype = "rest"\n'
+    for name, width, height, y in blocks:
+        text += (
+            f'[[blocks]]\nname = "{name}"\nwidth_m = {width}\nheight_m = {height}\nthickness_m = 1.0\n'
+            f"density_kg_m3 = 1600.0\nposition_m = [0.0, {y}]\n"
+        )
+    scene = tmp_path / "two_storeys.toml"
+    scene.write_text(text)
+    height = ["--z", "3.3", "--building-height", "9.8", "--storeys", "3", "--static-only"]
+    assert main(["assess", str(scene), *LC1, *NTC, *height]) == 0
+    out = capsys.readouterr().out
+    assert "w02 turns clockwise on w01 about (0.2, 3.2) m" in out
+    assert "hinges at y = 3.2 m of the scene" in out and "give --z 6.5" in out
+    single = tmp_path / "one.toml"
+    single.write_text(text.split("[[blocks]]")[0] + "[[blocks]]" + text.split("[[blocks]]")[2])
+    single.write_text(single.read_text().replace("position_m = [0.0, 3.2]", "position_m = [0.0, 0.0]"))
+    assert main(["assess", str(single), *LC1, *NTC, *height]) == 0
+    assert "of the scene, above its base" not in capsys.readouterr().out  # it turns on its base: Z is --z
