@@ -281,3 +281,11 @@ def test_a_mechanism_turning_above_the_scenes_base_at_height_says_which_z_the_co
     single.write_text(single.read_text().replace("position_m = [0.0, 3.2]", "position_m = [0.0, 0.0]"))
     assert main(["assess", str(single), *LC1, *NTC, *height]) == 0
     assert "of the scene, above its base" not in capsys.readouterr().out  # it turns on its base: Z is --z
+
+
+def test_a_period_beyond_the_spectra_is_refused_without_naming_a_spectrum_not_used(capsys):
+    """On the NTC 2018 site (the default) the refusal of --t1 named 'the EC8 spectrum'."""
+    height = ["--z", "3", "--building-height", "9", "--storeys", "3", "--t1", "5", "--static-only"]
+    assert main(["assess", str(EXAMPLES / "tuff_wall_roof.toml"), *LC1, *NTC, *height]) == 2
+    err = capsys.readouterr().err
+    assert "--t1: must be in (0, 4] s" in err and "EC8" not in err
