@@ -229,3 +229,63 @@ def test_rotations_are_against_the_whole_alpha(tmp_path):
     assert ratios[1][0] == pytest.approx(ratios[1][1], rel=1e-9)
     assert ratios[4][0] == pytest.approx(ratios[1][0], rel=0.25)
     assert ratios[4][1] < 0.5 * ratios[4][0]
+
+
+@pytest.mark.parametrize("position", [Position(), Position(3.3, 9.8, 3)], ids=["ground", "at height"])
+def test_the_ag_at_which_a_check_is_met_is_met_there_on_an_ntc_site(position):
+    """NTC 2018's spectrum is not proportional to ag: on soil C, SS = 1.70 - 0.60 F0 ag/g (Tab. 3.2.IV) rises
+    to its bound 1.5 as ag falls, and TD = 4 ag/g + 1.6 s falls with it, so 'met up to ag = ag x capacity /
+    demand' was not where the check is met (a two-storey tuff wall at 0.18 g: 0.0531 g against 0.0508 g
+    for the linear check at height, 0.0921 g against 0.1019 g for the nonlinear one); made again at the ag
+    it gives, each check is met exactly (capacity / demand = 1)."""
+    kin = limit_analysis(courses(1, 0.4, 6.5), fc=1.35).kinematic
+    site = NtcSite(0.18, 2.45, 0.32, "C")
+    checks = code_checks(kin, site, position)
+    assert len(checks) == 2 and all(c.applies for c in checks)
+    for i, check in enumerate(checks):
+        there = NtcSite(check.ag_capacity_m_s2 / CODE_GRAVITY, 2.45, 0.32, "C")
+        assert code_checks(kin, there, position)[i].ratio == pytest.approx(1.0, rel=1e-7), check.name
+    linear = checks[0]
+    assert linear.ag_capacity_m_s2 < site.ag_m_s2 * linear.ratio  # SS is larger at the lower ag
+    # by hand, ground level: a0* q = ag 1.5 (SS at its bound), so ag = a0* q / 1.5
+    if not position.at_height:
+        assert linear.ag_capacity_m_s2 == pytest.approx(kin.a0_star_m_s2 * 2 / 1.5, rel=1e-9)
+    # on soil B at 0.2 g SS is at its bound 1.2 down to ag = 0: proportional, the same as before
+    flat = code_checks(kin, NtcSite(0.2, 2.4, 0.3, "B"), Position())[0]
+    assert flat.ag_capacity_m_s2 == pytest.approx(0.2 * CODE_GRAVITY * flat.ratio, rel=1e-9)
+
+
+def test_a_mechanism_turning_above_the_scenes_base_at_height_says_which_z_the_code_means(tmp_path, capsys):
+    """Z is the height of the lines the mechanism turns about (Circolare 2019 C8.7.1.2.1.5): a two-storey
+    wall whose upper storey overturns on the lower one turns 3.2 m above the scene's base, and --z given as
+    the wall's base put the floor's demand at psi = 3.3 / 9.8 where the code's is 6.5 / 9.8, without a word."""
+    blocks = [
+        ("w01", 0.8, 3.2, 0.0),
+        ("w02", 0.4, 3.3, 3.2),
+    ]
+    text = 'duration_s = 3.0\nsample_dt_s = 0.002\n[contact]\nfriction_angle_deg = 30.0\n[motion]\ntype = "rest"\n'
+    for name, width, height, y in blocks:
+        text += (
+            f'[[blocks]]\nname = "{name}"\nwidth_m = {width}\nheight_m = {height}\nthickness_m = 1.0\n'
+            f"density_kg_m3 = 1600.0\nposition_m = [0.0, {y}]\n"
+        )
+    scene = tmp_path / "two_storeys.toml"
+    scene.write_text(text)
+    height = ["--z", "3.3", "--building-height", "9.8", "--storeys", "3", "--static-only"]
+    assert main(["assess", str(scene), *LC1, *NTC, *height]) == 0
+    out = capsys.readouterr().out
+    assert "w02 turns clockwise on w01 about (0.2, 3.2) m" in out
+    assert "hinges at y = 3.2 m of the scene" in out and "give --z 6.5" in out
+    single = tmp_path / "one.toml"
+    single.write_text(text.split("[[blocks]]")[0] + "[[blocks]]" + text.split("[[blocks]]")[2])
+    single.write_text(single.read_text().replace("position_m = [0.0, 3.2]", "position_m = [0.0, 0.0]"))
+    assert main(["assess", str(single), *LC1, *NTC, *height]) == 0
+    assert "of the scene, above its base" not in capsys.readouterr().out  # it turns on its base: Z is --z
+
+
+def test_a_period_beyond_the_spectra_is_refused_without_naming_a_spectrum_not_used(capsys):
+    """On the NTC 2018 site (the default) the refusal of --t1 named 'the EC8 spectrum'."""
+    height = ["--z", "3", "--building-height", "9", "--storeys", "3", "--t1", "5", "--static-only"]
+    assert main(["assess", str(EXAMPLES / "tuff_wall_roof.toml"), *LC1, *NTC, *height]) == 2
+    err = capsys.readouterr().err
+    assert "--t1: must be in (0, 4] s" in err and "EC8" not in err

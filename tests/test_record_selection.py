@@ -167,6 +167,20 @@ def test_an_out_folder_holding_other_files_or_the_records_is_refused(selection, 
     assert "is a selection" in capsys.readouterr().err
 
 
+def test_an_out_folder_that_is_a_link_is_refused_and_nothing_is_written_through_it(tmp_path, capsys):
+    """As every study's --out (rockyade.runner.study_folder): a link to an empty folder was written through."""
+    target = tmp_path / "elsewhere"
+    target.mkdir()
+    link = tmp_path / "sel"
+    link.symlink_to(target)
+    dangling = tmp_path / "dangling"
+    dangling.symlink_to(tmp_path / "nothing")
+    for out in (link, dangling):
+        assert main(["motion", "select", "--records", str(RECORDS), *SITE, "--out", str(out)]) == 2
+        assert "--out" in (err := capsys.readouterr().err) and "symbolic link" in err
+    assert not any(target.iterdir()) and not (tmp_path / "nothing").exists()
+
+
 def test_three_records_with_the_maximum_response_rule(tmp_path, capsys):
     out = tmp_path / "three"
     args = ["--records", str(RECORDS), "--count", "3", "--max-response", *SITE, "--out", str(out)]

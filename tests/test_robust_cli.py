@@ -249,3 +249,32 @@ def test_motion_synth_shows_progress(tmp_path, monkeypatch, capsys):
     code = main([*argv, "--strong", "2", "--decay", "2", "--rise", "1", "--out", str(tmp_path / "s")])
     err = capsys.readouterr().err
     assert code == 0 and "synthesising suite" in err and "1/1" in err
+
+
+def test_motion_synth_replaces_its_suite_as_a_whole_and_writes_nowhere_else(tmp_path, monkeypatch, capsys):
+    """A suite of 1 record written over one of 2 left the old record_02.csv beside the new suite.json
+    ('motion check' then read 2 records of two seeds); an assessment's folder got the records mixed
+    into it, and a link was written through."""
+    monkeypatch.setenv("ROCKYADE_CACHE", str(tmp_path / "cache"))
+    argv = ["motion", "synth", "--type", "2", "--ground", "D", "--ag-s", "2.8", "--strong", "2", "--decay", "2"]
+    out = tmp_path / "s"
+    assert main([*argv, "--rise", "1", "--count", "2", "--seed", "3", "--out", str(out), "--quiet"]) == 0
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "record_01.csv",
+        "record_02.csv",
+        "suite.json",
+    ]
+    assert main([*argv, "--rise", "1", "--count", "1", "--seed", "4", "--out", str(out), "--quiet"]) == 0
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["record_01.csv", "suite.json"]
+    assert json.loads((out / "suite.json").read_text())["settings"]["seed"] == 4
+    capsys.readouterr()
+    other = tmp_path / "assessment"
+    other.mkdir()
+    (other / "assess.json").write_text("{}")
+    target = tmp_path / "elsewhere"
+    target.mkdir()
+    (tmp_path / "link").symlink_to(target)
+    for folder, words in ((other, "not a suite's (assess.json)"), (tmp_path / "link", "symbolic link")):
+        assert main([*argv, "--rise", "1", "--count", "1", "--seed", "4", "--out", str(folder), "--quiet"]) == 2
+        assert "--out" in (err := capsys.readouterr().err) and words in err
+    assert [p.name for p in other.iterdir()] == ["assess.json"] and not any(target.iterdir())

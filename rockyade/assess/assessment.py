@@ -440,6 +440,27 @@ def dynamic_plan(
     return FragilityPlan(stripes, table, levels, source, settings.extend)
 
 
+def _raised_hinge_note(result: LimitResult, position: Position) -> str:
+    """At height, a note where the mechanism turns about hinges above the scene's base: the code's Z is
+    the height of the lines about which the mechanism's blocks turn on the rest of the structure
+    (Circolare 2019 C8.7.1.2.1.5), which ``--z`` is taken to be as given; empty otherwise."""
+    mech = result.mechanism
+    if not position.at_height or mech is None:
+        return ""
+    moving = {name for name, m in zip(result.model.names, mech.moving, strict=True) if m}
+    heights = sorted({round(h.point_m[1], 6) for h in mech.hinges if (h.a in moving) != (h.b in moving)})
+    if not heights or heights[0] <= 1e-6:  # a hinge on the base: Z is the scene's base
+        return ""
+    where = ", ".join(f"{y:g}" for y in heights)
+    z = position.z_m or 0.0
+    return (
+        f"the mechanism turns on the rest of the structure about hinges at y = {where} m of the scene, above its "
+        f"base: the code's Z (Circolare 2019 C8.7.1.2.1.5) is the height of those lines above the foundation; "
+        f"--z {z:g} was taken as given: if it is the height of the scene's base, give --z {z + heights[0]:g} (or "
+        "the height of the lines' barycentre) instead"
+    )
+
+
 def assess(
     scene: Scene,
     site: AnySite,
@@ -523,6 +544,9 @@ def assess(
     rigid = rigid_body_mechanism(best)
     if rigid is not None:
         out.notes.append(rigid["note"])
+    raised = _raised_hinge_note(best, position)
+    if raised:
+        out.notes.append(raised)
     out.notes.extend(checks_not_made(best.kinematic, position, direction, fm_MPa is not None))
     if dynamic is not None:
         add_dynamics(out, scene, dynamic, executor, allow_large=allow_large, progress=progress, on_plan=on_plan)

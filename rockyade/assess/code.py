@@ -33,9 +33,12 @@ clause and formula (:data:`CHECK_SOURCES`):
 
 with the behaviour factor q = 2. The linear and the nonlinear analyses are two ways of checking
 the same mechanism (the linear one, with q, the simpler and more conservative): the mechanism
-is verified when one of the checks that apply is met. Every demand is proportional to ag, so
-each check also gives the ag at which it is met exactly, ag_capacity = ag x capacity / demand:
-the code's capacity in the units of the site's shaking.
+is verified when one of the checks that apply is met. Each check also gives the ag at which it is
+met, its ag_capacity: the code's capacity in the units of the site's shaking, with the site's other
+parameters (F0, TC*, soil, topography) held. EC8's demand is proportional to ag, so there it is
+ag x capacity / demand; NTC 2018's is not where SS (Tab. 3.2.IV: soils C, D, E, and B below its
+bound) or TD = 4 ag/g + 1.6 s (Eq 3.2.6, for a period beyond TD) change with ag, so there the
+check is made again at other ag until capacity = demand (:func:`_ag_met`).
 
 Checks the tool does not make are listed, with the reason, by :func:`checks_not_made` (they
 go into the output's notes).
@@ -51,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from rockyade.assess.floor_spectra import SLD_DAMPING, displacement_demand, secant_period
-from rockyade.assess.site import AnySite, Position
+from rockyade.assess.site import MAX_AG_G, AnySite, NtcSite, Position
 from rockyade.constants import CODE_GRAVITY as G
 from rockyade.errors import InputError
 from rockyade.limit.kinematic import KinematicQuantities
@@ -244,6 +247,50 @@ def code_checks(kin: KinematicQuantities, site: AnySite, position: Position, q: 
     q
         Behaviour factor of the linear check (2).
     """
+    checks = _checks_at(kin, site, position, q)
+    if not isinstance(site, NtcSite):
+        return checks
+    return [
+        dataclasses.replace(c, ag_capacity_m_s2=_ag_met(kin, site, position, q, i, c.ag_capacity_m_s2))
+        if c.applies and math.isfinite(c.ag_capacity_m_s2)
+        else c
+        for i, c in enumerate(checks)
+    ]
+
+
+def _ratio_at(kin: KinematicQuantities, site: NtcSite, position: Position, q: float, i: int, ag_g: float) -> float:
+    """capacity / demand of check ``i`` with the site's ag set to ``ag_g`` (g), minus 1."""
+    check = _checks_at(kin, dataclasses.replace(site, ag_g=ag_g), position, q)[i]
+    return check.ratio - 1.0
+
+
+def _ag_met(kin: KinematicQuantities, site: NtcSite, position: Position, q: float, i: int, guess: float) -> float:
+    """The ag (m/s^2) at which check ``i`` is met exactly on the NTC 2018 site with its other
+    parameters held: the root of capacity / demand = 1, bracketed from ``guess`` (ag x capacity /
+    demand, exact where the spectrum is proportional to ag) within NTC 2018's ag of (0, 1] g;
+    ``guess`` where no root lies there."""
+    from scipy.optimize import brentq
+
+    lo_limit, hi_limit = 1e-4, MAX_AG_G
+    x0 = min(max(guess / G, lo_limit), hi_limit)
+    f0 = _ratio_at(kin, site, position, q, i, x0)
+    if f0 == 0.0 or not math.isfinite(f0):
+        return guess
+    step = 1.25 if f0 > 0 else 0.8
+    x1, f1 = x0, f0
+    while f1 * f0 > 0:
+        x_next = min(max(x1 * step, lo_limit), hi_limit)
+        if x_next == x1:
+            return guess
+        x1, f1 = x_next, _ratio_at(kin, site, position, q, i, x_next)
+        if not math.isfinite(f1):
+            return guess
+    a, b = sorted((x0, x1))
+    return float(brentq(lambda x: _ratio_at(kin, site, position, q, i, x), a, b, xtol=1e-10, rtol=1e-12)) * G
+
+
+def _checks_at(kin: KinematicQuantities, site: AnySite, position: Position, q: float) -> list[Check]:
+    """The checks with each ag_capacity = ag x capacity / demand (:func:`code_checks` refines it)."""
     ag, S = site.ag_m_s2, site.S
     a0 = kin.a0_star_m_s2
     checks = []

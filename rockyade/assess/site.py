@@ -347,7 +347,7 @@ class Position:
             raise InputError("--storeys", f"must be an integer in [1, {MAX_STOREYS}], got {n!r}")
         t1 = self.T1_s
         if t1 is not None and not (isinstance(t1, (int, float)) and math.isfinite(t1) and 0.0 < t1 <= 4.0):
-            raise InputError("--t1", f"must be in (0, 4] s (the EC8 spectrum is defined up to 4 s), got {t1!r}")
+            raise InputError("--t1", f"must be in (0, 4] s (the spectra are taken up to 4 s), got {t1!r}")
 
     def _check_form_options(self) -> None:
         """The form of the checks, the options of the 2019 form, and none of them with the 2009 form."""

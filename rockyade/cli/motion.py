@@ -183,7 +183,9 @@ def cmd_synth(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from rockyade.io.atomic import atomic_open, write_json
+    from rockyade.io.folders import output_folder
     from rockyade.io.locking import output_lock
+    from rockyade.io.resultset import replacing_set
     from rockyade.motion.processing import integrate
     from rockyade.motion.suite_cache import suite_record
     from rockyade.motion.synthetic import compatibility_report
@@ -193,12 +195,14 @@ def cmd_synth(args: argparse.Namespace) -> int:
     spec = _suite_spec(args)
     out: Path = args.out
     check_output_dir(out, "out")
+    names = _suite_files(out, args.plot)
     if args.plot:
         check_output_file(args.plot, "plot", ".png")
     records = []
-    out.mkdir(parents=True, exist_ok=True)
     with (
-        output_lock(out),
+        output_folder(out),
+        output_lock(out, "--out"),
+        replacing_set(out, names, SUITE_JSON) as stage,
         tqdm(total=spec.count, desc=f"synthesising {spec.name}", unit="record", disable=args.quiet) as bar,
     ):
         for i in range(1, spec.count + 1):
@@ -206,19 +210,47 @@ def cmd_synth(args: argparse.Namespace) -> int:
             records.append(rec)
             v, d = integrate(rec.t_s, rec.accel_m_s2)
             frame = pd.DataFrame({"t_s": rec.t_s, "accel_m_s2": rec.accel_m_s2, "vel_m_s": v, "disp_m": d})
-            with atomic_open(out / f"record_{i:02d}.csv") as fh:
+            with atomic_open(stage / f"record_{i:02d}.csv") as fh:
                 frame.to_csv(fh, index=False, float_format="%.10g", lineterminator="\n")
             bar.update(1)
-    report = compatibility_report(records, spec.target)
-    write_json(
-        out / "suite.json", {"settings": spec.as_dict(), "target": spec.target.as_dict(), "check": _short(report)}
-    )
+        report = compatibility_report(records, spec.target)
+        write_json(
+            stage / SUITE_JSON,
+            {"settings": spec.as_dict(), "target": spec.target.as_dict(), "check": _short(report)},
+        )
     print(f"wrote {spec.count} records and suite.json to {out}")
     _print_report(report)
     if args.plot:
         _plot_report(records, spec.target, report, args.plot)
         print(f"wrote {args.plot}")
     return 0
+
+
+SUITE_JSON = "suite.json"
+
+
+def _suite_files(out: Path, plot: Path | None) -> list[str]:
+    """Every file a suite's folder may hold (its records, ``suite.json`` last), after refusing an
+    ``--out`` that is a link or holds another command's files: a suite is written as one set
+    (:mod:`rockyade.io.resultset`), so a smaller suite leaves no record of a previous one beside it."""
+    from rockyade.io.folders import other_files
+
+    if out.is_symlink():
+        raise InputError(
+            "--out", f"{out} is a symbolic link; give a real folder (rockyade writes nothing through a link)"
+        )
+    names = [*(f"record_{i:02d}.csv" for i in range(1, 1001)), SUITE_JSON]
+    if out.is_dir():
+        keep = [*names, plot.name] if plot is not None and plot.parent.resolve() == out.resolve() else names
+        others = other_files(out, keep)
+        if others:
+            shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
+            raise InputError(
+                "--out",
+                f"{out} holds files that are not a suite's ({shown}): give an empty folder, or one a previous "
+                "'motion synth' wrote (its suite is then replaced as a whole)",
+            )
+    return names
 
 
 def _short(report: dict[str, Any]) -> dict[str, Any]:

@@ -64,13 +64,17 @@ def _previous_records(folder: Path) -> list[str]:
 
 
 def check_out_folder(out: Path, records_folder: Path) -> None:
-    """Refuse an ``--out`` that is the records' folder, or holds files that are not a selection's.
+    """Refuse an ``--out`` that is a symbolic link, the records' folder, or holds files that are not a
+    selection's.
 
     Raises
     ------
     InputError
         Naming ``--out``.
     """
+    if out.is_symlink():
+        what = "a symbolic link" if out.exists() else "a symbolic link to nothing"
+        raise InputError("--out", f"{out} is {what}; give a real folder (rockyade writes nothing through a link)")
     if out.exists() and not out.is_dir():
         raise InputError("--out", f"{out} is a file; give a folder")
     if out.exists() and records_folder.exists() and out.resolve() == records_folder.resolve():
