@@ -233,23 +233,13 @@ def _suite_files(out: Path, plot: Path | None) -> list[str]:
     """Every file a suite's folder may hold (its records, ``suite.json`` last), after refusing an
     ``--out`` that is a link or holds another command's files: a suite is written as one set
     (:mod:`rockyade.io.resultset`), so a smaller suite leaves no record of a previous one beside it."""
-    from rockyade.io.folders import other_files
+    from rockyade.io.folders import refuse_link, refuse_other_files
 
-    if out.is_symlink():
-        raise InputError(
-            "--out", f"{out} is a symbolic link; give a real folder (rockyade writes nothing through a link)"
-        )
+    refuse_link(out, "--out")
     names = [*(f"record_{i:02d}.csv" for i in range(1, 1001)), SUITE_JSON]
     if out.is_dir():
         keep = [*names, plot.name] if plot is not None and plot.parent.resolve() == out.resolve() else names
-        others = other_files(out, keep)
-        if others:
-            shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
-            raise InputError(
-                "--out",
-                f"{out} holds files that are not a suite's ({shown}): give an empty folder, or one a previous "
-                "'motion synth' wrote (its suite is then replaced as a whole)",
-            )
+        refuse_other_files(out, keep, "a suite", "motion synth --out")
     return names
 
 

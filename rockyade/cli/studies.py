@@ -192,10 +192,12 @@ def cmd_paper(args: argparse.Namespace) -> int:
     unknown = [p for p in parts if p not in PARTS]
     if unknown:
         raise InputError("only", f"parts must be among {', '.join(PARTS)}, got {unknown}")
-    from rockyade.runner.executor import MAX_WORKERS
+    from rockyade.runner import Executor
 
-    if not 1 <= args.workers <= MAX_WORKERS:  # before any part: a part would stop on it, exit 1
-        raise InputError("--workers", f"must be an integer in [1, {MAX_WORKERS}], got {args.workers}")
+    try:  # before any part: a part would stop on it, exit 1
+        Executor("local", args.workers)
+    except InputError as exc:
+        raise InputError("--workers", exc.message) from None
     check_paper_out(args.out)
     report = run_paper_study(args.out, args.workers, parts, use_yade=not args.no_yade, accel_unit=args.accel_units)
     failed = report.failures()
@@ -212,23 +214,14 @@ def cmd_paper(args: argparse.Namespace) -> int:
 
 def check_paper_out(out: Path) -> None:
     """Refuse, before anything is written, a paper ``--out`` that is a symbolic link or that holds
-    another command's results (:func:`rockyade.runner.study_folder.holders`): the paper's tables,
-    figures and index.md would be mixed into them (InputError naming ``--out``)."""
-    from rockyade.runner.study_folder import holders
+    another command's results (:func:`rockyade.runner.study_folder.check_no_study`): the paper's
+    tables, figures and index.md would be mixed into them (InputError naming ``--out``)."""
+    from rockyade.io.folders import refuse_link
+    from rockyade.runner.study_folder import check_no_study
 
-    if out.is_symlink():
-        raise InputError(
-            "--out", f"{out} is a symbolic link; give a real folder (rockyade writes nothing through a link)"
-        )
+    refuse_link(out, "--out")
     check_output_dir(out, "--out")
-    others = holders(out)
-    if others:
-        command, why = others[0]
-        raise InputError(
-            "--out",
-            f"{out} holds the results of 'rockyade {command}' ({why}); 'rockyade paper' never writes over another "
-            "command's results: give another folder, or remove that one first",
-        )
+    check_no_study(out, "paper")
 
 
 def _part_line(report: Any, part: str) -> str:

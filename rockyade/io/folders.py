@@ -8,6 +8,8 @@ import os
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
+from rockyade.errors import InputError
+
 #: What a command leaves in a folder it has not written a result to yet: its lock, and the
 #: study's identity in an otherwise empty runs folder.
 BOOKKEEPING = (".rockyade.lock", "study.json")
@@ -62,4 +64,42 @@ def other_files(folder: Path, names: Iterable[str]) -> list[str]:
     return sorted(p.name for p in folder.iterdir() if p.name not in known and not p.name.startswith("."))
 
 
-__all__ = ["BOOKKEEPING", "other_files", "output_folder", "remove_if_unused"]
+def refuse_link(path: Path, field: str) -> None:
+    """Refuse ``path`` when it is a symbolic link, dangling or not: rockyade writes nothing through
+    a link (InputError naming ``field``)."""
+    if path.is_symlink():
+        what = "a symbolic link to nothing" if not path.exists() else "a symbolic link"
+        raise InputError(field, f"{path} is {what}; give a real folder (rockyade writes nothing through a link)")
+
+
+def refuse_other_files(folder: Path, names: Iterable[str], what: str, writer: str, field: str = "--out") -> None:
+    """Refuse a ``folder`` that holds files besides ``names`` (:func:`other_files`): a set written
+    there would be mixed with them. Nothing to refuse where ``folder`` is not a directory yet.
+
+    Parameters
+    ----------
+    folder, names
+        The folder and every file its set may hold.
+    what, writer
+        The set in words ("a fragility study") and the command that writes it ("fragility --out").
+    field
+        The option that names ``folder``.
+
+    Raises
+    ------
+    InputError
+        Naming ``field`` and the first five files that are not the set's.
+    """
+    if not folder.is_dir():
+        return
+    others = other_files(folder, names)
+    if others:
+        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
+        raise InputError(
+            field,
+            f"{folder} holds files that are not {what}'s ({shown}): give an empty folder, or one a previous "
+            f"'{writer}' wrote (its set is then replaced as a whole)",
+        )
+
+
+__all__ = ["BOOKKEEPING", "other_files", "output_folder", "refuse_link", "refuse_other_files", "remove_if_unused"]

@@ -72,25 +72,15 @@ def check_out_folder(out: Path, records_folder: Path) -> None:
     InputError
         Naming ``--out``.
     """
-    if out.is_symlink():
-        what = "a symbolic link" if out.exists() else "a symbolic link to nothing"
-        raise InputError("--out", f"{out} is {what}; give a real folder (rockyade writes nothing through a link)")
+    from rockyade.io.folders import refuse_link, refuse_other_files
+
+    refuse_link(out, "--out")
     if out.exists() and not out.is_dir():
         raise InputError("--out", f"{out} is a file; give a folder")
     if out.exists() and records_folder.exists() and out.resolve() == records_folder.resolve():
         raise InputError("--out", "is the records' folder: give another folder for the selection")
-    if not out.is_dir():
-        return
-    from rockyade.io.folders import other_files
-
-    others = other_files(out, (*FIXED_FILES, *_previous_records(out)))
-    if others:
-        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
-        raise InputError(
-            "--out",
-            f"{out} holds files that are not a selection's ({shown}): give an empty folder, or one a previous "
-            f"'motion select' wrote (its set is then replaced as a whole)",
-        )
+    if out.is_dir():
+        refuse_other_files(out, (*FIXED_FILES, *_previous_records(out)), "a selection", "motion select --out")
 
 
 def write_selection(

@@ -146,10 +146,10 @@ def check_out(
     InputError
         Naming ``field`` and what is wrong (the other command, by name).
     """
+    from rockyade.io.folders import refuse_link
+
     for path in (out, out / kind.journal, out / PARTIAL_DIR):
-        if path.is_symlink():
-            what = "a symbolic link to nothing" if not path.exists() else "a symbolic link"
-            raise InputError(field, f"{path} is {what}; give a real folder (rockyade writes nothing through a link)")
+        refuse_link(path, field)
     if out.exists() and not out.is_dir():
         raise InputError(field, f"{out} is a file; give a folder")
     others = [(command, why) for command, why in holders(out) if command != kind.command]
@@ -193,19 +193,11 @@ def check_only_its_set(out: Path, kind: StudySet, field: str = "--out") -> None:
     InputError
         Naming ``field`` and the first five files that are not the set's.
     """
-    from rockyade.io.folders import other_files
+    from rockyade.io.folders import refuse_other_files
 
-    if not out.is_dir():
-        return
     summary = BATCH.names if kind.keeps_runs else ()  # a study whose runs are kept has their batch summary
-    others = other_files(out, (*kind.names, *summary, kind.journal, PARTIAL_DIR))
-    if others:
-        shown = ", ".join(others[:5]) + (" ..." if len(others) > 5 else "")
-        raise InputError(
-            field,
-            f"{out} holds files that are not {kind.what}'s ({shown}): give an empty folder, or one a previous "
-            f"'{kind.command} --out' wrote (its set is then replaced as a whole)",
-        )
+    names = (*kind.names, *summary, kind.journal, PARTIAL_DIR)
+    refuse_other_files(out, names, kind.what, f"{kind.command} --out", field)
 
 
 def check_no_study(out: Path, command: str, field: str = "--out") -> None:
