@@ -13,7 +13,7 @@ import pandas as pd
 from rockyade.batch import BatchTask, batch_task
 from rockyade.motion.intensity import intensity_measures, scaled
 from rockyade.studies.sampling import PARAMETERS, Ranges, draw_parameters, parameter_ranges
-from rockyade.studies.uncertainty.study_file import UncertaintyStudy
+from rockyade.studies.uncertainty.study_file import UncertaintyStudy, block_probe
 
 
 def draw_samples(study: UncertaintyStudy) -> pd.DataFrame:
@@ -42,13 +42,9 @@ def sample_ranges(study: UncertaintyStudy) -> Ranges:
     """The range each parameter's samples are drawn in: those a scene takes for this block
     (:func:`rockyade.studies.sampling.parameter_ranges`, p's from the block's geometry), so that
     every sample is a block its runs can be given."""
-    from rockyade.scene import scene_from_dict
     from rockyade.scene.bounds import p_range
 
-    probe = scene_from_dict(
-        {"duration_s": 1.0, "sample_dt_s": 0.1, "blocks": [dict(study.block)], "motion": {"type": "rest"}},
-        source=study.source or None,
-    )
+    probe = block_probe(study.block, study.source or None)
     return parameter_ranges(p_range(probe.blocks[0].block()))
 
 

@@ -56,15 +56,19 @@ from __future__ import annotations
 
 import copy
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rockyade.errors import InputError
 from rockyade.io.fields import TableReader
 from rockyade.motion.intensity import INTENSITY_MEASURES, check_measure
 from rockyade.solvers import solver_names
 from rockyade.studies.sampling import PARAMETERS, JointNormal, Marginal, joint_from_identified, parse_marginal
+
+if TYPE_CHECKING:
+    from rockyade.scene import Scene
 
 PAIRINGS = ("all", "sampled")
 DEFAULT_LEVELS = (0.25, 0.5, 1.0)
@@ -124,9 +128,20 @@ class UncertaintyStudy:
 # ------------------------------------------------------------------ reading
 
 
+def block_probe(table: Mapping[str, object], source: str | None = None) -> Scene:
+    """A scene of the block ``table`` alone, at rest: read and checked as any scene's block (its
+    classical parameters, its geometry's ranges)."""
+    from rockyade.scene import scene_from_dict
+
+    return scene_from_dict(
+        {"duration_s": 1.0, "sample_dt_s": 0.1, "blocks": [dict(table)], "motion": {"type": "rest"}},
+        source=source,
+    )
+
+
 def _block_table(r: TableReader, base_dir: Path) -> tuple[dict[str, object], dict[str, float]]:
     """(block table without alpha/p/mu, nominal alpha/p/mu)."""
-    from rockyade.scene import load_scene, scene_from_dict
+    from rockyade.scene import load_scene
     from rockyade.studies.specimen_scenes import block_table
 
     if r.has("specimen"):
@@ -146,11 +161,7 @@ def _block_table(r: TableReader, base_dir: Path) -> tuple[dict[str, object], dic
     else:
         table = dict(r.table)
         r.used.update(table)
-    probe = scene_from_dict(
-        {"duration_s": 1.0, "sample_dt_s": 0.1, "blocks": [table], "motion": {"type": "rest"}},
-        source=r.source,
-    )
-    cp = probe.blocks[0].classical()
+    cp = block_probe(table, r.source).blocks[0].classical()
     nominal = {"alpha_rad": cp.alpha_rad, "p_rad_s": cp.p_rad_s, "mu": cp.mu}
     clean = {k: v for k, v in copy.deepcopy(table).items() if k not in PARAMETERS}
     clean.setdefault("name", "block")
